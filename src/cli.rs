@@ -1,0 +1,163 @@
+//! The command line: one argument struct per subcommand (clap derive), with the help a designer
+//! reads. Parsing only; [`crate::commands`] runs them.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+use crate::level::Game;
+use crate::level::params;
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "arlpcg",
+    version,
+    about = "Generate 3D game levels with a difficulty knob, prove them playable, export them.",
+    long_about = "arlpcg generates levels for a 3D platform game (blocks to jump across), checks \
+        each one by playing it many times, and exports it as YAML (the source of truth) and glTF \
+        (for Blender, Godot, Unity).\n\n\
+        Levels come from rule-based generation for now; a Generator trained against a Solver \
+        (ARLPCG, EA SEED 2021), steered by one knob, comes next.",
+    after_help = "Examples:\n  \
+        arlpcg generate --game platform --rules --count 20 --seed 1 --out levels/mine\n  \
+        arlpcg verify levels/mine/*.yaml --trials 100\n  \
+        arlpcg export levels/mine/platform_seed1.yaml --out level.glb"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Generate levels and write them as YAML and glTF files.
+    Generate(GenerateArgs),
+    /// Convert a level file to glTF (.glb, or .gltf with a .bin beside it).
+    Export(ExportArgs),
+    /// Play levels many times and report how often the Solver gets through.
+    Verify(VerifyArgs),
+}
+
+/// Output file formats of `generate`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// The level file (source of truth; `arlpcg export` and `verify` read it).
+    Yaml,
+    /// glTF 2.0, one binary file.
+    Glb,
+    /// glTF 2.0 as JSON with a separate .bin buffer.
+    Gltf,
+}
+
+#[derive(Debug, Args)]
+pub struct GenerateArgs {
+    /// Which game.
+    #[arg(long, default_value = "platform", value_parser = parse_game)]
+    pub game: Game,
+    /// Use the rule-based generator (random parameters within the game's ranges, kept valid
+    /// and within the character's reach). Trained Generator policies come later.
+    #[arg(long, required = true)]
+    pub rules: bool,
+    /// How many levels; level i uses seed SEED + i.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub count: u32,
+    /// Seed of the first level: the same seed gives the same level, byte for byte.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// The aux input λ in [-1, 1] (+1 easy, -1 hard), recorded in the level. The rule-based
+    /// generator does not use it.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_aux)]
+    pub aux: Option<f64>,
+    /// Goal position x,y,z in metres (default: drawn from the seed).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_point)]
+    pub goal: Option<[f64; 3]>,
+    /// Folder to write into (created if missing).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// File formats to write, comma-separated.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "yaml,glb")]
+    pub format: Vec<Format>,
+    /// Replace files that already exist (by default nothing is overwritten).
+    #[arg(long)]
+    pub force: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// The level file (.yaml).
+    pub level: PathBuf,
+    /// Output file: .glb for binary glTF, .gltf for JSON glTF plus a .bin beside it.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Replace files that already exist.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Who plays the verification trials.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SolverChoice {
+    /// The scripted controller: faces the next block, runs, jumps at the edge (no learning).
+    Scripted,
+}
+
+#[derive(Debug, Args)]
+pub struct VerifyArgs {
+    /// Level files (.yaml).
+    #[arg(required = true)]
+    pub levels: Vec<PathBuf>,
+    /// Runs per level.
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub trials: u32,
+    /// Seed of the first run; run i uses SEED + i.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Who plays. Until a trained Solver ships, the scripted controller.
+    #[arg(long, value_enum, default_value = "scripted")]
+    pub solver: SolverChoice,
+    /// Print one JSON object per level instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_game(s: &str) -> Result<Game, String> {
+    s.parse()
+}
+
+fn parse_aux(s: &str) -> Result<f64, String> {
+    let value: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    params::AUX.check(value).map_err(|e| e.to_string())
+}
+
+fn parse_point(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let [x, y, z] = parts.as_slice() else {
+        return Err(format!("`{s}` is not x,y,z"));
+    };
+    let mut point = [0.0; 3];
+    for (slot, part) in point.iter_mut().zip([x, y, z]) {
+        let value: f64 = part.trim().parse().map_err(|_| format!("`{part}` is not a number"))?;
+        *slot = params::COORDINATE.check(value).map_err(|e| e.to_string())?;
+    }
+    Ok(point)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cli_definition_is_consistent() {
+        use clap::CommandFactory;
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn aux_and_goal_are_checked() {
+        assert_eq!(parse_aux("-0.5"), Ok(-0.5));
+        assert!(parse_aux("2").unwrap_err().contains("out of range"));
+        assert!(parse_aux("NaN").unwrap_err().contains("NaN"));
+        assert_eq!(parse_point("1,-2, 3.5"), Ok([1.0, -2.0, 3.5]));
+        assert!(parse_point("1,2").is_err());
+    }
+}

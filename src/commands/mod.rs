@@ -1,0 +1,38 @@
+//! The subcommands: each resolves its arguments, runs the pure core, reports and writes files.
+//! Errors come back as `anyhow` errors with the file and field named; `main` turns them into
+//! one line and a non-zero exit code.
+
+mod export;
+mod generate;
+mod verify;
+
+pub use export::{LevelFiles, write_level_files};
+
+use anyhow::Result;
+
+use crate::cli::{Cli, Command};
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Some(Command::Generate(args)) => generate::run(&args),
+        Some(Command::Export(args)) => export::run(&args),
+        Some(Command::Verify(args)) => verify::run(&args),
+        None => {
+            use clap::CommandFactory;
+            Cli::command().print_long_help()?;
+            Ok(())
+        }
+    }
+}
+
+/// A progress bar on stderr (hidden when stderr is not a terminal).
+fn progress_bar(total: u64, what: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(total);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} [{elapsed} < {eta}]")
+            .expect("the template is valid"),
+    );
+    bar.set_message(what.to_string());
+    bar
+}

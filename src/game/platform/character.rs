@@ -1,0 +1,143 @@
+//! The platform character: a capsule moved by rapier's kinematic character controller under our
+//! own velocity rules (run, turn, jump, gravity, limited air control). The constants are the
+//! calibration described in `docs/platform-physics.md`.
+
+use rapier3d::math::Vector;
+use rapier3d::parry::shape::Capsule;
+
+use super::world::PlatformWorld;
+
+/// Top horizontal speed, m/s.
+pub const RUN_SPEED: f32 = 8.0;
+/// Backwards the character runs at this fraction of `RUN_SPEED`.
+pub const BACKWARD_FACTOR: f32 = 0.5;
+/// Gravity, m/s².
+pub const GRAVITY: f32 = 20.0;
+/// Vertical take-off speed of a jump, m/s (apex 2.14 m). Calibrated so that a 6 m gap 2 m up is
+/// out of reach and 5 m is just within it (docs/platform-physics.md).
+pub const JUMP_SPEED: f32 = 9.25;
+/// Fastest turn, degrees per second.
+pub const TURN_RATE_DEG: f32 = 270.0;
+/// Horizontal acceleration toward the commanded velocity on the ground, m/s².
+pub const GROUND_ACCEL: f32 = 60.0;
+/// Horizontal acceleration in the air (a little steering, no second jump), m/s².
+pub const AIR_ACCEL: f32 = 6.0;
+/// Capsule radius, m.
+pub const RADIUS: f32 = 0.4;
+/// Half the length of the capsule's straight part, m (total height 1.8 m).
+pub const HALF_HEIGHT: f32 = 0.5;
+/// Physics steps per second.
+pub const PHYSICS_HZ: f32 = 60.0;
+/// Physics steps per Solver decision (decisions at 30 Hz).
+pub const ACTION_REPEAT: u32 = 2;
+/// Seconds between Solver decisions.
+pub const DECISION_DT: f32 = ACTION_REPEAT as f32 / PHYSICS_HZ;
+
+/// One Solver decision.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PlatformAction {
+    /// Run forward (1) or backward (-1), in [-1, 1].
+    pub forward: f32,
+    /// Turn left (1, counter-clockwise seen from above) or right (-1), in [-1, 1].
+    pub turn: f32,
+    /// Jump (only takes effect on the ground).
+    pub jump: bool,
+}
+
+impl PlatformAction {
+    /// Clamps the continuous parts into [-1, 1]; NaN becomes 0.
+    pub fn sanitized(self) -> Self {
+        let clean = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(-1.0, 1.0) };
+        Self {
+            forward: clean(self.forward),
+            turn: clean(self.turn),
+            jump: self.jump,
+        }
+    }
+}
+
+/// The character's state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Character {
+    /// The bottom of the capsule (the feet).
+    pub feet: Vector,
+    pub velocity: Vector,
+    /// Facing, radians about +Y (0 along +X).
+    pub yaw: f32,
+    pub grounded: bool,
+}
+
+impl Character {
+    pub fn new(feet: Vector, yaw: f32) -> Self {
+        Self {
+            feet,
+            velocity: Vector::ZERO,
+            yaw,
+            grounded: true,
+        }
+    }
+
+    /// The unit vector the character faces.
+    pub fn facing(&self) -> Vector {
+        Vector::new(self.yaw.cos(), 0.0, -self.yaw.sin())
+    }
+
+    fn shape() -> Capsule {
+        Capsule::new_y(HALF_HEIGHT, RADIUS)
+    }
+
+    fn centre_offset() -> Vector {
+        Vector::Y * (HALF_HEIGHT + RADIUS)
+    }
+
+    /// Advances one decision (`ACTION_REPEAT` physics steps) under `action`.
+    pub fn step(&mut self, world: &PlatformWorld, action: PlatformAction) {
+        let action = action.sanitized();
+        let dt = 1.0 / PHYSICS_HZ;
+        let shape = Self::shape();
+        for substep in 0..ACTION_REPEAT {
+            self.yaw += action.turn * TURN_RATE_DEG.to_radians() * dt;
+            let speed = if action.forward >= 0.0 {
+                action.forward * RUN_SPEED
+            } else {
+                action.forward * RUN_SPEED * BACKWARD_FACTOR
+            };
+            let wanted = self.facing() * speed;
+            let accel = if self.grounded { GROUND_ACCEL } else { AIR_ACCEL };
+            let horizontal = Vector::new(self.velocity.x, 0.0, self.velocity.z);
+            let change = wanted - horizontal;
+            let max_change = accel * dt;
+            let horizontal = if change.length() <= max_change {
+                wanted
+            } else {
+                horizontal + change * (max_change / change.length())
+            };
+            let mut vertical = self.velocity.y;
+            if action.jump && self.grounded && substep == 0 {
+                vertical = JUMP_SPEED;
+            }
+            // On the ground, snap-to-ground holds the character down; pushing into the floor
+            // as well makes rapier's controller stall now and then (it reads the floor as a wall).
+            if !(self.grounded && vertical <= 0.0) {
+                vertical -= GRAVITY * dt;
+            }
+            let desired = Vector::new(horizontal.x, vertical, horizontal.z) * dt;
+            let moved = world.move_character(dt, &shape, self.feet + Self::centre_offset(), desired);
+            self.feet += moved.translation;
+            // Blocked by a wall or a ceiling: lose the velocity into it.
+            let mut velocity = Vector::new(horizontal.x, vertical, horizontal.z);
+            if (moved.translation.x - desired.x).abs() > 1e-4 || (moved.translation.z - desired.z).abs() > 1e-4 {
+                velocity.x = moved.translation.x / dt;
+                velocity.z = moved.translation.z / dt;
+            }
+            if vertical > 0.0 && moved.translation.y < desired.y - 1e-4 {
+                velocity.y = 0.0;
+            }
+            self.grounded = moved.grounded && velocity.y <= 0.0;
+            if self.grounded {
+                velocity.y = 0.0;
+            }
+            self.velocity = velocity;
+        }
+    }
+}

@@ -1,0 +1,13 @@
+//! The platform game: blocks to jump across. [`world`] holds the blocks in rapier3d,
+//! [`character`] moves the capsule, [`env`] is the Solver's environment, [`scripted`] a
+//! non-learning controller, and [`reach`] the calibrated jumping range.
+
+pub mod character;
+pub mod env;
+pub mod reach;
+pub mod scripted;
+pub mod world;
+
+pub use character::PlatformAction;
+pub use env::{OBSERVATION_SIZE, PlatformEnv, SolverRewards};
+pub use scripted::ScriptedController;

@@ -1,0 +1,83 @@
+//! How far the character can jump: the reach table (largest makeable edge gap per height change),
+//! measured with the scripted controller in the real simulation, and the function that measures
+//! it. `docs/platform-physics.md` prints the table; a test re-measures it.
+
+use super::env::{PlatformEnv, SolverRewards};
+use super::scripted::ScriptedController;
+use crate::level::platform::{BlockParams, PlatformTrack, Start};
+use crate::level::stats::{Outcome, TrialResult};
+
+/// The height changes the table lists, m.
+pub const REACH_HEIGHTS: [f64; 5] = [-2.0, -1.0, 0.0, 1.0, 2.0];
+/// Largest edge gap, m, that the scripted controller (take-off jitter `REACH_JITTER`) clears in
+/// every one of `REACH_TRIALS` seeded runs, for each height change of `REACH_HEIGHTS`, measured
+/// in steps of `REACH_STEP` from 1 m up to the largest gap the parameter ranges allow (6 m).
+pub const REACH_TABLE: [f64; 5] = [6.0, 6.0, 6.0, 6.0, 5.0];
+/// Resolution of the table, m.
+pub const REACH_STEP: f64 = 0.25;
+/// Seeded runs per table entry.
+pub const REACH_TRIALS: u64 = 8;
+/// Take-off jitter of the scripted controller when measuring, m.
+pub const REACH_JITTER: f32 = 0.3;
+/// The gaps the table scans: the ranges allow edge gaps up to 6 m (10 m between 4 m blocks).
+const GAP_RANGE: (f64, f64) = (1.0, 6.0);
+
+/// The largest makeable gap at a height change, interpolated from the table.
+pub fn max_gap(height: f64) -> f64 {
+    let h = height.clamp(REACH_HEIGHTS[0], REACH_HEIGHTS[4]);
+    let i = REACH_HEIGHTS.iter().rposition(|&x| x <= h).unwrap_or(0).min(3);
+    let t = (h - REACH_HEIGHTS[i]) / (REACH_HEIGHTS[i + 1] - REACH_HEIGHTS[i]);
+    REACH_TABLE[i] + t * (REACH_TABLE[i + 1] - REACH_TABLE[i])
+}
+
+/// A level of one jump: a 4 m start block, then a 4 m block `gap` metres away and `height`
+/// metres up.
+pub fn single_jump(gap: f64, height: f64) -> PlatformTrack {
+    let start = Start { size: 4.0, ..Start::default() };
+    let block = BlockParams::new(gap + 4.0, 0.0, 4.0, height).expect("gap within [1, 6] m and height within [-2, 2] m");
+    PlatformTrack::from_params(start, &[block]).expect("one block never overlaps")
+}
+
+/// Plays one run of `env` with the scripted controller, seeded by `seed`.
+pub fn play_scripted(env: &mut PlatformEnv, seed: u64, jitter: f32) -> TrialResult {
+    env.reset(seed);
+    let mut controller = ScriptedController::new(seed, jitter);
+    loop {
+        let step = env.step(controller.act(env));
+        if let Some(outcome) = step.outcome {
+            return TrialResult {
+                outcome,
+                progress: env.progress(),
+                target_piece: env.furthest(),
+                steps: env.steps(),
+            };
+        }
+    }
+}
+
+/// How many of `trials` seeded scripted runs clear the jump.
+pub fn successes(gap: f64, height: f64, trials: u64, jitter: f32) -> u64 {
+    let track = single_jump(gap, height);
+    let goal = track.last().position;
+    let mut env = PlatformEnv::new(&track, goal, SolverRewards::default());
+    (0..trials)
+        .filter(|&seed| play_scripted(&mut env, seed, jitter).outcome == Outcome::Success)
+        .count() as u64
+}
+
+/// Measures the reach table: for each height change, the largest gap such that every gap up to
+/// it (in `REACH_STEP` steps from 1 m) is cleared in all `REACH_TRIALS` runs.
+pub fn measure_reach() -> [f64; 5] {
+    REACH_HEIGHTS.map(|height| {
+        let steps = ((GAP_RANGE.1 - GAP_RANGE.0) / REACH_STEP).round() as usize;
+        let mut best = GAP_RANGE.0 - REACH_STEP;
+        for k in 0..=steps {
+            let gap = GAP_RANGE.0 + k as f64 * REACH_STEP;
+            if successes(gap, height, REACH_TRIALS, REACH_JITTER) < REACH_TRIALS {
+                break;
+            }
+            best = gap;
+        }
+        best
+    })
+}

@@ -1,0 +1,191 @@
+//! Levels as pure data: what a Generator (or the rules, or a designer's hand) built, where it came
+//! from, and what the Solver measured on it. Files in and out live in [`yaml`] and [`gltf`];
+//! nothing here touches the disk.
+
+pub mod gltf;
+pub mod params;
+pub mod platform;
+pub mod racing;
+pub mod scene;
+pub mod stats;
+pub mod yaml;
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+pub use platform::{BlockParams, Platform, PlatformTrack, Start};
+pub use racing::{RacingTrack, SegmentParams};
+pub use stats::{SolverRef, SolverStats};
+
+/// The two games of the paper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Game {
+    /// Jump across blocks to the goal block.
+    Platform,
+    /// Drive a banked road to the goal.
+    Racing,
+}
+
+impl Game {
+    pub fn name(self) -> &'static str {
+        match self {
+            Game::Platform => "platform",
+            Game::Racing => "racing",
+        }
+    }
+}
+
+impl std::str::FromStr for Game {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "platform" => Ok(Game::Platform),
+            "racing" => Ok(Game::Racing),
+            other => Err(format!("unknown game `{other}`: expected platform or racing")),
+        }
+    }
+}
+
+impl fmt::Display for Game {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The pieces of a level, one kind per game.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Track {
+    Platform(PlatformTrack),
+    Racing(RacingTrack),
+}
+
+/// A trained policy file a level depends on, pinned by the hash of its contents.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PolicyRef {
+    pub path: String,
+    pub sha256: String,
+}
+
+/// The settings of the rule-based generator (the paper's Rule-PCG baseline).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RulesConfig {
+    /// Give up on a level (and draw another) after this many blocks without reaching the goal.
+    pub max_blocks: u32,
+    /// Each block's heading is drawn within this many degrees either side of the goal direction.
+    pub angle_spread: f64,
+    /// Jumps are kept this many metres shorter than the character's longest jump at that height.
+    pub reach_margin: f64,
+}
+
+impl Default for RulesConfig {
+    fn default() -> Self {
+        Self {
+            max_blocks: 40,
+            angle_spread: 60.0,
+            reach_margin: 0.5,
+        }
+    }
+}
+
+/// Where a level came from.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum Source {
+    /// Written by hand (the default for files that say nothing).
+    #[default]
+    Hand,
+    /// Drawn by the rule-based generator.
+    Rules { rules: RulesConfig },
+    /// Built by a trained Generator policy.
+    Policy { generator: PolicyRef },
+}
+
+/// A level of either game.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Level {
+    /// The seed it was generated from (none for hand-made levels).
+    pub seed: Option<u64>,
+    /// The aux input λ it was generated with (+1 easy, -1 hard).
+    pub aux: Option<f64>,
+    /// The point the track leads to.
+    pub goal: [f64; 3],
+    pub track: Track,
+    pub source: Source,
+    /// What the Solver measured on it, when it has been verified.
+    pub stats: Option<SolverStats>,
+}
+
+/// A level that breaks a rule of its game.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum InvalidLevel {
+    #[error("the level has no {0}: it needs at least one")]
+    NoPieces(&'static str),
+    #[error(
+        "the last block (at {at:?}) does not reach the goal {goal:?}: it must be within {h} m horizontally and {v} m vertically",
+        h = platform::GOAL_REACH_HORIZONTAL,
+        v = platform::GOAL_REACH_VERTICAL
+    )]
+    GoalNotReached { at: [f64; 3], goal: [f64; 3] },
+    #[error("stats: {0}")]
+    Stats(String),
+}
+
+impl Level {
+    pub fn game(&self) -> Game {
+        match self.track {
+            Track::Platform(_) => Game::Platform,
+            Track::Racing(_) => Game::Racing,
+        }
+    }
+
+    /// The platform track, if this is a platform level.
+    pub fn platform(&self) -> Option<&PlatformTrack> {
+        match &self.track {
+            Track::Platform(track) => Some(track),
+            Track::Racing(_) => None,
+        }
+    }
+
+    /// How many pieces (blocks or segments) the level has.
+    pub fn piece_count(&self) -> usize {
+        match &self.track {
+            Track::Platform(track) => track.block_count(),
+            Track::Racing(track) => track.segments.len(),
+        }
+    }
+
+    /// Checks the rules that span the whole level (ranges and overlaps are checked as pieces are
+    /// built): the track reaches its goal and the statistics fit the track.
+    pub fn validate(&self) -> Result<(), InvalidLevel> {
+        match &self.track {
+            Track::Platform(track) => {
+                if track.block_count() == 0 {
+                    return Err(InvalidLevel::NoPieces("blocks"));
+                }
+                let last = track.last();
+                if !last.reaches(self.goal) {
+                    return Err(InvalidLevel::GoalNotReached {
+                        at: last.position,
+                        goal: self.goal,
+                    });
+                }
+            }
+            Track::Racing(track) => {
+                if track.segments.is_empty() {
+                    return Err(InvalidLevel::NoPieces("segments"));
+                }
+            }
+        }
+        if let Some(stats) = &self.stats {
+            stats
+                .check(self.piece_count())
+                .map_err(InvalidLevel::Stats)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,215 @@
+//! What the Solver measured on a level: trials, successes, the success ratio with its 95% Wilson
+//! interval, progress, and where the runs failed.
+
+use serde::{Deserialize, Serialize};
+
+use super::PolicyRef;
+
+/// Who played the trials.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum SolverRef {
+    /// The scripted (non-learning) controller: walk to the edge, jump.
+    Scripted,
+    /// A trained Solver policy.
+    Policy { policy: PolicyRef },
+}
+
+impl SolverRef {
+    pub fn describe(&self) -> String {
+        match self {
+            SolverRef::Scripted => "scripted controller".to_string(),
+            SolverRef::Policy { policy } => format!("policy {}", policy.path),
+        }
+    }
+}
+
+/// How one Solver run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Outcome {
+    /// Reached the goal block.
+    Success,
+    /// Fell off the track.
+    Fell,
+    /// Ran out of time.
+    TimedOut,
+}
+
+/// One finished Solver run, as verification records it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrialResult {
+    pub outcome: Outcome,
+    /// Fraction of the track covered, in [0, 1].
+    pub progress: f64,
+    /// The piece the run was heading for when it ended (index into the level's pieces).
+    pub target_piece: usize,
+    /// Decisions taken.
+    pub steps: u32,
+}
+
+/// Aggregate statistics of many Solver runs on one level.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverStats {
+    pub solver: SolverRef,
+    /// Seed of the first trial; trial `i` uses `seed + i`.
+    pub seed: u64,
+    pub trials: u32,
+    pub successes: u32,
+    pub fell: u32,
+    pub timed_out: u32,
+    /// `successes / trials`.
+    pub success_ratio: f64,
+    /// 95% Wilson score interval of the success ratio.
+    pub ci95: [f64; 2],
+    /// Mean fraction of the track covered.
+    pub mean_progress: f64,
+    /// Mean decisions taken by the successful runs (0 when none succeeded).
+    pub mean_success_steps: f64,
+    /// `failures_by_piece[i]`: runs that failed on their way to piece `i`.
+    pub failures_by_piece: Vec<u32>,
+}
+
+impl SolverStats {
+    /// Aggregates trial results over a level with `pieces` pieces.
+    pub fn from_trials(solver: SolverRef, seed: u64, pieces: usize, trials: &[TrialResult]) -> Self {
+        let count = |o: Outcome| trials.iter().filter(|t| t.outcome == o).count() as u32;
+        let n = trials.len() as u32;
+        let successes = count(Outcome::Success);
+        let mut failures_by_piece = vec![0; pieces];
+        for t in trials.iter().filter(|t| t.outcome != Outcome::Success) {
+            failures_by_piece[t.target_piece.min(pieces.saturating_sub(1))] += 1;
+        }
+        let mean = |values: &mut dyn Iterator<Item = f64>| {
+            let (sum, k) = values.fold((0.0, 0u32), |(s, k), v| (s + v, k + 1));
+            if k == 0 { 0.0 } else { round4(sum / k as f64) }
+        };
+        Self {
+            solver,
+            seed,
+            trials: n,
+            successes,
+            fell: count(Outcome::Fell),
+            timed_out: count(Outcome::TimedOut),
+            success_ratio: round4(ratio(successes, n)),
+            ci95: wilson_interval(successes, n).map(round4),
+            mean_progress: mean(&mut trials.iter().map(|t| t.progress)),
+            mean_success_steps: mean(
+                &mut trials
+                    .iter()
+                    .filter(|t| t.outcome == Outcome::Success)
+                    .map(|t| t.steps as f64),
+            ),
+            failures_by_piece,
+        }
+    }
+
+    /// Checks that the counts add up, the derived numbers match them, and the per-piece
+    /// failures fit a level of `pieces` pieces.
+    pub fn check(&self, pieces: usize) -> Result<(), String> {
+        if self.trials == 0 {
+            return Err("trials must be at least 1".into());
+        }
+        let ended = self.successes as u64 + self.fell as u64 + self.timed_out as u64;
+        if ended != self.trials as u64 {
+            return Err(format!(
+                "successes + fell + timed_out = {ended}, but trials = {}",
+                self.trials
+            ));
+        }
+        let expected_ratio = round4(ratio(self.successes, self.trials));
+        if (self.success_ratio - expected_ratio).abs() > 1e-3 {
+            return Err(format!(
+                "success_ratio {} does not match successes / trials = {expected_ratio}",
+                self.success_ratio
+            ));
+        }
+        let expected_ci = wilson_interval(self.successes, self.trials).map(round4);
+        if (self.ci95[0] - expected_ci[0]).abs() > 1e-3 || (self.ci95[1] - expected_ci[1]).abs() > 1e-3 {
+            return Err(format!("ci95 {:?} does not match the Wilson interval {expected_ci:?}", self.ci95));
+        }
+        if !(0.0..=1.0).contains(&self.mean_progress) {
+            return Err(format!("mean_progress {} is out of range [0, 1]", self.mean_progress));
+        }
+        if !self.mean_success_steps.is_finite() || self.mean_success_steps < 0.0 {
+            return Err(format!("mean_success_steps {} must be a number >= 0", self.mean_success_steps));
+        }
+        if self.failures_by_piece.len() != pieces {
+            return Err(format!(
+                "failures_by_piece has {} entries but the level has {pieces} pieces",
+                self.failures_by_piece.len()
+            ));
+        }
+        let failures: u64 = self.failures_by_piece.iter().map(|&f| f as u64).sum();
+        if failures != (self.fell + self.timed_out) as u64 {
+            return Err(format!(
+                "failures_by_piece adds up to {failures}, but fell + timed_out = {}",
+                self.fell as u64 + self.timed_out as u64
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn ratio(successes: u32, trials: u32) -> f64 {
+    if trials == 0 { 0.0 } else { successes as f64 / trials as f64 }
+}
+
+fn round4(x: f64) -> f64 {
+    (x * 10_000.0).round() / 10_000.0
+}
+
+/// The 95% Wilson score interval for `successes` out of `trials` (z = 1.96).
+pub fn wilson_interval(successes: u32, trials: u32) -> [f64; 2] {
+    if trials == 0 {
+        return [0.0, 1.0];
+    }
+    const Z: f64 = 1.959_963_984_540_054;
+    let n = trials as f64;
+    let p = successes as f64 / n;
+    let z2 = Z * Z;
+    let denominator = 1.0 + z2 / n;
+    let centre = (p + z2 / (2.0 * n)) / denominator;
+    let half = Z * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt() / denominator;
+    let low = if successes == 0 { 0.0 } else { (centre - half).max(0.0) };
+    let high = if successes == trials { 1.0 } else { (centre + half).min(1.0) };
+    [low, high]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wilson_interval_matches_published_values() {
+        // 81 of 263 (Wilson 1927, as in Newcombe 1998, method 3): 0.2553 to 0.3662.
+        let [lo, hi] = wilson_interval(81, 263);
+        assert!((lo - 0.2553).abs() < 1e-4 && (hi - 0.3662).abs() < 1e-4, "{lo} {hi}");
+        // All successes: the upper bound is 1, the lower bound below it.
+        let [lo, hi] = wilson_interval(10, 10);
+        assert!((lo - 0.7225).abs() < 1e-4 && hi == 1.0, "{lo} {hi}");
+        assert_eq!(wilson_interval(0, 0), [0.0, 1.0]);
+    }
+
+    #[test]
+    fn from_trials_counts_and_places_failures() {
+        let t = |outcome, progress, target_piece| TrialResult { outcome, progress, target_piece, steps: 100 };
+        let trials = [
+            t(Outcome::Success, 1.0, 2),
+            t(Outcome::Fell, 0.5, 1),
+            t(Outcome::Fell, 0.2, 0),
+            t(Outcome::TimedOut, 0.5, 1),
+        ];
+        let stats = SolverStats::from_trials(SolverRef::Scripted, 7, 3, &trials);
+        assert_eq!((stats.trials, stats.successes, stats.fell, stats.timed_out), (4, 1, 2, 1));
+        assert_eq!(stats.failures_by_piece, vec![1, 2, 0]);
+        assert_eq!(stats.success_ratio, 0.25);
+        assert_eq!(stats.mean_progress, 0.55);
+        assert_eq!(stats.mean_success_steps, 100.0);
+        stats.check(3).unwrap();
+        assert!(stats.check(4).unwrap_err().contains("failures_by_piece has 3 entries"));
+        let mut lying = stats.clone();
+        lying.success_ratio = 0.9;
+        assert!(lying.check(3).unwrap_err().contains("success_ratio 0.9"));
+    }
+}

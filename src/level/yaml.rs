@@ -1,0 +1,555 @@
+//! The level file, format `arlpcg-level` version 1 (YAML): the source of truth for a level.
+//!
+//! Loading checks everything and names the file, the field and, where it can, the line of the
+//! first problem. A designer may write a level by hand giving only the relative parameters: the
+//! resolved transforms (`position`, `heading` of each block) and the goal are then computed.
+
+use std::io::Read;
+use std::marker::PhantomData;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use super::params::{self, ParamRange};
+use super::platform::{self, BlockParams, PlatformTrack, Start};
+use super::racing::{RacingTrack, SegmentParams};
+use super::{Game, Level, Source, SolverStats, Track};
+
+/// The `format` every level file declares.
+pub const FORMAT_NAME: &str = "arlpcg-level";
+/// The version of the format this build reads and writes.
+pub const FORMAT_VERSION: u32 = 1;
+/// Level files larger than this are refused before parsing (real ones are a few kB).
+pub const MAX_FILE_BYTES: u64 = 4 << 20;
+/// Resolved positions and headings in a file must match the parameters this closely.
+const TRANSFORM_TOLERANCE: f64 = 1e-3;
+
+/// A level file that could not be loaded.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {problem}", path.display())]
+pub struct LoadError {
+    pub path: PathBuf,
+    pub problem: Problem,
+}
+
+/// What is wrong with a level file.
+#[derive(Debug, thiserror::Error)]
+pub enum Problem {
+    #[error("cannot read the file: {0}")]
+    Io(#[from] std::io::Error),
+    #[error("the file is empty")]
+    Empty,
+    #[error("the file is larger than {} MiB; a level file is a few kB", MAX_FILE_BYTES >> 20)]
+    TooLarge,
+    #[error("not a text file (invalid UTF-8 at byte {0})")]
+    NotText(usize),
+    #[error("not an arlpcg level: {0}")]
+    NotALevel(String),
+    #[error("format version {0} is not supported: this arlpcg reads version {FORMAT_VERSION}")]
+    UnsupportedVersion(String),
+    /// A syntax, type or range error found while parsing (serde_yaml names field and line).
+    #[error("{0}")]
+    Parse(String),
+    /// A rule of the level broken by otherwise well-formed values.
+    #[error("{field}: {message}{}", line.map(|l| format!(" (line {l})")).unwrap_or_default())]
+    Invalid {
+        field: String,
+        line: Option<usize>,
+        message: String,
+    },
+}
+
+/// Reads and validates a level file.
+pub fn load(path: &Path) -> Result<Level, LoadError> {
+    let fail = |problem| LoadError {
+        path: path.to_path_buf(),
+        problem,
+    };
+    let file = std::fs::File::open(path).map_err(|e| fail(e.into()))?;
+    let mut bytes = Vec::new();
+    file.take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| fail(e.into()))?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(fail(Problem::TooLarge));
+    }
+    let text = String::from_utf8(bytes).map_err(|e| fail(Problem::NotText(e.utf8_error().valid_up_to())))?;
+    parse(&text).map_err(fail)
+}
+
+/// Parses and validates the text of a level file.
+pub fn parse(text: &str) -> Result<Level, Problem> {
+    if text.trim().is_empty() {
+        return Err(Problem::Empty);
+    }
+    check_header(text)?;
+    let file: LevelFile = serde_yaml::from_str(text).map_err(|e| Problem::Parse(e.to_string()))?;
+    file.into_level(text)
+}
+
+/// The level as the text of a level file (deterministic: same level, same bytes).
+pub fn to_string(level: &Level) -> String {
+    let file = LevelFile::from_level(level);
+    serde_yaml::to_string(&file).expect("a level always serializes")
+}
+
+/// Checks `format` and `version` before anything else, so that a file of another kind or
+/// version gets that error rather than a confusing one about its fields.
+fn check_header(text: &str) -> Result<(), Problem> {
+    #[derive(Deserialize)]
+    struct Header {
+        format: Option<serde_yaml::Value>,
+        version: Option<serde_yaml::Value>,
+    }
+    let header: Header = serde_yaml::from_str(text).map_err(|e| {
+        Problem::NotALevel(format!(
+            "expected a YAML mapping starting with `format: {FORMAT_NAME}` ({e})"
+        ))
+    })?;
+    match header.format {
+        Some(serde_yaml::Value::String(name)) if name == FORMAT_NAME => {}
+        Some(other) => {
+            return Err(Problem::NotALevel(format!(
+                "format is {}, expected {FORMAT_NAME}",
+                describe_value(&other)
+            )));
+        }
+        None => return Err(Problem::NotALevel(format!("missing field `format: {FORMAT_NAME}`"))),
+    }
+    match header.version {
+        Some(serde_yaml::Value::Number(n)) if n.as_u64() == Some(FORMAT_VERSION as u64) => Ok(()),
+        Some(other) => Err(Problem::UnsupportedVersion(describe_value(&other))),
+        None => Err(Problem::NotALevel("missing field `version`".into())),
+    }
+}
+
+fn describe_value(value: &serde_yaml::Value) -> String {
+    let text = serde_yaml::to_string(value).unwrap_or_default();
+    let text = text.trim();
+    if text.len() > 40 { format!("{}...", &text[..text.floor_char_boundary(40)]) } else { text.to_string() }
+}
+
+/// A number that must lie in the range `B` names; checked while parsing, so serde_yaml's error
+/// carries the field path and line.
+#[derive(Debug, Clone, Copy)]
+struct Bounded<B>(f64, PhantomData<B>);
+
+trait Bound {
+    const RANGE: ParamRange;
+}
+
+macro_rules! bounds {
+    ($($marker:ident => $range:expr),* $(,)?) => {
+        $(
+            #[derive(Debug, Clone, Copy)]
+            struct $marker;
+            impl Bound for $marker {
+                const RANGE: ParamRange = $range;
+            }
+        )*
+    };
+}
+
+bounds! {
+    Distance => params::BLOCK_DISTANCE,
+    Angle => params::BLOCK_ANGLE,
+    Size => params::BLOCK_SIZE,
+    BlockHeight => params::BLOCK_HEIGHT,
+    Length => params::SEGMENT_LENGTH,
+    Curve => params::SEGMENT_CURVE,
+    SegmentHeight => params::SEGMENT_HEIGHT,
+    Aux => params::AUX,
+    Heading => params::HEADING,
+    Coordinate => params::COORDINATE,
+}
+
+impl<B> Bounded<B> {
+    fn new(value: f64) -> Self {
+        Self(value, PhantomData)
+    }
+}
+
+impl<B> Serialize for Bounded<B> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_f64(self.0)
+    }
+}
+
+impl<'de, B: Bound> Deserialize<'de> for Bounded<B> {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        // The message names the parameter too: in flow style (`{size: 12}`) serde_yaml's path
+        // stops at the enclosing mapping.
+        let value = f64::deserialize(deserializer)?;
+        B::RANGE.check(value).map(Self::new).map_err(serde::de::Error::custom)
+    }
+}
+
+type Point = [Bounded<Coordinate>; 3];
+
+fn point(p: &Point) -> [f64; 3] {
+    p.map(|c| c.0)
+}
+
+fn write_point(p: [f64; 3]) -> Point {
+    p.map(|c| Bounded::new((c * 10_000.0).round() / 10_000.0))
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LevelFile {
+    format: String,
+    version: u32,
+    game: Game,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    seed: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    aux: Option<Bounded<Aux>>,
+    start: StartFile,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    goal: Option<Point>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    blocks: Option<Vec<BlockFile>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    segments: Option<Vec<SegmentFile>>,
+    #[serde(default)]
+    source: Source,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    stats: Option<SolverStats>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StartFile {
+    position: Point,
+    heading: Bounded<Heading>,
+    /// Side of the start block (platform levels; default 6 m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    size: Option<Bounded<Size>>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BlockFile {
+    distance: Bounded<Distance>,
+    angle: Bounded<Angle>,
+    size: Bounded<Size>,
+    height: Bounded<BlockHeight>,
+    /// Resolved top centre (written by arlpcg; optional and checked when read).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    position: Option<Point>,
+    /// Resolved heading, degrees (written by arlpcg; optional and checked when read).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    heading: Option<Bounded<Heading>>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SegmentFile {
+    length: Bounded<Length>,
+    curve: Bounded<Curve>,
+    height: Bounded<SegmentHeight>,
+}
+
+impl LevelFile {
+    fn from_level(level: &Level) -> Self {
+        let (start, blocks, segments) = match &level.track {
+            Track::Platform(track) => {
+                let s = track.start();
+                let start = StartFile {
+                    position: write_point(s.position),
+                    heading: Bounded::new(s.heading),
+                    size: Some(Bounded::new(s.size)),
+                };
+                let blocks = track
+                    .block_params()
+                    .iter()
+                    .zip(&track.platforms()[1..])
+                    .map(|(p, placed)| BlockFile {
+                        distance: Bounded::new(p.distance),
+                        angle: Bounded::new(p.angle),
+                        size: Bounded::new(p.size),
+                        height: Bounded::new(p.height),
+                        position: Some(write_point(placed.position)),
+                        heading: Some(Bounded::new((placed.heading * 1000.0).round() / 1000.0)),
+                    })
+                    .collect();
+                (start, Some(blocks), None)
+            }
+            Track::Racing(track) => {
+                let start = StartFile {
+                    position: write_point(track.position),
+                    heading: Bounded::new(track.heading),
+                    size: None,
+                };
+                let segments = track
+                    .segments
+                    .iter()
+                    .map(|s| SegmentFile {
+                        length: Bounded::new(s.length),
+                        curve: Bounded::new(s.curve),
+                        height: Bounded::new(s.height),
+                    })
+                    .collect();
+                (start, None, Some(segments))
+            }
+        };
+        Self {
+            format: FORMAT_NAME.to_string(),
+            version: FORMAT_VERSION,
+            game: level.game(),
+            seed: level.seed,
+            aux: level.aux.map(Bounded::new),
+            start,
+            goal: Some(level.goal.map(Bounded::new)),
+            blocks,
+            segments,
+            source: level.source.clone(),
+            stats: level.stats.clone(),
+        }
+    }
+
+    fn into_level(self, text: &str) -> Result<Level, Problem> {
+        let invalid = |field: String, line: Option<usize>, message: String| Problem::Invalid {
+            field,
+            line,
+            message,
+        };
+        let (track, default_goal) = match self.game {
+            Game::Platform => {
+                if self.segments.is_some() {
+                    return Err(invalid(
+                        "segments".into(),
+                        line_of_key(text, "segments"),
+                        "a platform level has `blocks`, not `segments`".into(),
+                    ));
+                }
+                let blocks = self.blocks.ok_or_else(|| {
+                    invalid("blocks".into(), None, "missing: a platform level needs its blocks".into())
+                })?;
+                let start = Start {
+                    position: point(&self.start.position),
+                    heading: self.start.heading.0,
+                    size: self.start.size.map_or(Start::default().size, |s| s.0),
+                };
+                let mut track = PlatformTrack::new(start);
+                for (i, block) in blocks.iter().enumerate() {
+                    let field = format!("blocks[{i}]");
+                    let line = || line_of_item(text, "blocks", i);
+                    let params = BlockParams {
+                        distance: block.distance.0,
+                        angle: block.angle.0,
+                        size: block.size.0,
+                        height: block.height.0,
+                    };
+                    track
+                        .push(params)
+                        .map_err(|e| invalid(field.clone(), line(), e.to_string()))?;
+                    let placed = track.last();
+                    if let Some(position) = &block.position {
+                        let written = point(position);
+                        let off = (0..3).any(|k| (written[k] - placed.position[k]).abs() > TRANSFORM_TOLERANCE);
+                        if off {
+                            return Err(invalid(
+                                format!("{field}.position"),
+                                line(),
+                                format!(
+                                    "{written:?} is not where the block's parameters put it ({:?}); delete `position` and `heading` to recompute them",
+                                    placed.position.map(|c| (c * 1000.0).round() / 1000.0)
+                                ),
+                            ));
+                        }
+                    }
+                    if let Some(heading) = block.heading {
+                        let off = platform::wrap_degrees(heading.0 - placed.heading).abs();
+                        if off > TRANSFORM_TOLERANCE {
+                            return Err(invalid(
+                                format!("{field}.heading"),
+                                line(),
+                                format!(
+                                    "{} is not the heading the block's parameters give ({:.3}); delete `position` and `heading` to recompute them",
+                                    heading.0, placed.heading
+                                ),
+                            ));
+                        }
+                    }
+                }
+                let last = track.last().position;
+                (Track::Platform(track), last)
+            }
+            Game::Racing => {
+                if self.blocks.is_some() {
+                    return Err(invalid(
+                        "blocks".into(),
+                        line_of_key(text, "blocks"),
+                        "a racing level has `segments`, not `blocks`".into(),
+                    ));
+                }
+                if self.start.size.is_some() {
+                    return Err(invalid(
+                        "start.size".into(),
+                        None,
+                        "a racing level's start has no size".into(),
+                    ));
+                }
+                let segments = self.segments.ok_or_else(|| {
+                    invalid("segments".into(), None, "missing: a racing level needs its segments".into())
+                })?;
+                let segments = segments
+                    .iter()
+                    .map(|s| SegmentParams {
+                        length: s.length.0,
+                        curve: s.curve.0,
+                        height: s.height.0,
+                    })
+                    .collect();
+                let track = RacingTrack {
+                    position: point(&self.start.position),
+                    heading: self.start.heading.0,
+                    segments,
+                };
+                // The road's end is only known once the racing game resolves its geometry.
+                let goal = self.goal.as_ref().map(point).ok_or_else(|| {
+                    invalid("goal".into(), None, "missing: a racing level names its goal".into())
+                })?;
+                (Track::Racing(track), goal)
+            }
+        };
+        let level = Level {
+            seed: self.seed,
+            aux: self.aux.map(|a| a.0),
+            goal: self.goal.as_ref().map_or(default_goal.map(params::quantize), point),
+            track,
+            source: self.source,
+            stats: self.stats,
+        };
+        level.validate().map_err(|e| {
+            let (field, key) = match e {
+                super::InvalidLevel::Stats(_) => ("stats", "stats"),
+                super::InvalidLevel::NoPieces(what) => (what, what),
+                super::InvalidLevel::GoalNotReached { .. } => ("goal", "goal"),
+            };
+            invalid(field.into(), line_of_key(text, key), e.to_string())
+        })?;
+        Ok(level)
+    }
+}
+
+/// The 1-based line of a top-level `key:`, if written in block style.
+fn line_of_key(text: &str, key: &str) -> Option<usize> {
+    text.lines()
+        .position(|l| l.strip_prefix(key).is_some_and(|rest| rest.starts_with(':')))
+        .map(|i| i + 1)
+}
+
+/// The 1-based line where item `index` of the top-level sequence `key` starts, if the sequence
+/// is written in block style (one `- ` per item, as arlpcg writes it).
+fn line_of_item(text: &str, key: &str, index: usize) -> Option<usize> {
+    let start = line_of_key(text, key)?;
+    let mut item_indent = None;
+    let mut seen = 0;
+    for (i, line) in text.lines().enumerate().skip(start) {
+        let content = line.trim_start();
+        if content.is_empty() || content.starts_with('#') {
+            continue;
+        }
+        let indent = line.len() - content.len();
+        let is_item = content == "-" || content.starts_with("- ");
+        let items_at = *item_indent.get_or_insert(indent);
+        if indent < items_at || (indent == 0 && !is_item) {
+            return None;
+        }
+        if is_item && indent == items_at {
+            if seen == index {
+                return Some(i + 1);
+            }
+            seen += 1;
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HAND_MADE: &str = "\
+format: arlpcg-level
+version: 1
+game: platform
+start: {position: [0, 0, 0], heading: 0}
+blocks:
+- {distance: 7, angle: 0, size: 5, height: 1}
+- {distance: 6, angle: 30, size: 4, height: -1}
+";
+
+    #[test]
+    fn a_hand_made_level_needs_only_relative_parameters() {
+        let level = parse(HAND_MADE).unwrap();
+        let track = level.platform().unwrap();
+        assert_eq!(track.block_count(), 2);
+        assert_eq!(level.goal, track.last().position.map(params::quantize), "the goal defaults to the last block");
+        assert_eq!(level.source, Source::Hand);
+        // Written back, it reads back to the same level, byte for byte on a second round.
+        let text = to_string(&level);
+        let again = parse(&text).unwrap();
+        assert_eq!(again, level);
+        assert_eq!(to_string(&again), text);
+    }
+
+    fn problem(text: &str) -> String {
+        parse(text).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn out_of_range_values_name_field_and_line() {
+        let msg = problem(&HAND_MADE.replace("size: 4,", "size: 12,"));
+        assert!(msg.contains("blocks[1]") && msg.contains("size 12 is out of range [4, 6] m"), "{msg}");
+        assert!(msg.contains("line 7"), "{msg}");
+        let msg = problem(&HAND_MADE.replace("height: 1}", "height: .nan}"));
+        assert!(msg.contains("blocks[0]: height must be a number, not NaN"), "{msg}");
+        // In block style too, the item and its line are named.
+        let block_style = to_string(&parse(HAND_MADE).unwrap()).replacen("size: 5.0", "size: 5.5e3", 1);
+        let msg = problem(&block_style);
+        assert!(msg.contains("blocks[0]: size 5500 is out of range") && msg.contains("line 16"), "{msg}");
+    }
+
+    #[test]
+    fn header_problems_come_first() {
+        assert!(problem("").contains("empty"));
+        assert!(problem(&HAND_MADE.replace("version: 1", "version: 2")).contains("format version 2 is not supported"));
+        assert!(problem(&HAND_MADE.replace("arlpcg-level", "gltf")).contains("format is gltf"));
+        assert!(problem("just some words").contains("not an arlpcg level"));
+        assert!(problem("- a\n- list").contains("not an arlpcg level"));
+    }
+
+    #[test]
+    fn unknown_missing_and_misplaced_fields_are_named() {
+        let msg = problem(&HAND_MADE.replace("game: platform", "game: platform\ncolour: red"));
+        assert!(msg.contains("unknown field `colour`"), "{msg}");
+        let msg = problem(&HAND_MADE.replace("game: platform", "game: chess"));
+        assert!(msg.contains("unknown variant `chess`"), "{msg}");
+        let msg = problem(&HAND_MADE.replace("size: 5, ", ""));
+        assert!(msg.contains("blocks[0]: missing field `size`"), "{msg}");
+        let msg = problem(&HAND_MADE.replace("blocks:", "segments:"));
+        assert!(msg.contains("segments"), "{msg}");
+    }
+
+    #[test]
+    fn overlaps_moved_transforms_and_unreached_goals_are_caught() {
+        let overlap = HAND_MADE.replace("{distance: 6, angle: 30, size: 4, height: -1}", "{distance: 7, angle: 180, size: 4, height: -1}");
+        let msg = problem(&overlap);
+        assert!(msg.contains("blocks[1]: block 1 overlaps the start block (line 7)"), "{msg}");
+        let moved = HAND_MADE.replace("height: 1}", "height: 1, position: [7, 1, 3]}");
+        assert!(problem(&moved).contains("blocks[0].position"));
+        let far_goal = format!("{HAND_MADE}goal: [100, 0, 0]\n");
+        assert!(problem(&far_goal).contains("does not reach the goal"));
+    }
+
+    #[test]
+    fn line_of_item_finds_block_style_items() {
+        let text = "a: 1\nblocks:\n  - x: 1\n    y: 2\n  - x: 3\nsource:\n  kind: hand\n";
+        assert_eq!(line_of_item(text, "blocks", 0), Some(3));
+        assert_eq!(line_of_item(text, "blocks", 1), Some(5));
+        assert_eq!(line_of_item(text, "blocks", 2), None);
+    }
+}

@@ -1,0 +1,17 @@
+//! arlpcg: Adversarial Reinforcement Learning for Procedural Content Generation, as a tool.
+//!
+//! Layers, dependencies pointing down:
+//! - shells: [`cli`] and [`commands`] (parse, run, report, write files atomically via [`fsio`]);
+//! - [`verify`]: play a level many times and aggregate the Solver's statistics;
+//! - [`game`]: the games as deterministic rapier3d simulations, and rule-based generation;
+//! - [`level`]: levels as pure data, their YAML file format and glTF export.
+//!
+//! Nothing below the shells prints, reads the clock or uses a global RNG: the same inputs give
+//! the same bytes.
+
+pub mod cli;
+pub mod commands;
+pub mod fsio;
+pub mod game;
+pub mod level;
+pub mod verify;

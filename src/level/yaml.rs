@@ -96,29 +96,27 @@ pub fn to_string(level: &Level) -> String {
 /// Checks `format` and `version` before anything else, so that a file of another kind or
 /// version gets that error rather than a confusing one about its fields.
 fn check_header(text: &str) -> Result<(), Problem> {
-    #[derive(Deserialize)]
-    struct Header {
-        format: Option<serde_yaml::Value>,
-        version: Option<serde_yaml::Value>,
-    }
-    let header: Header = serde_yaml::from_str(text).map_err(|e| {
-        Problem::NotALevel(format!(
-            "expected a YAML mapping starting with `format: {FORMAT_NAME}` ({e})"
-        ))
-    })?;
-    match header.format {
+    let document: serde_yaml::Value =
+        serde_yaml::from_str(text).map_err(|e| Problem::Parse(format!("invalid YAML: {e}")))?;
+    let serde_yaml::Value::Mapping(fields) = document else {
+        return Err(Problem::NotALevel(format!(
+            "expected a YAML mapping starting with `format: {FORMAT_NAME}`, found {}",
+            describe_value(&document)
+        )));
+    };
+    match fields.get("format") {
         Some(serde_yaml::Value::String(name)) if name == FORMAT_NAME => {}
         Some(other) => {
             return Err(Problem::NotALevel(format!(
                 "format is {}, expected {FORMAT_NAME}",
-                describe_value(&other)
+                describe_value(other)
             )));
         }
         None => return Err(Problem::NotALevel(format!("missing field `format: {FORMAT_NAME}`"))),
     }
-    match header.version {
+    match fields.get("version") {
         Some(serde_yaml::Value::Number(n)) if n.as_u64() == Some(FORMAT_VERSION as u64) => Ok(()),
-        Some(other) => Err(Problem::UnsupportedVersion(describe_value(&other))),
+        Some(other) => Err(Problem::UnsupportedVersion(describe_value(other))),
         None => Err(Problem::NotALevel("missing field `version`".into())),
     }
 }

@@ -7,7 +7,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rapier3d::math::Vector;
 
-use super::character::{DECISION_DT, GRAVITY, JUMP_SPEED, PlatformAction, RUN_SPEED, TURN_RATE_DEG};
+use super::character::{DECISION_DT, GRAVITY, JUMP_SPEED, PlatformAction, RADIUS, RUN_SPEED, TURN_RATE_DEG};
 use super::env::PlatformEnv;
 use super::world::PlatformBox;
 
@@ -58,13 +58,15 @@ impl ScriptedController {
             return PlatformAction { forward: self.forward, turn, jump: false };
         }
         let direction = to_next.normalize_or_zero();
-        let exit = exit_distance(&current, c.feet, direction);
         let (enter, leave) = crossing(&next, c.feet, direction);
+        // Take off at this block's edge, or sooner where the next block overlaps it: its side
+        // stops the capsule one radius short of its footprint.
+        let takeoff = exit_distance(&current, c.feet, direction).min((enter - RADIUS).max(0.0));
         let aim = enter + LANDING_DEPTH.min(0.5 * (leave - enter));
         let flight = flight_time(next.top.y - c.feet.y);
-        let speed = ((aim - exit) / flight).clamp(1.0, RUN_SPEED);
+        let speed = ((aim - takeoff) / flight).clamp(1.0, RUN_SPEED);
         self.forward = speed / RUN_SPEED;
-        let jump = exit < speed * DECISION_DT + self.takeoff_margin;
+        let jump = takeoff < speed * DECISION_DT + self.takeoff_margin;
         if jump {
             self.takeoff_margin = self.rng.random_range(0.0..=self.takeoff_jitter);
         }

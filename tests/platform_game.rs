@@ -1,0 +1,149 @@
+//! The platform world: determinism, the calibrated reach, observations and rewards as the
+//! Solver sees them, and how runs end.
+
+use arlpcg::game::platform::reach::{self, REACH_HEIGHTS, REACH_TABLE, play_scripted, single_jump};
+use arlpcg::game::platform::{OBSERVATION_SIZE, PlatformAction, PlatformEnv, SolverRewards};
+use arlpcg::level::platform::{BlockParams, PlatformTrack, Start};
+use arlpcg::level::stats::Outcome;
+
+fn env_of(track: &PlatformTrack) -> PlatformEnv {
+    PlatformEnv::new(track, track.last().position, SolverRewards::default())
+}
+
+/// A fixed, varied action sequence: run, turn, jump now and then.
+fn scripted_actions(n: usize) -> Vec<PlatformAction> {
+    (0..n)
+        .map(|i| PlatformAction {
+            forward: ((i as f32) * 0.37).sin(),
+            turn: ((i as f32) * 0.11).cos(),
+            jump: i % 17 == 0,
+        })
+        .collect()
+}
+
+fn trajectory(track: &PlatformTrack, seed: u64, actions: &[PlatformAction]) -> Vec<u32> {
+    let mut env = env_of(track);
+    env.reset(seed);
+    let mut bits = Vec::new();
+    for &action in actions {
+        let step = env.step(action);
+        bits.extend(env.observation().iter().map(|x| x.to_bits()));
+        bits.push(step.reward.to_bits());
+        if step.outcome.is_some() {
+            break;
+        }
+    }
+    bits
+}
+
+#[test]
+fn same_level_seed_and_actions_give_a_bitwise_identical_trajectory() {
+    let level = arlpcg::game::rules::platform_level(11, None, None, &Default::default()).unwrap();
+    let track = level.platform().unwrap();
+    let actions = scripted_actions(400);
+    let a = trajectory(track, 5, &actions);
+    assert!(a.len() > 10 * OBSERVATION_SIZE, "the run should last a while");
+    assert_eq!(a, trajectory(track, 5, &actions));
+    assert_ne!(a, trajectory(track, 6, &actions), "the seed should place the character differently");
+}
+
+#[test]
+fn the_scripted_controller_completes_an_easy_level_and_fails_an_impossible_jump() {
+    let easy = PlatformTrack::from_params(
+        Start::default(),
+        &[
+            BlockParams::new(7.0, 0.0, 6.0, 1.0).unwrap(),
+            BlockParams::new(8.0, 40.0, 5.0, -1.0).unwrap(),
+            BlockParams::new(8.0, -60.0, 5.0, 2.0).unwrap(),
+            BlockParams::new(9.0, 20.0, 5.0, 0.0).unwrap(),
+        ],
+    )
+    .unwrap();
+    let mut env = env_of(&easy);
+    for seed in 0..10 {
+        let run = play_scripted(&mut env, seed, 0.3);
+        assert_eq!(run.outcome, Outcome::Success, "seed {seed}: {run:?}");
+        assert_eq!(run.progress, 1.0);
+    }
+    // 6 m across and 2 m up is beyond the character's reach.
+    let impossible = single_jump(6.0, 2.0);
+    let mut env = env_of(&impossible);
+    for seed in 0..10 {
+        let run = play_scripted(&mut env, seed, 0.3);
+        assert_eq!(run.outcome, Outcome::Fell, "seed {seed}: {run:?}");
+        assert_eq!((run.progress, run.target_piece), (0.0, 0));
+    }
+}
+
+#[test]
+fn the_documented_reach_table_is_what_the_simulation_measures() {
+    assert_eq!(reach::measure_reach(), REACH_TABLE, "heights {REACH_HEIGHTS:?}: update REACH_TABLE and docs/platform-physics.md");
+    // The edge of reach: 5 m up 2 m is made every time, 5.75 m never.
+    assert_eq!(reach::successes(5.0, 2.0, 16, 0.3), 16);
+    assert_eq!(reach::successes(5.75, 2.0, 16, 0.3), 0);
+}
+
+#[test]
+fn standing_still_runs_out_of_time_as_a_truncation_with_the_failure_penalty() {
+    let track = single_jump(2.0, 0.0);
+    let mut env = env_of(&track);
+    env.reset(0);
+    let rewards = SolverRewards::default();
+    let mut last = None;
+    for _ in 0..100_000 {
+        let step = env.step(PlatformAction::default());
+        if step.outcome.is_some() {
+            last = Some(step);
+            break;
+        }
+        assert_eq!(step.reward, 0.0, "no progress, no reward");
+    }
+    let step = last.expect("the run must end");
+    assert_eq!(step.outcome, Some(Outcome::TimedOut));
+    assert!(step.truncated && !step.terminated);
+    assert_eq!(step.reward, rewards.failure);
+    // (10 s + 4 s per block) at 30 decisions per second
+    assert_eq!(env.steps(), 420);
+}
+
+#[test]
+fn running_off_the_edge_falls_and_moving_toward_the_goal_pays() {
+    let track = single_jump(4.0, 0.0);
+    let mut env = env_of(&track);
+    env.reset(3);
+    // Turn to face the block first (the start heading is drawn within 90 degrees of it).
+    let mut total = 0.0;
+    let mut outcome = None;
+    for _ in 0..300 {
+        let yaw = env.character().yaw;
+        let turn = (-3.0 * yaw.sin()).clamp(-1.0, 1.0);
+        let forward = if yaw.abs() < 0.05 { 1.0 } else { 0.0 };
+        let step = env.step(PlatformAction { forward, turn, jump: false });
+        total += step.reward;
+        if step.outcome.is_some() {
+            outcome = step.outcome;
+            break;
+        }
+    }
+    assert_eq!(outcome, Some(Outcome::Fell), "running without jumping must fall into the gap");
+    // It ran about 2 m toward the block before dropping: positive progress, then the penalty.
+    assert!(total < 0.0 && total > SolverRewards::default().failure, "total {total}");
+}
+
+#[test]
+fn observation_is_finite_and_the_height_map_sees_ground_and_gap() {
+    let track = single_jump(4.0, 0.0);
+    let mut env = env_of(&track);
+    env.reset(0);
+    let obs = env.observation();
+    assert_eq!(obs.len(), OBSERVATION_SIZE);
+    assert!(obs.iter().all(|x| x.is_finite()), "{obs:?}");
+    let map = &obs[OBSERVATION_SIZE - 25..];
+    // The ray under the feet (row forward 0, column left 0) sees the ground at the feet.
+    assert!(map[5 + 2].abs() < 0.05, "{map:?}");
+    // Rays 3 m to the side of a 4 m start block look down into the void.
+    assert!(map.iter().any(|&h| h < -1.0), "{map:?}");
+    // NaN actions are treated as no input instead of corrupting the state.
+    env.step(PlatformAction { forward: f32::NAN, turn: f32::NAN, jump: false });
+    assert!(env.observation().iter().all(|x| x.is_finite()));
+}

@@ -136,7 +136,10 @@ fn parse_point(s: &str) -> Result<[f64; 3], String> {
     };
     let mut point = [0.0; 3];
     for (slot, part) in point.iter_mut().zip([x, y, z]) {
-        let value: f64 = part.trim().parse().map_err(|_| format!("`{part}` is not a number"))?;
+        let value: f64 = part
+            .trim()
+            .parse()
+            .map_err(|_| format!("`{part}` is not a number"))?;
         *slot = params::COORDINATE.check(value).map_err(|e| e.to_string())?;
     }
     Ok(point)

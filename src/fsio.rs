@@ -17,7 +17,10 @@ pub enum Overwrite {
 /// Fails if `path` exists and may not be overwritten (checked before any work is written).
 pub fn check_writable(path: &Path, overwrite: Overwrite) -> Result<()> {
     if overwrite == Overwrite::Never && path.exists() {
-        bail!("{} already exists (use --force to overwrite it)", path.display());
+        bail!(
+            "{} already exists (use --force to overwrite it)",
+            path.display()
+        );
     }
     Ok(())
 }
@@ -58,13 +61,21 @@ mod tests {
         assert_eq!(std::fs::read(&path).unwrap(), b"one");
         write_atomic(&path, b"three", Overwrite::Allowed).unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"three");
-        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+        let names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
         assert_eq!(names, vec!["level.yaml"]);
     }
 
     #[test]
     fn a_missing_directory_is_a_clear_error() {
-        let err = write_atomic(Path::new("/nonexistent-dir/level.yaml"), b"x", Overwrite::Never).unwrap_err();
+        let err = write_atomic(
+            Path::new("/nonexistent-dir/level.yaml"),
+            b"x",
+            Overwrite::Never,
+        )
+        .unwrap_err();
         assert!(format!("{err:#}").contains("/nonexistent-dir"), "{err:#}");
     }
 }

@@ -53,5 +53,10 @@ pub fn verify(
             },
         )
         .collect();
-    Ok(SolverStats::from_trials(solver.reference(), seed, track.block_count(), &results))
+    Ok(SolverStats::from_trials(
+        solver.reference(),
+        seed,
+        track.block_count(),
+        &results,
+    ))
 }

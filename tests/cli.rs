@@ -16,7 +16,14 @@ fn stderr(output: &Output) -> String {
 }
 
 fn generate(dir: &Path, extra: &[&str]) -> Output {
-    let mut args = vec!["generate", "--game", "platform", "--rules", "--out", dir.to_str().unwrap()];
+    let mut args = vec![
+        "generate",
+        "--game",
+        "platform",
+        "--rules",
+        "--out",
+        dir.to_str().unwrap(),
+    ];
     args.extend_from_slice(extra);
     arlpcg(&args)
 }
@@ -26,7 +33,10 @@ fn files_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
         .unwrap()
         .map(|e| {
             let path = e.unwrap().path();
-            (path.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read(&path).unwrap())
+            (
+                path.file_name().unwrap().to_string_lossy().into_owned(),
+                std::fs::read(&path).unwrap(),
+            )
         })
         .collect();
     files.sort();
@@ -37,7 +47,10 @@ fn files_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
 fn generate_is_reproducible_byte_for_byte_and_files_load_back() {
     let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
     for dir in [&a, &b] {
-        let out = generate(dir.path(), &["--count", "20", "--seed", "1", "--format", "yaml,glb"]);
+        let out = generate(
+            dir.path(),
+            &["--count", "20", "--seed", "1", "--format", "yaml,glb"],
+        );
         assert!(out.status.success(), "{}", stderr(&out));
     }
     let (files_a, files_b) = (files_of(a.path()), files_of(b.path()));
@@ -45,25 +58,57 @@ fn generate_is_reproducible_byte_for_byte_and_files_load_back() {
     assert!(files_a == files_b, "two runs with the same seed differ");
     for (name, bytes) in files_a.iter().filter(|(n, _)| n.ends_with(".yaml")) {
         let level = arlpcg::level::yaml::load(&a.path().join(name)).unwrap();
-        assert_eq!(arlpcg::level::yaml::to_string(&level).as_bytes(), bytes.as_slice(), "{name} does not read back to itself");
-        assert_eq!(level.seed.map(|s| format!("platform_seed{s}.yaml")), Some(name.clone()));
+        assert_eq!(
+            arlpcg::level::yaml::to_string(&level).as_bytes(),
+            bytes.as_slice(),
+            "{name} does not read back to itself"
+        );
+        assert_eq!(
+            level.seed.map(|s| format!("platform_seed{s}.yaml")),
+            Some(name.clone())
+        );
     }
 }
 
 #[test]
 fn generate_names_files_by_game_seed_and_aux_and_never_overwrites() {
     let dir = tempfile::tempdir().unwrap();
-    let out = generate(dir.path(), &["--count", "2", "--seed", "5", "--aux", "-0.5", "--format", "yaml"]);
+    let out = generate(
+        dir.path(),
+        &[
+            "--count", "2", "--seed", "5", "--aux", "-0.5", "--format", "yaml",
+        ],
+    );
     assert!(out.status.success(), "{}", stderr(&out));
     let names: Vec<String> = files_of(dir.path()).into_iter().map(|(n, _)| n).collect();
-    assert_eq!(names, ["platform_seed5_aux-0.50.yaml", "platform_seed6_aux-0.50.yaml"]);
+    assert_eq!(
+        names,
+        [
+            "platform_seed5_aux-0.50.yaml",
+            "platform_seed6_aux-0.50.yaml"
+        ]
+    );
     let before = files_of(dir.path());
     // Seed 6 exists already: the run refuses before writing anything, seed 7 included.
-    let out = generate(dir.path(), &["--count", "2", "--seed", "6", "--aux", "-0.5", "--format", "yaml"]);
+    let out = generate(
+        dir.path(),
+        &[
+            "--count", "2", "--seed", "6", "--aux", "-0.5", "--format", "yaml",
+        ],
+    );
     assert_eq!(out.status.code(), Some(1));
-    assert!(stderr(&out).contains("already exists (use --force"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("already exists (use --force"),
+        "{}",
+        stderr(&out)
+    );
     assert_eq!(files_of(dir.path()), before);
-    let out = generate(dir.path(), &["--count", "2", "--seed", "6", "--aux", "-0.5", "--format", "yaml", "--force"]);
+    let out = generate(
+        dir.path(),
+        &[
+            "--count", "2", "--seed", "6", "--aux", "-0.5", "--format", "yaml", "--force",
+        ],
+    );
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(files_of(dir.path()).len(), 3);
 }
@@ -81,35 +126,77 @@ fn export_writes_glb_and_gltf_with_bin() {
     let out = generate(dir.path(), &["--seed", "3", "--format", "yaml,glb,gltf"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let names: Vec<String> = files_of(dir.path()).into_iter().map(|(n, _)| n).collect();
-    assert_eq!(names, ["platform_seed3.bin", "platform_seed3.glb", "platform_seed3.gltf", "platform_seed3.yaml"]);
+    assert_eq!(
+        names,
+        [
+            "platform_seed3.bin",
+            "platform_seed3.glb",
+            "platform_seed3.gltf",
+            "platform_seed3.yaml"
+        ]
+    );
     let level = dir.path().join("platform_seed3.yaml");
     let exports = gltf_export_dir();
     for name in ["cli_export.glb", "cli_export.gltf"] {
         let target = exports.join(name);
-        let out = arlpcg(&["export", level.to_str().unwrap(), "--out", target.to_str().unwrap(), "--force"]);
+        let out = arlpcg(&[
+            "export",
+            level.to_str().unwrap(),
+            "--out",
+            target.to_str().unwrap(),
+            "--force",
+        ]);
         assert!(out.status.success(), "{}", stderr(&out));
     }
     assert!(exports.join("cli_export.bin").exists());
     // The exported .glb equals the one generate wrote: one exporter.
-    assert_eq!(std::fs::read(exports.join("cli_export.glb")).unwrap(), std::fs::read(dir.path().join("platform_seed3.glb")).unwrap());
+    assert_eq!(
+        std::fs::read(exports.join("cli_export.glb")).unwrap(),
+        std::fs::read(dir.path().join("platform_seed3.glb")).unwrap()
+    );
     let existing = exports.join("cli_export.glb");
-    let out = arlpcg(&["export", level.to_str().unwrap(), "--out", existing.to_str().unwrap()]);
+    let out = arlpcg(&[
+        "export",
+        level.to_str().unwrap(),
+        "--out",
+        existing.to_str().unwrap(),
+    ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("already exists"));
     let out = arlpcg(&["export", level.to_str().unwrap(), "--out", "level.obj"]);
-    assert!(stderr(&out).contains("must end in .glb or .gltf"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("must end in .glb or .gltf"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]
 fn verify_reports_json_with_the_documented_keys() {
     let dir = tempfile::tempdir().unwrap();
-    assert!(generate(dir.path(), &["--seed", "2", "--format", "yaml"]).status.success());
+    assert!(
+        generate(dir.path(), &["--seed", "2", "--format", "yaml"])
+            .status
+            .success()
+    );
     let level = dir.path().join("platform_seed2.yaml");
-    let out = arlpcg(&["verify", level.to_str().unwrap(), "--trials", "20", "--json"]);
+    let out = arlpcg(&[
+        "verify",
+        level.to_str().unwrap(),
+        "--trials",
+        "20",
+        "--json",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let line = String::from_utf8(out.stdout).unwrap();
     let report: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
-    for key in ["level", "trials", "successes", "success_ratio", "mean_progress"] {
+    for key in [
+        "level",
+        "trials",
+        "successes",
+        "success_ratio",
+        "mean_progress",
+    ] {
         assert!(report.get(key).is_some(), "missing {key} in {report}");
     }
     assert_eq!(report["trials"], 20);
@@ -122,14 +209,28 @@ fn assert_rejected(name: &str, contents: &[u8], expected: &str) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join(name);
     std::fs::write(&path, contents).unwrap();
-    for command in [vec!["verify", path.to_str().unwrap(), "--trials", "1"], vec!["export", path.to_str().unwrap(), "--out", dir.path().join("x.glb").to_str().unwrap()]] {
+    for command in [
+        vec!["verify", path.to_str().unwrap(), "--trials", "1"],
+        vec![
+            "export",
+            path.to_str().unwrap(),
+            "--out",
+            dir.path().join("x.glb").to_str().unwrap(),
+        ],
+    ] {
         let out = arlpcg(&command);
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(1), "{name}: {err}");
         assert!(!err.contains("panicked"), "{name} panicked: {err}");
         let error_lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
-        assert!(!error_lines.is_empty() && error_lines[0].contains(name), "{name}: the error must name the file: {err}");
-        assert!(error_lines[0].contains(expected), "{name}: expected `{expected}` in: {err}");
+        assert!(
+            !error_lines.is_empty() && error_lines[0].contains(name),
+            "{name}: the error must name the file: {err}"
+        );
+        assert!(
+            error_lines[0].contains(expected),
+            "{name}: expected `{expected}` in: {err}"
+        );
     }
     assert!(!dir.path().join("x.glb").exists());
 }
@@ -139,35 +240,81 @@ const GOOD: &str = "format: arlpcg-level\nversion: 1\ngame: platform\nstart: {po
 #[test]
 fn hand_broken_level_files_get_one_clear_line_and_a_non_zero_exit() {
     assert_rejected("empty.yaml", b"", "the file is empty");
-    assert_rejected("truncated.yaml", &GOOD.as_bytes()[..GOOD.len() - 20], "invalid YAML: did not find expected node content at line 7");
-    assert_rejected("cut.yaml", &GOOD.as_bytes()[..GOOD.len() - 46], "blocks: missing: a platform level needs its blocks");
-    assert_rejected("version.yaml", GOOD.replace("version: 1", "version: 7").as_bytes(), "format version 7 is not supported");
-    assert_rejected("range.yaml", GOOD.replace("size: 5", "size: 12").as_bytes(), "size 12 is out of range [4, 6] m");
-    assert_rejected("nan.yaml", GOOD.replace("height: 1", "height: .nan").as_bytes(), "height must be a number, not NaN");
-    assert_rejected("game.yaml", GOOD.replace("game: platform", "game: tetris").as_bytes(), "unknown variant `tetris`");
-    assert_rejected("racing.yaml", GOOD.replace("game: platform", "game: racing").as_bytes(), "a racing level has `segments`, not `blocks`");
-    let random: Vec<u8> = (0..4096u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8).collect();
+    assert_rejected(
+        "truncated.yaml",
+        &GOOD.as_bytes()[..GOOD.len() - 20],
+        "invalid YAML: did not find expected node content at line 7",
+    );
+    assert_rejected(
+        "cut.yaml",
+        &GOOD.as_bytes()[..GOOD.len() - 46],
+        "blocks: missing: a platform level needs its blocks",
+    );
+    assert_rejected(
+        "version.yaml",
+        GOOD.replace("version: 1", "version: 7").as_bytes(),
+        "format version 7 is not supported",
+    );
+    assert_rejected(
+        "range.yaml",
+        GOOD.replace("size: 5", "size: 12").as_bytes(),
+        "size 12 is out of range [4, 6] m",
+    );
+    assert_rejected(
+        "nan.yaml",
+        GOOD.replace("height: 1", "height: .nan").as_bytes(),
+        "height must be a number, not NaN",
+    );
+    assert_rejected(
+        "game.yaml",
+        GOOD.replace("game: platform", "game: tetris").as_bytes(),
+        "unknown variant `tetris`",
+    );
+    assert_rejected(
+        "racing.yaml",
+        GOOD.replace("game: platform", "game: racing").as_bytes(),
+        "a racing level has `segments`, not `blocks`",
+    );
+    let random: Vec<u8> = (0..4096u32)
+        .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
+        .collect();
     assert_rejected("random.yaml", &random, "not a text file");
     let large = format!("{GOOD}# {}\n", "x".repeat(5 << 20));
     assert_rejected("large.yaml", large.as_bytes(), "larger than 4 MiB");
-    assert_rejected("unknown.yaml", format!("{GOOD}colour: red\n").as_bytes(), "unknown field `colour`");
+    assert_rejected(
+        "unknown.yaml",
+        format!("{GOOD}colour: red\n").as_bytes(),
+        "unknown field `colour`",
+    );
 }
 
 #[test]
 fn a_missing_level_file_is_named() {
     let out = arlpcg(&["verify", "/no/such/level.yaml"]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(stderr(&out).contains("/no/such/level.yaml: cannot read the file"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("/no/such/level.yaml: cannot read the file"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]
 fn bad_arguments_are_usage_errors() {
     let out = arlpcg(&["generate", "--rules", "--out", "x", "--aux", "3"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("aux 3 is out of range [-1, 1]"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("aux 3 is out of range [-1, 1]"),
+        "{}",
+        stderr(&out)
+    );
     let out = arlpcg(&["generate", "--rules", "--game", "racing", "--out", "x"]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(stderr(&out).contains("only the platform game"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("only the platform game"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]

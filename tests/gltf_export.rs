@@ -17,7 +17,13 @@ fn node_bounds(node: &gltf::Node) -> ([f32; 3], [f32; 3]) {
         // q * v * q^-1 for a unit quaternion [x, y, z, w].
         let [x, y, z, w] = r;
         let u = [x, y, z];
-        let cross = |a: [f32; 3], b: [f32; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+        let cross = |a: [f32; 3], b: [f32; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
         let uv = cross(u, v);
         let uuv = cross(u, uv);
         [0, 1, 2].map(|k| v[k] + 2.0 * (w * uv[k] + uuv[k]))
@@ -25,7 +31,13 @@ fn node_bounds(node: &gltf::Node) -> ([f32; 3], [f32; 3]) {
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
     for corner in 0..8 {
-        let local = [0, 1, 2].map(|k| if corner >> k & 1 == 1 { 0.5 * s[k] } else { -0.5 * s[k] });
+        let local = [0, 1, 2].map(|k| {
+            if corner >> k & 1 == 1 {
+                0.5 * s[k]
+            } else {
+                -0.5 * s[k]
+            }
+        });
         let world = rotate(local);
         for k in 0..3 {
             lo[k] = lo[k].min(world[k] + t[k]);
@@ -41,6 +53,10 @@ fn glb_reads_back_with_one_node_per_block_and_matching_bounds() {
         let level = level(seed);
         let track = level.platform().unwrap();
         let glb = export::to_glb(&Scene::of_level(&level).unwrap());
+        // Left for `.ci/run` to pass through the Khronos validator.
+        let exports = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("gltf-exports");
+        std::fs::create_dir_all(&exports).unwrap();
+        std::fs::write(exports.join(format!("rules_seed{seed}.glb")), &glb).unwrap();
         let (document, buffers, _) = gltf::import_slice(&glb).expect("the .glb imports");
         let nodes: Vec<gltf::Node> = document.nodes().collect();
         // start block, every block, start and goal markers
@@ -53,18 +69,30 @@ fn glb_reads_back_with_one_node_per_block_and_matching_bounds() {
         // Block nodes sit where the level says: top face at the block's height, centred on it.
         for (node, platform) in nodes.iter().zip(track.platforms()) {
             let (lo, hi) = node_bounds(node);
-            assert!((hi[1] as f64 - platform.position[1]).abs() < 1e-4, "{:?}: top {} vs {}", node.name(), hi[1], platform.position[1]);
+            assert!(
+                (hi[1] as f64 - platform.position[1]).abs() < 1e-4,
+                "{:?}: top {} vs {}",
+                node.name(),
+                hi[1],
+                platform.position[1]
+            );
             assert!(((hi[1] - lo[1]) as f64 - BLOCK_THICKNESS).abs() < 1e-4);
             for k in [0, 2] {
                 let centre = 0.5 * (lo[k] + hi[k]) as f64;
-                assert!((centre - platform.position[k]).abs() < 1e-3, "{:?} centre {centre} vs {}", node.name(), platform.position[k]);
+                assert!(
+                    (centre - platform.position[k]).abs() < 1e-3,
+                    "{:?} centre {centre} vs {}",
+                    node.name(),
+                    platform.position[k]
+                );
                 // A square of side s turned by any heading spans between s and s*sqrt(2).
                 let span = (hi[k] - lo[k]) as f64;
                 assert!(span >= platform.size - 1e-3 && span <= platform.size * 2f64.sqrt() + 1e-3);
             }
         }
         // The block's generator parameters travel in its extras.
-        let extras: serde_json::Value = serde_json::from_str(nodes[1].extras().as_ref().unwrap().get()).unwrap();
+        let extras: serde_json::Value =
+            serde_json::from_str(nodes[1].extras().as_ref().unwrap().get()).unwrap();
         assert_eq!(extras["distance"], track.block_params()[0].distance);
         // The mesh data is a unit cube.
         let mesh = nodes[1].mesh().unwrap();
@@ -84,7 +112,13 @@ fn export_is_deterministic_and_gltf_matches_glb() {
     let gltf_out = export::to_gltf(&scene, "level.bin");
     let root: serde_json::Value = serde_json::from_slice(&gltf_out.main).unwrap();
     assert_eq!(root["buffers"][0]["uri"], "level.bin");
-    assert_eq!(root["nodes"].as_array().unwrap().len(), level.piece_count() + 3);
+    assert_eq!(
+        root["nodes"].as_array().unwrap().len(),
+        level.piece_count() + 3
+    );
     assert_eq!(root["scenes"][0]["extras"]["aux"], -1.0);
-    assert_eq!(gltf_out.bin.unwrap().len(), root["buffers"][0]["byteLength"].as_u64().unwrap() as usize);
+    assert_eq!(
+        gltf_out.bin.unwrap().len(),
+        root["buffers"][0]["byteLength"].as_u64().unwrap() as usize
+    );
 }

@@ -42,9 +42,16 @@ fn same_level_seed_and_actions_give_a_bitwise_identical_trajectory() {
     let track = level.platform().unwrap();
     let actions = scripted_actions(400);
     let a = trajectory(track, 5, &actions);
-    assert!(a.len() > 10 * OBSERVATION_SIZE, "the run should last a while");
+    assert!(
+        a.len() > 10 * OBSERVATION_SIZE,
+        "the run should last a while"
+    );
     assert_eq!(a, trajectory(track, 5, &actions));
-    assert_ne!(a, trajectory(track, 6, &actions), "the seed should place the character differently");
+    assert_ne!(
+        a,
+        trajectory(track, 6, &actions),
+        "the seed should place the character differently"
+    );
 }
 
 #[test]
@@ -77,7 +84,11 @@ fn the_scripted_controller_completes_an_easy_level_and_fails_an_impossible_jump(
 
 #[test]
 fn the_documented_reach_table_is_what_the_simulation_measures() {
-    assert_eq!(reach::measure_reach(), REACH_TABLE, "heights {REACH_HEIGHTS:?}: update REACH_TABLE and docs/platform-physics.md");
+    assert_eq!(
+        reach::measure_reach(),
+        REACH_TABLE,
+        "heights {REACH_HEIGHTS:?}: update REACH_TABLE and docs/platform-physics.md"
+    );
     // The edge of reach: 5 m up 2 m is made every time, 5.75 m never.
     assert_eq!(reach::successes(5.0, 2.0, 16, 0.3), 16);
     assert_eq!(reach::successes(5.75, 2.0, 16, 0.3), 0);
@@ -118,16 +129,27 @@ fn running_off_the_edge_falls_and_moving_toward_the_goal_pays() {
         let yaw = env.character().yaw;
         let turn = (-3.0 * yaw.sin()).clamp(-1.0, 1.0);
         let forward = if yaw.abs() < 0.05 { 1.0 } else { 0.0 };
-        let step = env.step(PlatformAction { forward, turn, jump: false });
+        let step = env.step(PlatformAction {
+            forward,
+            turn,
+            jump: false,
+        });
         total += step.reward;
         if step.outcome.is_some() {
             outcome = step.outcome;
             break;
         }
     }
-    assert_eq!(outcome, Some(Outcome::Fell), "running without jumping must fall into the gap");
+    assert_eq!(
+        outcome,
+        Some(Outcome::Fell),
+        "running without jumping must fall into the gap"
+    );
     // It ran about 2 m toward the block before dropping: positive progress, then the penalty.
-    assert!(total < 0.0 && total > SolverRewards::default().failure, "total {total}");
+    assert!(
+        total < 0.0 && total > SolverRewards::default().failure,
+        "total {total}"
+    );
 }
 
 #[test]
@@ -144,6 +166,10 @@ fn observation_is_finite_and_the_height_map_sees_ground_and_gap() {
     // Rays 3 m to the side of a 4 m start block look down into the void.
     assert!(map.iter().any(|&h| h < -1.0), "{map:?}");
     // NaN actions are treated as no input instead of corrupting the state.
-    env.step(PlatformAction { forward: f32::NAN, turn: f32::NAN, jump: false });
+    env.step(PlatformAction {
+        forward: f32::NAN,
+        turn: f32::NAN,
+        jump: false,
+    });
     assert!(env.observation().iter().all(|x| x.is_finite()));
 }

@@ -15,11 +15,26 @@ pub fn run(args: &ExportArgs) -> Result<()> {
     let format = match args.out.extension().and_then(|e| e.to_str()) {
         Some("glb") => Format::Glb,
         Some("gltf") => Format::Gltf,
-        _ => bail!("--out {}: the file name must end in .glb or .gltf", args.out.display()),
+        _ => bail!(
+            "--out {}: the file name must end in .glb or .gltf",
+            args.out.display()
+        ),
     };
-    let stem = args.out.file_stem().and_then(|s| s.to_str()).context("--out has no file name")?;
-    let dir = args.out.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let overwrite = if args.force { Overwrite::Allowed } else { Overwrite::Never };
+    let stem = args
+        .out
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .context("--out has no file name")?;
+    let dir = args
+        .out
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let overwrite = if args.force {
+        Overwrite::Allowed
+    } else {
+        Overwrite::Never
+    };
     let files = LevelFiles::new(dir, stem, &[format]);
     files.check_writable(overwrite)?;
     write_level_files(&level, &files, overwrite)?;
@@ -46,7 +61,11 @@ impl LevelFiles {
                 unique.push(*f);
             }
         }
-        Self { dir: dir.to_path_buf(), stem: stem.to_string(), formats: unique }
+        Self {
+            dir: dir.to_path_buf(),
+            stem: stem.to_string(),
+            formats: unique,
+        }
     }
 
     fn path(&self, extension: &str) -> PathBuf {
@@ -67,7 +86,9 @@ impl LevelFiles {
 
     /// Fails if any of the files exists and may not be replaced.
     pub fn check_writable(&self, overwrite: Overwrite) -> Result<()> {
-        self.paths().iter().try_for_each(|p| fsio::check_writable(p, overwrite))
+        self.paths()
+            .iter()
+            .try_for_each(|p| fsio::check_writable(p, overwrite))
     }
 }
 
@@ -76,8 +97,14 @@ pub fn write_level_files(level: &Level, files: &LevelFiles, overwrite: Overwrite
     let scene = || Scene::of_level(level);
     for format in &files.formats {
         match format {
-            Format::Yaml => fsio::write_atomic(&files.path("yaml"), yaml::to_string(level).as_bytes(), overwrite)?,
-            Format::Glb => fsio::write_atomic(&files.path("glb"), &gltf::to_glb(&scene()?), overwrite)?,
+            Format::Yaml => fsio::write_atomic(
+                &files.path("yaml"),
+                yaml::to_string(level).as_bytes(),
+                overwrite,
+            )?,
+            Format::Glb => {
+                fsio::write_atomic(&files.path("glb"), &gltf::to_glb(&scene()?), overwrite)?
+            }
             Format::Gltf => {
                 let bin_name = format!("{}.bin", files.stem);
                 let output = gltf::to_gltf(&scene()?, &bin_name);

@@ -10,17 +10,34 @@ use crate::level::{Game, RulesConfig};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
     if args.game != Game::Platform {
-        bail!("--game {}: only the platform game is implemented so far", args.game);
+        bail!(
+            "--game {}: only the platform game is implemented so far",
+            args.game
+        );
     }
     let seeds: Vec<u64> = (0..args.count as u64)
         .map(|i| args.seed.checked_add(i))
         .collect::<Option<_>>()
         .context("--seed plus --count overflows a 64-bit seed")?;
-    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
-    let overwrite = if args.force { Overwrite::Allowed } else { Overwrite::Never };
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let overwrite = if args.force {
+        Overwrite::Allowed
+    } else {
+        Overwrite::Never
+    };
     let plans: Vec<(u64, LevelFiles)> = seeds
         .iter()
-        .map(|&seed| (seed, LevelFiles::new(&args.out, &file_stem(args.game, seed, args.aux), &args.format)))
+        .map(|&seed| {
+            (
+                seed,
+                LevelFiles::new(
+                    &args.out,
+                    &file_stem(args.game, seed, args.aux),
+                    &args.format,
+                ),
+            )
+        })
         .collect();
     // Refuse before writing anything, so that a refused run leaves the folder as it was.
     for (_, files) in &plans {
@@ -36,7 +53,11 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     }
     bar.finish_and_clear();
     let files: usize = plans.iter().map(|(_, f)| f.paths().len()).sum();
-    println!("wrote {} levels ({files} files) to {}", plans.len(), args.out.display());
+    println!(
+        "wrote {} levels ({files} files) to {}",
+        plans.len(),
+        args.out.display()
+    );
     Ok(())
 }
 

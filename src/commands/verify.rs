@@ -19,12 +19,14 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
     }
     let mut failed = 0;
     for path in &args.levels {
-        let outcome = yaml::load(path).map_err(anyhow::Error::from).and_then(|level| {
-            let bar = super::progress_bar(args.trials as u64, &path.display().to_string());
-            let stats = verify(&level, solver, args.trials, args.seed, &|| bar.inc(1))?;
-            bar.finish_and_clear();
-            Ok(stats)
-        });
+        let outcome = yaml::load(path)
+            .map_err(anyhow::Error::from)
+            .and_then(|level| {
+                let bar = super::progress_bar(args.trials as u64, &path.display().to_string());
+                let stats = verify(&level, solver, args.trials, args.seed, &|| bar.inc(1))?;
+                bar.finish_and_clear();
+                Ok(stats)
+            });
         match outcome {
             Ok(stats) if args.json => println!("{}", to_json(path, &stats)),
             Ok(stats) => println!("{}", describe(path, &stats)),
@@ -35,7 +37,10 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
         }
     }
     if failed > 0 {
-        anyhow::bail!("{failed} of {} level files could not be verified", args.levels.len());
+        anyhow::bail!(
+            "{failed} of {} level files could not be verified",
+            args.levels.len()
+        );
     }
     Ok(())
 }
@@ -75,7 +80,12 @@ fn describe(path: &Path, s: &SolverStats) -> String {
         .map(|(i, n)| format!("block {i}: {n}"))
         .collect();
     if !failures.is_empty() {
-        text += &format!("\n  failed on the way to {} (fell {}, out of time {})", failures.join(", "), s.fell, s.timed_out);
+        text += &format!(
+            "\n  failed on the way to {} (fell {}, out of time {})",
+            failures.join(", "),
+            s.fell,
+            s.timed_out
+        );
     }
     text
 }

@@ -27,12 +27,18 @@ pub fn random_goal(rng: &mut ChaCha8Rng) -> [f64; 3] {
     let distance = rng.random_range(GOAL_DISTANCE.0..=GOAL_DISTANCE.1);
     let height = rng.random_range(GOAL_HEIGHT.0..=GOAL_HEIGHT.1);
     let [x, z] = platform::heading_direction(heading);
-    [quantize(distance * x), quantize(height), quantize(distance * z)]
+    [
+        quantize(distance * x),
+        quantize(height),
+        quantize(distance * z),
+    ]
 }
 
 /// Why the rules could not build a level.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("the rules found no valid level toward goal {goal:?} in {ATTEMPTS} attempts of at most {max_blocks} blocks")]
+#[error(
+    "the rules found no valid level toward goal {goal:?} in {ATTEMPTS} attempts of at most {max_blocks} blocks"
+)]
 pub struct NoLevel {
     pub goal: [f64; 3],
     pub max_blocks: u32,
@@ -40,7 +46,12 @@ pub struct NoLevel {
 
 /// A rule-based platform level, reproducible from `seed`: the goal and start heading are drawn
 /// from it, unless `goal` is given. `aux` is recorded in the level; the rules do not use it.
-pub fn platform_level(seed: u64, aux: Option<f64>, goal: Option<[f64; 3]>, config: &RulesConfig) -> Result<Level, NoLevel> {
+pub fn platform_level(
+    seed: u64,
+    aux: Option<f64>,
+    goal: Option<[f64; 3]>,
+    config: &RulesConfig,
+) -> Result<Level, NoLevel> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let drawn_goal = random_goal(&mut rng);
     let goal = goal.unwrap_or(drawn_goal);
@@ -67,12 +78,18 @@ pub fn platform_level(seed: u64, aux: Option<f64>, goal: Option<[f64; 3]>, confi
 }
 
 /// One try at a whole track; `None` when it gets stuck or runs out of blocks.
-fn attempt(rng: &mut ChaCha8Rng, start: Start, goal: [f64; 3], config: &RulesConfig) -> Option<PlatformTrack> {
+fn attempt(
+    rng: &mut ChaCha8Rng,
+    start: Start,
+    goal: [f64; 3],
+    config: &RulesConfig,
+) -> Option<PlatformTrack> {
     let mut track = PlatformTrack::new(start);
     while track.block_count() < config.max_blocks as usize {
         let placed = (0..CANDIDATES).any(|_| {
             let candidate = draw(rng, track.last(), goal, config);
-            is_jumpable(track.last(), &track.preview(&candidate), config) && track.push(candidate).is_ok()
+            is_jumpable(track.last(), &track.preview(&candidate), config)
+                && track.push(candidate).is_ok()
         });
         if !placed {
             return None;
@@ -92,13 +109,19 @@ fn is_jumpable(from: &Platform, to: &Platform, config: &RulesConfig) -> bool {
 
 /// Draws one block's parameters: aimed at the goal when it is within one block's distance,
 /// otherwise heading for it within the configured spread, climbing toward its height.
-fn draw(rng: &mut ChaCha8Rng, last: &Platform, goal: [f64; 3], config: &RulesConfig) -> BlockParams {
+fn draw(
+    rng: &mut ChaCha8Rng,
+    last: &Platform,
+    goal: [f64; 3],
+    config: &RulesConfig,
+) -> BlockParams {
     let (dx, dz) = (goal[0] - last.position[0], goal[2] - last.position[2]);
     let horizontal = dx.hypot(dz);
     let rise = goal[1] - last.position[1];
     let to_goal = platform::direction_heading(dx, dz);
     let size = rng.random_range(params::BLOCK_SIZE.min..=params::BLOCK_SIZE.max);
-    let finish = params::BLOCK_DISTANCE.check(horizontal).is_ok() && rise.abs() <= params::BLOCK_HEIGHT.max + platform::GOAL_REACH_VERTICAL;
+    let finish = params::BLOCK_DISTANCE.check(horizontal).is_ok()
+        && rise.abs() <= params::BLOCK_HEIGHT.max + platform::GOAL_REACH_VERTICAL;
     let (distance, heading, height) = if finish && rng.random_bool(0.8) {
         let height = rise.clamp(params::BLOCK_HEIGHT.min, params::BLOCK_HEIGHT.max);
         (horizontal, to_goal, height)
@@ -106,8 +129,10 @@ fn draw(rng: &mut ChaCha8Rng, last: &Platform, goal: [f64; 3], config: &RulesCon
         let spread = config.angle_spread.clamp(0.0, 180.0);
         let heading = to_goal + rng.random_range(-spread..=spread);
         let blocks_left = (horizontal / 7.5).max(1.0);
-        let climb = (rise / blocks_left + rng.random_range(-1.0..=1.0)).clamp(params::BLOCK_HEIGHT.min, params::BLOCK_HEIGHT.max);
-        let longest = (reach::max_gap(climb) - config.reach_margin + 0.5 * (last.size + size)).clamp(params::BLOCK_DISTANCE.min, params::BLOCK_DISTANCE.max);
+        let climb = (rise / blocks_left + rng.random_range(-1.0..=1.0))
+            .clamp(params::BLOCK_HEIGHT.min, params::BLOCK_HEIGHT.max);
+        let longest = (reach::max_gap(climb) - config.reach_margin + 0.5 * (last.size + size))
+            .clamp(params::BLOCK_DISTANCE.min, params::BLOCK_DISTANCE.max);
         let distance = rng.random_range(params::BLOCK_DISTANCE.min..=longest);
         (distance, heading, climb)
     };
@@ -134,7 +159,10 @@ mod tests {
             assert_eq!(level, again, "seed {seed} is not reproducible");
             let track = level.platform().unwrap();
             for pair in track.platforms().windows(2) {
-                assert!(is_jumpable(&pair[0], &pair[1], &config), "seed {seed}: a jump out of reach");
+                assert!(
+                    is_jumpable(&pair[0], &pair[1], &config),
+                    "seed {seed}: a jump out of reach"
+                );
             }
         }
     }
@@ -151,7 +179,8 @@ mod tests {
 
     #[test]
     fn a_goal_high_above_the_start_gets_a_climbing_track() {
-        let level = platform_level(3, None, Some([5.0, 10.0, 0.0]), &RulesConfig::default()).unwrap();
+        let level =
+            platform_level(3, None, Some([5.0, 10.0, 0.0]), &RulesConfig::default()).unwrap();
         let last = level.platform().unwrap().last();
         assert!(last.position[1] >= 8.0, "{last:?}");
     }

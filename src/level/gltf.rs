@@ -107,27 +107,66 @@ fn document(scene: &Scene, buffer_length: usize, uri: Option<String>) -> json::R
             extras: None,
         })
     };
-    let positions_view = view(0, vertex_bytes, json::buffer::Target::ArrayBuffer, "positions");
-    let normals_view = view(vertex_bytes, vertex_bytes, json::buffer::Target::ArrayBuffer, "normals");
-    let indices_view = view(2 * vertex_bytes, 2 * CUBE_INDICES, json::buffer::Target::ElementArrayBuffer, "indices");
-    let accessor = |view, count: usize, component, type_, bounds: Option<(f32, f32)>, name: &str| json::Accessor {
-        buffer_view: Some(view),
-        byte_offset: None,
-        count: USize64::from(count),
-        component_type: Valid(json::accessor::GenericComponentType(component)),
-        extensions: None,
-        extras: None,
-        type_: Valid(type_),
-        min: bounds.map(|(lo, _)| json::Value::from(vec![lo; 3])),
-        max: bounds.map(|(_, hi)| json::Value::from(vec![hi; 3])),
-        name: Some(name.into()),
-        normalized: false,
-        sparse: None,
-    };
+    let positions_view = view(
+        0,
+        vertex_bytes,
+        json::buffer::Target::ArrayBuffer,
+        "positions",
+    );
+    let normals_view = view(
+        vertex_bytes,
+        vertex_bytes,
+        json::buffer::Target::ArrayBuffer,
+        "normals",
+    );
+    let indices_view = view(
+        2 * vertex_bytes,
+        2 * CUBE_INDICES,
+        json::buffer::Target::ElementArrayBuffer,
+        "indices",
+    );
+    let accessor =
+        |view, count: usize, component, type_, bounds: Option<(f32, f32)>, name: &str| {
+            json::Accessor {
+                buffer_view: Some(view),
+                byte_offset: None,
+                count: USize64::from(count),
+                component_type: Valid(json::accessor::GenericComponentType(component)),
+                extensions: None,
+                extras: None,
+                type_: Valid(type_),
+                min: bounds.map(|(lo, _)| json::Value::from(vec![lo; 3])),
+                max: bounds.map(|(_, hi)| json::Value::from(vec![hi; 3])),
+                name: Some(name.into()),
+                normalized: false,
+                sparse: None,
+            }
+        };
     use json::accessor::{ComponentType, Type};
-    let positions = root.push(accessor(positions_view, CUBE_VERTICES, ComponentType::F32, Type::Vec3, Some((-0.5, 0.5)), "positions"));
-    let normals = root.push(accessor(normals_view, CUBE_VERTICES, ComponentType::F32, Type::Vec3, None, "normals"));
-    let indices = root.push(accessor(indices_view, CUBE_INDICES, ComponentType::U16, Type::Scalar, None, "indices"));
+    let positions = root.push(accessor(
+        positions_view,
+        CUBE_VERTICES,
+        ComponentType::F32,
+        Type::Vec3,
+        Some((-0.5, 0.5)),
+        "positions",
+    ));
+    let normals = root.push(accessor(
+        normals_view,
+        CUBE_VERTICES,
+        ComponentType::F32,
+        Type::Vec3,
+        None,
+        "normals",
+    ));
+    let indices = root.push(accessor(
+        indices_view,
+        CUBE_INDICES,
+        ComponentType::U16,
+        Type::Scalar,
+        None,
+        "indices",
+    ));
 
     let mut meshes = BTreeMap::new();
     for material in Material::ALL {
@@ -174,7 +213,8 @@ fn document(scene: &Scene, buffer_length: usize, uri: Option<String>) -> json::R
                 name: Some(node.name.clone()),
                 mesh: Some(meshes[&node.material]),
                 translation: Some(node.centre.map(|c| c as f32)),
-                rotation: (node.heading != 0.0).then(|| json::scene::UnitQuaternion([0.0, half.sin(), 0.0, half.cos()])),
+                rotation: (node.heading != 0.0)
+                    .then(|| json::scene::UnitQuaternion([0.0, half.sin(), 0.0, half.cos()])),
                 scale: Some(node.extents.map(|e| e as f32)),
                 extras: node.extras.as_ref().map(raw),
                 ..Default::default()
@@ -197,10 +237,10 @@ fn raw(value: &serde_json::Value) -> Box<serde_json::value::RawValue> {
 
 /// Wraps JSON and binary chunks in the GLB container (glTF 2.0, section 4.4).
 fn glb_container(mut json: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + json.len() + 8 + bin.len();

@@ -44,7 +44,9 @@ impl std::str::FromStr for Game {
         match s {
             "platform" => Ok(Game::Platform),
             "racing" => Ok(Game::Racing),
-            other => Err(format!("unknown game `{other}`: expected platform or racing")),
+            other => Err(format!(
+                "unknown game `{other}`: expected platform or racing"
+            )),
         }
     }
 }

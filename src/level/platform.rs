@@ -138,7 +138,8 @@ impl Platform {
     /// Signed distance between the facing edges of two consecutive blocks along the line joining
     /// their centres, as the SPEC defines it: distance - (size_a + size_b) / 2.
     pub fn edge_gap(&self, next: &Platform) -> f64 {
-        let distance = (next.position[0] - self.position[0]).hypot(next.position[2] - self.position[2]);
+        let distance =
+            (next.position[0] - self.position[0]).hypot(next.position[2] - self.position[2]);
         distance - 0.5 * (self.size + next.size)
     }
 }
@@ -235,7 +236,9 @@ impl PlatformTrack {
 
     /// The most recently placed block (the start block while none is placed).
     pub fn last(&self) -> &Platform {
-        self.platforms.last().expect("a track always has its start block")
+        self.platforms
+            .last()
+            .expect("a track always has its start block")
     }
 
     pub fn block_count(&self) -> usize {
@@ -323,8 +326,16 @@ mod tests {
 
     #[test]
     fn rotated_squares_overlap_only_when_they_touch() {
-        let a = Platform { position: [0.0; 3], heading: 0.0, size: 4.0 };
-        let diamond = |x: f64| Platform { position: [x, 0.0, 0.0], heading: 45.0, size: 4.0 };
+        let a = Platform {
+            position: [0.0; 3],
+            heading: 0.0,
+            size: 4.0,
+        };
+        let diamond = |x: f64| Platform {
+            position: [x, 0.0, 0.0],
+            heading: 45.0,
+            size: 4.0,
+        };
         // The diamond's corner reaches 2*sqrt(2) = 2.83 m from its centre.
         assert!(a.overlaps(&diamond(4.8)));
         assert!(!a.overlaps(&diamond(4.9)));
@@ -332,7 +343,11 @@ mod tests {
 
     #[test]
     fn goal_reach_is_measured_from_the_top_centre() {
-        let p = Platform { position: [10.0, 2.0, 0.0], heading: 0.0, size: 5.0 };
+        let p = Platform {
+            position: [10.0, 2.0, 0.0],
+            heading: 0.0,
+            size: 5.0,
+        };
         assert!(p.reaches([12.0, 3.0, 2.0]));
         assert!(!p.reaches([13.5, 2.0, 0.0]));
         assert!(!p.reaches([10.0, 4.5, 0.0]));

@@ -73,7 +73,9 @@ pub struct Scene {
 
 /// Why a level cannot be turned into a scene yet.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("exporting {0} levels is not supported yet: the racing game's road geometry lands with the racing game")]
+#[error(
+    "exporting {0} levels is not supported yet: the racing game's road geometry lands with the racing game"
+)]
 pub struct UnsupportedGame(pub &'static str);
 
 impl Scene {
@@ -85,16 +87,29 @@ impl Scene {
         let platforms = track.platforms();
         let block_node = |name: String, p: &Platform, material, extras| SceneNode {
             name,
-            centre: [p.position[0], p.position[1] - 0.5 * BLOCK_THICKNESS, p.position[2]],
+            centre: [
+                p.position[0],
+                p.position[1] - 0.5 * BLOCK_THICKNESS,
+                p.position[2],
+            ],
             heading: p.heading,
             extents: [p.size, BLOCK_THICKNESS, p.size],
             material,
             extras,
         };
-        let mut nodes = vec![block_node("start_block".into(), &platforms[0], Material::StartBlock, None)];
+        let mut nodes = vec![block_node(
+            "start_block".into(),
+            &platforms[0],
+            Material::StartBlock,
+            None,
+        )];
         let last = track.block_count() - 1;
         for (i, (params, placed)) in track.block_params().iter().zip(&platforms[1..]).enumerate() {
-            let material = if i == last { Material::GoalBlock } else { Material::Block };
+            let material = if i == last {
+                Material::GoalBlock
+            } else {
+                Material::Block
+            };
             let extras = json!({
                 "index": i,
                 "distance": params.distance,
@@ -102,7 +117,12 @@ impl Scene {
                 "size": params.size,
                 "height": params.height,
             });
-            nodes.push(block_node(format!("block_{i:03}"), placed, material, Some(extras)));
+            nodes.push(block_node(
+                format!("block_{i:03}"),
+                placed,
+                material,
+                Some(extras),
+            ));
         }
         let marker = |name: &str, base: [f64; 3], height: f64, material| SceneNode {
             name: name.into(),
@@ -112,7 +132,12 @@ impl Scene {
             material,
             extras: None,
         };
-        nodes.push(marker("start", platforms[0].position, 2.0, Material::StartMarker));
+        nodes.push(marker(
+            "start",
+            platforms[0].position,
+            2.0,
+            Material::StartMarker,
+        ));
         nodes.push(marker("goal", level.goal, 3.0, Material::GoalMarker));
         Ok(Scene {
             name: format!("{}_level", level.game()),

@@ -72,7 +72,12 @@ pub struct SolverStats {
 
 impl SolverStats {
     /// Aggregates trial results over a level with `pieces` pieces.
-    pub fn from_trials(solver: SolverRef, seed: u64, pieces: usize, trials: &[TrialResult]) -> Self {
+    pub fn from_trials(
+        solver: SolverRef,
+        seed: u64,
+        pieces: usize,
+        trials: &[TrialResult],
+    ) -> Self {
         let count = |o: Outcome| trials.iter().filter(|t| t.outcome == o).count() as u32;
         let n = trials.len() as u32;
         let successes = count(Outcome::Success);
@@ -125,14 +130,25 @@ impl SolverStats {
             ));
         }
         let expected_ci = wilson_interval(self.successes, self.trials).map(round4);
-        if (self.ci95[0] - expected_ci[0]).abs() > 1e-3 || (self.ci95[1] - expected_ci[1]).abs() > 1e-3 {
-            return Err(format!("ci95 {:?} does not match the Wilson interval {expected_ci:?}", self.ci95));
+        if (self.ci95[0] - expected_ci[0]).abs() > 1e-3
+            || (self.ci95[1] - expected_ci[1]).abs() > 1e-3
+        {
+            return Err(format!(
+                "ci95 {:?} does not match the Wilson interval {expected_ci:?}",
+                self.ci95
+            ));
         }
         if !(0.0..=1.0).contains(&self.mean_progress) {
-            return Err(format!("mean_progress {} is out of range [0, 1]", self.mean_progress));
+            return Err(format!(
+                "mean_progress {} is out of range [0, 1]",
+                self.mean_progress
+            ));
         }
         if !self.mean_success_steps.is_finite() || self.mean_success_steps < 0.0 {
-            return Err(format!("mean_success_steps {} must be a number >= 0", self.mean_success_steps));
+            return Err(format!(
+                "mean_success_steps {} must be a number >= 0",
+                self.mean_success_steps
+            ));
         }
         if self.failures_by_piece.len() != pieces {
             return Err(format!(
@@ -152,7 +168,11 @@ impl SolverStats {
 }
 
 fn ratio(successes: u32, trials: u32) -> f64 {
-    if trials == 0 { 0.0 } else { successes as f64 / trials as f64 }
+    if trials == 0 {
+        0.0
+    } else {
+        successes as f64 / trials as f64
+    }
 }
 
 fn round4(x: f64) -> f64 {
@@ -171,8 +191,16 @@ pub fn wilson_interval(successes: u32, trials: u32) -> [f64; 2] {
     let denominator = 1.0 + z2 / n;
     let centre = (p + z2 / (2.0 * n)) / denominator;
     let half = Z * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt() / denominator;
-    let low = if successes == 0 { 0.0 } else { (centre - half).max(0.0) };
-    let high = if successes == trials { 1.0 } else { (centre + half).min(1.0) };
+    let low = if successes == 0 {
+        0.0
+    } else {
+        (centre - half).max(0.0)
+    };
+    let high = if successes == trials {
+        1.0
+    } else {
+        (centre + half).min(1.0)
+    };
     [low, high]
 }
 
@@ -184,7 +212,10 @@ mod tests {
     fn wilson_interval_matches_published_values() {
         // 81 of 263 (Wilson 1927, as in Newcombe 1998, method 3): 0.2553 to 0.3662.
         let [lo, hi] = wilson_interval(81, 263);
-        assert!((lo - 0.2553).abs() < 1e-4 && (hi - 0.3662).abs() < 1e-4, "{lo} {hi}");
+        assert!(
+            (lo - 0.2553).abs() < 1e-4 && (hi - 0.3662).abs() < 1e-4,
+            "{lo} {hi}"
+        );
         // All successes: the upper bound is 1, the lower bound below it.
         let [lo, hi] = wilson_interval(10, 10);
         assert!((lo - 0.7225).abs() < 1e-4 && hi == 1.0, "{lo} {hi}");
@@ -193,7 +224,12 @@ mod tests {
 
     #[test]
     fn from_trials_counts_and_places_failures() {
-        let t = |outcome, progress, target_piece| TrialResult { outcome, progress, target_piece, steps: 100 };
+        let t = |outcome, progress, target_piece| TrialResult {
+            outcome,
+            progress,
+            target_piece,
+            steps: 100,
+        };
         let trials = [
             t(Outcome::Success, 1.0, 2),
             t(Outcome::Fell, 0.5, 1),
@@ -201,13 +237,21 @@ mod tests {
             t(Outcome::TimedOut, 0.5, 1),
         ];
         let stats = SolverStats::from_trials(SolverRef::Scripted, 7, 3, &trials);
-        assert_eq!((stats.trials, stats.successes, stats.fell, stats.timed_out), (4, 1, 2, 1));
+        assert_eq!(
+            (stats.trials, stats.successes, stats.fell, stats.timed_out),
+            (4, 1, 2, 1)
+        );
         assert_eq!(stats.failures_by_piece, vec![1, 2, 0]);
         assert_eq!(stats.success_ratio, 0.25);
         assert_eq!(stats.mean_progress, 0.55);
         assert_eq!(stats.mean_success_steps, 100.0);
         stats.check(3).unwrap();
-        assert!(stats.check(4).unwrap_err().contains("failures_by_piece has 3 entries"));
+        assert!(
+            stats
+                .check(4)
+                .unwrap_err()
+                .contains("failures_by_piece has 3 entries")
+        );
         let mut lying = stats.clone();
         lying.success_ratio = 0.9;
         assert!(lying.check(3).unwrap_err().contains("success_ratio 0.9"));

@@ -13,7 +13,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use super::params::{self, ParamRange};
 use super::platform::{self, BlockParams, PlatformTrack, Start};
 use super::racing::{RacingTrack, SegmentParams};
-use super::{Game, Level, Source, SolverStats, Track};
+use super::{Game, Level, SolverStats, Source, Track};
 
 /// The `format` every level file declares.
 pub const FORMAT_NAME: &str = "arlpcg-level";
@@ -73,7 +73,8 @@ pub fn load(path: &Path) -> Result<Level, LoadError> {
     if bytes.len() as u64 > MAX_FILE_BYTES {
         return Err(fail(Problem::TooLarge));
     }
-    let text = String::from_utf8(bytes).map_err(|e| fail(Problem::NotText(e.utf8_error().valid_up_to())))?;
+    let text = String::from_utf8(bytes)
+        .map_err(|e| fail(Problem::NotText(e.utf8_error().valid_up_to())))?;
     parse(&text).map_err(fail)
 }
 
@@ -112,7 +113,11 @@ fn check_header(text: &str) -> Result<(), Problem> {
                 describe_value(other)
             )));
         }
-        None => return Err(Problem::NotALevel(format!("missing field `format: {FORMAT_NAME}`"))),
+        None => {
+            return Err(Problem::NotALevel(format!(
+                "missing field `format: {FORMAT_NAME}`"
+            )));
+        }
     }
     match fields.get("version") {
         Some(serde_yaml::Value::Number(n)) if n.as_u64() == Some(FORMAT_VERSION as u64) => Ok(()),
@@ -124,7 +129,11 @@ fn check_header(text: &str) -> Result<(), Problem> {
 fn describe_value(value: &serde_yaml::Value) -> String {
     let text = serde_yaml::to_string(value).unwrap_or_default();
     let text = text.trim();
-    if text.len() > 40 { format!("{}...", &text[..text.floor_char_boundary(40)]) } else { text.to_string() }
+    if text.len() > 40 {
+        format!("{}...", &text[..text.floor_char_boundary(40)])
+    } else {
+        text.to_string()
+    }
 }
 
 /// A number that must lie in the range `B` names; checked while parsing, so serde_yaml's error
@@ -178,7 +187,10 @@ impl<'de, B: Bound> Deserialize<'de> for Bounded<B> {
         // The message names the parameter too: in flow style (`{size: 12}`) serde_yaml's path
         // stops at the enclosing mapping.
         let value = f64::deserialize(deserializer)?;
-        B::RANGE.check(value).map(Self::new).map_err(serde::de::Error::custom)
+        B::RANGE
+            .check(value)
+            .map(Self::new)
+            .map_err(serde::de::Error::custom)
     }
 }
 
@@ -322,7 +334,11 @@ impl LevelFile {
                     ));
                 }
                 let blocks = self.blocks.ok_or_else(|| {
-                    invalid("blocks".into(), None, "missing: a platform level needs its blocks".into())
+                    invalid(
+                        "blocks".into(),
+                        None,
+                        "missing: a platform level needs its blocks".into(),
+                    )
                 })?;
                 let start = Start {
                     position: point(&self.start.position),
@@ -345,7 +361,8 @@ impl LevelFile {
                     let placed = track.last();
                     if let Some(position) = &block.position {
                         let written = point(position);
-                        let off = (0..3).any(|k| (written[k] - placed.position[k]).abs() > TRANSFORM_TOLERANCE);
+                        let off = (0..3)
+                            .any(|k| (written[k] - placed.position[k]).abs() > TRANSFORM_TOLERANCE);
                         if off {
                             return Err(invalid(
                                 format!("{field}.position"),
@@ -390,7 +407,11 @@ impl LevelFile {
                     ));
                 }
                 let segments = self.segments.ok_or_else(|| {
-                    invalid("segments".into(), None, "missing: a racing level needs its segments".into())
+                    invalid(
+                        "segments".into(),
+                        None,
+                        "missing: a racing level needs its segments".into(),
+                    )
                 })?;
                 let segments = segments
                     .iter()
@@ -407,7 +428,11 @@ impl LevelFile {
                 };
                 // The road's end is only known once the racing game resolves its geometry.
                 let goal = self.goal.as_ref().map(point).ok_or_else(|| {
-                    invalid("goal".into(), None, "missing: a racing level names its goal".into())
+                    invalid(
+                        "goal".into(),
+                        None,
+                        "missing: a racing level names its goal".into(),
+                    )
                 })?;
                 (Track::Racing(track), goal)
             }
@@ -415,7 +440,10 @@ impl LevelFile {
         let level = Level {
             seed: self.seed,
             aux: self.aux.map(|a| a.0),
-            goal: self.goal.as_ref().map_or(default_goal.map(params::quantize), point),
+            goal: self
+                .goal
+                .as_ref()
+                .map_or(default_goal.map(params::quantize), point),
             track,
             source: self.source,
             stats: self.stats,
@@ -435,7 +463,10 @@ impl LevelFile {
 /// The 1-based line of a top-level `key:`, if written in block style.
 fn line_of_key(text: &str, key: &str) -> Option<usize> {
     text.lines()
-        .position(|l| l.strip_prefix(key).is_some_and(|rest| rest.starts_with(':')))
+        .position(|l| {
+            l.strip_prefix(key)
+                .is_some_and(|rest| rest.starts_with(':'))
+        })
         .map(|i| i + 1)
 }
 
@@ -485,7 +516,11 @@ blocks:
         let level = parse(HAND_MADE).unwrap();
         let track = level.platform().unwrap();
         assert_eq!(track.block_count(), 2);
-        assert_eq!(level.goal, track.last().position.map(params::quantize), "the goal defaults to the last block");
+        assert_eq!(
+            level.goal,
+            track.last().position.map(params::quantize),
+            "the goal defaults to the last block"
+        );
         assert_eq!(level.source, Source::Hand);
         // Written back, it reads back to the same level, byte for byte on a second round.
         let text = to_string(&level);
@@ -501,20 +536,33 @@ blocks:
     #[test]
     fn out_of_range_values_name_field_and_line() {
         let msg = problem(&HAND_MADE.replace("size: 4,", "size: 12,"));
-        assert!(msg.contains("blocks[1]") && msg.contains("size 12 is out of range [4, 6] m"), "{msg}");
+        assert!(
+            msg.contains("blocks[1]") && msg.contains("size 12 is out of range [4, 6] m"),
+            "{msg}"
+        );
         assert!(msg.contains("line 7"), "{msg}");
         let msg = problem(&HAND_MADE.replace("height: 1}", "height: .nan}"));
-        assert!(msg.contains("blocks[0]: height must be a number, not NaN"), "{msg}");
+        assert!(
+            msg.contains("blocks[0]: height must be a number, not NaN"),
+            "{msg}"
+        );
         // In block style too, the item and its line are named.
-        let block_style = to_string(&parse(HAND_MADE).unwrap()).replacen("size: 5.0", "size: 5.5e3", 1);
+        let block_style =
+            to_string(&parse(HAND_MADE).unwrap()).replacen("size: 5.0", "size: 5.5e3", 1);
         let msg = problem(&block_style);
-        assert!(msg.contains("blocks[0]: size 5500 is out of range") && msg.contains("line 16"), "{msg}");
+        assert!(
+            msg.contains("blocks[0]: size 5500 is out of range") && msg.contains("line 16"),
+            "{msg}"
+        );
     }
 
     #[test]
     fn header_problems_come_first() {
         assert!(problem("").contains("empty"));
-        assert!(problem(&HAND_MADE.replace("version: 1", "version: 2")).contains("format version 2 is not supported"));
+        assert!(
+            problem(&HAND_MADE.replace("version: 1", "version: 2"))
+                .contains("format version 2 is not supported")
+        );
         assert!(problem(&HAND_MADE.replace("arlpcg-level", "gltf")).contains("format is gltf"));
         assert!(problem("just some words").contains("not an arlpcg level"));
         assert!(problem("- a\n- list").contains("not an arlpcg level"));
@@ -534,9 +582,15 @@ blocks:
 
     #[test]
     fn overlaps_moved_transforms_and_unreached_goals_are_caught() {
-        let overlap = HAND_MADE.replace("{distance: 6, angle: 30, size: 4, height: -1}", "{distance: 7, angle: 180, size: 4, height: -1}");
+        let overlap = HAND_MADE.replace(
+            "{distance: 6, angle: 30, size: 4, height: -1}",
+            "{distance: 7, angle: 180, size: 4, height: -1}",
+        );
         let msg = problem(&overlap);
-        assert!(msg.contains("blocks[1]: block 1 overlaps the start block (line 7)"), "{msg}");
+        assert!(
+            msg.contains("blocks[1]: block 1 overlaps the start block (line 7)"),
+            "{msg}"
+        );
         let moved = HAND_MADE.replace("height: 1}", "height: 1, position: [7, 1, 3]}");
         assert!(problem(&moved).contains("blocks[0].position"));
         let far_goal = format!("{HAND_MADE}goal: [100, 0, 0]\n");

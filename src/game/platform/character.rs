@@ -103,7 +103,11 @@ impl Character {
                 action.forward * RUN_SPEED * BACKWARD_FACTOR
             };
             let wanted = self.facing() * speed;
-            let accel = if self.grounded { GROUND_ACCEL } else { AIR_ACCEL };
+            let accel = if self.grounded {
+                GROUND_ACCEL
+            } else {
+                AIR_ACCEL
+            };
             let horizontal = Vector::new(self.velocity.x, 0.0, self.velocity.z);
             let change = wanted - horizontal;
             let max_change = accel * dt;
@@ -122,11 +126,14 @@ impl Character {
                 vertical -= GRAVITY * dt;
             }
             let desired = Vector::new(horizontal.x, vertical, horizontal.z) * dt;
-            let moved = world.move_character(dt, &shape, self.feet + Self::centre_offset(), desired);
+            let moved =
+                world.move_character(dt, &shape, self.feet + Self::centre_offset(), desired);
             self.feet += moved.translation;
             // Blocked by a wall or a ceiling: lose the velocity into it.
             let mut velocity = Vector::new(horizontal.x, vertical, horizontal.z);
-            if (moved.translation.x - desired.x).abs() > 1e-4 || (moved.translation.z - desired.z).abs() > 1e-4 {
+            if (moved.translation.x - desired.x).abs() > 1e-4
+                || (moved.translation.z - desired.z).abs() > 1e-4
+            {
                 velocity.x = moved.translation.x / dt;
                 velocity.z = moved.translation.z / dt;
             }

@@ -126,7 +126,11 @@ impl PlatformEnv {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let start = self.world.platforms()[0];
         let reach = (0.5 * start.size - RADIUS - 0.5).clamp(0.0, 1.0);
-        let local = Vector::new(rng.random_range(-reach..=reach), 0.0, rng.random_range(-reach..=reach));
+        let local = Vector::new(
+            rng.random_range(-reach..=reach),
+            0.0,
+            rng.random_range(-reach..=reach),
+        );
         let offset = rapier3d::math::Rotation::from_rotation_y(start.heading) * local;
         let yaw = start.heading + rng.random_range(-90.0f32..=90.0).to_radians();
         self.character = Character::new(start.top + offset, yaw);
@@ -210,12 +214,19 @@ impl PlatformEnv {
             return 0.0;
         }
         let next = self.next_index();
-        self.character.feet.distance(self.world.platforms()[next].top) + self.path_after[next]
+        self.character
+            .feet
+            .distance(self.world.platforms()[next].top)
+            + self.path_after[next]
     }
 
     /// Writes the observation (see [`OBSERVATION_LAYOUT`]) into `out`.
     pub fn observe(&self, out: &mut [f32]) {
-        assert_eq!(out.len(), OBSERVATION_SIZE, "observation buffer of the wrong size");
+        assert_eq!(
+            out.len(),
+            OBSERVATION_SIZE,
+            "observation buffer of the wrong size"
+        );
         let c = &self.character;
         let forward = c.facing();
         let left = Vector::new(forward.z, 0.0, -forward.x);

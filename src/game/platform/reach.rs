@@ -25,7 +25,11 @@ const GAP_RANGE: (f64, f64) = (1.0, 6.0);
 /// The largest makeable gap at a height change, interpolated from the table.
 pub fn max_gap(height: f64) -> f64 {
     let h = height.clamp(REACH_HEIGHTS[0], REACH_HEIGHTS[4]);
-    let i = REACH_HEIGHTS.iter().rposition(|&x| x <= h).unwrap_or(0).min(3);
+    let i = REACH_HEIGHTS
+        .iter()
+        .rposition(|&x| x <= h)
+        .unwrap_or(0)
+        .min(3);
     let t = (h - REACH_HEIGHTS[i]) / (REACH_HEIGHTS[i + 1] - REACH_HEIGHTS[i]);
     REACH_TABLE[i] + t * (REACH_TABLE[i + 1] - REACH_TABLE[i])
 }
@@ -33,8 +37,12 @@ pub fn max_gap(height: f64) -> f64 {
 /// A level of one jump: a 4 m start block, then a 4 m block `gap` metres away and `height`
 /// metres up.
 pub fn single_jump(gap: f64, height: f64) -> PlatformTrack {
-    let start = Start { size: 4.0, ..Start::default() };
-    let block = BlockParams::new(gap + 4.0, 0.0, 4.0, height).expect("gap within [1, 6] m and height within [-2, 2] m");
+    let start = Start {
+        size: 4.0,
+        ..Start::default()
+    };
+    let block = BlockParams::new(gap + 4.0, 0.0, 4.0, height)
+        .expect("gap within [1, 6] m and height within [-2, 2] m");
     PlatformTrack::from_params(start, &[block]).expect("one block never overlaps")
 }
 

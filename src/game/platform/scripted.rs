@@ -7,7 +7,9 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rapier3d::math::Vector;
 
-use super::character::{DECISION_DT, GRAVITY, JUMP_SPEED, PlatformAction, RADIUS, RUN_SPEED, TURN_RATE_DEG};
+use super::character::{
+    DECISION_DT, GRAVITY, JUMP_SPEED, PlatformAction, RADIUS, RUN_SPEED, TURN_RATE_DEG,
+};
 use super::env::PlatformEnv;
 use super::world::PlatformBox;
 
@@ -51,11 +53,19 @@ impl ScriptedController {
         let error = wrap_radians(wanted_yaw - c.yaw);
         let turn = (error / (TURN_RATE_DEG.to_radians() * DECISION_DT)).clamp(-1.0, 1.0);
         if !c.grounded {
-            return PlatformAction { forward: self.forward, turn, jump: false };
+            return PlatformAction {
+                forward: self.forward,
+                turn,
+                jump: false,
+            };
         }
         if error.abs() > ALIGNED_DEG.to_radians() {
             self.forward = 0.1;
-            return PlatformAction { forward: self.forward, turn, jump: false };
+            return PlatformAction {
+                forward: self.forward,
+                turn,
+                jump: false,
+            };
         }
         let direction = to_next.normalize_or_zero();
         let (enter, leave) = crossing(&next, c.feet, direction);
@@ -70,7 +80,11 @@ impl ScriptedController {
         if jump {
             self.takeoff_margin = self.rng.random_range(0.0..=self.takeoff_jitter);
         }
-        PlatformAction { forward: self.forward, turn, jump }
+        PlatformAction {
+            forward: self.forward,
+            turn,
+            jump,
+        }
     }
 }
 
@@ -111,5 +125,9 @@ fn crossing(block: &PlatformBox, point: Vector, direction: Vector) -> (f32, f32)
 fn wrap_radians(angle: f32) -> f32 {
     let tau = std::f32::consts::TAU;
     let wrapped = angle.rem_euclid(tau);
-    if wrapped > std::f32::consts::PI { wrapped - tau } else { wrapped }
+    if wrapped > std::f32::consts::PI {
+        wrapped - tau
+    } else {
+        wrapped
+    }
 }

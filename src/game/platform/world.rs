@@ -1,7 +1,9 @@
 //! The static rapier3d world of a platform level: one fixed cuboid collider per block, and the
 //! scene queries (shape casts of the character, downward rays of the height map) against it.
 
-use rapier3d::control::{CharacterLength, EffectiveCharacterMovement, KinematicCharacterController};
+use rapier3d::control::{
+    CharacterLength, EffectiveCharacterMovement, KinematicCharacterController,
+};
 use rapier3d::math::{Pose, Rotation, Vector};
 use rapier3d::prelude::*;
 
@@ -32,7 +34,11 @@ pub struct PlatformBox {
 impl PlatformBox {
     fn from_platform(p: &Platform) -> Self {
         Self {
-            top: Vector::new(p.position[0] as f32, p.position[1] as f32, p.position[2] as f32),
+            top: Vector::new(
+                p.position[0] as f32,
+                p.position[1] as f32,
+                p.position[2] as f32,
+            ),
             heading: p.heading.to_radians() as f32,
             size: p.size as f32,
         }
@@ -55,7 +61,11 @@ impl PlatformBox {
 impl PlatformWorld {
     /// Builds the world of a track.
     pub fn new(track: &PlatformTrack) -> Self {
-        let platforms: Vec<PlatformBox> = track.platforms().iter().map(PlatformBox::from_platform).collect();
+        let platforms: Vec<PlatformBox> = track
+            .platforms()
+            .iter()
+            .map(PlatformBox::from_platform)
+            .collect();
         let mut colliders = ColliderSet::new();
         let bodies = RigidBodySet::new();
         let mut broad_phase = BroadPhaseBvh::new();
@@ -63,15 +73,22 @@ impl PlatformWorld {
         let half_thickness = 0.5 * BLOCK_THICKNESS as f32;
         for (index, block) in platforms.iter().enumerate() {
             let centre = block.top - Vector::Y * half_thickness;
-            let collider = ColliderBuilder::cuboid(0.5 * block.size, half_thickness, 0.5 * block.size)
-                .position(Pose::from_parts(centre, Rotation::from_rotation_y(block.heading)))
-                .user_data(index as u128)
-                .build();
+            let collider =
+                ColliderBuilder::cuboid(0.5 * block.size, half_thickness, 0.5 * block.size)
+                    .position(Pose::from_parts(
+                        centre,
+                        Rotation::from_rotation_y(block.heading),
+                    ))
+                    .user_data(index as u128)
+                    .build();
             let aabb = collider.compute_aabb();
             let handle = colliders.insert(collider);
             broad_phase.set_aabb(&params, handle, aabb);
         }
-        let lowest_top = platforms.iter().map(|p| p.top.y).fold(f32::INFINITY, f32::min);
+        let lowest_top = platforms
+            .iter()
+            .map(|p| p.top.y)
+            .fold(f32::INFINITY, f32::min);
         let controller = KinematicCharacterController {
             offset: CharacterLength::Absolute(0.02),
             snap_to_ground: Some(CharacterLength::Absolute(0.1)),
@@ -129,7 +146,12 @@ impl PlatformWorld {
 
     /// Casts rays straight down from each origin, writing the distance to the first block hit
     /// (or `max_distance` when nothing is hit).
-    pub fn cast_down(&self, origins: impl Iterator<Item = Vector>, max_distance: f32, out: &mut [f32]) {
+    pub fn cast_down(
+        &self,
+        origins: impl Iterator<Item = Vector>,
+        max_distance: f32,
+        out: &mut [f32],
+    ) {
         let queries = self.queries();
         for (origin, slot) in origins.zip(out.iter_mut()) {
             let ray = Ray::new(origin, -Vector::Y);

@@ -14,4 +14,5 @@ pub mod commands;
 pub mod fsio;
 pub mod game;
 pub mod level;
+pub mod rl;
 pub mod verify;

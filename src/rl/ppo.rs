@@ -1,0 +1,333 @@
+//! Proximal Policy Optimization, shaped like CleanRL's `ppo.py`: one documented config, `gae`,
+//! the clipped surrogate loss, and `update` over shuffled minibatches with Adam, advantage
+//! normalization, an entropy bonus and gradient-norm clipping.
+
+use candle_core::{Device, Tensor};
+use rand::seq::SliceRandom;
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use super::adam::Adam;
+use super::policy::ActorCritic;
+
+/// Every PPO hyper-parameter, with CleanRL's meanings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PpoConfig {
+    /// Adam step size.
+    pub learning_rate: f64,
+    /// Decay the learning rate linearly to 0 over the run.
+    pub anneal_lr: bool,
+    /// Discount factor γ.
+    pub gamma: f32,
+    /// λ of generalized advantage estimation.
+    pub gae_lambda: f32,
+    /// Environments stepped together.
+    pub num_envs: usize,
+    /// Steps per environment per rollout (batch = num_envs × num_steps).
+    pub num_steps: usize,
+    /// Passes over each batch.
+    pub update_epochs: usize,
+    /// Minibatches per pass.
+    pub num_minibatches: usize,
+    /// Surrogate clipping ε.
+    pub clip_coef: f32,
+    /// Entropy bonus weight.
+    pub ent_coef: f32,
+    /// Value loss weight.
+    pub vf_coef: f32,
+    /// Gradients are scaled down to at most this global norm.
+    pub max_grad_norm: f32,
+    /// Normalize advantages within each minibatch.
+    pub norm_adv: bool,
+    /// Stop an update's remaining epochs once the approximate KL exceeds this (none: never).
+    pub target_kl: Option<f32>,
+}
+
+impl Default for PpoConfig {
+    fn default() -> Self {
+        Self {
+            learning_rate: 3e-4,
+            anneal_lr: true,
+            gamma: 0.99,
+            gae_lambda: 0.95,
+            num_envs: 32,
+            num_steps: 128,
+            update_epochs: 4,
+            num_minibatches: 4,
+            clip_coef: 0.2,
+            ent_coef: 0.0,
+            vf_coef: 0.5,
+            max_grad_norm: 0.5,
+            norm_adv: true,
+            target_kl: None,
+        }
+    }
+}
+
+impl PpoConfig {
+    pub fn batch_size(&self) -> usize {
+        self.num_envs * self.num_steps
+    }
+
+    pub fn minibatch_size(&self) -> usize {
+        self.batch_size() / self.num_minibatches.max(1)
+    }
+}
+
+/// Generalized advantage estimation over a time-major rollout (index `t * num_envs + e`).
+/// `ended[i]`: the episode ended with transition `i`, so nothing is bootstrapped past it.
+/// `last_values`: value estimates of the observations after the last step. Returns
+/// (advantages, returns).
+pub fn gae(
+    rewards: &[f32],
+    values: &[f32],
+    ended: &[bool],
+    last_values: &[f32],
+    gamma: f32,
+    lambda: f32,
+) -> (Vec<f32>, Vec<f32>) {
+    let num_envs = last_values.len();
+    let steps = rewards.len() / num_envs;
+    let mut advantages = vec![0.0; rewards.len()];
+    for (e, &last_value) in last_values.iter().enumerate() {
+        let mut next_advantage = 0.0;
+        for t in (0..steps).rev() {
+            let i = t * num_envs + e;
+            let next_value = if t + 1 < steps {
+                values[i + num_envs]
+            } else {
+                last_value
+            };
+            let carry = if ended[i] { 0.0 } else { 1.0 };
+            let delta = rewards[i] + gamma * next_value * carry - values[i];
+            next_advantage = delta + gamma * lambda * carry * next_advantage;
+            advantages[i] = next_advantage;
+        }
+    }
+    let returns = advantages.iter().zip(values).map(|(a, v)| a + v).collect();
+    (advantages, returns)
+}
+
+/// PPO's clipped surrogate objective (to minimize): the mean over the batch of
+/// `max(-A·r, -A·clip(r, 1-ε, 1+ε))` with `r = exp(new_log_prob - old_log_prob)`.
+pub fn clipped_policy_loss(
+    new_log_prob: &Tensor,
+    old_log_prob: &Tensor,
+    advantages: &Tensor,
+    clip: f32,
+) -> candle_core::Result<Tensor> {
+    let ratio = (new_log_prob - old_log_prob)?.exp()?;
+    let unclipped = (advantages.neg()? * &ratio)?;
+    let clipped = (advantages.neg()? * ratio.clamp(1.0 - clip, 1.0 + clip)?)?;
+    unclipped.maximum(&clipped)?.mean_all()
+}
+
+/// One rollout, flattened, ready to learn from.
+pub struct Batch {
+    /// Normalized observations, rows of `observation` values.
+    pub observations: Vec<f32>,
+    pub actions: Vec<f32>,
+    pub log_probs: Vec<f32>,
+    pub advantages: Vec<f32>,
+    pub returns: Vec<f32>,
+    pub values: Vec<f32>,
+}
+
+/// What an update did, CleanRL's diagnostics.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct UpdateStats {
+    pub policy_loss: f32,
+    pub value_loss: f32,
+    pub entropy: f32,
+    pub approx_kl: f32,
+    pub clip_fraction: f32,
+    pub explained_variance: f32,
+    /// Minibatch gradient steps taken.
+    pub gradient_steps: u32,
+}
+
+/// A policy and its optimizer.
+pub struct Ppo {
+    pub config: PpoConfig,
+    pub policy: ActorCritic,
+    pub adam: Adam,
+}
+
+impl Ppo {
+    pub fn new(config: PpoConfig, policy: ActorCritic) -> candle_core::Result<Self> {
+        let adam = Adam::new(&policy.named_vars())?;
+        Ok(Self {
+            config,
+            policy,
+            adam,
+        })
+    }
+
+    /// Learns from one batch at `learning_rate`: `update_epochs` passes of shuffled minibatches.
+    pub fn update(
+        &mut self,
+        batch: &Batch,
+        learning_rate: f64,
+        rng: &mut ChaCha8Rng,
+    ) -> candle_core::Result<UpdateStats> {
+        let shape = self.policy.shape().clone();
+        let n = batch.log_probs.len();
+        let minibatch = self.config.minibatch_size().clamp(1, n);
+        let vars = self.policy.named_vars();
+        let mut order: Vec<usize> = (0..n).collect();
+        let mut stats = UpdateStats::default();
+        let mut sums = [0.0f32; 5];
+        let mut count = 0.0f32;
+        'epochs: for _ in 0..self.config.update_epochs {
+            order.shuffle(rng);
+            for ids in order.chunks(minibatch) {
+                let rows = |data: &[f32], width: usize| -> candle_core::Result<Tensor> {
+                    let mut out = Vec::with_capacity(ids.len() * width);
+                    for &i in ids {
+                        out.extend_from_slice(&data[i * width..(i + 1) * width]);
+                    }
+                    Tensor::from_vec(out, (ids.len(), width), &Device::Cpu)
+                };
+                let column =
+                    |data: &[f32]| -> candle_core::Result<Tensor> { rows(data, 1)?.flatten_all() };
+                let obs = rows(&batch.observations, shape.observation)?;
+                let actions = rows(&batch.actions, shape.action_size())?;
+                let old_log_prob = column(&batch.log_probs)?;
+                let mut advantages = column(&batch.advantages)?;
+                if self.config.norm_adv && ids.len() > 1 {
+                    let mean = advantages.mean_all()?;
+                    let centred = advantages.broadcast_sub(&mean)?;
+                    let std = centred.sqr()?.mean_all()?.sqrt()?;
+                    advantages = centred.broadcast_div(&(std + 1e-8)?)?;
+                }
+                let returns = column(&batch.returns)?;
+
+                let (new_log_prob, entropy, values) = self.policy.evaluate(&obs, &actions)?;
+                let log_ratio = (&new_log_prob - &old_log_prob)?.detach();
+                let ratio = log_ratio.exp()?;
+                let approx_kl = ((&ratio - 1.0)? - &log_ratio)?
+                    .mean_all()?
+                    .to_scalar::<f32>()?;
+                let clip_fraction = (&ratio - 1.0)?
+                    .abs()?
+                    .gt(self.config.clip_coef as f64)?
+                    .to_dtype(candle_core::DType::F32)?
+                    .mean_all()?
+                    .to_scalar::<f32>()?;
+                let policy_loss = clipped_policy_loss(
+                    &new_log_prob,
+                    &old_log_prob,
+                    &advantages,
+                    self.config.clip_coef,
+                )?;
+                let value_loss = ((values - &returns)?.sqr()?.mean_all()? * 0.5)?;
+                let entropy = entropy.mean_all()?;
+                let loss = ((&policy_loss - (&entropy * self.config.ent_coef as f64)?)?
+                    + (&value_loss * self.config.vf_coef as f64)?)?;
+                let grads = loss.backward()?;
+                let mut squared = 0.0f64;
+                for (_, var) in &vars {
+                    if let Some(g) = grads.get(var.as_tensor()) {
+                        squared += g.sqr()?.sum_all()?.to_scalar::<f32>()? as f64;
+                    }
+                }
+                let norm = squared.sqrt();
+                let scale = if norm > self.config.max_grad_norm as f64 {
+                    self.config.max_grad_norm as f64 / (norm + 1e-6)
+                } else {
+                    1.0
+                };
+                self.adam.apply(&vars, &grads, learning_rate, scale)?;
+
+                for (sum, value) in sums.iter_mut().zip([
+                    policy_loss.to_scalar::<f32>()?,
+                    value_loss.to_scalar::<f32>()?,
+                    entropy.to_scalar::<f32>()?,
+                    approx_kl,
+                    clip_fraction,
+                ]) {
+                    *sum += value;
+                }
+                count += 1.0;
+                stats.gradient_steps += 1;
+                if self.config.target_kl.is_some_and(|limit| approx_kl > limit) {
+                    break 'epochs;
+                }
+            }
+        }
+        let [policy_loss, value_loss, entropy, approx_kl, clip_fraction] =
+            sums.map(|s| s / count.max(1.0));
+        stats.policy_loss = policy_loss;
+        stats.value_loss = value_loss;
+        stats.entropy = entropy;
+        stats.approx_kl = approx_kl;
+        stats.clip_fraction = clip_fraction;
+        stats.explained_variance = explained_variance(&batch.values, &batch.returns);
+        Ok(stats)
+    }
+}
+
+/// 1 - Var(returns - values) / Var(returns): how much of the return the critic explains.
+pub fn explained_variance(values: &[f32], returns: &[f32]) -> f32 {
+    let variance = |xs: &mut dyn Iterator<Item = f32>| {
+        let v: Vec<f32> = xs.collect();
+        let mean = v.iter().sum::<f32>() / v.len().max(1) as f32;
+        v.iter().map(|x| (x - mean).powi(2)).sum::<f32>() / v.len().max(1) as f32
+    };
+    let var_returns = variance(&mut returns.iter().copied());
+    if var_returns == 0.0 {
+        return f32::NAN;
+    }
+    1.0 - variance(&mut returns.iter().zip(values).map(|(r, v)| r - v)) / var_returns
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gae_matches_hand_computed_values() {
+        // One env, three steps, γ = 0.5, λ = 0.5, the episode ends after step 1.
+        let rewards = [1.0, 2.0, 3.0];
+        let values = [0.5, 1.0, 2.0];
+        let ended = [false, true, false];
+        let (adv, ret) = gae(&rewards, &values, &ended, &[4.0], 0.5, 0.5);
+        // t=2: δ = 3 + 0.5·4 - 2 = 3;                      A = 3
+        // t=1: δ = 2 + 0 - 1 = 1 (ended: no bootstrap);    A = 1
+        // t=0: δ = 1 + 0.5·1 - 0.5 = 1;                    A = 1 + 0.25·1 = 1.25
+        assert_eq!(adv, vec![1.25, 1.0, 3.0]);
+        assert_eq!(ret, vec![1.75, 2.0, 5.0]);
+    }
+
+    #[test]
+    fn gae_keeps_environments_apart() {
+        // Two envs interleaved time-major; env 1 has zero reward throughout.
+        let rewards = [1.0, 0.0, 1.0, 0.0];
+        let values = [0.0; 4];
+        let (adv, _) = gae(&rewards, &values, &[false; 4], &[0.0, 0.0], 1.0, 1.0);
+        assert_eq!(adv, vec![2.0, 0.0, 1.0, 0.0]);
+    }
+
+    #[test]
+    fn clipped_loss_matches_hand_computed_values() {
+        let t = |v: &[f32]| Tensor::from_slice(v, v.len(), &Device::Cpu).unwrap();
+        // ratios e^0.5 = 1.6487 (clipped to 1.2) and e^-0.5 = 0.6065 (clipped to 0.8)
+        let new = t(&[0.5, -0.5, 0.5]);
+        let old = t(&[0.0, 0.0, 0.0]);
+        let adv = t(&[1.0, 1.0, -1.0]);
+        let loss = clipped_policy_loss(&new, &old, &adv, 0.2)
+            .unwrap()
+            .to_scalar::<f32>()
+            .unwrap();
+        // rows: max(-1.6487, -1.2) = -1.2; max(-0.6065, -0.8) = -0.6065; max(1.6487, 1.2) = 1.6487
+        let expected = (-1.2 - 0.606_530_6 + 1.648_721_3) / 3.0;
+        assert!((loss - expected).abs() < 1e-5, "{loss} vs {expected}");
+    }
+
+    #[test]
+    fn explained_variance_is_one_for_a_perfect_critic() {
+        assert_eq!(explained_variance(&[1.0, 2.0, 3.0], &[1.0, 2.0, 3.0]), 1.0);
+        assert_eq!(explained_variance(&[2.0, 2.0, 2.0], &[1.0, 2.0, 3.0]), 0.0);
+    }
+}

@@ -1,0 +1,155 @@
+//! Many environments stepped together, and the rollout loop that drives them: one batched forward
+//! pass of the policy per tick for all environments, then PPO on the collected batch.
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+use super::normalizer::RunningNorm;
+use super::policy::ActMode;
+use super::ppo::{Batch, Ppo, UpdateStats, gae};
+
+/// What one environment's step led to. Finished episodes are reset by the environment.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Transition {
+    pub reward: f32,
+    /// The episode ended with this step (success, failure or time limit): no bootstrapping.
+    pub ended: bool,
+    /// For an ended episode of a task with a goal: whether it was reached.
+    pub success: Option<bool>,
+}
+
+/// A set of environments with automatic reset.
+pub trait VecEnv {
+    fn num_envs(&self) -> usize;
+    fn observation_size(&self) -> usize;
+    /// Writes every environment's current observation, rows of `observation_size`.
+    fn observe(&mut self, out: &mut [f32]);
+    /// Steps environment `i` with action row `i` and records its transition in `out[i]`.
+    fn step(&mut self, actions: &[f32], out: &mut [Transition]);
+}
+
+/// Episode statistics of one rollout.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RolloutStats {
+    pub steps: u64,
+    pub episodes: u32,
+    /// Mean undiscounted return of the episodes that ended (NaN when none did).
+    pub mean_return: f32,
+    /// Fraction of ended episodes that reached their goal (NaN when none reported).
+    pub success_ratio: f32,
+}
+
+/// A PPO learner bound to its environments.
+pub struct Trainer<E: VecEnv> {
+    pub ppo: Ppo,
+    pub env: E,
+    pub norm: RunningNorm,
+    pub rng: ChaCha8Rng,
+    pub global_step: u64,
+    observations: Vec<f32>,
+    episode_returns: Vec<f32>,
+}
+
+impl<E: VecEnv> Trainer<E> {
+    pub fn new(ppo: Ppo, mut env: E, seed: u64) -> Self {
+        let (n, d) = (env.num_envs(), env.observation_size());
+        let mut observations = vec![0.0; n * d];
+        env.observe(&mut observations);
+        Self {
+            ppo,
+            env,
+            norm: RunningNorm::new(d),
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            global_step: 0,
+            observations,
+            episode_returns: vec![0.0; n],
+        }
+    }
+
+    /// Plays `num_steps` ticks of every environment with the current policy.
+    pub fn collect(&mut self) -> candle_core::Result<(Batch, RolloutStats)> {
+        let (n, d) = (self.env.num_envs(), self.env.observation_size());
+        let steps = self.ppo.config.num_steps;
+        let action_size = self.ppo.policy.shape().action_size();
+        let mut batch = Batch {
+            observations: Vec::with_capacity(steps * n * d),
+            actions: Vec::with_capacity(steps * n * action_size),
+            log_probs: Vec::with_capacity(steps * n),
+            advantages: Vec::new(),
+            returns: Vec::new(),
+            values: Vec::with_capacity(steps * n),
+        };
+        let mut rewards = Vec::with_capacity(steps * n);
+        let mut ended = Vec::with_capacity(steps * n);
+        let mut transitions = vec![Transition::default(); n];
+        let (mut episodes, mut return_sum, mut successes, mut judged) = (0u32, 0.0f64, 0u32, 0u32);
+        for _ in 0..steps {
+            self.norm.update(&self.observations);
+            let mut normalized = self.observations.clone();
+            self.norm.normalize(&mut normalized);
+            let acted = self
+                .ppo
+                .policy
+                .act(&normalized, ActMode::Sample, &mut self.rng)?;
+            self.env.step(&acted.actions, &mut transitions);
+            for (e, t) in transitions.iter().enumerate() {
+                self.episode_returns[e] += t.reward;
+                rewards.push(t.reward);
+                ended.push(t.ended);
+                if t.ended {
+                    episodes += 1;
+                    return_sum += self.episode_returns[e] as f64;
+                    self.episode_returns[e] = 0.0;
+                    if let Some(success) = t.success {
+                        judged += 1;
+                        successes += success as u32;
+                    }
+                }
+            }
+            batch.observations.extend_from_slice(&normalized);
+            batch.actions.extend_from_slice(&acted.actions);
+            batch.log_probs.extend_from_slice(&acted.log_probs);
+            batch.values.extend_from_slice(&acted.values);
+            self.env.observe(&mut self.observations);
+        }
+        let mut normalized = self.observations.clone();
+        self.norm.normalize(&mut normalized);
+        let last_values = self
+            .ppo
+            .policy
+            .act(&normalized, ActMode::Deterministic, &mut self.rng)?
+            .values;
+        let (advantages, returns) = gae(
+            &rewards,
+            &batch.values,
+            &ended,
+            &last_values,
+            self.ppo.config.gamma,
+            self.ppo.config.gae_lambda,
+        );
+        batch.advantages = advantages;
+        batch.returns = returns;
+        let collected = (steps * n) as u64;
+        self.global_step += collected;
+        let stats = RolloutStats {
+            steps: collected,
+            episodes,
+            mean_return: if episodes > 0 {
+                (return_sum / episodes as f64) as f32
+            } else {
+                f32::NAN
+            },
+            success_ratio: if judged > 0 {
+                successes as f32 / judged as f32
+            } else {
+                f32::NAN
+            },
+        };
+        Ok((batch, stats))
+    }
+
+    /// One PPO update on `batch`.
+    pub fn learn(&mut self, batch: &Batch, learning_rate: f64) -> candle_core::Result<UpdateStats> {
+        self.ppo.update(batch, learning_rate, &mut self.rng)
+    }
+}

@@ -82,19 +82,20 @@ impl Mlp {
 
     fn forward(&self, x: &Tensor, track: bool) -> candle_core::Result<Tensor> {
         let mut h = x.clone();
+        // The bias enters as `1 · b` ([n, 1] × [1, out]) when learning: its gradient is then a
+        // matmul, much faster in candle than the batch reduction of `broadcast_add`'s backward.
+        let ones = match track {
+            true => Some(Tensor::ones((x.dim(0)?, 1), DType::F32, &Device::Cpu)?),
+            false => None,
+        };
         for (k, layer) in self.layers.iter().enumerate() {
-            let (w, b) = if track {
-                (
-                    layer.weight.as_tensor().clone(),
-                    layer.bias.as_tensor().clone(),
-                )
-            } else {
-                (
-                    layer.weight.as_tensor().detach(),
-                    layer.bias.as_tensor().detach(),
-                )
+            h = match &ones {
+                Some(ones) => (h.matmul(layer.weight.as_tensor())?
+                    + ones.matmul(layer.bias.as_tensor())?)?,
+                None => h
+                    .matmul(&layer.weight.as_tensor().detach())?
+                    .broadcast_add(&layer.bias.as_tensor().detach())?,
             };
-            h = h.matmul(&w)?.broadcast_add(&b)?;
             if k + 1 < self.layers.len() {
                 h = h.relu()?;
             }

@@ -29,14 +29,32 @@ fn matmul_gflops(n: usize) -> f64 {
 }
 
 fn main() {
-    let shape = PolicyShape { observation: 40, hidden: vec![512, 512], continuous: 2, binary: 1 };
-    let config = PpoConfig { num_envs: 64, num_steps: 128, update_epochs: 1, num_minibatches: 4, ..PpoConfig::default() };
+    let shape = PolicyShape {
+        observation: 40,
+        hidden: vec![512, 512],
+        continuous: 2,
+        binary: 1,
+    };
+    let config = PpoConfig {
+        num_envs: 64,
+        num_steps: 128,
+        update_epochs: 1,
+        num_minibatches: 4,
+        ..PpoConfig::default()
+    };
     let n = config.batch_size();
     let mut rng = ChaCha8Rng::seed_from_u64(0);
-    let mut random = |len: usize| (0..len).map(|_| rng.random_range(-1.0f32..1.0)).collect::<Vec<f32>>();
+    let mut random = |len: usize| {
+        (0..len)
+            .map(|_| rng.random_range(-1.0f32..1.0))
+            .collect::<Vec<f32>>()
+    };
     let batch = Batch {
         observations: random(n * shape.observation),
-        actions: random(n * 3).chunks(3).flat_map(|a| [a[0], a[1], if a[2] > 0.0 { 1.0 } else { 0.0 }]).collect(),
+        actions: random(n * 3)
+            .chunks(3)
+            .flat_map(|a| [a[0], a[1], if a[2] > 0.0 { 1.0 } else { 0.0 }])
+            .collect(),
         log_probs: random(n).iter().map(|x| x - 3.0).collect(),
         advantages: random(n),
         returns: random(n),
@@ -61,8 +79,19 @@ fn main() {
     let flops_per_sample = 6.0 * (layers(shape.action_size()) + layers(1)) as f64;
     let achieved = rate * flops_per_sample / 1e9;
     let peak = matmul_gflops(2048);
-    println!("PPO update, 2 x 512 actor-critic, minibatch {}: {rate:.0} samples/s per epoch", config.minibatch_size());
-    println!("  {:.1} GFLOP/s in the update vs {peak:.1} GFLOP/s for a 2048^3 matmul: {:.0}% of the machine's matmul peak", achieved, 100.0 * achieved / peak);
-    let verdict = if rate >= 20_000.0 { "reached" } else { "MISSED" };
+    println!(
+        "PPO update, 2 x 512 actor-critic, minibatch {}: {rate:.0} samples/s per epoch",
+        config.minibatch_size()
+    );
+    println!(
+        "  {:.1} GFLOP/s in the update vs {peak:.1} GFLOP/s for a 2048^3 matmul: {:.0}% of the machine's matmul peak",
+        achieved,
+        100.0 * achieved / peak
+    );
+    let verdict = if rate >= 20_000.0 {
+        "reached"
+    } else {
+        "MISSED"
+    };
     println!("  target 20000 samples/s per epoch: {verdict}");
 }

@@ -7,6 +7,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::level::Game;
 use crate::level::params;
+use crate::train::platform::SolverMode;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -36,6 +37,8 @@ pub enum Command {
     Export(ExportArgs),
     /// Play levels many times and report how often the Solver gets through.
     Verify(VerifyArgs),
+    /// Train a Solver with PPO (checkpointed, resumable, stoppable with Ctrl-C).
+    Train(TrainArgs),
 }
 
 /// Output file formats of `generate`.
@@ -118,6 +121,48 @@ pub struct VerifyArgs {
     /// Print one JSON object per level instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(Debug, Args)]
+#[command(after_help = "Examples:\n  \
+    arlpcg train --game platform --mode rule-pcg --minutes 60 --out runs/solver\n  \
+    arlpcg train --game platform --mode rule-pcg --minutes 60 --out runs/solver --resume\n  \
+    arlpcg train --print-config > solver.yaml")]
+pub struct TrainArgs {
+    /// Which game.
+    #[arg(long, default_value = "platform", value_parser = parse_game)]
+    pub game: Game,
+    /// Where the Solver's training levels come from.
+    #[arg(long, value_enum, default_value = "rule-pcg")]
+    pub mode: SolverMode,
+    /// Stop when the run has taken this many environment steps in all (over every resume).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub steps: Option<u64>,
+    /// Stop after this many minutes of this session.
+    #[arg(long, value_parser = parse_minutes)]
+    pub minutes: Option<f64>,
+    /// Training configuration (YAML; see --print-config for every field and its default).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Folder of the run: config, checkpoint, metrics.csv, the trained policy and its card.
+    #[arg(long, required_unless_present = "print_config")]
+    pub out: Option<PathBuf>,
+    /// Continue the run in --out from its checkpoint.
+    #[arg(long)]
+    pub resume: bool,
+    /// Print the default configuration as YAML and exit.
+    #[arg(long)]
+    pub print_config: bool,
+    /// Worker threads for environments and networks (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
+}
+
+fn parse_minutes(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(m) if m.is_finite() && m > 0.0 => Ok(m),
+        _ => Err(format!("`{s}` is not a positive number of minutes")),
+    }
 }
 
 fn parse_game(s: &str) -> Result<Game, String> {

@@ -15,4 +15,5 @@ pub mod fsio;
 pub mod game;
 pub mod level;
 pub mod rl;
+pub mod train;
 pub mod verify;

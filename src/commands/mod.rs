@@ -18,6 +18,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Generate(args)) => generate::run(&args),
         Some(Command::Export(args)) => export::run(&args),
         Some(Command::Verify(args)) => verify::run(&args),
+        Some(Command::Train(args)) => crate::train::run(&args),
         None => {
             use clap::CommandFactory;
             Cli::command().print_long_help()?;
@@ -27,7 +28,7 @@ pub fn run(cli: Cli) -> Result<()> {
 }
 
 /// A progress bar on stderr (hidden when stderr is not a terminal).
-fn progress_bar(total: u64, what: &str) -> indicatif::ProgressBar {
+pub(crate) fn progress_bar(total: u64, what: &str) -> indicatif::ProgressBar {
     let bar = indicatif::ProgressBar::new(total);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} [{elapsed} < {eta}]")

@@ -3,6 +3,7 @@
 //! environments ([`vec_env`]). Nothing here reads the clock or prints.
 
 pub mod adam;
+pub mod checkpoint;
 pub mod normalizer;
 pub mod policy;
 pub mod ppo;

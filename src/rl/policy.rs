@@ -90,8 +90,9 @@ impl Mlp {
         };
         for (k, layer) in self.layers.iter().enumerate() {
             h = match &ones {
-                Some(ones) => (h.matmul(layer.weight.as_tensor())?
-                    + ones.matmul(layer.bias.as_tensor())?)?,
+                Some(ones) => {
+                    (h.matmul(layer.weight.as_tensor())? + ones.matmul(layer.bias.as_tensor())?)?
+                }
                 None => h
                     .matmul(&layer.weight.as_tensor().detach())?
                     .broadcast_add(&layer.bias.as_tensor().detach())?,

@@ -1,0 +1,298 @@
+//! Policies and training checkpoints as bytes: safetensors for the tensors, with everything
+//! else (card, normalizer, counters, RNG) as JSON in the safetensors metadata, so that one file
+//! is one atomic unit. The shell writes the bytes atomically.
+
+use std::collections::HashMap;
+
+use candle_core::{Device, Tensor};
+use serde::{Deserialize, Serialize};
+
+use super::normalizer::RunningNorm;
+use super::policy::{ActorCritic, PolicyShape};
+use super::ppo::Ppo;
+use crate::level::Game;
+
+/// The `format` of every policy card.
+pub const POLICY_FORMAT: &str = "arlpcg-policy";
+pub const POLICY_VERSION: u32 = 1;
+const CARD_KEY: &str = "card";
+const TRAINING_KEY: &str = "training_state";
+
+/// Which side of the game a policy plays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Role {
+    Solver,
+    Generator,
+}
+
+impl std::fmt::Display for Role {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Role::Solver => "solver",
+            Role::Generator => "generator",
+        })
+    }
+}
+
+/// What a policy is and how it came to be: saved beside its weights (and inside them).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PolicyCard {
+    pub format: String,
+    pub version: u32,
+    pub game: Game,
+    pub role: Role,
+    /// Named parts of the observation vector and their sizes, in order.
+    pub observation: Vec<(String, usize)>,
+    pub continuous_actions: Vec<String>,
+    pub binary_actions: Vec<String>,
+    pub network: PolicyShape,
+    pub normalizer: RunningNorm,
+    pub training: TrainingRecord,
+    /// Measured results, filled in by evaluation.
+    #[serde(default)]
+    pub results: HashMap<String, f64>,
+}
+
+/// How a policy was trained.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrainingRecord {
+    pub mode: String,
+    pub steps: u64,
+    pub wall_time_s: f64,
+    pub seed: u64,
+    pub commit: String,
+    pub command: String,
+}
+
+/// Everything needed to continue a training run where it stopped.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct TrainingState {
+    pub global_step: u64,
+    pub iteration: u64,
+    pub adam_step: u64,
+    /// Wall-clock seconds trained so far, over all sessions.
+    pub wall_time_s: f64,
+    /// The run's configuration (game-specific), as it started.
+    pub config: serde_json::Value,
+    pub rng: rand_chacha::ChaCha8Rng,
+    /// Game-specific progress (e.g. the next level seed), opaque here.
+    pub source: serde_json::Value,
+}
+
+/// Why a policy or checkpoint could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum PolicyError {
+    #[error("not a safetensors file: {0}")]
+    NotSafetensors(String),
+    #[error("no policy card inside: not an arlpcg policy")]
+    NoCard,
+    #[error("policy card: {0}")]
+    Card(String),
+    #[error("this is a {found} policy, expected a {expected} one")]
+    WrongKind { found: String, expected: String },
+    #[error("tensor `{name}`: {problem}")]
+    Tensor { name: String, problem: String },
+    #[error("no training state inside: not a checkpoint")]
+    NoTrainingState,
+}
+
+/// Serializes a policy (weights + card) to safetensors bytes.
+pub fn policy_bytes(policy: &ActorCritic, card: &PolicyCard) -> Vec<u8> {
+    let tensors: Vec<(String, Tensor)> = policy
+        .named_vars()
+        .into_iter()
+        .map(|(n, v)| (n, v.as_tensor().clone()))
+        .collect();
+    let metadata = HashMap::from([(
+        CARD_KEY.to_string(),
+        serde_json::to_string(card).expect("cards serialize"),
+    )]);
+    safetensors::serialize(tensors, Some(metadata)).expect("policy tensors serialize")
+}
+
+/// Serializes a training checkpoint: policy, optimizer moments, card and training state.
+pub fn checkpoint_bytes(ppo: &Ppo, card: &PolicyCard, state: &TrainingState) -> Vec<u8> {
+    let vars = ppo.policy.named_vars();
+    let mut tensors: Vec<(String, Tensor)> = vars
+        .iter()
+        .map(|(n, v)| (n.clone(), v.as_tensor().clone()))
+        .collect();
+    tensors.extend(ppo.adam.named_state(&vars));
+    let metadata = HashMap::from([
+        (
+            CARD_KEY.to_string(),
+            serde_json::to_string(card).expect("cards serialize"),
+        ),
+        (
+            TRAINING_KEY.to_string(),
+            serde_json::to_string(state).expect("training state serializes"),
+        ),
+    ]);
+    safetensors::serialize(tensors, Some(metadata)).expect("checkpoint tensors serialize")
+}
+
+/// A policy read back, checked against the game and role it must play.
+pub struct LoadedPolicy {
+    pub policy: ActorCritic,
+    pub card: PolicyCard,
+    pub tensors: HashMap<String, Tensor>,
+    training: Option<String>,
+}
+
+impl LoadedPolicy {
+    /// The training state, for checkpoints.
+    pub fn training_state(&self) -> Result<TrainingState, PolicyError> {
+        let text = self.training.as_ref().ok_or(PolicyError::NoTrainingState)?;
+        serde_json::from_str(text).map_err(|e| PolicyError::Card(format!("training state: {e}")))
+    }
+}
+
+/// Reads a policy or checkpoint, requiring `game` and `role` and the observation size the game
+/// produces now.
+pub fn load_policy(
+    bytes: &[u8],
+    game: Game,
+    role: Role,
+    observation_size: usize,
+) -> Result<LoadedPolicy, PolicyError> {
+    let (_, metadata) = safetensors::SafeTensors::read_metadata(bytes)
+        .map_err(|e| PolicyError::NotSafetensors(e.to_string()))?;
+    let metadata = metadata.metadata().clone().unwrap_or_default();
+    let card_text = metadata.get(CARD_KEY).ok_or(PolicyError::NoCard)?;
+    let card: PolicyCard =
+        serde_json::from_str(card_text).map_err(|e| PolicyError::Card(e.to_string()))?;
+    if card.format != POLICY_FORMAT || card.version != POLICY_VERSION {
+        return Err(PolicyError::Card(format!(
+            "format {} version {} is not {POLICY_FORMAT} version {POLICY_VERSION}",
+            card.format, card.version
+        )));
+    }
+    if card.game != game || card.role != role {
+        return Err(PolicyError::WrongKind {
+            found: format!("{} {}", card.game, card.role),
+            expected: format!("{game} {role}"),
+        });
+    }
+    if card.network.observation != observation_size || card.normalizer.size() != observation_size {
+        return Err(PolicyError::Card(format!(
+            "it observes {} values but the {game} {role} observes {observation_size}",
+            card.network.observation
+        )));
+    }
+    let tensors = candle_core::safetensors::load_buffer(bytes, &Device::Cpu)
+        .map_err(|e| PolicyError::NotSafetensors(e.to_string()))?;
+    let policy =
+        ActorCritic::new(card.network.clone(), 0).map_err(|e| PolicyError::Card(e.to_string()))?;
+    for (name, var) in policy.named_vars() {
+        let saved = tensors.get(&name).ok_or_else(|| PolicyError::Tensor {
+            name: name.clone(),
+            problem: "missing".into(),
+        })?;
+        if saved.dims() != var.as_tensor().dims() {
+            return Err(PolicyError::Tensor {
+                name,
+                problem: format!(
+                    "shape {:?}, the card's network needs {:?}",
+                    saved.dims(),
+                    var.as_tensor().dims()
+                ),
+            });
+        }
+        let values = saved
+            .flatten_all()
+            .and_then(|t| t.to_vec1::<f32>())
+            .map_err(|e| PolicyError::Tensor {
+                name: name.clone(),
+                problem: e.to_string(),
+            })?;
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(PolicyError::Tensor {
+                name,
+                problem: "holds NaN or infinite values".into(),
+            });
+        }
+        var.set(saved).map_err(|e| PolicyError::Tensor {
+            name: name.clone(),
+            problem: e.to_string(),
+        })?;
+    }
+    Ok(LoadedPolicy {
+        policy,
+        card,
+        tensors,
+        training: metadata.get(TRAINING_KEY).cloned(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn card(shape: &PolicyShape) -> PolicyCard {
+        PolicyCard {
+            format: POLICY_FORMAT.into(),
+            version: POLICY_VERSION,
+            game: Game::Platform,
+            role: Role::Solver,
+            observation: vec![("x".into(), shape.observation)],
+            continuous_actions: vec!["forward".into(), "turn".into()],
+            binary_actions: vec!["jump".into()],
+            network: shape.clone(),
+            normalizer: RunningNorm::new(shape.observation),
+            training: TrainingRecord {
+                mode: "test".into(),
+                steps: 0,
+                wall_time_s: 0.0,
+                seed: 0,
+                commit: "none".into(),
+                command: String::new(),
+            },
+            results: HashMap::new(),
+        }
+    }
+
+    #[test]
+    fn a_policy_round_trips_and_wrong_kinds_are_refused() {
+        let shape = PolicyShape {
+            observation: 5,
+            hidden: vec![8],
+            continuous: 2,
+            binary: 1,
+        };
+        let policy = ActorCritic::new(shape.clone(), 4).unwrap();
+        let bytes = policy_bytes(&policy, &card(&shape));
+        let loaded = load_policy(&bytes, Game::Platform, Role::Solver, 5).unwrap();
+        let weights = |p: &ActorCritic| {
+            p.named_vars()[0]
+                .1
+                .as_tensor()
+                .flatten_all()
+                .unwrap()
+                .to_vec1::<f32>()
+                .unwrap()
+        };
+        assert_eq!(weights(&loaded.policy), weights(&policy));
+        let err = load_policy(&bytes, Game::Platform, Role::Generator, 5)
+            .err()
+            .unwrap();
+        assert_eq!(
+            err.to_string(),
+            "this is a platform solver policy, expected a platform generator one"
+        );
+        let err = load_policy(&bytes, Game::Platform, Role::Solver, 40)
+            .err()
+            .unwrap();
+        assert!(err.to_string().contains("observes 5 values"), "{err}");
+        assert!(matches!(
+            load_policy(b"garbage", Game::Platform, Role::Solver, 5),
+            Err(PolicyError::NotSafetensors(_))
+        ));
+        assert!(matches!(
+            loaded.training_state(),
+            Err(PolicyError::NoTrainingState)
+        ));
+    }
+}

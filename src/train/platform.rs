@@ -1,0 +1,192 @@
+//! The platform Solver's training environments: many [`PlatformEnv`]s stepped in parallel on the
+//! rayon pool, each starting a new level when its episode ends. Levels come from the rules
+//! (`rule-pcg`: a fresh level every episode) or from a small fixed set (`fixed-track`).
+//!
+//! Training levels use seeds from [`TRAINING_SEED_BASE`] up, so that evaluation on seeds below it
+//! always plays levels the Solver never trained on. New levels and reset seeds are handed out in
+//! environment order after each parallel step, so results do not depend on thread timing.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::game::platform::env::OBSERVATION_LAYOUT;
+use crate::game::platform::{OBSERVATION_SIZE, PlatformAction, PlatformEnv, SolverRewards};
+use crate::game::rules;
+use crate::level::stats::Outcome;
+use crate::level::{Level, RulesConfig};
+use crate::rl::vec_env::{Transition, VecEnv};
+
+/// Rule levels used for training have seeds at or above this; evaluation uses seeds below it.
+pub const TRAINING_SEED_BASE: u64 = 1 << 40;
+/// How many levels `fixed-track` trains on.
+pub const FIXED_TRACK_COUNT: u64 = 8;
+
+/// The Solver's action names, in the policy's order.
+pub const CONTINUOUS_ACTIONS: [&str; 2] = ["forward", "turn"];
+pub const BINARY_ACTIONS: [&str; 1] = ["jump"];
+
+/// Where the training levels come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum SolverMode {
+    /// A fresh rule-based level every episode (the paper's Rule-PCG baseline).
+    RulePcg,
+    /// A small fixed set of rule-based levels (the paper's Fixed-Track baseline).
+    FixedTrack,
+}
+
+impl SolverMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverMode::RulePcg => "rule-pcg",
+            SolverMode::FixedTrack => "fixed-track",
+        }
+    }
+}
+
+/// Progress of the level source, saved in checkpoints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SourceState {
+    /// Levels handed out so far.
+    pub levels_drawn: u64,
+    /// Episodes started so far (each gets its own reset seed).
+    pub episodes_started: u64,
+}
+
+/// The observation layout as the policy card records it.
+pub fn observation_layout() -> Vec<(String, usize)> {
+    OBSERVATION_LAYOUT
+        .iter()
+        .map(|(n, s)| (n.to_string(), *s))
+        .collect()
+}
+
+/// Many platform environments with automatic reset onto new levels.
+pub struct PlatformSolverEnvs {
+    mode: SolverMode,
+    envs: Vec<PlatformEnv>,
+    fixed: Vec<Level>,
+    state: SourceState,
+    rewards: SolverRewards,
+}
+
+impl PlatformSolverEnvs {
+    /// `num_envs` environments, continuing from `state` (a fresh run starts from the default).
+    pub fn new(mode: SolverMode, num_envs: usize, state: SourceState) -> Self {
+        let fixed = match mode {
+            SolverMode::RulePcg => Vec::new(),
+            SolverMode::FixedTrack => (0..FIXED_TRACK_COUNT)
+                .map(|k| rule_level(TRAINING_SEED_BASE + k))
+                .collect(),
+        };
+        let mut this = Self {
+            mode,
+            envs: Vec::with_capacity(num_envs),
+            fixed,
+            state,
+            rewards: SolverRewards::default(),
+        };
+        let starts: Vec<(Level, u64)> = (0..num_envs).map(|_| this.next_episode()).collect();
+        this.envs = starts
+            .par_iter()
+            .map(|(level, seed)| this.start(level, *seed))
+            .collect();
+        this
+    }
+
+    pub fn state(&self) -> SourceState {
+        self.state
+    }
+
+    /// The level and reset seed of the next episode to start.
+    fn next_episode(&mut self) -> (Level, u64) {
+        let level = match self.mode {
+            SolverMode::RulePcg => {
+                let level =
+                    rule_level(TRAINING_SEED_BASE + FIXED_TRACK_COUNT + self.state.levels_drawn);
+                self.state.levels_drawn += 1;
+                level
+            }
+            SolverMode::FixedTrack => {
+                let k = self.state.levels_drawn % FIXED_TRACK_COUNT;
+                self.state.levels_drawn += 1;
+                self.fixed[k as usize].clone()
+            }
+        };
+        let seed = TRAINING_SEED_BASE + self.state.episodes_started;
+        self.state.episodes_started += 1;
+        (level, seed)
+    }
+
+    fn start(&self, level: &Level, seed: u64) -> PlatformEnv {
+        let track = level
+            .platform()
+            .expect("training levels are platform levels");
+        let mut env = PlatformEnv::new(track, level.goal, self.rewards);
+        env.reset(seed);
+        env
+    }
+}
+
+fn rule_level(seed: u64) -> Level {
+    // The rules find a level for every seed in practice; if one ever fails, the next seed serves.
+    (seed..)
+        .find_map(|s| rules::platform_level(s, None, None, &RulesConfig::default()).ok())
+        .expect("the rules produce levels")
+}
+
+/// A policy's action row as the character's input: continuous parts clipped to [-1, 1].
+pub fn platform_action(row: &[f32]) -> PlatformAction {
+    PlatformAction {
+        forward: row[0].clamp(-1.0, 1.0),
+        turn: row[1].clamp(-1.0, 1.0),
+        jump: row[2] > 0.5,
+    }
+}
+
+impl VecEnv for PlatformSolverEnvs {
+    fn num_envs(&self) -> usize {
+        self.envs.len()
+    }
+
+    fn observation_size(&self) -> usize {
+        OBSERVATION_SIZE
+    }
+
+    fn observe(&mut self, out: &mut [f32]) {
+        self.envs
+            .par_iter()
+            .zip(out.par_chunks_mut(OBSERVATION_SIZE))
+            .for_each(|(env, row)| env.observe(row));
+    }
+
+    fn step(&mut self, actions: &[f32], out: &mut [Transition]) {
+        let width = actions.len() / self.envs.len();
+        self.envs
+            .par_iter_mut()
+            .zip(actions.par_chunks(width))
+            .zip(out.par_iter_mut())
+            .for_each(|((env, row), t)| {
+                let step = env.step(platform_action(row));
+                *t = Transition {
+                    reward: step.reward,
+                    ended: step.outcome.is_some(),
+                    success: step.outcome.map(|o| o == Outcome::Success),
+                };
+            });
+        let restarts: Vec<(usize, Level, u64)> = (0..self.envs.len())
+            .filter(|&i| out[i].ended)
+            .map(|i| {
+                let (level, seed) = self.next_episode();
+                (i, level, seed)
+            })
+            .collect();
+        let fresh: Vec<(usize, PlatformEnv)> = restarts
+            .par_iter()
+            .map(|(i, level, seed)| (*i, self.start(level, *seed)))
+            .collect();
+        for (i, env) in fresh {
+            self.envs[i] = env;
+        }
+    }
+}

@@ -1,0 +1,183 @@
+//! `arlpcg train` with tiny budgets: a killed run resumes from its checkpoint and its learning
+//! curve continues (no restart, no gap, no repeat); runs refuse to clobber each other; the
+//! trained policy loads with its card.
+
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use arlpcg::game::platform::OBSERVATION_SIZE;
+use arlpcg::level::Game;
+use arlpcg::rl::checkpoint::{Role, load_policy};
+
+const TINY: &str = "\
+seed: 3
+hidden: [16, 16]
+checkpoint_minutes: 0.0
+ppo:
+  num_envs: 4
+  num_steps: 32
+  update_epochs: 2
+  num_minibatches: 2
+";
+
+fn arlpcg(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+/// (iteration, global_step) of every metrics row.
+fn curve(dir: &Path) -> Vec<(u64, u64)> {
+    let text = std::fs::read_to_string(dir.join("metrics.csv")).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|line| {
+            let mut fields = line.split(',');
+            (
+                fields.next().unwrap().parse().unwrap(),
+                fields.next().unwrap().parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn a_killed_run_resumes_where_its_checkpoint_stopped() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.yaml");
+    std::fs::write(&config, TINY).unwrap();
+    let out = dir.path().join("run");
+    let out_s = out.to_str().unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+        .args([
+            "train",
+            "--mode",
+            "fixed-track",
+            "--steps",
+            "100000000",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            out_s,
+            "--threads",
+            "2",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Let it checkpoint a few iterations (every iteration with checkpoint_minutes 0), then kill it.
+    let start = Instant::now();
+    while out
+        .join("metrics.csv")
+        .exists()
+        .then(|| curve(&out).len())
+        .unwrap_or(0)
+        < 4
+    {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "the run made no progress"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let before = curve(&out);
+    let checkpoint = std::fs::read(out.join("checkpoint.safetensors")).unwrap();
+    let saved = load_policy(&checkpoint, Game::Platform, Role::Solver, OBSERVATION_SIZE).unwrap();
+    let state = saved.training_state().unwrap();
+    assert!(
+        state.iteration >= 3 && state.global_step == state.iteration * 128,
+        "{:?}",
+        (state.iteration, state.global_step)
+    );
+
+    // Resuming without --resume is refused and changes nothing.
+    let refused = arlpcg(&[
+        "train",
+        "--mode",
+        "fixed-track",
+        "--steps",
+        "100",
+        "--out",
+        out_s,
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("add --resume"));
+    // A resume with another mode is refused.
+    let refused = arlpcg(&[
+        "train", "--mode", "rule-pcg", "--steps", "100", "--out", out_s, "--resume",
+    ]);
+    assert!(
+        String::from_utf8_lossy(&refused.stderr).contains("was trained with --mode fixed-track")
+    );
+
+    let target = state.global_step + 3 * 128;
+    let resumed = arlpcg(&[
+        "train",
+        "--mode",
+        "fixed-track",
+        "--steps",
+        &target.to_string(),
+        "--out",
+        out_s,
+        "--resume",
+        "--threads",
+        "2",
+    ]);
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    let after = curve(&out);
+    // The rows up to the checkpoint are kept, later ones (written after it) dropped and redone.
+    assert_eq!(
+        &after[..state.iteration as usize],
+        &before[..state.iteration as usize]
+    );
+    for (k, (iteration, step)) in after.iter().enumerate() {
+        assert_eq!(
+            (*iteration, *step),
+            (k as u64 + 1, (k as u64 + 1) * 128),
+            "the curve restarted or skipped: {after:?}"
+        );
+    }
+    assert_eq!(after.last().unwrap().1, target);
+    // The finished policy loads with its card, which records the whole run.
+    let policy = std::fs::read(out.join("solver.safetensors")).unwrap();
+    let loaded = load_policy(&policy, Game::Platform, Role::Solver, OBSERVATION_SIZE).unwrap();
+    assert_eq!(loaded.card.training.steps, target);
+    assert_eq!(loaded.card.training.mode, "fixed-track");
+    assert_eq!(loaded.card.network.hidden, vec![16, 16]);
+    let card: serde_yaml::Value =
+        serde_yaml::from_str(&std::fs::read_to_string(out.join("solver.yaml")).unwrap()).unwrap();
+    assert_eq!(card["role"], "solver");
+}
+
+#[test]
+fn bad_training_configs_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("bad.yaml");
+    std::fs::write(&config, "ppo:\n  learning_rat: 0.1\n").unwrap();
+    let out = arlpcg(&[
+        "train",
+        "--steps",
+        "10",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        dir.path().join("r").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        err.contains("bad.yaml") && err.contains("unknown field `learning_rat`"),
+        "{err}"
+    );
+    let out = arlpcg(&["train", "--out", dir.path().join("r").to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("give a budget"));
+}

@@ -127,10 +127,11 @@ fn load_config(path: &Path) -> Result<SolverTrainConfig> {
             path.display()
         );
     }
-    if !(p.learning_rate.is_finite() && p.learning_rate > 0.0)
-        || !(0.0..=1.0).contains(&p.gamma)
-        || !(0.0..=1.0).contains(&p.gae_lambda)
-    {
+    let valid = p.learning_rate.is_finite()
+        && p.learning_rate > 0.0
+        && (0.0..=1.0).contains(&p.gamma)
+        && (0.0..=1.0).contains(&p.gae_lambda);
+    if !valid {
         bail!(
             "{}: learning_rate must be > 0, gamma and gae_lambda within [0, 1]",
             path.display()

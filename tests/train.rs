@@ -70,13 +70,14 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
         .unwrap();
     // Let it checkpoint a few iterations (every iteration with checkpoint_minutes 0), then kill it.
     let start = Instant::now();
-    while out
-        .join("metrics.csv")
-        .exists()
-        .then(|| curve(&out).len())
-        .unwrap_or(0)
-        < 4
-    {
+    let rows = |out: &Path| {
+        if out.join("metrics.csv").exists() {
+            curve(out).len()
+        } else {
+            0
+        }
+    };
+    while rows(&out) < 4 {
         assert!(
             start.elapsed() < Duration::from_secs(120),
             "the run made no progress"

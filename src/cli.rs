@@ -100,9 +100,16 @@ pub struct ExportArgs {
 /// Who plays the verification trials.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum SolverChoice {
+    /// A trained Solver policy (--policy, default policies/platform/solver.safetensors).
+    Policy,
     /// The scripted controller: faces the next block, runs, jumps at the edge (no learning).
     Scripted,
+    /// Uniformly random actions (a baseline).
+    Random,
 }
+
+/// Where the shipped platform Solver lives.
+pub const DEFAULT_SOLVER: &str = "policies/platform/solver.safetensors";
 
 #[derive(Debug, Args)]
 pub struct VerifyArgs {
@@ -115,9 +122,12 @@ pub struct VerifyArgs {
     /// Seed of the first run; run i uses SEED + i.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Who plays. Until a trained Solver ships, the scripted controller.
-    #[arg(long, value_enum, default_value = "scripted")]
-    pub solver: SolverChoice,
+    /// Who plays (default: the trained Solver when one is found, else the scripted controller).
+    #[arg(long, value_enum)]
+    pub solver: Option<SolverChoice>,
+    /// The Solver policy file (.safetensors) for --solver policy.
+    #[arg(long, default_value = DEFAULT_SOLVER)]
+    pub policy: PathBuf,
     /// Print one JSON object per level instead of text.
     #[arg(long)]
     pub json: bool,

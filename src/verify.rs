@@ -1,38 +1,62 @@
-//! Verification: play a level many times with a Solver and aggregate the statistics. Trials run
-//! in parallel on the rayon pool; trial `i` is seeded with `seed + i`, so the result does not
-//! depend on the number of threads.
+//! Verification: play a level many times with a Solver and aggregate the statistics. Runs are
+//! seeded from `seed` and the trial index, so the same level, Solver, seed and trial count give
+//! the same statistics whatever the number of threads.
+//!
+//! A trained policy plays trials in lockstep, up to [`LOCKSTEP`] at a time: all their worlds step
+//! in parallel and one batched forward pass picks every action. It samples its actions (the
+//! stochastic policy it was trained as).
 
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 use crate::game::platform::reach::play_scripted;
-use crate::game::platform::{PlatformEnv, SolverRewards};
+use crate::game::platform::{OBSERVATION_SIZE, PlatformAction, PlatformEnv, SolverRewards};
 use crate::level::scene::UnsupportedGame;
 use crate::level::stats::{SolverRef, SolverStats, TrialResult};
-use crate::level::{Level, Track};
+use crate::level::{Level, PlatformTrack, PolicyRef, Track};
+use crate::rl::normalizer::RunningNorm;
+use crate::rl::policy::{ActMode, ActorCritic};
 
 /// Take-off jitter of the scripted controller when it verifies levels, m.
 pub const SCRIPTED_JITTER: f32 = 0.3;
+/// Trials a policy plays at once.
+pub const LOCKSTEP: usize = 64;
 
-/// Who plays the trials.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Solver {
-    /// The scripted (non-learning) controller.
-    Scripted,
+/// A trained Solver, ready to play.
+pub struct SolverPolicy {
+    pub policy: ActorCritic,
+    pub normalizer: RunningNorm,
+    pub reference: PolicyRef,
 }
 
-impl Solver {
-    fn reference(self) -> SolverRef {
+/// Who plays the trials.
+pub enum Solver<'a> {
+    /// The scripted (non-learning) controller.
+    Scripted,
+    /// Uniformly random actions (a baseline).
+    Random,
+    /// A trained Solver policy.
+    Policy(&'a SolverPolicy),
+}
+
+impl Solver<'_> {
+    fn reference(&self) -> SolverRef {
         match self {
             Solver::Scripted => SolverRef::Scripted,
+            Solver::Random => SolverRef::Random,
+            Solver::Policy(p) => SolverRef::Policy {
+                policy: p.reference.clone(),
+            },
         }
     }
 }
 
 /// Plays `trials` runs of the level and returns their statistics. `on_trial` is called after
-/// each finished trial (from worker threads), for progress reporting.
+/// each finished trial (possibly from worker threads), for progress reporting.
 pub fn verify(
     level: &Level,
-    solver: Solver,
+    solver: &Solver,
     trials: u32,
     seed: u64,
     on_trial: &(dyn Fn() + Sync),
@@ -40,23 +64,152 @@ pub fn verify(
     let Track::Platform(track) = &level.track else {
         return Err(UnsupportedGame("racing"));
     };
-    let results: Vec<TrialResult> = (0..trials as u64)
-        .into_par_iter()
-        .map_init(
-            || PlatformEnv::new(track, level.goal, SolverRewards::default()),
-            |env, i| {
-                let result = match solver {
-                    Solver::Scripted => play_scripted(env, seed.wrapping_add(i), SCRIPTED_JITTER),
-                };
+    let new_env = || PlatformEnv::new(track, level.goal, SolverRewards::default());
+    let results: Vec<TrialResult> = match solver {
+        Solver::Scripted => (0..trials as u64)
+            .into_par_iter()
+            .map_init(new_env, |env, i| {
+                let result = play_scripted(env, seed.wrapping_add(i), SCRIPTED_JITTER);
                 on_trial();
                 result
-            },
-        )
-        .collect();
+            })
+            .collect(),
+        Solver::Random => (0..trials as u64)
+            .into_par_iter()
+            .map_init(new_env, |env, i| {
+                let result = play_random(env, seed.wrapping_add(i));
+                on_trial();
+                result
+            })
+            .collect(),
+        Solver::Policy(policy) => (0..trials as u64)
+            .collect::<Vec<_>>()
+            .chunks(LOCKSTEP)
+            .flat_map(|chunk| play_policy(track, level.goal, policy, seed, chunk, on_trial))
+            .collect(),
+    };
     Ok(SolverStats::from_trials(
         solver.reference(),
         seed,
         track.block_count(),
         &results,
     ))
+}
+
+fn finish(env: &PlatformEnv, outcome: crate::level::stats::Outcome) -> TrialResult {
+    TrialResult {
+        outcome,
+        progress: env.progress(),
+        target_piece: env.furthest(),
+        steps: env.steps(),
+    }
+}
+
+fn play_random(env: &mut PlatformEnv, seed: u64) -> TrialResult {
+    env.reset(seed);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    loop {
+        let action = PlatformAction {
+            forward: rng.random_range(-1.0..=1.0),
+            turn: rng.random_range(-1.0..=1.0),
+            jump: rng.random_bool(0.5),
+        };
+        if let Some(outcome) = env.step(action).outcome {
+            return finish(env, outcome);
+        }
+    }
+}
+
+/// Plays the trials `indices` together: parallel worlds, one forward pass per tick.
+fn play_policy(
+    track: &PlatformTrack,
+    goal: [f64; 3],
+    solver: &SolverPolicy,
+    seed: u64,
+    indices: &[u64],
+    on_trial: &(dyn Fn() + Sync),
+) -> Vec<TrialResult> {
+    let mut envs: Vec<PlatformEnv> = indices
+        .par_iter()
+        .map(|&i| {
+            let mut env = PlatformEnv::new(track, goal, SolverRewards::default());
+            env.reset(seed.wrapping_add(i));
+            env
+        })
+        .collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(indices[0]).rotate_left(17));
+    let mut results: Vec<Option<TrialResult>> = vec![None; envs.len()];
+    let mut observations = vec![0.0; envs.len() * OBSERVATION_SIZE];
+    loop {
+        let active: Vec<usize> = (0..envs.len()).filter(|&k| results[k].is_none()).collect();
+        if active.is_empty() {
+            break;
+        }
+        let rows = &mut observations[..active.len() * OBSERVATION_SIZE];
+        rows.par_chunks_mut(OBSERVATION_SIZE)
+            .zip(&active)
+            .for_each(|(row, &k)| envs[k].observe(row));
+        solver.normalizer.normalize(rows);
+        let acted = solver
+            .policy
+            .act(rows, ActMode::Sample, &mut rng)
+            .expect("a loaded policy acts on observations of its size");
+        let width = solver.policy.shape().action_size();
+        let mut stepping: Vec<(usize, &mut PlatformEnv)> = envs
+            .iter_mut()
+            .enumerate()
+            .filter(|(k, _)| results[*k].is_none())
+            .collect();
+        let finished: Vec<(usize, TrialResult)> = stepping
+            .par_iter_mut()
+            .zip(acted.actions.par_chunks(width))
+            .filter_map(|((k, env), row)| {
+                env.step(PlatformAction::from_policy_row(row))
+                    .outcome
+                    .map(|o| (*k, finish(env, o)))
+            })
+            .collect();
+        for (k, result) in finished {
+            results[k] = Some(result);
+            on_trial();
+        }
+    }
+    results
+        .into_iter()
+        .map(|r| r.expect("every trial finished"))
+        .collect()
+}
+
+/// Aggregates over many levels, as the paper's generalization table does.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Summary {
+    pub levels: usize,
+    /// Mean over levels of each level's success ratio.
+    pub mean_success: f64,
+    /// Standard deviation over levels of the success ratio.
+    pub std_success: f64,
+    /// Fraction of levels completed by at least one run.
+    pub completed_by_any: f64,
+    pub mean_progress: f64,
+    /// Mean decisions of successful runs (over levels with a success).
+    pub mean_success_steps: f64,
+}
+
+impl Summary {
+    pub fn of(stats: &[SolverStats]) -> Self {
+        let n = stats.len().max(1) as f64;
+        let mean = |f: &dyn Fn(&SolverStats) -> f64| stats.iter().map(f).sum::<f64>() / n;
+        let mean_success = mean(&|s| s.success_ratio);
+        let variance = mean(&|s| (s.success_ratio - mean_success).powi(2));
+        let solved: Vec<&SolverStats> = stats.iter().filter(|s| s.successes > 0).collect();
+        Self {
+            levels: stats.len(),
+            mean_success,
+            std_success: variance.sqrt(),
+            completed_by_any: solved.len() as f64 / n,
+            mean_progress: mean(&|s| s.mean_progress),
+            mean_success_steps: solved.iter().map(|s| s.mean_success_steps).sum::<f64>()
+                / solved.len().max(1) as f64,
+        }
+    }
 }

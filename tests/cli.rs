@@ -290,7 +290,7 @@ fn hand_broken_level_files_get_one_clear_line_and_a_non_zero_exit() {
 
 #[test]
 fn a_missing_level_file_is_named() {
-    let out = arlpcg(&["verify", "/no/such/level.yaml"]);
+    let out = arlpcg(&["verify", "/no/such/level.yaml", "--solver", "scripted"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
         stderr(&out).contains("/no/such/level.yaml: cannot read the file"),

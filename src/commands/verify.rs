@@ -1,40 +1,84 @@
-//! `arlpcg verify`: play each level many times and report the Solver's statistics.
+//! `arlpcg verify`: play each level many times and report the Solver's statistics, then a
+//! summary over all the levels.
 
 use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use serde_json::json;
+use sha2::{Digest, Sha256};
 
-use crate::cli::{SolverChoice, VerifyArgs};
+use crate::cli::{DEFAULT_SOLVER, SolverChoice, VerifyArgs};
+use crate::game::platform::OBSERVATION_SIZE;
 use crate::level::stats::SolverStats;
-use crate::level::yaml;
-use crate::verify::{Solver, verify};
+use crate::level::{Game, PolicyRef, yaml};
+use crate::rl::checkpoint::{Role, load_policy};
+use crate::verify::{Solver, SolverPolicy, Summary, verify};
 
 pub fn run(args: &VerifyArgs) -> Result<()> {
-    let solver = match args.solver {
+    let choice = args.solver.unwrap_or(
+        if args.policy.exists() || args.policy != Path::new(DEFAULT_SOLVER) {
+            SolverChoice::Policy
+        } else {
+            SolverChoice::Scripted
+        },
+    );
+    let loaded;
+    let solver = match choice {
+        SolverChoice::Policy => {
+            loaded = load_solver(&args.policy)?;
+            Solver::Policy(&loaded)
+        }
         SolverChoice::Scripted => Solver::Scripted,
+        SolverChoice::Random => Solver::Random,
     };
     if !args.json {
-        eprintln!("solver: scripted controller (no trained Solver ships yet)");
+        let note = match (&solver, args.solver) {
+            (Solver::Scripted, None) => format!(" (no trained Solver at {DEFAULT_SOLVER})"),
+            _ => String::new(),
+        };
+        let who = match &solver {
+            Solver::Policy(p) => format!("policy {}", p.reference.path),
+            Solver::Scripted => "scripted controller".into(),
+            Solver::Random => "random actions".into(),
+        };
+        eprintln!("solver: {who}{note}");
     }
     let mut failed = 0;
+    let mut all = Vec::new();
     for path in &args.levels {
         let outcome = yaml::load(path)
             .map_err(anyhow::Error::from)
             .and_then(|level| {
                 let bar = super::progress_bar(args.trials as u64, &path.display().to_string());
-                let stats = verify(&level, solver, args.trials, args.seed, &|| bar.inc(1))?;
+                let stats = verify(&level, &solver, args.trials, args.seed, &|| bar.inc(1))?;
                 bar.finish_and_clear();
                 Ok(stats)
             });
         match outcome {
-            Ok(stats) if args.json => println!("{}", to_json(path, &stats)),
-            Ok(stats) => println!("{}", describe(path, &stats)),
+            Ok(stats) => {
+                if args.json {
+                    println!("{}", to_json(path, &stats));
+                } else {
+                    println!("{}", describe(path, &stats));
+                }
+                all.push(stats);
+            }
             Err(err) => {
                 failed += 1;
                 eprintln!("error: {}", one_line(&format!("{err:#}")));
             }
         }
+    }
+    if all.len() > 1 && !args.json {
+        let s = Summary::of(&all);
+        let steps = match s.completed_by_any > 0.0 {
+            true => format!("{:.0}", s.mean_success_steps),
+            false => "n/a".into(),
+        };
+        println!(
+            "{} levels: success ratio {:.3} ± {:.3} (mean ± std over levels), completed by at least one run {:.2}, mean progress {:.2}, mean steps of successful runs {steps}",
+            s.levels, s.mean_success, s.std_success, s.completed_by_any, s.mean_progress
+        );
     }
     if failed > 0 {
         anyhow::bail!(
@@ -43,6 +87,26 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Loads a platform Solver policy, pinned by the SHA-256 of its file.
+pub fn load_solver(path: &Path) -> Result<SolverPolicy> {
+    let bytes = std::fs::read(path)
+        .with_context(|| format!("cannot read the Solver policy {}", path.display()))?;
+    let loaded = load_policy(&bytes, Game::Platform, Role::Solver, OBSERVATION_SIZE)
+        .with_context(|| format!("{}", path.display()))?;
+    let sha256 = Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    Ok(SolverPolicy {
+        policy: loaded.policy,
+        normalizer: loaded.card.normalizer,
+        reference: PolicyRef {
+            path: path.display().to_string(),
+            sha256,
+        },
+    })
 }
 
 fn to_json(path: &Path, s: &SolverStats) -> serde_json::Value {
@@ -55,6 +119,7 @@ fn to_json(path: &Path, s: &SolverStats) -> serde_json::Value {
         "success_ratio": s.success_ratio,
         "ci95": s.ci95,
         "mean_progress": s.mean_progress,
+        "mean_success_steps": s.mean_success_steps,
         "fell": s.fell,
         "timed_out": s.timed_out,
         "failures_by_block": s.failures_by_piece,

@@ -11,6 +11,8 @@ use super::PolicyRef;
 pub enum SolverRef {
     /// The scripted (non-learning) controller: walk to the edge, jump.
     Scripted,
+    /// Uniformly random actions (a baseline).
+    Random,
     /// A trained Solver policy.
     Policy { policy: PolicyRef },
 }
@@ -19,6 +21,7 @@ impl SolverRef {
     pub fn describe(&self) -> String {
         match self {
             SolverRef::Scripted => "scripted controller".to_string(),
+            SolverRef::Random => "random actions".to_string(),
             SolverRef::Policy { policy } => format!("policy {}", policy.path),
         }
     }

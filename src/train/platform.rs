@@ -167,7 +167,7 @@ impl VecEnv for PlatformSolverEnvs {
             .zip(actions.par_chunks(width))
             .zip(out.par_iter_mut())
             .for_each(|((env, row), t)| {
-                let step = env.step(platform_action(row));
+                let step = env.step(PlatformAction::from_policy_row(row));
                 *t = Transition {
                     reward: step.reward,
                     ended: step.outcome.is_some(),

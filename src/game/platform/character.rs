@@ -45,6 +45,17 @@ pub struct PlatformAction {
 }
 
 impl PlatformAction {
+    /// A policy's action row `[forward, turn, jump]`: continuous parts clipped to [-1, 1] (they
+    /// are unbounded Gaussian samples), jump when the binary part is 1.
+    pub fn from_policy_row(row: &[f32]) -> Self {
+        Self {
+            forward: row[0].clamp(-1.0, 1.0),
+            turn: row[1].clamp(-1.0, 1.0),
+            jump: row[2] > 0.5,
+        }
+        .sanitized()
+    }
+
     /// Clamps the continuous parts into [-1, 1]; NaN becomes 0.
     pub fn sanitized(self) -> Self {
         let clean = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(-1.0, 1.0) };

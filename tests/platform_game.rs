@@ -123,7 +123,7 @@ fn running_off_the_edge_falls_and_moving_toward_the_goal_pays() {
     let mut env = env_of(&track);
     env.reset(3);
     // Turn to face the block first (the start heading is drawn within 90 degrees of it).
-    let mut total = 0.0;
+    let mut rewards = Vec::new();
     let mut outcome = None;
     for _ in 0..300 {
         let yaw = env.character().yaw;
@@ -134,7 +134,7 @@ fn running_off_the_edge_falls_and_moving_toward_the_goal_pays() {
             turn,
             jump: false,
         });
-        total += step.reward;
+        rewards.push(step.reward);
         if step.outcome.is_some() {
             outcome = step.outcome;
             break;
@@ -145,10 +145,18 @@ fn running_off_the_edge_falls_and_moving_toward_the_goal_pays() {
         Some(Outcome::Fell),
         "running without jumping must fall into the gap"
     );
-    // It ran about 2 m toward the block before dropping: positive progress, then the penalty.
+    // Running at the block paid per metre closed (less than the 8 m to its centre)...
+    let per_metre = SolverRewards::default().progress_per_metre;
+    let running: f32 = rewards.iter().take_while(|&&r| r >= 0.0).sum();
     assert!(
-        total < 0.0 && total > SolverRewards::default().failure,
-        "total {total}"
+        running > per_metre && running < 8.0 * per_metre,
+        "running paid {running}"
+    );
+    // ...and the run ended with the failure penalty.
+    let last = *rewards.last().unwrap();
+    assert!(
+        last < SolverRewards::default().failure + per_metre,
+        "last reward {last}"
     );
 }
 

@@ -182,3 +182,58 @@ fn bad_training_configs_are_named() {
     let out = arlpcg(&["train", "--out", dir.path().join("r").to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("give a budget"));
 }
+
+#[test]
+fn ctrl_c_saves_a_checkpoint_and_the_policy_and_exits_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.yaml");
+    // Checkpoints only at the end: Ctrl-C must write one itself.
+    std::fs::write(
+        &config,
+        TINY.replace("checkpoint_minutes: 0.0", "checkpoint_minutes: 600.0"),
+    )
+    .unwrap();
+    let out = dir.path().join("run");
+    let child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+        .args([
+            "train",
+            "--steps",
+            "100000000",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !out.join("metrics.csv").exists() || curve(&out).len() < 2 {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "the run made no progress"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(!out.join("checkpoint.safetensors").exists());
+    let interrupted = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(interrupted.success());
+    let output = child.wait_with_output().unwrap();
+    assert!(output.status.success());
+    assert!(String::from_utf8_lossy(&output.stdout).contains("stopped (Ctrl-C)"));
+    let checkpoint = std::fs::read(out.join("checkpoint.safetensors")).unwrap();
+    let state = load_policy(&checkpoint, Game::Platform, Role::Solver, OBSERVATION_SIZE)
+        .unwrap()
+        .training_state()
+        .unwrap();
+    assert_eq!(
+        state.iteration as usize,
+        curve(&out).len(),
+        "the checkpoint holds every iteration the metrics show"
+    );
+    assert!(out.join("solver.safetensors").exists() && out.join("solver.yaml").exists());
+}

@@ -257,7 +257,10 @@ impl Run {
                 wall_time_s: (wall_time_s * 10.0).round() / 10.0,
                 seed: self.config.seed,
                 commit: git_commit(),
-                command: std::env::args().collect::<Vec<_>>().join(" "),
+                command: std::iter::once("arlpcg".to_string())
+                    .chain(std::env::args().skip(1))
+                    .collect::<Vec<_>>()
+                    .join(" "),
             },
             results: Default::default(),
         }

@@ -1,5 +1,5 @@
-//! Every level shipped under `levels/` loads, and its `.glb` (when shipped) is exactly what
-//! export makes of it today.
+//! What ships loads: every level under `levels/` (and its `.glb` is exactly what export makes
+//! of it today), and every policy under `policies/` with the card beside it.
 
 use std::path::{Path, PathBuf};
 
@@ -40,4 +40,26 @@ fn every_shipped_level_loads_and_its_glb_is_current() {
             );
         }
     }
+}
+
+#[test]
+fn the_shipped_platform_solver_loads_and_its_card_matches() {
+    use arlpcg::game::platform::OBSERVATION_SIZE;
+    use arlpcg::level::Game;
+    use arlpcg::rl::checkpoint::{PolicyCard, Role, load_policy};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    let bytes = std::fs::read(dir.join("solver.safetensors")).expect("the platform Solver ships");
+    let loaded = load_policy(&bytes, Game::Platform, Role::Solver, OBSERVATION_SIZE)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let card: PolicyCard =
+        serde_yaml::from_str(&std::fs::read_to_string(dir.join("solver.yaml")).unwrap()).unwrap();
+    assert_eq!(
+        card, loaded.card,
+        "solver.yaml differs from the card inside solver.safetensors"
+    );
+    assert_eq!(card.network.hidden, vec![512, 512]);
+    assert!(
+        card.training.steps >= 1_000_000,
+        "the shipped Solver is trained"
+    );
 }

@@ -186,6 +186,8 @@ fn verify_reports_json_with_the_documented_keys() {
         "--trials",
         "20",
         "--json",
+        "--solver",
+        "scripted",
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let line = String::from_utf8(out.stdout).unwrap();
@@ -210,7 +212,14 @@ fn assert_rejected(name: &str, contents: &[u8], expected: &str) {
     let path = dir.path().join(name);
     std::fs::write(&path, contents).unwrap();
     for command in [
-        vec!["verify", path.to_str().unwrap(), "--trials", "1"],
+        vec![
+            "verify",
+            path.to_str().unwrap(),
+            "--trials",
+            "1",
+            "--solver",
+            "scripted",
+        ],
         vec![
             "export",
             path.to_str().unwrap(),

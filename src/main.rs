@@ -11,11 +11,7 @@ fn main() -> ExitCode {
     match arlpcg::commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            let message = format!("{err:#}");
-            eprintln!(
-                "error: {}",
-                message.split_whitespace().collect::<Vec<_>>().join(" ")
-            );
+            eprintln!("error: {}", arlpcg::commands::one_line(&format!("{err:#}")));
             ExitCode::FAILURE
         }
     }

@@ -118,7 +118,7 @@ fn export_is_deterministic_and_gltf_matches_glb() {
     );
     assert_eq!(root["scenes"][0]["extras"]["aux"], -1.0);
     assert_eq!(
-        gltf_out.bin.unwrap().len(),
+        gltf_out.bin.len(),
         root["buffers"][0]["byteLength"].as_u64().unwrap() as usize
     );
 }

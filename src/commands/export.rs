@@ -108,8 +108,7 @@ pub fn write_level_files(level: &Level, files: &LevelFiles, overwrite: Overwrite
             Format::Gltf => {
                 let bin_name = format!("{}.bin", files.stem);
                 let output = gltf::to_gltf(&scene()?, &bin_name);
-                let bin = output.bin.expect("the .gltf layout always has a buffer");
-                fsio::write_atomic(&files.path("bin"), &bin, overwrite)?;
+                fsio::write_atomic(&files.path("bin"), &output.bin, overwrite)?;
                 fsio::write_atomic(&files.path("gltf"), &output.main, overwrite)?;
             }
         }

@@ -7,6 +7,7 @@ mod generate;
 mod verify;
 
 pub use export::{LevelFiles, write_level_files};
+pub use verify::one_line;
 
 use anyhow::Result;
 

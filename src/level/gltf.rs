@@ -9,13 +9,13 @@ use json::validation::{Checked::Valid, USize64};
 
 use super::scene::{Material, Scene};
 
-/// A glTF file and, for the `.gltf` layout, its separate buffer.
+/// A `.gltf` document and the `.bin` buffer it refers to.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GltfOutput {
-    /// The `.glb` bytes, or the `.gltf` JSON text.
+    /// The `.gltf` JSON text.
     pub main: Vec<u8>,
-    /// The `.bin` buffer of a `.gltf` (none for `.glb`).
-    pub bin: Option<Vec<u8>>,
+    /// The `.bin` buffer.
+    pub bin: Vec<u8>,
 }
 
 /// The scene as a single `.glb`.
@@ -33,7 +33,7 @@ pub fn to_gltf(scene: &Scene, bin_uri: &str) -> GltfOutput {
     let json = json::serialize::to_vec_pretty(&root).expect("a glTF document always serializes");
     GltfOutput {
         main: json,
-        bin: Some(buffer),
+        bin: buffer,
     }
 }
 

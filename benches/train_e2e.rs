@@ -9,24 +9,24 @@ use std::time::Instant;
 use arlpcg::rl::policy::{ActorCritic, PolicyShape};
 use arlpcg::rl::ppo::Ppo;
 use arlpcg::rl::vec_env::Trainer;
-use arlpcg::train::SolverTrainConfig;
+use arlpcg::train::TrainConfig;
 use arlpcg::train::platform::{PlatformSolverEnvs, SolverMode, SourceState};
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() {
-    let config = SolverTrainConfig::default();
+    let config = TrainConfig::default();
     let shape = PolicyShape {
         observation: arlpcg::game::platform::OBSERVATION_SIZE,
         hidden: config.hidden.clone(),
         continuous: 2,
         binary: 1,
     };
-    let ppo = Ppo::new(config.ppo.clone(), ActorCritic::new(shape, 0).unwrap()).unwrap();
+    let ppo = Ppo::new(config.solver.clone(), ActorCritic::new(shape, 0).unwrap()).unwrap();
     let envs = PlatformSolverEnvs::new(
         SolverMode::RulePcg,
-        config.ppo.num_envs,
+        config.solver.num_envs,
         SourceState {
             levels_drawn: 0,
             episodes_started: 0,
@@ -46,17 +46,17 @@ fn main() {
             update_s += t1.elapsed().as_secs_f64();
         }
     }
-    let steps = (iterations * config.ppo.batch_size()) as f64;
+    let steps = (iterations * config.solver.batch_size()) as f64;
     let rate = steps / (rollout_s + update_s);
     println!(
         "end-to-end training, {} worlds x {} steps, {} epochs, 2 x 512: {rate:.0} env steps/s",
-        config.ppo.num_envs, config.ppo.num_steps, config.ppo.update_epochs
+        config.solver.num_envs, config.solver.num_steps, config.solver.update_epochs
     );
     println!(
         "  rollout {:.0} steps/s ({:.0}% of the time), update {:.0} samples/s per epoch",
         steps / rollout_s,
         100.0 * rollout_s / (rollout_s + update_s),
-        steps * config.ppo.update_epochs as f64 / update_s
+        steps * config.solver.update_epochs as f64 / update_s
     );
     let verdict = if rate >= 10_000.0 {
         "reached"

@@ -7,7 +7,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::level::Game;
 use crate::level::params;
-use crate::train::platform::SolverMode;
+use crate::train::TrainMode;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -37,7 +37,8 @@ pub enum Command {
     Export(ExportArgs),
     /// Play levels many times and report how often the Solver gets through.
     Verify(VerifyArgs),
-    /// Train a Solver with PPO (checkpointed, resumable, stoppable with Ctrl-C).
+    /// Train a Solver, alone or against a Generator, with PPO (checkpointed, resumable,
+    /// stoppable with Ctrl-C).
     Train(TrainArgs),
 }
 
@@ -137,15 +138,19 @@ pub struct VerifyArgs {
 #[command(after_help = "Examples:\n  \
     arlpcg train --game platform --mode rule-pcg --minutes 60 --out runs/solver\n  \
     arlpcg train --game platform --mode rule-pcg --minutes 60 --out runs/solver --resume\n  \
-    arlpcg train --print-config > solver.yaml")]
+    arlpcg train --game platform --mode arlpcg --steps 4000000 --out runs/arlpcg\n  \
+    arlpcg train --print-config > train.yaml")]
 pub struct TrainArgs {
     /// Which game.
     #[arg(long, default_value = "platform", value_parser = parse_game)]
     pub game: Game,
-    /// Where the Solver's training levels come from.
+    /// How the Solver is trained: on rule levels, on a fixed set, or against a Generator
+    /// (`arlpcg`: λ drawn per match; `fixed-aux`: λ = 1). The adversarial modes train and save
+    /// the Generator too.
     #[arg(long, value_enum, default_value = "rule-pcg")]
-    pub mode: SolverMode,
-    /// Stop when the run has taken this many environment steps in all (over every resume).
+    pub mode: TrainMode,
+    /// Stop when the Solver has learned from this many environment steps in all (over every
+    /// resume).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub steps: Option<u64>,
     /// Stop after this many minutes of this session.

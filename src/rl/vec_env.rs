@@ -148,6 +148,29 @@ impl<E: VecEnv> Trainer<E> {
         Ok((batch, stats))
     }
 
+    /// Plays one tick of every environment with the current policy, learning nothing (the
+    /// normalizer stays as it is too): the frozen side of an adversarial phase.
+    pub fn play_tick(&mut self) -> candle_core::Result<()> {
+        let n = self.env.num_envs();
+        let mut normalized = self.observations.clone();
+        self.norm.normalize(&mut normalized);
+        let acted = self
+            .ppo
+            .policy
+            .act(&normalized, ActMode::Sample, &mut self.rng)?;
+        let mut transitions = vec![Transition::default(); n];
+        self.env.step(&acted.actions, &mut transitions);
+        for (e, t) in transitions.iter().enumerate() {
+            self.episode_returns[e] = if t.ended {
+                0.0
+            } else {
+                self.episode_returns[e] + t.reward
+            };
+        }
+        self.env.observe(&mut self.observations);
+        Ok(())
+    }
+
     /// One PPO update on `batch`.
     pub fn learn(&mut self, batch: &Batch, learning_rate: f64) -> candle_core::Result<UpdateStats> {
         self.ppo.update(batch, learning_rate, &mut self.rng)

@@ -1,9 +1,14 @@
-//! `arlpcg train`: the training runs. For now the platform Solver alone on rule-pcg or
-//! fixed-track levels; the adversarial loop joins later. A run lives in its output folder:
-//! `config.yaml`, `checkpoint.safetensors` (written atomically every few minutes, on Ctrl-C and at
-//! the end), `metrics.csv` (one row per PPO iteration), and the final `solver.safetensors` with
-//! its card `solver.yaml`. `--resume` continues from the checkpoint.
+//! `arlpcg train`: the training runs of the platform game, in the paper's four modes: the Solver
+//! alone on rule levels (`rule-pcg`) or on a small fixed set (`fixed-track`), and the adversarial
+//! loop with a Generator (`arlpcg`, λ drawn per match; `fixed-aux`, λ = 1).
+//!
+//! A run lives in its output folder: `config.yaml`, `checkpoint.safetensors` (the Solver;
+//! written atomically every few minutes, on Ctrl-C and at the end), `metrics.csv` (one row per
+//! Solver update), the final `solver.safetensors` with its card `solver.yaml`, and for the
+//! adversarial modes `generator-checkpoint.safetensors`, `generator-metrics.csv` and
+//! `generator.safetensors` + `generator.yaml`. `--resume` continues from the checkpoints.
 
+pub mod arlpcg;
 pub mod platform;
 
 use std::io::Write;
@@ -13,39 +18,104 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::cli::TrainArgs;
 use crate::fsio::{self, Overwrite};
+use crate::game::platform::generator::{
+    GENERATOR_ACTIONS, GENERATOR_OBSERVATION_LAYOUT, GENERATOR_OBSERVATION_SIZE, GeneratorRewards,
+};
 use crate::level::Game;
 use crate::rl::checkpoint::{self, PolicyCard, Role, TrainingRecord, TrainingState};
+use crate::rl::normalizer::RunningNorm;
 use crate::rl::policy::{ActorCritic, PolicyShape};
 use crate::rl::ppo::{Ppo, PpoConfig, UpdateStats};
-use crate::rl::vec_env::{RolloutStats, Trainer};
+use crate::rl::vec_env::{RolloutStats, Trainer, VecEnv};
+use arlpcg::{AdversarialEnvs, AdversarialState, Generator, MatchRules, MatchStats, Phase};
 use platform::{PlatformSolverEnvs, SolverMode, SourceState};
 
-/// Everything a Solver training run is configured by (`--config FILE`, YAML; every field has
-/// the default `arlpcg train --print-config` shows).
+/// How the Solver is trained (the paper's baselines and its method, SPEC 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum TrainMode {
+    /// On a fresh rule-based level every episode (the Rule-PCG baseline).
+    RulePcg,
+    /// On a small fixed set of rule-based levels (the Fixed-Track baseline).
+    FixedTrack,
+    /// Against a Generator that always has λ = 1 (the ablation).
+    FixedAux,
+    /// Against a Generator with λ drawn per match (the full method).
+    Arlpcg,
+}
+
+impl TrainMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            TrainMode::RulePcg => "rule-pcg",
+            TrainMode::FixedTrack => "fixed-track",
+            TrainMode::FixedAux => "fixed-aux",
+            TrainMode::Arlpcg => "arlpcg",
+        }
+    }
+
+    /// The level source of the Solver-only modes; `None` for the adversarial ones.
+    fn solver_only(self) -> Option<SolverMode> {
+        match self {
+            TrainMode::RulePcg => Some(SolverMode::RulePcg),
+            TrainMode::FixedTrack => Some(SolverMode::FixedTrack),
+            TrainMode::FixedAux | TrainMode::Arlpcg => None,
+        }
+    }
+}
+
+/// Everything a training run is configured by (`--config FILE`, YAML; every field has the
+/// default `arlpcg train --print-config` shows, the paper's values where it gives them).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-pub struct SolverTrainConfig {
+pub struct TrainConfig {
     /// Seeds network initialization and action sampling.
     pub seed: u64,
-    /// Hidden layer sizes of the actor and of the critic (the paper: 2 × 512).
+    /// Hidden layer sizes of the actors and critics of both agents (the paper: 2 × 512).
     pub hidden: Vec<usize>,
     /// Minutes between checkpoints.
     pub checkpoint_minutes: f64,
-    /// PPO (the paper's Solver: learning rate 3e-4, γ 0.99 on the platform game).
-    pub ppo: PpoConfig,
+    /// The Solver's PPO (the paper: learning rate 3e-4, γ 0.99 on the platform game);
+    /// `num_envs` is also the number of matches in the adversarial modes.
+    #[serde(alias = "ppo")]
+    pub solver: PpoConfig,
+    /// The Generator (adversarial modes only).
+    pub generator: GeneratorConfig,
 }
 
-impl Default for SolverTrainConfig {
+/// The Generator's side of an adversarial run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GeneratorConfig {
+    /// The Generator's PPO (the paper: learning rate 2e-4, γ 0.99). One Generator step is one
+    /// block; a batch is `num_envs × num_steps` completed decisions.
+    pub ppo: PpoConfig,
+    /// Reward terms and the weights of each aux input (paper eq. 1; SPEC 2).
+    pub rewards: GeneratorRewards,
+    /// λ of each match is drawn uniformly from these (`fixed-aux` holds λ = 1).
+    pub aux_values: Vec<f32>,
+    /// A track that has not reached its goal in this many blocks ends as invalid.
+    pub max_blocks: usize,
+    /// Solver steps learned from in each Solver phase...
+    pub solver_phase_steps: u64,
+    /// ...and Generator decisions in each Generator phase. The Solver acts about 25 times per
+    /// block, so its phase switches about a tenth as often as the Generator's in its own steps.
+    pub generator_phase_steps: u64,
+}
+
+impl Default for TrainConfig {
     fn default() -> Self {
         Self {
             seed: 0,
             hidden: vec![512, 512],
             checkpoint_minutes: 5.0,
-            ppo: PpoConfig {
+            solver: PpoConfig {
                 learning_rate: 3e-4,
                 gamma: 0.99,
                 num_envs: 64,
@@ -53,18 +123,42 @@ impl Default for SolverTrainConfig {
                 ent_coef: 0.005,
                 ..PpoConfig::default()
             },
+            generator: GeneratorConfig::default(),
+        }
+    }
+}
+
+impl Default for GeneratorConfig {
+    fn default() -> Self {
+        Self {
+            ppo: PpoConfig {
+                learning_rate: 2e-4,
+                gamma: 0.99,
+                num_envs: 64,
+                num_steps: 16,
+                ent_coef: 0.0,
+                ..PpoConfig::default()
+            },
+            rewards: GeneratorRewards::default(),
+            aux_values: vec![-1.0, -1.0, -0.5, 0.5, 1.0, 1.0],
+            max_blocks: 30,
+            solver_phase_steps: 100_000,
+            generator_phase_steps: 10_000,
         }
     }
 }
 
 const CHECKPOINT: &str = "checkpoint.safetensors";
+const GENERATOR_CHECKPOINT: &str = "generator-checkpoint.safetensors";
 const METRICS: &str = "metrics.csv";
+const GENERATOR_METRICS: &str = "generator-metrics.csv";
 const METRICS_HEADER: &str = "iteration,global_step,wall_time_s,steps_per_s,rollout_s,update_s,learning_rate,episodes,mean_return,success_ratio,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance";
+const GENERATOR_METRICS_HEADER: &str = "iteration,solver_step,generator_step,wall_time_s,rollout_s,update_s,learning_rate,episodes,mean_return,invalid_ratio,success_easy,success_hard,distance_easy,distance_hard,size_easy,size_hard,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance";
 
 /// Runs `arlpcg train`.
 pub fn run(args: &TrainArgs) -> Result<()> {
     if args.print_config {
-        print!("{}", serde_yaml::to_string(&SolverTrainConfig::default())?);
+        print!("{}", serde_yaml::to_string(&TrainConfig::default())?);
         return Ok(());
     }
     if args.game != Game::Platform {
@@ -79,9 +173,10 @@ pub fn run(args: &TrainArgs) -> Result<()> {
         .as_ref()
         .context("--out DIR is required: where the run's checkpoint, metrics and policy go")?;
     if args.steps.is_none() && args.minutes.is_none() {
-        bail!("give a budget: --steps N (total environment steps) or --minutes M (this session)");
+        bail!(
+            "give a budget: --steps N (total Solver environment steps) or --minutes M (this session)"
+        );
     }
-    let checkpoint_path = out.join(CHECKPOINT);
     let threads = args.threads.map_or_else(
         || std::thread::available_parallelism().map_or(2, |n| n.get()),
         |t| t as usize,
@@ -90,77 +185,330 @@ pub fn run(args: &TrainArgs) -> Result<()> {
         .num_threads(threads)
         .build()?;
     pool.install(|| {
-        let mut run = if args.resume {
+        let config = if args.resume {
             if args.config.is_some() {
-                bail!("--config cannot change a resumed run: its configuration is in {}", checkpoint_path.display());
+                bail!(
+                    "--config cannot change a resumed run: its configuration is in {}",
+                    out.join(CHECKPOINT).display()
+                );
             }
-            Run::resume(out, mode)?
+            None
         } else {
-            if checkpoint_path.exists() {
-                bail!("{} already holds a training run: add --resume to continue it, or choose another --out", out.display());
+            if out.join(CHECKPOINT).exists() {
+                bail!(
+                    "{} already holds a training run: add --resume to continue it, or choose another --out",
+                    out.display()
+                );
             }
-            let config = match &args.config {
+            Some(match &args.config {
                 Some(path) => load_config(path)?,
-                None => SolverTrainConfig::default(),
-            };
-            Run::start(out, mode, config)?
+                None => TrainConfig::default(),
+            })
         };
-        run.train(args)
+        match mode.solver_only() {
+            Some(source) => {
+                let build = |config: &TrainConfig, state: Option<serde_json::Value>| {
+                    let state: SourceState = match state {
+                        Some(json) => serde_json::from_value(json).context("level source")?,
+                        None => SourceState::default(),
+                    };
+                    Ok(PlatformSolverEnvs::new(
+                        source,
+                        config.solver.num_envs,
+                        state,
+                    ))
+                };
+                let mut run = match config {
+                    Some(config) => Run::start(out, mode, config, build)?,
+                    None => Run::resume(out, mode, build)?,
+                };
+                train_loop(&mut run, args)
+            }
+            None => {
+                let mut run = match config {
+                    Some(config) => AdversarialRun::start(out, mode, config)?,
+                    None => AdversarialRun::resume(out, mode)?,
+                };
+                train_loop(&mut run, args)
+            }
+        }
     })
 }
 
-fn load_config(path: &Path) -> Result<SolverTrainConfig> {
+fn load_config(path: &Path) -> Result<TrainConfig> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let config: SolverTrainConfig =
+    let config: TrainConfig =
         serde_yaml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let p = &config.ppo;
-    if config.hidden.is_empty()
-        || config.hidden.contains(&0)
-        || p.num_envs == 0
-        || p.num_steps == 0
-        || p.num_minibatches == 0
-        || p.update_epochs == 0
-    {
-        bail!(
-            "{}: hidden sizes, num_envs, num_steps, num_minibatches and update_epochs must be at least 1",
-            path.display()
-        );
-    }
-    let valid = p.learning_rate.is_finite()
-        && p.learning_rate > 0.0
-        && (0.0..=1.0).contains(&p.gamma)
-        && (0.0..=1.0).contains(&p.gae_lambda);
-    if !valid {
-        bail!(
-            "{}: learning_rate must be > 0, gamma and gae_lambda within [0, 1]",
-            path.display()
-        );
-    }
+    check_config(&config).map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))?;
     Ok(config)
 }
 
-/// A training run in progress.
-struct Run {
-    out: PathBuf,
-    mode: SolverMode,
-    config: SolverTrainConfig,
-    trainer: Trainer<PlatformSolverEnvs>,
-    iteration: u64,
-    wall_before: f64,
-}
-
-impl Run {
-    fn shape(config: &SolverTrainConfig) -> PolicyShape {
-        PolicyShape {
-            observation: crate::game::platform::OBSERVATION_SIZE,
-            hidden: config.hidden.clone(),
-            continuous: platform::CONTINUOUS_ACTIONS.len(),
-            binary: platform::BINARY_ACTIONS.len(),
+/// Checks the values serde cannot: sizes, ranges, finite numbers.
+fn check_config(config: &TrainConfig) -> Result<(), String> {
+    if config.hidden.is_empty() || config.hidden.contains(&0) {
+        return Err("hidden: give at least one layer, each of at least 1 unit".into());
+    }
+    for (name, p) in [
+        ("solver", &config.solver),
+        ("generator.ppo", &config.generator.ppo),
+    ] {
+        if p.num_envs == 0 || p.num_steps == 0 || p.num_minibatches == 0 || p.update_epochs == 0 {
+            return Err(format!(
+                "{name}: num_envs, num_steps, num_minibatches and update_epochs must be at least 1"
+            ));
+        }
+        let valid = p.learning_rate.is_finite()
+            && p.learning_rate > 0.0
+            && (0.0..=1.0).contains(&p.gamma)
+            && (0.0..=1.0).contains(&p.gae_lambda);
+        if !valid {
+            return Err(format!(
+                "{name}: learning_rate must be > 0, gamma and gae_lambda within [0, 1]"
+            ));
         }
     }
+    let g = &config.generator;
+    if g.aux_values.is_empty() || g.aux_values.iter().any(|l| !(-1.0..=1.0).contains(l)) {
+        return Err("generator.aux_values: give at least one, each within [-1, 1]".into());
+    }
+    if g.rewards.aux.len() != 1 {
+        return Err(format!(
+            "generator.rewards.aux: the platform game has 1 aux input, so give 1 weight pair, not {}",
+            g.rewards.aux.len()
+        ));
+    }
+    let r = &g.rewards;
+    let weights = r.aux.iter().flat_map(|w| [w.alpha, w.beta]);
+    if ![r.progress_per_metre, r.failure, r.step_penalty, r.invalid]
+        .into_iter()
+        .chain(weights)
+        .all(f32::is_finite)
+    {
+        return Err("generator.rewards: every weight must be a finite number".into());
+    }
+    if !(1..=crate::level::platform::MAX_BLOCKS).contains(&g.max_blocks) {
+        return Err(format!(
+            "generator.max_blocks must be within [1, {}]",
+            crate::level::platform::MAX_BLOCKS
+        ));
+    }
+    if g.solver_phase_steps == 0 || g.generator_phase_steps == 0 {
+        return Err(
+            "generator: solver_phase_steps and generator_phase_steps must be at least 1".into(),
+        );
+    }
+    Ok(())
+}
 
-    fn start(out: &Path, mode: SolverMode, config: SolverTrainConfig) -> Result<Self> {
+/// What the training loop drives: one iteration at a time, checkpoints, the final policies.
+trait Training {
+    /// Solver environment steps learned from so far (the budget `--steps` counts).
+    fn solver_steps(&self) -> u64;
+    /// Wall-clock seconds of earlier sessions.
+    fn wall_before(&self) -> f64;
+    /// One PPO iteration (of whichever agent learns now) at `lr_scale` times the configured
+    /// learning rates; returns the progress bar's message.
+    fn iterate(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String>;
+    fn checkpoint_minutes(&self) -> f64;
+    fn save_checkpoint(&self, wall: f64) -> Result<()>;
+    fn save_policies(&self, wall: f64) -> Result<()>;
+    fn out(&self) -> &Path;
+}
+
+fn train_loop(run: &mut dyn Training, args: &TrainArgs) -> Result<()> {
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        // A second handler cannot be installed (tests run several runs in one process).
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    let session = Instant::now();
+    let wall_before = run.wall_before();
+    let wall = || wall_before + session.elapsed().as_secs_f64();
+    let mut last_checkpoint = Instant::now();
+    let total_steps = args.steps;
+    let bar = match total_steps {
+        Some(total) => crate::commands::progress_bar(total, "training"),
+        None => crate::commands::progress_bar(
+            args.minutes.map_or(0, |m| (m * 60.0) as u64),
+            "training (s)",
+        ),
+    };
+    bar.set_position(match total_steps {
+        Some(_) => run.solver_steps(),
+        None => 0,
+    });
+    loop {
+        let done_by_steps = total_steps.is_some_and(|t| run.solver_steps() >= t);
+        let done_by_time = args
+            .minutes
+            .is_some_and(|m| session.elapsed().as_secs_f64() >= m * 60.0);
+        if done_by_steps || done_by_time || stop.load(Ordering::SeqCst) {
+            break;
+        }
+        let lr_scale = match total_steps {
+            Some(total) => (1.0 - run.solver_steps() as f64 / total as f64).max(0.0),
+            None => 1.0,
+        };
+        let message = run.iterate(lr_scale, &wall)?;
+        bar.set_message(message);
+        match total_steps {
+            Some(_) => bar.set_position(run.solver_steps()),
+            None => bar.set_position(session.elapsed().as_secs()),
+        }
+        if last_checkpoint.elapsed().as_secs_f64() >= run.checkpoint_minutes() * 60.0 {
+            run.save_checkpoint(wall())?;
+            last_checkpoint = Instant::now();
+        }
+    }
+    bar.finish_and_clear();
+    let wall = wall();
+    run.save_checkpoint(wall)?;
+    run.save_policies(wall)?;
+    let why = if stop.load(Ordering::SeqCst) {
+        "stopped (Ctrl-C)"
+    } else {
+        "finished"
+    };
+    println!(
+        "{why} at {} Solver steps after {:.1} min in all; checkpoints and policies in {}",
+        run.solver_steps(),
+        wall / 60.0,
+        run.out().display()
+    );
+    Ok(())
+}
+
+/// Environments whose progress is saved in checkpoints.
+trait Resumable: VecEnv {
+    fn source_state(&self) -> serde_json::Value;
+}
+
+impl Resumable for PlatformSolverEnvs {
+    fn source_state(&self) -> serde_json::Value {
+        serde_json::to_value(self.state()).expect("source states serialize")
+    }
+}
+
+impl Resumable for AdversarialEnvs {
+    fn source_state(&self) -> serde_json::Value {
+        serde_json::to_value(self.state).expect("source states serialize")
+    }
+}
+
+/// The Solver's policy shape.
+fn solver_shape(config: &TrainConfig) -> PolicyShape {
+    PolicyShape {
+        observation: crate::game::platform::OBSERVATION_SIZE,
+        hidden: config.hidden.clone(),
+        continuous: platform::CONTINUOUS_ACTIONS.len(),
+        binary: platform::BINARY_ACTIONS.len(),
+    }
+}
+
+/// The Generator's policy shape.
+fn generator_shape(config: &TrainConfig) -> PolicyShape {
+    PolicyShape {
+        observation: GENERATOR_OBSERVATION_SIZE,
+        hidden: config.hidden.clone(),
+        continuous: GENERATOR_ACTIONS.len(),
+        binary: 0,
+    }
+}
+
+/// A policy card for a policy trained by this run.
+fn card(
+    role: Role,
+    mode: TrainMode,
+    config: &TrainConfig,
+    normalizer: &RunningNorm,
+    steps: u64,
+    wall_time_s: f64,
+) -> PolicyCard {
+    let names = |list: &[&str]| list.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let layout = |list: &[(&str, usize)]| {
+        list.iter()
+            .map(|(n, k)| (n.to_string(), *k))
+            .collect::<Vec<_>>()
+    };
+    let (observation, continuous_actions, binary_actions, network) = match role {
+        Role::Solver => (
+            platform::observation_layout(),
+            names(&platform::CONTINUOUS_ACTIONS),
+            names(&platform::BINARY_ACTIONS),
+            solver_shape(config),
+        ),
+        Role::Generator => (
+            layout(&GENERATOR_OBSERVATION_LAYOUT),
+            names(&GENERATOR_ACTIONS),
+            Vec::new(),
+            generator_shape(config),
+        ),
+    };
+    PolicyCard {
+        format: checkpoint::POLICY_FORMAT.into(),
+        version: checkpoint::POLICY_VERSION,
+        game: Game::Platform,
+        role,
+        observation,
+        continuous_actions,
+        binary_actions,
+        network,
+        normalizer: normalizer.clone(),
+        training: TrainingRecord {
+            mode: mode.name().into(),
+            steps,
+            wall_time_s: (wall_time_s * 10.0).round() / 10.0,
+            seed: config.seed,
+            commit: git_commit(),
+            command: std::iter::once("arlpcg".to_string())
+                .chain(std::env::args().skip(1))
+                .collect::<Vec<_>>()
+                .join(" "),
+        },
+        results: Default::default(),
+    }
+}
+
+/// Writes a policy and its YAML card (`<name>.safetensors`, `<name>.yaml`) into `out`.
+fn save_policy_files(
+    out: &Path,
+    name: &str,
+    policy: &ActorCritic,
+    card: &PolicyCard,
+) -> Result<()> {
+    fsio::write_atomic(
+        &out.join(format!("{name}.safetensors")),
+        &checkpoint::policy_bytes(policy, card),
+        Overwrite::Allowed,
+    )?;
+    fsio::write_atomic(
+        &out.join(format!("{name}.yaml")),
+        serde_yaml::to_string(card)?.as_bytes(),
+        Overwrite::Allowed,
+    )
+}
+
+/// A Solver training run in progress (the Solver-only modes, and the Solver of the adversarial
+/// ones, whose environments hold the Generator).
+struct Run<E: Resumable> {
+    out: PathBuf,
+    mode: TrainMode,
+    config: TrainConfig,
+    trainer: Trainer<E>,
+    iteration: u64,
+    wall_before: f64,
+    metrics: std::fs::File,
+}
+
+impl<E: Resumable> Run<E> {
+    fn start(
+        out: &Path,
+        mode: TrainMode,
+        config: TrainConfig,
+        build: impl FnOnce(&TrainConfig, Option<serde_json::Value>) -> Result<E>,
+    ) -> Result<Self> {
         std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
         fsio::write_atomic(
             &out.join("config.yaml"),
@@ -172,18 +520,12 @@ impl Run {
             format!("{METRICS_HEADER}\n").as_bytes(),
             Overwrite::Allowed,
         )?;
-        let policy = ActorCritic::new(Self::shape(&config), config.seed)?;
-        let ppo = Ppo::new(config.ppo.clone(), policy)?;
-        let envs = PlatformSolverEnvs::new(
-            mode,
-            config.ppo.num_envs,
-            SourceState {
-                levels_drawn: 0,
-                episodes_started: 0,
-            },
-        );
+        let policy = ActorCritic::new(solver_shape(&config), config.seed)?;
+        let ppo = Ppo::new(config.solver.clone(), policy)?;
+        let envs = build(&config, None)?;
         let trainer = Trainer::new(ppo, envs, config.seed);
         Ok(Self {
+            metrics: open_append(&out.join(METRICS))?,
             out: out.to_path_buf(),
             mode,
             config,
@@ -193,44 +535,29 @@ impl Run {
         })
     }
 
-    fn resume(out: &Path, mode: SolverMode) -> Result<Self> {
+    fn resume(
+        out: &Path,
+        mode: TrainMode,
+        build: impl FnOnce(&TrainConfig, Option<serde_json::Value>) -> Result<E>,
+    ) -> Result<Self> {
         let path = out.join(CHECKPOINT);
-        let bytes = std::fs::read(&path)
-            .with_context(|| format!("cannot resume: cannot read {}", path.display()))?;
-        let loaded = checkpoint::load_policy(
-            &bytes,
-            Game::Platform,
-            Role::Solver,
-            crate::game::platform::OBSERVATION_SIZE,
-        )
-        .with_context(|| format!("{}", path.display()))?;
-        let state = loaded
-            .training_state()
-            .with_context(|| format!("{}", path.display()))?;
-        if loaded.card.training.mode != mode.name() {
-            bail!(
-                "{} was trained with --mode {}, not {}",
-                path.display(),
-                loaded.card.training.mode,
-                mode.name()
-            );
-        }
-        let config: SolverTrainConfig = serde_json::from_value(state.config.clone())
+        let (loaded, state) = read_checkpoint(&path, Role::Solver, mode)?;
+        let config: TrainConfig = serde_json::from_value(state.config.clone())
             .with_context(|| format!("{}: configuration", path.display()))?;
-        let source: SourceState = serde_json::from_value(state.source.clone())
-            .with_context(|| format!("{}: level source", path.display()))?;
         let vars = loaded.policy.named_vars();
-        let mut ppo = Ppo::new(config.ppo.clone(), loaded.policy)?;
+        let mut ppo = Ppo::new(config.solver.clone(), loaded.policy)?;
         ppo.adam
             .restore(&vars, &loaded.tensors, state.adam_step)
             .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        let envs = PlatformSolverEnvs::new(mode, config.ppo.num_envs, source);
+        let envs = build(&config, Some(state.source.clone()))
+            .with_context(|| format!("{}", path.display()))?;
         let mut trainer = Trainer::new(ppo, envs, config.seed);
         trainer.norm = loaded.card.normalizer.clone();
         trainer.rng = state.rng;
         trainer.global_step = state.global_step;
-        truncate_metrics(&out.join(METRICS), state.iteration)?;
+        truncate_metrics(&out.join(METRICS), METRICS_HEADER, state.iteration)?;
         Ok(Self {
+            metrics: open_append(&out.join(METRICS))?,
             out: out.to_path_buf(),
             mode,
             config,
@@ -240,182 +567,401 @@ impl Run {
         })
     }
 
-    fn card(&self, wall_time_s: f64) -> PolicyCard {
-        PolicyCard {
-            format: checkpoint::POLICY_FORMAT.into(),
-            version: checkpoint::POLICY_VERSION,
-            game: Game::Platform,
-            role: Role::Solver,
-            observation: platform::observation_layout(),
-            continuous_actions: platform::CONTINUOUS_ACTIONS.map(String::from).to_vec(),
-            binary_actions: platform::BINARY_ACTIONS.map(String::from).to_vec(),
-            network: Self::shape(&self.config),
-            normalizer: self.trainer.norm.clone(),
-            training: TrainingRecord {
-                mode: self.mode.name().into(),
-                steps: self.trainer.global_step,
-                wall_time_s: (wall_time_s * 10.0).round() / 10.0,
-                seed: self.config.seed,
-                commit: git_commit(),
-                command: std::iter::once("arlpcg".to_string())
-                    .chain(std::env::args().skip(1))
-                    .collect::<Vec<_>>()
-                    .join(" "),
-            },
-            results: Default::default(),
-        }
-    }
-
-    fn save_checkpoint(&self, wall_time_s: f64) -> Result<()> {
+    fn save_solver_checkpoint(&self, wall_time_s: f64) -> Result<()> {
         let state = TrainingState {
             global_step: self.trainer.global_step,
             iteration: self.iteration,
             adam_step: self.trainer.ppo.adam.step,
             wall_time_s,
             rng: self.trainer.rng.clone(),
-            source: serde_json::to_value(self.trainer.env.state())?,
+            source: self.trainer.env.source_state(),
             config: serde_json::to_value(&self.config)?,
         };
-        let bytes =
-            checkpoint::checkpoint_bytes(&self.trainer.ppo, &self.card(wall_time_s), &state);
+        let card = self.solver_card(wall_time_s);
+        let bytes = checkpoint::checkpoint_bytes(&self.trainer.ppo, &card, &state);
         fsio::write_atomic(&self.out.join(CHECKPOINT), &bytes, Overwrite::Allowed)
     }
 
-    fn save_policy(&self, wall_time_s: f64) -> Result<()> {
-        let card = self.card(wall_time_s);
-        fsio::write_atomic(
-            &self.out.join("solver.safetensors"),
-            &checkpoint::policy_bytes(&self.trainer.ppo.policy, &card),
-            Overwrite::Allowed,
-        )?;
-        fsio::write_atomic(
-            &self.out.join("solver.yaml"),
-            serde_yaml::to_string(&card)?.as_bytes(),
-            Overwrite::Allowed,
+    fn solver_card(&self, wall_time_s: f64) -> PolicyCard {
+        card(
+            Role::Solver,
+            self.mode,
+            &self.config,
+            &self.trainer.norm,
+            self.trainer.global_step,
+            wall_time_s,
         )
     }
 
-    fn train(&mut self, args: &TrainArgs) -> Result<()> {
-        let stop = Arc::new(AtomicBool::new(false));
-        {
-            let stop = stop.clone();
-            // A second handler cannot be installed (tests run several runs in one process).
-            let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
-        }
-        let session = Instant::now();
-        let mut last_checkpoint = Instant::now();
-        let config = self.config.ppo.clone();
-        let total_steps = args.steps;
-        let bar = match total_steps {
-            Some(total) => crate::commands::progress_bar(total, "training"),
-            None => crate::commands::progress_bar(
-                args.minutes.map_or(0, |m| (m * 60.0) as u64),
-                "training (s)",
-            ),
-        };
-        bar.set_position(match total_steps {
-            Some(_) => self.trainer.global_step,
-            None => 0,
-        });
-        let mut metrics = std::fs::OpenOptions::new()
-            .append(true)
-            .open(self.out.join(METRICS))
-            .context("cannot open metrics.csv")?;
-        loop {
-            let done_by_steps = total_steps.is_some_and(|t| self.trainer.global_step >= t);
-            let done_by_time = args
-                .minutes
-                .is_some_and(|m| session.elapsed().as_secs_f64() >= m * 60.0);
-            if done_by_steps || done_by_time || stop.load(Ordering::SeqCst) {
-                break;
-            }
-            let learning_rate = match (config.anneal_lr, total_steps) {
-                (true, Some(total)) => {
-                    config.learning_rate
-                        * (1.0 - self.trainer.global_step as f64 / total as f64).max(0.0)
-                }
-                _ => config.learning_rate,
-            };
-            let t0 = Instant::now();
-            let (batch, rollout) = self.trainer.collect()?;
-            let t1 = Instant::now();
-            let update = self.trainer.learn(&batch, learning_rate)?;
-            let t2 = Instant::now();
-            self.iteration += 1;
-            let wall = self.wall_before + session.elapsed().as_secs_f64();
-            let timing = [(t1 - t0).as_secs_f64(), (t2 - t1).as_secs_f64()];
-            writeln!(
-                metrics,
-                "{}",
-                self.metrics_row(wall, timing, learning_rate, &rollout, &update)
-            )?;
-            bar.set_message(format!(
-                "return {:.2}, success {:.2}, {:.0} steps/s",
-                rollout.mean_return,
-                rollout.success_ratio,
-                rollout.steps as f64 / (timing[0] + timing[1])
-            ));
-            match total_steps {
-                Some(_) => bar.set_position(self.trainer.global_step),
-                None => bar.set_position(session.elapsed().as_secs()),
-            }
-            if last_checkpoint.elapsed().as_secs_f64() >= self.config.checkpoint_minutes * 60.0 {
-                self.save_checkpoint(wall)?;
-                last_checkpoint = Instant::now();
-            }
-        }
-        bar.finish_and_clear();
-        let wall = self.wall_before + session.elapsed().as_secs_f64();
-        self.save_checkpoint(wall)?;
-        self.save_policy(wall)?;
-        let why = if stop.load(Ordering::SeqCst) {
-            "stopped (Ctrl-C)"
+    /// Collects a rollout, updates the Solver, logs a metrics row.
+    fn solver_iteration(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<RolloutStats> {
+        let learning_rate = if self.config.solver.anneal_lr {
+            self.config.solver.learning_rate * lr_scale
         } else {
-            "finished"
+            self.config.solver.learning_rate
         };
-        println!(
-            "{why} at {} steps after {:.1} min in all; checkpoint and solver.safetensors in {}",
-            self.trainer.global_step,
-            wall / 60.0,
-            self.out.display()
-        );
-        Ok(())
-    }
-
-    fn metrics_row(
-        &self,
-        wall: f64,
-        [rollout_s, update_s]: [f64; 2],
-        learning_rate: f64,
-        r: &RolloutStats,
-        u: &UpdateStats,
-    ) -> String {
-        format!(
-            "{},{},{:.2},{:.1},{:.3},{:.3},{:.3e},{},{:.4},{:.4},{:.5},{:.5},{:.4},{:.5},{:.4},{:.4}",
+        let t0 = Instant::now();
+        let (batch, rollout) = self.trainer.collect()?;
+        let t1 = Instant::now();
+        let update = self.trainer.learn(&batch, learning_rate)?;
+        let t2 = Instant::now();
+        self.iteration += 1;
+        let (rollout_s, update_s) = ((t1 - t0).as_secs_f64(), (t2 - t1).as_secs_f64());
+        writeln!(
+            self.metrics,
+            "{},{},{:.2},{:.1},{:.3},{:.3},{:.3e},{},{:.4},{:.4},{}",
             self.iteration,
             self.trainer.global_step,
-            wall,
-            r.steps as f64 / (rollout_s + update_s),
+            wall(),
+            rollout.steps as f64 / (rollout_s + update_s),
             rollout_s,
             update_s,
             learning_rate,
-            r.episodes,
-            r.mean_return,
-            r.success_ratio,
-            u.policy_loss,
-            u.value_loss,
-            u.entropy,
-            u.approx_kl,
-            u.clip_fraction,
-            u.explained_variance
+            rollout.episodes,
+            rollout.mean_return,
+            rollout.success_ratio,
+            update_columns(&update)
+        )?;
+        Ok(rollout)
+    }
+}
+
+/// The loss columns of a metrics row.
+fn update_columns(u: &UpdateStats) -> String {
+    format!(
+        "{:.5},{:.5},{:.4},{:.5},{:.4},{:.4}",
+        u.policy_loss, u.value_loss, u.entropy, u.approx_kl, u.clip_fraction, u.explained_variance
+    )
+}
+
+fn open_append(path: &Path) -> Result<std::fs::File> {
+    std::fs::OpenOptions::new()
+        .append(true)
+        .open(path)
+        .with_context(|| format!("cannot open {}", path.display()))
+}
+
+/// Reads a checkpoint of `role`, checking that it was trained in `mode`.
+fn read_checkpoint(
+    path: &Path,
+    role: Role,
+    mode: TrainMode,
+) -> Result<(checkpoint::LoadedPolicy, TrainingState)> {
+    let bytes = std::fs::read(path)
+        .with_context(|| format!("cannot resume: cannot read {}", path.display()))?;
+    let observation = match role {
+        Role::Solver => crate::game::platform::OBSERVATION_SIZE,
+        Role::Generator => GENERATOR_OBSERVATION_SIZE,
+    };
+    let loaded = checkpoint::load_policy(&bytes, Game::Platform, role, observation)
+        .with_context(|| format!("{}", path.display()))?;
+    let state = loaded
+        .training_state()
+        .with_context(|| format!("{}", path.display()))?;
+    if loaded.card.training.mode != mode.name() {
+        bail!(
+            "{} was trained with --mode {}, not {}",
+            path.display(),
+            loaded.card.training.mode,
+            mode.name()
+        );
+    }
+    Ok((loaded, state))
+}
+
+impl Training for Run<PlatformSolverEnvs> {
+    fn solver_steps(&self) -> u64 {
+        self.trainer.global_step
+    }
+
+    fn wall_before(&self) -> f64 {
+        self.wall_before
+    }
+
+    fn iterate(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String> {
+        let t0 = Instant::now();
+        let rollout = self.solver_iteration(lr_scale, wall)?;
+        Ok(format!(
+            "return {:.2}, success {:.2}, {:.0} steps/s",
+            rollout.mean_return,
+            rollout.success_ratio,
+            rollout.steps as f64 / t0.elapsed().as_secs_f64()
+        ))
+    }
+
+    fn checkpoint_minutes(&self) -> f64 {
+        self.config.checkpoint_minutes
+    }
+
+    fn save_checkpoint(&self, wall: f64) -> Result<()> {
+        self.save_solver_checkpoint(wall)
+    }
+
+    fn save_policies(&self, wall: f64) -> Result<()> {
+        save_policy_files(
+            &self.out,
+            "solver",
+            &self.trainer.ppo.policy,
+            &self.solver_card(wall),
         )
+    }
+
+    fn out(&self) -> &Path {
+        &self.out
+    }
+}
+
+/// An adversarial run: the Solver's run, whose environments hold the Generator, and the
+/// Generator's own counters and metrics.
+struct AdversarialRun {
+    solver: Run<AdversarialEnvs>,
+    generator_iteration: u64,
+    generator_metrics: std::fs::File,
+}
+
+impl AdversarialRun {
+    fn rules(mode: TrainMode, config: &TrainConfig) -> MatchRules {
+        MatchRules {
+            aux_values: match mode {
+                TrainMode::FixedAux => vec![1.0],
+                _ => config.generator.aux_values.clone(),
+            },
+            max_blocks: config.generator.max_blocks,
+            rewards: config.generator.rewards.clone(),
+        }
+    }
+
+    fn start(out: &Path, mode: TrainMode, config: TrainConfig) -> Result<Self> {
+        let build = |config: &TrainConfig, _: Option<serde_json::Value>| {
+            let policy = ActorCritic::new(generator_shape(config), config.seed.wrapping_add(1))?;
+            let generator = Generator {
+                ppo: Ppo::new(config.generator.ppo.clone(), policy)?,
+                norm: RunningNorm::new(GENERATOR_OBSERVATION_SIZE),
+            };
+            let rng = ChaCha8Rng::seed_from_u64(config.seed.wrapping_add(1));
+            Ok(AdversarialEnvs::new(
+                config.solver.num_envs,
+                generator,
+                rng,
+                Self::rules(mode, config),
+                AdversarialState::default(),
+            )?)
+        };
+        let solver = Run::start(out, mode, config, build)?;
+        fsio::write_atomic(
+            &out.join(GENERATOR_METRICS),
+            format!("{GENERATOR_METRICS_HEADER}\n").as_bytes(),
+            Overwrite::Allowed,
+        )?;
+        Ok(Self {
+            solver,
+            generator_iteration: 0,
+            generator_metrics: open_append(&out.join(GENERATOR_METRICS))?,
+        })
+    }
+
+    fn resume(out: &Path, mode: TrainMode) -> Result<Self> {
+        let path = out.join(GENERATOR_CHECKPOINT);
+        let (loaded, generator_state) = read_checkpoint(&path, Role::Generator, mode)?;
+        let generator_iteration = generator_state.iteration;
+        let build = move |config: &TrainConfig, source: Option<serde_json::Value>| {
+            let state: AdversarialState =
+                serde_json::from_value(source.unwrap_or_default()).context("match source")?;
+            let vars = loaded.policy.named_vars();
+            let mut ppo = Ppo::new(config.generator.ppo.clone(), loaded.policy)?;
+            ppo.adam
+                .restore(&vars, &loaded.tensors, generator_state.adam_step)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            let generator = Generator {
+                ppo,
+                norm: loaded.card.normalizer.clone(),
+            };
+            // Unfinished matches are gone: the run goes on with fresh ones, in the same phase.
+            Ok(AdversarialEnvs::new(
+                config.solver.num_envs,
+                generator,
+                generator_state.rng,
+                Self::rules(mode, config),
+                state,
+            )?)
+        };
+        let solver = Run::resume(out, mode, build)?;
+        truncate_metrics(
+            &out.join(GENERATOR_METRICS),
+            GENERATOR_METRICS_HEADER,
+            generator_iteration,
+        )?;
+        Ok(Self {
+            solver,
+            generator_iteration,
+            generator_metrics: open_append(&out.join(GENERATOR_METRICS))?,
+        })
+    }
+
+    fn envs(&mut self) -> &mut AdversarialEnvs {
+        &mut self.solver.trainer.env
+    }
+
+    fn generator_card(&self, wall_time_s: f64) -> PolicyCard {
+        let envs = &self.solver.trainer.env;
+        card(
+            Role::Generator,
+            self.solver.mode,
+            &self.solver.config,
+            &envs.generator.norm,
+            envs.state.generator_steps,
+            wall_time_s,
+        )
+    }
+
+    /// Plays until a batch of Generator decisions is complete, and learns from it.
+    fn generator_iteration(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String> {
+        let config = self.solver.config.generator.ppo.clone();
+        let learning_rate = if config.anneal_lr {
+            config.learning_rate * lr_scale
+        } else {
+            config.learning_rate
+        };
+        let t0 = Instant::now();
+        self.envs().take_stats();
+        while self.envs().completed_decisions() < config.batch_size() {
+            self.solver.trainer.play_tick()?;
+        }
+        let batch = self.envs().take_generator_batch();
+        let stats = self.envs().take_stats();
+        let t1 = Instant::now();
+        let envs = self.envs();
+        let update = envs
+            .generator
+            .ppo
+            .update(&batch, learning_rate, &mut envs.rng)?;
+        let t2 = Instant::now();
+        let decisions = batch.log_probs.len() as u64;
+        envs.state.generator_steps += decisions;
+        envs.state.phase_steps += decisions;
+        self.generator_iteration += 1;
+        let row = generator_row(&stats);
+        writeln!(
+            self.generator_metrics,
+            "{},{},{},{:.2},{:.3},{:.3},{:.3e},{row},{}",
+            self.generator_iteration,
+            self.solver.trainer.global_step,
+            self.solver.trainer.env.state.generator_steps,
+            wall(),
+            (t1 - t0).as_secs_f64(),
+            (t2 - t1).as_secs_f64(),
+            learning_rate,
+            update_columns(&update)
+        )?;
+        let ratio = |a: u32, b: u32| a as f64 / b.max(1) as f64;
+        Ok(format!(
+            "generator: success easy {:.2} / hard {:.2}, invalid {:.2}",
+            ratio(stats.successes[0], stats.judged[0]),
+            ratio(stats.successes[1], stats.judged[1]),
+            ratio(stats.invalid, stats.episodes)
+        ))
+    }
+}
+
+/// The match columns of a Generator metrics row.
+fn generator_row(s: &MatchStats) -> String {
+    let ratio = |a: f64, b: u32| if b == 0 { f64::NAN } else { a / b as f64 };
+    format!(
+        "{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}",
+        s.episodes,
+        ratio(s.generator_return_sum, s.episodes),
+        ratio(s.invalid as f64, s.episodes),
+        ratio(s.successes[0] as f64, s.judged[0]),
+        ratio(s.successes[1] as f64, s.judged[1]),
+        ratio(s.distance_sum[0], s.blocks[0]),
+        ratio(s.distance_sum[1], s.blocks[1]),
+        ratio(s.size_sum[0], s.blocks[0]),
+        ratio(s.size_sum[1], s.blocks[1]),
+    )
+}
+
+impl Training for AdversarialRun {
+    fn solver_steps(&self) -> u64 {
+        self.solver.trainer.global_step
+    }
+
+    fn wall_before(&self) -> f64 {
+        self.solver.wall_before
+    }
+
+    fn iterate(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String> {
+        let phases = self.solver.config.generator.clone();
+        match self.envs().state.phase {
+            Phase::Solver => {
+                let rollout = self.solver.solver_iteration(lr_scale, wall)?;
+                let envs = self.envs();
+                envs.state.phase_steps += rollout.steps;
+                if envs.state.phase_steps >= phases.solver_phase_steps {
+                    envs.set_phase(Phase::Generator);
+                }
+                Ok(format!(
+                    "solver: return {:.2}, success {:.2}",
+                    rollout.mean_return, rollout.success_ratio
+                ))
+            }
+            Phase::Generator => {
+                let message = self.generator_iteration(lr_scale, wall)?;
+                let envs = self.envs();
+                if envs.state.phase_steps >= phases.generator_phase_steps {
+                    envs.set_phase(Phase::Solver);
+                }
+                Ok(message)
+            }
+        }
+    }
+
+    fn checkpoint_minutes(&self) -> f64 {
+        self.solver.config.checkpoint_minutes
+    }
+
+    fn save_checkpoint(&self, wall: f64) -> Result<()> {
+        let envs = &self.solver.trainer.env;
+        let state = TrainingState {
+            global_step: envs.state.generator_steps,
+            iteration: self.generator_iteration,
+            adam_step: envs.generator.ppo.adam.step,
+            wall_time_s: wall,
+            rng: envs.rng.clone(),
+            source: serde_json::Value::Null,
+            config: serde_json::to_value(&self.solver.config)?,
+        };
+        let bytes =
+            checkpoint::checkpoint_bytes(&envs.generator.ppo, &self.generator_card(wall), &state);
+        let out = &self.solver.out;
+        fsio::write_atomic(&out.join(GENERATOR_CHECKPOINT), &bytes, Overwrite::Allowed)?;
+        self.solver.save_solver_checkpoint(wall)
+    }
+
+    fn save_policies(&self, wall: f64) -> Result<()> {
+        let out = &self.solver.out;
+        save_policy_files(
+            out,
+            "generator",
+            &self.solver.trainer.env.generator.ppo.policy,
+            &self.generator_card(wall),
+        )?;
+        save_policy_files(
+            out,
+            "solver",
+            &self.solver.trainer.ppo.policy,
+            &self.solver.solver_card(wall),
+        )
+    }
+
+    fn out(&self) -> &Path {
+        &self.solver.out
     }
 }
 
 /// Drops metric rows written after the checkpoint a run resumes from, so the curve continues
 /// without a gap or a repeat.
-fn truncate_metrics(path: &Path, last_iteration: u64) -> Result<()> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|_| format!("{METRICS_HEADER}\n"));
+fn truncate_metrics(path: &Path, header: &str, last_iteration: u64) -> Result<()> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|_| format!("{header}\n"));
     let kept: Vec<&str> = text
         .lines()
         .enumerate()

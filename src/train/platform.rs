@@ -45,7 +45,7 @@ impl SolverMode {
 }
 
 /// Progress of the level source, saved in checkpoints.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct SourceState {
     /// Levels handed out so far.
     pub levels_drawn: u64,

@@ -9,6 +9,7 @@ use super::character::{Character, DECISION_DT, PlatformAction, RADIUS};
 use super::world::PlatformWorld;
 use crate::game::Step;
 use crate::level::PlatformTrack;
+use crate::level::platform::Platform;
 use crate::level::stats::Outcome;
 
 /// Rows and columns of the height map.
@@ -88,6 +89,9 @@ pub struct PlatformEnv {
     /// Path length from each platform's top centre to the last one's, along the track.
     path_after: Vec<f32>,
     max_steps: u32,
+    /// The track is still growing (the Generator places blocks as the Solver advances): reaching
+    /// the last block is not yet success.
+    open: bool,
     character: Character,
     /// Highest platform index the character has stood on (0 is the start block).
     furthest: usize,
@@ -100,28 +104,57 @@ impl PlatformEnv {
     /// The environment of a track leading to `goal`, with the character on the start block.
     pub fn new(track: &PlatformTrack, goal: [f64; 3], rewards: SolverRewards) -> Self {
         let world = PlatformWorld::new(track);
-        let tops: Vec<Vector> = world.platforms().iter().map(|p| p.top).collect();
-        let mut path_after = vec![0.0; tops.len()];
-        for i in (0..tops.len() - 1).rev() {
-            path_after[i] = path_after[i + 1] + tops[i].distance(tops[i + 1]);
-        }
-        let blocks = (tops.len() - 1) as f32;
-        let max_steps = ((TIME_BASE_S + TIME_PER_BLOCK_S * blocks) / DECISION_DT).ceil() as u32;
         let start = world.platforms()[0];
         let mut env = Self {
             world,
             goal: Vector::new(goal[0] as f32, goal[1] as f32, goal[2] as f32),
             rewards,
-            path_after,
-            max_steps,
+            path_after: Vec::new(),
+            max_steps: 0,
+            open: false,
             character: Character::new(start.top, start.heading),
             furthest: 0,
             steps: 0,
             remaining: 0.0,
             outcome: None,
         };
+        env.measure_track();
         env.reset(0);
         env
+    }
+
+    /// The environment of a track the Generator is still building: it starts with `track`
+    /// (often just the start block) and grows with [`PlatformEnv::push_platform`].
+    pub fn open(track: &PlatformTrack, goal: [f64; 3], rewards: SolverRewards) -> Self {
+        let mut env = Self::new(track, goal, rewards);
+        env.open = true;
+        env
+    }
+
+    /// Adds the Generator's next block. `closes`: it is the last one (it reaches the goal), so
+    /// standing on it is success. The run goes on where it was; its time limit grows.
+    pub fn push_platform(&mut self, platform: &Platform, closes: bool) {
+        self.world.push(platform);
+        self.open = !closes;
+        self.measure_track();
+        self.remaining = self.path_remaining();
+    }
+
+    /// Path lengths along the track and the time limit, from the platforms placed so far.
+    fn measure_track(&mut self) {
+        let tops: Vec<Vector> = self.world.platforms().iter().map(|p| p.top).collect();
+        self.path_after = vec![0.0; tops.len()];
+        for i in (0..tops.len() - 1).rev() {
+            self.path_after[i] = self.path_after[i + 1] + tops[i].distance(tops[i + 1]);
+        }
+        let blocks = (tops.len() - 1) as f32;
+        self.max_steps = ((TIME_BASE_S + TIME_PER_BLOCK_S * blocks) / DECISION_DT).ceil() as u32;
+    }
+
+    /// Whether the character stands on the newest block of a growing track: the Generator's
+    /// turn to place the next one.
+    pub fn awaits_platform(&self) -> bool {
+        self.open && self.outcome.is_none() && self.furthest == self.world.platforms().len() - 1
     }
 
     /// Starts a new run: the character stands on the start block, placed and turned at random
@@ -159,7 +192,7 @@ impl PlatformEnv {
         let mut reward = self.rewards.progress_per_metre * (self.remaining - remaining);
         self.remaining = remaining;
         let last = self.world.platforms().len() - 1;
-        let outcome = if self.furthest == last {
+        let outcome = if self.furthest == last && !self.open {
             Some(Outcome::Success)
         } else if self.character.feet.y < self.world.lowest_top() - FALL_MARGIN {
             Some(Outcome::Fell)
@@ -215,6 +248,7 @@ impl PlatformEnv {
     fn path_remaining(&self) -> f32 {
         let last = self.world.platforms().len() - 1;
         if self.furthest == last {
+            // Done, or waiting for the Generator's next block.
             return 0.0;
         }
         let next = self.next_index();
@@ -286,7 +320,7 @@ impl PlatformEnv {
 
     /// Fraction of the blocks reached, in [0, 1].
     pub fn progress(&self) -> f64 {
-        self.furthest as f64 / (self.world.platforms().len() - 1) as f64
+        self.furthest as f64 / (self.world.platforms().len() - 1).max(1) as f64
     }
 
     pub fn steps(&self) -> u32 {

@@ -66,29 +66,6 @@ impl PlatformWorld {
             .iter()
             .map(PlatformBox::from_platform)
             .collect();
-        let mut colliders = ColliderSet::new();
-        let bodies = RigidBodySet::new();
-        let mut broad_phase = BroadPhaseBvh::new();
-        let params = IntegrationParameters::default();
-        let half_thickness = 0.5 * BLOCK_THICKNESS as f32;
-        for (index, block) in platforms.iter().enumerate() {
-            let centre = block.top - Vector::Y * half_thickness;
-            let collider =
-                ColliderBuilder::cuboid(0.5 * block.size, half_thickness, 0.5 * block.size)
-                    .position(Pose::from_parts(
-                        centre,
-                        Rotation::from_rotation_y(block.heading),
-                    ))
-                    .user_data(index as u128)
-                    .build();
-            let aabb = collider.compute_aabb();
-            let handle = colliders.insert(collider);
-            broad_phase.set_aabb(&params, handle, aabb);
-        }
-        let lowest_top = platforms
-            .iter()
-            .map(|p| p.top.y)
-            .fold(f32::INFINITY, f32::min);
         let controller = KinematicCharacterController {
             offset: CharacterLength::Absolute(0.02),
             snap_to_ground: Some(CharacterLength::Absolute(0.1)),
@@ -96,15 +73,42 @@ impl PlatformWorld {
             slide: true,
             ..Default::default()
         };
-        Self {
-            bodies,
-            colliders,
-            broad_phase,
+        let mut world = Self {
+            bodies: RigidBodySet::new(),
+            colliders: ColliderSet::new(),
+            broad_phase: BroadPhaseBvh::new(),
             narrow_phase: NarrowPhase::new(),
             controller,
-            platforms,
-            lowest_top,
+            platforms: Vec::with_capacity(platforms.len()),
+            lowest_top: f32::INFINITY,
+        };
+        for block in platforms {
+            world.add(block);
         }
+        world
+    }
+
+    /// Adds the next platform of a growing track (the Generator's latest block).
+    pub fn push(&mut self, platform: &Platform) {
+        self.add(PlatformBox::from_platform(platform));
+    }
+
+    fn add(&mut self, block: PlatformBox) {
+        let half_thickness = 0.5 * BLOCK_THICKNESS as f32;
+        let centre = block.top - Vector::Y * half_thickness;
+        let collider = ColliderBuilder::cuboid(0.5 * block.size, half_thickness, 0.5 * block.size)
+            .position(Pose::from_parts(
+                centre,
+                Rotation::from_rotation_y(block.heading),
+            ))
+            .user_data(self.platforms.len() as u128)
+            .build();
+        let aabb = collider.compute_aabb();
+        let handle = self.colliders.insert(collider);
+        self.broad_phase
+            .set_aabb(&IntegrationParameters::default(), handle, aabb);
+        self.lowest_top = self.lowest_top.min(block.top.y);
+        self.platforms.push(block);
     }
 
     pub fn platforms(&self) -> &[PlatformBox] {

@@ -1,0 +1,426 @@
+//! The platform Generator's side of the game (SPEC 1.1 and 2): its observation, its action, its
+//! rewards, and a [`Match`]: one Generator building a level while one Solver plays it. The
+//! Generator places the next block only when the Solver stands on the newest one, and its episode
+//! ends with the Solver's.
+//!
+//! Rewards follow the paper's eq. 1 with a vector of aux inputs λᵢ, each with weights αᵢ (on the
+//! Generator's own, internal reward) and βᵢ (on the reward from the Solver's behaviour):
+//! - progress: `progress_per_metre` for every metre the Solver's furthest block comes closer to
+//!   the goal, whatever λ;
+//! - the Solver fails: `failure · Σ βᵢ λᵢ` (with the default `failure = -10` and β = 1: -10·λ,
+//!   +10 at λ = -1, the SPEC's sign);
+//! - each block placed: `step_penalty · Σ αᵢ min(λᵢ, 0)` (a small cost only when λ < 0: finish or
+//!   fail fast);
+//! - an invalid placement (overlap) or a track that runs out of blocks before the goal:
+//!   `invalid`, and the match ends.
+
+use serde::{Deserialize, Serialize};
+
+use super::PlatformAction;
+use super::env::{PlatformEnv, SolverRewards};
+use crate::game::Step;
+use crate::level::platform::{BlockParams, Platform, PlatformTrack, Start};
+use crate::level::stats::Outcome;
+
+/// The named parts of the Generator's observation, in order, with their lengths (one aux input).
+pub const GENERATOR_OBSERVATION_LAYOUT: [(&str, usize); 9] = [
+    ("goal_relative_position", 3),
+    ("goal_bearing_sin_cos", 2),
+    ("goal_distance", 1),
+    ("last_block_size", 1),
+    ("previous_block_relative_position", 3),
+    ("previous_block_size", 1),
+    ("last_turn_sin_cos", 2),
+    ("blocks_left", 1),
+    ("aux", 1),
+];
+
+/// Length of the Generator's observation vector.
+pub const GENERATOR_OBSERVATION_SIZE: usize = {
+    let mut total = 0;
+    let mut i = 0;
+    while i < GENERATOR_OBSERVATION_LAYOUT.len() {
+        total += GENERATOR_OBSERVATION_LAYOUT[i].1;
+        i += 1;
+    }
+    total
+};
+
+/// The Generator's action names, in the policy's order (each a value in [-1, 1] mapped onto its
+/// SPEC range).
+pub const GENERATOR_ACTIONS: [&str; 4] = ["distance", "angle", "size", "height"];
+
+/// The weights of one aux input in the Generator's reward (paper eq. 1).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AuxWeights {
+    /// α: weight on the Generator's internal reward (the per-block cost when λ < 0).
+    pub alpha: f32,
+    /// β: weight on the external reward (the Solver's failure).
+    pub beta: f32,
+}
+
+/// The Generator's reward terms (SPEC 2); see the module documentation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GeneratorRewards {
+    /// Per metre the Solver's furthest block comes closer to the goal.
+    pub progress_per_metre: f32,
+    /// Scaled by Σ βᵢ λᵢ when the Solver fails (falls or times out).
+    pub failure: f32,
+    /// Scaled by Σ αᵢ min(λᵢ, 0) for each block placed.
+    pub step_penalty: f32,
+    /// An overlapping block, or no goal within `max_blocks`: the match ends.
+    pub invalid: f32,
+    /// The weights of each aux input (the platform game uses one).
+    pub aux: Vec<AuxWeights>,
+}
+
+impl Default for GeneratorRewards {
+    fn default() -> Self {
+        Self {
+            progress_per_metre: 0.1,
+            failure: -10.0,
+            step_penalty: 0.1,
+            invalid: -10.0,
+            aux: vec![AuxWeights {
+                alpha: 1.0,
+                beta: 1.0,
+            }],
+        }
+    }
+}
+
+impl GeneratorRewards {
+    /// The reward when the Solver fails, at aux inputs `aux`.
+    pub fn on_failure(&self, aux: &[f32]) -> f32 {
+        self.failure
+            * self
+                .aux
+                .iter()
+                .zip(aux)
+                .map(|(w, l)| w.beta * l)
+                .sum::<f32>()
+    }
+
+    /// The reward for placing a block, at aux inputs `aux`.
+    pub fn per_block(&self, aux: &[f32]) -> f32 {
+        self.step_penalty
+            * self
+                .aux
+                .iter()
+                .zip(aux)
+                .map(|(w, l)| w.alpha * l.min(0.0))
+                .sum::<f32>()
+    }
+}
+
+/// A policy's action row (unbounded Gaussian samples) as block parameters: each value is clipped
+/// to [-1, 1] and mapped onto its range (NaN becomes the middle of the range).
+pub fn block_from_action(row: &[f32]) -> BlockParams {
+    let unit = |v: f32| if v.is_nan() { 0.0 } else { v as f64 };
+    BlockParams::from_unit([unit(row[0]), unit(row[1]), unit(row[2]), unit(row[3])])
+}
+
+/// Writes the Generator's observation of a track (see [`GENERATOR_OBSERVATION_LAYOUT`]) into
+/// `out`: the goal and the previous block in the frame of the last block, and the aux inputs.
+pub fn observe(
+    track: &PlatformTrack,
+    goal: [f64; 3],
+    aux: &[f32],
+    max_blocks: usize,
+    out: &mut [f32],
+) {
+    assert_eq!(
+        out.len(),
+        GENERATOR_OBSERVATION_SIZE,
+        "observation buffer of the wrong size"
+    );
+    let platforms = track.platforms();
+    let last = track.last();
+    let local = |point: [f64; 3]| -> [f64; 3] {
+        let [fx, fz] = crate::level::platform::heading_direction(last.heading);
+        let d = [
+            point[0] - last.position[0],
+            point[1] - last.position[1],
+            point[2] - last.position[2],
+        ];
+        // Forward along the heading, up, and left (a positive turn).
+        [d[0] * fx + d[2] * fz, d[1], d[0] * fz - d[2] * fx]
+    };
+    let to_goal = local(goal);
+    let goal_distance = to_goal[0].hypot(to_goal[2]);
+    let bearing = to_goal[2].atan2(to_goal[0]);
+    let (previous, turn) = match platforms.len() {
+        1 => (None, 0.0),
+        n => (
+            Some(platforms[n - 2]),
+            track.block_params()[n - 2].angle.to_radians(),
+        ),
+    };
+    let previous_position = previous.map_or([0.0; 3], |p| local(p.position).map(|x| x / 10.0));
+    let values = to_goal
+        .map(|x| x / 50.0)
+        .into_iter()
+        .chain([bearing.sin(), bearing.cos(), goal_distance / 50.0])
+        .chain([last.size / 6.0])
+        .chain(previous_position)
+        .chain([previous.map_or(0.0, |p| p.size / 6.0)])
+        .chain([turn.sin(), turn.cos()])
+        .chain([1.0 - track.block_count() as f64 / max_blocks as f64])
+        .map(|x| x as f32)
+        .chain(aux.iter().copied());
+    let mut written = 0;
+    for (slot, value) in out.iter_mut().zip(values) {
+        *slot = value;
+        written += 1;
+    }
+    debug_assert_eq!(written, GENERATOR_OBSERVATION_SIZE);
+}
+
+/// What a Generator's placement led to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Placement {
+    /// Placed; the track goes on.
+    Placed,
+    /// Placed, and it reaches the goal: the track is complete.
+    Completed,
+    /// It overlaps an earlier block (other than the previous one): the match ends.
+    Overlap,
+    /// The track already holds `max_blocks` blocks without reaching the goal: the match ends.
+    OutOfBlocks,
+}
+
+/// One Generator building a level while one Solver plays it.
+pub struct Match {
+    pub goal: [f64; 3],
+    pub aux: Vec<f32>,
+    track: PlatformTrack,
+    env: PlatformEnv,
+    max_blocks: usize,
+    complete: bool,
+    /// Index of the furthest platform the Solver has stood on, as the Generator was last paid.
+    paid_up_to: usize,
+}
+
+impl Match {
+    /// A new match: only the start block stands; the Generator places the first block next.
+    pub fn new(
+        start: Start,
+        goal: [f64; 3],
+        aux: Vec<f32>,
+        max_blocks: usize,
+        solver_seed: u64,
+    ) -> Self {
+        let track = PlatformTrack::new(start);
+        let mut env = PlatformEnv::open(&track, goal, SolverRewards::default());
+        env.reset(solver_seed);
+        Self {
+            goal,
+            aux,
+            track,
+            env,
+            max_blocks,
+            complete: false,
+            paid_up_to: 0,
+        }
+    }
+
+    pub fn track(&self) -> &PlatformTrack {
+        &self.track
+    }
+
+    pub fn env(&self) -> &PlatformEnv {
+        &self.env
+    }
+
+    /// Whether it is the Generator's turn: at the start, and whenever the Solver stands on the
+    /// newest block of an unfinished track.
+    pub fn needs_block(&self) -> bool {
+        !self.complete && (self.track.block_count() == 0 || self.env.awaits_platform())
+    }
+
+    /// The Generator's observation, into `out`.
+    pub fn observe_generator(&self, out: &mut [f32]) {
+        observe(&self.track, self.goal, &self.aux, self.max_blocks, out);
+    }
+
+    /// Places the Generator's block (action row of [`GENERATOR_ACTIONS`]).
+    pub fn place(&mut self, row: &[f32]) -> Placement {
+        if self.track.block_count() >= self.max_blocks {
+            return Placement::OutOfBlocks;
+        }
+        if self.track.push(block_from_action(row)).is_err() {
+            return Placement::Overlap;
+        }
+        let last: Platform = *self.track.last();
+        self.complete = last.reaches(self.goal);
+        self.env.push_platform(&last, self.complete);
+        if self.complete {
+            Placement::Completed
+        } else {
+            Placement::Placed
+        }
+    }
+
+    /// Steps the Solver; returns its step and the Generator's reward from it (progress toward
+    /// the goal, and the failure term when the run failed).
+    pub fn step_solver(
+        &mut self,
+        action: PlatformAction,
+        rewards: &GeneratorRewards,
+    ) -> (Step, f32) {
+        let step = self.env.step(action);
+        let mut generator = 0.0;
+        let furthest = self.env.furthest();
+        if furthest > self.paid_up_to {
+            let platforms = self.track.platforms();
+            let to_goal = |p: &Platform| {
+                let d = [
+                    self.goal[0] - p.position[0],
+                    self.goal[1] - p.position[1],
+                    self.goal[2] - p.position[2],
+                ];
+                (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+            };
+            let gained = to_goal(&platforms[self.paid_up_to]) - to_goal(&platforms[furthest]);
+            generator += rewards.progress_per_metre * gained as f32;
+            self.paid_up_to = furthest;
+        }
+        if matches!(step.outcome, Some(Outcome::Fell | Outcome::TimedOut)) {
+            generator += rewards.on_failure(&self.aux);
+        }
+        (step, generator)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::level::params::{BLOCK_ANGLE, BLOCK_DISTANCE, BLOCK_HEIGHT, BLOCK_SIZE};
+    use crate::level::platform::{direction_heading, wrap_degrees};
+
+    /// The action row that aims the next block straight at `goal` (within the ranges).
+    fn aimed(track: &PlatformTrack, goal: [f64; 3]) -> [f32; 4] {
+        let last = track.last();
+        let (dx, dz) = (goal[0] - last.position[0], goal[2] - last.position[2]);
+        let turn = wrap_degrees(direction_heading(dx, dz) - last.heading);
+        [
+            BLOCK_DISTANCE.to_unit(dx.hypot(dz).clamp(5.0, 6.0)),
+            BLOCK_ANGLE.to_unit(turn),
+            BLOCK_SIZE.to_unit(6.0),
+            BLOCK_HEIGHT.to_unit((goal[1] - last.position[1]).clamp(-1.0, 1.0)),
+        ]
+        .map(|x| x as f32)
+    }
+
+    #[test]
+    fn failure_and_block_rewards_follow_the_sign_of_aux() {
+        let r = GeneratorRewards::default();
+        assert_eq!(r.on_failure(&[-1.0]), 10.0);
+        assert_eq!(r.on_failure(&[1.0]), -10.0);
+        assert_eq!(r.on_failure(&[0.0]), 0.0);
+        assert_eq!(r.per_block(&[1.0]), 0.0);
+        assert_eq!(r.per_block(&[0.5]), 0.0);
+        assert!((r.per_block(&[-0.5]) + 0.05).abs() < 1e-6);
+        let two = GeneratorRewards {
+            aux: vec![
+                AuxWeights {
+                    alpha: 1.0,
+                    beta: 1.0,
+                },
+                AuxWeights {
+                    alpha: 0.0,
+                    beta: 0.5,
+                },
+            ],
+            ..GeneratorRewards::default()
+        };
+        assert_eq!(two.on_failure(&[1.0, -1.0]), -10.0 + 5.0);
+    }
+
+    #[test]
+    fn the_observation_sees_the_goal_in_the_last_blocks_frame() {
+        let start = Start {
+            heading: 90.0,
+            ..Start::default()
+        };
+        let track = PlatformTrack::new(start);
+        // Heading 90 points along -z; a goal 20 m along -z is straight ahead, one to +x is right.
+        let mut out = [0.0; GENERATOR_OBSERVATION_SIZE];
+        observe(&track, [0.0, 4.0, -20.0], &[0.5], 30, &mut out);
+        assert!((out[0] - 0.4).abs() < 1e-6 && (out[1] - 0.08).abs() < 1e-6 && out[2].abs() < 1e-6);
+        assert!(
+            out[3].abs() < 1e-6 && (out[4] - 1.0).abs() < 1e-6,
+            "bearing 0"
+        );
+        assert_eq!(out[GENERATOR_OBSERVATION_SIZE - 1], 0.5, "aux last");
+        assert_eq!(out[GENERATOR_OBSERVATION_SIZE - 2], 1.0, "all blocks left");
+        observe(&track, [20.0, 0.0, 0.0], &[0.5], 30, &mut out);
+        assert!(
+            (out[3] + 1.0).abs() < 1e-6,
+            "a goal to the right is a negative turn"
+        );
+        let aim = aimed(&track, [20.0, 0.0, 0.0]);
+        assert!((block_from_action(&aim).angle + 90.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn a_match_grows_its_track_as_the_solver_advances_and_ends_at_the_goal() {
+        let goal = [30.0, 2.0, 0.0];
+        let mut game = Match::new(Start::default(), goal, vec![1.0], 30, 7);
+        let rewards = GeneratorRewards::default();
+        let mut controller = crate::game::platform::ScriptedController::new(7, 0.0);
+        let mut generator_return = 0.0;
+        let mut placements = 0;
+        for _ in 0..10_000 {
+            if game.needs_block() {
+                let row = aimed(game.track(), goal);
+                let placed = game.place(&row);
+                assert!(
+                    matches!(placed, Placement::Placed | Placement::Completed),
+                    "{placed:?}"
+                );
+                placements += 1;
+            }
+            let action = controller.act(game.env());
+            let (step, reward) = game.step_solver(action, &rewards);
+            generator_return += reward;
+            if let Some(outcome) = step.outcome {
+                assert_eq!(
+                    outcome,
+                    Outcome::Success,
+                    "the scripted Solver finishes easy jumps"
+                );
+                break;
+            }
+        }
+        assert!(
+            placements >= 5,
+            "{placements} blocks for 30 m in steps of at most 6 m"
+        );
+        assert!(game.track().last().reaches(goal));
+        // Paid 0.1 per metre for the whole way: from the start block (30.07 m from the goal) to
+        // within 3 m of it.
+        assert!(
+            (2.7..=3.01).contains(&generator_return),
+            "{generator_return}"
+        );
+    }
+
+    #[test]
+    fn overlaps_and_running_out_of_blocks_end_the_match() {
+        let goal = [60.0, 0.0, 0.0];
+        let mut game = Match::new(Start::default(), goal, vec![-1.0], 2, 1);
+        let ahead = [-1.0, 0.0, 0.0, 0.0];
+        assert_eq!(game.place(&ahead), Placement::Placed);
+        let back = [-1.0, 1.0, 0.0, 0.0];
+        assert_eq!(
+            game.place(&back),
+            Placement::Overlap,
+            "a U-turn onto the start block"
+        );
+        assert_eq!(game.place(&ahead), Placement::Placed);
+        assert_eq!(game.place(&ahead), Placement::OutOfBlocks);
+    }
+}

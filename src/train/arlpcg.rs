@@ -1,0 +1,378 @@
+//! The adversarial loop (ARLPCG) on the platform game: many [`Match`]es, each a Generator
+//! building a level while a Solver plays it, stepped together. Seen from the Solver's trainer
+//! this is a [`VecEnv`]: the Generator lives inside it and places blocks (one batched forward pass
+//! for every match that needs one) whenever Solvers reach their newest block.
+//!
+//! Training alternates phases (SPEC 3): while the Solver learns, the Generator only runs
+//! inference; while the Generator learns, the Solver only runs inference and the Generator's
+//! decisions are recorded per match, to be learned from with PPO once enough have completed.
+//! Each match draws its goal, start heading and λ from its own seed (episode counter from
+//! [`TRAINING_SEED_BASE`]), so runs are reproducible and resumable.
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::platform::TRAINING_SEED_BASE;
+use crate::game::platform::generator::{
+    GENERATOR_OBSERVATION_SIZE, GeneratorRewards, Match, Placement,
+};
+use crate::game::platform::{OBSERVATION_SIZE, PlatformAction};
+use crate::game::rules;
+use crate::level::params::quantize;
+use crate::level::platform::Start;
+use crate::level::stats::Outcome;
+use crate::rl::normalizer::RunningNorm;
+use crate::rl::policy::ActMode;
+use crate::rl::ppo::{Batch, Ppo, gae};
+use crate::rl::vec_env::{Transition, VecEnv};
+
+/// Which agent is learning.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Phase {
+    Solver,
+    Generator,
+}
+
+/// Progress of the match source and the phase schedule, saved in checkpoints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct AdversarialState {
+    /// Matches started so far (each gets its own seed).
+    pub episodes_started: u64,
+    pub phase: Phase,
+    /// Steps the learning agent has learned from in the current phase.
+    pub phase_steps: u64,
+    /// Generator decisions learned from, over the run.
+    pub generator_steps: u64,
+}
+
+impl Default for AdversarialState {
+    fn default() -> Self {
+        Self {
+            episodes_started: 0,
+            phase: Phase::Solver,
+            phase_steps: 0,
+            generator_steps: 0,
+        }
+    }
+}
+
+/// What the matches are made of.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MatchRules {
+    /// λ is drawn uniformly from these for each match.
+    pub aux_values: Vec<f32>,
+    pub max_blocks: usize,
+    pub rewards: GeneratorRewards,
+}
+
+/// The Generator with its optimizer and normalizer.
+pub struct Generator {
+    pub ppo: Ppo,
+    pub norm: RunningNorm,
+}
+
+/// One recorded Generator decision.
+#[derive(Debug, Clone)]
+struct Decision {
+    observation: Vec<f32>,
+    action: Vec<f32>,
+    log_prob: f32,
+    value: f32,
+    /// Reward from this decision until the next one (still growing while it is the newest).
+    reward: f32,
+    /// The match ended before the next decision.
+    ended: bool,
+}
+
+/// Episode statistics since they were last taken, split by the sign of λ.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MatchStats {
+    pub episodes: u32,
+    pub invalid: u32,
+    pub generator_return_sum: f64,
+    /// [easy (λ > 0), hard (λ < 0)]: finished (valid) matches, Solver successes, blocks placed,
+    /// and the sums of their distances and sizes.
+    pub judged: [u32; 2],
+    pub successes: [u32; 2],
+    pub blocks: [u32; 2],
+    pub distance_sum: [f64; 2],
+    pub size_sum: [f64; 2],
+}
+
+/// Many matches of the Generator against the Solver, as the Solver's environments.
+pub struct AdversarialEnvs {
+    matches: Vec<Match>,
+    pub generator: Generator,
+    /// Samples the Generator's actions and shuffles its minibatches.
+    pub rng: ChaCha8Rng,
+    pub rules: MatchRules,
+    pub state: AdversarialState,
+    /// Per match, the Generator decisions recorded while it learns (oldest first).
+    recorded: Vec<Vec<Decision>>,
+    generator_returns: Vec<f32>,
+    pub stats: MatchStats,
+}
+
+impl AdversarialEnvs {
+    /// `num_matches` matches, continuing from `state`; every match gets its first block.
+    pub fn new(
+        num_matches: usize,
+        generator: Generator,
+        rng: ChaCha8Rng,
+        rules: MatchRules,
+        state: AdversarialState,
+    ) -> candle_core::Result<Self> {
+        let mut this = Self {
+            matches: Vec::with_capacity(num_matches),
+            generator,
+            rng,
+            rules,
+            state,
+            recorded: vec![Vec::new(); num_matches],
+            generator_returns: vec![0.0; num_matches],
+            stats: MatchStats::default(),
+        };
+        for _ in 0..num_matches {
+            let fresh = this.next_match();
+            this.matches.push(fresh);
+        }
+        let all: Vec<usize> = (0..num_matches).collect();
+        let ended = this.decide(&all)?;
+        debug_assert!(ended.is_empty(), "a first block is always valid");
+        Ok(this)
+    }
+
+    pub fn learning(&self) -> bool {
+        self.state.phase == Phase::Generator
+    }
+
+    /// Switches phase; recordings of the Generator start afresh when it starts learning.
+    pub fn set_phase(&mut self, phase: Phase) {
+        self.state.phase = phase;
+        self.state.phase_steps = 0;
+        for recorded in &mut self.recorded {
+            recorded.clear();
+        }
+    }
+
+    fn next_match(&mut self) -> Match {
+        let seed = TRAINING_SEED_BASE + self.state.episodes_started;
+        self.state.episodes_started += 1;
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let goal = rules::random_goal(&mut rng);
+        let start = Start {
+            heading: quantize(rng.random_range(-180.0..180.0)),
+            ..Start::default()
+        };
+        let values = &self.rules.aux_values;
+        let aux = values[rng.random_range(0..values.len())];
+        Match::new(start, goal, vec![aux], self.rules.max_blocks, seed)
+    }
+
+    /// Lets the Generator place a block in each of the matches `indices`; returns the matches
+    /// that ended because the placement was invalid.
+    fn decide(&mut self, indices: &[usize]) -> candle_core::Result<Vec<usize>> {
+        if indices.is_empty() {
+            return Ok(Vec::new());
+        }
+        let d = GENERATOR_OBSERVATION_SIZE;
+        let mut observations = vec![0.0; indices.len() * d];
+        for (&i, row) in indices.iter().zip(observations.chunks_mut(d)) {
+            self.matches[i].observe_generator(row);
+        }
+        let learning = self.learning();
+        if learning {
+            self.generator.norm.update(&observations);
+        }
+        self.generator.norm.normalize(&mut observations);
+        let acted = self
+            .generator
+            .ppo
+            .policy
+            .act(&observations, ActMode::Sample, &mut self.rng)?;
+        let width = acted.actions.len() / indices.len();
+        let mut ended = Vec::new();
+        for (k, &i) in indices.iter().enumerate() {
+            let action = &acted.actions[k * width..(k + 1) * width];
+            let game = &mut self.matches[i];
+            let placement = game.place(action);
+            let invalid = matches!(placement, Placement::Overlap | Placement::OutOfBlocks);
+            let mut reward = self.rules.rewards.per_block(&game.aux);
+            if invalid {
+                reward += self.rules.rewards.invalid;
+                ended.push(i);
+            }
+            self.generator_returns[i] += reward;
+            if learning {
+                self.recorded[i].push(Decision {
+                    observation: observations[k * d..(k + 1) * d].to_vec(),
+                    action: action.to_vec(),
+                    log_prob: acted.log_probs[k],
+                    value: acted.values[k],
+                    reward,
+                    ended: invalid,
+                });
+            }
+        }
+        Ok(ended)
+    }
+
+    /// Ends match `i` (recording its statistics) and starts the next one in its place.
+    fn restart(&mut self, i: usize, solver_outcome: Option<Outcome>) {
+        let game = &self.matches[i];
+        let aux = game.aux[0];
+        let stats = &mut self.stats;
+        stats.episodes += 1;
+        stats.generator_return_sum += self.generator_returns[i] as f64;
+        self.generator_returns[i] = 0.0;
+        match solver_outcome {
+            None => stats.invalid += 1,
+            Some(outcome) if aux != 0.0 => {
+                let side = usize::from(aux < 0.0);
+                stats.judged[side] += 1;
+                stats.successes[side] += u32::from(outcome == Outcome::Success);
+                for block in game.track().block_params() {
+                    stats.blocks[side] += 1;
+                    stats.distance_sum[side] += block.distance;
+                    stats.size_sum[side] += block.size;
+                }
+            }
+            Some(_) => {}
+        }
+        if let Some(last) = self.recorded[i].last_mut() {
+            last.ended = true;
+        }
+        self.matches[i] = self.next_match();
+    }
+
+    /// Recorded Generator decisions that are complete (their reward is final).
+    pub fn completed_decisions(&self) -> usize {
+        self.recorded
+            .iter()
+            .map(|r| r.len() - usize::from(r.last().is_some_and(|d| !d.ended)))
+            .sum()
+    }
+
+    /// Takes the completed decisions as a PPO batch (advantages by GAE along each match's
+    /// sequence of decisions); a decision still waiting for its reward stays for the next batch.
+    pub fn take_generator_batch(&mut self) -> Batch {
+        let config = &self.generator.ppo.config;
+        let mut batch = Batch {
+            observations: Vec::new(),
+            actions: Vec::new(),
+            log_probs: Vec::new(),
+            advantages: Vec::new(),
+            returns: Vec::new(),
+            values: Vec::new(),
+        };
+        for recorded in &mut self.recorded {
+            let pending = recorded.last().filter(|d| !d.ended).cloned();
+            if pending.is_some() {
+                recorded.pop();
+            }
+            if !recorded.is_empty() {
+                let rewards: Vec<f32> = recorded.iter().map(|d| d.reward).collect();
+                let values: Vec<f32> = recorded.iter().map(|d| d.value).collect();
+                let ended: Vec<bool> = recorded.iter().map(|d| d.ended).collect();
+                let last_value = pending.as_ref().map_or(0.0, |d| d.value);
+                let (advantages, returns) = gae(
+                    &rewards,
+                    &values,
+                    &ended,
+                    &[last_value],
+                    config.gamma,
+                    config.gae_lambda,
+                );
+                for d in recorded.iter() {
+                    batch.observations.extend_from_slice(&d.observation);
+                    batch.actions.extend_from_slice(&d.action);
+                    batch.log_probs.push(d.log_prob);
+                    batch.values.push(d.value);
+                }
+                batch.advantages.extend(advantages);
+                batch.returns.extend(returns);
+            }
+            recorded.clear();
+            recorded.extend(pending);
+        }
+        batch
+    }
+
+    /// The match statistics gathered since the last call.
+    pub fn take_stats(&mut self) -> MatchStats {
+        std::mem::take(&mut self.stats)
+    }
+
+    pub fn matches(&self) -> &[Match] {
+        &self.matches
+    }
+}
+
+impl VecEnv for AdversarialEnvs {
+    fn num_envs(&self) -> usize {
+        self.matches.len()
+    }
+
+    fn observation_size(&self) -> usize {
+        OBSERVATION_SIZE
+    }
+
+    fn observe(&mut self, out: &mut [f32]) {
+        self.matches
+            .par_iter()
+            .zip(out.par_chunks_mut(OBSERVATION_SIZE))
+            .for_each(|(game, row)| game.env().observe(row));
+    }
+
+    fn step(&mut self, actions: &[f32], out: &mut [Transition]) {
+        let width = actions.len() / self.matches.len();
+        let rewards = &self.rules.rewards;
+        let steps: Vec<(crate::game::Step, f32)> = self
+            .matches
+            .par_iter_mut()
+            .zip(actions.par_chunks(width))
+            .map(|(game, row)| game.step_solver(PlatformAction::from_policy_row(row), rewards))
+            .collect();
+        let mut finished = Vec::new();
+        let mut turns = Vec::new();
+        for (i, (step, generator_reward)) in steps.into_iter().enumerate() {
+            self.generator_returns[i] += generator_reward;
+            if let Some(last) = self.recorded[i].last_mut().filter(|d| !d.ended) {
+                last.reward += generator_reward;
+            }
+            out[i] = Transition {
+                reward: step.reward,
+                ended: step.outcome.is_some(),
+                success: step.outcome.map(|o| o == Outcome::Success),
+            };
+            match step.outcome {
+                Some(outcome) => finished.push((i, Some(outcome))),
+                None if self.matches[i].needs_block() => turns.push(i),
+                None => {}
+            }
+        }
+        // A failed placement ends the match: the Solver's run is cut, not failed.
+        let invalid = self
+            .decide(&turns)
+            .expect("the Generator's forward pass runs on the CPU");
+        for i in invalid {
+            out[i] = Transition {
+                reward: out[i].reward,
+                ended: true,
+                success: None,
+            };
+            finished.push((i, None));
+        }
+        let restarted: Vec<usize> = finished.iter().map(|&(i, _)| i).collect();
+        for (i, outcome) in finished {
+            self.restart(i, outcome);
+        }
+        let ended = self
+            .decide(&restarted)
+            .expect("the Generator's forward pass runs on the CPU");
+        debug_assert!(ended.is_empty(), "a first block is always valid");
+    }
+}

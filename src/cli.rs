@@ -17,9 +17,10 @@ use crate::train::TrainMode;
     long_about = "arlpcg generates levels for a 3D platform game (blocks to jump across), checks \
         each one by playing it many times, and exports it as YAML (the source of truth) and glTF \
         (for Blender, Godot, Unity).\n\n\
-        Levels come from rule-based generation for now; a Generator trained against a Solver \
-        (ARLPCG, EA SEED 2021), steered by one knob, comes next.",
+        Levels come from a Generator trained against a Solver (ARLPCG, EA SEED 2021) and \
+        steered by one knob, the aux input λ (+1 easy, -1 hard), or from rule-based generation.",
     after_help = "Examples:\n  \
+        arlpcg generate --policies policies/platform --aux -0.5 --verify 100 --out levels/mine\n  \
         arlpcg generate --game platform --rules --count 20 --seed 1 --out levels/mine\n  \
         arlpcg verify levels/mine/*.yaml --trials 100\n  \
         arlpcg export levels/mine/platform_seed1.yaml --out level.glb"
@@ -54,22 +55,27 @@ pub enum Format {
 }
 
 #[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("source").required(true).args(["rules", "policies"])))]
 pub struct GenerateArgs {
     /// Which game.
     #[arg(long, default_value = "platform", value_parser = parse_game)]
     pub game: Game,
     /// Use the rule-based generator (random parameters within the game's ranges, kept valid
-    /// and within the character's reach). Trained Generator policies come later.
-    #[arg(long, required = true)]
+    /// and within the character's reach).
+    #[arg(long)]
     pub rules: bool,
+    /// Use the trained Generator in this folder (generator.safetensors; --verify plays the
+    /// solver.safetensors beside it). The shipped one: policies/platform.
+    #[arg(long, value_name = "DIR")]
+    pub policies: Option<PathBuf>,
     /// How many levels; level i uses seed SEED + i.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub count: u32,
     /// Seed of the first level: the same seed gives the same level, byte for byte.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// The aux input λ in [-1, 1] (+1 easy, -1 hard), recorded in the level. The rule-based
-    /// generator does not use it.
+    /// The aux input λ in [-1, 1]: +1 easy, -1 hard (required with --policies). The rule-based
+    /// generator only records it.
     #[arg(long, allow_hyphen_values = true, value_parser = parse_aux)]
     pub aux: Option<f64>,
     /// Goal position x,y,z in metres (default: drawn from the seed).
@@ -81,6 +87,10 @@ pub struct GenerateArgs {
     /// File formats to write, comma-separated.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "yaml,glb")]
     pub format: Vec<Format>,
+    /// Play each level this many times with the Solver (with --policies the one beside the
+    /// Generator, with --rules the shipped one) and store the statistics in the YAML.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub verify: Option<u32>,
     /// Replace files that already exist (by default nothing is overwritten).
     #[arg(long)]
     pub force: bool,

@@ -3,6 +3,8 @@
 //! Layers, dependencies pointing down:
 //! - shells: [`cli`] and [`commands`] (parse, run, report, write files atomically via [`fsio`]);
 //! - [`verify`]: play a level many times and aggregate the Solver's statistics;
+//! - [`generation`]: levels from a trained Generator; [`train`] and [`rl`]: PPO and the
+//!   training runs that make the policies;
 //! - [`game`]: the games as deterministic rapier3d simulations, and rule-based generation;
 //! - [`level`]: levels as pure data, their YAML file format and glTF export.
 //!
@@ -13,6 +15,7 @@ pub mod cli;
 pub mod commands;
 pub mod fsio;
 pub mod game;
+pub mod generation;
 pub mod level;
 pub mod rl;
 pub mod train;

@@ -7,6 +7,7 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use arlpcg::game::platform::OBSERVATION_SIZE;
+use arlpcg::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
 use arlpcg::level::Game;
 use arlpcg::rl::checkpoint::{Role, load_policy};
 
@@ -236,4 +237,164 @@ fn ctrl_c_saves_a_checkpoint_and_the_policy_and_exits_cleanly() {
         "the checkpoint holds every iteration the metrics show"
     );
     assert!(out.join("solver.safetensors").exists() && out.join("solver.yaml").exists());
+}
+
+const TINY_ADVERSARIAL: &str = "\
+seed: 5
+hidden: [16, 16]
+checkpoint_minutes: 0.0
+solver:
+  num_envs: 4
+  num_steps: 32
+  update_epochs: 1
+  num_minibatches: 2
+generator:
+  ppo:
+    num_envs: 4
+    num_steps: 4
+    update_epochs: 1
+    num_minibatches: 2
+  solver_warmup_steps: 128
+  solver_phase_steps: 128
+  generator_phase_steps: 16
+";
+
+/// Generator iterations logged so far (rows of generator-metrics.csv).
+fn generator_rows(dir: &Path) -> usize {
+    std::fs::read_to_string(dir.join("generator-metrics.csv"))
+        .unwrap()
+        .lines()
+        .count()
+        - 1
+}
+
+#[test]
+fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.yaml");
+    std::fs::write(&config, TINY_ADVERSARIAL).unwrap();
+    let out = dir.path().join("run");
+    let out_s = out.to_str().unwrap();
+    let config_s = config.to_str().unwrap();
+    let first = arlpcg(&[
+        "train", "--mode", "arlpcg", "--steps", "512", "--config", config_s, "--out", out_s,
+    ]);
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    // 512 Solver steps in phases of 128: both agents learned, in turn.
+    assert_eq!(curve(&out).last().unwrap().1, 512);
+    let generator_before = generator_rows(&out);
+    assert!(
+        generator_before >= 3,
+        "{generator_before} Generator iterations"
+    );
+    let resumed = arlpcg(&[
+        "train", "--mode", "arlpcg", "--steps", "1024", "--out", out_s, "--resume",
+    ]);
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    assert_eq!(curve(&out).last().unwrap().1, 1024);
+    assert!(
+        generator_rows(&out) > generator_before,
+        "the Generator went on learning"
+    );
+    for (file, role, size) in [
+        ("solver.safetensors", Role::Solver, OBSERVATION_SIZE),
+        (
+            "generator.safetensors",
+            Role::Generator,
+            GENERATOR_OBSERVATION_SIZE,
+        ),
+    ] {
+        let loaded = load_policy(
+            &std::fs::read(out.join(file)).unwrap(),
+            Game::Platform,
+            role,
+            size,
+        )
+        .unwrap();
+        assert_eq!(loaded.card.training.mode, "arlpcg");
+    }
+
+    // The run's folder is a policies folder: generate with its Generator, verify with its Solver.
+    let levels = dir.path().join("levels");
+    let generated = arlpcg(&[
+        "generate",
+        "--policies",
+        out_s,
+        "--aux",
+        "-0.5",
+        "--seed",
+        "3",
+        "--verify",
+        "4",
+        "--goal",
+        "0,0,0",
+        "--format",
+        "yaml",
+        "--out",
+        levels.to_str().unwrap(),
+    ]);
+    // An untrained Generator may find no way to an arbitrary goal; a goal on the start block's
+    // own spot is never reached either (blocks are at least 5 m apart), so expect the clear error.
+    assert!(!generated.status.success());
+    let stderr = String::from_utf8_lossy(&generated.stderr);
+    assert!(stderr.contains("no valid level"), "{stderr}");
+    let (_, start, _) = arlpcg::game::rules::goal_and_start(3, None);
+    let [x, z] = arlpcg::level::platform::heading_direction(start.heading);
+    let goal = format!("{},0,{}", 7.5 * x, 7.5 * z);
+    let generated = arlpcg(&[
+        "generate",
+        "--policies",
+        out_s,
+        "--aux",
+        "-0.5",
+        "--seed",
+        "3",
+        "--verify",
+        "4",
+        "--goal",
+        &goal,
+        "--format",
+        "yaml",
+        "--out",
+        levels.to_str().unwrap(),
+    ]);
+    assert!(
+        generated.status.success(),
+        "{}",
+        String::from_utf8_lossy(&generated.stderr)
+    );
+    let level = arlpcg::level::yaml::load(&levels.join("platform_seed3_aux-0.50.yaml")).unwrap();
+    assert_eq!(level.aux, Some(-0.5));
+    assert!(matches!(level.source, arlpcg::level::Source::Policy { .. }));
+    let stats = level
+        .stats
+        .expect("--verify stores the Solver's statistics");
+    assert_eq!(stats.trials, 4);
+    assert!(stats.solver.describe().contains("solver.safetensors"));
+    let missing_aux = arlpcg(&[
+        "generate",
+        "--policies",
+        out_s,
+        "--out",
+        levels.to_str().unwrap(),
+    ]);
+    assert!(String::from_utf8_lossy(&missing_aux.stderr).contains("--aux"));
+    let wrong = arlpcg(&[
+        "generate",
+        "--policies",
+        dir.path().to_str().unwrap(),
+        "--aux",
+        "1",
+        "--out",
+        levels.to_str().unwrap(),
+    ]);
+    assert!(String::from_utf8_lossy(&wrong.stderr).contains("generator.safetensors"));
 }

@@ -1,12 +1,18 @@
-//! `arlpcg generate`: levels from the rules, written as files named after game, seed and aux.
+//! `arlpcg generate`: levels from a trained Generator or from the rules, optionally verified by
+//! the Solver, written as files named after game, seed and aux.
+
+use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 
 use super::export::{LevelFiles, write_level_files};
-use crate::cli::GenerateArgs;
+use super::policies::{load_generator, load_solver, policy_paths};
+use crate::cli::{DEFAULT_SOLVER, GenerateArgs};
 use crate::fsio::Overwrite;
 use crate::game::rules;
-use crate::level::{Game, RulesConfig};
+use crate::generation::{self, GeneratorPolicy};
+use crate::level::{Game, Level, RulesConfig};
+use crate::verify::{Solver, SolverPolicy, verify};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
     if args.game != Game::Platform {
@@ -15,6 +21,23 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
             args.game
         );
     }
+    let generator = match &args.policies {
+        Some(dir) => {
+            if args.aux.is_none() {
+                bail!("--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard)");
+            }
+            Some(load_generator(&policy_paths(dir).0)?.0)
+        }
+        None => None,
+    };
+    let solver: Option<SolverPolicy> = match (args.verify, &args.policies) {
+        (None, _) => None,
+        (Some(_), Some(dir)) => Some(load_solver(&policy_paths(dir).1)?.0),
+        (Some(_), None) if Path::new(DEFAULT_SOLVER).exists() => {
+            Some(load_solver(Path::new(DEFAULT_SOLVER))?.0)
+        }
+        (Some(_), None) => None,
+    };
     let seeds: Vec<u64> = (0..args.count as u64)
         .map(|i| args.seed.checked_add(i))
         .collect::<Option<_>>()
@@ -43,11 +66,14 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     for (_, files) in &plans {
         files.check_writable(overwrite)?;
     }
-    let config = RulesConfig::default();
     let bar = super::progress_bar(plans.len() as u64, "generating");
     for (seed, files) in &plans {
-        let level = rules::platform_level(*seed, args.aux, args.goal, &config)
+        let mut level = build(generator.as_ref(), *seed, args.aux, args.goal)
             .with_context(|| format!("seed {seed}"))?;
+        if let Some(trials) = args.verify {
+            let who = solver.as_ref().map_or(Solver::Scripted, Solver::Policy);
+            level.stats = Some(verify(&level, &who, trials, *seed, &|| {})?);
+        }
         write_level_files(&level, files, overwrite)?;
         bar.inc(1);
     }
@@ -59,6 +85,21 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// Level `seed` from the Generator when there is one, else from the rules.
+fn build(
+    generator: Option<&GeneratorPolicy>,
+    seed: u64,
+    aux: Option<f64>,
+    goal: Option<[f64; 3]>,
+) -> Result<Level> {
+    Ok(match generator {
+        Some(generator) => {
+            generation::platform_level(generator, seed, aux.unwrap_or_default(), goal)?
+        }
+        None => rules::platform_level(seed, aux, goal, &RulesConfig::default())?,
+    })
 }
 
 /// `platform_seed7` or, with an aux value, `platform_seed7_aux-0.50`.

@@ -4,6 +4,7 @@
 
 mod export;
 mod generate;
+pub mod policies;
 mod verify;
 
 pub use export::{LevelFiles, write_level_files};

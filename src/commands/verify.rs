@@ -3,16 +3,14 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde_json::json;
-use sha2::{Digest, Sha256};
 
+use super::policies::load_solver;
 use crate::cli::{DEFAULT_SOLVER, SolverChoice, VerifyArgs};
-use crate::game::platform::OBSERVATION_SIZE;
 use crate::level::stats::SolverStats;
-use crate::level::{Game, PolicyRef, yaml};
-use crate::rl::checkpoint::{Role, load_policy};
-use crate::verify::{Solver, SolverPolicy, Summary, verify};
+use crate::level::yaml;
+use crate::verify::{Solver, Summary, verify};
 
 pub fn run(args: &VerifyArgs) -> Result<()> {
     let choice = args.solver.unwrap_or(
@@ -25,7 +23,7 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
     let loaded;
     let solver = match choice {
         SolverChoice::Policy => {
-            loaded = load_solver(&args.policy)?;
+            loaded = load_solver(&args.policy)?.0;
             Solver::Policy(&loaded)
         }
         SolverChoice::Scripted => Solver::Scripted,
@@ -87,26 +85,6 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
         );
     }
     Ok(())
-}
-
-/// Loads a platform Solver policy, pinned by the SHA-256 of its file.
-pub fn load_solver(path: &Path) -> Result<SolverPolicy> {
-    let bytes = std::fs::read(path)
-        .with_context(|| format!("cannot read the Solver policy {}", path.display()))?;
-    let loaded = load_policy(&bytes, Game::Platform, Role::Solver, OBSERVATION_SIZE)
-        .with_context(|| format!("{}", path.display()))?;
-    let sha256 = Sha256::digest(&bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    Ok(SolverPolicy {
-        policy: loaded.policy,
-        normalizer: loaded.card.normalizer,
-        reference: PolicyRef {
-            path: path.display().to_string(),
-            sha256,
-        },
-    })
 }
 
 fn to_json(path: &Path, s: &SolverStats) -> serde_json::Value {

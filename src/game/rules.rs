@@ -34,6 +34,19 @@ pub fn random_goal(rng: &mut ChaCha8Rng) -> [f64; 3] {
     ]
 }
 
+/// The goal (drawn unless given) and start block of level `seed`, and the seeded stream the
+/// level's other draws continue from. Every level source draws them this way, so levels of the
+/// same seed lead to the same goal whoever builds them.
+pub fn goal_and_start(seed: u64, goal: Option<[f64; 3]>) -> ([f64; 3], Start, ChaCha8Rng) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let drawn = random_goal(&mut rng);
+    let start = Start {
+        heading: quantize(rng.random_range(-180.0..180.0)),
+        ..Start::default()
+    };
+    (goal.unwrap_or(drawn), start, rng)
+}
+
 /// Why the rules could not build a level.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error(
@@ -52,13 +65,7 @@ pub fn platform_level(
     goal: Option<[f64; 3]>,
     config: &RulesConfig,
 ) -> Result<Level, NoLevel> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let drawn_goal = random_goal(&mut rng);
-    let goal = goal.unwrap_or(drawn_goal);
-    let start = Start {
-        heading: quantize(rng.random_range(-180.0..180.0)),
-        ..Start::default()
-    };
+    let (goal, start, mut rng) = goal_and_start(seed, goal);
     for _ in 0..ATTEMPTS {
         if let Some(track) = attempt(&mut rng, start, goal, config) {
             return Ok(Level {

@@ -53,6 +53,10 @@ pub struct PolicyCard {
     /// Measured results, filled in by evaluation.
     #[serde(default)]
     pub results: HashMap<String, f64>,
+    /// Generators only: the block budget its `blocks_left` observation counts down from
+    /// (absent: the default of `train`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_blocks: Option<usize>,
 }
 
 /// How a policy was trained.
@@ -251,6 +255,7 @@ mod tests {
                 command: String::new(),
             },
             results: HashMap::new(),
+            max_blocks: None,
         }
     }
 

@@ -9,7 +9,7 @@
 //! Each match draws its goal, start heading and λ from its own seed (episode counter from
 //! [`TRAINING_SEED_BASE`]), so runs are reproducible and resumable.
 
-use rand::{RngExt, SeedableRng};
+use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -20,8 +20,6 @@ use crate::game::platform::generator::{
 };
 use crate::game::platform::{OBSERVATION_SIZE, PlatformAction};
 use crate::game::rules;
-use crate::level::params::quantize;
-use crate::level::platform::Start;
 use crate::level::stats::Outcome;
 use crate::rl::normalizer::RunningNorm;
 use crate::rl::policy::ActMode;
@@ -161,12 +159,7 @@ impl AdversarialEnvs {
     fn next_match(&mut self) -> Match {
         let seed = TRAINING_SEED_BASE + self.state.episodes_started;
         self.state.episodes_started += 1;
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let goal = rules::random_goal(&mut rng);
-        let start = Start {
-            heading: quantize(rng.random_range(-180.0..180.0)),
-            ..Start::default()
-        };
+        let (goal, start, mut rng) = rules::goal_and_start(seed, None);
         let values = &self.rules.aux_values;
         let aux = values[rng.random_range(0..values.len())];
         Match::new(start, goal, vec![aux], self.rules.max_blocks, seed)

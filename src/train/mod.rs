@@ -102,6 +102,12 @@ pub struct GeneratorConfig {
     pub aux_values: Vec<f32>,
     /// A track that has not reached its goal in this many blocks ends as invalid.
     pub max_blocks: usize,
+    /// The first Solver phase lasts at least this many steps, against the untrained Generator
+    /// (random blocks). Without it the Generator learns against a Solver that cannot jump yet:
+    /// every match fails whatever it builds, so it learns only to avoid overlaps (long jumps
+    /// at every λ), which in turn keeps the Solver from learning (seen in a first run: no
+    /// success after 300k steps, where rule-pcg had 0.5).
+    pub solver_warmup_steps: u64,
     /// Solver steps learned from in each Solver phase...
     pub solver_phase_steps: u64,
     /// ...and Generator decisions in each Generator phase. The Solver acts about 25 times per
@@ -142,6 +148,7 @@ impl Default for GeneratorConfig {
             rewards: GeneratorRewards::default(),
             aux_values: vec![-1.0, -1.0, -0.5, 0.5, 1.0, 1.0],
             max_blocks: 30,
+            solver_warmup_steps: 1_000_000,
             solver_phase_steps: 100_000,
             generator_phase_steps: 10_000,
         }
@@ -468,6 +475,7 @@ fn card(
                 .join(" "),
         },
         results: Default::default(),
+        max_blocks: (role == Role::Generator).then_some(config.generator.max_blocks),
     }
 }
 
@@ -896,7 +904,9 @@ impl Training for AdversarialRun {
                 let rollout = self.solver.solver_iteration(lr_scale, wall)?;
                 let envs = self.envs();
                 envs.state.phase_steps += rollout.steps;
-                if envs.state.phase_steps >= phases.solver_phase_steps {
+                let warm = self.solver.trainer.global_step >= phases.solver_warmup_steps;
+                let envs = self.envs();
+                if warm && envs.state.phase_steps >= phases.solver_phase_steps {
                     envs.set_phase(Phase::Generator);
                 }
                 Ok(format!(

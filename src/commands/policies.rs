@@ -1,0 +1,71 @@
+//! Loading trained policies from files: each pinned by the SHA-256 of its bytes (levels record
+//! it), checked for game, role and shape, with errors that name the file.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use sha2::{Digest, Sha256};
+
+use crate::game::platform::OBSERVATION_SIZE;
+use crate::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
+use crate::generation::GeneratorPolicy;
+use crate::level::{Game, PolicyRef};
+use crate::rl::checkpoint::{LoadedPolicy, PolicyCard, Role, load_policy};
+use crate::train::GeneratorConfig;
+use crate::verify::SolverPolicy;
+
+/// File names inside a policies folder.
+pub const GENERATOR_FILE: &str = "generator.safetensors";
+pub const SOLVER_FILE: &str = "solver.safetensors";
+
+fn load_pinned(path: &Path, role: Role, observation: usize) -> Result<(LoadedPolicy, PolicyRef)> {
+    let bytes = std::fs::read(path)
+        .with_context(|| format!("cannot read the {role} policy {}", path.display()))?;
+    let loaded = load_policy(&bytes, Game::Platform, role, observation)
+        .with_context(|| format!("{}", path.display()))?;
+    let sha256 = Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    let reference = PolicyRef {
+        path: path.display().to_string(),
+        sha256,
+    };
+    Ok((loaded, reference))
+}
+
+/// Loads a platform Solver policy.
+pub fn load_solver(path: &Path) -> Result<(SolverPolicy, PolicyCard)> {
+    let (loaded, reference) = load_pinned(path, Role::Solver, OBSERVATION_SIZE)?;
+    let card = loaded.card.clone();
+    Ok((
+        SolverPolicy {
+            policy: loaded.policy,
+            normalizer: loaded.card.normalizer,
+            reference,
+        },
+        card,
+    ))
+}
+
+/// Loads a platform Generator policy.
+pub fn load_generator(path: &Path) -> Result<(GeneratorPolicy, PolicyCard)> {
+    let (loaded, reference) = load_pinned(path, Role::Generator, GENERATOR_OBSERVATION_SIZE)?;
+    let card = loaded.card.clone();
+    Ok((
+        GeneratorPolicy {
+            policy: loaded.policy,
+            max_blocks: card
+                .max_blocks
+                .unwrap_or(GeneratorConfig::default().max_blocks),
+            normalizer: loaded.card.normalizer,
+            reference,
+        },
+        card,
+    ))
+}
+
+/// The paths of the Generator and the Solver in a policies folder.
+pub fn policy_paths(dir: &Path) -> (PathBuf, PathBuf) {
+    (dir.join(GENERATOR_FILE), dir.join(SOLVER_FILE))
+}

@@ -1,0 +1,137 @@
+//! Levels from a trained Generator policy: it places block after block toward the goal at the
+//! chosen λ, as it learned to (sampling its actions from a generator seeded by the level's seed).
+//! An attempt that overlaps itself or runs out of blocks is dropped and the next one, drawn from
+//! the same seeded stream, is tried; so the same policy, seed, λ and goal give the same level.
+//!
+//! The goal and start heading are drawn from the seed exactly as the rules draw them, so a rule
+//! level and a Generator level of the same seed lead to the same goal.
+
+use crate::game::platform::generator::{GENERATOR_OBSERVATION_SIZE, block_from_action, observe};
+use crate::game::rules::goal_and_start;
+use crate::level::platform::PlatformTrack;
+use crate::level::{Level, PolicyRef, Source, Track};
+use crate::rl::normalizer::RunningNorm;
+use crate::rl::policy::{ActMode, ActorCritic};
+
+/// Attempts before giving up on a level.
+pub const ATTEMPTS: usize = 64;
+
+/// A trained Generator, ready to build levels.
+pub struct GeneratorPolicy {
+    pub policy: ActorCritic,
+    pub normalizer: RunningNorm,
+    pub reference: PolicyRef,
+    /// The block budget it was trained with (its observation counts down from it).
+    pub max_blocks: usize,
+}
+
+/// Why the Generator built no level.
+#[derive(Debug, thiserror::Error)]
+pub enum GenerationError {
+    #[error(
+        "the Generator built no valid level toward goal {goal:?} at aux {aux} in {ATTEMPTS} attempts (each overlapped itself or ran out of blocks); try another seed or goal"
+    )]
+    NoLevel { goal: [f64; 3], aux: f64 },
+    #[error("the Generator's network failed: {0}")]
+    Network(#[from] candle_core::Error),
+}
+
+/// A platform level built by the Generator at aux `aux` toward `goal` (drawn from `seed` when
+/// not given).
+pub fn platform_level(
+    generator: &GeneratorPolicy,
+    seed: u64,
+    aux: f64,
+    goal: Option<[f64; 3]>,
+) -> Result<Level, GenerationError> {
+    let (goal, start, mut rng) = goal_and_start(seed, goal);
+    let aux_input = [aux as f32];
+    let mut observation = vec![0.0; GENERATOR_OBSERVATION_SIZE];
+    for _ in 0..ATTEMPTS {
+        let mut track = PlatformTrack::new(start);
+        while track.block_count() < generator.max_blocks {
+            observe(
+                &track,
+                goal,
+                &aux_input,
+                generator.max_blocks,
+                &mut observation,
+            );
+            generator.normalizer.normalize(&mut observation);
+            let acted = generator
+                .policy
+                .act(&observation, ActMode::Sample, &mut rng)?;
+            if track.push(block_from_action(&acted.actions)).is_err() {
+                break;
+            }
+            if track.last().reaches(goal) {
+                return Ok(Level {
+                    seed: Some(seed),
+                    aux: Some(aux),
+                    goal,
+                    track: Track::Platform(track),
+                    source: Source::Policy {
+                        generator: generator.reference.clone(),
+                    },
+                    stats: None,
+                });
+            }
+        }
+    }
+    Err(GenerationError::NoLevel { goal, aux })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::game::platform::generator::GENERATOR_ACTIONS;
+    use crate::level::platform::heading_direction;
+    use crate::rl::policy::PolicyShape;
+
+    fn untrained() -> GeneratorPolicy {
+        let shape = PolicyShape {
+            observation: GENERATOR_OBSERVATION_SIZE,
+            hidden: vec![16],
+            continuous: GENERATOR_ACTIONS.len(),
+            binary: 0,
+        };
+        GeneratorPolicy {
+            policy: ActorCritic::new(shape, 3).unwrap(),
+            normalizer: RunningNorm::new(GENERATOR_OBSERVATION_SIZE),
+            reference: PolicyRef {
+                path: "generator.safetensors".into(),
+                sha256: "0".repeat(64),
+            },
+            max_blocks: 30,
+        }
+    }
+
+    #[test]
+    fn the_same_policy_seed_aux_and_goal_give_the_same_valid_level() {
+        let generator = untrained();
+        // A goal one block ahead of the start: even an untrained Generator gets there.
+        let (_, start, _) = goal_and_start(5, None);
+        let [x, z] = heading_direction(start.heading);
+        let goal = [7.5 * x, 0.0, 7.5 * z];
+        let a = platform_level(&generator, 5, -1.0, Some(goal)).unwrap();
+        let b = platform_level(&generator, 5, -1.0, Some(goal)).unwrap();
+        assert_eq!(a, b);
+        a.validate().unwrap();
+        assert_eq!(a.aux, Some(-1.0));
+        assert!(matches!(a.source, Source::Policy { .. }));
+        let other = platform_level(&generator, 6, -1.0, Some(goal)).unwrap();
+        assert_ne!(
+            a.platform(),
+            other.platform(),
+            "another seed, another level"
+        );
+    }
+
+    #[test]
+    fn an_unreachable_goal_is_a_clear_error() {
+        let mut generator = untrained();
+        generator.max_blocks = 1;
+        let err = platform_level(&generator, 1, 0.5, Some([500.0, 0.0, 0.0])).unwrap_err();
+        assert!(err.to_string().contains("no valid level"), "{err}");
+    }
+}

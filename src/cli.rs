@@ -38,9 +38,48 @@ pub enum Command {
     Export(ExportArgs),
     /// Play levels many times and report how often the Solver gets through.
     Verify(VerifyArgs),
+    /// Reproduce the paper's tables (controllability, generalization, each Solver at each λ)
+    /// for trained policies: markdown, CSV and results.json.
+    Eval(EvalArgs),
     /// Train a Solver, alone or against a Generator, with PPO (checkpointed, resumable,
     /// stoppable with Ctrl-C).
     Train(TrainArgs),
+}
+
+#[derive(Debug, Args)]
+#[command(after_help = "Examples:\n  \
+    arlpcg eval --policies policies/platform --out results/platform\n  \
+    arlpcg eval --policies runs/platform-solver-arlpcg runs/platform-solver-rule-pcg --full --out results/full")]
+pub struct EvalArgs {
+    /// Which game.
+    #[arg(long, default_value = "platform", value_parser = parse_game)]
+    pub game: Game,
+    /// Folders of trained policies: the Generator (generator.safetensors, from the first folder
+    /// that has one) and every Solver (solver*.safetensors; each named by its card's training
+    /// mode). One Solver must be the arlpcg one.
+    #[arg(long, num_args = 1.., required = true, value_name = "DIR")]
+    pub policies: Vec<PathBuf>,
+    /// Generator levels per λ (default 20; 50 with --full).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub tracks: Option<u32>,
+    /// Solver runs per level (default 20; 1000 with --full).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub trials: Option<u32>,
+    /// Validation levels for the generalization table (default 40; 1000 with --full).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=100_000))]
+    pub validation_tracks: Option<u32>,
+    /// The paper's scale (hours on 2 cores) instead of a few minutes.
+    #[arg(long)]
+    pub full: bool,
+    /// Folder for results.md, the CSV tables and results.json.
+    #[arg(long, default_value = "results/platform")]
+    pub out: PathBuf,
+    /// Replace result files that already exist.
+    #[arg(long)]
+    pub force: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
 }
 
 /// Output file formats of `generate`.

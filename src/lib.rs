@@ -2,6 +2,7 @@
 //!
 //! Layers, dependencies pointing down:
 //! - shells: [`cli`] and [`commands`] (parse, run, report, write files atomically via [`fsio`]);
+//! - [`eval`]: the paper's tables, measured on our game;
 //! - [`verify`]: play a level many times and aggregate the Solver's statistics;
 //! - [`generation`]: levels from a trained Generator; [`train`] and [`rl`]: PPO and the
 //!   training runs that make the policies;
@@ -13,6 +14,7 @@
 
 pub mod cli;
 pub mod commands;
+pub mod eval;
 pub mod fsio;
 pub mod game;
 pub mod generation;

@@ -379,6 +379,64 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
         .expect("--verify stores the Solver's statistics");
     assert_eq!(stats.trials, 4);
     assert!(stats.solver.describe().contains("solver.safetensors"));
+
+    // `eval` over the run: every table, in every format, with the keys results.json promises.
+    let results = dir.path().join("results");
+    let evaluated = arlpcg(&[
+        "eval",
+        "--policies",
+        out_s,
+        "--tracks",
+        "2",
+        "--trials",
+        "2",
+        "--validation-tracks",
+        "4",
+        "--out",
+        results.to_str().unwrap(),
+    ]);
+    assert!(
+        evaluated.status.success(),
+        "{}",
+        String::from_utf8_lossy(&evaluated.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(results.join("results.json")).unwrap()).unwrap();
+    let rows = json["controllability"].as_array().unwrap();
+    assert_eq!(rows.len(), 5);
+    for key in [
+        "aux",
+        "success_ratio",
+        "completed_by_any",
+        "avg_block_distance",
+        "avg_block_size",
+    ] {
+        assert!(rows[0].get(key).is_some(), "controllability.{key}");
+    }
+    let generalization = json["generalization"].as_array().unwrap();
+    assert_eq!(generalization[0]["mode"], "arlpcg");
+    // Half the validation set is rule levels, so the Solver has something to play.
+    assert!(generalization[0]["success_ratio"].is_number());
+    for name in [
+        "results.md",
+        "controllability.csv",
+        "generalization.csv",
+        "cross.csv",
+    ] {
+        assert!(results.join(name).exists(), "{name}");
+    }
+    let again = arlpcg(&[
+        "eval",
+        "--policies",
+        out_s,
+        "--out",
+        results.to_str().unwrap(),
+    ]);
+    assert!(
+        String::from_utf8_lossy(&again.stderr).contains("--force"),
+        "results are not clobbered"
+    );
+
     let missing_aux = arlpcg(&[
         "generate",
         "--policies",

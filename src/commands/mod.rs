@@ -2,6 +2,7 @@
 //! Errors come back as `anyhow` errors with the file and field named; `main` turns them into
 //! one line and a non-zero exit code.
 
+mod eval;
 mod export;
 mod generate;
 pub mod policies;
@@ -20,6 +21,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Generate(args)) => generate::run(&args),
         Some(Command::Export(args)) => export::run(&args),
         Some(Command::Verify(args)) => verify::run(&args),
+        Some(Command::Eval(args)) => eval::run(&args),
         Some(Command::Train(args)) => crate::train::run(&args),
         None => {
             use clap::CommandFactory;

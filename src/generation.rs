@@ -61,7 +61,8 @@ pub fn platform_level(
             let acted = generator
                 .policy
                 .act(&observation, ActMode::Sample, &mut rng)?;
-            if track.push(block_from_action(&acted.actions)).is_err() {
+            let block = block_from_action(&track, goal, &acted.actions);
+            if track.push(block).is_err() {
                 break;
             }
             if track.last().reaches(goal) {

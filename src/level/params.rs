@@ -42,6 +42,11 @@ impl ParamRange {
         self.min + (t + 1.0) * 0.5 * (self.max - self.min)
     }
 
+    /// The nearest value inside the range.
+    pub fn clamp(&self, value: f64) -> f64 {
+        value.clamp(self.min, self.max)
+    }
+
     /// Maps a value of the range onto [-1, 1] (the inverse of [`ParamRange::from_unit`]).
     pub fn to_unit(&self, value: f64) -> f64 {
         (value - self.min) / (self.max - self.min) * 2.0 - 1.0

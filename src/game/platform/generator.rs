@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use super::PlatformAction;
 use super::env::{PlatformEnv, SolverRewards};
 use crate::game::Step;
-use crate::level::params::quantize;
+use crate::level::params::{self, quantize};
 use crate::level::platform::{
     BlockParams, Platform, PlatformTrack, Start, direction_heading, wrap_degrees,
 };
@@ -50,12 +50,19 @@ pub const GENERATOR_OBSERVATION_SIZE: usize = {
 };
 
 /// The Generator's action names, in the policy's order, each a value in [-1, 1] mapped onto its
-/// SPEC range. The turn is taken relative to the bearing of the goal (0 aims straight at it);
-/// the level stores it, as the SPEC defines it, relative to the direction of the last two blocks.
-/// (With the turn relative to the last blocks, an untrained Generator wanders at random: in a
-/// first run 74-90% of its tracks overlapped themselves or ran out of blocks, and none reached
-/// its goal in a million Solver steps, so the Solver never saw a success.)
-pub const GENERATOR_ACTIONS: [&str; 4] = ["distance", "turn_from_goal_bearing", "size", "height"];
+/// SPEC range. The turn is taken relative to the bearing of the goal (0 aims straight at it) and
+/// the height change relative to the climb that stays on course for the goal (0 keeps the slope
+/// from the last block to the goal); the level stores both as the SPEC defines them (turn
+/// relative to the last two blocks, height relative to the last block). With the SPEC's own
+/// frames an untrained Generator wanders: in a first run 74-90% of its tracks overlapped
+/// themselves or ran out of blocks and none reached its goal in a million Solver steps, so the
+/// Solver never saw a success.
+pub const GENERATOR_ACTIONS: [&str; 4] = [
+    "distance",
+    "turn_from_goal_bearing",
+    "size",
+    "height_from_goal_slope",
+];
 
 /// The weights of one aux input in the Generator's reward (paper eq. 1).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -124,14 +131,19 @@ impl GeneratorRewards {
 
 /// A policy's action row (unbounded Gaussian samples) as the next block of `track` toward
 /// `goal`: each value is clipped to [-1, 1] and mapped onto its range (NaN becomes the middle),
-/// the turn added to the goal's bearing from the last block.
+/// the turn added to the goal's bearing from the last block, the height change to the climb
+/// that keeps the slope toward the goal (see [`GENERATOR_ACTIONS`]).
 pub fn block_from_action(track: &PlatformTrack, goal: [f64; 3], row: &[f32]) -> BlockParams {
     let unit = |v: f32| if v.is_nan() { 0.0 } else { v as f64 };
     let mut block =
         BlockParams::from_unit([unit(row[0]), unit(row[1]), unit(row[2]), unit(row[3])]);
     let last = track.last();
-    let bearing = direction_heading(goal[0] - last.position[0], goal[2] - last.position[2]);
+    let (dx, dz) = (goal[0] - last.position[0], goal[2] - last.position[2]);
+    let bearing = direction_heading(dx, dz);
     block.angle = quantize(wrap_degrees(bearing - last.heading + block.angle));
+    let rise = goal[1] - last.position[1];
+    let on_course = rise * (block.distance / dx.hypot(dz).max(1e-6)).min(1.0);
+    block.height = quantize(params::BLOCK_HEIGHT.clamp(on_course + block.height));
     block
 }
 
@@ -419,6 +431,20 @@ mod tests {
             (2.7..=3.01).contains(&generator_return),
             "{generator_return}"
         );
+    }
+
+    #[test]
+    fn a_zero_action_heads_straight_for_the_goal_in_three_dimensions() {
+        let track = PlatformTrack::new(Start {
+            heading: 90.0,
+            ..Start::default()
+        });
+        let block = block_from_action(&track, [20.0, 4.0, 0.0], &[0.0; 4]);
+        assert_eq!(block.distance, 7.5);
+        assert_eq!(block.angle, -90.0, "a right turn from heading 90 to the goal along +x");
+        assert_eq!(block.height, 1.5, "4 m over 20 m, for 7.5 m");
+        let steep = block_from_action(&track, [20.0, 40.0, 0.0], &[0.0, 0.0, 0.0, 1.0]);
+        assert_eq!(steep.height, 2.0, "clamped to the SPEC range");
     }
 
     #[test]

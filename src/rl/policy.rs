@@ -154,6 +154,13 @@ impl ActorCritic {
         vars
     }
 
+    /// Sets the log standard deviation of every continuous action (a new policy starts at 0).
+    pub fn set_log_std(&self, value: f32) -> candle_core::Result<()> {
+        let n = self.shape.continuous.max(1);
+        self.log_std
+            .set(&Tensor::full(value, (1, n), &Device::Cpu)?)
+    }
+
     /// Chooses actions for a batch of (normalized) observations.
     pub fn act(
         &self,

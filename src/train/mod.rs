@@ -102,6 +102,10 @@ pub struct GeneratorConfig {
     pub aux_values: Vec<f32>,
     /// A track that has not reached its goal in this many blocks ends as invalid.
     pub max_blocks: usize,
+    /// Log standard deviation of the new Generator's actions (in [-1, 1] units). At 0 (std 1)
+    /// its turns span ±180° and almost no track reaches its goal; -1.6 (std 0.2) starts it at
+    /// ±36°, ±0.5 m of distance, ±0.4 m of height, and lets PPO widen what pays.
+    pub initial_log_std: f32,
     /// The first Solver phase lasts at least this many steps, against the untrained Generator
     /// (random blocks). Without it the Generator learns against a Solver that cannot jump yet:
     /// every match fails whatever it builds, so it learns only to avoid overlaps (long jumps
@@ -148,7 +152,8 @@ impl Default for GeneratorConfig {
             rewards: GeneratorRewards::default(),
             aux_values: vec![-1.0, -1.0, -0.5, 0.5, 1.0, 1.0],
             max_blocks: 30,
-            solver_warmup_steps: 1_000_000,
+            initial_log_std: -1.6,
+            solver_warmup_steps: 500_000,
             solver_phase_steps: 100_000,
             generator_phase_steps: 10_000,
         }
@@ -299,6 +304,9 @@ fn check_config(config: &TrainConfig) -> Result<(), String> {
             "generator.max_blocks must be within [1, {}]",
             crate::level::platform::MAX_BLOCKS
         ));
+    }
+    if !(-10.0..=2.0).contains(&g.initial_log_std) {
+        return Err("generator.initial_log_std must be within [-10, 2]".into());
     }
     if g.solver_phase_steps == 0 || g.generator_phase_steps == 0 {
         return Err(
@@ -742,6 +750,7 @@ impl AdversarialRun {
     fn start(out: &Path, mode: TrainMode, config: TrainConfig) -> Result<Self> {
         let build = |config: &TrainConfig, _: Option<serde_json::Value>| {
             let policy = ActorCritic::new(generator_shape(config), config.seed.wrapping_add(1))?;
+            policy.set_log_std(config.generator.initial_log_std)?;
             let generator = Generator {
                 ppo: Ppo::new(config.generator.ppo.clone(), policy)?,
                 norm: RunningNorm::new(GENERATOR_OBSERVATION_SIZE),

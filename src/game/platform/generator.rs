@@ -441,7 +441,10 @@ mod tests {
         });
         let block = block_from_action(&track, [20.0, 4.0, 0.0], &[0.0; 4]);
         assert_eq!(block.distance, 7.5);
-        assert_eq!(block.angle, -90.0, "a right turn from heading 90 to the goal along +x");
+        assert_eq!(
+            block.angle, -90.0,
+            "a right turn from heading 90 to the goal along +x"
+        );
         assert_eq!(block.height, 1.5, "4 m over 20 m, for 7.5 m");
         let steep = block_from_action(&track, [20.0, 40.0, 0.0], &[0.0, 0.0, 0.0, 1.0]);
         assert_eq!(steep.height, 2.0, "clamped to the SPEC range");

@@ -31,6 +31,18 @@ pub fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// The rayon pool that environments, trials and candle's matrix products share: `threads`
+/// workers, or one per core.
+pub(crate) fn thread_pool(threads: Option<u64>) -> Result<rayon::ThreadPool> {
+    let threads = threads.map_or_else(
+        || std::thread::available_parallelism().map_or(2, |n| n.get()),
+        |t| t as usize,
+    );
+    Ok(rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?)
+}
+
 /// A progress bar on stderr (hidden when stderr is not a terminal).
 pub(crate) fn progress_bar(total: u64, what: &str) -> indicatif::ProgressBar {
     let bar = indicatif::ProgressBar::new(total);

@@ -298,10 +298,6 @@ impl AdversarialEnvs {
     pub fn take_stats(&mut self) -> MatchStats {
         std::mem::take(&mut self.stats)
     }
-
-    pub fn matches(&self) -> &[Match] {
-        &self.matches
-    }
 }
 
 impl VecEnv for AdversarialEnvs {

@@ -189,13 +189,7 @@ pub fn run(args: &TrainArgs) -> Result<()> {
             "give a budget: --steps N (total Solver environment steps) or --minutes M (this session)"
         );
     }
-    let threads = args.threads.map_or_else(
-        || std::thread::available_parallelism().map_or(2, |n| n.get()),
-        |t| t as usize,
-    );
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()?;
+    let pool = crate::commands::thread_pool(args.threads)?;
     pool.install(|| {
         let config = if args.resume {
             if args.config.is_some() {

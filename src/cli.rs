@@ -39,7 +39,7 @@ pub enum Command {
     /// Play levels many times and report how often the Solver gets through.
     Verify(VerifyArgs),
     /// Reproduce the paper's tables (controllability, generalization, each Solver at each λ)
-    /// for trained policies: markdown, CSV and results.json.
+    /// for trained policies: markdown, CSV, a PNG chart and results.json.
     Eval(EvalArgs),
     /// Train a Solver, alone or against a Generator, with PPO (checkpointed, resumable,
     /// stoppable with Ctrl-C).
@@ -71,7 +71,7 @@ pub struct EvalArgs {
     /// The paper's scale (hours on 2 cores) instead of a few minutes.
     #[arg(long)]
     pub full: bool,
-    /// Folder for results.md, the CSV tables and results.json.
+    /// Folder for results.md, the CSV tables, results.png and results.json.
     #[arg(long, default_value = "results/platform")]
     pub out: PathBuf,
     /// Replace result files that already exist.

@@ -342,6 +342,28 @@ pub fn markdown(results: &Results) -> String {
     md
 }
 
+/// The chart of `eval`: each Solver's success ratio on Generator levels against λ.
+pub fn chart(results: &Results) -> crate::chart::LineChart {
+    crate::chart::LineChart {
+        title: "Success ratio on Generator levels (λ: +1 easy, -1 hard)".into(),
+        x_label: "aux input λ".into(),
+        y_label: "success ratio".into(),
+        series: results
+            .cross
+            .iter()
+            .map(|row| crate::chart::Series {
+                name: row.mode.clone(),
+                points: AUX_VALUES
+                    .iter()
+                    .copied()
+                    .zip(row.success_ratio.iter().copied())
+                    .collect(),
+            })
+            .collect(),
+        y_range: Some((0.0, 1.0)),
+    }
+}
+
 /// The three tables as CSV files: (file name, contents).
 pub fn csv_tables(results: &Results) -> Vec<(&'static str, String)> {
     let mut controllability = String::from(

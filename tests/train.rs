@@ -419,6 +419,7 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     assert!(generalization[0]["success_ratio"].is_number());
     for name in [
         "results.md",
+        "results.png",
         "controllability.csv",
         "generalization.csv",
         "cross.csv",

@@ -1,5 +1,5 @@
 //! `arlpcg eval`: loads the Generator and the Solvers, runs [`crate::eval::evaluate`], writes
-//! results.md, the CSV tables and results.json.
+//! results.md, the CSV tables, results.json and results.png.
 
 use std::path::PathBuf;
 
@@ -75,6 +75,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     let names = [
         "results.md",
         "results.json",
+        "results.png",
         "controllability.csv",
         "generalization.csv",
         "cross.csv",
@@ -116,6 +117,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     let mut files: Vec<(String, Vec<u8>)> = vec![
         ("results.md".into(), markdown.clone().into_bytes()),
         ("results.json".into(), serde_json::to_vec_pretty(&results)?),
+        ("results.png".into(), eval::chart(&results).to_png()),
     ];
     for (name, text) in eval::csv_tables(&results) {
         files.push((name.into(), text.into_bytes()));

@@ -368,6 +368,7 @@ fn train_loop(run: &mut dyn Training, args: &TrainArgs) -> Result<()> {
         }
         if last_checkpoint.elapsed().as_secs_f64() >= run.checkpoint_minutes() * 60.0 {
             run.save_checkpoint(wall())?;
+            write_learning_curve(run.out())?;
             last_checkpoint = Instant::now();
         }
     }
@@ -375,6 +376,7 @@ fn train_loop(run: &mut dyn Training, args: &TrainArgs) -> Result<()> {
     let wall = wall();
     run.save_checkpoint(wall)?;
     run.save_policies(wall)?;
+    write_learning_curve(run.out())?;
     let why = if stop.load(Ordering::SeqCst) {
         "stopped (Ctrl-C)"
     } else {
@@ -387,6 +389,68 @@ fn train_loop(run: &mut dyn Training, args: &TrainArgs) -> Result<()> {
         run.out().display()
     );
     Ok(())
+}
+
+/// Column `name` of a metrics CSV as (x column, value) pairs, smoothed over `window` rows.
+fn metric_series(text: &str, x: &str, name: &str, window: usize) -> Vec<(f64, f64)> {
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    let (Some(xi), Some(yi)) = (
+        header.iter().position(|h| *h == x),
+        header.iter().position(|h| *h == name),
+    ) else {
+        return Vec::new();
+    };
+    let rows: Vec<(f64, f64)> = lines
+        .filter_map(|line| {
+            let fields: Vec<&str> = line.split(',').collect();
+            Some((fields.get(xi)?.parse().ok()?, fields.get(yi)?.parse().ok()?))
+        })
+        .collect();
+    (0..rows.len())
+        .map(|i| {
+            let recent: Vec<f64> = rows[i.saturating_sub(window - 1)..=i]
+                .iter()
+                .map(|r| r.1)
+                .filter(|v: &f64| v.is_finite())
+                .collect();
+            let mean = recent.iter().sum::<f64>() / recent.len() as f64;
+            (rows[i].0, if recent.is_empty() { f64::NAN } else { mean })
+        })
+        .collect()
+}
+
+/// `learning-curve.png`: the Solver's training success ratio against its steps (and, in the
+/// adversarial modes, its success on easy and hard Generator levels), smoothed over 10 updates.
+fn write_learning_curve(out: &Path) -> Result<()> {
+    let read = |name: &str| std::fs::read_to_string(out.join(name)).unwrap_or_default();
+    let solver = read(METRICS);
+    let generator = read(GENERATOR_METRICS);
+    let mut series = vec![crate::chart::Series {
+        name: "Solver, training".into(),
+        points: metric_series(&solver, "global_step", "success_ratio", 10),
+    }];
+    for (column, name) in [("success_easy", "λ > 0"), ("success_hard", "λ < 0")] {
+        let points = metric_series(&generator, "solver_step", column, 10);
+        if !points.is_empty() {
+            series.push(crate::chart::Series {
+                name: name.into(),
+                points,
+            });
+        }
+    }
+    let chart = crate::chart::LineChart {
+        title: format!("Solver success ratio ({})", out.display()),
+        x_label: "Solver environment steps".into(),
+        y_label: "success ratio".into(),
+        series,
+        y_range: Some((0.0, 1.0)),
+    };
+    fsio::write_atomic(
+        &out.join("learning-curve.png"),
+        &chart.to_png(),
+        Overwrite::Allowed,
+    )
 }
 
 /// Environments whose progress is saved in checkpoints.

@@ -7,11 +7,10 @@ use anyhow::{Context, Result};
 use sha2::{Digest, Sha256};
 
 use crate::game::platform::OBSERVATION_SIZE;
-use crate::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
+use crate::game::platform::generator::{DEFAULT_MAX_BLOCKS, GENERATOR_OBSERVATION_SIZE};
 use crate::generation::GeneratorPolicy;
 use crate::level::{Game, PolicyRef};
 use crate::rl::checkpoint::{LoadedPolicy, PolicyCard, Role, load_policy};
-use crate::train::GeneratorConfig;
 use crate::verify::SolverPolicy;
 
 /// File names inside a policies folder.
@@ -55,9 +54,7 @@ pub fn load_generator(path: &Path) -> Result<(GeneratorPolicy, PolicyCard)> {
     Ok((
         GeneratorPolicy {
             policy: loaded.policy,
-            max_blocks: card
-                .max_blocks
-                .unwrap_or(GeneratorConfig::default().max_blocks),
+            max_blocks: card.max_blocks.unwrap_or(DEFAULT_MAX_BLOCKS),
             normalizer: loaded.card.normalizer,
             reference,
         },

@@ -5,7 +5,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::normalizer::RunningNorm;
-use super::policy::ActMode;
+use super::policy::{ActMode, Acted};
 use super::ppo::{Batch, Ppo, UpdateStats, gae};
 
 /// What one environment's step led to. Finished episodes are reset by the environment.
@@ -85,12 +85,7 @@ impl<E: VecEnv> Trainer<E> {
         let (mut episodes, mut return_sum, mut successes, mut judged) = (0u32, 0.0f64, 0u32, 0u32);
         for _ in 0..steps {
             self.norm.update(&self.observations);
-            let mut normalized = self.observations.clone();
-            self.norm.normalize(&mut normalized);
-            let acted = self
-                .ppo
-                .policy
-                .act(&normalized, ActMode::Sample, &mut self.rng)?;
+            let (normalized, acted) = self.act_sampled()?;
             self.env.step(&acted.actions, &mut transitions);
             for (e, t) in transitions.iter().enumerate() {
                 self.episode_returns[e] += t.reward;
@@ -148,17 +143,22 @@ impl<E: VecEnv> Trainer<E> {
         Ok((batch, stats))
     }
 
-    /// Plays one tick of every environment with the current policy, learning nothing (the
-    /// normalizer stays as it is too): the frozen side of an adversarial phase.
-    pub fn play_tick(&mut self) -> candle_core::Result<()> {
-        let n = self.env.num_envs();
+    /// The current observations normalized, and the actions sampled for them.
+    fn act_sampled(&mut self) -> candle_core::Result<(Vec<f32>, Acted)> {
         let mut normalized = self.observations.clone();
         self.norm.normalize(&mut normalized);
         let acted = self
             .ppo
             .policy
             .act(&normalized, ActMode::Sample, &mut self.rng)?;
-        let mut transitions = vec![Transition::default(); n];
+        Ok((normalized, acted))
+    }
+
+    /// Plays one tick of every environment with the current policy, learning nothing (the
+    /// normalizer stays as it is too): the frozen side of an adversarial phase.
+    pub fn play_tick(&mut self) -> candle_core::Result<()> {
+        let (_, acted) = self.act_sampled()?;
+        let mut transitions = vec![Transition::default(); self.env.num_envs()];
         self.env.step(&acted.actions, &mut transitions);
         for (e, t) in transitions.iter().enumerate() {
             self.episode_returns[e] = if t.ended {

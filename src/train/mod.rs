@@ -9,7 +9,10 @@
 //! `generator.safetensors` + `generator.yaml`. `--resume` continues from the checkpoints.
 
 pub mod arlpcg;
+mod config;
 pub mod platform;
+
+pub use config::{GeneratorConfig, TrainConfig, TrainMode};
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -20,145 +23,21 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use serde::{Deserialize, Serialize};
 
 use crate::cli::TrainArgs;
 use crate::fsio::{self, Overwrite};
 use crate::game::platform::generator::{
-    GENERATOR_ACTIONS, GENERATOR_OBSERVATION_LAYOUT, GENERATOR_OBSERVATION_SIZE, GeneratorRewards,
+    GENERATOR_ACTIONS, GENERATOR_OBSERVATION_LAYOUT, GENERATOR_OBSERVATION_SIZE,
 };
 use crate::level::Game;
 use crate::rl::checkpoint::{self, PolicyCard, Role, TrainingRecord, TrainingState};
 use crate::rl::normalizer::RunningNorm;
 use crate::rl::policy::{ActorCritic, PolicyShape};
-use crate::rl::ppo::{Ppo, PpoConfig, UpdateStats};
+use crate::rl::ppo::{Ppo, UpdateStats};
 use crate::rl::vec_env::{RolloutStats, Trainer, VecEnv};
 use arlpcg::{AdversarialEnvs, AdversarialState, Generator, MatchRules, MatchStats, Phase};
-use platform::{PlatformSolverEnvs, SolverMode, SourceState};
-
-/// How the Solver is trained (the paper's baselines and its method, SPEC 3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "kebab-case")]
-pub enum TrainMode {
-    /// On a fresh rule-based level every episode (the Rule-PCG baseline).
-    RulePcg,
-    /// On a small fixed set of rule-based levels (the Fixed-Track baseline).
-    FixedTrack,
-    /// Against a Generator that always has λ = 1 (the ablation).
-    FixedAux,
-    /// Against a Generator with λ drawn per match (the full method).
-    Arlpcg,
-}
-
-impl TrainMode {
-    pub fn name(self) -> &'static str {
-        match self {
-            TrainMode::RulePcg => "rule-pcg",
-            TrainMode::FixedTrack => "fixed-track",
-            TrainMode::FixedAux => "fixed-aux",
-            TrainMode::Arlpcg => "arlpcg",
-        }
-    }
-
-    /// The level source of the Solver-only modes; `None` for the adversarial ones.
-    fn solver_only(self) -> Option<SolverMode> {
-        match self {
-            TrainMode::RulePcg => Some(SolverMode::RulePcg),
-            TrainMode::FixedTrack => Some(SolverMode::FixedTrack),
-            TrainMode::FixedAux | TrainMode::Arlpcg => None,
-        }
-    }
-}
-
-/// Everything a training run is configured by (`--config FILE`, YAML; every field has the
-/// default `arlpcg train --print-config` shows, the paper's values where it gives them).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct TrainConfig {
-    /// Seeds network initialization and action sampling.
-    pub seed: u64,
-    /// Hidden layer sizes of the actors and critics of both agents (the paper: 2 × 512).
-    pub hidden: Vec<usize>,
-    /// Minutes between checkpoints.
-    pub checkpoint_minutes: f64,
-    /// The Solver's PPO (the paper: learning rate 3e-4, γ 0.99 on the platform game);
-    /// `num_envs` is also the number of matches in the adversarial modes.
-    #[serde(alias = "ppo")]
-    pub solver: PpoConfig,
-    /// The Generator (adversarial modes only).
-    pub generator: GeneratorConfig,
-}
-
-/// The Generator's side of an adversarial run.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct GeneratorConfig {
-    /// The Generator's PPO (the paper: learning rate 2e-4, γ 0.99). One Generator step is one
-    /// block; a batch is `num_envs × num_steps` completed decisions.
-    pub ppo: PpoConfig,
-    /// Reward terms and the weights of each aux input (paper eq. 1; SPEC 2).
-    pub rewards: GeneratorRewards,
-    /// λ of each match is drawn uniformly from these (`fixed-aux` holds λ = 1).
-    pub aux_values: Vec<f32>,
-    /// A track that has not reached its goal in this many blocks ends as invalid.
-    pub max_blocks: usize,
-    /// Log standard deviation of the new Generator's actions (in [-1, 1] units). At 0 (std 1)
-    /// its turns span ±180° and almost no track reaches its goal; -1.6 (std 0.2) starts it at
-    /// ±36°, ±0.5 m of distance, ±0.4 m of height, and lets PPO widen what pays.
-    pub initial_log_std: f32,
-    /// The first Solver phase lasts at least this many steps, against the untrained Generator
-    /// (random blocks). Without it the Generator learns against a Solver that cannot jump yet:
-    /// every match fails whatever it builds, so it learns only to avoid overlaps (long jumps
-    /// at every λ), which in turn keeps the Solver from learning (seen in a first run: no
-    /// success after 300k steps, where rule-pcg had 0.5).
-    pub solver_warmup_steps: u64,
-    /// Solver steps learned from in each Solver phase...
-    pub solver_phase_steps: u64,
-    /// ...and Generator decisions in each Generator phase. The Solver acts about 25 times per
-    /// block, so its phase switches about a tenth as often as the Generator's in its own steps.
-    pub generator_phase_steps: u64,
-}
-
-impl Default for TrainConfig {
-    fn default() -> Self {
-        Self {
-            seed: 0,
-            hidden: vec![512, 512],
-            checkpoint_minutes: 5.0,
-            solver: PpoConfig {
-                learning_rate: 3e-4,
-                gamma: 0.99,
-                num_envs: 64,
-                num_steps: 128,
-                ent_coef: 0.005,
-                ..PpoConfig::default()
-            },
-            generator: GeneratorConfig::default(),
-        }
-    }
-}
-
-impl Default for GeneratorConfig {
-    fn default() -> Self {
-        Self {
-            ppo: PpoConfig {
-                learning_rate: 2e-4,
-                gamma: 0.99,
-                num_envs: 64,
-                num_steps: 16,
-                ent_coef: 0.0,
-                ..PpoConfig::default()
-            },
-            rewards: GeneratorRewards::default(),
-            aux_values: vec![-1.0, -1.0, -0.5, 0.5, 1.0, 1.0],
-            max_blocks: 30,
-            initial_log_std: -1.6,
-            solver_warmup_steps: 500_000,
-            solver_phase_steps: 100_000,
-            generator_phase_steps: 10_000,
-        }
-    }
-}
+use config::load_config;
+use platform::{PlatformSolverEnvs, SourceState};
 
 const CHECKPOINT: &str = "checkpoint.safetensors";
 const GENERATOR_CHECKPOINT: &str = "generator-checkpoint.safetensors";
@@ -239,75 +118,6 @@ pub fn run(args: &TrainArgs) -> Result<()> {
             }
         }
     })
-}
-
-fn load_config(path: &Path) -> Result<TrainConfig> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let config: TrainConfig =
-        serde_yaml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    check_config(&config).map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))?;
-    Ok(config)
-}
-
-/// Checks the values serde cannot: sizes, ranges, finite numbers.
-fn check_config(config: &TrainConfig) -> Result<(), String> {
-    if config.hidden.is_empty() || config.hidden.contains(&0) {
-        return Err("hidden: give at least one layer, each of at least 1 unit".into());
-    }
-    for (name, p) in [
-        ("solver", &config.solver),
-        ("generator.ppo", &config.generator.ppo),
-    ] {
-        if p.num_envs == 0 || p.num_steps == 0 || p.num_minibatches == 0 || p.update_epochs == 0 {
-            return Err(format!(
-                "{name}: num_envs, num_steps, num_minibatches and update_epochs must be at least 1"
-            ));
-        }
-        let valid = p.learning_rate.is_finite()
-            && p.learning_rate > 0.0
-            && (0.0..=1.0).contains(&p.gamma)
-            && (0.0..=1.0).contains(&p.gae_lambda);
-        if !valid {
-            return Err(format!(
-                "{name}: learning_rate must be > 0, gamma and gae_lambda within [0, 1]"
-            ));
-        }
-    }
-    let g = &config.generator;
-    if g.aux_values.is_empty() || g.aux_values.iter().any(|l| !(-1.0..=1.0).contains(l)) {
-        return Err("generator.aux_values: give at least one, each within [-1, 1]".into());
-    }
-    if g.rewards.aux.len() != 1 {
-        return Err(format!(
-            "generator.rewards.aux: the platform game has 1 aux input, so give 1 weight pair, not {}",
-            g.rewards.aux.len()
-        ));
-    }
-    let r = &g.rewards;
-    let weights = r.aux.iter().flat_map(|w| [w.alpha, w.beta]);
-    if ![r.progress_per_metre, r.failure, r.step_penalty, r.invalid]
-        .into_iter()
-        .chain(weights)
-        .all(f32::is_finite)
-    {
-        return Err("generator.rewards: every weight must be a finite number".into());
-    }
-    if !(1..=crate::level::platform::MAX_BLOCKS).contains(&g.max_blocks) {
-        return Err(format!(
-            "generator.max_blocks must be within [1, {}]",
-            crate::level::platform::MAX_BLOCKS
-        ));
-    }
-    if !(-10.0..=2.0).contains(&g.initial_log_std) {
-        return Err("generator.initial_log_std must be within [-10, 2]".into());
-    }
-    if g.solver_phase_steps == 0 || g.generator_phase_steps == 0 {
-        return Err(
-            "generator: solver_phase_steps and generator_phase_steps must be at least 1".into(),
-        );
-    }
-    Ok(())
 }
 
 /// What the training loop drives: one iteration at a time, checkpoints, the final policies.
@@ -414,8 +224,8 @@ fn metric_series(text: &str, x: &str, name: &str, window: usize) -> Vec<(f64, f6
                 .map(|r| r.1)
                 .filter(|v: &f64| v.is_finite())
                 .collect();
-            let mean = recent.iter().sum::<f64>() / recent.len() as f64;
-            (rows[i].0, if recent.is_empty() { f64::NAN } else { mean })
+            // An empty window is NaN (0/0): the chart breaks the line there.
+            (rows[i].0, recent.iter().sum::<f64>() / recent.len() as f64)
         })
         .collect()
 }

@@ -64,6 +64,10 @@ pub const GENERATOR_ACTIONS: [&str; 4] = [
     "height_from_goal_slope",
 ];
 
+/// The block budget of a Generator's track by default: a track that has not reached its goal
+/// within it is invalid (goals are at most 70 m away, blocks 5-10 m apart).
+pub const DEFAULT_MAX_BLOCKS: usize = 30;
+
 /// The weights of one aux input in the Generator's reward (paper eq. 1).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -20,6 +20,8 @@ use crate::train::TrainMode;
         Levels come from a Generator trained against a Solver (ARLPCG, EA SEED 2021) and \
         steered by one knob, the aux input λ (+1 easy, -1 hard), or from rule-based generation.",
     after_help = "Examples:\n  \
+        arlpcg                      (the designer, on the shipped policies)\n  \
+        arlpcg design --policies runs/platform-solver-arlpcg --out levels/mine\n  \
         arlpcg generate --policies policies/platform --aux -0.5 --verify 100 --out levels/mine\n  \
         arlpcg generate --game platform --rules --count 20 --seed 1 --out levels/mine\n  \
         arlpcg verify levels/mine/*.yaml --trials 100\n  \
@@ -32,6 +34,9 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Open the designer (the default without a subcommand): steer λ, generate, watch the
+    /// Solver's statistics, export. Keys: ? in the designer.
+    Design(DesignArgs),
     /// Generate levels and write them as YAML and glTF files.
     Generate(GenerateArgs),
     /// Convert a level file to glTF (.glb, or .gltf with a .bin beside it).
@@ -44,6 +49,27 @@ pub enum Command {
     /// Train a Solver, alone or against a Generator, with PPO (checkpointed, resumable,
     /// stoppable with Ctrl-C).
     Train(TrainArgs),
+}
+
+#[derive(Debug, Args)]
+#[command(after_help = "Examples:\n  \
+    arlpcg design\n  \
+    arlpcg design --policies runs/platform-solver-arlpcg --out levels/mine --seed 7")]
+pub struct DesignArgs {
+    /// Which game.
+    #[arg(long, default_value = "platform", value_parser = parse_game)]
+    pub game: Game,
+    /// A policies folder (generator.safetensors and/or solver.safetensors) or one policy file.
+    /// Default: the shipped policies/<game>/; without them, rule levels and the scripted
+    /// controller.
+    #[arg(long, value_name = "PATH")]
+    pub policies: Option<PathBuf>,
+    /// Where exports go (into a folder per game).
+    #[arg(long, default_value = "levels", value_name = "DIR")]
+    pub out: PathBuf,
+    /// The seed of the first level.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
 }
 
 #[derive(Debug, Args)]
@@ -188,6 +214,7 @@ pub struct VerifyArgs {
     arlpcg train --game platform --mode rule-pcg --minutes 60 --out runs/solver\n  \
     arlpcg train --game platform --mode rule-pcg --minutes 60 --out runs/solver --resume\n  \
     arlpcg train --game platform --mode arlpcg --steps 4000000 --out runs/arlpcg\n  \
+    arlpcg train --mode arlpcg --steps 4000000 --out runs/arlpcg --resume --config new.yaml\n  \
     arlpcg train --print-config > train.yaml")]
 pub struct TrainArgs {
     /// Which game.
@@ -205,7 +232,10 @@ pub struct TrainArgs {
     /// Stop after this many minutes of this session.
     #[arg(long, value_parser = parse_minutes)]
     pub minutes: Option<f64>,
-    /// Training configuration (YAML; see --print-config for every field and its default).
+    /// Training configuration (YAML; see --print-config for every field and its default). With
+    /// --resume it replaces the run's hyper-parameters from the checkpoint on (not `seed`,
+    /// `hidden`, `solver.num_envs` or `generator.max_blocks`); the old file is kept as
+    /// config-until-step-N.yaml.
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Folder of the run: config, checkpoint, metrics.csv, the trained policy and its card.

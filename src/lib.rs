@@ -15,6 +15,7 @@
 pub mod chart;
 pub mod cli;
 pub mod commands;
+pub mod design;
 pub mod eval;
 pub mod fsio;
 pub mod game;

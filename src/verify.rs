@@ -61,39 +61,116 @@ pub fn verify(
     seed: u64,
     on_trial: &(dyn Fn() + Sync),
 ) -> Result<SolverStats, UnsupportedGame> {
+    let watch = Watch {
+        on_trial: &|_| on_trial(),
+        stop: &|| false,
+    };
+    let stats = verify_watched(level, solver, trials, seed, &watch)?;
+    Ok(stats.expect("verification without a stop condition runs to the end"))
+}
+
+/// Who watches a verification: told of each finished trial, asked whether to stop.
+pub struct Watch<'a> {
+    /// Called with each finished trial, possibly from worker threads, in any order.
+    pub on_trial: &'a (dyn Fn(&TrialResult) + Sync),
+    /// Checked between ticks (policy) or trials (scripted, random); true abandons the work.
+    pub stop: &'a (dyn Fn() -> bool + Sync),
+}
+
+/// [`verify`], watched: the same trials with the same statistics, unless `watch.stop` says to
+/// stop, which returns `Ok(None)` soon after.
+pub fn verify_watched(
+    level: &Level,
+    solver: &Solver,
+    trials: u32,
+    seed: u64,
+    watch: &Watch,
+) -> Result<Option<SolverStats>, UnsupportedGame> {
     let Track::Platform(track) = &level.track else {
         return Err(UnsupportedGame("racing"));
     };
     let new_env = || PlatformEnv::new(track, level.goal, SolverRewards::default());
-    let results: Vec<TrialResult> = match solver {
+    let reported = |result: TrialResult| {
+        (watch.on_trial)(&result);
+        result
+    };
+    let results: Option<Vec<TrialResult>> = match solver {
         Solver::Scripted => (0..trials as u64)
             .into_par_iter()
             .map_init(new_env, |env, i| {
-                let result = play_scripted(env, seed.wrapping_add(i), SCRIPTED_JITTER);
-                on_trial();
-                result
+                (!(watch.stop)())
+                    .then(|| reported(play_scripted(env, seed.wrapping_add(i), SCRIPTED_JITTER)))
             })
             .collect(),
         Solver::Random => (0..trials as u64)
             .into_par_iter()
             .map_init(new_env, |env, i| {
-                let result = play_random(env, seed.wrapping_add(i));
-                on_trial();
-                result
+                (!(watch.stop)()).then(|| reported(play_random(env, seed.wrapping_add(i))))
             })
             .collect(),
         Solver::Policy(policy) => (0..trials as u64)
             .collect::<Vec<_>>()
             .chunks(LOCKSTEP)
-            .flat_map(|chunk| play_policy(track, level.goal, policy, seed, chunk, on_trial))
-            .collect(),
+            .map(|chunk| play_policy(track, level.goal, policy, seed, chunk, watch))
+            .collect::<Option<Vec<Vec<TrialResult>>>>()
+            .map(|chunks| chunks.concat()),
     };
-    Ok(SolverStats::from_trials(
-        solver.reference(),
-        seed,
-        track.block_count(),
-        &results,
-    ))
+    Ok(results.map(|results| {
+        SolverStats::from_trials(solver.reference(), seed, track.block_count(), &results)
+    }))
+}
+
+/// One run recorded for display: where the character's feet were at every step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recording {
+    pub path: Vec<[f32; 3]>,
+    pub result: TrialResult,
+}
+
+/// Plays one run of the level with `seed` and records it. A policy plays it alone (one forward
+/// pass per step), so the run is not one of [`verify`]'s lockstep trials of the same seed.
+pub fn record(level: &Level, solver: &Solver, seed: u64) -> Result<Recording, UnsupportedGame> {
+    let Track::Platform(track) = &level.track else {
+        return Err(UnsupportedGame("racing"));
+    };
+    let mut env = PlatformEnv::new(track, level.goal, SolverRewards::default());
+    env.reset(seed);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut scripted =
+        crate::game::platform::scripted::ScriptedController::new(seed, SCRIPTED_JITTER);
+    let mut observation = vec![0.0; OBSERVATION_SIZE];
+    let feet = |env: &PlatformEnv| {
+        let f = env.character().feet;
+        [f.x, f.y, f.z]
+    };
+    let mut path = vec![feet(&env)];
+    loop {
+        let action = match solver {
+            Solver::Scripted => scripted.act(&env),
+            Solver::Random => PlatformAction {
+                forward: rng.random_range(-1.0..=1.0),
+                turn: rng.random_range(-1.0..=1.0),
+                jump: rng.random_bool(0.5),
+            },
+            Solver::Policy(policy) => {
+                env.observe(&mut observation);
+                policy.normalizer.normalize(&mut observation);
+                let acted = policy
+                    .policy
+                    .act(&observation, ActMode::Sample, &mut rng)
+                    .expect("a loaded policy acts on observations of its size");
+                PlatformAction::from_policy_row(&acted.actions)
+            }
+        };
+        let outcome = env.step(action).outcome;
+        path.push(feet(&env));
+        if let Some(outcome) = outcome {
+            return Ok(Recording {
+                path,
+                result: finish(&env, outcome),
+            });
+        }
+    }
 }
 
 fn finish(env: &PlatformEnv, outcome: crate::level::stats::Outcome) -> TrialResult {
@@ -127,8 +204,8 @@ fn play_policy(
     solver: &SolverPolicy,
     seed: u64,
     indices: &[u64],
-    on_trial: &(dyn Fn() + Sync),
-) -> Vec<TrialResult> {
+    watch: &Watch,
+) -> Option<Vec<TrialResult>> {
     let mut envs: Vec<PlatformEnv> = indices
         .par_iter()
         .map(|&i| {
@@ -144,6 +221,9 @@ fn play_policy(
         let active: Vec<usize> = (0..envs.len()).filter(|&k| results[k].is_none()).collect();
         if active.is_empty() {
             break;
+        }
+        if (watch.stop)() {
+            return None;
         }
         let rows = &mut observations[..active.len() * OBSERVATION_SIZE];
         rows.par_chunks_mut(OBSERVATION_SIZE)
@@ -170,14 +250,16 @@ fn play_policy(
             })
             .collect();
         for (k, result) in finished {
+            (watch.on_trial)(&result);
             results[k] = Some(result);
-            on_trial();
         }
     }
-    results
-        .into_iter()
-        .map(|r| r.expect("every trial finished"))
-        .collect()
+    Some(
+        results
+            .into_iter()
+            .map(|r| r.expect("every trial finished"))
+            .collect(),
+    )
 }
 
 /// Aggregates over many levels, as the paper's generalization table does.

@@ -23,12 +23,32 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Verify(args)) => verify::run(&args),
         Some(Command::Eval(args)) => eval::run(&args),
         Some(Command::Train(args)) => crate::train::run(&args),
+        Some(Command::Design(args)) => design(args),
         None => {
-            use clap::CommandFactory;
-            Cli::command().print_long_help()?;
-            Ok(())
+            use std::io::IsTerminal;
+            if std::io::stdin().is_terminal() && std::io::stdout().is_terminal() {
+                design(crate::cli::DesignArgs {
+                    game: crate::level::Game::Platform,
+                    policies: None,
+                    out: "levels".into(),
+                    seed: 1,
+                })
+            } else {
+                use clap::CommandFactory;
+                Cli::command().print_long_help()?;
+                Ok(())
+            }
         }
     }
+}
+
+fn design(args: crate::cli::DesignArgs) -> Result<()> {
+    crate::design::run(crate::design::DesignOptions {
+        game: args.game,
+        policies: args.policies,
+        out: args.out,
+        seed: args.seed,
+    })
 }
 
 /// The rayon pool that environments, trials and candle's matrix products share: `threads`

@@ -144,6 +144,30 @@ pub(super) fn load_config(path: &Path) -> Result<TrainConfig> {
     Ok(config)
 }
 
+/// Checks that `new` may replace `old` in a resumed run: the fields that fix the networks'
+/// shapes, the number of matches and the seed stream stay; learning rates, coefficients,
+/// rewards and the phase schedule may change.
+pub(super) fn check_resumable_change(old: &TrainConfig, new: &TrainConfig) -> Result<(), String> {
+    let fixed = [
+        ("seed", old.seed == new.seed),
+        ("hidden", old.hidden == new.hidden),
+        (
+            "solver.num_envs",
+            old.solver.num_envs == new.solver.num_envs,
+        ),
+        (
+            "generator.max_blocks",
+            old.generator.max_blocks == new.generator.max_blocks,
+        ),
+    ];
+    match fixed.iter().find(|(_, same)| !same) {
+        Some((name, _)) => Err(format!(
+            "{name} cannot change in a resumed run (it fixes the networks, the matches or the seed stream)"
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Checks the values serde cannot: sizes, ranges, finite numbers.
 fn check_config(config: &TrainConfig) -> Result<(), String> {
     if config.hidden.is_empty() || config.hidden.contains(&0) {

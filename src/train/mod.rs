@@ -36,7 +36,7 @@ use crate::rl::policy::{ActorCritic, PolicyShape};
 use crate::rl::ppo::{Ppo, UpdateStats};
 use crate::rl::vec_env::{RolloutStats, Trainer, VecEnv};
 use arlpcg::{AdversarialEnvs, AdversarialState, Generator, MatchRules, MatchStats, Phase};
-use config::load_config;
+use config::{check_resumable_change, load_config};
 use platform::{PlatformSolverEnvs, SourceState};
 
 const CHECKPOINT: &str = "checkpoint.safetensors";
@@ -70,14 +70,9 @@ pub fn run(args: &TrainArgs) -> Result<()> {
     }
     let pool = crate::commands::thread_pool(args.threads)?;
     pool.install(|| {
+        // A new run's configuration, or a resumed run's replacement (None: keep its own).
         let config = if args.resume {
-            if args.config.is_some() {
-                bail!(
-                    "--config cannot change a resumed run: its configuration is in {}",
-                    out.join(CHECKPOINT).display()
-                );
-            }
-            None
+            args.config.as_deref().map(load_config).transpose()?
         } else {
             if out.join(CHECKPOINT).exists() {
                 bail!(
@@ -103,16 +98,18 @@ pub fn run(args: &TrainArgs) -> Result<()> {
                         state,
                     ))
                 };
-                let mut run = match config {
-                    Some(config) => Run::start(out, mode, config, build)?,
-                    None => Run::resume(out, mode, build)?,
+                let mut run = if args.resume {
+                    Run::resume(out, mode, config, build)?
+                } else {
+                    Run::start(out, mode, config.unwrap_or_default(), build)?
                 };
                 train_loop(&mut run, args)
             }
             None => {
-                let mut run = match config {
-                    Some(config) => AdversarialRun::start(out, mode, config)?,
-                    None => AdversarialRun::resume(out, mode)?,
+                let mut run = if args.resume {
+                    AdversarialRun::resume(out, mode, config)?
+                } else {
+                    AdversarialRun::start(out, mode, config.unwrap_or_default())?
                 };
                 train_loop(&mut run, args)
             }
@@ -419,15 +416,42 @@ impl<E: Resumable> Run<E> {
         })
     }
 
+    /// Resumes the run in `out`; `replacement` (from `--config`) replaces its configuration from
+    /// here on, the old one kept as `config-until-step-N.yaml`.
     fn resume(
         out: &Path,
         mode: TrainMode,
+        replacement: Option<TrainConfig>,
         build: impl FnOnce(&TrainConfig, Option<serde_json::Value>) -> Result<E>,
     ) -> Result<Self> {
         let path = out.join(CHECKPOINT);
         let (loaded, state) = read_checkpoint(&path, Role::Solver, mode)?;
-        let config: TrainConfig = serde_json::from_value(state.config.clone())
+        let stored: TrainConfig = serde_json::from_value(state.config.clone())
             .with_context(|| format!("{}: configuration", path.display()))?;
+        let config = match replacement {
+            None => stored,
+            Some(new) => {
+                check_resumable_change(&stored, &new).map_err(|problem| {
+                    anyhow::anyhow!(
+                        "--config with --resume: {problem} (the run in {})",
+                        out.display()
+                    )
+                })?;
+                if new != stored {
+                    fsio::write_atomic(
+                        &out.join(format!("config-until-step-{}.yaml", state.global_step)),
+                        serde_yaml::to_string(&stored)?.as_bytes(),
+                        Overwrite::Never,
+                    )?;
+                    fsio::write_atomic(
+                        &out.join("config.yaml"),
+                        serde_yaml::to_string(&new)?.as_bytes(),
+                        Overwrite::Allowed,
+                    )?;
+                }
+                new
+            }
+        };
         let vars = loaded.policy.named_vars();
         let mut ppo = Ppo::new(config.solver.clone(), loaded.policy)?;
         ppo.adam
@@ -645,7 +669,7 @@ impl AdversarialRun {
         })
     }
 
-    fn resume(out: &Path, mode: TrainMode) -> Result<Self> {
+    fn resume(out: &Path, mode: TrainMode, replacement: Option<TrainConfig>) -> Result<Self> {
         let path = out.join(GENERATOR_CHECKPOINT);
         let (loaded, generator_state) = read_checkpoint(&path, Role::Generator, mode)?;
         let generator_iteration = generator_state.iteration;
@@ -670,7 +694,7 @@ impl AdversarialRun {
                 state,
             )?)
         };
-        let solver = Run::resume(out, mode, build)?;
+        let solver = Run::resume(out, mode, replacement, build)?;
         truncate_metrics(
             &out.join(GENERATOR_METRICS),
             GENERATOR_METRICS_HEADER,

@@ -1,0 +1,875 @@
+//! The designer's state and its pure update: `update(state, message) -> effects`. Keys, mouse,
+//! ticks and the worker's answers come in as [`Message`]s; the work to do goes out as
+//! [`Effect`]s, which the shell hands to the worker threads. Nothing here touches the terminal,
+//! the file system or a clock, so key scripts drive it in tests.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use ratatui::crossterm::event::{
+    KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEvent, MouseEventKind,
+};
+use ratatui::layout::{Position, Rect};
+
+use crate::level::params::quantize;
+use crate::level::platform::heading_direction;
+use crate::level::stats::{Outcome, SolverStats, TrialResult, wilson_interval};
+use crate::level::{Game, Level};
+use crate::rl::checkpoint::PolicyCard;
+use crate::verify::Recording;
+
+use super::layout::Areas;
+
+/// Steps of the λ slider (keys), and its range.
+pub const AUX_STEP: f64 = 0.1;
+/// The λ values of a sweep.
+pub const SWEEP_AUX: [f64; 9] = [-1.0, -0.75, -0.5, -0.25, 0.0, 0.25, 0.5, 0.75, 1.0];
+/// Trials per λ in a sweep.
+pub const SWEEP_TRIALS: u32 = 40;
+/// Default Solver trials on each generated level.
+pub const DEFAULT_TRIALS: u32 = 100;
+/// Most trials one level may be given from the prompt.
+pub const MAX_TRIALS: u32 = 10_000;
+/// Replay steps shown per tick (the game runs at 50 steps/s; ticks come every ~33 ms).
+pub const REPLAY_STEPS_PER_TICK: usize = 2;
+
+/// Where the goal comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GoalSetting {
+    /// Drawn from the seed, as the rules and the Generator draw it.
+    FromSeed,
+    /// Set by the designer: horizontal distance (m), height above the start (m), direction
+    /// (degrees, the heading convention of level files).
+    Custom {
+        distance: f64,
+        height: f64,
+        direction: f64,
+    },
+}
+
+impl GoalSetting {
+    /// The goal position, or `None` to draw it from the seed.
+    pub fn position(&self) -> Option<[f64; 3]> {
+        match *self {
+            GoalSetting::FromSeed => None,
+            GoalSetting::Custom {
+                distance,
+                height,
+                direction,
+            } => {
+                let [x, z] = heading_direction(direction);
+                Some([quantize(distance * x), height, quantize(distance * z)])
+            }
+        }
+    }
+}
+
+/// What is known about a loaded policy, for display.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PolicyInfo {
+    pub path: PathBuf,
+    pub card: PolicyCard,
+}
+
+/// The policies the worker holds: a Generator and a Solver, each optional (without a Generator
+/// the designer draws rule levels; without a Solver the scripted controller plays).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LoadedInfo {
+    pub generator: Option<PolicyInfo>,
+    pub solver: Option<PolicyInfo>,
+}
+
+/// A prompt being typed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PromptKind {
+    Seed,
+    Trials,
+    Policies,
+}
+
+impl PromptKind {
+    pub fn label(self) -> &'static str {
+        match self {
+            PromptKind::Seed => "seed",
+            PromptKind::Trials => "Solver trials per level",
+            PromptKind::Policies => "policies folder, or a Generator/Solver .safetensors file",
+        }
+    }
+}
+
+/// What covers the screen, if anything.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Overlay {
+    None,
+    Help,
+    /// The loaded policies' cards.
+    Cards,
+    Prompt {
+        kind: PromptKind,
+        text: String,
+    },
+    /// Export would overwrite these files.
+    ConfirmOverwrite {
+        paths: Vec<PathBuf>,
+    },
+}
+
+/// What the bottom-right panel shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Panel {
+    Failures,
+    Sweep,
+}
+
+/// The Solver's trials on the level on screen, as they come in.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trials {
+    pub id: u64,
+    pub wanted: u32,
+    pub results: Vec<TrialResult>,
+    /// The final statistics (the same as `arlpcg verify` gives), once all trials are in.
+    pub stats: Option<SolverStats>,
+}
+
+impl Trials {
+    pub fn done(&self) -> u32 {
+        self.results.len() as u32
+    }
+
+    pub fn successes(&self) -> u32 {
+        self.results
+            .iter()
+            .filter(|r| r.outcome == Outcome::Success)
+            .count() as u32
+    }
+
+    /// Success ratio and its 95% interval so far (`None` before the first trial).
+    pub fn success(&self) -> Option<(f64, [f64; 2])> {
+        let n = self.done();
+        (n > 0).then(|| {
+            let s = self.successes();
+            (s as f64 / n as f64, wilson_interval(s, n))
+        })
+    }
+
+    pub fn mean_progress(&self) -> Option<f64> {
+        let n = self.results.len();
+        (n > 0).then(|| self.results.iter().map(|r| r.progress).sum::<f64>() / n as f64)
+    }
+
+    pub fn count(&self, outcome: Outcome) -> u32 {
+        self.results.iter().filter(|r| r.outcome == outcome).count() as u32
+    }
+
+    /// Failed runs per block so far (`blocks` blocks), as `SolverStats::failures_by_piece`.
+    pub fn failures_by_block(&self, blocks: usize) -> Vec<u32> {
+        let mut failures = vec![0; blocks];
+        for r in self
+            .results
+            .iter()
+            .filter(|r| r.outcome != Outcome::Success)
+        {
+            if blocks > 0 {
+                failures[r.target_piece.min(blocks - 1)] += 1;
+            }
+        }
+        failures
+    }
+}
+
+/// A recorded run being played back.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Replay {
+    pub seed: u64,
+    pub recording: Recording,
+    /// Index into the recording's path.
+    pub frame: usize,
+}
+
+/// One λ of a sweep: its success ratio, or why it has none.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SweepPoint {
+    Pending,
+    Success(f64),
+    NoLevel(String),
+}
+
+/// A λ sweep for the seed and goal it was started with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sweep {
+    pub id: u64,
+    pub seed: u64,
+    pub points: Vec<(f64, SweepPoint)>,
+}
+
+/// A message from the user (through the terminal) or from the worker.
+#[derive(Debug, Clone)]
+pub enum Message {
+    Key(KeyEvent),
+    Mouse(MouseEvent),
+    Resize {
+        width: u16,
+        height: u16,
+    },
+    /// Animation clock (about 30 per second).
+    Tick,
+    Worker(Response),
+}
+
+/// The worker's answers; each names the request it answers.
+#[derive(Debug, Clone)]
+pub enum Response {
+    Level {
+        id: u64,
+        result: Result<Arc<Level>, String>,
+    },
+    Trial {
+        id: u64,
+        result: TrialResult,
+    },
+    TrialsDone {
+        id: u64,
+        stats: Box<SolverStats>,
+    },
+    Recorded {
+        id: u64,
+        result: Result<Box<Recording>, String>,
+    },
+    SweepPoint {
+        id: u64,
+        index: usize,
+        point: SweepPoint,
+    },
+    /// Export done (the paths written), refused because files exist, or failed.
+    Exported(ExportOutcome),
+    Loaded(Result<Box<LoadedInfo>, String>),
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum ExportOutcome {
+    Written(Vec<PathBuf>),
+    WouldOverwrite(Vec<PathBuf>),
+    Failed(String),
+}
+
+/// Work for the worker threads.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Effect {
+    Generate {
+        id: u64,
+        seed: u64,
+        aux: f64,
+        goal: Option<[f64; 3]>,
+    },
+    Trials {
+        id: u64,
+        level: Arc<Level>,
+        trials: u32,
+        seed: u64,
+    },
+    Record {
+        id: u64,
+        level: Arc<Level>,
+        seed: u64,
+    },
+    Sweep {
+        id: u64,
+        seed: u64,
+        goal: Option<[f64; 3]>,
+        auxes: Vec<f64>,
+        trials: u32,
+    },
+    Export {
+        level: Box<Level>,
+        dir: PathBuf,
+        stem: String,
+        overwrite: bool,
+    },
+    Load {
+        path: PathBuf,
+    },
+}
+
+/// Everything the designer shows and remembers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct App {
+    pub game: Game,
+    pub policies: LoadedInfo,
+    pub aux: f64,
+    pub seed: u64,
+    pub goal: GoalSetting,
+    pub trials_wanted: u32,
+    pub out_dir: PathBuf,
+    /// The level on screen.
+    pub level: Option<Arc<Level>>,
+    /// The id of the newest generation asked for; the level on screen answers it when equal.
+    pub requested: u64,
+    pub shown: u64,
+    pub generation_error: Option<String>,
+    pub trials: Option<Trials>,
+    pub replay: Option<Replay>,
+    /// The recording asked for (request id, run seed), until it arrives.
+    recording: Option<(u64, u64)>,
+    replays: u64,
+    pub sweep: Option<Sweep>,
+    pub panel: Panel,
+    /// Selected block (index into the level's blocks).
+    pub selected: Option<usize>,
+    pub overlay: Overlay,
+    /// The latest message for the footer, and whether it reports a problem.
+    pub status: Option<(String, bool)>,
+    pub size: Rect,
+    /// Whether the mouse is dragging the slider.
+    dragging: bool,
+    next_id: u64,
+    pub quit: bool,
+}
+
+impl App {
+    /// A designer for `game` that will show a level as soon as the first effects run.
+    pub fn new(game: Game, policies: LoadedInfo, seed: u64, out_dir: PathBuf) -> Self {
+        Self {
+            game,
+            policies,
+            aux: 1.0,
+            seed,
+            goal: GoalSetting::FromSeed,
+            trials_wanted: DEFAULT_TRIALS,
+            out_dir,
+            level: None,
+            requested: 0,
+            shown: 0,
+            generation_error: None,
+            trials: None,
+            replay: None,
+            recording: None,
+            replays: 0,
+            sweep: None,
+            panel: Panel::Failures,
+            selected: None,
+            overlay: Overlay::None,
+            status: None,
+            size: Rect::new(0, 0, 80, 24),
+            dragging: false,
+            next_id: 1,
+            quit: false,
+        }
+    }
+
+    /// The first effects: generate the level for the starting settings.
+    pub fn start(&mut self) -> Vec<Effect> {
+        self.generate()
+    }
+
+    fn id(&mut self) -> u64 {
+        let id = self.next_id;
+        self.next_id += 1;
+        id
+    }
+
+    /// Whether a generation is in flight.
+    pub fn generating(&self) -> bool {
+        self.requested != self.shown
+    }
+
+    fn generate(&mut self) -> Vec<Effect> {
+        if self.game != Game::Platform {
+            return Vec::new();
+        }
+        let id = self.id();
+        self.requested = id;
+        self.replay = None;
+        self.recording = None;
+        vec![Effect::Generate {
+            id,
+            seed: self.seed,
+            aux: self.aux,
+            goal: self.goal.position(),
+        }]
+    }
+
+    fn set_aux(&mut self, aux: f64) -> Vec<Effect> {
+        let aux = (aux.clamp(-1.0, 1.0) * 100.0).round() / 100.0;
+        if aux == self.aux {
+            return Vec::new();
+        }
+        self.aux = aux;
+        self.generate()
+    }
+
+    fn say(&mut self, text: impl Into<String>) {
+        self.status = Some((text.into(), false));
+    }
+
+    fn complain(&mut self, text: impl Into<String>) {
+        self.status = Some((text.into(), true));
+    }
+
+    /// The file stem exports use: game, seed and λ.
+    pub fn export_stem(&self) -> String {
+        format!("{}-seed{}-aux{:+.2}", self.game.name(), self.seed, self.aux)
+    }
+
+    fn export(&mut self, overwrite: bool) -> Vec<Effect> {
+        let Some(level) = &self.level else {
+            self.complain("no level to export yet");
+            return Vec::new();
+        };
+        let mut level = Level::clone(level);
+        level.stats = self.trials.as_ref().and_then(|t| t.stats.clone());
+        if level.stats.is_none() {
+            self.say("exporting without Solver statistics (trials still running)");
+        }
+        vec![Effect::Export {
+            level: Box::new(level),
+            dir: self.out_dir.join(self.game.name()),
+            stem: self.export_stem(),
+            overwrite,
+        }]
+    }
+
+    fn record(&mut self) -> Vec<Effect> {
+        let Some(level) = self.level.clone() else {
+            return Vec::new();
+        };
+        let id = self.id();
+        self.replays += 1;
+        let seed = level
+            .seed
+            .unwrap_or(0)
+            .wrapping_add(1_000_000 + self.replays);
+        self.replay = None;
+        self.recording = Some((id, seed));
+        self.say(format!("recording a run (seed {seed})"));
+        vec![Effect::Record { id, level, seed }]
+    }
+
+    fn sweep(&mut self) -> Vec<Effect> {
+        let id = self.id();
+        self.sweep = Some(Sweep {
+            id,
+            seed: self.seed,
+            points: SWEEP_AUX
+                .iter()
+                .map(|&a| (a, SweepPoint::Pending))
+                .collect(),
+        });
+        self.panel = Panel::Sweep;
+        vec![Effect::Sweep {
+            id,
+            seed: self.seed,
+            goal: self.goal.position(),
+            auxes: SWEEP_AUX.to_vec(),
+            trials: SWEEP_TRIALS,
+        }]
+    }
+
+    fn adjust_goal(&mut self, d_distance: f64, d_height: f64, d_direction: f64) -> Vec<Effect> {
+        let GoalSetting::Custom {
+            distance,
+            height,
+            direction,
+        } = self.goal
+        else {
+            self.complain("the goal is drawn from the seed: press g to set it by hand");
+            return Vec::new();
+        };
+        use crate::game::rules::{GOAL_DISTANCE, GOAL_HEIGHT};
+        self.goal = GoalSetting::Custom {
+            distance: (distance + d_distance).clamp(GOAL_DISTANCE.0, GOAL_DISTANCE.1),
+            height: (height + d_height).clamp(GOAL_HEIGHT.0, GOAL_HEIGHT.1),
+            direction: crate::level::platform::wrap_degrees(direction + d_direction),
+        };
+        self.generate()
+    }
+
+    fn toggle_goal(&mut self) -> Vec<Effect> {
+        self.goal = match self.goal {
+            GoalSetting::Custom { .. } => GoalSetting::FromSeed,
+            GoalSetting::FromSeed => {
+                // Start from the goal on screen, so the level changes only when adjusted.
+                let [x, y, z] = self
+                    .level
+                    .as_ref()
+                    .map_or([0.0, 0.0, 50.0], |level| level.goal);
+                GoalSetting::Custom {
+                    distance: x.hypot(z).round(),
+                    height: y.round(),
+                    direction: crate::level::platform::direction_heading(x, z).round(),
+                }
+            }
+        };
+        self.generate()
+    }
+
+    fn select(&mut self, delta: isize) {
+        let blocks = self.level.as_ref().map_or(0, |l| l.piece_count());
+        if blocks == 0 {
+            self.selected = None;
+            return;
+        }
+        let next = match self.selected {
+            None if delta > 0 => 0,
+            None => blocks - 1,
+            Some(i) => (i as isize + delta).rem_euclid(blocks as isize) as usize,
+        };
+        self.selected = Some(next);
+    }
+
+    fn key(&mut self, key: KeyEvent) -> Vec<Effect> {
+        if key.kind == KeyEventKind::Release {
+            return Vec::new();
+        }
+        if key.modifiers.contains(KeyModifiers::CONTROL) && key.code == KeyCode::Char('c') {
+            self.quit = true;
+            return Vec::new();
+        }
+        match std::mem::replace(&mut self.overlay, Overlay::None) {
+            Overlay::None => {}
+            Overlay::Help | Overlay::Cards => {
+                if !matches!(key.code, KeyCode::Char('q')) {
+                    return Vec::new();
+                }
+            }
+            Overlay::Prompt { kind, text } => return self.prompt_key(kind, text, key),
+            Overlay::ConfirmOverwrite { .. } => {
+                if matches!(key.code, KeyCode::Char('y' | 'Y')) {
+                    return self.export(true);
+                }
+                self.say("export cancelled: nothing written");
+                return Vec::new();
+            }
+        }
+        self.status = None;
+        let platform = self.game == Game::Platform;
+        match key.code {
+            KeyCode::Char('q') | KeyCode::Esc => {
+                self.quit = true;
+                Vec::new()
+            }
+            KeyCode::Char('?') => {
+                self.overlay = Overlay::Help;
+                Vec::new()
+            }
+            KeyCode::Char('c') => {
+                self.overlay = Overlay::Cards;
+                Vec::new()
+            }
+            KeyCode::Tab => {
+                self.game = match self.game {
+                    Game::Platform => Game::Racing,
+                    Game::Racing => Game::Platform,
+                };
+                if platform {
+                    self.complain(
+                        "racing: no Generator or Solver is trained for it yet; Tab goes back",
+                    );
+                    Vec::new()
+                } else {
+                    self.generate()
+                }
+            }
+            _ if !platform => {
+                self.complain("racing is not available yet: Tab returns to the platform game");
+                Vec::new()
+            }
+            KeyCode::Left => self.set_aux(self.aux - AUX_STEP),
+            KeyCode::Right => self.set_aux(self.aux + AUX_STEP),
+            KeyCode::Home => self.set_aux(-1.0),
+            KeyCode::End => self.set_aux(1.0),
+            KeyCode::Enter | KeyCode::Char(' ') => self.generate(),
+            KeyCode::Char('n') => {
+                self.seed = next_seed(self.seed);
+                self.generate()
+            }
+            KeyCode::Char('s') => self.open_prompt(PromptKind::Seed),
+            KeyCode::Char('t') => self.open_prompt(PromptKind::Trials),
+            KeyCode::Char('p') => self.open_prompt(PromptKind::Policies),
+            KeyCode::Char('g') => self.toggle_goal(),
+            KeyCode::Char('d') => self.adjust_goal(-5.0, 0.0, 0.0),
+            KeyCode::Char('D') => self.adjust_goal(5.0, 0.0, 0.0),
+            KeyCode::Char('h') => self.adjust_goal(0.0, -1.0, 0.0),
+            KeyCode::Char('H') => self.adjust_goal(0.0, 1.0, 0.0),
+            KeyCode::Char('a') => self.adjust_goal(0.0, 0.0, -15.0),
+            KeyCode::Char('A') => self.adjust_goal(0.0, 0.0, 15.0),
+            KeyCode::Up => {
+                self.select(-1);
+                Vec::new()
+            }
+            KeyCode::Down => {
+                self.select(1);
+                Vec::new()
+            }
+            KeyCode::Char('r') => self.record(),
+            KeyCode::Char('w') => self.sweep(),
+            KeyCode::Char('v') => {
+                self.panel = match self.panel {
+                    Panel::Failures => Panel::Sweep,
+                    Panel::Sweep => Panel::Failures,
+                };
+                Vec::new()
+            }
+            KeyCode::Char('x') => self.export(false),
+            _ => Vec::new(),
+        }
+    }
+
+    fn open_prompt(&mut self, kind: PromptKind) -> Vec<Effect> {
+        let text = match kind {
+            PromptKind::Seed => self.seed.to_string(),
+            PromptKind::Trials => self.trials_wanted.to_string(),
+            PromptKind::Policies => String::new(),
+        };
+        self.overlay = Overlay::Prompt { kind, text };
+        Vec::new()
+    }
+
+    fn prompt_key(&mut self, kind: PromptKind, mut text: String, key: KeyEvent) -> Vec<Effect> {
+        match key.code {
+            KeyCode::Esc => return Vec::new(),
+            KeyCode::Enter => return self.submit(kind, text.trim()),
+            KeyCode::Backspace => {
+                text.pop();
+            }
+            KeyCode::Char(c) if text.chars().count() < 200 => text.push(c),
+            _ => {}
+        }
+        self.overlay = Overlay::Prompt { kind, text };
+        Vec::new()
+    }
+
+    fn submit(&mut self, kind: PromptKind, text: &str) -> Vec<Effect> {
+        match kind {
+            PromptKind::Seed => match text.parse::<u64>() {
+                Ok(seed) => {
+                    self.seed = seed;
+                    self.generate()
+                }
+                Err(_) => {
+                    self.complain(format!("seed `{text}`: give a whole number ≥ 0"));
+                    Vec::new()
+                }
+            },
+            PromptKind::Trials => match text.parse::<u32>() {
+                Ok(n) if (1..=MAX_TRIALS).contains(&n) => {
+                    self.trials_wanted = n;
+                    self.start_trials()
+                }
+                _ => {
+                    self.complain(format!(
+                        "trials `{text}`: give a number from 1 to {MAX_TRIALS}"
+                    ));
+                    Vec::new()
+                }
+            },
+            PromptKind::Policies if text.is_empty() => Vec::new(),
+            PromptKind::Policies => {
+                self.say(format!("loading {text}"));
+                vec![Effect::Load {
+                    path: PathBuf::from(text),
+                }]
+            }
+        }
+    }
+
+    /// Starts the trials on the level on screen.
+    fn start_trials(&mut self) -> Vec<Effect> {
+        let Some(level) = self.level.clone() else {
+            return Vec::new();
+        };
+        let id = self.id();
+        self.trials = Some(Trials {
+            id,
+            wanted: self.trials_wanted,
+            results: Vec::new(),
+            stats: None,
+        });
+        vec![Effect::Trials {
+            id,
+            seed: level.seed.unwrap_or(0),
+            level,
+            trials: self.trials_wanted,
+        }]
+    }
+
+    fn mouse(&mut self, mouse: MouseEvent) -> Vec<Effect> {
+        if self.overlay != Overlay::None {
+            return Vec::new();
+        }
+        let slider = Areas::of(self.size).slider;
+        let at = Position::new(mouse.column, mouse.row);
+        match mouse.kind {
+            MouseEventKind::Down(MouseButton::Left) if slider.contains(at) => {
+                self.dragging = true;
+                self.set_aux(slider_aux(slider, mouse.column))
+            }
+            MouseEventKind::Drag(MouseButton::Left) if self.dragging => {
+                self.set_aux(slider_aux(slider, mouse.column))
+            }
+            MouseEventKind::Up(_) => {
+                self.dragging = false;
+                Vec::new()
+            }
+            MouseEventKind::ScrollUp if slider.contains(at) => self.set_aux(self.aux + AUX_STEP),
+            MouseEventKind::ScrollDown if slider.contains(at) => self.set_aux(self.aux - AUX_STEP),
+            _ => Vec::new(),
+        }
+    }
+
+    fn response(&mut self, response: Response) -> Vec<Effect> {
+        match response {
+            Response::Level { id, result } => {
+                if id != self.requested {
+                    return Vec::new();
+                }
+                self.shown = id;
+                match result {
+                    Ok(level) => {
+                        self.generation_error = None;
+                        self.selected = self.selected.filter(|&i| i < level.piece_count());
+                        self.level = Some(level);
+                        self.start_trials()
+                    }
+                    Err(problem) => {
+                        self.generation_error = Some(problem.clone());
+                        self.level = None;
+                        self.trials = None;
+                        self.complain(problem);
+                        Vec::new()
+                    }
+                }
+            }
+            Response::Trial { id, result } => {
+                if let Some(trials) = self.trials.as_mut().filter(|t| t.id == id) {
+                    trials.results.push(result);
+                }
+                Vec::new()
+            }
+            Response::TrialsDone { id, stats } => {
+                if let Some(trials) = self.trials.as_mut().filter(|t| t.id == id) {
+                    trials.stats = Some(*stats);
+                }
+                Vec::new()
+            }
+            Response::Recorded { id, result } => {
+                let Some((_, seed)) = self.recording.filter(|&(wanted, _)| wanted == id) else {
+                    return Vec::new();
+                };
+                self.recording = None;
+                match result {
+                    Ok(recording) => {
+                        self.say(format!(
+                            "replay: {} after {} steps",
+                            describe_outcome(recording.result.outcome),
+                            recording.result.steps
+                        ));
+                        self.replay = Some(Replay {
+                            seed,
+                            recording: *recording,
+                            frame: 0,
+                        });
+                    }
+                    Err(problem) => self.complain(problem),
+                }
+                Vec::new()
+            }
+            Response::SweepPoint { id, index, point } => {
+                if let Some(sweep) = self.sweep.as_mut().filter(|s| s.id == id)
+                    && let Some(slot) = sweep.points.get_mut(index)
+                {
+                    slot.1 = point;
+                }
+                Vec::new()
+            }
+            Response::Exported(outcome) => {
+                match outcome {
+                    ExportOutcome::Written(paths) => self.say(format!(
+                        "exported {}",
+                        paths
+                            .iter()
+                            .map(|p| p.display().to_string())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )),
+                    ExportOutcome::WouldOverwrite(paths) => {
+                        self.overlay = Overlay::ConfirmOverwrite { paths };
+                    }
+                    ExportOutcome::Failed(problem) => self.complain(problem),
+                }
+                Vec::new()
+            }
+            Response::Loaded(result) => match result {
+                Ok(info) => {
+                    self.say(format!(
+                        "loaded {}",
+                        [&info.generator, &info.solver]
+                            .into_iter()
+                            .flatten()
+                            .map(|p| p.path.display().to_string())
+                            .collect::<Vec<_>>()
+                            .join(" and ")
+                    ));
+                    if info.generator.is_some() {
+                        self.policies.generator = info.generator;
+                    }
+                    if info.solver.is_some() {
+                        self.policies.solver = info.solver;
+                    }
+                    self.generate()
+                }
+                Err(problem) => {
+                    self.complain(problem);
+                    Vec::new()
+                }
+            },
+        }
+    }
+
+    fn tick(&mut self) {
+        if let Some(replay) = &mut self.replay {
+            let last = replay.recording.path.len().saturating_sub(1);
+            replay.frame = (replay.frame + REPLAY_STEPS_PER_TICK).min(last);
+        }
+    }
+}
+
+/// The designer's update: applies `message` to `app` and returns the work it asks for.
+pub fn update(app: &mut App, message: Message) -> Vec<Effect> {
+    match message {
+        Message::Key(key) => app.key(key),
+        Message::Mouse(mouse) => app.mouse(mouse),
+        Message::Resize { width, height } => {
+            app.size = Rect::new(0, 0, width, height);
+            Vec::new()
+        }
+        Message::Tick => {
+            app.tick();
+            Vec::new()
+        }
+        Message::Worker(response) => app.response(response),
+    }
+}
+
+/// The λ under column `column` of the slider track `slider` (-1 at its left end, +1 at its right).
+pub fn slider_aux(slider: Rect, column: u16) -> f64 {
+    let span = slider.width.saturating_sub(1).max(1) as f64;
+    let t = (column.saturating_sub(slider.x) as f64 / span).clamp(0.0, 1.0);
+    ((-1.0 + 2.0 * t) * 20.0).round() / 20.0
+}
+
+/// The next seed `n` draws: a fixed scramble of the current one (SplitMix64), so key scripts
+/// are reproducible.
+pub fn next_seed(seed: u64) -> u64 {
+    let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    (z ^ (z >> 31)) % 1_000_000
+}
+
+pub fn describe_outcome(outcome: Outcome) -> &'static str {
+    match outcome {
+        Outcome::Success => "reached the goal",
+        Outcome::Fell => "fell",
+        Outcome::TimedOut => "ran out of time",
+    }
+}

@@ -1,0 +1,328 @@
+//! The designer's worker threads: they hold the policies, do the [`Effect`]s and answer with
+//! [`Response`]s. The newest request of each kind wins: a request that a newer one of its kind
+//! has superseded is skipped, and long work (trials, sweeps) stops as soon as it is superseded,
+//! so moving the slider never queues stale work.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, Sender};
+use std::sync::{Arc, Mutex};
+
+use anyhow::Result;
+
+use super::app::{Effect, ExportOutcome, LoadedInfo, PolicyInfo, Response, SweepPoint};
+use crate::commands::policies::{load_generator, load_solver, policy_paths};
+use crate::commands::{LevelFiles, write_level_files};
+use crate::fsio::Overwrite;
+use crate::generation::{self, GeneratorPolicy};
+use crate::level::{Level, RulesConfig};
+use crate::rl::checkpoint::PolicyError;
+use crate::verify::{self, Solver, SolverPolicy, Watch};
+
+/// The policies in use; either may be missing (rule levels; the scripted controller).
+#[derive(Default, Clone)]
+pub struct Policies {
+    pub generator: Option<Arc<GeneratorPolicy>>,
+    pub solver: Option<Arc<SolverPolicy>>,
+}
+
+impl Policies {
+    fn solver(&self) -> Solver<'_> {
+        match &self.solver {
+            Some(policy) => Solver::Policy(policy.as_ref()),
+            None => Solver::Scripted,
+        }
+    }
+
+    /// A level at `aux` for `seed` toward `goal`: the Generator's, or the rules' without one.
+    pub fn level(&self, seed: u64, aux: f64, goal: Option<[f64; 3]>) -> Result<Level, String> {
+        match &self.generator {
+            Some(generator) => {
+                generation::platform_level(generator, seed, aux, goal).map_err(|e| e.to_string())
+            }
+            None => {
+                crate::game::rules::platform_level(seed, Some(aux), goal, &RulesConfig::default())
+                    .map_err(|e| e.to_string())
+            }
+        }
+    }
+}
+
+/// Loads the policies at `path`: a folder (its generator.safetensors and solver.safetensors,
+/// whichever exist) or one policy file (a Generator or a Solver, from its card).
+pub fn load(path: &Path) -> Result<(Policies, LoadedInfo)> {
+    let mut policies = Policies::default();
+    let mut info = LoadedInfo::default();
+    let mut load_generator_at = |p: &Path, policies: &mut Policies| -> Result<()> {
+        let (generator, card) = load_generator(p)?;
+        policies.generator = Some(Arc::new(generator));
+        info.generator = Some(PolicyInfo {
+            path: p.to_path_buf(),
+            card,
+        });
+        Ok(())
+    };
+    if path.is_dir() {
+        let (generator, solver) = policy_paths(path);
+        if !generator.exists() && !solver.exists() {
+            anyhow::bail!(
+                "{} holds neither {} nor {}",
+                path.display(),
+                crate::commands::policies::GENERATOR_FILE,
+                crate::commands::policies::SOLVER_FILE
+            );
+        }
+        if generator.exists() {
+            load_generator_at(&generator, &mut policies)?;
+        }
+        if solver.exists() {
+            let (policy, card) = load_solver(&solver)?;
+            policies.solver = Some(Arc::new(policy));
+            info.solver = Some(PolicyInfo { path: solver, card });
+        }
+        return Ok((policies, info));
+    }
+    match load_generator_at(path, &mut policies) {
+        Ok(()) => Ok((policies, info)),
+        Err(e) if matches!(e.downcast_ref(), Some(PolicyError::WrongKind { .. })) => {
+            let (policy, card) = load_solver(path)?;
+            policies.solver = Some(Arc::new(policy));
+            info.solver = Some(PolicyInfo {
+                path: path.to_path_buf(),
+                card,
+            });
+            Ok((policies, info))
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// Which requests supersede each other.
+#[derive(Debug, Clone, Copy)]
+enum Slot {
+    /// Generation and the trials on the generated level.
+    Level = 0,
+    Record = 1,
+    Sweep = 2,
+    /// Exports and loads: never superseded.
+    Always = 3,
+}
+
+fn slot(effect: &Effect) -> (Slot, u64) {
+    match effect {
+        Effect::Generate { id, .. } | Effect::Trials { id, .. } => (Slot::Level, *id),
+        Effect::Record { id, .. } => (Slot::Record, *id),
+        Effect::Sweep { id, .. } => (Slot::Sweep, *id),
+        Effect::Export { .. } | Effect::Load { .. } => (Slot::Always, 0),
+    }
+}
+
+/// The newest request id of each slot, shared by the UI (which raises them) and the workers.
+#[derive(Default)]
+struct Latest([AtomicU64; 4]);
+
+impl Latest {
+    fn superseded(&self, slot: Slot, id: u64) -> bool {
+        !matches!(slot, Slot::Always) && self.0[slot as usize].load(Ordering::Relaxed) != id
+    }
+}
+
+/// The worker threads: one for levels, trials, replays, exports and loads; one for sweeps (so a
+/// sweep never holds up the level on screen).
+pub struct Workers {
+    latest: Arc<Latest>,
+    main: Sender<Effect>,
+    sweeps: Sender<Effect>,
+}
+
+impl Workers {
+    /// Starts the workers on `policies`; their answers go to `answers`.
+    pub fn start(policies: Policies, answers: Sender<Response>) -> Self {
+        let policies = Arc::new(Mutex::new(policies));
+        let latest = Arc::new(Latest::default());
+        let spawn = |name: &str| {
+            let (tx, rx) = std::sync::mpsc::channel();
+            let (policies, latest, answers) = (policies.clone(), latest.clone(), answers.clone());
+            std::thread::Builder::new()
+                .name(name.into())
+                .spawn(move || serve(rx, &policies, &latest, &answers))
+                .expect("the OS starts a thread");
+            tx
+        };
+        Self {
+            main: spawn("designer-worker"),
+            sweeps: spawn("designer-sweeps"),
+            latest,
+        }
+    }
+
+    /// Hands `effect` to its worker; it supersedes older requests of its kind.
+    pub fn submit(&self, effect: Effect) {
+        let (slot, id) = slot(&effect);
+        if !matches!(slot, Slot::Always) {
+            self.latest.0[slot as usize].store(id, Ordering::Relaxed);
+        }
+        let to = match slot {
+            Slot::Sweep => &self.sweeps,
+            _ => &self.main,
+        };
+        // A worker only stops when the designer drops its sender, so sending cannot fail.
+        let _ = to.send(effect);
+    }
+}
+
+type SharedPolicies = Mutex<Policies>;
+
+fn serve(
+    requests: Receiver<Effect>,
+    policies: &SharedPolicies,
+    latest: &Latest,
+    answers: &Sender<Response>,
+) {
+    while let Ok(effect) = requests.recv() {
+        let (slot, id) = slot(&effect);
+        if latest.superseded(slot, id) {
+            continue;
+        }
+        perform(
+            effect,
+            policies,
+            &|| latest.superseded(slot, id),
+            &|response| {
+                // The designer may have quit; its answers are then of no use.
+                let _ = answers.send(response);
+            },
+        );
+    }
+}
+
+/// Does `effect` with `policies`, answering through `send`; long work ends early when `stop`
+/// says so. The worker threads call it; tests call it inline.
+pub fn perform(
+    effect: Effect,
+    policies: &Mutex<Policies>,
+    stop: &(dyn Fn() -> bool + Sync),
+    send: &(dyn Fn(Response) + Sync),
+) {
+    let current = policies.lock().map(|p| p.clone()).unwrap_or_default();
+    match effect {
+        Effect::Generate {
+            id,
+            seed,
+            aux,
+            goal,
+        } => send(Response::Level {
+            id,
+            result: current.level(seed, aux, goal).map(Arc::new),
+        }),
+        Effect::Trials {
+            id,
+            level,
+            trials,
+            seed,
+        } => {
+            let on_trial = |result: &_| {
+                send(Response::Trial {
+                    id,
+                    result: *result,
+                })
+            };
+            let watch = Watch {
+                on_trial: &on_trial,
+                stop,
+            };
+            match verify::verify_watched(&level, &current.solver(), trials, seed, &watch) {
+                Ok(Some(stats)) => send(Response::TrialsDone {
+                    id,
+                    stats: Box::new(stats),
+                }),
+                Ok(None) => {}
+                Err(e) => send(Response::Level {
+                    id,
+                    result: Err(e.to_string()),
+                }),
+            }
+        }
+        Effect::Record { id, level, seed } => send(Response::Recorded {
+            id,
+            result: verify::record(&level, &current.solver(), seed)
+                .map(Box::new)
+                .map_err(|e| e.to_string()),
+        }),
+        Effect::Sweep {
+            id,
+            seed,
+            goal,
+            auxes,
+            trials,
+        } => {
+            for (index, aux) in auxes.into_iter().enumerate() {
+                if stop() {
+                    return;
+                }
+                let point = match current.level(seed, aux, goal) {
+                    Ok(level) => {
+                        let watch = Watch {
+                            on_trial: &|_| {},
+                            stop,
+                        };
+                        match verify::verify_watched(
+                            &level,
+                            &current.solver(),
+                            trials,
+                            seed,
+                            &watch,
+                        ) {
+                            Ok(Some(stats)) => SweepPoint::Success(stats.success_ratio),
+                            Ok(None) => return,
+                            Err(e) => SweepPoint::NoLevel(e.to_string()),
+                        }
+                    }
+                    Err(problem) => SweepPoint::NoLevel(problem),
+                };
+                send(Response::SweepPoint { id, index, point });
+            }
+        }
+        Effect::Export {
+            level,
+            dir,
+            stem,
+            overwrite,
+        } => send(Response::Exported(export(&level, &dir, &stem, overwrite))),
+        Effect::Load { path } => send(Response::Loaded(match load(&path) {
+            Ok((loaded, info)) => {
+                // A single file replaces only its own role.
+                if let Ok(mut shared) = policies.lock() {
+                    *shared = Policies {
+                        generator: loaded.generator.or(shared.generator.clone()),
+                        solver: loaded.solver.or(shared.solver.clone()),
+                    };
+                }
+                Ok(Box::new(info))
+            }
+            Err(e) => Err(format!("{e:#}")),
+        })),
+    }
+}
+
+/// Writes the level's YAML and `.glb` into `dir` as `stem.*`, unless one exists and `overwrite`
+/// is false.
+fn export(level: &Level, dir: &Path, stem: &str, overwrite: bool) -> ExportOutcome {
+    let files = LevelFiles::new(
+        dir,
+        stem,
+        &[crate::cli::Format::Yaml, crate::cli::Format::Glb],
+    );
+    let paths = files.paths();
+    let existing: Vec<PathBuf> = paths.iter().filter(|p| p.exists()).cloned().collect();
+    if !existing.is_empty() && !overwrite {
+        return ExportOutcome::WouldOverwrite(existing);
+    }
+    let written = std::fs::create_dir_all(dir)
+        .map_err(anyhow::Error::from)
+        .and_then(|()| write_level_files(level, &files, Overwrite::Allowed));
+    match written {
+        Ok(()) => ExportOutcome::Written(paths),
+        Err(e) => ExportOutcome::Failed(format!("export to {} failed: {e:#}", dir.display())),
+    }
+}

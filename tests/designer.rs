@@ -1,0 +1,419 @@
+//! The designer: its pure update driven by key scripts, whole screens on ratatui's TestBackend,
+//! the worker's latest-wins rule, and one scripted session on the shipped policies that ends in
+//! exported files that load and validate.
+
+use std::path::Path;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use arlpcg::design::app::{self, App, Effect, GoalSetting, LoadedInfo, Message, Overlay, Response};
+use arlpcg::design::layout::Areas;
+use arlpcg::design::view;
+use arlpcg::design::worker::{self, Policies, Workers};
+use arlpcg::level::{Game, yaml};
+use ratatui::Terminal;
+use ratatui::backend::TestBackend;
+use ratatui::crossterm::event::{
+    KeyCode, KeyEvent, KeyModifiers, MouseButton, MouseEvent, MouseEventKind,
+};
+
+/// A designer whose effects run inline, on `policies`.
+struct Harness {
+    app: App,
+    policies: Mutex<Policies>,
+    pending: Vec<Effect>,
+}
+
+impl Harness {
+    fn new(policies: Policies, info: LoadedInfo, out: &Path) -> Self {
+        let mut app = App::new(Game::Platform, info, 1, out.to_path_buf());
+        let pending = app.start();
+        Self {
+            app,
+            policies: Mutex::new(policies),
+            pending,
+        }
+    }
+
+    /// Rules and the scripted controller: no trained policy, fully deterministic.
+    fn rules(out: &Path) -> Self {
+        Self::new(Policies::default(), LoadedInfo::default(), out)
+    }
+
+    fn send(&mut self, message: Message) {
+        let effects = app::update(&mut self.app, message);
+        self.pending.extend(effects);
+    }
+
+    fn key(&mut self, code: KeyCode) {
+        self.send(Message::Key(KeyEvent::new(code, KeyModifiers::NONE)));
+    }
+
+    fn keys(&mut self, text: &str) {
+        for c in text.chars() {
+            self.key(KeyCode::Char(c));
+        }
+    }
+
+    /// Runs every pending effect (and those their answers ask for) to the end.
+    fn settle(&mut self) {
+        while !self.pending.is_empty() {
+            let effects = std::mem::take(&mut self.pending);
+            for effect in effects {
+                let answers = Mutex::new(Vec::new());
+                worker::perform(effect, &self.policies, &|| false, &|r| {
+                    answers.lock().unwrap().push(r)
+                });
+                for response in answers.into_inner().unwrap() {
+                    self.send(Message::Worker(response));
+                }
+            }
+        }
+    }
+
+    fn screen(&self, width: u16, height: u16) -> String {
+        let mut terminal = Terminal::new(TestBackend::new(width, height)).unwrap();
+        terminal.draw(|f| view::render(&self.app, f)).unwrap();
+        terminal.backend().to_string()
+    }
+}
+
+#[test]
+fn starts_with_a_level_and_its_statistics() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    assert!(matches!(h.pending[..], [Effect::Generate { .. }]));
+    h.settle();
+    let level = h.app.level.clone().expect("a level is on screen");
+    assert!(level.piece_count() > 0);
+    let trials = h.app.trials.as_ref().expect("trials started");
+    assert_eq!(trials.done(), app::DEFAULT_TRIALS);
+    let stats = trials.stats.as_ref().expect("final statistics");
+    assert_eq!(stats.trials, app::DEFAULT_TRIALS);
+    // The live counters agree with the final statistics.
+    assert_eq!(trials.successes(), stats.successes);
+    assert_eq!(
+        trials.failures_by_block(level.piece_count()),
+        stats.failures_by_piece
+    );
+}
+
+#[test]
+fn whole_screen_at_80x24() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    h.settle();
+    insta::assert_snapshot!("start_80x24", h.screen(80, 24));
+    h.key(KeyCode::Char('?'));
+    insta::assert_snapshot!("help_80x24", h.screen(80, 24));
+}
+
+#[test]
+fn whole_screen_larger_and_too_small() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    h.settle();
+    h.key(KeyCode::Down);
+    h.key(KeyCode::Down);
+    insta::assert_snapshot!("selected_block_120x36", h.screen(120, 36));
+    assert!(h.screen(60, 20).contains("at least 80×24"));
+}
+
+#[test]
+fn slider_keys_and_mouse_change_lambda_and_regenerate() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    h.settle();
+    h.key(KeyCode::Left);
+    assert_eq!(h.app.aux, 0.9);
+    assert!(matches!(h.pending[..], [Effect::Generate { aux, .. }] if aux == 0.9));
+    h.key(KeyCode::Right);
+    h.key(KeyCode::Right);
+    assert_eq!(h.app.aux, 1.0, "clamped at +1");
+    h.key(KeyCode::Home);
+    assert_eq!(h.app.aux, -1.0);
+    // Only the newest generation's level is shown.
+    let newest = h.app.requested;
+    h.settle();
+    assert_eq!(h.app.shown, newest);
+    assert_eq!(h.app.level.as_ref().unwrap().aux, Some(-1.0));
+
+    h.send(Message::Resize {
+        width: 100,
+        height: 30,
+    });
+    let slider = Areas::of(h.app.size).slider;
+    let mouse = |kind, column| {
+        Message::Mouse(MouseEvent {
+            kind,
+            column,
+            row: slider.y,
+            modifiers: KeyModifiers::NONE,
+        })
+    };
+    h.send(mouse(
+        MouseEventKind::Down(MouseButton::Left),
+        slider.right() - 1,
+    ));
+    assert_eq!(h.app.aux, 1.0, "the right end is +1");
+    h.send(mouse(
+        MouseEventKind::Drag(MouseButton::Left),
+        slider.x + slider.width / 2,
+    ));
+    assert!(h.app.aux.abs() < 0.06, "the middle is 0, got {}", h.app.aux);
+    h.send(mouse(MouseEventKind::Up(MouseButton::Left), slider.x));
+    h.send(mouse(MouseEventKind::Drag(MouseButton::Left), slider.x));
+    assert!(h.app.aux.abs() < 0.06, "no drag after release");
+}
+
+#[test]
+fn seed_and_goal_settings() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    h.settle();
+    let first = h.app.level.clone().unwrap();
+
+    h.key(KeyCode::Char('s'));
+    h.key(KeyCode::Backspace);
+    h.keys("x");
+    h.key(KeyCode::Enter);
+    let (text, is_error) = h.app.status.clone().unwrap();
+    assert!(is_error && text.contains("seed `x`"), "{text}");
+    assert_eq!(h.app.seed, 1);
+
+    h.key(KeyCode::Char('s'));
+    h.key(KeyCode::Backspace);
+    h.keys("42");
+    h.key(KeyCode::Enter);
+    assert_eq!(h.app.seed, 42);
+    h.settle();
+    assert_ne!(h.app.level.as_ref().unwrap().goal, first.goal);
+
+    h.key(KeyCode::Char('n'));
+    assert_ne!(h.app.seed, 42);
+
+    // By hand: starts from the goal on screen, then moves with d/D, h/H, a/A.
+    h.settle();
+    let drawn = h.app.level.as_ref().unwrap().goal;
+    h.key(KeyCode::Char('g'));
+    let GoalSetting::Custom { distance, .. } = h.app.goal else {
+        panic!("goal set by hand");
+    };
+    assert!((distance - drawn[0].hypot(drawn[2])).abs() < 0.6);
+    h.keys("DDHa");
+    h.settle();
+    let goal = h.app.level.as_ref().unwrap().goal;
+    assert!((goal[0].hypot(goal[2]) - (distance + 10.0).min(70.0)).abs() < 0.6);
+    h.key(KeyCode::Char('g'));
+    assert_eq!(h.app.goal, GoalSetting::FromSeed);
+}
+
+#[test]
+fn replay_sweep_and_trial_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    h.settle();
+    h.key(KeyCode::Char('r'));
+    h.settle();
+    let replay = h.app.replay.clone().expect("a recorded run");
+    assert!(replay.recording.path.len() > 10);
+    for _ in 0..5 {
+        h.send(Message::Tick);
+    }
+    assert_eq!(
+        h.app.replay.as_ref().unwrap().frame,
+        5 * app::REPLAY_STEPS_PER_TICK
+    );
+    assert!(h.screen(80, 24).contains('@'), "the runner is drawn");
+
+    h.key(KeyCode::Char('w'));
+    h.settle();
+    let sweep = h.app.sweep.clone().expect("a sweep");
+    assert_eq!(sweep.points.len(), app::SWEEP_AUX.len());
+    assert!(
+        sweep
+            .points
+            .iter()
+            .all(|(_, p)| matches!(p, app::SweepPoint::Success(s) if (0.0..=1.0).contains(s)))
+    );
+
+    h.key(KeyCode::Char('t'));
+    for _ in 0..3 {
+        h.key(KeyCode::Backspace);
+    }
+    h.keys("20");
+    h.key(KeyCode::Enter);
+    h.settle();
+    assert_eq!(
+        h.app
+            .trials
+            .as_ref()
+            .unwrap()
+            .stats
+            .as_ref()
+            .unwrap()
+            .trials,
+        20
+    );
+    h.key(KeyCode::Char('t'));
+    h.key(KeyCode::Backspace);
+    h.key(KeyCode::Backspace);
+    h.keys("0");
+    h.key(KeyCode::Enter);
+    let (text, is_error) = h.app.status.clone().unwrap();
+    assert!(is_error && text.contains("trials `0`"), "{text}");
+    assert_eq!(h.app.trials_wanted, 20);
+}
+
+#[test]
+fn export_asks_before_overwriting() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    h.settle();
+    h.key(KeyCode::Char('x'));
+    let Some(Effect::Export { stem, .. }) = h.pending.first().cloned() else {
+        panic!("an export effect");
+    };
+    assert_eq!(stem, "platform-seed1-aux+1.00");
+    h.settle();
+    let yaml_path = dir.path().join("platform").join(format!("{stem}.yaml"));
+    let glb_path = dir.path().join("platform").join(format!("{stem}.glb"));
+    let level = yaml::load(&yaml_path).expect("the export loads");
+    assert_eq!(
+        level.stats.as_ref().map(|s| s.trials),
+        Some(app::DEFAULT_TRIALS)
+    );
+    assert!(h.app.status.as_ref().unwrap().0.contains("exported"));
+    gltf::Gltf::open(&glb_path).expect("a valid glb");
+
+    let before = std::fs::read(&yaml_path).unwrap();
+    h.key(KeyCode::Right); // nothing changes at +1: same level, same name
+    h.key(KeyCode::Char('x'));
+    h.settle();
+    assert!(matches!(h.app.overlay, Overlay::ConfirmOverwrite { ref paths } if paths.len() == 2));
+    h.key(KeyCode::Char('n'));
+    h.settle();
+    assert_eq!(h.app.overlay, Overlay::None);
+    assert!(h.app.status.as_ref().unwrap().0.contains("nothing written"));
+    assert_eq!(std::fs::read(&yaml_path).unwrap(), before);
+
+    h.key(KeyCode::Char('x'));
+    h.settle();
+    h.key(KeyCode::Char('y'));
+    let Some(Effect::Export { overwrite, .. }) = h.pending.first().cloned() else {
+        panic!("an export effect");
+    };
+    assert!(overwrite);
+    h.settle();
+    assert!(h.app.status.as_ref().unwrap().0.contains("exported"));
+}
+
+#[test]
+fn loading_a_wrong_file_is_a_message_not_a_crash() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    h.settle();
+    let bad = dir.path().join("bad.safetensors");
+    std::fs::write(&bad, b"not a policy").unwrap();
+    for path in [bad.display().to_string(), "no/such/folder".to_string()] {
+        h.key(KeyCode::Char('p'));
+        h.keys(&path);
+        h.key(KeyCode::Enter);
+        h.settle();
+        let (text, is_error) = h.app.status.clone().unwrap();
+        assert!(is_error, "{text}");
+        assert!(text.contains(&path), "the message names the file: {text}");
+    }
+    assert_eq!(h.app.policies, LoadedInfo::default());
+}
+
+#[test]
+fn racing_is_selectable_but_not_yet_available() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    h.settle();
+    h.key(KeyCode::Tab);
+    assert_eq!(h.app.game, Game::Racing);
+    assert!(
+        h.screen(80, 24)
+            .contains("Racing: the game selector is ready")
+    );
+    h.key(KeyCode::Left);
+    assert!(h.pending.is_empty(), "nothing to generate for racing");
+    h.key(KeyCode::Tab);
+    assert_eq!(h.app.game, Game::Platform);
+    h.key(KeyCode::Char('q'));
+    assert!(h.app.quit);
+}
+
+/// The workers answer the newest request of a kind: trials of a level the slider has moved
+/// away from stop, and never report final statistics.
+#[test]
+fn newer_requests_supersede_older_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    h.settle();
+    let level = h.app.level.clone().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let workers = Workers::start(Policies::default(), tx);
+    workers.submit(Effect::Trials {
+        id: 100,
+        level,
+        trials: 100_000,
+        seed: 1,
+    });
+    std::thread::sleep(Duration::from_millis(50));
+    workers.submit(Effect::Generate {
+        id: 101,
+        seed: 2,
+        aux: 0.0,
+        goal: None,
+    });
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let mut old_trials = 0;
+    loop {
+        match rx
+            .recv_timeout(deadline - Instant::now())
+            .expect("an answer")
+        {
+            Response::Level { id: 101, result } => {
+                assert!(result.is_ok());
+                break;
+            }
+            Response::Trial { id: 100, .. } => old_trials += 1,
+            Response::TrialsDone { id: 100, .. } => panic!("superseded trials finished"),
+            other => panic!("unexpected {other:?}"),
+        }
+    }
+    assert!(old_trials < 100_000);
+}
+
+/// The newcomer's session on the shipped policies: start, move λ, generate, trials, export;
+/// the files load and the .glb validates.
+#[test]
+fn scripted_session_on_the_shipped_policies() {
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    let (policies, info) = worker::load(&shipped).expect("the shipped policies load");
+    assert!(info.solver.is_some(), "a Solver is shipped");
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::new(policies, info, dir.path());
+    h.settle();
+    assert!(h.app.level.is_some(), "a level at once");
+    h.key(KeyCode::Left);
+    h.key(KeyCode::Left);
+    h.key(KeyCode::Enter);
+    h.settle();
+    let trials = h.app.trials.as_ref().unwrap();
+    assert_eq!(trials.stats.as_ref().unwrap().trials, app::DEFAULT_TRIALS);
+    assert!(h.screen(80, 24).contains("trials 100/100  successes"));
+    h.key(KeyCode::Char('x'));
+    h.settle();
+    let yaml_path = dir.path().join("platform/platform-seed1-aux+0.80.yaml");
+    let level = yaml::load(&yaml_path).expect("the export loads");
+    assert_eq!(level.aux, Some(0.8));
+    assert!(level.stats.is_some());
+    let glb = dir.path().join("platform/platform-seed1-aux+0.80.glb");
+    gltf::Gltf::open(&glb).expect("a valid glb");
+    assert_eq!(level.seed, Some(1));
+    assert!(matches!(h.app.status, Some((ref t, false)) if t.contains("exported")));
+}

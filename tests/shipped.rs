@@ -43,35 +43,73 @@ fn every_shipped_level_loads_and_its_glb_is_current() {
 }
 
 #[test]
-fn the_shipped_platform_solver_loads_and_its_card_matches() {
+fn every_shipped_platform_policy_loads_and_its_card_matches() {
     use arlpcg::game::platform::OBSERVATION_SIZE;
+    use arlpcg::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
     use arlpcg::level::Game;
     use arlpcg::rl::checkpoint::{PolicyCard, Role, load_policy};
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
-    let bytes = std::fs::read(dir.join("solver.safetensors")).expect("the platform Solver ships");
-    let loaded = load_policy(&bytes, Game::Platform, Role::Solver, OBSERVATION_SIZE)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let card: PolicyCard =
-        serde_yaml::from_str(&std::fs::read_to_string(dir.join("solver.yaml")).unwrap()).unwrap();
-    // serde_yaml parses floats to within an ulp, not exactly: the normalizer is compared closely.
-    let close = |a: &[f64], b: &[f64]| {
-        a.iter()
-            .zip(b)
-            .all(|(x, y)| (x - y).abs() <= 1e-12 * (1.0 + y.abs()))
-    };
-    assert!(
-        close(&card.normalizer.mean, &loaded.card.normalizer.mean)
-            && close(&card.normalizer.var, &loaded.card.normalizer.var)
-    );
-    let mut card = card;
-    card.normalizer = loaded.card.normalizer.clone();
-    assert_eq!(
-        card, loaded.card,
-        "solver.yaml differs from the card inside solver.safetensors"
-    );
-    assert_eq!(card.network.hidden, vec![512, 512]);
-    assert!(
-        card.training.steps >= 1_000_000,
-        "the shipped Solver is trained"
-    );
+    let shipped = [
+        (
+            "generator",
+            Role::Generator,
+            GENERATOR_OBSERVATION_SIZE,
+            "arlpcg",
+        ),
+        ("solver", Role::Solver, OBSERVATION_SIZE, "arlpcg"),
+        (
+            "solver-rule-pcg",
+            Role::Solver,
+            OBSERVATION_SIZE,
+            "rule-pcg",
+        ),
+        (
+            "solver-fixed-track",
+            Role::Solver,
+            OBSERVATION_SIZE,
+            "fixed-track",
+        ),
+        (
+            "solver-fixed-aux",
+            Role::Solver,
+            OBSERVATION_SIZE,
+            "fixed-aux",
+        ),
+    ];
+    for (name, role, observation, mode) in shipped {
+        let bytes = std::fs::read(dir.join(format!("{name}.safetensors")))
+            .unwrap_or_else(|e| panic!("{name}.safetensors ships: {e}"));
+        let loaded = load_policy(&bytes, Game::Platform, role, observation)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let card: PolicyCard = serde_yaml::from_str(
+            &std::fs::read_to_string(dir.join(format!("{name}.yaml"))).unwrap(),
+        )
+        .unwrap();
+        // serde_yaml parses floats to within an ulp, not exactly: the normalizer is compared closely.
+        let close = |a: &[f64], b: &[f64]| {
+            a.iter()
+                .zip(b)
+                .all(|(x, y)| (x - y).abs() <= 1e-12 * (1.0 + y.abs()))
+        };
+        assert!(
+            close(&card.normalizer.mean, &loaded.card.normalizer.mean)
+                && close(&card.normalizer.var, &loaded.card.normalizer.var),
+            "{name}"
+        );
+        let mut card = card;
+        card.normalizer = loaded.card.normalizer.clone();
+        assert_eq!(
+            card, loaded.card,
+            "{name}.yaml differs from the card inside {name}.safetensors"
+        );
+        assert_eq!(card.training.mode, mode, "{name}");
+        assert_eq!(card.network.hidden, vec![512, 512]);
+        // All four Solvers share one budget: 4M Solver steps.
+        if role == Role::Solver {
+            assert!(
+                card.training.steps >= 4_000_000,
+                "{name} is trained to the budget"
+            );
+        }
+    }
 }

@@ -1,0 +1,93 @@
+//! The designer's latencies, through its real path (pure update, worker threads, drawing on an
+//! 80×24 TestBackend), on the shipped policies: from the key that asks for a new level
+//! to the level drawn, to the first Solver statistics, and to 100 trials done.
+//!
+//! Run with `cargo bench --bench designer`. Targets (issue 5): level on screen < 100 ms, first
+//! statistics < 300 ms, 100 trials < 2 s on 2 cores.
+
+use std::path::Path;
+use std::sync::mpsc::channel;
+use std::time::{Duration, Instant};
+
+use arlpcg::design::app::{self, App, Message, Response};
+use arlpcg::design::{view, worker};
+use arlpcg::level::Game;
+use ratatui::Terminal;
+use ratatui::backend::TestBackend;
+use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+
+const LEVELS: usize = 20;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    let (policies, info) = worker::load(&shipped).expect("the shipped policies load");
+    println!(
+        "policies: Generator {}, Solver {}",
+        info.generator
+            .as_ref()
+            .map_or("none (rules)", |p| p.card.training.mode.as_str()),
+        info.solver
+            .as_ref()
+            .map_or("none (scripted)", |p| p.card.training.mode.as_str()),
+    );
+    let (tx, rx) = channel();
+    let workers = worker::Workers::start(policies, tx);
+    let out = tempfile::tempdir().expect("a temporary folder");
+    let mut app = App::new(Game::Platform, info, 1, out.path().to_path_buf());
+    let mut terminal = Terminal::new(TestBackend::new(80, 24)).expect("a test terminal");
+    let (mut to_screen, mut to_stats, mut to_done) = (Vec::new(), Vec::new(), Vec::new());
+    for round in 0..=LEVELS {
+        let pressed = Instant::now();
+        let key = KeyEvent::new(KeyCode::Char('n'), KeyModifiers::NONE);
+        for effect in app::update(&mut app, Message::Key(key)) {
+            workers.submit(effect);
+        }
+        let (mut screen, mut stats) = (None, None);
+        loop {
+            let response = rx
+                .recv_timeout(Duration::from_secs(120))
+                .expect("the worker answers");
+            let done = matches!(response, Response::TrialsDone { .. });
+            let level = matches!(response, Response::Level { .. });
+            let trial = matches!(response, Response::Trial { .. });
+            for effect in app::update(&mut app, Message::Worker(response)) {
+                workers.submit(effect);
+            }
+            if level || (trial && stats.is_none()) || done {
+                terminal
+                    .draw(|f| view::render(&app, f))
+                    .expect("drawing on a test backend");
+            }
+            let t = pressed.elapsed().as_secs_f64();
+            if level {
+                screen.get_or_insert(t);
+            }
+            if trial {
+                stats.get_or_insert(t);
+            }
+            if done {
+                // The first round warms caches and threads; it is not counted.
+                if round > 0 {
+                    to_screen.push(screen.expect("a level before its trials"));
+                    to_stats.push(stats.expect("trials before the end"));
+                    to_done.push(t);
+                }
+                break;
+            }
+        }
+    }
+    println!(
+        "{LEVELS} levels, median (max): level on screen {:.1} ms ({:.1}), first statistics {:.0} ms ({:.0}), 100 trials {:.2} s ({:.2})",
+        median(to_screen.clone()) * 1e3,
+        to_screen.iter().copied().fold(0.0, f64::max) * 1e3,
+        median(to_stats.clone()) * 1e3,
+        to_stats.iter().copied().fold(0.0, f64::max) * 1e3,
+        median(to_done.clone()),
+        to_done.iter().copied().fold(0.0, f64::max),
+    );
+}

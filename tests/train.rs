@@ -457,3 +457,52 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     ]);
     assert!(String::from_utf8_lossy(&wrong.stderr).contains("generator.safetensors"));
 }
+
+/// `--resume --config` replaces the hyper-parameters (the old file is kept) but refuses the
+/// fields that fix the networks, the matches or the seed stream.
+#[test]
+fn a_resumed_run_takes_new_hyper_parameters_but_not_a_new_shape() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.yaml");
+    std::fs::write(&config, TINY).unwrap();
+    let out = dir.path().join("run");
+    let (config_s, out_s) = (config.to_str().unwrap(), out.to_str().unwrap());
+    let train = |steps: &str, config: &str| {
+        arlpcg(&[
+            "train", "--mode", "rule-pcg", "--steps", steps, "--config", config, "--out", out_s,
+            "--resume",
+        ])
+    };
+    let first = arlpcg(&[
+        "train", "--mode", "rule-pcg", "--steps", "128", "--config", config_s, "--out", out_s,
+    ]);
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+
+    let reshaped = dir.path().join("reshaped.yaml");
+    std::fs::write(
+        &reshaped,
+        TINY.replace("hidden: [16, 16]", "hidden: [32, 16]"),
+    )
+    .unwrap();
+    let refused = train("256", reshaped.to_str().unwrap());
+    assert_eq!(refused.status.code(), Some(1));
+    let message = String::from_utf8_lossy(&refused.stderr);
+    assert!(message.contains("hidden cannot change"), "{message}");
+
+    let faster = dir.path().join("faster.yaml");
+    std::fs::write(&faster, format!("{TINY}  learning_rate: 0.001\n")).unwrap();
+    let resumed = train("256", faster.to_str().unwrap());
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    let kept = std::fs::read_to_string(out.join("config-until-step-128.yaml")).unwrap();
+    assert!(kept.contains("learning_rate: 0.0003"), "{kept}");
+    let now = std::fs::read_to_string(out.join("config.yaml")).unwrap();
+    assert!(now.contains("learning_rate: 0.001"), "{now}");
+}

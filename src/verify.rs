@@ -147,11 +147,7 @@ pub fn record(level: &Level, solver: &Solver, seed: u64) -> Result<Recording, Un
     loop {
         let action = match solver {
             Solver::Scripted => scripted.act(&env),
-            Solver::Random => PlatformAction {
-                forward: rng.random_range(-1.0..=1.0),
-                turn: rng.random_range(-1.0..=1.0),
-                jump: rng.random_bool(0.5),
-            },
+            Solver::Random => random_action(&mut rng),
             Solver::Policy(policy) => {
                 env.observe(&mut observation);
                 policy.normalizer.normalize(&mut observation);
@@ -182,16 +178,20 @@ fn finish(env: &PlatformEnv, outcome: crate::level::stats::Outcome) -> TrialResu
     }
 }
 
+/// Uniformly random actions: the random baseline.
+fn random_action(rng: &mut ChaCha8Rng) -> PlatformAction {
+    PlatformAction {
+        forward: rng.random_range(-1.0..=1.0),
+        turn: rng.random_range(-1.0..=1.0),
+        jump: rng.random_bool(0.5),
+    }
+}
+
 fn play_random(env: &mut PlatformEnv, seed: u64) -> TrialResult {
     env.reset(seed);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     loop {
-        let action = PlatformAction {
-            forward: rng.random_range(-1.0..=1.0),
-            turn: rng.random_range(-1.0..=1.0),
-            jump: rng.random_bool(0.5),
-        };
-        if let Some(outcome) = env.step(action).outcome {
+        if let Some(outcome) = env.step(random_action(&mut rng)).outcome {
             return finish(env, outcome);
         }
     }

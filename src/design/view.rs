@@ -223,31 +223,32 @@ fn corners(p: &Platform) -> [[f64; 2]; 4] {
     })
 }
 
-/// The colour of block `i` (index into the blocks) from its share of the failures.
-fn block_colour(app: &App, blocks: usize, i: usize) -> Color {
-    if app.selected == Some(i) {
-        return Color::Cyan;
-    }
+/// The colour of every platform (0 is the start block; `i + 1` is block `i`): the selected
+/// block cyan, the others by their share of the failures so far.
+fn platform_colours(app: &App, blocks: usize) -> Vec<Color> {
     let failures = app
         .trials
         .as_ref()
         .map(|t| t.failures_by_block(blocks))
-        .unwrap_or_default();
+        .unwrap_or_else(|| vec![0; blocks]);
     let most = failures.iter().copied().max().unwrap_or(0);
-    match failures.get(i) {
-        Some(&f) if f > 0 && most > 0 => {
-            if f * 2 >= most {
-                Color::Red
-            } else {
-                Color::Yellow
-            }
+    let block = failures.iter().enumerate().map(|(i, &f)| {
+        if app.selected == Some(i) {
+            Color::Cyan
+        } else if f == 0 {
+            Color::White
+        } else if f * 2 >= most {
+            Color::Red
+        } else {
+            Color::Yellow
         }
-        _ => Color::White,
-    }
+    });
+    std::iter::once(Color::Blue).chain(block).collect()
 }
 
 fn map(app: &App, level: &Level, track: &PlatformTrack, frame: &mut Frame, area: Rect) {
     let platforms = track.platforms();
+    let colours = platform_colours(app, track.block_count());
     let mut points: Vec<[f64; 2]> = platforms.iter().flat_map(corners).collect();
     points.push([level.goal[0], level.goal[2]]);
     let (x_bounds, y_bounds) = bounds(&points, area, 2.0);
@@ -262,11 +263,7 @@ fn map(app: &App, level: &Level, track: &PlatformTrack, frame: &mut Frame, area:
         .x_bounds(x_bounds)
         .y_bounds(y_bounds)
         .paint(|ctx| {
-            for (i, p) in platforms.iter().enumerate() {
-                let colour = match i {
-                    0 => Color::Blue,
-                    i => block_colour(app, track.block_count(), i - 1),
-                };
+            for (p, &colour) in platforms.iter().zip(&colours) {
                 let c = corners(p);
                 for k in 0..4 {
                     let (a, b) = (c[k], c[(k + 1) % 4]);
@@ -333,6 +330,7 @@ fn along(platforms: &[Platform], stations: &[f64], x: f64, z: f64) -> f64 {
 
 fn profile(app: &App, level: &Level, track: &PlatformTrack, frame: &mut Frame, area: Rect) {
     let platforms = track.platforms();
+    let colours = platform_colours(app, track.block_count());
     let s = stations(platforms);
     let last = *s.last().unwrap_or(&0.0);
     let mut lo = level.goal[1].min(0.0);
@@ -350,11 +348,7 @@ fn profile(app: &App, level: &Level, track: &PlatformTrack, frame: &mut Frame, a
         .x_bounds([-4.0, last + 4.0])
         .y_bounds([lo - 2.0, hi + 2.0])
         .paint(|ctx| {
-            for (i, (p, &at)) in platforms.iter().zip(&s).enumerate() {
-                let colour = match i {
-                    0 => Color::Blue,
-                    i => block_colour(app, track.block_count(), i - 1),
-                };
+            for ((p, &at), &colour) in platforms.iter().zip(&s).zip(&colours) {
                 let (y, h) = (p.position[1], p.size / 2.0);
                 ctx.draw(&CanvasLine::new(at - h, y, at + h, y, colour));
             }

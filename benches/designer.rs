@@ -24,6 +24,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() {
+    // SAFETY: first thing in main, before any other thread exists.
+    unsafe { arlpcg::rl::threads::fix_thread_count() };
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
     let (policies, info) = worker::load(&shipped).expect("the shipped policies load");
     println!(

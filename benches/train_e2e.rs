@@ -16,6 +16,8 @@ use arlpcg::train::platform::{PlatformSolverEnvs, SolverMode, SourceState};
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() {
+    // SAFETY: first thing in main, before any other thread exists.
+    unsafe { arlpcg::rl::threads::fix_thread_count() };
     let config = TrainConfig::default();
     let shape = PolicyShape {
         observation: arlpcg::game::platform::OBSERVATION_SIZE,

@@ -58,10 +58,10 @@ pub fn platform_level(
                 &mut observation,
             );
             generator.normalizer.normalize(&mut observation);
-            let acted = generator
+            let action = generator
                 .policy
-                .act(&observation, ActMode::Sample, &mut rng)?;
-            let block = block_from_action(&track, goal, &acted.actions);
+                .choose(&observation, ActMode::Sample, &mut rng)?;
+            let block = block_from_action(&track, goal, &action);
             if track.push(block).is_err() {
                 break;
             }

@@ -151,11 +151,11 @@ pub fn record(level: &Level, solver: &Solver, seed: u64) -> Result<Recording, Un
             Solver::Policy(policy) => {
                 env.observe(&mut observation);
                 policy.normalizer.normalize(&mut observation);
-                let acted = policy
+                let action = policy
                     .policy
-                    .act(&observation, ActMode::Sample, &mut rng)
+                    .choose(&observation, ActMode::Sample, &mut rng)
                     .expect("a loaded policy acts on observations of its size");
-                PlatformAction::from_policy_row(&acted.actions)
+                PlatformAction::from_policy_row(&action)
             }
         };
         let outcome = env.step(action).outcome;
@@ -230,9 +230,9 @@ fn play_policy(
             .zip(&active)
             .for_each(|(row, &k)| envs[k].observe(row));
         solver.normalizer.normalize(rows);
-        let acted = solver
+        let actions = solver
             .policy
-            .act(rows, ActMode::Sample, &mut rng)
+            .choose(rows, ActMode::Sample, &mut rng)
             .expect("a loaded policy acts on observations of its size");
         let width = solver.policy.shape().action_size();
         let mut stepping: Vec<(usize, &mut PlatformEnv)> = envs
@@ -242,7 +242,7 @@ fn play_policy(
             .collect();
         let finished: Vec<(usize, TrialResult)> = stepping
             .par_iter_mut()
-            .zip(acted.actions.par_chunks(width))
+            .zip(actions.par_chunks(width))
             .filter_map(|((k, env), row)| {
                 env.step(PlatformAction::from_policy_row(row))
                     .outcome

@@ -161,25 +161,61 @@ impl ActorCritic {
             .set(&Tensor::full(value, (1, n), &Device::Cpu)?)
     }
 
-    /// Chooses actions for a batch of (normalized) observations.
+    /// Chooses actions for a batch of (normalized) observations, with their log-probabilities
+    /// and the critic's value estimates (what PPO learns from).
     pub fn act(
         &self,
         observations: &[f32],
         mode: ActMode,
         rng: &mut ChaCha8Rng,
     ) -> candle_core::Result<Acted> {
+        let obs = self.observation_tensor(observations)?;
+        let (actions, log_probs) = self.sample(&obs, mode, rng)?;
+        Ok(Acted {
+            actions,
+            log_probs,
+            values: self.critic_values(&obs)?,
+        })
+    }
+
+    /// The critic's value estimates alone (the actor is not run).
+    pub fn values(&self, observations: &[f32]) -> candle_core::Result<Vec<f32>> {
+        self.critic_values(&self.observation_tensor(observations)?)
+    }
+
+    fn critic_values(&self, obs: &Tensor) -> candle_core::Result<Vec<f32>> {
+        self.critic.forward(obs, false)?.flatten_all()?.to_vec1::<f32>()
+    }
+
+    /// The actions alone (rows of `action_size`), for playing rather than learning: the critic
+    /// is not run. Draws the same random numbers as [`Self::act`], so both choose alike.
+    pub fn choose(
+        &self,
+        observations: &[f32],
+        mode: ActMode,
+        rng: &mut ChaCha8Rng,
+    ) -> candle_core::Result<Vec<f32>> {
+        let obs = self.observation_tensor(observations)?;
+        Ok(self.sample(&obs, mode, rng)?.0)
+    }
+
+    fn observation_tensor(&self, observations: &[f32]) -> candle_core::Result<Tensor> {
         let n = observations.len() / self.shape.observation;
-        let obs = Tensor::from_slice(observations, (n, self.shape.observation), &Device::Cpu)?;
-        let head = self.actor.forward(&obs, false)?.to_vec2::<f32>()?;
-        let values = self
-            .critic
-            .forward(&obs, false)?
-            .flatten_all()?
-            .to_vec1::<f32>()?;
+        Tensor::from_slice(observations, (n, self.shape.observation), &Device::Cpu)
+    }
+
+    /// Runs the actor and draws each row's action: continuous values first, then binaries.
+    fn sample(
+        &self,
+        obs: &Tensor,
+        mode: ActMode,
+        rng: &mut ChaCha8Rng,
+    ) -> candle_core::Result<(Vec<f32>, Vec<f32>)> {
+        let head = self.actor.forward(obs, false)?.to_vec2::<f32>()?;
         let log_std = self.log_std.as_tensor().flatten_all()?.to_vec1::<f32>()?;
         let (c, b) = (self.shape.continuous, self.shape.binary);
-        let mut actions = Vec::with_capacity(n * (c + b));
-        let mut log_probs = Vec::with_capacity(n);
+        let mut actions = Vec::with_capacity(head.len() * (c + b));
+        let mut log_probs = Vec::with_capacity(head.len());
         for row in &head {
             let mut log_prob = 0.0;
             for k in 0..c {
@@ -206,11 +242,7 @@ impl ActorCritic {
             }
             log_probs.push(log_prob);
         }
-        Ok(Acted {
-            actions,
-            log_probs,
-            values,
-        })
+        Ok((actions, log_probs))
     }
 
     /// Log-probabilities of `actions`, the entropy of each row's distribution and the value
@@ -281,6 +313,23 @@ mod tests {
             hidden: vec![16, 16],
             continuous: 2,
             binary: 1,
+        }
+    }
+
+    #[test]
+    fn choose_and_values_give_what_act_gives() {
+        let policy = ActorCritic::new(shape(), 2).unwrap();
+        policy.set_log_std(-0.5).unwrap();
+        let obs: Vec<f32> = (0..15).map(|i| (i as f32 * 1.3).cos()).collect();
+        for mode in [ActMode::Sample, ActMode::Deterministic] {
+            let acted = policy
+                .act(&obs, mode, &mut ChaCha8Rng::seed_from_u64(9))
+                .unwrap();
+            let chosen = policy
+                .choose(&obs, mode, &mut ChaCha8Rng::seed_from_u64(9))
+                .unwrap();
+            assert_eq!(chosen, acted.actions, "{mode:?}");
+            assert_eq!(policy.values(&obs).unwrap(), acted.values);
         }
     }
 

@@ -109,11 +109,7 @@ impl<E: VecEnv> Trainer<E> {
         }
         let mut normalized = self.observations.clone();
         self.norm.normalize(&mut normalized);
-        let last_values = self
-            .ppo
-            .policy
-            .act(&normalized, ActMode::Deterministic, &mut self.rng)?
-            .values;
+        let last_values = self.ppo.policy.values(&normalized)?;
         let (advantages, returns) = gae(
             &rewards,
             &batch.values,

@@ -125,16 +125,29 @@ fn header(app: &App, frame: &mut Frame, area: Rect) {
         };
         Span::styled(format!(" {} ", g.name()), style)
     };
-    let line = Line::from(vec![
+    let mut line = Line::from(vec![
         Span::styled(" arlpcg designer ", Style::new().bold()),
         game(Game::Platform),
         game(Game::Racing),
-        Span::raw(format!(
-            "  Generator: {}  Solver: {}",
-            policy_label(&app.policies.generator, "rules"),
-            policy_label(&app.policies.solver, "scripted"),
-        )),
     ]);
+    // The training budgets, in each policy's own unit, where the width allows.
+    let mode = |info: &Option<PolicyInfo>, none: &str, unit: &str| match info {
+        Some(p) => {
+            let budget = format!(" {} {unit}", millions(p.card.training.steps));
+            (p.card.training.mode.clone(), budget)
+        }
+        None => (none.to_string(), String::new()),
+    };
+    let (generator, generator_budget) = mode(&app.policies.generator, "rules", "blocks");
+    let (solver, solver_budget) = mode(&app.policies.solver, "scripted", "steps");
+    let long =
+        format!("  Generator: {generator}{generator_budget}  Solver: {solver}{solver_budget}");
+    let policies = if line.width() + long.chars().count() <= area.width as usize {
+        long
+    } else {
+        format!("  Generator: {generator}  Solver: {solver}")
+    };
+    line.push_span(Span::raw(policies));
     frame.render_widget(Paragraph::new(line), area);
 }
 
@@ -577,11 +590,16 @@ fn overlay(app: &App, frame: &mut Frame, screen: Rect) {
                         let t = &p.card.training;
                         lines.push(Line::from(format!("{role}: {}", p.path.display())).bold());
                         lines.push(Line::from(format!(
-                            "  {} {}, mode {}, {} steps, {:.0} min, seed {}",
+                            "  {} {}, mode {}, {} {}, {:.0} min, seed {}",
                             p.card.game,
                             p.card.role,
                             t.mode,
                             t.steps,
+                            if role == "Generator" {
+                                "blocks placed"
+                            } else {
+                                "steps"
+                            },
                             t.wall_time_s / 60.0,
                             t.seed
                         )));

@@ -184,7 +184,10 @@ impl ActorCritic {
     }
 
     fn critic_values(&self, obs: &Tensor) -> candle_core::Result<Vec<f32>> {
-        self.critic.forward(obs, false)?.flatten_all()?.to_vec1::<f32>()
+        self.critic
+            .forward(obs, false)?
+            .flatten_all()?
+            .to_vec1::<f32>()
     }
 
     /// The actions alone (rows of `action_size`), for playing rather than learning: the critic

@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use super::PlatformAction;
 use super::env::{PlatformEnv, SolverRewards};
+use super::reach;
 use crate::game::Step;
 use crate::level::params::{self, quantize};
 use crate::level::platform::{
@@ -136,7 +137,8 @@ impl GeneratorRewards {
 /// A policy's action row (unbounded Gaussian samples) as the next block of `track` toward
 /// `goal`: each value is clipped to [-1, 1] and mapped onto its range (NaN becomes the middle),
 /// the turn added to the goal's bearing from the last block, the height change to the climb
-/// that keeps the slope toward the goal (see [`GENERATOR_ACTIONS`]).
+/// that keeps the slope toward the goal (see [`GENERATOR_ACTIONS`]), the distance shortened to
+/// keep the edge gap within the reach table ([`reach::max_gap`]) for that height change.
 pub fn block_from_action(track: &PlatformTrack, goal: [f64; 3], row: &[f32]) -> BlockParams {
     let unit = |v: f32| if v.is_nan() { 0.0 } else { v as f64 };
     let mut block =
@@ -148,6 +150,10 @@ pub fn block_from_action(track: &PlatformTrack, goal: [f64; 3], row: &[f32]) -> 
     let rise = goal[1] - last.position[1];
     let on_course = rise * (block.distance / dx.hypot(dz).max(1e-6)).min(1.0);
     block.height = quantize(params::BLOCK_HEIGHT.clamp(on_course + block.height));
+    // Never beyond the character's reach: a longer jump makes a level impossible, not harder,
+    // and a failure there teaches the Solver nothing.
+    let longest = reach::max_gap(block.height) + 0.5 * (last.size + block.size);
+    block.distance = quantize(block.distance.min(longest));
     block
 }
 
@@ -328,6 +334,8 @@ impl Match {
 mod tests {
     use super::*;
     use crate::level::params::{BLOCK_DISTANCE, BLOCK_HEIGHT, BLOCK_SIZE};
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
 
     /// The action row that places the next block straight toward `goal`, short jumps.
     fn aimed(track: &PlatformTrack, goal: [f64; 3]) -> [f32; 4] {
@@ -452,6 +460,34 @@ mod tests {
         assert_eq!(block.height, 1.5, "4 m over 20 m, for 7.5 m");
         let steep = block_from_action(&track, [20.0, 40.0, 0.0], &[0.0, 0.0, 0.0, 1.0]);
         assert_eq!(steep.height, 2.0, "clamped to the SPEC range");
+    }
+
+    #[test]
+    fn no_action_places_a_block_beyond_reach() {
+        let track = PlatformTrack::new(Start {
+            size: 4.0,
+            ..Start::default()
+        });
+        // Longest, smallest, steepest up: 10 m between 4 m blocks would be a 6 m gap 2 m up,
+        // where the reach table allows 5 m.
+        let far_up = block_from_action(&track, [60.0, 30.0, 0.0], &[1.0, 0.0, -1.0, 1.0]);
+        assert_eq!(far_up.height, 2.0);
+        assert_eq!(far_up.distance, 5.0 + 0.5 * (4.0 + 4.0));
+        let far_flat = block_from_action(&track, [60.0, 0.0, 0.0], &[1.0, 0.0, -1.0, 0.0]);
+        assert_eq!(far_flat.distance, 10.0, "a flat 6 m gap is within reach");
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        for _ in 0..2000 {
+            let row: [f32; 4] = std::array::from_fn(|_| rng.random_range(-1.5..1.5));
+            let goal = [60.0, rng.random_range(-20.0..20.0), 10.0];
+            let block = block_from_action(&track, goal, &row);
+            let placed = track.preview(&block);
+            let gap = track.last().edge_gap(&placed);
+            assert!(
+                gap <= reach::max_gap(block.height) + 1e-3,
+                "{block:?}: gap {gap}"
+            );
+            assert!(BLOCK_DISTANCE.check(block.distance).is_ok(), "{block:?}");
+        }
     }
 
     #[test]

@@ -21,7 +21,7 @@ use crate::train::TrainMode;
         steered by one knob, the aux input λ (+1 easy, -1 hard), or from rule-based generation.",
     after_help = "Examples:\n  \
         arlpcg                      (the designer, on the shipped policies)\n  \
-        arlpcg design --policies runs/platform-solver-arlpcg --out levels/mine\n  \
+        arlpcg design --policies runs/platform-solver-arlpcg-reach --out levels/mine\n  \
         arlpcg generate --policies policies/platform --aux -0.5 --verify 100 --out levels/mine\n  \
         arlpcg generate --game platform --rules --count 20 --seed 1 --out levels/mine\n  \
         arlpcg verify levels/mine/*.yaml --trials 100\n  \
@@ -54,7 +54,7 @@ pub enum Command {
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     arlpcg design\n  \
-    arlpcg design --policies runs/platform-solver-arlpcg --out levels/mine --seed 7")]
+    arlpcg design --policies runs/platform-solver-arlpcg-reach --out levels/mine --seed 7")]
 pub struct DesignArgs {
     /// Which game.
     #[arg(long, default_value = "platform", value_parser = parse_game)]
@@ -75,7 +75,7 @@ pub struct DesignArgs {
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     arlpcg eval --policies policies/platform --out results/platform\n  \
-    arlpcg eval --policies runs/platform-solver-arlpcg runs/platform-solver-rule-pcg --full --out results/full")]
+    arlpcg eval --policies runs/platform-solver-arlpcg-reach runs/platform-solver-rule-pcg --full --out results/full")]
 pub struct EvalArgs {
     /// Which game.
     #[arg(long, default_value = "platform", value_parser = parse_game)]

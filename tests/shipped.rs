@@ -104,11 +104,13 @@ fn every_shipped_platform_policy_loads_and_its_card_matches() {
         );
         assert_eq!(card.training.mode, mode, "{name}");
         assert_eq!(card.network.hidden, vec![512, 512]);
-        // All four Solvers share one budget: 4M Solver steps.
+        // All four Solvers share one budget: 5M Solver steps (the last 8k-step update may
+        // overshoot it).
         if role == Role::Solver {
             assert!(
-                card.training.steps >= 4_000_000,
-                "{name} is trained to the budget"
+                (5_000_000..5_100_000).contains(&card.training.steps),
+                "{name} is trained to the budget, not {}",
+                card.training.steps
             );
         }
     }

@@ -15,6 +15,7 @@ use super::layout::{Areas, SLIDER_LEFT, SLIDER_RIGHT, fits};
 use crate::level::platform::{Platform, PlatformTrack, heading_direction};
 use crate::level::stats::Outcome;
 use crate::level::{Game, Level};
+use crate::rl::checkpoint::Role;
 
 /// The key map, as the help overlay and the README show it.
 pub const KEYS: [(&str, &str); 20] = [
@@ -116,6 +117,14 @@ fn millions(steps: u64) -> String {
     }
 }
 
+/// What a policy's training budget counts: the Solver's steps, the Generator's blocks.
+fn budget_unit(role: Role) -> &'static str {
+    match role {
+        Role::Solver => "steps",
+        Role::Generator => "blocks",
+    }
+}
+
 fn header(app: &App, frame: &mut Frame, area: Rect) {
     let game = |g: Game| {
         let style = if app.game == g {
@@ -131,15 +140,16 @@ fn header(app: &App, frame: &mut Frame, area: Rect) {
         game(Game::Racing),
     ]);
     // The training budgets, in each policy's own unit, where the width allows.
-    let mode = |info: &Option<PolicyInfo>, none: &str, unit: &str| match info {
+    let mode = |info: &Option<PolicyInfo>, none: &str| match info {
         Some(p) => {
-            let budget = format!(" {} {unit}", millions(p.card.training.steps));
-            (p.card.training.mode.clone(), budget)
+            let t = &p.card.training;
+            let budget = format!(" {} {}", millions(t.steps), budget_unit(p.card.role));
+            (t.mode.clone(), budget)
         }
         None => (none.to_string(), String::new()),
     };
-    let (generator, generator_budget) = mode(&app.policies.generator, "rules", "blocks");
-    let (solver, solver_budget) = mode(&app.policies.solver, "scripted", "steps");
+    let (generator, generator_budget) = mode(&app.policies.generator, "rules");
+    let (solver, solver_budget) = mode(&app.policies.solver, "scripted");
     let long =
         format!("  Generator: {generator}{generator_budget}  Solver: {solver}{solver_budget}");
     let policies = if line.width() + long.chars().count() <= area.width as usize {
@@ -595,11 +605,7 @@ fn overlay(app: &App, frame: &mut Frame, screen: Rect) {
                             p.card.role,
                             t.mode,
                             t.steps,
-                            if role == "Generator" {
-                                "blocks placed"
-                            } else {
-                                "steps"
-                            },
+                            budget_unit(p.card.role),
                             t.wall_time_s / 60.0,
                             t.seed
                         )));

@@ -1,9 +1,13 @@
-//! Adam with its moments kept as named tensors, so that a checkpoint can store and restore them
-//! (candle-nn's AdamW keeps its state private).
+//! Adam over the policy's flat parameter vector (see [`super::fused`]), one fused pass split
+//! across rayon's threads, with its moments exposed as named tensors so that a checkpoint can
+//! store and restore them.
 
 use std::collections::HashMap;
 
-use candle_core::{Tensor, Var, backprop::GradStore};
+use candle_core::{Device, Tensor, Var};
+use rayon::prelude::*;
+
+use super::fused::PARAM_CHUNK;
 
 /// Adam's state: step count and first and second moments per parameter.
 pub struct Adam {
@@ -11,64 +15,69 @@ pub struct Adam {
     pub beta2: f64,
     pub eps: f64,
     pub step: u64,
-    moments: Vec<(Tensor, Tensor)>,
+    first: Vec<f32>,
+    second: Vec<f32>,
 }
 
 impl Adam {
     /// Zeroed moments for `vars` (CleanRL's eps of 1e-5).
-    pub fn new(vars: &[(String, Var)]) -> candle_core::Result<Self> {
-        let moments = vars
-            .iter()
-            .map(|(_, v)| Ok((v.as_tensor().zeros_like()?, v.as_tensor().zeros_like()?)))
-            .collect::<candle_core::Result<_>>()?;
-        Ok(Self {
+    pub fn new(vars: &[(String, Var)]) -> Self {
+        let len = vars.iter().map(|(_, v)| v.as_tensor().elem_count()).sum();
+        Self {
             beta1: 0.9,
             beta2: 0.999,
             eps: 1e-5,
             step: 0,
-            moments,
-        })
+            first: vec![0.0; len],
+            second: vec![0.0; len],
+        }
     }
 
-    /// One update of every var with its gradient times `grad_scale` (gradient-norm clipping).
+    /// One update of every parameter with its gradient times `grad_scale` (gradient-norm
+    /// clipping). Each element is independent of the others: no result depends on the threads.
     pub fn apply(
         &mut self,
-        vars: &[(String, Var)],
-        grads: &GradStore,
+        params: &mut [f32],
+        gradients: &[f32],
         learning_rate: f64,
         grad_scale: f64,
-    ) -> candle_core::Result<()> {
+    ) {
+        assert_eq!(params.len(), self.first.len());
+        assert_eq!(gradients.len(), self.first.len());
         self.step += 1;
-        let correction1 = 1.0 - self.beta1.powi(self.step as i32);
-        let correction2 = 1.0 - self.beta2.powi(self.step as i32);
-        for ((_, var), (m, v)) in vars.iter().zip(self.moments.iter_mut()) {
-            let Some(grad) = grads.get(var.as_tensor()) else {
-                continue;
-            };
-            // Detached: a gradient carries its autograd history, and moments built from it would
-            // chain every update's graph (activations included) into memory.
-            let grad = grad.detach().affine(grad_scale, 0.0)?;
-            *m = ((&*m * self.beta1)? + (&grad * (1.0 - self.beta1))?)?;
-            *v = ((&*v * self.beta2)? + (grad.sqr()? * (1.0 - self.beta2))?)?;
-            let m_hat = (&*m / correction1)?;
-            let v_hat = (&*v / correction2)?;
-            let delta = (m_hat / (v_hat.sqrt()? + self.eps)?)?;
-            var.set(&(var.as_tensor() - (delta * learning_rate)?)?)?;
-        }
-        Ok(())
+        let (beta1, beta2) = (self.beta1 as f32, self.beta2 as f32);
+        let correction1 = (1.0 - self.beta1.powi(self.step as i32)) as f32;
+        let correction2 = (1.0 - self.beta2.powi(self.step as i32)) as f32;
+        let (rate, scale, eps) = (learning_rate as f32, grad_scale as f32, self.eps as f32);
+        params
+            .par_chunks_mut(PARAM_CHUNK)
+            .zip(gradients.par_chunks(PARAM_CHUNK))
+            .zip(self.first.par_chunks_mut(PARAM_CHUNK))
+            .zip(self.second.par_chunks_mut(PARAM_CHUNK))
+            .for_each(|(((p, g), m), v)| {
+                for (((p, g), m), v) in p.iter_mut().zip(g).zip(m).zip(v) {
+                    let g = g * scale;
+                    *m = beta1 * *m + (1.0 - beta1) * g;
+                    *v = beta2 * *v + (1.0 - beta2) * g * g;
+                    *p -= rate * (*m / correction1) / ((*v / correction2).sqrt() + eps);
+                }
+            });
     }
 
-    /// The moments as named tensors (`adam.m.<var>`, `adam.v.<var>`).
+    /// The moments as named tensors (`adam.m.<var>`, `adam.v.<var>`), shaped as their vars.
     pub fn named_state(&self, vars: &[(String, Var)]) -> Vec<(String, Tensor)> {
-        vars.iter()
-            .zip(&self.moments)
-            .flat_map(|((name, _), (m, v))| {
-                [
-                    (format!("adam.m.{name}"), m.clone()),
-                    (format!("adam.v.{name}"), v.clone()),
-                ]
-            })
-            .collect()
+        let mut offset = 0;
+        let mut state = Vec::with_capacity(2 * vars.len());
+        for (name, var) in vars {
+            let (len, dims) = (var.as_tensor().elem_count(), var.as_tensor().dims());
+            for (prefix, moments) in [("m", &self.first), ("v", &self.second)] {
+                let tensor = Tensor::from_slice(&moments[offset..offset + len], dims, &Device::Cpu)
+                    .expect("moments are laid out as their vars");
+                state.push((format!("adam.{prefix}.{name}"), tensor));
+            }
+            offset += len;
+        }
+        state
     }
 
     /// Restores the moments saved by [`Adam::named_state`].
@@ -78,8 +87,11 @@ impl Adam {
         tensors: &HashMap<String, Tensor>,
         step: u64,
     ) -> Result<(), String> {
-        for ((name, var), (m, v)) in vars.iter().zip(self.moments.iter_mut()) {
-            for (slot, key) in [(m, format!("adam.m.{name}")), (v, format!("adam.v.{name}"))] {
+        let mut offset = 0;
+        for (name, var) in vars {
+            let len = var.as_tensor().elem_count();
+            for (prefix, moments) in [("m", &mut self.first), ("v", &mut self.second)] {
+                let key = format!("adam.{prefix}.{name}");
                 let saved = tensors
                     .get(&key)
                     .ok_or_else(|| format!("missing optimizer tensor `{key}`"))?;
@@ -90,8 +102,13 @@ impl Adam {
                         var.as_tensor().dims()
                     ));
                 }
-                *slot = saved.clone();
+                let values = saved
+                    .flatten_all()
+                    .and_then(|t| t.to_vec1::<f32>())
+                    .map_err(|e| format!("optimizer tensor `{key}`: {e}"))?;
+                moments[offset..offset + len].copy_from_slice(&values);
             }
+            offset += len;
         }
         self.step = step;
         Ok(())
@@ -101,32 +118,58 @@ impl Adam {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use candle_core::{DType, Device};
+    use candle_core::DType;
+
+    fn vars() -> Vec<(String, Var)> {
+        vec![
+            (
+                "w".to_string(),
+                Var::ones((4, 3), DType::F32, &Device::Cpu).unwrap(),
+            ),
+            (
+                "b".to_string(),
+                Var::ones((1, 3), DType::F32, &Device::Cpu).unwrap(),
+            ),
+        ]
+    }
 
     #[test]
-    fn moments_do_not_keep_the_autograd_graph_regression_oom() {
-        // Training ran out of memory (24 GB in two minutes): the moments were built from
-        // gradients that still tracked their graph, chaining every update into memory.
-        let var = Var::ones((4, 3), DType::F32, &Device::Cpu).unwrap();
-        let vars = vec![("w".to_string(), var.clone())];
-        let mut adam = Adam::new(&vars).unwrap();
+    fn each_step_moves_a_weight_by_about_the_learning_rate_downhill() {
+        let mut adam = Adam::new(&vars());
+        let mut params = vec![1.0f32; 15];
         for _ in 0..3 {
-            let loss = var.as_tensor().sqr().unwrap().sum_all().unwrap();
-            let grads = loss.backward().unwrap();
-            adam.apply(&vars, &grads, 0.1, 1.0).unwrap();
+            // The gradient of Σ p² is 2p; Adam's first steps move by the learning rate.
+            let gradients: Vec<f32> = params.iter().map(|p| 2.0 * p).collect();
+            adam.apply(&mut params, &gradients, 0.1, 1.0);
         }
-        assert!(
-            adam.moments
-                .iter()
-                .all(|(m, v)| !m.track_op() && !v.track_op())
+        assert!(params.iter().all(|&x| (x - 0.7).abs() < 0.01), "{params:?}");
+        assert_eq!(adam.step, 3);
+    }
+
+    #[test]
+    fn named_state_restores_into_the_same_moments() {
+        let vars = vars();
+        let mut adam = Adam::new(&vars);
+        let mut params: Vec<f32> = (0..15).map(|i| i as f32).collect();
+        let gradients: Vec<f32> = (0..15).map(|i| (i as f32).sin()).collect();
+        adam.apply(&mut params, &gradients, 0.01, 0.5);
+        let saved: HashMap<String, Tensor> = adam.named_state(&vars).into_iter().collect();
+        assert_eq!(saved["adam.v.b"].dims(), &[1, 3]);
+        let mut restored = Adam::new(&vars);
+        restored.restore(&vars, &saved, adam.step).unwrap();
+        assert_eq!(
+            (restored.first.clone(), restored.second.clone()),
+            (adam.first, adam.second)
         );
-        // Adam moves each weight by about the learning rate per step, toward 0.
-        let w = var
-            .as_tensor()
-            .flatten_all()
-            .unwrap()
-            .to_vec1::<f32>()
-            .unwrap();
-        assert!(w.iter().all(|&x| (x - 0.7).abs() < 0.01), "{w:?}");
+        let mut wrong = saved.clone();
+        wrong.insert(
+            "adam.m.w".into(),
+            Tensor::zeros((3, 4), DType::F32, &Device::Cpu).unwrap(),
+        );
+        let error = restored.restore(&vars, &wrong, 1).unwrap_err();
+        assert!(
+            error.contains("adam.m.w") && error.contains("[3, 4]"),
+            "{error}"
+        );
     }
 }

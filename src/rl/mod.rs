@@ -1,9 +1,12 @@
-//! Game-agnostic learning on candle: the actor-critic [`policy`], [`ppo`] with its optimizer
-//! ([`adam`]), running observation normalization ([`normalizer`]) and the rollout loop over many
-//! environments ([`vec_env`]); candle's thread count ([`threads`]). Nothing here reads the clock or prints.
+//! Game-agnostic learning: the actor-critic on candle ([`policy`]), [`ppo`] with its hand-written
+//! forward/backward pass ([`fused`]) and optimizer ([`adam`]), running observation normalization
+//! ([`normalizer`]), the rollout loop over many environments ([`vec_env`]), policy and checkpoint
+//! files ([`checkpoint`]) and candle's thread count ([`threads`]). Nothing here reads the clock or
+//! prints.
 
 pub mod adam;
 pub mod checkpoint;
+pub mod fused;
 pub mod normalizer;
 pub mod policy;
 pub mod ppo;

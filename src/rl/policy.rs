@@ -5,7 +5,7 @@
 //! Actions travel as rows `[continuous..., binary...]`, binaries as 0.0 or 1.0. Continuous
 //! samples are unbounded; environments clip them to [-1, 1] (CleanRL's `ClipAction`).
 
-use candle_core::{D, DType, Device, Tensor, Var};
+use candle_core::{DType, Device, Tensor, Var};
 use rand::RngExt;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -13,7 +13,7 @@ use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
 /// ln(2π) / 2
-const HALF_LN_TAU: f32 = 0.918_938_5;
+pub(super) const HALF_LN_TAU: f32 = 0.918_938_5;
 
 /// The sizes of a policy.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -80,22 +80,15 @@ impl Mlp {
         Ok(Self { layers })
     }
 
+    /// The network's output for a batch of rows. `track`: gradients may flow to the weights
+    /// (only the autograd reference of the tests asks for them; learning uses [`super::fused`]).
     fn forward(&self, x: &Tensor, track: bool) -> candle_core::Result<Tensor> {
         let mut h = x.clone();
-        // The bias enters as `1 · b` ([n, 1] × [1, out]) when learning: its gradient is then a
-        // matmul, much faster in candle than the batch reduction of `broadcast_add`'s backward.
-        let ones = match track {
-            true => Some(Tensor::ones((x.dim(0)?, 1), DType::F32, &Device::Cpu)?),
-            false => None,
-        };
         for (k, layer) in self.layers.iter().enumerate() {
-            h = match &ones {
-                Some(ones) => {
-                    (h.matmul(layer.weight.as_tensor())? + ones.matmul(layer.bias.as_tensor())?)?
-                }
-                None => h
-                    .matmul(&layer.weight.as_tensor().detach())?
-                    .broadcast_add(&layer.bias.as_tensor().detach())?,
+            let (weight, bias) = (layer.weight.as_tensor(), layer.bias.as_tensor());
+            h = match track {
+                true => h.matmul(weight)?.broadcast_add(bias)?,
+                false => h.matmul(&weight.detach())?.broadcast_add(&bias.detach())?,
             };
             if k + 1 < self.layers.len() {
                 h = h.relu()?;
@@ -248,8 +241,38 @@ impl ActorCritic {
         Ok((actions, log_probs))
     }
 
+    /// Every parameter in one flat vector, in [`Self::named_vars`] order (the layout of
+    /// [`super::fused::Layout`]).
+    pub fn flat_parameters(&self) -> candle_core::Result<Vec<f32>> {
+        let mut flat = Vec::new();
+        for (_, var) in self.named_vars() {
+            flat.extend(var.as_tensor().flatten_all()?.to_vec1::<f32>()?);
+        }
+        Ok(flat)
+    }
+
+    /// Sets every parameter from a flat vector in [`Self::named_vars`] order.
+    pub fn set_flat_parameters(&self, flat: &[f32]) -> candle_core::Result<()> {
+        let mut offset = 0;
+        for (_, var) in self.named_vars() {
+            let len = var.as_tensor().elem_count();
+            let values = flat.get(offset..offset + len).ok_or_else(|| {
+                candle_core::Error::Msg(format!("{} parameters for a larger policy", flat.len()))
+            })?;
+            var.set(&Tensor::from_slice(
+                values,
+                var.as_tensor().dims(),
+                &Device::Cpu,
+            )?)?;
+            offset += len;
+        }
+        Ok(())
+    }
+
     /// Log-probabilities of `actions`, the entropy of each row's distribution and the value
-    /// estimates, as tensors that gradients flow through.
+    /// estimates, as tensors that gradients flow through: the autograd definition of what
+    /// [`super::fused`] differentiates by hand, which its tests check it against.
+    #[cfg(test)]
     pub fn evaluate(
         &self,
         observations: &Tensor,
@@ -261,7 +284,7 @@ impl ActorCritic {
         let values = self
             .critic
             .forward(observations, true)?
-            .squeeze(D::Minus1)?;
+            .squeeze(candle_core::D::Minus1)?;
         let mut log_prob = Tensor::zeros(n, DType::F32, &Device::Cpu)?;
         let mut entropy = Tensor::zeros(n, DType::F32, &Device::Cpu)?;
         if c > 0 {
@@ -292,15 +315,16 @@ impl ActorCritic {
     }
 }
 
-fn sigmoid(x: f32) -> f32 {
+pub(super) fn sigmoid(x: f32) -> f32 {
     1.0 / (1.0 + (-x).exp())
 }
 
-fn softplus(x: f32) -> f32 {
+pub(super) fn softplus(x: f32) -> f32 {
     x.max(0.0) + (-x.abs()).exp().ln_1p()
 }
 
 /// softplus(x) = max(x, 0) + ln(1 + e^-|x|), stable for large |x|.
+#[cfg(test)]
 fn softplus_tensor(x: &Tensor) -> candle_core::Result<Tensor> {
     x.relu()?
         .add(&x.abs()?.neg()?.exp()?.affine(1.0, 1.0)?.log()?)

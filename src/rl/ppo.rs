@@ -2,12 +2,12 @@
 //! the clipped surrogate loss, and `update` over shuffled minibatches with Adam, advantage
 //! normalization, an entropy bonus and gradient-norm clipping.
 
-use candle_core::{Device, Tensor};
 use rand::seq::SliceRandom;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::adam::Adam;
+use super::fused::{Layout, LossWeights, Minibatch, Workspace, global_norm};
 use super::policy::ActorCritic;
 
 /// Every PPO hyper-parameter, with CleanRL's meanings.
@@ -109,20 +109,6 @@ pub fn gae(
     (advantages, returns)
 }
 
-/// PPO's clipped surrogate objective (to minimize): the mean over the batch of
-/// `max(-A·r, -A·clip(r, 1-ε, 1+ε))` with `r = exp(new_log_prob - old_log_prob)`.
-pub fn clipped_policy_loss(
-    new_log_prob: &Tensor,
-    old_log_prob: &Tensor,
-    advantages: &Tensor,
-    clip: f32,
-) -> candle_core::Result<Tensor> {
-    let ratio = (new_log_prob - old_log_prob)?.exp()?;
-    let unclipped = (advantages.neg()? * &ratio)?;
-    let clipped = (advantages.neg()? * ratio.clamp(1.0 - clip, 1.0 + clip)?)?;
-    unclipped.maximum(&clipped)?.mean_all()
-}
-
 /// One rollout, flattened, ready to learn from.
 pub struct Batch {
     /// Normalized observations, rows of `observation` values.
@@ -152,19 +138,24 @@ pub struct Ppo {
     pub config: PpoConfig,
     pub policy: ActorCritic,
     pub adam: Adam,
+    /// The fused update's buffers, made at the first update for the minibatch size.
+    workspace: Option<Workspace>,
 }
 
 impl Ppo {
     pub fn new(config: PpoConfig, policy: ActorCritic) -> candle_core::Result<Self> {
-        let adam = Adam::new(&policy.named_vars())?;
+        let adam = Adam::new(&policy.named_vars());
         Ok(Self {
             config,
             policy,
             adam,
+            workspace: None,
         })
     }
 
-    /// Learns from one batch at `learning_rate`: `update_epochs` passes of shuffled minibatches.
+    /// Learns from one batch at `learning_rate`: `update_epochs` passes of shuffled minibatches,
+    /// each one fused forward/backward pass ([`super::fused`]) and one Adam step. The policy's
+    /// parameters are read before the first minibatch and written back after the last.
     pub fn update(
         &mut self,
         batch: &Batch,
@@ -172,9 +163,20 @@ impl Ppo {
         rng: &mut ChaCha8Rng,
     ) -> candle_core::Result<UpdateStats> {
         let shape = self.policy.shape().clone();
+        let (obs_width, action_width) = (shape.observation, shape.action_size());
         let n = batch.log_probs.len();
         let minibatch = self.config.minibatch_size().clamp(1, n);
-        let vars = self.policy.named_vars();
+        let workspace = match &mut self.workspace {
+            Some(workspace) if workspace.capacity() >= minibatch => workspace,
+            slot => slot.insert(Workspace::new(Layout::new(&shape), minibatch)),
+        };
+        let weights = LossWeights {
+            clip_coef: self.config.clip_coef,
+            ent_coef: self.config.ent_coef,
+            vf_coef: self.config.vf_coef,
+        };
+        let mut params = self.policy.flat_parameters()?;
+        let mut rows = Rows::with_capacity(minibatch, obs_width, action_width);
         let mut order: Vec<usize> = (0..n).collect();
         let mut stats = UpdateStats::default();
         let mut sums = [0.0f32; 5];
@@ -182,80 +184,40 @@ impl Ppo {
         'epochs: for _ in 0..self.config.update_epochs {
             order.shuffle(rng);
             for ids in order.chunks(minibatch) {
-                let rows = |data: &[f32], width: usize| -> candle_core::Result<Tensor> {
-                    let mut out = Vec::with_capacity(ids.len() * width);
-                    for &i in ids {
-                        out.extend_from_slice(&data[i * width..(i + 1) * width]);
-                    }
-                    Tensor::from_vec(out, (ids.len(), width), &Device::Cpu)
-                };
-                let column =
-                    |data: &[f32]| -> candle_core::Result<Tensor> { rows(data, 1)?.flatten_all() };
-                let obs = rows(&batch.observations, shape.observation)?;
-                let actions = rows(&batch.actions, shape.action_size())?;
-                let old_log_prob = column(&batch.log_probs)?;
-                let mut advantages = column(&batch.advantages)?;
+                rows.gather(batch, ids, obs_width, action_width);
                 if self.config.norm_adv && ids.len() > 1 {
-                    let mean = advantages.mean_all()?;
-                    let centred = advantages.broadcast_sub(&mean)?;
-                    let std = centred.sqr()?.mean_all()?.sqrt()?;
-                    advantages = centred.broadcast_div(&(std + 1e-8)?)?;
+                    normalize(&mut rows.advantages);
                 }
-                let returns = column(&batch.returns)?;
-
-                let (new_log_prob, entropy, values) = self.policy.evaluate(&obs, &actions)?;
-                let log_ratio = (&new_log_prob - &old_log_prob)?.detach();
-                let ratio = log_ratio.exp()?;
-                let approx_kl = ((&ratio - 1.0)? - &log_ratio)?
-                    .mean_all()?
-                    .to_scalar::<f32>()?;
-                let clip_fraction = (&ratio - 1.0)?
-                    .abs()?
-                    .gt(self.config.clip_coef as f64)?
-                    .to_dtype(candle_core::DType::F32)?
-                    .mean_all()?
-                    .to_scalar::<f32>()?;
-                let policy_loss = clipped_policy_loss(
-                    &new_log_prob,
-                    &old_log_prob,
-                    &advantages,
-                    self.config.clip_coef,
-                )?;
-                let value_loss = ((values - &returns)?.sqr()?.mean_all()? * 0.5)?;
-                let entropy = entropy.mean_all()?;
-                let loss = ((&policy_loss - (&entropy * self.config.ent_coef as f64)?)?
-                    + (&value_loss * self.config.vf_coef as f64)?)?;
-                let grads = loss.backward()?;
-                let mut squared = 0.0f64;
-                for (_, var) in &vars {
-                    if let Some(g) = grads.get(var.as_tensor()) {
-                        squared += g.sqr()?.sum_all()?.to_scalar::<f32>()? as f64;
-                    }
-                }
-                let norm = squared.sqrt();
+                let terms = workspace.loss_and_gradients(&params, &rows.minibatch(), weights);
+                let norm = global_norm(&workspace.gradients);
                 let scale = if norm > self.config.max_grad_norm as f64 {
                     self.config.max_grad_norm as f64 / (norm + 1e-6)
                 } else {
                     1.0
                 };
-                self.adam.apply(&vars, &grads, learning_rate, scale)?;
-
+                self.adam
+                    .apply(&mut params, &workspace.gradients, learning_rate, scale);
                 for (sum, value) in sums.iter_mut().zip([
-                    policy_loss.to_scalar::<f32>()?,
-                    value_loss.to_scalar::<f32>()?,
-                    entropy.to_scalar::<f32>()?,
-                    approx_kl,
-                    clip_fraction,
+                    terms.policy_loss,
+                    terms.value_loss,
+                    terms.entropy,
+                    terms.approx_kl,
+                    terms.clip_fraction,
                 ]) {
                     *sum += value;
                 }
                 count += 1.0;
                 stats.gradient_steps += 1;
-                if self.config.target_kl.is_some_and(|limit| approx_kl > limit) {
+                if self
+                    .config
+                    .target_kl
+                    .is_some_and(|limit| terms.approx_kl > limit)
+                {
                     break 'epochs;
                 }
             }
         }
+        self.policy.set_flat_parameters(&params)?;
         let [policy_loss, value_loss, entropy, approx_kl, clip_fraction] =
             sums.map(|s| s / count.max(1.0));
         stats.policy_loss = policy_loss;
@@ -265,6 +227,69 @@ impl Ppo {
         stats.clip_fraction = clip_fraction;
         stats.explained_variance = explained_variance(&batch.values, &batch.returns);
         Ok(stats)
+    }
+}
+
+/// One minibatch's rows, gathered from a [`Batch`] into buffers reused across minibatches.
+struct Rows {
+    observations: Vec<f32>,
+    actions: Vec<f32>,
+    old_log_probs: Vec<f32>,
+    advantages: Vec<f32>,
+    returns: Vec<f32>,
+}
+
+impl Rows {
+    fn with_capacity(rows: usize, obs_width: usize, action_width: usize) -> Self {
+        Self {
+            observations: Vec::with_capacity(rows * obs_width),
+            actions: Vec::with_capacity(rows * action_width),
+            old_log_probs: Vec::with_capacity(rows),
+            advantages: Vec::with_capacity(rows),
+            returns: Vec::with_capacity(rows),
+        }
+    }
+
+    fn gather(&mut self, batch: &Batch, ids: &[usize], obs_width: usize, action_width: usize) {
+        self.observations.clear();
+        self.actions.clear();
+        self.old_log_probs.clear();
+        self.advantages.clear();
+        self.returns.clear();
+        for &i in ids {
+            self.observations
+                .extend_from_slice(&batch.observations[i * obs_width..(i + 1) * obs_width]);
+            self.actions
+                .extend_from_slice(&batch.actions[i * action_width..(i + 1) * action_width]);
+            self.old_log_probs.push(batch.log_probs[i]);
+            self.advantages.push(batch.advantages[i]);
+            self.returns.push(batch.returns[i]);
+        }
+    }
+
+    fn minibatch(&self) -> Minibatch<'_> {
+        Minibatch {
+            observations: &self.observations,
+            actions: &self.actions,
+            old_log_probs: &self.old_log_probs,
+            advantages: &self.advantages,
+            returns: &self.returns,
+        }
+    }
+}
+
+/// Centres `values` and scales them to unit (population) standard deviation.
+fn normalize(values: &mut [f32]) {
+    let n = values.len() as f64;
+    let mean = values.iter().map(|&v| v as f64).sum::<f64>() / n;
+    let variance = values
+        .iter()
+        .map(|&v| (v as f64 - mean).powi(2))
+        .sum::<f64>()
+        / n;
+    let std = variance.sqrt() as f32;
+    for v in values {
+        *v = (*v - mean as f32) / (std + 1e-8);
     }
 }
 
@@ -282,9 +307,26 @@ pub fn explained_variance(values: &[f32], returns: &[f32]) -> f32 {
     1.0 - variance(&mut returns.iter().zip(values).map(|(r, v)| r - v)) / var_returns
 }
 
+/// PPO's clipped surrogate objective in candle (to minimize), the mean over the batch of
+/// `max(-A·r, -A·clip(r, 1-ε, 1+ε))` with `r = exp(new_log_prob - old_log_prob)`: the autograd
+/// reference that [`super::fused`]'s tests check the hand-written gradients against.
+#[cfg(test)]
+pub fn clipped_policy_loss(
+    new_log_prob: &candle_core::Tensor,
+    old_log_prob: &candle_core::Tensor,
+    advantages: &candle_core::Tensor,
+    clip: f32,
+) -> candle_core::Result<candle_core::Tensor> {
+    let ratio = (new_log_prob - old_log_prob)?.exp()?;
+    let unclipped = (advantages.neg()? * &ratio)?;
+    let clipped = (advantages.neg()? * ratio.clamp(1.0 - clip, 1.0 + clip)?)?;
+    unclipped.maximum(&clipped)?.mean_all()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use candle_core::{Device, Tensor};
 
     #[test]
     fn gae_matches_hand_computed_values() {
@@ -323,6 +365,64 @@ mod tests {
         // rows: max(-1.6487, -1.2) = -1.2; max(-0.6065, -0.8) = -0.6065; max(1.6487, 1.2) = 1.6487
         let expected = (-1.2 - 0.606_530_6 + 1.648_721_3) / 3.0;
         assert!((loss - expected).abs() < 1e-5, "{loss} vs {expected}");
+    }
+
+    fn small_shape() -> crate::rl::policy::PolicyShape {
+        crate::rl::policy::PolicyShape {
+            observation: 9,
+            hidden: vec![512, 512],
+            continuous: 2,
+            binary: 1,
+        }
+    }
+
+    /// The parameters after two updates of a 2 × 64 policy on a random batch of 600 rows.
+    fn parameters_after_updates(threads: usize) -> Vec<f32> {
+        use rand::{RngExt, SeedableRng};
+        let shape = small_shape();
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let mut random =
+            |n: usize| -> Vec<f32> { (0..n).map(|_| rng.random_range(-1.0f32..1.0)).collect() };
+        let n = 600;
+        let batch = Batch {
+            observations: random(n * 9),
+            actions: random(n * 3)
+                .chunks(3)
+                .flat_map(|a| [a[0], a[1], (a[2] > 0.0) as u8 as f32])
+                .collect(),
+            log_probs: random(n).iter().map(|x| x - 3.0).collect(),
+            advantages: random(n),
+            returns: random(n),
+            values: random(n),
+        };
+        let config = PpoConfig {
+            num_envs: 10,
+            num_steps: 60,
+            num_minibatches: 3,
+            ent_coef: 0.01,
+            ..PpoConfig::default()
+        };
+        let mut ppo = Ppo::new(config, ActorCritic::new(shape, 1).unwrap()).unwrap();
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                let mut rng = ChaCha8Rng::seed_from_u64(2);
+                for _ in 0..2 {
+                    ppo.update(&batch, 1e-3, &mut rng).unwrap();
+                }
+            });
+        ppo.policy.flat_parameters().unwrap()
+    }
+
+    #[test]
+    fn updates_are_deterministic_and_do_not_depend_on_the_thread_count() {
+        let one = parameters_after_updates(1);
+        let initial = ActorCritic::new(small_shape(), 1).unwrap();
+        assert_ne!(one, initial.flat_parameters().unwrap());
+        assert_eq!(one, parameters_after_updates(1));
+        assert_eq!(one, parameters_after_updates(3));
     }
 
     #[test]

@@ -335,3 +335,34 @@ fn running_without_a_command_prints_usage() {
         assert!(text.contains(word), "usage lacks {word}: {text}");
     }
 }
+
+/// A policy path that is a device, a folder or a file far larger than any policy is refused
+/// before it is read (`/dev/zero` read GBs).
+#[test]
+fn policy_paths_that_are_not_policy_files_are_refused_unread() {
+    let dir = tempfile::tempdir().unwrap();
+    let big = dir.path().join("big.safetensors");
+    let file = std::fs::File::create(&big).unwrap();
+    file.set_len(300 * 1024 * 1024).unwrap(); // sparse: takes no disk
+    let cases = [
+        ("/dev/zero", "is not a regular file"),
+        ("/", "is not a regular file"),
+        (big.to_str().unwrap(), "more than the 268435456"),
+    ];
+    for (path, expected) in cases {
+        let out = arlpcg(&[
+            "verify",
+            "levels/platform/platform_seed7_aux+1.00.yaml",
+            "--solver",
+            "policy",
+            "--policy",
+            path,
+        ]);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{path}: {err}");
+        assert!(
+            err.contains(path) && err.contains(expected),
+            "{path}: {err}"
+        );
+    }
+}

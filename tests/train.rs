@@ -184,6 +184,65 @@ fn bad_training_configs_are_named() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("give a budget"));
 }
 
+/// Every field is range-checked before anything is allocated or written: values that aborted
+/// with out-of-memory, trained on NaN or were silently accepted are refused with the field's
+/// name, and no run folder is left behind.
+#[test]
+fn out_of_range_training_configs_are_refused_before_anything_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        ("ppo:\n  num_envs: 100000000\n", "solver.num_envs"),
+        ("hidden: [1000000000, 1000000000]\n", "hidden"),
+        ("hidden: [1e9, 1e9]\n", "hidden"),
+        ("ppo:\n  ent_coef: .nan\n", "solver.ent_coef"),
+        ("ppo:\n  clip_coef: .nan\n", "solver.clip_coef"),
+        ("ppo:\n  clip_coef: -0.2\n", "solver.clip_coef"),
+        ("ppo:\n  learning_rate: .inf\n", "solver.learning_rate"),
+        ("ppo:\n  max_grad_norm: 0\n", "solver.max_grad_norm"),
+        ("ppo:\n  target_kl: -1\n", "solver.target_kl"),
+        ("checkpoint_minutes: -1\n", "checkpoint_minutes"),
+        ("checkpoint_minutes: .nan\n", "checkpoint_minutes"),
+        (
+            "ppo:\n  num_envs: 2\n  num_steps: 4\n  num_minibatches: 9\n",
+            "solver.num_minibatches",
+        ),
+        (
+            "generator:\n  ppo:\n    gamma: 1.5\n",
+            "generator.ppo.gamma",
+        ),
+        (
+            "generator:\n  solver_phase_steps: 0\n",
+            "solver_phase_steps",
+        ),
+    ];
+    for (k, (text, field)) in cases.iter().enumerate() {
+        let config = dir.path().join(format!("bad-{k}.yaml"));
+        std::fs::write(&config, text).unwrap();
+        let run = dir.path().join(format!("run-{k}"));
+        let out = arlpcg(&[
+            "train",
+            "--steps",
+            "10",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            run.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{text}: {err}");
+        assert!(
+            err.contains(&format!("bad-{k}.yaml")) && err.contains(field),
+            "{text}: the error should name the file and {field}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(
+            !run.exists(),
+            "{text}: a refused config left {}",
+            run.display()
+        );
+    }
+}
+
 #[test]
 fn ctrl_c_saves_a_checkpoint_and_the_policy_and_exits_cleanly() {
     let dir = tempfile::tempdir().unwrap();

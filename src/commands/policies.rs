@@ -10,7 +10,7 @@ use crate::game::platform::OBSERVATION_SIZE;
 use crate::game::platform::generator::{DEFAULT_MAX_BLOCKS, GENERATOR_OBSERVATION_SIZE};
 use crate::generation::GeneratorPolicy;
 use crate::level::{Game, PolicyRef};
-use crate::rl::checkpoint::{LoadedPolicy, PolicyCard, Role, load_policy};
+use crate::rl::checkpoint::{LoadedPolicy, MAX_POLICY_BYTES, PolicyCard, Role, load_policy};
 use crate::verify::SolverPolicy;
 
 /// File names inside a policies folder.
@@ -18,8 +18,7 @@ pub const GENERATOR_FILE: &str = "generator.safetensors";
 pub const SOLVER_FILE: &str = "solver.safetensors";
 
 fn load_pinned(path: &Path, role: Role, observation: usize) -> Result<(LoadedPolicy, PolicyRef)> {
-    let bytes = std::fs::read(path)
-        .with_context(|| format!("cannot read the {role} policy {}", path.display()))?;
+    let bytes = crate::fsio::read_limited(path, MAX_POLICY_BYTES, &format!("{role} policy"))?;
     let loaded = load_policy(&bytes, Game::Platform, role, observation)
         .with_context(|| format!("{}", path.display()))?;
     let sha256 = Sha256::digest(&bytes)

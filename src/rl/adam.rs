@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use super::fused::PARAM_CHUNK;
 
 /// Adam's state: step count and first and second moments per parameter.
+#[derive(Clone)]
 pub struct Adam {
     pub beta1: f64,
     pub beta2: f64,

@@ -15,6 +15,11 @@ use crate::level::Game;
 /// The `format` of every policy card.
 pub const POLICY_FORMAT: &str = "arlpcg-policy";
 pub const POLICY_VERSION: u32 = 1;
+/// The largest policy or checkpoint file read (the paper's 2 × 512 network is 2.3 MB, its
+/// checkpoint with optimizer moments 7 MB).
+pub const MAX_POLICY_BYTES: u64 = 256 * 1024 * 1024;
+/// The most hidden layers a policy card may claim.
+const MAX_HIDDEN_LAYERS: usize = 64;
 const CARD_KEY: &str = "card";
 const TRAINING_KEY: &str = "training_state";
 
@@ -154,6 +159,20 @@ impl LoadedPolicy {
     }
 }
 
+/// A normalizer must hold finite means, finite positive variances and a positive count.
+fn check_normalizer(norm: &RunningNorm) -> Result<(), PolicyError> {
+    let problem = if norm.mean.iter().any(|m| !m.is_finite()) {
+        "normalizer: a mean is not a finite number"
+    } else if norm.var.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+        "normalizer: a variance is not a finite number > 0"
+    } else if !(norm.count.is_finite() && norm.count > 0.0) {
+        "normalizer: count is not a finite number > 0"
+    } else {
+        return Ok(());
+    };
+    Err(PolicyError::Card(problem.into()))
+}
+
 /// Reads a policy or checkpoint, requiring `game` and `role` and the observation size the game
 /// produces now.
 pub fn load_policy(
@@ -162,9 +181,9 @@ pub fn load_policy(
     role: Role,
     observation_size: usize,
 ) -> Result<LoadedPolicy, PolicyError> {
-    let (_, metadata) = safetensors::SafeTensors::read_metadata(bytes)
+    let (_, header) = safetensors::SafeTensors::read_metadata(bytes)
         .map_err(|e| PolicyError::NotSafetensors(e.to_string()))?;
-    let metadata = metadata.metadata().clone().unwrap_or_default();
+    let metadata = header.metadata().clone().unwrap_or_default();
     let card_text = metadata.get(CARD_KEY).ok_or(PolicyError::NoCard)?;
     let card: PolicyCard =
         serde_json::from_str(card_text).map_err(|e| PolicyError::Card(e.to_string()))?;
@@ -180,11 +199,43 @@ pub fn load_policy(
             expected: format!("{game} {role}"),
         });
     }
-    if card.network.observation != observation_size || card.normalizer.size() != observation_size {
+    if card.network.observation != observation_size {
         return Err(PolicyError::Card(format!(
-            "it observes {} values but the {game} {role} observes {observation_size}",
+            "its network observes {} values but the {game} {role} observes {observation_size}",
             card.network.observation
         )));
+    }
+    if card.normalizer.mean.len() != observation_size
+        || card.normalizer.var.len() != observation_size
+    {
+        return Err(PolicyError::Card(format!(
+            "its normalizer has {} means and {} variances but the {game} {role} observes {observation_size} values",
+            card.normalizer.mean.len(),
+            card.normalizer.var.len()
+        )));
+    }
+    check_normalizer(&card.normalizer)?;
+    if card.network.hidden.len() > MAX_HIDDEN_LAYERS {
+        return Err(PolicyError::Card(format!(
+            "its network has {} hidden layers, more than {MAX_HIDDEN_LAYERS}",
+            card.network.hidden.len()
+        )));
+    }
+    // The card's network against the file's own tensor table, before anything is allocated:
+    // a card may claim any size, the tensors are bounded by the file.
+    let table = header.tensors();
+    for (name, dims) in card.network.named_dims() {
+        let problem = match table.get(&name) {
+            None => "missing".to_string(),
+            Some(info) if info.dtype != safetensors::Dtype::F32 => {
+                format!("holds {:?} values, not F32", info.dtype)
+            }
+            Some(info) if info.shape != dims => {
+                format!("shape {:?}, the card's network needs {dims:?}", info.shape)
+            }
+            Some(_) => continue,
+        };
+        return Err(PolicyError::Tensor { name, problem });
     }
     let tensors = candle_core::safetensors::load_buffer(bytes, &Device::Cpu)
         .map_err(|e| PolicyError::NotSafetensors(e.to_string()))?;
@@ -299,5 +350,60 @@ mod tests {
             loaded.training_state(),
             Err(PolicyError::NoTrainingState)
         ));
+    }
+
+    /// A card that claims a huge network, or a normalizer that is not a distribution, is refused
+    /// before any tensor is allocated (a card claiming 2^30 hidden units made the loader
+    /// allocate 172 GB and abort).
+    #[test]
+    fn cards_that_disagree_with_the_tensors_or_hold_bad_normalizers_are_refused() {
+        let shape = PolicyShape {
+            observation: 5,
+            hidden: vec![8],
+            continuous: 2,
+            binary: 1,
+        };
+        let policy = ActorCritic::new(shape.clone(), 4).unwrap();
+        let refused = |card: PolicyCard| {
+            load_policy(
+                &policy_bytes(&policy, &card),
+                Game::Platform,
+                Role::Solver,
+                5,
+            )
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+        };
+        let mut huge = card(&shape);
+        huge.network.hidden = vec![1 << 30, 1 << 30];
+        let err = refused(huge);
+        assert!(
+            err.contains("actor.0.weight") && err.contains("[5, 1073741824]"),
+            "{err}"
+        );
+        let mut deep = card(&shape);
+        deep.network.hidden = vec![8; 100];
+        assert!(refused(deep).contains("100 hidden layers"));
+        for (k, bad) in [0.0, -1.0].into_iter().enumerate() {
+            let mut card = card(&shape);
+            card.normalizer.var[k] = bad;
+            let err = refused(card);
+            assert!(
+                err.contains("variance is not a finite number > 0"),
+                "{bad}: {err}"
+            );
+        }
+        // JSON has no NaN or infinity: they arrive as null and are refused as not a number.
+        for bad in [f64::NAN, f64::INFINITY] {
+            let mut card = card(&shape);
+            card.normalizer.var[0] = bad;
+            let err = refused(card);
+            assert!(err.contains("policy card: invalid type: null"), "{err}");
+        }
+        let mut short = card(&shape);
+        short.normalizer.var.pop();
+        let err = refused(short);
+        assert!(err.contains("5 means and 4 variances"), "{err}");
     }
 }

@@ -29,6 +29,23 @@ impl PolicyShape {
     pub fn action_size(&self) -> usize {
         self.continuous + self.binary
     }
+
+    /// The name and dimensions of every parameter tensor, in [`ActorCritic::named_vars`] order:
+    /// what a policy file of this shape must hold (checked before anything is allocated).
+    pub fn named_dims(&self) -> Vec<(String, Vec<usize>)> {
+        let mut dims = Vec::new();
+        for (prefix, out) in [("actor", self.action_size()), ("critic", 1)] {
+            let mut sizes = vec![self.observation];
+            sizes.extend(&self.hidden);
+            sizes.push(out);
+            for (k, pair) in sizes.windows(2).enumerate() {
+                dims.push((format!("{prefix}.{k}.weight"), vec![pair[0], pair[1]]));
+                dims.push((format!("{prefix}.{k}.bias"), vec![1, pair[1]]));
+            }
+        }
+        dims.push(("log_std".to_string(), vec![1, self.continuous.max(1)]));
+        dims
+    }
 }
 
 /// Whether to sample actions or take the most likely ones.
@@ -386,6 +403,18 @@ mod tests {
             (h - (2.0 * 1.418_938_5 + std::f32::consts::LN_2)).abs() < 1e-2,
             "{h}"
         );
+    }
+
+    #[test]
+    fn named_dims_are_the_dims_of_named_vars() {
+        let shape = shape();
+        let policy = ActorCritic::new(shape.clone(), 0).unwrap();
+        let vars: Vec<(String, Vec<usize>)> = policy
+            .named_vars()
+            .into_iter()
+            .map(|(name, var)| (name, var.as_tensor().dims().to_vec()))
+            .collect();
+        assert_eq!(shape.named_dims(), vars);
     }
 
     #[test]

@@ -65,7 +65,87 @@ impl Default for PpoConfig {
     }
 }
 
+/// The most environments, steps per rollout and rows per batch a configuration may ask for: a
+/// batch of 2^20 rows of 100 observations is already 400 MB.
+pub const MAX_ENVS: usize = 4096;
+pub const MAX_STEPS: usize = 65_536;
+pub const MAX_BATCH: usize = 1 << 20;
+
 impl PpoConfig {
+    /// Checks every field's range (and that it is a number): `Err("field: what it must be")`.
+    pub fn check(&self) -> Result<(), String> {
+        let unit = |x: f32| (0.0..=1.0).contains(&x);
+        let checks = [
+            (
+                "learning_rate",
+                self.learning_rate.is_finite()
+                    && self.learning_rate > 0.0
+                    && self.learning_rate <= 1.0,
+                "a number in (0, 1]".to_string(),
+            ),
+            ("gamma", unit(self.gamma), "a number in [0, 1]".into()),
+            (
+                "gae_lambda",
+                unit(self.gae_lambda),
+                "a number in [0, 1]".into(),
+            ),
+            (
+                "num_envs",
+                (1..=MAX_ENVS).contains(&self.num_envs),
+                format!("within [1, {MAX_ENVS}]"),
+            ),
+            (
+                "num_steps",
+                (1..=MAX_STEPS).contains(&self.num_steps),
+                format!("within [1, {MAX_STEPS}]"),
+            ),
+            (
+                "num_envs × num_steps",
+                self.num_envs.saturating_mul(self.num_steps) <= MAX_BATCH,
+                format!("at most {MAX_BATCH} rows per batch"),
+            ),
+            (
+                "update_epochs",
+                (1..=1000).contains(&self.update_epochs),
+                "within [1, 1000]".into(),
+            ),
+            (
+                "num_minibatches",
+                self.num_minibatches >= 1
+                    && self.num_minibatches <= self.num_envs.saturating_mul(self.num_steps),
+                format!(
+                    "within [1, num_envs × num_steps = {}]",
+                    self.num_envs.saturating_mul(self.num_steps)
+                ),
+            ),
+            (
+                "clip_coef",
+                self.clip_coef > 0.0 && self.clip_coef <= 1.0,
+                "a number in (0, 1]".into(),
+            ),
+            ("ent_coef", unit(self.ent_coef), "a number in [0, 1]".into()),
+            (
+                "vf_coef",
+                self.vf_coef.is_finite() && (0.0..=100.0).contains(&self.vf_coef),
+                "a number in [0, 100]".into(),
+            ),
+            (
+                "max_grad_norm",
+                self.max_grad_norm.is_finite() && self.max_grad_norm > 0.0,
+                "a finite number > 0".into(),
+            ),
+            (
+                "target_kl",
+                self.target_kl.is_none_or(|kl| kl.is_finite() && kl > 0.0),
+                "a finite number > 0, or null".into(),
+            ),
+        ];
+        match checks.into_iter().find(|(_, ok, _)| !ok) {
+            Some((field, _, must)) => Err(format!("{field} must be {must}")),
+            None => Ok(()),
+        }
+    }
+
     pub fn batch_size(&self) -> usize {
         self.num_envs * self.num_steps
     }
@@ -176,12 +256,14 @@ impl Ppo {
             vf_coef: self.config.vf_coef,
         };
         let mut params = self.policy.flat_parameters()?;
+        // A loss that turns out not to be a number rolls the optimizer back with the policy.
+        let adam_before = self.adam.clone();
         let mut rows = Rows::with_capacity(minibatch, obs_width, action_width);
         let mut order: Vec<usize> = (0..n).collect();
         let mut stats = UpdateStats::default();
         let mut sums = [0.0f32; 5];
         let mut count = 0.0f32;
-        'epochs: for _ in 0..self.config.update_epochs {
+        'epochs: for epoch in 1..=self.config.update_epochs {
             order.shuffle(rng);
             for ids in order.chunks(minibatch) {
                 rows.gather(batch, ids, obs_width, action_width);
@@ -190,6 +272,15 @@ impl Ppo {
                 }
                 let terms = workspace.loss_and_gradients(&params, &rows.minibatch(), weights);
                 let norm = global_norm(&workspace.gradients);
+                if !norm.is_finite() || !terms.total(weights).is_finite() {
+                    // The policy keeps the parameters it had before this update.
+                    self.adam = adam_before;
+                    return Err(candle_core::Error::Msg(format!(
+                        "the PPO loss or its gradient is not a number (loss {}, gradient norm {norm}) \
+                         in update epoch {epoch}: the policy and its optimizer are left as they were before this update",
+                        terms.total(weights)
+                    )));
+                }
                 let scale = if norm > self.config.max_grad_norm as f64 {
                     self.config.max_grad_norm as f64 / (norm + 1e-6)
                 } else {
@@ -423,6 +514,40 @@ mod tests {
         assert_ne!(one, initial.flat_parameters().unwrap());
         assert_eq!(one, parameters_after_updates(1));
         assert_eq!(one, parameters_after_updates(3));
+    }
+
+    #[test]
+    fn a_loss_that_is_not_a_number_stops_the_update_and_keeps_the_policy() {
+        let shape = crate::rl::policy::PolicyShape {
+            observation: 2,
+            hidden: vec![8],
+            continuous: 1,
+            binary: 0,
+        };
+        let mut ppo = Ppo::new(
+            PpoConfig {
+                num_envs: 2,
+                num_steps: 4,
+                ..PpoConfig::default()
+            },
+            ActorCritic::new(shape, 0).unwrap(),
+        )
+        .unwrap();
+        let before = ppo.policy.flat_parameters().unwrap();
+        let batch = Batch {
+            observations: vec![0.5; 16],
+            actions: vec![0.1; 8],
+            log_probs: vec![-1.0; 8],
+            advantages: vec![1.0, f32::NAN, 0.0, 1.0, 1.0, 0.0, 2.0, 1.0],
+            returns: vec![1.0; 8],
+            values: vec![0.0; 8],
+        };
+        let error = ppo
+            .update(&batch, 1e-3, &mut rand::SeedableRng::seed_from_u64(0))
+            .unwrap_err();
+        assert!(error.to_string().contains("not a number"), "{error}");
+        assert_eq!(ppo.policy.flat_parameters().unwrap(), before);
+        assert_eq!(ppo.adam.step, 0);
     }
 
     #[test]

@@ -135,6 +135,12 @@ impl Default for GeneratorConfig {
     }
 }
 
+/// Limits on the networks' size (a 4096-unit layer is already 64 MB of weights and moments).
+const MAX_HIDDEN_LAYERS: usize = 8;
+const MAX_HIDDEN_UNITS: usize = 4096;
+/// Limit on each phase length and the warm-up (10^12 steps: years of training).
+const MAX_PHASE_STEPS: u64 = 1_000_000_000_000;
+
 pub(super) fn load_config(path: &Path) -> Result<TrainConfig> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
@@ -170,31 +176,35 @@ pub(super) fn check_resumable_change(old: &TrainConfig, new: &TrainConfig) -> Re
 
 /// Checks the values serde cannot: sizes, ranges, finite numbers.
 fn check_config(config: &TrainConfig) -> Result<(), String> {
-    if config.hidden.is_empty() || config.hidden.contains(&0) {
-        return Err("hidden: give at least one layer, each of at least 1 unit".into());
+    if config.hidden.is_empty()
+        || config.hidden.len() > MAX_HIDDEN_LAYERS
+        || !config
+            .hidden
+            .iter()
+            .all(|h| (1..=MAX_HIDDEN_UNITS).contains(h))
+    {
+        return Err(format!(
+            "hidden: give 1 to {MAX_HIDDEN_LAYERS} layers, each of 1 to {MAX_HIDDEN_UNITS} units"
+        ));
+    }
+    let minutes = config.checkpoint_minutes;
+    if !(minutes.is_finite() && (0.0..=24.0 * 60.0).contains(&minutes)) {
+        return Err(
+            "checkpoint_minutes must be a number in [0, 1440] (0: after every iteration)".into(),
+        );
     }
     for (name, p) in [
         ("solver", &config.solver),
         ("generator.ppo", &config.generator.ppo),
     ] {
-        if p.num_envs == 0 || p.num_steps == 0 || p.num_minibatches == 0 || p.update_epochs == 0 {
-            return Err(format!(
-                "{name}: num_envs, num_steps, num_minibatches and update_epochs must be at least 1"
-            ));
-        }
-        let valid = p.learning_rate.is_finite()
-            && p.learning_rate > 0.0
-            && (0.0..=1.0).contains(&p.gamma)
-            && (0.0..=1.0).contains(&p.gae_lambda);
-        if !valid {
-            return Err(format!(
-                "{name}: learning_rate must be > 0, gamma and gae_lambda within [0, 1]"
-            ));
-        }
+        p.check().map_err(|problem| format!("{name}.{problem}"))?;
     }
     let g = &config.generator;
-    if g.aux_values.is_empty() || g.aux_values.iter().any(|l| !(-1.0..=1.0).contains(l)) {
-        return Err("generator.aux_values: give at least one, each within [-1, 1]".into());
+    if g.aux_values.is_empty()
+        || g.aux_values.len() > 1000
+        || g.aux_values.iter().any(|l| !(-1.0..=1.0).contains(l))
+    {
+        return Err("generator.aux_values: give 1 to 1000 values, each within [-1, 1]".into());
     }
     if g.rewards.aux.len() != 1 {
         return Err(format!(
@@ -220,10 +230,13 @@ fn check_config(config: &TrainConfig) -> Result<(), String> {
     if !(-10.0..=2.0).contains(&g.initial_log_std) {
         return Err("generator.initial_log_std must be within [-10, 2]".into());
     }
-    if g.solver_phase_steps == 0 || g.generator_phase_steps == 0 {
-        return Err(
-            "generator: solver_phase_steps and generator_phase_steps must be at least 1".into(),
-        );
+    if g.solver_warmup_steps > MAX_PHASE_STEPS
+        || !(1..=MAX_PHASE_STEPS).contains(&g.solver_phase_steps)
+        || !(1..=MAX_PHASE_STEPS).contains(&g.generator_phase_steps)
+    {
+        return Err(format!(
+            "generator: solver_phase_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}], solver_warmup_steps at most that"
+        ));
     }
     Ok(())
 }

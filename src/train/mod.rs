@@ -167,7 +167,14 @@ fn train_loop(run: &mut dyn Training, args: &TrainArgs) -> Result<()> {
             Some(total) => (1.0 - run.solver_steps() as f64 / total as f64).max(0.0),
             None => 1.0,
         };
-        let message = run.iterate(lr_scale, &wall)?;
+        let message = run.iterate(lr_scale, &wall).with_context(|| {
+            format!(
+                "training stopped at {} Solver steps; the last checkpoint in {} is kept \
+                 (--resume, with --config for a smaller learning rate, continues from it)",
+                run.solver_steps(),
+                run.out().display()
+            )
+        })?;
         bar.set_message(message);
         match total_steps {
             Some(_) => bar.set_position(run.solver_steps()),
@@ -555,8 +562,8 @@ fn read_checkpoint(
     role: Role,
     mode: TrainMode,
 ) -> Result<(checkpoint::LoadedPolicy, TrainingState)> {
-    let bytes = std::fs::read(path)
-        .with_context(|| format!("cannot resume: cannot read {}", path.display()))?;
+    let bytes = crate::fsio::read_limited(path, checkpoint::MAX_POLICY_BYTES, "checkpoint")
+        .context("cannot resume")?;
     let observation = match role {
         Role::Solver => crate::game::platform::OBSERVATION_SIZE,
         Role::Generator => GENERATOR_OBSERVATION_SIZE,

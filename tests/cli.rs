@@ -366,3 +366,34 @@ fn policy_paths_that_are_not_policy_files_are_refused_unread() {
         );
     }
 }
+
+/// Nesting and alias bombs are refused before serde_yaml builds anything: a 100,000-deep level
+/// took 45 s to fail, a file of repeated aliases grew to gigabytes and aborted.
+#[test]
+fn yaml_nesting_and_alias_bombs_are_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let header = "format: arlpcg-level\nversion: 1\ngame: platform\n";
+    let deep = format!(
+        "{header}x: {}1{}\n",
+        "[".repeat(100_000),
+        "]".repeat(100_000)
+    );
+    let blocks = "  - {distance: 6, angle: 0, size: 5, height: 0}\n".repeat(50);
+    let aliases = vec!["*b"; 100_000].join(", ");
+    let bomb = format!("{header}b: &b\n{blocks}c: [{aliases}]\n");
+    for (name, text, expected) in [
+        (
+            "deep.yaml",
+            deep,
+            "nested more than 32 levels deep (line 4)",
+        ),
+        ("bomb.yaml", bomb, "aliases (*name) are not allowed"),
+    ] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = arlpcg(&["verify", path.to_str().unwrap(), "--solver", "scripted"]);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains(name) && err.contains(expected), "{err}");
+    }
+}

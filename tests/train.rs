@@ -215,9 +215,21 @@ fn out_of_range_training_configs_are_refused_before_anything_is_written() {
             "solver_phase_steps",
         ),
     ];
-    for (k, (text, field)) in cases.iter().enumerate() {
+    let deep = format!("seed: {}1{}\n", "[".repeat(100_000), "]".repeat(100_000));
+    let aliases = format!(
+        "hidden: &h [8, 8]\ngenerator:\n  aux_values: [{}]\n",
+        vec!["*h"; 1000].join(",")
+    );
+    let cases = cases
+        .iter()
+        .map(|(text, field)| (text.to_string(), *field))
+        .chain([
+            (deep, "nested more than 32 levels deep (line 1)"),
+            (aliases, "aliases (*name) are not allowed"),
+        ]);
+    for (k, (text, field)) in cases.enumerate() {
         let config = dir.path().join(format!("bad-{k}.yaml"));
-        std::fs::write(&config, text).unwrap();
+        std::fs::write(&config, &text).unwrap();
         let run = dir.path().join(format!("run-{k}"));
         let out = arlpcg(&[
             "train",

@@ -9,6 +9,7 @@ pub mod racing;
 pub mod scene;
 pub mod stats;
 pub mod yaml;
+pub mod yaml_limits;
 
 use std::fmt;
 

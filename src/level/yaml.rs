@@ -83,6 +83,7 @@ pub fn parse(text: &str) -> Result<Level, Problem> {
     if text.trim().is_empty() {
         return Err(Problem::Empty);
     }
+    super::yaml_limits::check(text).map_err(Problem::Parse)?;
     check_header(text)?;
     let file: LevelFile = serde_yaml::from_str(text).map_err(|e| Problem::Parse(e.to_string()))?;
     file.into_level(text)

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde::{Deserialize, Serialize};
 
 use super::platform::SolverMode;
@@ -135,6 +135,8 @@ impl Default for GeneratorConfig {
     }
 }
 
+/// Configuration files larger than this are refused unread (a full one is 2 kB).
+const MAX_CONFIG_BYTES: u64 = 1 << 20;
 /// Limits on the networks' size (a 4096-unit layer is already 64 MB of weights and moments).
 const MAX_HIDDEN_LAYERS: usize = 8;
 const MAX_HIDDEN_UNITS: usize = 4096;
@@ -142,8 +144,16 @@ const MAX_HIDDEN_UNITS: usize = 4096;
 const MAX_PHASE_STEPS: u64 = 1_000_000_000_000;
 
 pub(super) fn load_config(path: &Path) -> Result<TrainConfig> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let bytes = crate::fsio::read_limited(path, MAX_CONFIG_BYTES, "training configuration")?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: not a text file (invalid UTF-8 at byte {})",
+            path.display(),
+            e.utf8_error().valid_up_to()
+        )
+    })?;
+    crate::level::yaml_limits::check(&text)
+        .map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))?;
     let config: TrainConfig =
         serde_yaml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     check_config(&config).map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))?;

@@ -8,34 +8,33 @@
 
 use std::mem::MaybeUninit;
 
-use unsafe_libyaml as libyaml;
-
 /// The deepest nesting of mappings and sequences a level or configuration may have (theirs is
 /// at most 4).
 pub const MAX_DEPTH: usize = 32;
 
 /// Checks `text` against the limits: `Err("what, line N")`.
 pub fn check(text: &str) -> Result<(), String> {
-    let mut parser = MaybeUninit::<libyaml::yaml_parser_t>::uninit();
+    let mut parser = MaybeUninit::<unsafe_libyaml::yaml_parser_t>::uninit();
     // SAFETY: the parser is initialized before use and deleted once, after the last event; it
     // reads `text` (valid for the whole function) through a pointer and length; every event
     // it returns is deleted before the next is asked for.
     unsafe {
-        if libyaml::yaml_parser_initialize(parser.as_mut_ptr()).fail {
+        if unsafe_libyaml::yaml_parser_initialize(parser.as_mut_ptr()).fail {
             return Err("cannot start the YAML parser (out of memory)".into());
         }
         let parser = parser.as_mut_ptr();
-        libyaml::yaml_parser_set_input_string(parser, text.as_ptr(), text.len() as _);
+        unsafe_libyaml::yaml_parser_set_input_string(parser, text.as_ptr(), text.len() as _);
         let mut depth = 0usize;
         let verdict = loop {
-            let mut event = MaybeUninit::<libyaml::yaml_event_t>::uninit();
-            if libyaml::yaml_parser_parse(parser, event.as_mut_ptr()).fail {
+            let mut event = MaybeUninit::<unsafe_libyaml::yaml_event_t>::uninit();
+            if unsafe_libyaml::yaml_parser_parse(parser, event.as_mut_ptr()).fail {
                 break Ok(()); // a syntax error: serde_yaml names it
             }
             let event = event.as_mut_ptr();
             let line = (*event).start_mark.line as usize + 1;
             let outcome = match (*event).type_ {
-                libyaml::YAML_SEQUENCE_START_EVENT | libyaml::YAML_MAPPING_START_EVENT => {
+                unsafe_libyaml::YAML_SEQUENCE_START_EVENT
+                | unsafe_libyaml::YAML_MAPPING_START_EVENT => {
                     depth += 1;
                     (depth > MAX_DEPTH).then(|| {
                         Err(format!(
@@ -43,22 +42,23 @@ pub fn check(text: &str) -> Result<(), String> {
                         ))
                     })
                 }
-                libyaml::YAML_SEQUENCE_END_EVENT | libyaml::YAML_MAPPING_END_EVENT => {
+                unsafe_libyaml::YAML_SEQUENCE_END_EVENT
+                | unsafe_libyaml::YAML_MAPPING_END_EVENT => {
                     depth = depth.saturating_sub(1);
                     None
                 }
-                libyaml::YAML_ALIAS_EVENT => Some(Err(format!(
+                unsafe_libyaml::YAML_ALIAS_EVENT => Some(Err(format!(
                     "aliases (*name) are not allowed: write the values out (line {line})"
                 ))),
-                libyaml::YAML_STREAM_END_EVENT => Some(Ok(())),
+                unsafe_libyaml::YAML_STREAM_END_EVENT => Some(Ok(())),
                 _ => None,
             };
-            libyaml::yaml_event_delete(event);
+            unsafe_libyaml::yaml_event_delete(event);
             if let Some(verdict) = outcome {
                 break verdict;
             }
         };
-        libyaml::yaml_parser_delete(parser);
+        unsafe_libyaml::yaml_parser_delete(parser);
         verdict
     }
 }

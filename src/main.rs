@@ -14,7 +14,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("error: {}", arlpcg::commands::one_line(&format!("{err:#}")));
-            ExitCode::FAILURE
+            ExitCode::from(arlpcg::commands::exit_code(&err))
         }
     }
 }

@@ -295,6 +295,56 @@ fn hand_broken_level_files_get_one_clear_line_and_a_non_zero_exit() {
         format!("{GOOD}colour: red\n").as_bytes(),
         "unknown field `colour`",
     );
+    // Statistics and the source are checked like the track: NaN and absurd values were accepted.
+    let rules = |spread: &str, margin: &str, max: &str| {
+        format!(
+            "{GOOD}source: {{kind: rules, rules: {{max_blocks: {max}, angle_spread: {spread}, reach_margin: {margin}}}}}\n"
+        )
+    };
+    assert_rejected(
+        "spread.yaml",
+        rules(".nan", "0.5", "40").as_bytes(),
+        "source: rules.angle_spread NaN must be a number of degrees within [0, 180] (line 7)",
+    );
+    assert_rejected(
+        "margin.yaml",
+        rules("60", "-4", "40").as_bytes(),
+        "source: rules.reach_margin -4 must be",
+    );
+    assert_rejected(
+        "max.yaml",
+        rules("60", "0.5", "0").as_bytes(),
+        "source: rules.max_blocks 0 must be within [1, 400]",
+    );
+    let stats = |ratio: &str, ci: &str| {
+        format!(
+            "{GOOD}stats: {{solver: {{kind: scripted}}, seed: 3, trials: 3, successes: 3, fell: 0, timed_out: 0, \
+             success_ratio: {ratio}, ci95: [0.4385, {ci}], mean_progress: 1.0, mean_success_steps: 297.3, \
+             failures_by_piece: [0]}}\n"
+        )
+    };
+    let good = dir_with_level(stats("1.0", "1.0").as_bytes());
+    let out = arlpcg(&["verify", good.1.to_str().unwrap(), "--solver", "scripted"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    good.0.close().unwrap();
+    assert_rejected(
+        "ratio.yaml",
+        stats(".nan", "1.0").as_bytes(),
+        "stats: success_ratio NaN does not match successes / trials = 1 (line 7)",
+    );
+    assert_rejected(
+        "ci.yaml",
+        stats("1.0", ".inf").as_bytes(),
+        "stats: ci95 [0.4385, inf] does not match",
+    );
+}
+
+/// A temporary folder holding `level.yaml` with these bytes.
+fn dir_with_level(bytes: &[u8]) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("level.yaml");
+    std::fs::write(&path, bytes).unwrap();
+    (dir, path)
 }
 
 #[test]
@@ -324,6 +374,59 @@ fn bad_arguments_are_usage_errors() {
         "{}",
         stderr(&out)
     );
+}
+
+/// Arguments that cannot go together are usage errors (exit 2) as clap's own are; a missing
+/// folder is named as such.
+#[test]
+fn arguments_that_do_not_fit_together_exit_2() {
+    for (args, expected) in [
+        (
+            vec!["generate", "--policies", "policies/platform", "--out", "x"],
+            "--policies needs --aux",
+        ),
+        (vec!["train", "--out", "x"], "give a budget"),
+        (vec!["train", "--steps", "10"], "--out <OUT>"),
+        (
+            vec![
+                "generate",
+                "--rules",
+                "--seed",
+                "99999999999999999999999",
+                "--out",
+                "x",
+            ],
+            "number too large",
+        ),
+    ] {
+        let out = arlpcg(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains(expected),
+            "{args:?}: {}",
+            stderr(&out)
+        );
+    }
+    let out = arlpcg(&["eval", "--policies", "/nonexistent", "--out", "x"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("--policies /nonexistent: no such folder"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+/// `--aux=-0` is λ = 0: the same file name and the same bytes as `--aux 0`.
+#[test]
+fn minus_zero_aux_is_zero() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    for (out, aux) in [(&a, "--aux=-0"), (&b, "--aux=0")] {
+        let run = generate(out, &["--count", "1", "--format", "yaml", aux]);
+        assert!(run.status.success(), "{}", stderr(&run));
+    }
+    assert_eq!(files_of(&a), files_of(&b));
+    assert_eq!(files_of(&a)[0].0, "platform_seed0_aux+0.00.yaml");
 }
 
 #[test]

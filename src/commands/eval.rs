@@ -19,6 +19,9 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             args.game
         );
     }
+    if let Some(missing) = args.policies.iter().find(|dir| !dir.is_dir()) {
+        bail!("--policies {}: no such folder", missing.display());
+    }
     let generator_path = args
         .policies
         .iter()

@@ -24,7 +24,10 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     let generator = match &args.policies {
         Some(dir) => {
             if args.aux.is_none() {
-                bail!("--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard)");
+                return Err(super::UsageError(
+                    "--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard)".into(),
+                )
+                .into());
             }
             Some(load_generator(&policy_paths(dir).0)?.0)
         }
@@ -105,7 +108,8 @@ fn build(
 /// `platform_seed7` or, with an aux value, `platform_seed7_aux-0.50`.
 pub fn file_stem(game: Game, seed: u64, aux: Option<f64>) -> String {
     match aux {
-        Some(aux) => format!("{game}_seed{seed}_aux{aux:+.2}"),
+        // `+ 0.0` turns -0 into +0: `--aux=-0` names its files as `--aux 0` does.
+        Some(aux) => format!("{game}_seed{seed}_aux{:+.2}", aux + 0.0),
         None => format!("{game}_seed{seed}"),
     }
 }

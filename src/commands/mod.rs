@@ -15,6 +15,20 @@ use anyhow::Result;
 
 use crate::cli::{Cli, Command};
 
+/// Arguments that do not fit together (exit code 2, as clap's own usage errors); every other
+/// error is bad input or a failure (exit code 1).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct UsageError(pub String);
+
+/// The exit code for an error: 2 for a [`UsageError`], 1 for the rest.
+pub fn exit_code(err: &anyhow::Error) -> u8 {
+    match err.downcast_ref::<UsageError>() {
+        Some(_) => 2,
+        None => 1,
+    }
+}
+
 /// Runs the parsed command line.
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {

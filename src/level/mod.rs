@@ -85,6 +85,35 @@ pub struct RulesConfig {
     pub reach_margin: f64,
 }
 
+impl RulesConfig {
+    /// Checks each setting's range (NaN fails): `Err("field: what it must be")`.
+    pub fn check(&self) -> Result<(), String> {
+        if !(1..=platform::MAX_BLOCKS as u32).contains(&self.max_blocks) {
+            return Err(format!(
+                "max_blocks {} must be within [1, {}]",
+                self.max_blocks,
+                platform::MAX_BLOCKS
+            ));
+        }
+        if !(0.0..=180.0).contains(&self.angle_spread) {
+            return Err(format!(
+                "angle_spread {} must be a number of degrees within [0, 180]",
+                self.angle_spread
+            ));
+        }
+        if !(0.0..=MAX_REACH_MARGIN).contains(&self.reach_margin) {
+            return Err(format!(
+                "reach_margin {} must be a number of metres within [0, {MAX_REACH_MARGIN}]",
+                self.reach_margin
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The largest `reach_margin` (metres): beyond it few jumps remain possible.
+pub const MAX_REACH_MARGIN: f64 = 3.0;
+
 impl Default for RulesConfig {
     fn default() -> Self {
         Self {
@@ -134,8 +163,10 @@ pub enum InvalidLevel {
         v = platform::GOAL_REACH_VERTICAL
     )]
     GoalNotReached { at: [f64; 3], goal: [f64; 3] },
-    #[error("stats: {0}")]
+    #[error("{0}")]
     Stats(String),
+    #[error("{0}")]
+    Source(String),
 }
 
 impl Level {
@@ -183,6 +214,11 @@ impl Level {
                     return Err(InvalidLevel::NoPieces("segments"));
                 }
             }
+        }
+        if let Source::Rules { rules } = &self.source {
+            rules
+                .check()
+                .map_err(|problem| InvalidLevel::Source(format!("rules.{problem}")))?;
         }
         if let Some(stats) = &self.stats {
             stats

@@ -126,16 +126,15 @@ impl SolverStats {
             ));
         }
         let expected_ratio = round4(ratio(self.successes, self.trials));
-        if (self.success_ratio - expected_ratio).abs() > 1e-3 {
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-3; // false for NaN
+        if !close(self.success_ratio, expected_ratio) {
             return Err(format!(
                 "success_ratio {} does not match successes / trials = {expected_ratio}",
                 self.success_ratio
             ));
         }
         let expected_ci = wilson_interval(self.successes, self.trials).map(round4);
-        if (self.ci95[0] - expected_ci[0]).abs() > 1e-3
-            || (self.ci95[1] - expected_ci[1]).abs() > 1e-3
-        {
+        if !(close(self.ci95[0], expected_ci[0]) && close(self.ci95[1], expected_ci[1])) {
             return Err(format!(
                 "ci95 {:?} does not match the Wilson interval {expected_ci:?}",
                 self.ci95
@@ -258,5 +257,22 @@ mod tests {
         let mut lying = stats.clone();
         lying.success_ratio = 0.9;
         assert!(lying.check(3).unwrap_err().contains("success_ratio 0.9"));
+        for bad in [f64::NAN, f64::INFINITY] {
+            let mut lying = stats.clone();
+            lying.success_ratio = bad;
+            assert!(
+                lying.check(3).unwrap_err().contains("success_ratio"),
+                "{bad}"
+            );
+            let mut lying = stats.clone();
+            lying.ci95[1] = bad;
+            assert!(lying.check(3).unwrap_err().contains("ci95"), "{bad}");
+            let mut lying = stats.clone();
+            lying.mean_progress = bad;
+            assert!(
+                lying.check(3).unwrap_err().contains("mean_progress"),
+                "{bad}"
+            );
+        }
     }
 }

@@ -452,6 +452,7 @@ impl LevelFile {
         level.validate().map_err(|e| {
             let (field, key) = match e {
                 super::InvalidLevel::Stats(_) => ("stats", "stats"),
+                super::InvalidLevel::Source(_) => ("source", "source"),
                 super::InvalidLevel::NoPieces(what) => (what, what),
                 super::InvalidLevel::GoalNotReached { .. } => ("goal", "goal"),
             };

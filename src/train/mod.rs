@@ -59,14 +59,14 @@ pub fn run(args: &TrainArgs) -> Result<()> {
         );
     }
     let mode = args.mode;
-    let out = args
-        .out
-        .as_ref()
-        .context("--out DIR is required: where the run's checkpoint, metrics and policy go")?;
+    let usage = |message: &str| anyhow::Error::from(crate::commands::UsageError(message.into()));
+    let out = args.out.as_ref().ok_or_else(|| {
+        usage("--out DIR is required: where the run's checkpoint, metrics and policy go")
+    })?;
     if args.steps.is_none() && args.minutes.is_none() {
-        bail!(
-            "give a budget: --steps N (total Solver environment steps) or --minutes M (this session)"
-        );
+        return Err(usage(
+            "give a budget: --steps N (total Solver environment steps) or --minutes M (this session)",
+        ));
     }
     let pool = crate::commands::thread_pool(args.threads)?;
     pool.install(|| {
@@ -677,6 +677,8 @@ impl AdversarialRun {
     }
 
     fn resume(out: &Path, mode: TrainMode, replacement: Option<TrainConfig>) -> Result<Self> {
+        // The Solver's checkpoint says which mode the run is (a rule-pcg run has no Generator).
+        read_checkpoint(&out.join(CHECKPOINT), Role::Solver, mode)?;
         let path = out.join(GENERATOR_CHECKPOINT);
         let (loaded, generator_state) = read_checkpoint(&path, Role::Generator, mode)?;
         let generator_iteration = generator_state.iteration;

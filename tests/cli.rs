@@ -500,3 +500,76 @@ fn yaml_nesting_and_alias_bombs_are_refused_at_once() {
         assert!(err.contains(name) && err.contains(expected), "{err}");
     }
 }
+
+/// A batch that cannot finish writes nothing: with --force, the files of an earlier batch keep
+/// their bytes (an unreachable --goal failed after the first levels were written, or rewritten).
+#[test]
+fn a_batch_that_fails_writes_nothing_and_overwrites_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let first = generate(dir.path(), &["--count", "3", "--format", "yaml"]);
+    assert!(first.status.success(), "{}", stderr(&first));
+    let before = files_of(dir.path());
+    let failed = generate(
+        dir.path(),
+        &[
+            "--count", "3", "--format", "yaml", "--force", "--goal", "0,300,5",
+        ],
+    );
+    assert_eq!(failed.status.code(), Some(1), "{}", stderr(&failed));
+    assert!(
+        stderr(&failed).contains("nothing was written"),
+        "{}",
+        stderr(&failed)
+    );
+    assert_eq!(files_of(dir.path()), before);
+}
+
+/// Ctrl-C in a batch writes the levels finished so far, complete, leaves no temporary file,
+/// says how many and exits 130.
+#[test]
+fn ctrl_c_in_a_batch_keeps_finished_levels_and_no_temporaries() {
+    let dir = tempfile::tempdir().unwrap();
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+        .args([
+            "generate", "--game", "platform", "--rules", "--count", "5000",
+        ])
+        .args(["--verify", "20", "--format", "yaml,glb", "--out"])
+        .arg(dir.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let sent = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let output = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(130), "{err}");
+    let files = files_of(dir.path());
+    assert!(
+        files.iter().all(|(name, _)| !name.starts_with('.')),
+        "temporary files left: {:?}",
+        files.iter().map(|f| &f.0).collect::<Vec<_>>()
+    );
+    assert_eq!(files.len() % 2, 0, "a level with only some of its files");
+    let levels = files.len() / 2;
+    assert!(
+        err.contains(&format!("wrote the {levels} of 5000 levels")),
+        "{err}"
+    );
+    for (name, _) in files.iter().filter(|(n, _)| n.ends_with(".yaml")) {
+        let path = dir.path().join(name);
+        let check = arlpcg(&[
+            "verify",
+            path.to_str().unwrap(),
+            "--solver",
+            "scripted",
+            "--trials",
+            "1",
+        ]);
+        assert!(check.status.success(), "{name}: {}", stderr(&check));
+    }
+}

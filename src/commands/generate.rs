@@ -2,6 +2,8 @@
 //! the Solver, written as files named after game, seed and aux.
 
 use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result, bail};
 
@@ -69,19 +71,47 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     for (_, files) in &plans {
         files.check_writable(overwrite)?;
     }
+    // Ctrl-C stops generating; the levels finished so far are still written.
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    // Every level is built (and verified) before the first file is written: a level that
+    // cannot be built leaves the folder as it was, and --force replaces nothing.
     let bar = super::progress_bar(plans.len() as u64, "generating");
-    for (seed, files) in &plans {
+    let mut levels = Vec::with_capacity(plans.len());
+    for (seed, _) in &plans {
+        if stop.load(Ordering::SeqCst) {
+            break;
+        }
         let mut level = build(generator.as_ref(), *seed, args.aux, args.goal)
-            .with_context(|| format!("seed {seed}"))?;
+            .with_context(|| format!("seed {seed} (nothing was written)"))?;
         if let Some(trials) = args.verify {
             let who = solver.as_ref().map_or(Solver::Scripted, Solver::Policy);
             level.stats = Some(verify(&level, &who, trials, *seed, &|| {})?);
         }
-        write_level_files(&level, files, overwrite)?;
+        levels.push(level);
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let files: usize = plans.iter().map(|(_, f)| f.paths().len()).sum();
+    for (written, (level, (_, files))) in levels.iter().zip(&plans).enumerate() {
+        write_level_files(level, files, overwrite)
+            .with_context(|| format!("after writing {written} of {} levels", plans.len()))?;
+    }
+    let files: usize = plans[..levels.len()]
+        .iter()
+        .map(|(_, f)| f.paths().len())
+        .sum();
+    if levels.len() < plans.len() {
+        return Err(super::Interrupted(format!(
+            "interrupted (Ctrl-C): wrote the {} of {} levels finished before it ({files} files) to {}",
+            levels.len(),
+            plans.len(),
+            args.out.display()
+        ))
+        .into());
+    }
     println!(
         "wrote {} levels ({files} files) to {}",
         plans.len(),

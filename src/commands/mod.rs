@@ -21,11 +21,20 @@ use crate::cli::{Cli, Command};
 #[error("{0}")]
 pub struct UsageError(pub String);
 
-/// The exit code for an error: 2 for a [`UsageError`], 1 for the rest.
+/// Work stopped by Ctrl-C after keeping what was finished (exit code 130, as a shell reports
+/// SIGINT).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct Interrupted(pub String);
+
+/// The exit code for an error: 2 for a [`UsageError`], 130 for [`Interrupted`], 1 for the rest.
 pub fn exit_code(err: &anyhow::Error) -> u8 {
-    match err.downcast_ref::<UsageError>() {
-        Some(_) => 2,
-        None => 1,
+    if err.downcast_ref::<UsageError>().is_some() {
+        2
+    } else if err.downcast_ref::<Interrupted>().is_some() {
+        130
+    } else {
+        1
     }
 }
 

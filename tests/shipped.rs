@@ -103,6 +103,12 @@ fn every_shipped_platform_policy_loads_and_its_card_matches() {
             "{name}.yaml differs from the card inside {name}.safetensors"
         );
         assert_eq!(card.training.mode, mode, "{name}");
+        // A policy trained from uncommitted code cannot be reproduced: none ships.
+        assert!(
+            !card.training.commit.ends_with("-dirty"),
+            "{name} was trained on a working tree with uncommitted changes ({})",
+            card.training.commit
+        );
         assert_eq!(card.network.hidden, vec![512, 512]);
         // All four Solvers share one budget: 5M Solver steps (the last 8k-step update may
         // overshoot it).

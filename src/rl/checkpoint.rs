@@ -72,6 +72,7 @@ pub struct TrainingRecord {
     pub steps: u64,
     pub wall_time_s: f64,
     pub seed: u64,
+    /// The commit that trained it, `-dirty` when the tree held uncommitted changes.
     pub commit: String,
     pub command: String,
 }

@@ -902,10 +902,12 @@ fn truncate_metrics(path: &Path, header: &str, last_iteration: u64) -> Result<()
     )
 }
 
-/// The current commit, for policy cards ("unknown" outside a git checkout).
+/// The current commit, for policy cards, with `-dirty` when the working tree has changes that
+/// are not committed (so the card cannot name the code that trained it); "unknown" outside a
+/// git checkout.
 fn git_commit() -> String {
     std::process::Command::new("git")
-        .args(["rev-parse", "--short", "HEAD"])
+        .args(["describe", "--always", "--abbrev=7", "--dirty"])
         .output()
         .ok()
         .filter(|o| o.status.success())

@@ -152,12 +152,18 @@ pub(super) fn load_config(path: &Path) -> Result<TrainConfig> {
             e.utf8_error().valid_up_to()
         )
     })?;
-    crate::level::yaml_limits::check(&text)
-        .map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))?;
-    let config: TrainConfig =
-        serde_yaml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    check_config(&config).map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))?;
-    Ok(config)
+    TrainConfig::parse(&text).map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))
+}
+
+impl TrainConfig {
+    /// Parses and checks the text of a configuration file: `Err` names the field (and, for
+    /// syntax and type errors, the line).
+    pub fn parse(text: &str) -> Result<TrainConfig, String> {
+        crate::level::yaml_limits::check(text)?;
+        let config: TrainConfig = serde_yaml::from_str(text).map_err(|e| e.to_string())?;
+        check_config(&config)?;
+        Ok(config)
+    }
 }
 
 /// Checks that `new` may replace `old` in a resumed run: the fields that fix the networks'

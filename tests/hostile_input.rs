@@ -1,0 +1,265 @@
+//! Fuzz-style properties of everything a user can feed in: arbitrary bytes and arbitrary YAML
+//! trees (with the formats' own field names, and hostile numbers) into the level loader, the
+//! training-configuration parser and the policy loader. Each must answer with an error or a
+//! value, never a panic; the limits of `level::yaml_limits` and the file caps keep time and
+//! memory bounded (a case that hung or aborted before would stall or kill this test).
+
+use arlpcg::game::platform::OBSERVATION_SIZE;
+use arlpcg::level::{Game, yaml};
+use arlpcg::rl::checkpoint::{Role, load_policy};
+use arlpcg::train::TrainConfig;
+use proptest::prelude::*;
+use serde_yaml::{Mapping, Value};
+
+/// Field names of the level file and the training configuration, so that trees reach past
+/// "unknown field" into the checks behind it.
+const KEYS: &[&str] = &[
+    "format",
+    "version",
+    "game",
+    "seed",
+    "aux",
+    "start",
+    "goal",
+    "blocks",
+    "segments",
+    "source",
+    "stats",
+    "position",
+    "heading",
+    "size",
+    "distance",
+    "angle",
+    "height",
+    "length",
+    "curve",
+    "kind",
+    "rules",
+    "max_blocks",
+    "angle_spread",
+    "reach_margin",
+    "solver",
+    "trials",
+    "successes",
+    "fell",
+    "timed_out",
+    "success_ratio",
+    "ci95",
+    "mean_progress",
+    "mean_success_steps",
+    "failures_by_piece",
+    "hidden",
+    "checkpoint_minutes",
+    "ppo",
+    "generator",
+    "num_envs",
+    "num_steps",
+    "num_minibatches",
+    "update_epochs",
+    "learning_rate",
+    "clip_coef",
+    "ent_coef",
+    "vf_coef",
+    "gamma",
+    "gae_lambda",
+    "max_grad_norm",
+    "target_kl",
+    "aux_values",
+    "solver_phase_steps",
+    "generator_phase_steps",
+    "initial_log_std",
+];
+
+fn number() -> impl Strategy<Value = Value> {
+    prop_oneof![
+        prop::sample::select(vec![
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            1e308,
+            -1e308,
+            -0.0,
+            0.0,
+            0.5,
+            1.0,
+            -1.0,
+            5.0,
+            7.0,
+            1e-320,
+        ])
+        .prop_map(Value::from),
+        any::<i64>().prop_map(Value::from),
+        any::<u64>().prop_map(Value::from),
+        (-100.0f64..100.0).prop_map(Value::from),
+    ]
+}
+
+fn leaf() -> impl Strategy<Value = Value> {
+    prop_oneof![
+        3 => number(),
+        1 => prop::sample::select(vec![
+            "arlpcg-level", "platform", "racing", "rules", "hand", "policy", "scripted", "0x7",
+            "1e9", "", "~",
+        ])
+        .prop_map(Value::from),
+        1 => any::<bool>().prop_map(Value::from),
+        1 => Just(Value::Null),
+    ]
+}
+
+fn tree() -> impl Strategy<Value = Value> {
+    leaf().prop_recursive(6, 200, 8, |inner| {
+        prop_oneof![
+            prop::collection::vec(inner.clone(), 0..8).prop_map(Value::Sequence),
+            prop::collection::vec((prop::sample::select(KEYS), inner), 0..8).prop_map(|pairs| {
+                let mut map = Mapping::new();
+                for (k, v) in pairs {
+                    map.insert(Value::from(k), v);
+                }
+                Value::Mapping(map)
+            }),
+        ]
+    })
+}
+
+/// A tree under a valid level header half of the time.
+fn level_text() -> impl Strategy<Value = String> {
+    (any::<bool>(), tree()).prop_map(|(header, tree)| {
+        let body = serde_yaml::to_string(&tree).unwrap_or_default();
+        if header {
+            format!("format: arlpcg-level\nversion: 1\ngame: platform\n{body}")
+        } else {
+            body
+        }
+    })
+}
+
+/// Replaces the `n`-th node (pre-order, modulo the node count) of `value` with `with`.
+fn replace_node(value: &mut Value, n: usize, with: Value) {
+    fn count(v: &Value) -> usize {
+        1 + match v {
+            Value::Sequence(s) => s.iter().map(count).sum(),
+            Value::Mapping(m) => m.values().map(count).sum(),
+            _ => 0,
+        }
+    }
+    fn visit(v: &mut Value, n: &mut usize, with: &mut Option<Value>) {
+        if *n == 0 {
+            if let Some(with) = with.take() {
+                *v = with;
+            }
+            return;
+        }
+        *n -= 1;
+        match v {
+            Value::Sequence(s) => s.iter_mut().for_each(|x| visit(x, n, with)),
+            Value::Mapping(m) => m.values_mut().for_each(|x| visit(x, n, with)),
+            _ => {}
+        }
+    }
+    let mut n = n % count(value);
+    visit(value, &mut n, &mut Some(with));
+}
+
+/// A valid document (parsed from `text`) with one to three of its nodes replaced by hostile
+/// values or trees: past the syntax, into every range check.
+fn mutated(text: &'static str) -> impl Strategy<Value = String> {
+    let node = prop_oneof![6 => number(), 2 => leaf(), 1 => tree()];
+    prop::collection::vec((any::<usize>(), node), 1..4).prop_map(move |edits| {
+        let mut value: Value = serde_yaml::from_str(text).unwrap();
+        for (n, with) in edits {
+            replace_node(&mut value, n, with);
+        }
+        serde_yaml::to_string(&value).unwrap_or_default()
+    })
+}
+
+const SHIPPED_LEVEL: &str = include_str!("../levels/platform/platform_seed7_aux-0.50.yaml");
+
+fn default_config() -> &'static str {
+    static TEXT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    TEXT.get_or_init(|| serde_yaml::to_string(&TrainConfig::default()).unwrap())
+}
+
+fn shipped_solver() -> Vec<u8> {
+    std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/policies/platform/solver.safetensors"
+    ))
+    .unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(400))]
+
+    #[test]
+    fn arbitrary_bytes_never_panic_the_level_loader(bytes in prop::collection::vec(any::<u8>(), 0..2000)) {
+        let _ = yaml::parse(&String::from_utf8_lossy(&bytes));
+    }
+
+    #[test]
+    fn arbitrary_yaml_trees_never_panic_the_level_loader(text in level_text()) {
+        let _ = yaml::parse(&text);
+    }
+
+    #[test]
+    fn damaged_levels_never_panic_the_level_loader(text in mutated(SHIPPED_LEVEL)) {
+        let _ = yaml::parse(&text);
+    }
+
+    #[test]
+    fn arbitrary_yaml_trees_never_panic_the_config_parser(tree in tree()) {
+        let text = serde_yaml::to_string(&tree).unwrap_or_default();
+        let _ = TrainConfig::parse(&text);
+    }
+
+    #[test]
+    fn damaged_configs_are_refused_or_within_the_limits(text in mutated(default_config())) {
+        if let Ok(c) = TrainConfig::parse(&text) {
+            // What is accepted is within the documented limits (stated here independently of
+            // the checks themselves).
+            prop_assert!(!c.hidden.is_empty() && c.hidden.len() <= 8);
+            prop_assert!(c.hidden.iter().all(|&h| (1..=4096).contains(&h)));
+            prop_assert!((0.0..=1440.0).contains(&c.checkpoint_minutes));
+            for p in [&c.solver, &c.generator.ppo] {
+                prop_assert!(p.learning_rate > 0.0 && p.learning_rate <= 1.0);
+                prop_assert!((0.0..=1.0).contains(&p.gamma) && (0.0..=1.0).contains(&p.gae_lambda));
+                prop_assert!(p.clip_coef > 0.0 && p.clip_coef <= 1.0);
+                prop_assert!((0.0..=1.0).contains(&p.ent_coef) && (0.0..=100.0).contains(&p.vf_coef));
+                prop_assert!(p.max_grad_norm.is_finite() && p.max_grad_norm > 0.0);
+                prop_assert!(p.target_kl.is_none_or(|k| k.is_finite() && k > 0.0));
+                prop_assert!(p.num_envs >= 1 && p.num_steps >= 1 && p.update_epochs >= 1);
+                prop_assert!(p.num_envs * p.num_steps <= 1 << 20);
+                prop_assert!(p.num_minibatches >= 1 && p.num_minibatches <= p.num_envs * p.num_steps);
+            }
+            prop_assert!(c.generator.aux_values.iter().all(|l| (-1.0..=1.0).contains(l)));
+        }
+    }
+
+    #[test]
+    fn arbitrary_bytes_never_panic_the_policy_loader(bytes in prop::collection::vec(any::<u8>(), 0..600)) {
+        let _ = load_policy(&bytes, Game::Platform, Role::Solver, OBSERVATION_SIZE);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(60))]
+
+    /// Bytes of a real policy with some of its header bytes changed, or cut short.
+    #[test]
+    fn damaged_policy_files_are_refused_or_load_never_panic(
+        edits in prop::collection::vec((0usize..4000, any::<u8>()), 1..6),
+        cut in prop::option::of(0usize..3_000_000),
+    ) {
+        let mut bytes = shipped_solver();
+        for (at, value) in edits {
+            if at < bytes.len() {
+                bytes[at] = value;
+            }
+        }
+        if let Some(cut) = cut {
+            bytes.truncate(cut);
+        }
+        let _ = load_policy(&bytes, Game::Platform, Role::Solver, OBSERVATION_SIZE);
+    }
+}

@@ -333,6 +333,11 @@ fn hand_broken_level_files_get_one_clear_line_and_a_non_zero_exit() {
         "stats: success_ratio NaN does not match successes / trials = 1 (line 7)",
     );
     assert_rejected(
+        "huge.yaml",
+        GOOD.replace("distance: 7", "distance: 1e308").as_bytes(),
+        "distance 1e308 is out of range [5, 10] m",
+    );
+    assert_rejected(
         "ci.yaml",
         stats("1.0", ".inf").as_bytes(),
         "stats: ci95 [0.4385, inf] does not match",

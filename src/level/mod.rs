@@ -98,13 +98,13 @@ impl RulesConfig {
         if !(0.0..=180.0).contains(&self.angle_spread) {
             return Err(format!(
                 "angle_spread {} must be a number of degrees within [0, 180]",
-                self.angle_spread
+                params::show_number(self.angle_spread)
             ));
         }
         if !(0.0..=MAX_REACH_MARGIN).contains(&self.reach_margin) {
             return Err(format!(
                 "reach_margin {} must be a number of metres within [0, {MAX_REACH_MARGIN}]",
-                self.reach_margin
+                params::show_number(self.reach_margin)
             ));
         }
         Ok(())

@@ -63,11 +63,21 @@ impl fmt::Display for ParamRange {
     }
 }
 
+/// A number as a message shows it: `12`, `0.5`, `NaN`, and `1e308` rather than its 309 digits.
+pub fn show_number(value: f64) -> String {
+    let magnitude = value.abs();
+    if value.is_finite() && (magnitude >= 1e9 || (magnitude != 0.0 && magnitude < 1e-6)) {
+        format!("{value:e}")
+    } else {
+        format!("{value}")
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RangeError {
     #[error("{} must be a number, not NaN", range.name)]
     NotANumber { range: ParamRange },
-    #[error("{} {value} is out of range {range}", range.name)]
+    #[error("{} {} is out of range {range}", range.name, show_number(*value))]
     OutOfRange { range: ParamRange, value: f64 },
 }
 
@@ -112,6 +122,8 @@ mod tests {
         let err = BLOCK_SIZE.check(f64::NAN).unwrap_err();
         assert_eq!(err.to_string(), "size must be a number, not NaN");
         assert!(AUX.check(f64::INFINITY).is_err());
+        let err = BLOCK_SIZE.check(-1e300).unwrap_err();
+        assert_eq!(err.to_string(), "size -1e300 is out of range [4, 6] m");
     }
 
     #[test]

@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::PolicyRef;
+use super::params::show_number;
 
 /// Who played the trials.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -130,7 +131,7 @@ impl SolverStats {
         if !close(self.success_ratio, expected_ratio) {
             return Err(format!(
                 "success_ratio {} does not match successes / trials = {expected_ratio}",
-                self.success_ratio
+                show_number(self.success_ratio)
             ));
         }
         let expected_ci = wilson_interval(self.successes, self.trials).map(round4);
@@ -143,13 +144,13 @@ impl SolverStats {
         if !(0.0..=1.0).contains(&self.mean_progress) {
             return Err(format!(
                 "mean_progress {} is out of range [0, 1]",
-                self.mean_progress
+                show_number(self.mean_progress)
             ));
         }
         if !self.mean_success_steps.is_finite() || self.mean_success_steps < 0.0 {
             return Err(format!(
                 "mean_success_steps {} must be a number >= 0",
-                self.mean_success_steps
+                show_number(self.mean_success_steps)
             ));
         }
         if self.failures_by_piece.len() != pieces {

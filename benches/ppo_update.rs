@@ -92,13 +92,15 @@ fn main() {
         achieved,
         100.0 * achieved / peak
     );
-    let verdict = if rate >= 30_000.0 {
-        "reached"
+    let threads = rayon::current_num_threads();
+    if threads == 2 {
+        let verdict = if rate >= 30_000.0 {
+            "reached"
+        } else {
+            "MISSED"
+        };
+        println!("  2 threads; target 30000 samples/s per epoch: {verdict}");
     } else {
-        "MISSED"
-    };
-    println!(
-        "  {} threads; target 30000 samples/s per epoch on 2 threads: {verdict}",
-        rayon::current_num_threads()
-    );
+        println!("  {threads} threads (the target, 30000 samples/s per epoch, is for 2)");
+    }
 }

@@ -75,9 +75,7 @@ fn main() {
     let rate = (epochs * n) as f64 / start.elapsed().as_secs_f64();
     // Forward 2·in·out and backward 4·in·out multiply-adds per layer, actor and critic.
     let layers = |out: usize| {
-        let mut sizes = vec![shape.observation];
-        sizes.extend(&shape.hidden);
-        sizes.push(out);
+        let sizes = shape.layer_sizes(out);
         sizes.windows(2).map(|w| w[0] * w[1]).sum::<usize>()
     };
     let flops_per_sample = 6.0 * (layers(shape.action_size()) + layers(1)) as f64;

@@ -311,14 +311,18 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_policy_round_trips_and_wrong_kinds_are_refused() {
-        let shape = PolicyShape {
+    fn small_shape() -> PolicyShape {
+        PolicyShape {
             observation: 5,
             hidden: vec![8],
             continuous: 2,
             binary: 1,
-        };
+        }
+    }
+
+    #[test]
+    fn a_policy_round_trips_and_wrong_kinds_are_refused() {
+        let shape = small_shape();
         let policy = ActorCritic::new(shape.clone(), 4).unwrap();
         let bytes = policy_bytes(&policy, &card(&shape));
         let loaded = load_policy(&bytes, Game::Platform, Role::Solver, 5).unwrap();
@@ -358,12 +362,7 @@ mod tests {
     /// allocate 172 GB and abort).
     #[test]
     fn cards_that_disagree_with_the_tensors_or_hold_bad_normalizers_are_refused() {
-        let shape = PolicyShape {
-            observation: 5,
-            hidden: vec![8],
-            continuous: 2,
-            binary: 1,
-        };
+        let shape = small_shape();
         let policy = ActorCritic::new(shape.clone(), 4).unwrap();
         let refused = |card: PolicyCard| {
             load_policy(

@@ -49,10 +49,8 @@ impl Layout {
     pub fn new(shape: &PolicyShape) -> Self {
         let mut offset = 0;
         let mut stack = |out: usize| {
-            let mut sizes = vec![shape.observation];
-            sizes.extend(&shape.hidden);
-            sizes.push(out);
-            sizes
+            shape
+                .layer_sizes(out)
                 .windows(2)
                 .map(|pair| {
                     let dense = Dense {

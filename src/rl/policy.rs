@@ -30,15 +30,20 @@ impl PolicyShape {
         self.continuous + self.binary
     }
 
+    /// The width of each layer of a network from the observation to `out` outputs.
+    pub fn layer_sizes(&self, out: usize) -> Vec<usize> {
+        let mut sizes = vec![self.observation];
+        sizes.extend(&self.hidden);
+        sizes.push(out);
+        sizes
+    }
+
     /// The name and dimensions of every parameter tensor, in [`ActorCritic::named_vars`] order:
     /// what a policy file of this shape must hold (checked before anything is allocated).
     pub fn named_dims(&self) -> Vec<(String, Vec<usize>)> {
         let mut dims = Vec::new();
         for (prefix, out) in [("actor", self.action_size()), ("critic", 1)] {
-            let mut sizes = vec![self.observation];
-            sizes.extend(&self.hidden);
-            sizes.push(out);
-            for (k, pair) in sizes.windows(2).enumerate() {
+            for (k, pair) in self.layer_sizes(out).windows(2).enumerate() {
                 dims.push((format!("{prefix}.{k}.weight"), vec![pair[0], pair[1]]));
                 dims.push((format!("{prefix}.{k}.bias"), vec![1, pair[1]]));
             }
@@ -134,14 +139,8 @@ impl ActorCritic {
     /// A freshly initialized policy, reproducible from `seed`.
     pub fn new(shape: PolicyShape, seed: u64) -> candle_core::Result<Self> {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let sizes = |out: usize| {
-            let mut s = vec![shape.observation];
-            s.extend(&shape.hidden);
-            s.push(out);
-            s
-        };
-        let actor = Mlp::new(&sizes(shape.action_size()), 0.01, &mut rng)?;
-        let critic = Mlp::new(&sizes(1), 1.0, &mut rng)?;
+        let actor = Mlp::new(&shape.layer_sizes(shape.action_size()), 0.01, &mut rng)?;
+        let critic = Mlp::new(&shape.layer_sizes(1), 1.0, &mut rng)?;
         let log_std = Var::zeros((1, shape.continuous.max(1)), DType::F32, &Device::Cpu)?;
         Ok(Self {
             shape,

@@ -677,9 +677,11 @@ impl AdversarialRun {
     }
 
     fn resume(out: &Path, mode: TrainMode, replacement: Option<TrainConfig>) -> Result<Self> {
-        // The Solver's checkpoint says which mode the run is (a rule-pcg run has no Generator).
-        read_checkpoint(&out.join(CHECKPOINT), Role::Solver, mode)?;
         let path = out.join(GENERATOR_CHECKPOINT);
+        if !path.exists() && out.join(CHECKPOINT).exists() {
+            // A Solver-only run: its checkpoint says which mode it was trained in.
+            read_checkpoint(&out.join(CHECKPOINT), Role::Solver, mode)?;
+        }
         let (loaded, generator_state) = read_checkpoint(&path, Role::Generator, mode)?;
         let generator_iteration = generator_state.iteration;
         let build = move |config: &TrainConfig, source: Option<serde_json::Value>| {

@@ -6,6 +6,7 @@ pub mod gltf;
 pub mod params;
 pub mod platform;
 pub mod racing;
+pub mod road;
 pub mod scene;
 pub mod stats;
 pub mod yaml;
@@ -16,7 +17,7 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 
 pub use platform::{BlockParams, Platform, PlatformTrack, Start};
-pub use racing::{RacingTrack, SegmentParams};
+pub use racing::{Obstacle, RacingTrack, SegmentParams};
 pub use stats::{SolverRef, SolverStats};
 
 /// The two games of the paper.
@@ -163,6 +164,22 @@ pub enum InvalidLevel {
         v = platform::GOAL_REACH_VERTICAL
     )]
     GoalNotReached { at: [f64; 3], goal: [f64; 3] },
+    #[error(
+        "the road ends at {at:?}, which does not reach the goal {goal:?}: it must end within {h} m horizontally and {v} m vertically",
+        h = racing::GOAL_REACH_HORIZONTAL,
+        v = racing::GOAL_REACH_VERTICAL
+    )]
+    RoadShort { at: [f64; 3], goal: [f64; 3] },
+    #[error("{0}")]
+    Road(#[from] racing::TrackError),
+    #[error("the level has {count} {what}: at most {max} are allowed")]
+    TooMany {
+        what: &'static str,
+        count: usize,
+        max: usize,
+    },
+    #[error("obstacles[{index}].{problem}")]
+    Obstacle { index: usize, problem: String },
     #[error("{0}")]
     Stats(String),
     #[error("{0}")]
@@ -212,6 +229,29 @@ impl Level {
             Track::Racing(track) => {
                 if track.segments.is_empty() {
                     return Err(InvalidLevel::NoPieces("segments"));
+                }
+                let too_many = |what, count, max| {
+                    (count > max).then_some(InvalidLevel::TooMany { what, count, max })
+                };
+                if let Some(e) = too_many("segments", track.segments.len(), racing::MAX_SEGMENTS)
+                    .or_else(|| {
+                        too_many("obstacles", track.obstacles.len(), racing::MAX_OBSTACLES)
+                    })
+                {
+                    return Err(e);
+                }
+                for (index, obstacle) in track.obstacles.iter().enumerate() {
+                    obstacle
+                        .check()
+                        .map_err(|problem| InvalidLevel::Obstacle { index, problem })?;
+                }
+                track.check_geometry()?;
+                let (end, _) = track.road().end();
+                if !racing::reaches(end, self.goal) {
+                    return Err(InvalidLevel::RoadShort {
+                        at: end.map(params::quantize),
+                        goal: self.goal,
+                    });
                 }
             }
         }

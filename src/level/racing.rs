@@ -1,16 +1,28 @@
-//! Racing levels as data: road segments, each relative to the end of the previous one. The road
-//! geometry (C1 joins, banking) is built by the racing game; here are only the parameters.
+//! Racing levels as data: where the road starts, its segments (each relative to the end of the
+//! previous one) and the obstacles the road must avoid. The road's shape is resolved by
+//! [`super::road`]; the rules a track must keep (no crossing, no obstacle hit, the goal reached)
+//! are checked here, with that geometry.
 
 use serde::{Deserialize, Serialize};
 
 use super::params::{self, RangeError};
+use super::road::{self, Road};
+
+/// The most segments a track may have (a 10 km road).
+pub const MAX_SEGMENTS: usize = 400;
+/// The most obstacles a track may have.
+pub const MAX_OBSTACLES: usize = 200;
+/// The road's end must come this close to the goal, horizontally, m...
+pub const GOAL_REACH_HORIZONTAL: f64 = 12.0;
+/// ...and vertically, m.
+pub const GOAL_REACH_VERTICAL: f64 = 6.0;
 
 /// The Generator's action for one road segment.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SegmentParams {
     /// Segment length along the centre line, m.
     pub length: f64,
-    /// Heading change over the segment, degrees.
+    /// Heading change over the segment, degrees (positive turns left).
     pub curve: f64,
     /// Height change over the segment, m.
     pub height: f64,
@@ -27,7 +39,99 @@ impl SegmentParams {
     }
 }
 
-/// A racing track: where the road starts and its segments.
+/// Something in the scene the road must go around (in plan: the road passes neither over nor
+/// under it). `position` is the centre of its base.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum Obstacle {
+    /// A box of `size` (x, y, z before turning), turned `heading` degrees about +Y.
+    Box {
+        position: [f64; 3],
+        size: [f64; 3],
+        heading: f64,
+    },
+    /// An upright cylinder.
+    Cylinder {
+        position: [f64; 3],
+        radius: f64,
+        height: f64,
+    },
+}
+
+/// The sides of a box and a cylinder's radius and height lie in this range, m.
+pub const OBSTACLE_SIZE: params::ParamRange =
+    params::ParamRange::new("obstacle size", 0.1, 200.0, "m");
+
+impl Obstacle {
+    pub fn position(&self) -> [f64; 3] {
+        match *self {
+            Obstacle::Box { position, .. } | Obstacle::Cylinder { position, .. } => position,
+        }
+    }
+
+    /// Horizontal distance from `(x, z)` to the obstacle's footprint (0 inside it).
+    pub fn plan_distance(&self, x: f64, z: f64) -> f64 {
+        match *self {
+            Obstacle::Box {
+                position,
+                size,
+                heading,
+            } => {
+                let (dx, dz) = (x - position[0], z - position[2]);
+                // Into the box's frame: undo the heading's turn about +Y.
+                let (s, c) = heading.to_radians().sin_cos();
+                let local_x = c * dx - s * dz;
+                let local_z = s * dx + c * dz;
+                let out_x = (local_x.abs() - 0.5 * size[0]).max(0.0);
+                let out_z = (local_z.abs() - 0.5 * size[2]).max(0.0);
+                out_x.hypot(out_z)
+            }
+            Obstacle::Cylinder {
+                position, radius, ..
+            } => ((x - position[0]).hypot(z - position[2]) - radius).max(0.0),
+        }
+    }
+
+    /// Checks the sizes and that the numbers are finite: `Err("field: what it must be")`.
+    pub fn check(&self) -> Result<(), String> {
+        let coordinate = |p: [f64; 3]| {
+            p.iter()
+                .try_for_each(|&c| params::COORDINATE.check(c).map(|_| ()))
+                .map_err(|e| format!("position: {e}"))
+        };
+        let size = |field: &str, v: f64| {
+            OBSTACLE_SIZE
+                .check(v)
+                .map(|_| ())
+                .map_err(|e| format!("{field}: {e}"))
+        };
+        match *self {
+            Obstacle::Box {
+                position,
+                size: sides,
+                heading,
+            } => {
+                coordinate(position)?;
+                sides.iter().try_for_each(|&v| size("size", v))?;
+                params::HEADING
+                    .check(heading)
+                    .map(|_| ())
+                    .map_err(|e| format!("heading: {e}"))
+            }
+            Obstacle::Cylinder {
+                position,
+                radius,
+                height,
+            } => {
+                coordinate(position)?;
+                size("radius", radius)?;
+                size("height", height)
+            }
+        }
+    }
+}
+
+/// A racing track: where the road starts, its segments and the obstacles around it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RacingTrack {
     /// Start of the road's centre line.
@@ -35,4 +139,100 @@ pub struct RacingTrack {
     /// Initial road direction, degrees.
     pub heading: f64,
     pub segments: Vec<SegmentParams>,
+    pub obstacles: Vec<Obstacle>,
+}
+
+/// A rule of the road broken by a track.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TrackError {
+    #[error(
+        "segment {later} crosses segment {earlier}: the road's centre lines come {distance:.1} m apart, less than {min} m",
+        min = road::MIN_SELF_DISTANCE
+    )]
+    Crosses {
+        earlier: usize,
+        later: usize,
+        distance: f64,
+    },
+    #[error(
+        "segment {segment} runs into obstacle {obstacle}: its centre line passes {distance:.1} m from it, less than {min} m",
+        min = road::MIN_OBSTACLE_DISTANCE
+    )]
+    HitsObstacle {
+        segment: usize,
+        obstacle: usize,
+        distance: f64,
+    },
+}
+
+impl RacingTrack {
+    /// An empty track starting at `position`, heading `heading` degrees.
+    pub fn new(position: [f64; 3], heading: f64) -> Self {
+        Self {
+            position,
+            heading,
+            segments: Vec::new(),
+            obstacles: Vec::new(),
+        }
+    }
+
+    /// The resolved road: centre line, banking and edges.
+    pub fn road(&self) -> Road {
+        Road::new(self)
+    }
+
+    /// Checks that the road never crosses itself or an obstacle.
+    pub fn check_geometry(&self) -> Result<(), TrackError> {
+        let road = self.road();
+        if let Some(e) = road.first_crossing(0) {
+            return Err(e);
+        }
+        road.first_obstacle_hit(&self.obstacles, 0).map_or(Ok(()), Err)
+    }
+}
+
+/// Whether the road's end `end` reaches `goal`.
+pub fn reaches(end: [f64; 3], goal: [f64; 3]) -> bool {
+    (end[0] - goal[0]).hypot(end[2] - goal[2]) <= GOAL_REACH_HORIZONTAL
+        && (end[1] - goal[1]).abs() <= GOAL_REACH_VERTICAL
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plan_distance_to_a_turned_box_and_a_cylinder() {
+        let boxed = Obstacle::Box {
+            position: [10.0, 0.0, 0.0],
+            size: [2.0, 3.0, 4.0],
+            heading: 90.0,
+        };
+        // Turned a quarter, the 4 m side lies along x: the footprint spans x in [8, 12].
+        assert!((boxed.plan_distance(15.0, 0.0) - 3.0).abs() < 1e-9);
+        assert!((boxed.plan_distance(10.0, 4.0) - 3.0).abs() < 1e-9);
+        assert_eq!(boxed.plan_distance(10.5, 0.5), 0.0);
+        let cylinder = Obstacle::Cylinder {
+            position: [0.0, 5.0, 0.0],
+            radius: 2.0,
+            height: 1.0,
+        };
+        assert!((cylinder.plan_distance(3.0, 4.0) - 3.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn obstacle_check_names_the_field() {
+        let bad = Obstacle::Cylinder {
+            position: [0.0, f64::NAN, 0.0],
+            radius: 1.0,
+            height: 1.0,
+        };
+        assert!(bad.check().unwrap_err().starts_with("position"));
+        let bad = Obstacle::Box {
+            position: [0.0; 3],
+            size: [1.0, 0.0, 1.0],
+            heading: 0.0,
+        };
+        assert!(bad.check().unwrap_err().starts_with("size"));
+    }
 }

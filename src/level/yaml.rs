@@ -12,7 +12,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use super::params::{self, ParamRange};
 use super::platform::{self, BlockParams, PlatformTrack, Start};
-use super::racing::{RacingTrack, SegmentParams};
+use super::racing::{Obstacle, RacingTrack, SegmentParams};
 use super::{Game, Level, SolverStats, Source, Track};
 
 /// The `format` every level file declares.
@@ -222,6 +222,9 @@ struct LevelFile {
     blocks: Option<Vec<BlockFile>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     segments: Option<Vec<SegmentFile>>,
+    /// Racing levels: what the road goes around.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    obstacles: Vec<Obstacle>,
     #[serde(default)]
     source: Source,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -263,7 +266,7 @@ struct SegmentFile {
 
 impl LevelFile {
     fn from_level(level: &Level) -> Self {
-        let (start, blocks, segments) = match &level.track {
+        let (start, blocks, segments, obstacles) = match &level.track {
             Track::Platform(track) => {
                 let s = track.start();
                 let start = StartFile {
@@ -284,7 +287,7 @@ impl LevelFile {
                         heading: Some(Bounded::new((placed.heading * 1000.0).round() / 1000.0)),
                     })
                     .collect();
-                (start, Some(blocks), None)
+                (start, Some(blocks), None, Vec::new())
             }
             Track::Racing(track) => {
                 let start = StartFile {
@@ -301,7 +304,7 @@ impl LevelFile {
                         height: Bounded::new(s.height),
                     })
                     .collect();
-                (start, None, Some(segments))
+                (start, None, Some(segments), track.obstacles.clone())
             }
         };
         Self {
@@ -314,6 +317,7 @@ impl LevelFile {
             goal: Some(level.goal.map(Bounded::new)),
             blocks,
             segments,
+            obstacles,
             source: level.source.clone(),
             stats: level.stats.clone(),
         }
@@ -332,6 +336,13 @@ impl LevelFile {
                         "segments".into(),
                         line_of_key(text, "segments"),
                         "a platform level has `blocks`, not `segments`".into(),
+                    ));
+                }
+                if !self.obstacles.is_empty() {
+                    return Err(invalid(
+                        "obstacles".into(),
+                        line_of_key(text, "obstacles"),
+                        "a platform level has no obstacles".into(),
                     ));
                 }
                 let blocks = self.blocks.ok_or_else(|| {
@@ -426,16 +437,29 @@ impl LevelFile {
                     position: point(&self.start.position),
                     heading: self.start.heading.0,
                     segments,
+                    obstacles: self.obstacles,
                 };
-                // The road's end is only known once the racing game resolves its geometry.
-                let goal = self.goal.as_ref().map(point).ok_or_else(|| {
-                    invalid(
-                        "goal".into(),
-                        None,
-                        "missing: a racing level names its goal".into(),
-                    )
-                })?;
-                (Track::Racing(track), goal)
+                // Checked here (not only in `validate`) to name the segment's line.
+                if track.segments.len() <= super::racing::MAX_SEGMENTS {
+                    let geometry = track.check_geometry().map_err(|e| {
+                        let (field, index) = match e {
+                            super::racing::TrackError::Crosses { later, .. } => {
+                                ("segments", later)
+                            }
+                            super::racing::TrackError::HitsObstacle { segment, .. } => {
+                                ("segments", segment)
+                            }
+                        };
+                        invalid(
+                            format!("{field}[{index}]"),
+                            line_of_item(text, field, index),
+                            e.to_string(),
+                        )
+                    });
+                    geometry?;
+                }
+                let (end, _) = track.road().end();
+                (Track::Racing(track), end)
             }
         };
         let level = Level {
@@ -450,13 +474,25 @@ impl LevelFile {
             stats: self.stats,
         };
         level.validate().map_err(|e| {
-            let (field, key) = match e {
-                super::InvalidLevel::Stats(_) => ("stats", "stats"),
-                super::InvalidLevel::Source(_) => ("source", "source"),
-                super::InvalidLevel::NoPieces(what) => (what, what),
-                super::InvalidLevel::GoalNotReached { .. } => ("goal", "goal"),
+            let key = |key: &str| (key.to_string(), line_of_key(text, key));
+            let (field, line) = match &e {
+                super::InvalidLevel::Stats(_) => key("stats"),
+                super::InvalidLevel::Source(_) => key("source"),
+                super::InvalidLevel::NoPieces(what) | super::InvalidLevel::TooMany { what, .. } => {
+                    key(what)
+                }
+                super::InvalidLevel::GoalNotReached { .. }
+                | super::InvalidLevel::RoadShort { .. } => key("goal"),
+                super::InvalidLevel::Road(_) => key("segments"),
+                super::InvalidLevel::Obstacle { index, problem } => {
+                    return invalid(
+                        format!("obstacles[{index}]"),
+                        line_of_item(text, "obstacles", *index),
+                        problem.clone(),
+                    );
+                }
             };
-            invalid(field.into(), line_of_key(text, key), e.to_string())
+            invalid(field, line, e.to_string())
         })?;
         Ok(level)
     }

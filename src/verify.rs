@@ -175,6 +175,7 @@ fn finish(env: &PlatformEnv, outcome: crate::level::stats::Outcome) -> TrialResu
         progress: env.progress(),
         target_piece: env.furthest(),
         steps: env.steps(),
+        air_steps: None,
     }
 }
 

@@ -690,5 +690,7 @@ pub fn describe_outcome(outcome: Outcome) -> &'static str {
         Outcome::Success => "reached the goal",
         Outcome::Fell => "fell",
         Outcome::TimedOut => "ran out of time",
+        Outcome::OffRoad => "left the road",
+        Outcome::Flipped => "turned over",
     }
 }

@@ -459,7 +459,9 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
 fn source_line(level: &Level) -> String {
     match &level.source {
         crate::level::Source::Policy { .. } => "Generator level".into(),
-        crate::level::Source::Rules { .. } => "rule level (no Generator)".into(),
+        crate::level::Source::Rules { .. } | crate::level::Source::RacingRules { .. } => {
+            "rule level (no Generator)".into()
+        }
         crate::level::Source::Hand => "made by hand".into(),
     }
 }

@@ -2,6 +2,7 @@
 //! the same trajectory, bit for bit. Nothing here prints, reads the clock or uses a global RNG.
 
 pub mod platform;
+pub mod racing;
 pub mod rules;
 
 use crate::level::stats::Outcome;

@@ -132,8 +132,13 @@ pub enum Source {
     /// Written by hand (the default for files that say nothing).
     #[default]
     Hand,
-    /// Drawn by the rule-based generator.
+    /// Drawn by the rule-based platform generator.
     Rules { rules: RulesConfig },
+    /// Drawn by the rule-based racing generator.
+    #[serde(rename = "racing-rules")]
+    RacingRules {
+        rules: racing::RacingRulesConfig,
+    },
     /// Built by a trained Generator policy.
     Policy { generator: PolicyRef },
 }
@@ -255,11 +260,18 @@ impl Level {
                 }
             }
         }
-        if let Source::Rules { rules } = &self.source {
-            rules
-                .check()
-                .map_err(|problem| InvalidLevel::Source(format!("rules.{problem}")))?;
+        match (&self.source, self.game()) {
+            (Source::Rules { rules }, Game::Platform) => rules.check(),
+            (Source::RacingRules { rules }, Game::Racing) => rules.check(),
+            (Source::Rules { .. }, Game::Racing) => {
+                Err("kind `rules` is for platform levels; racing levels use `racing-rules`".into())
+            }
+            (Source::RacingRules { .. }, Game::Platform) => {
+                Err("kind `racing-rules` is for racing levels; platform levels use `rules`".into())
+            }
+            _ => Ok(()),
         }
+        .map_err(|problem| InvalidLevel::Source(format!("rules.{problem}")))?;
         if let Some(stats) = &self.stats {
             stats
                 .check(self.piece_count())

@@ -131,6 +131,64 @@ impl Obstacle {
     }
 }
 
+/// The settings of the rule-based racing generator.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RacingRulesConfig {
+    /// Give up on a track (and draw another) after this many segments without reaching the goal.
+    pub max_segments: u32,
+    /// Curves are drawn within this many degrees either way (the range allows 30).
+    pub max_curve: f64,
+    /// Height changes are drawn within this many metres either way (the range allows 5).
+    pub max_height: f64,
+    /// Obstacles placed between the start and the goal, which the road must go around.
+    pub obstacles: u32,
+}
+
+impl Default for RacingRulesConfig {
+    fn default() -> Self {
+        Self {
+            max_segments: 30,
+            max_curve: 24.0,
+            max_height: 3.0,
+            obstacles: 0,
+        }
+    }
+}
+
+impl RacingRulesConfig {
+    /// Checks each setting's range (NaN fails): `Err("field: what it must be")`.
+    pub fn check(&self) -> Result<(), String> {
+        if !(1..=MAX_SEGMENTS as u32).contains(&self.max_segments) {
+            return Err(format!(
+                "max_segments {} must be within [1, {MAX_SEGMENTS}]",
+                self.max_segments
+            ));
+        }
+        if !(0.0..=params::SEGMENT_CURVE.max).contains(&self.max_curve) {
+            return Err(format!(
+                "max_curve {} must be a number of degrees within [0, {}]",
+                params::show_number(self.max_curve),
+                params::SEGMENT_CURVE.max
+            ));
+        }
+        if !(0.0..=params::SEGMENT_HEIGHT.max).contains(&self.max_height) {
+            return Err(format!(
+                "max_height {} must be a number of metres within [0, {}]",
+                params::show_number(self.max_height),
+                params::SEGMENT_HEIGHT.max
+            ));
+        }
+        if self.obstacles as usize > MAX_OBSTACLES {
+            return Err(format!(
+                "obstacles {} must be at most {MAX_OBSTACLES}",
+                self.obstacles
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// A racing track: where the road starts, its segments and the obstacles around it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RacingTrack {

@@ -268,6 +268,17 @@ impl Road {
         best
     }
 
+    /// The sample nearest to distance `s` along the road (clamped to its ends).
+    pub fn nearest_along(&self, s: f64) -> usize {
+        let after = self.samples.partition_point(|p| p.s < s);
+        match after {
+            0 => 0,
+            i if i == self.samples.len() => i - 1,
+            i if s - self.samples[i - 1].s < self.samples[i].s - s => i - 1,
+            i => i,
+        }
+    }
+
     /// The road's top surface as a triangle mesh: two vertices per cross-section, triangles
     /// counter-clockwise seen from above (their normals face up). UV: u across (0 left edge,
     /// 1 right edge), v along the road in road widths.

@@ -33,10 +33,14 @@ impl SolverRef {
 pub enum Outcome {
     /// Reached the goal block.
     Success,
-    /// Fell off the track.
+    /// Fell off the track (platform).
     Fell,
     /// Ran out of time.
     TimedOut,
+    /// Left the road (racing).
+    OffRoad,
+    /// Turned over (racing).
+    Flipped,
 }
 
 /// One finished Solver run, as verification records it.
@@ -49,6 +53,8 @@ pub struct TrialResult {
     pub target_piece: usize,
     /// Decisions taken.
     pub steps: u32,
+    /// Decisions with the car in the air (racing; `None` for games without air time).
+    pub air_steps: Option<u32>,
 }
 
 /// Aggregate statistics of many Solver runs on one level.
@@ -62,6 +68,12 @@ pub struct SolverStats {
     pub successes: u32,
     pub fell: u32,
     pub timed_out: u32,
+    /// Runs that left the road (racing).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub off_road: u32,
+    /// Runs that turned over (racing).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub flipped: u32,
     /// `successes / trials`.
     pub success_ratio: f64,
     /// 95% Wilson score interval of the success ratio.
@@ -72,6 +84,13 @@ pub struct SolverStats {
     pub mean_success_steps: f64,
     /// `failures_by_piece[i]`: runs that failed on their way to piece `i`.
     pub failures_by_piece: Vec<u32>,
+    /// Mean decisions per run with the car in the air (racing).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mean_air_steps: Option<f64>,
+}
+
+fn is_zero(count: &u32) -> bool {
+    *count == 0
 }
 
 impl SolverStats {
@@ -100,6 +119,8 @@ impl SolverStats {
             successes,
             fell: count(Outcome::Fell),
             timed_out: count(Outcome::TimedOut),
+            off_road: count(Outcome::OffRoad),
+            flipped: count(Outcome::Flipped),
             success_ratio: round4(ratio(successes, n)),
             ci95: wilson_interval(successes, n).map(round4),
             mean_progress: mean(&mut trials.iter().map(|t| t.progress)),
@@ -110,7 +131,21 @@ impl SolverStats {
                     .map(|t| t.steps as f64),
             ),
             failures_by_piece,
+            mean_air_steps: trials
+                .iter()
+                .map(|t| t.air_steps.map(f64::from))
+                .sum::<Option<f64>>()
+                .filter(|_| !trials.is_empty())
+                .map(|sum| round4(sum / n as f64)),
         }
+    }
+
+    /// Runs that did not succeed.
+    pub fn failures(&self) -> u64 {
+        [self.fell, self.timed_out, self.off_road, self.flipped]
+            .iter()
+            .map(|&c| c as u64)
+            .sum()
     }
 
     /// Checks that the counts add up, the derived numbers match them, and the per-piece
@@ -119,10 +154,10 @@ impl SolverStats {
         if self.trials == 0 {
             return Err("trials must be at least 1".into());
         }
-        let ended = self.successes as u64 + self.fell as u64 + self.timed_out as u64;
+        let ended = self.successes as u64 + self.failures();
         if ended != self.trials as u64 {
             return Err(format!(
-                "successes + fell + timed_out = {ended}, but trials = {}",
+                "successes + fell + timed_out + off_road + flipped = {ended}, but trials = {}",
                 self.trials
             ));
         }
@@ -160,10 +195,18 @@ impl SolverStats {
             ));
         }
         let failures: u64 = self.failures_by_piece.iter().map(|&f| f as u64).sum();
-        if failures != (self.fell + self.timed_out) as u64 {
+        if failures != self.failures() {
             return Err(format!(
-                "failures_by_piece adds up to {failures}, but fell + timed_out = {}",
-                self.fell as u64 + self.timed_out as u64
+                "failures_by_piece adds up to {failures}, but the failed runs (fell + timed_out + off_road + flipped) are {}",
+                self.failures()
+            ));
+        }
+        if let Some(air) = self.mean_air_steps
+            && !(air.is_finite() && air >= 0.0)
+        {
+            return Err(format!(
+                "mean_air_steps {} must be a number >= 0",
+                show_number(air)
             ));
         }
         Ok(())
@@ -232,6 +275,7 @@ mod tests {
             progress,
             target_piece,
             steps: 100,
+            air_steps: None,
         };
         let trials = [
             t(Outcome::Success, 1.0, 2),

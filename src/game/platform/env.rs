@@ -205,7 +205,9 @@ impl PlatformEnv {
             Some(outcome) => {
                 reward += match outcome {
                     Outcome::Success => self.rewards.success,
-                    Outcome::Fell | Outcome::TimedOut => self.rewards.failure,
+                    Outcome::Fell | Outcome::TimedOut | Outcome::OffRoad | Outcome::Flipped => {
+                        self.rewards.failure
+                    }
                 };
                 self.outcome = Some(outcome);
                 self.finished_step(outcome, reward)

@@ -58,6 +58,7 @@ pub fn play_scripted(env: &mut PlatformEnv, seed: u64, jitter: f32) -> TrialResu
                 progress: env.progress(),
                 target_piece: env.furthest(),
                 steps: env.steps(),
+                air_steps: None,
             };
         }
     }

@@ -1,0 +1,333 @@
+//! The car: rapier3d's ray-cast vehicle (`DynamicRayCastVehicleController`) on a dynamic chassis
+//! over the road's triangle mesh, with its calibrated constants (docs/racing-physics.md).
+//!
+//! A [`RacingWorld`] is rebuilt for every run from the road's shared shape (the mesh and its
+//! BVH are built once per track), so a run depends only on the track and its actions: the same
+//! inputs give a bitwise identical trajectory.
+
+use rapier3d::control::{DynamicRayCastVehicleController, WheelTuning};
+use rapier3d::math::{Pose, Rotation, Vector};
+use rapier3d::parry::shape::TriMeshFlags;
+use rapier3d::prelude::*;
+
+use crate::level::racing::{Obstacle, RacingTrack};
+use crate::level::road::Road;
+
+/// Seconds per decision (one physics step).
+pub const DECISION_DT: f32 = 1.0 / 30.0;
+/// Gravity, m/s².
+pub const GRAVITY: f32 = 9.81;
+/// Chassis mass, kg.
+pub const MASS: f32 = 1200.0;
+/// Half extents of the chassis box (length, height, width), m.
+pub const CHASSIS_HALF: [f32; 3] = [2.0, 0.3, 0.9];
+/// The centre of mass sits this far below the box's centre, m.
+const COM_DROP: f32 = 0.25;
+/// Wheel attachment points, chassis frame: front left, front right, rear left, rear right.
+const WHEELS: [[f32; 3]; 4] = [
+    [1.3, -0.2, -0.85],
+    [1.3, -0.2, 0.85],
+    [-1.3, -0.2, -0.85],
+    [-1.3, -0.2, 0.85],
+];
+pub const WHEEL_RADIUS: f32 = 0.35;
+pub const SUSPENSION_REST: f32 = 0.35;
+/// Total engine force at full throttle (rear wheels), N.
+pub const ENGINE_FORCE: f32 = 7200.0;
+/// Air and rolling drag on the chassis, per second: with the engine it sets the top speed
+/// `ENGINE_FORCE / (MASS · LINEAR_DAMPING)`.
+pub const LINEAR_DAMPING: f32 = 0.21;
+/// Brake impulse cap per wheel per step at full brake, N·s (about 0.8 g on four wheels).
+pub const BRAKE_IMPULSE: f32 = MASS * 0.8 * GRAVITY * DECISION_DT / 4.0;
+/// Front wheels' steering at full lock, radians.
+pub const MAX_STEER: f32 = 0.5;
+/// Tyre friction coefficient (rapier's `friction_slip`).
+pub const FRICTION: f32 = 1.1;
+/// The car starts this far along the road, m, and this high above it.
+pub const START_S: f64 = 5.0;
+const START_LIFT: f32 = 0.25;
+
+/// What the driver does for one decision.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct CarAction {
+    /// > 0: engine force (share of full throttle); < 0: brakes (share of full braking).
+    pub throttle: f32,
+    /// Steering, −1 full right … +1 full left.
+    pub steer: f32,
+}
+
+impl CarAction {
+    /// The action a policy's output row (two values in [−1, 1]) stands for.
+    pub fn from_policy_row(row: &[f32]) -> Self {
+        Self {
+            throttle: row[0].clamp(-1.0, 1.0),
+            steer: row[1].clamp(-1.0, 1.0),
+        }
+    }
+}
+
+/// The shapes of one track, built once and shared by every run on it.
+#[derive(Clone)]
+pub struct TrackShapes {
+    road: SharedShape,
+    obstacles: Vec<(Pose, SharedShape)>,
+}
+
+impl TrackShapes {
+    /// The road surface of `road` and the obstacles of `track` as rapier shapes.
+    pub fn new(road: &Road, obstacles: &[Obstacle]) -> Self {
+        let mesh = road.surface_mesh();
+        let vertices = mesh
+            .positions
+            .iter()
+            .map(|p| Vector::new(p[0], p[1], p[2]))
+            .collect();
+        let road = SharedShape::trimesh_with_flags(
+            vertices,
+            mesh.triangles,
+            TriMeshFlags::FIX_INTERNAL_EDGES,
+        )
+        .expect("a road of at least one segment is a valid triangle mesh");
+        let obstacles = obstacles
+            .iter()
+            .map(|o| match *o {
+                Obstacle::Box {
+                    position,
+                    size,
+                    heading,
+                } => (
+                    Pose::from_parts(
+                        Vector::new(
+                            position[0] as f32,
+                            (position[1] + 0.5 * size[1]) as f32,
+                            position[2] as f32,
+                        ),
+                        Rotation::from_rotation_y(heading.to_radians() as f32),
+                    ),
+                    SharedShape::cuboid(
+                        0.5 * size[0] as f32,
+                        0.5 * size[1] as f32,
+                        0.5 * size[2] as f32,
+                    ),
+                ),
+                Obstacle::Cylinder {
+                    position,
+                    radius,
+                    height,
+                } => (
+                    Pose::from_translation(Vector::new(
+                        position[0] as f32,
+                        (position[1] + 0.5 * height) as f32,
+                        position[2] as f32,
+                    )),
+                    SharedShape::cylinder(0.5 * height as f32, radius as f32),
+                ),
+            })
+            .collect();
+        Self { road, obstacles }
+    }
+
+    /// The shapes of a whole track.
+    pub fn of_track(track: &RacingTrack) -> Self {
+        Self::new(&track.road(), &track.obstacles)
+    }
+}
+
+/// One run's physics: the road, the obstacles and the car.
+pub struct RacingWorld {
+    gravity: Vector,
+    params: IntegrationParameters,
+    pipeline: PhysicsPipeline,
+    islands: IslandManager,
+    broad_phase: BroadPhaseBvh,
+    narrow_phase: NarrowPhase,
+    bodies: RigidBodySet,
+    colliders: ColliderSet,
+    impulse_joints: ImpulseJointSet,
+    multibody_joints: MultibodyJointSet,
+    soft_bodies: SoftBodySet,
+    ccd: CCDSolver,
+    vehicle: DynamicRayCastVehicleController,
+    chassis: RigidBodyHandle,
+}
+
+impl RacingWorld {
+    /// A world with the car standing at `position` (its wheels' height), heading `heading`
+    /// radians, at rest.
+    pub fn new(shapes: &TrackShapes, position: Vector, heading: f32) -> Self {
+        let mut bodies = RigidBodySet::new();
+        let mut colliders = ColliderSet::new();
+        colliders.insert(ColliderBuilder::new(shapes.road.clone()).friction(1.0));
+        for (pose, shape) in &shapes.obstacles {
+            colliders.insert(ColliderBuilder::new(shape.clone()).position(*pose));
+        }
+        let ride = SUSPENSION_REST + WHEEL_RADIUS + 0.2 + START_LIFT;
+        let chassis = bodies.insert(
+            RigidBodyBuilder::dynamic()
+                .pose(Pose::from_parts(
+                    position + Vector::Y * ride,
+                    Rotation::from_rotation_y(heading),
+                ))
+                .linear_damping(LINEAR_DAMPING)
+                .angular_damping(0.5)
+                .can_sleep(false),
+        );
+        let [hx, hy, hz] = CHASSIS_HALF;
+        let inertia = Vector::new(
+            MASS / 3.0 * (hy * hy + hz * hz),
+            MASS / 3.0 * (hx * hx + hz * hz),
+            MASS / 3.0 * (hx * hx + hy * hy),
+        );
+        colliders.insert_with_parent(
+            ColliderBuilder::cuboid(hx, hy, hz)
+                .mass_properties(MassProperties::new(
+                    Vector::new(0.0, -COM_DROP, 0.0),
+                    MASS,
+                    inertia,
+                ))
+                .friction(0.6),
+            chassis,
+            &mut bodies,
+        );
+        let mut vehicle = DynamicRayCastVehicleController::new(chassis);
+        let tuning = WheelTuning {
+            suspension_stiffness: 30.0,
+            suspension_compression: 3.0,
+            suspension_damping: 4.0,
+            max_suspension_travel: 0.3,
+            side_friction_stiffness: 1.0,
+            friction_slip: FRICTION,
+            max_suspension_force: MASS * GRAVITY * 2.0,
+        };
+        for [x, y, z] in WHEELS {
+            vehicle.add_wheel(
+                Vector::new(x, y, z),
+                -Vector::Y,
+                Vector::Z,
+                SUSPENSION_REST,
+                WHEEL_RADIUS,
+                &tuning,
+            );
+        }
+        let mut params = IntegrationParameters::default();
+        params.dt = DECISION_DT;
+        let mut world = Self {
+            gravity: Vector::new(0.0, -GRAVITY, 0.0),
+            params,
+            pipeline: PhysicsPipeline::new(),
+            islands: IslandManager::new(),
+            broad_phase: BroadPhaseBvh::new(),
+            narrow_phase: NarrowPhase::new(),
+            bodies,
+            colliders,
+            impulse_joints: ImpulseJointSet::new(),
+            multibody_joints: MultibodyJointSet::new(),
+            soft_bodies: SoftBodySet::new(),
+            ccd: CCDSolver::new(),
+            vehicle,
+            chassis,
+        };
+        // Queries see the colliders only after collision detection has run once.
+        world.pipeline.step(
+            Vector::ZERO,
+            &IntegrationParameters {
+                dt: 0.0,
+                ..world.params
+            },
+            &mut world.islands,
+            &mut world.broad_phase,
+            &mut world.narrow_phase,
+            &mut world.bodies,
+            &mut world.colliders,
+            &mut world.impulse_joints,
+            &mut world.multibody_joints,
+            &mut world.soft_bodies,
+            &mut world.ccd,
+            &(),
+            &(),
+        );
+        world
+    }
+
+    /// One decision: set the controls, update the wheels, step the physics.
+    pub fn step(&mut self, action: CarAction) {
+        let throttle = action.throttle.clamp(-1.0, 1.0);
+        let steer = action.steer.clamp(-1.0, 1.0) * MAX_STEER;
+        let engine = 0.5 * ENGINE_FORCE * throttle.max(0.0);
+        let brake = BRAKE_IMPULSE * (-throttle).max(0.0);
+        for (i, wheel) in self.vehicle.wheels_mut().iter_mut().enumerate() {
+            let front = i < 2;
+            wheel.steering = if front { steer } else { 0.0 };
+            wheel.engine_force = if front { 0.0 } else { engine };
+            wheel.brake = brake;
+        }
+        let filter = QueryFilter::exclude_dynamic().exclude_rigid_body(self.chassis);
+        let queries = self.broad_phase.as_query_pipeline_mut(
+            self.narrow_phase.query_dispatcher(),
+            &mut self.bodies,
+            &mut self.colliders,
+            filter,
+        );
+        self.vehicle.update_vehicle(self.params.dt, queries);
+        self.pipeline.step(
+            self.gravity,
+            &self.params,
+            &mut self.islands,
+            &mut self.broad_phase,
+            &mut self.narrow_phase,
+            &mut self.bodies,
+            &mut self.colliders,
+            &mut self.impulse_joints,
+            &mut self.multibody_joints,
+            &mut self.soft_bodies,
+            &mut self.ccd,
+            &(),
+            &(),
+        );
+    }
+
+    fn body(&self) -> &RigidBody {
+        &self.bodies[self.chassis]
+    }
+
+    /// Centre of the chassis box.
+    pub fn position(&self) -> Vector {
+        self.body().translation()
+    }
+
+    pub fn rotation(&self) -> Rotation {
+        *self.body().rotation()
+    }
+
+    pub fn velocity(&self) -> Vector {
+        self.body().linvel()
+    }
+
+    pub fn angular_velocity(&self) -> Vector {
+        self.body().angvel()
+    }
+
+    /// Wheels whose suspension ray touches the road (or an obstacle) this step.
+    pub fn wheels_in_contact(&self) -> usize {
+        self.vehicle
+            .wheels()
+            .iter()
+            .filter(|w| w.raycast_info().is_in_contact)
+            .count()
+    }
+
+    /// Distance down to the first surface below `origin`, up to `max`.
+    pub fn cast_down(&self, origins: impl Iterator<Item = Vector>, max: f32, out: &mut [f32]) {
+        let queries = self.broad_phase.as_query_pipeline(
+            self.narrow_phase.query_dispatcher(),
+            &self.bodies,
+            &self.colliders,
+            QueryFilter::exclude_dynamic(),
+        );
+        for (origin, slot) in origins.zip(out.iter_mut()) {
+            *slot = queries
+                .cast_ray(&Ray::new(origin, -Vector::Y), max, true)
+                .map_or(max, |(_, distance)| distance);
+        }
+    }
+}

@@ -1,0 +1,373 @@
+//! The Solver's racing environment: reset with a track and a seed, step with throttle and
+//! steering, read the observation (state + centre line ahead + a fan of downward rays), the
+//! reward (docs/rewards.md) and how the run ended: the goal, off the road, flipped or out of time.
+//! It counts the steps the car spends in the air.
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rapier3d::math::{Rotation, Vector};
+
+use super::car::{CarAction, DECISION_DT, RacingWorld, START_S, TrackShapes};
+use crate::game::Step;
+use crate::level::racing::RacingTrack;
+use crate::level::road::{ROAD_WIDTH, Road};
+use crate::level::stats::Outcome;
+
+/// Centre-line points the observation looks ahead to, m along the road from the car.
+pub const LOOK_AHEAD: [f64; 5] = [8.0, 16.0, 26.0, 40.0, 60.0];
+/// Ray fan, metres ahead of the car (its heading, level)...
+const FAN_FORWARD: [f32; 4] = [5.0, 11.0, 19.0, 30.0];
+/// ...and to its left.
+const FAN_LEFT: [f32; 5] = [-7.0, -3.5, 0.0, 3.5, 7.0];
+/// Fan rays start this high above the chassis...
+const FAN_START_HEIGHT: f32 = 6.0;
+/// ...and see this far down.
+const FAN_LENGTH: f32 = 18.0;
+/// The chassis centre this high over the road below it, with no wheel touching, is in the air, m
+/// (at rest it rides 0.8 m over the road).
+pub const AIR_HEIGHT: f32 = 1.4;
+/// Off the road: no wheel touching, the chassis beyond an edge, for this many seconds...
+const OFF_ROAD_S: f32 = 0.3;
+/// ...or this far below the road, m.
+const BELOW_ROAD: f64 = 4.0;
+/// Flipped: the chassis's up axis this close to horizontal or worse...
+const FLIP_UP: f32 = 0.3;
+/// ...for this many seconds.
+const FLIP_S: f32 = 1.0;
+/// The run succeeds this close to the end of the road, m.
+const FINISH_MARGIN: f64 = 3.0;
+/// Time allowed: this many seconds...
+const TIME_BASE_S: f64 = 10.0;
+/// ...plus the road's length at this speed, m/s.
+const TIME_SPEED: f64 = 6.0;
+/// The start is jittered (seeded) up to this far sideways, m...
+const START_JITTER_M: f64 = 1.0;
+/// ...and turned up to this much, degrees.
+const START_JITTER_DEG: f64 = 4.0;
+
+/// The named parts of the observation vector, in order, with their lengths.
+pub const OBSERVATION_LAYOUT: [(&str, usize); 11] = [
+    ("goal_relative_position", 3),
+    ("goal_bearing_sin_cos", 2),
+    ("velocity", 3),
+    ("angular_velocity", 3),
+    ("world_up_in_car_frame", 3),
+    ("progress", 1),
+    ("lateral_offset", 1),
+    ("road_bearing_sin_cos", 2),
+    ("centre_line_ahead", 2 * LOOK_AHEAD.len()),
+    ("time_left", 1),
+    ("ray_fan", FAN_FORWARD.len() * FAN_LEFT.len()),
+];
+
+/// Length of the observation vector.
+pub const OBSERVATION_SIZE: usize = {
+    let mut total = 0;
+    let mut i = 0;
+    while i < OBSERVATION_LAYOUT.len() {
+        total += OBSERVATION_LAYOUT[i].1;
+        i += 1;
+    }
+    total
+};
+const FAN_SIZE: usize = FAN_FORWARD.len() * FAN_LEFT.len();
+
+/// The Solver's reward weights (docs/rewards.md).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverRewards {
+    /// Per metre of progress along the centre line (negative when going back).
+    pub progress_per_metre: f32,
+    /// On reaching the end of the road.
+    pub success: f32,
+    /// On leaving the road, flipping or running out of time.
+    pub failure: f32,
+}
+
+impl Default for SolverRewards {
+    fn default() -> Self {
+        Self {
+            progress_per_metre: 0.1,
+            success: 10.0,
+            failure: -5.0,
+        }
+    }
+}
+
+/// One Solver run on one racing track.
+pub struct RacingEnv {
+    road: Road,
+    shapes: TrackShapes,
+    goal: [f64; 3],
+    rewards: SolverRewards,
+    world: RacingWorld,
+    max_steps: u32,
+    /// Index of the road sample nearest the car.
+    nearest: usize,
+    /// Distance along the road of the car, m.
+    along: f64,
+    steps: u32,
+    air_steps: u32,
+    loose_steps: u32,
+    flipped_steps: u32,
+    outcome: Option<Outcome>,
+}
+
+impl RacingEnv {
+    /// The environment of a track leading to `goal`, with the car at the start.
+    pub fn new(track: &RacingTrack, goal: [f64; 3], rewards: SolverRewards) -> Self {
+        let road = track.road();
+        let shapes = TrackShapes::new(&road, &track.obstacles);
+        let world = RacingWorld::new(&shapes, Vector::ZERO, 0.0);
+        let max_steps =
+            ((TIME_BASE_S + road.length() / TIME_SPEED) / DECISION_DT as f64).ceil() as u32;
+        let mut env = Self {
+            road,
+            shapes,
+            goal,
+            rewards,
+            world,
+            max_steps,
+            nearest: 0,
+            along: 0.0,
+            steps: 0,
+            air_steps: 0,
+            loose_steps: 0,
+            flipped_steps: 0,
+            outcome: None,
+        };
+        env.reset(0);
+        env
+    }
+
+    /// Starts a new run: the car at rest [`START_S`] m along the road, shifted and turned at
+    /// random (seeded) within a metre and a few degrees.
+    pub fn reset(&mut self, seed: u64) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let start = self.road.nearest_along(START_S);
+        let sample = self.road.samples()[start];
+        let offset = rng.random_range(-START_JITTER_M..=START_JITTER_M);
+        let turn = rng
+            .random_range(-START_JITTER_DEG..=START_JITTER_DEG)
+            .to_radians();
+        let p = sample.across(offset);
+        self.world = RacingWorld::new(
+            &self.shapes,
+            Vector::new(p[0] as f32, p[1] as f32, p[2] as f32),
+            (sample.heading + turn) as f32,
+        );
+        self.nearest = start;
+        self.along = sample.s;
+        self.steps = 0;
+        self.air_steps = 0;
+        self.loose_steps = 0;
+        self.flipped_steps = 0;
+        self.outcome = None;
+    }
+
+    /// Advances one decision.
+    pub fn step(&mut self, action: CarAction) -> Step {
+        if let Some(outcome) = self.outcome {
+            return finished_step(outcome, 0.0);
+        }
+        self.world.step(action);
+        self.steps += 1;
+        let position = to_f64(self.world.position());
+        self.nearest = self.road.nearest(position, Some(self.nearest), 8);
+        let sample = self.road.samples()[self.nearest];
+        let along = self.along_at(position);
+        let mut reward = self.rewards.progress_per_metre * (along - self.along) as f32;
+        self.along = along;
+
+        let wheels = self.world.wheels_in_contact();
+        if wheels == 0 && self.height_over_ground() > AIR_HEIGHT {
+            self.air_steps += 1;
+        }
+        let lateral = self.lateral_offset(position);
+        let beyond_edge = lateral.abs() > 0.5 * ROAD_WIDTH;
+        self.loose_steps = if wheels == 0 && beyond_edge {
+            self.loose_steps + 1
+        } else {
+            0
+        };
+        let up = self.world.rotation() * Vector::Y;
+        self.flipped_steps = if up.y < FLIP_UP {
+            self.flipped_steps + 1
+        } else {
+            0
+        };
+        let outcome = if along >= self.road.length() - FINISH_MARGIN && !beyond_edge {
+            Some(Outcome::Success)
+        } else if position[1] < sample.centre[1] - BELOW_ROAD
+            || self.loose_steps as f32 * DECISION_DT >= OFF_ROAD_S
+        {
+            Some(Outcome::OffRoad)
+        } else if self.flipped_steps as f32 * DECISION_DT >= FLIP_S {
+            Some(Outcome::Flipped)
+        } else if self.steps >= self.max_steps {
+            Some(Outcome::TimedOut)
+        } else {
+            None
+        };
+        match outcome {
+            Some(outcome) => {
+                reward += if outcome == Outcome::Success {
+                    self.rewards.success
+                } else {
+                    self.rewards.failure
+                };
+                self.outcome = Some(outcome);
+                finished_step(outcome, reward)
+            }
+            None => Step {
+                reward,
+                terminated: false,
+                truncated: false,
+                outcome: None,
+            },
+        }
+    }
+
+    /// Distance along the road of the point of the centre line nearest `position`.
+    fn along_at(&self, position: [f64; 3]) -> f64 {
+        let sample = self.road.samples()[self.nearest];
+        let f = sample.forward();
+        let flat = (f[0] * f[0] + f[2] * f[2]).sqrt();
+        let ahead = ((position[0] - sample.centre[0]) * f[0]
+            + (position[2] - sample.centre[2]) * f[2])
+            / flat;
+        (sample.s + ahead).clamp(0.0, self.road.length())
+    }
+
+    /// Signed horizontal distance of `position` left of the centre line, m.
+    fn lateral_offset(&self, position: [f64; 3]) -> f64 {
+        let sample = self.road.samples()[self.nearest];
+        let (s, c) = sample.heading.sin_cos();
+        // Left of heading h is (−sin h, 0, −cos h).
+        -(position[0] - sample.centre[0]) * s - (position[2] - sample.centre[2]) * c
+    }
+
+    fn height_over_ground(&self) -> f32 {
+        let mut distance = [0.0];
+        self.world.cast_down(
+            std::iter::once(self.world.position()),
+            2.0 * AIR_HEIGHT,
+            &mut distance,
+        );
+        distance[0]
+    }
+
+    /// Writes the observation (see [`OBSERVATION_LAYOUT`]) into `out`.
+    pub fn observe(&self, out: &mut [f32]) {
+        assert_eq!(
+            out.len(),
+            OBSERVATION_SIZE,
+            "observation buffer of the wrong size"
+        );
+        let position = self.world.position();
+        let rotation = self.world.rotation();
+        let into_car = rotation.inverse();
+        let forward = rotation * Vector::X;
+        let yaw = (-forward.z).atan2(forward.x);
+        let level = Rotation::from_rotation_y(yaw);
+        let into_level = level.inverse();
+        let goal = Vector::new(self.goal[0] as f32, self.goal[1] as f32, self.goal[2] as f32);
+        let to_goal = into_level * (goal - position);
+        let bearing = (-to_goal.z).atan2(to_goal.x);
+        let sample = self.road.samples()[self.nearest];
+        let road_bearing = wrap(sample.heading as f32 - yaw);
+        let velocity = into_car * self.world.velocity();
+        let spin = into_car * self.world.angular_velocity();
+        let up = into_car * Vector::Y;
+        let mut values = Vec::with_capacity(OBSERVATION_SIZE);
+        values.extend((to_goal / 100.0).to_array());
+        values.extend([bearing.sin(), bearing.cos()]);
+        values.extend((velocity / 20.0).to_array());
+        values.extend(spin.to_array());
+        values.extend(up.to_array());
+        values.push((self.along / self.road.length()) as f32);
+        values.push(self.lateral_offset(to_f64(position)) as f32 / (0.5 * ROAD_WIDTH as f32));
+        values.extend([road_bearing.sin(), road_bearing.cos()]);
+        for ahead in LOOK_AHEAD {
+            let point = self.road.samples()[self.road.nearest_along(self.along + ahead)].centre;
+            let local = into_level * (to_f32(point) - position);
+            values.extend([local.x / 60.0, local.z / 20.0]);
+        }
+        values.push(1.0 - self.steps as f32 / self.max_steps as f32);
+        out[..values.len()].copy_from_slice(&values);
+        let fan = &mut out[OBSERVATION_SIZE - FAN_SIZE..];
+        let origins = FAN_FORWARD.iter().flat_map(|&f| {
+            FAN_LEFT.iter().map(move |&l| {
+                position + level * Vector::new(f, FAN_START_HEIGHT, -l)
+            })
+        });
+        self.world.cast_down(origins, FAN_LENGTH, fan);
+        for depth in fan.iter_mut() {
+            // Height of what the ray hit relative to the chassis; nothing hit reads -12 m.
+            *depth = (FAN_START_HEIGHT - *depth) / 6.0;
+        }
+    }
+
+    /// The observation as a new vector.
+    pub fn observation(&self) -> Vec<f32> {
+        let mut out = vec![0.0; OBSERVATION_SIZE];
+        self.observe(&mut out);
+        out
+    }
+
+    pub fn road(&self) -> &Road {
+        &self.road
+    }
+
+    pub fn world(&self) -> &RacingWorld {
+        &self.world
+    }
+
+    /// Distance along the road the car has reached, m.
+    pub fn along(&self) -> f64 {
+        self.along
+    }
+
+    /// The segment the car is on.
+    pub fn segment(&self) -> usize {
+        self.road.samples()[self.nearest].segment
+    }
+
+    /// Fraction of the road covered, in [0, 1].
+    pub fn progress(&self) -> f64 {
+        (self.along / self.road.length()).clamp(0.0, 1.0)
+    }
+
+    pub fn steps(&self) -> u32 {
+        self.steps
+    }
+
+    /// Steps with the car in the air (no wheel touching, chassis [`AIR_HEIGHT`] over the road).
+    pub fn air_steps(&self) -> u32 {
+        self.air_steps
+    }
+
+    pub fn outcome(&self) -> Option<Outcome> {
+        self.outcome
+    }
+}
+
+fn finished_step(outcome: Outcome, reward: f32) -> Step {
+    Step {
+        reward,
+        terminated: outcome != Outcome::TimedOut,
+        truncated: outcome == Outcome::TimedOut,
+        outcome: Some(outcome),
+    }
+}
+
+fn wrap(angle: f32) -> f32 {
+    (angle + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI
+}
+
+fn to_f64(v: Vector) -> [f64; 3] {
+    [v.x as f64, v.y as f64, v.z as f64]
+}
+
+fn to_f32(p: [f64; 3]) -> Vector {
+    Vector::new(p[0] as f32, p[1] as f32, p[2] as f32)
+}

@@ -1,0 +1,198 @@
+//! Rule-based racing tracks (the Rule-PCG baseline for racing, and tracks that need no policy):
+//! head for a goal drawn from the seed, segment by segment, never crossing the road or an
+//! obstacle, with curves and height changes kept inside the car's ability by a margin
+//! (docs/racing-physics.md).
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use crate::level::params::{self, quantize};
+use crate::level::platform::{direction_heading, heading_direction, wrap_degrees};
+use crate::level::racing::{self, Obstacle, RacingRulesConfig, RacingTrack, SegmentParams};
+use crate::level::road::{MIN_OBSTACLE_DISTANCE, Road};
+use crate::level::{Level, Source, Track};
+
+/// Goals are drawn this far from the start, horizontally, m...
+pub const GOAL_DISTANCE: (f64, f64) = (220.0, 360.0);
+/// ...within this many degrees of the start heading...
+pub const GOAL_BEARING: f64 = 40.0;
+/// ...and this far above (or below) it, m.
+pub const GOAL_HEIGHT: (f64, f64) = (-12.0, 12.0);
+/// Candidate segments drawn for each placement.
+const CANDIDATES: usize = 24;
+/// Whole-track attempts before giving up.
+const ATTEMPTS: usize = 200;
+
+/// Why the rules could not build a track.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "the rules found no valid track toward goal {goal:?} in {ATTEMPTS} attempts of at most {max_segments} segments"
+)]
+pub struct NoTrack {
+    pub goal: [f64; 3],
+    pub max_segments: u32,
+}
+
+/// The goal (drawn unless given), the start heading and the obstacles of track `seed`, and the
+/// seeded stream the track's other draws continue from. Every track source draws them this
+/// way, so tracks of the same seed lead to the same goal around the same obstacles.
+pub fn goal_and_start(
+    seed: u64,
+    goal: Option<[f64; 3]>,
+    obstacles: u32,
+) -> ([f64; 3], f64, Vec<Obstacle>, ChaCha8Rng) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let heading = quantize(rng.random_range(-180.0..180.0));
+    let bearing = heading + rng.random_range(-GOAL_BEARING..=GOAL_BEARING);
+    let distance = rng.random_range(GOAL_DISTANCE.0..=GOAL_DISTANCE.1);
+    let [x, z] = heading_direction(bearing);
+    let drawn = [
+        quantize(distance * x),
+        quantize(rng.random_range(GOAL_HEIGHT.0..=GOAL_HEIGHT.1)),
+        quantize(distance * z),
+    ];
+    let goal = goal.unwrap_or(drawn);
+    let placed = (0..obstacles)
+        .filter_map(|_| draw_obstacle(&mut rng, goal))
+        .collect();
+    (goal, heading, placed, rng)
+}
+
+/// An obstacle somewhere between the start (the origin) and `goal`, clear of both.
+fn draw_obstacle(rng: &mut ChaCha8Rng, goal: [f64; 3]) -> Option<Obstacle> {
+    let along = rng.random_range(0.25..=0.75);
+    let across = rng.random_range(-25.0..=25.0);
+    let length = goal[0].hypot(goal[2]).max(1.0);
+    let (ux, uz) = (goal[0] / length, goal[2] / length);
+    let x = quantize(along * goal[0] - across * uz);
+    let z = quantize(along * goal[2] + across * ux);
+    let y = quantize(along * goal[1] - 2.0);
+    let obstacle = if rng.random_bool(0.5) {
+        Obstacle::Box {
+            position: [x, y, z],
+            size: [
+                quantize(rng.random_range(4.0..=14.0)),
+                quantize(rng.random_range(3.0..=10.0)),
+                quantize(rng.random_range(4.0..=14.0)),
+            ],
+            heading: quantize(rng.random_range(-180.0..180.0)),
+        }
+    } else {
+        Obstacle::Cylinder {
+            position: [x, y, z],
+            radius: quantize(rng.random_range(2.0..=7.0)),
+            height: quantize(rng.random_range(3.0..=10.0)),
+        }
+    };
+    let clear = MIN_OBSTACLE_DISTANCE + 12.0;
+    let far_from = |p: [f64; 3]| obstacle.plan_distance(p[0], p[2]) > clear;
+    (far_from([0.0; 3]) && far_from(goal)).then_some(obstacle)
+}
+
+/// A rule-based racing level, reproducible from `seed`: the goal, start heading and obstacles
+/// are drawn from it, unless `goal` is given. `aux` is recorded; the rules do not use it.
+pub fn racing_level(
+    seed: u64,
+    aux: Option<f64>,
+    goal: Option<[f64; 3]>,
+    config: &RacingRulesConfig,
+) -> Result<Level, NoTrack> {
+    let (goal, heading, obstacles, mut rng) = goal_and_start(seed, goal, config.obstacles);
+    for _ in 0..ATTEMPTS {
+        if let Some(mut track) = attempt(&mut rng, heading, goal, &obstacles, config) {
+            track.obstacles = obstacles;
+            return Ok(Level {
+                seed: Some(seed),
+                aux,
+                goal,
+                track: Track::Racing(track),
+                source: Source::RacingRules { rules: *config },
+                stats: None,
+            });
+        }
+    }
+    Err(NoTrack {
+        goal,
+        max_segments: config.max_segments,
+    })
+}
+
+/// One try at a whole track; `None` when it gets stuck or runs out of segments.
+fn attempt(
+    rng: &mut ChaCha8Rng,
+    heading: f64,
+    goal: [f64; 3],
+    obstacles: &[Obstacle],
+    config: &RacingRulesConfig,
+) -> Option<RacingTrack> {
+    let mut track = RacingTrack::new([0.0; 3], heading);
+    let mut road = Road::start(track.position, heading);
+    while track.segments.len() < config.max_segments as usize {
+        let index = track.segments.len();
+        let (end, end_heading) = road.end();
+        let before = plan_distance(end, goal);
+        let mut best: Option<(f64, SegmentParams, Road)> = None;
+        for _ in 0..CANDIDATES {
+            let candidate = draw(rng, end, end_heading, goal, config);
+            let mut next = road.clone();
+            next.push(candidate);
+            if next.first_crossing(index).is_some()
+                || next.first_obstacle_hit(obstacles, index).is_some()
+            {
+                continue;
+            }
+            let (new_end, _) = next.end();
+            if racing::reaches(new_end, goal) {
+                best = Some((f64::NEG_INFINITY, candidate, next));
+                break;
+            }
+            // The first candidate that closes in on the goal, else the one that gets closest.
+            let after = plan_distance(new_end, goal);
+            if after < before - 5.0 {
+                best = Some((f64::NEG_INFINITY + 1.0, candidate, next));
+                break;
+            }
+            if best.as_ref().is_none_or(|(score, ..)| after < *score) {
+                best = Some((after, candidate, next));
+            }
+        }
+        let (_, segment, next) = best?;
+        track.segments.push(segment);
+        road = next;
+        if racing::reaches(road.end().0, goal) {
+            return Some(track);
+        }
+    }
+    None
+}
+
+/// Draws one segment: a curve anywhere within the configured range (leaning toward the goal
+/// when far off course), climbing toward the goal's height.
+fn draw(
+    rng: &mut ChaCha8Rng,
+    end: [f64; 3],
+    heading: f64,
+    goal: [f64; 3],
+    config: &RacingRulesConfig,
+) -> SegmentParams {
+    let length = quantize(rng.random_range(params::SEGMENT_LENGTH.min..=params::SEGMENT_LENGTH.max));
+    let to_goal = direction_heading(goal[0] - end[0], goal[2] - end[2]);
+    let error = wrap_degrees(to_goal - heading);
+    let max_curve = config.max_curve;
+    let lean = (0.5 * error).clamp(-max_curve, max_curve);
+    let curve = quantize((lean + rng.random_range(-max_curve..=max_curve)).clamp(-max_curve, max_curve));
+    let segments_left = (plan_distance(end, goal) / 25.0).max(1.0);
+    let max_height = config.max_height;
+    let climb = (goal[1] - end[1]) / segments_left;
+    let height =
+        quantize((climb + rng.random_range(-max_height..=max_height)).clamp(-max_height, max_height));
+    SegmentParams {
+        length,
+        curve,
+        height,
+    }
+}
+
+fn plan_distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (a[0] - b[0]).hypot(a[2] - b[2])
+}

@@ -1,0 +1,99 @@
+//! A scripted, non-learning driver: pure pursuit of a point on the centre line ahead, at the
+//! speed the road ahead allows (its tightest curve at a share of the tyres' grip, its sharpest
+//! crest below take-off speed). It reads the road directly (a test instrument and a stand-in
+//! Solver, not a learner) and is seeded: each run drives a little faster or slower.
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rapier3d::math::Vector;
+
+use super::car::{CarAction, FRICTION, GRAVITY, MAX_STEER};
+use super::env::RacingEnv;
+
+/// Distance between the front and rear axles, m.
+const WHEELBASE: f32 = 2.6;
+/// The fastest the driver goes on a straight, m/s.
+pub const CRUISE_SPEED: f32 = 24.0;
+/// Share of the tyres' grip the driver uses in curves.
+const GRIP_SHARE: f32 = 0.7;
+/// Share of take-off speed the driver keeps to over crests (below 1: wheels stay down).
+const CREST_SHARE: f32 = 0.85;
+/// Deceleration the driver plans with when slowing for what is ahead, m/s².
+const PLANNED_BRAKING: f32 = 4.0;
+
+/// The scripted driver.
+pub struct ScriptedDriver {
+    /// Speed factor of this run (1 ± jitter).
+    pace: f32,
+}
+
+impl ScriptedDriver {
+    /// A driver whose speed varies by up to `jitter` (a share, e.g. 0.1 for ±10%), seeded.
+    pub fn new(seed: u64, jitter: f32) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5eed_d71e);
+        let jitter = jitter.clamp(0.0, 0.9);
+        Self {
+            pace: 1.0 + rng.random_range(-jitter..=jitter),
+        }
+    }
+
+    /// The speed the road ahead allows from distance `along`, m/s (before this run's pace).
+    pub fn safe_speed(env: &RacingEnv, along: f64, speed: f32) -> f32 {
+        let road = env.road();
+        let samples = road.samples();
+        let horizon = (speed * speed / (2.0 * PLANNED_BRAKING) + 15.0) as f64;
+        let first = road.nearest_along(along);
+        let mut limit = CRUISE_SPEED;
+        for pair in samples[first..].windows(2) {
+            let [a, b] = pair else { continue };
+            let ahead = (a.s - along).max(0.0) as f32;
+            if ahead as f64 > horizon {
+                break;
+            }
+            let ds = b.s - a.s;
+            let curvature = ((b.heading - a.heading) / ds).abs() as f32;
+            // Crests curve the road downward: slope falls along it.
+            let crest = (-(b.slope - a.slope) / ds).max(0.0) as f32;
+            let bank = a.bank.abs() as f32;
+            let grip = GRIP_SHARE * GRAVITY * (FRICTION + bank.tan());
+            let mut here = CRUISE_SPEED;
+            if curvature > 1e-4 {
+                here = here.min((grip / curvature).sqrt());
+            }
+            if crest > 1e-4 {
+                here = here.min(CREST_SHARE * (GRAVITY / crest).sqrt());
+            }
+            // What speed now still brakes down to `here` in the distance left.
+            let reachable = (here * here + 2.0 * PLANNED_BRAKING * ahead).sqrt();
+            limit = limit.min(reachable);
+        }
+        limit
+    }
+
+    /// The action for the current state of `env`.
+    pub fn act(&mut self, env: &RacingEnv) -> CarAction {
+        let world = env.world();
+        let position = world.position();
+        let rotation = world.rotation();
+        let velocity = world.velocity();
+        let forward = rotation * Vector::X;
+        let speed = velocity.dot(forward);
+        let look = (4.0 + 0.6 * speed.max(0.0)).clamp(6.0, 20.0);
+        let road = env.road();
+        let target = road.samples()[road.nearest_along(env.along() + look as f64)].centre;
+        let to_target = Vector::new(target[0] as f32, target[1] as f32, target[2] as f32) - position;
+        let yaw = (-forward.z).atan2(forward.x);
+        let (s, c) = yaw.sin_cos();
+        let ahead = to_target.x * c - to_target.z * s;
+        let left = -to_target.x * s - to_target.z * c;
+        let alpha = left.atan2(ahead);
+        let distance = ahead.hypot(left).max(1.0);
+        let steer = (2.0 * WHEELBASE * alpha.sin() / distance).atan() / MAX_STEER;
+        let wanted = self.pace * Self::safe_speed(env, env.along(), speed.max(0.0));
+        let throttle = (0.5 * (wanted - speed)).clamp(-1.0, 1.0);
+        CarAction {
+            throttle,
+            steer: steer.clamp(-1.0, 1.0),
+        }
+    }
+}

@@ -24,6 +24,7 @@ use crate::train::TrainMode;
         arlpcg design --policies runs/platform-solver-arlpcg-reach --out levels/mine\n  \
         arlpcg generate --policies policies/platform --aux -0.5 --verify 100 --out levels/mine\n  \
         arlpcg generate --game platform --rules --count 20 --seed 1 --out levels/mine\n  \
+        arlpcg generate --game racing --rules --obstacles 3 --count 20 --out tracks\n  \
         arlpcg verify levels/mine/*.yaml --trials 100\n  \
         arlpcg export levels/mine/platform_seed1.yaml --out level.glb"
 )]
@@ -126,9 +127,13 @@ pub struct GenerateArgs {
     #[arg(long, default_value = "platform", value_parser = parse_game)]
     pub game: Game,
     /// Use the rule-based generator (random parameters within the game's ranges, kept valid
-    /// and within the character's reach).
+    /// and within the character's or the car's ability).
     #[arg(long)]
     pub rules: bool,
+    /// Racing, with --rules: place this many obstacles between the start and the goal, which
+    /// the road goes around.
+    #[arg(long, value_name = "N", default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=200))]
+    pub obstacles: u32,
     /// Use the trained Generator in this folder (generator.safetensors; --verify plays the
     /// solver.safetensors beside it). The shipped one: policies/platform.
     #[arg(long, value_name = "DIR")]
@@ -176,16 +181,19 @@ pub struct ExportArgs {
 /// Who plays the verification trials.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum SolverChoice {
-    /// A trained Solver policy (--policy, default policies/platform/solver.safetensors).
+    /// A trained Solver policy (--policy, default policies/<game>/solver.safetensors).
     Policy,
-    /// The scripted controller: faces the next block, runs, jumps at the edge (no learning).
+    /// The scripted player (no learning). Platform: faces the next block, runs, jumps at the
+    /// edge. Racing: pure pursuit of the centre line at the speed the road ahead allows.
     Scripted,
     /// Uniformly random actions (a baseline).
     Random,
 }
 
-/// Where the shipped platform Solver lives.
-pub const DEFAULT_SOLVER: &str = "policies/platform/solver.safetensors";
+/// Where the shipped Solver of `game` lives.
+pub fn default_solver(game: Game) -> PathBuf {
+    PathBuf::from(format!("policies/{game}/solver.safetensors"))
+}
 
 #[derive(Debug, Args)]
 pub struct VerifyArgs {
@@ -198,12 +206,14 @@ pub struct VerifyArgs {
     /// Seed of the first run; run i uses SEED + i.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Who plays (default: the trained Solver when one is found, else the scripted controller).
+    /// Who plays (default: the trained Solver of the level's game when one is found, else the
+    /// scripted player).
     #[arg(long, value_enum)]
     pub solver: Option<SolverChoice>,
-    /// The Solver policy file (.safetensors) for --solver policy.
-    #[arg(long, default_value = DEFAULT_SOLVER)]
-    pub policy: PathBuf,
+    /// The Solver policy file (.safetensors) for --solver policy (default:
+    /// policies/<game>/solver.safetensors for each level's game).
+    #[arg(long)]
+    pub policy: Option<PathBuf>,
     /// Print one JSON object per level instead of text.
     #[arg(long)]
     pub json: bool,

@@ -6,25 +6,25 @@
 //! in parallel and one batched forward pass picks every action. It samples its actions (the
 //! stochastic policy it was trained as).
 
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::game::platform::reach::play_scripted;
-use crate::game::platform::{OBSERVATION_SIZE, PlatformAction, PlatformEnv, SolverRewards};
-use crate::level::scene::UnsupportedGame;
+use crate::game::platform::{PlatformEnv, SolverRewards};
+use crate::game::racing::{self, RacingEnv};
+use crate::game::{Scripted, SolverEnv};
 use crate::level::stats::{SolverRef, SolverStats, TrialResult};
-use crate::level::{Level, PlatformTrack, PolicyRef, Track};
+use crate::level::{Game, Level, PolicyRef, Track};
 use crate::rl::normalizer::RunningNorm;
 use crate::rl::policy::{ActMode, ActorCritic};
 
-/// Take-off jitter of the scripted controller when it verifies levels, m.
-pub const SCRIPTED_JITTER: f32 = 0.3;
 /// Trials a policy plays at once.
 pub const LOCKSTEP: usize = 64;
 
 /// A trained Solver, ready to play.
 pub struct SolverPolicy {
+    /// The game it was trained for.
+    pub game: Game,
     pub policy: ActorCritic,
     pub normalizer: RunningNorm,
     pub reference: PolicyRef,
@@ -32,7 +32,7 @@ pub struct SolverPolicy {
 
 /// Who plays the trials.
 pub enum Solver<'a> {
-    /// The scripted (non-learning) controller.
+    /// The scripted (non-learning) player of the level's game.
     Scripted,
     /// Uniformly random actions (a baseline).
     Random,
@@ -50,6 +50,27 @@ impl Solver<'_> {
             },
         }
     }
+
+    /// Checks that a policy plays the level's game.
+    fn check_game(&self, level: Game) -> Result<(), WrongGame> {
+        match self {
+            Solver::Policy(p) if p.game != level => Err(WrongGame {
+                policy: p.reference.path.clone(),
+                plays: p.game,
+                level,
+            }),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// A Solver policy asked to play a level of another game.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("the Solver policy {policy} plays the {plays} game, but this is a {level} level")]
+pub struct WrongGame {
+    pub policy: String,
+    pub plays: Game,
+    pub level: Game,
 }
 
 /// Plays `trials` runs of the level and returns their statistics. `on_trial` is called after
@@ -60,7 +81,7 @@ pub fn verify(
     trials: u32,
     seed: u64,
     on_trial: &(dyn Fn() + Sync),
-) -> Result<SolverStats, UnsupportedGame> {
+) -> Result<SolverStats, WrongGame> {
     let watch = Watch {
         on_trial: &|_| on_trial(),
         stop: &|| false,
@@ -85,21 +106,40 @@ pub fn verify_watched(
     trials: u32,
     seed: u64,
     watch: &Watch,
-) -> Result<Option<SolverStats>, UnsupportedGame> {
-    let Track::Platform(track) = &level.track else {
-        return Err(UnsupportedGame("racing"));
+) -> Result<Option<SolverStats>, WrongGame> {
+    solver.check_game(level.game())?;
+    let results = match &level.track {
+        Track::Platform(track) => {
+            let new_env = || PlatformEnv::new(track, level.goal, SolverRewards::default());
+            play_all(&new_env, solver, trials, seed, watch)
+        }
+        Track::Racing(track) => {
+            let template = RacingEnv::new(track, level.goal, racing::SolverRewards::default());
+            play_all(&|| template.clone(), solver, trials, seed, watch)
+        }
     };
-    let new_env = || PlatformEnv::new(track, level.goal, SolverRewards::default());
+    Ok(results.map(|results| {
+        SolverStats::from_trials(solver.reference(), seed, level.piece_count(), &results)
+    }))
+}
+
+/// Plays the trials on environments made by `new_env`; `None` when told to stop.
+fn play_all<E: SolverEnv>(
+    new_env: &(dyn Fn() -> E + Sync),
+    solver: &Solver,
+    trials: u32,
+    seed: u64,
+    watch: &Watch,
+) -> Option<Vec<TrialResult>> {
     let reported = |result: TrialResult| {
         (watch.on_trial)(&result);
         result
     };
-    let results: Option<Vec<TrialResult>> = match solver {
+    match solver {
         Solver::Scripted => (0..trials as u64)
             .into_par_iter()
             .map_init(new_env, |env, i| {
-                (!(watch.stop)())
-                    .then(|| reported(play_scripted(env, seed.wrapping_add(i), SCRIPTED_JITTER)))
+                (!(watch.stop)()).then(|| reported(play_scripted(env, seed.wrapping_add(i))))
             })
             .collect(),
         Solver::Random => (0..trials as u64)
@@ -111,16 +151,13 @@ pub fn verify_watched(
         Solver::Policy(policy) => (0..trials as u64)
             .collect::<Vec<_>>()
             .chunks(LOCKSTEP)
-            .map(|chunk| play_policy(track, level.goal, policy, seed, chunk, watch))
+            .map(|chunk| play_policy(new_env, policy, seed, chunk, watch))
             .collect::<Option<Vec<Vec<TrialResult>>>>()
             .map(|chunks| chunks.concat()),
-    };
-    Ok(results.map(|results| {
-        SolverStats::from_trials(solver.reference(), seed, track.block_count(), &results)
-    }))
+    }
 }
 
-/// One run recorded for display: where the character's feet were at every step.
+/// One run recorded for display: where the player was at every step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Recording {
     pub path: Vec<[f32; 3]>,
@@ -129,95 +166,94 @@ pub struct Recording {
 
 /// Plays one run of the level with `seed` and records it. A policy plays it alone (one forward
 /// pass per step), so the run is not one of [`verify`]'s lockstep trials of the same seed.
-pub fn record(level: &Level, solver: &Solver, seed: u64) -> Result<Recording, UnsupportedGame> {
-    let Track::Platform(track) = &level.track else {
-        return Err(UnsupportedGame("racing"));
-    };
-    let mut env = PlatformEnv::new(track, level.goal, SolverRewards::default());
+pub fn record(level: &Level, solver: &Solver, seed: u64) -> Result<Recording, WrongGame> {
+    solver.check_game(level.game())?;
+    Ok(match &level.track {
+        Track::Platform(track) => record_env(
+            PlatformEnv::new(track, level.goal, SolverRewards::default()),
+            solver,
+            seed,
+        ),
+        Track::Racing(track) => record_env(
+            RacingEnv::new(track, level.goal, racing::SolverRewards::default()),
+            solver,
+            seed,
+        ),
+    })
+}
+
+fn record_env<E: SolverEnv>(mut env: E, solver: &Solver, seed: u64) -> Recording {
     env.reset(seed);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut scripted =
-        crate::game::platform::scripted::ScriptedController::new(seed, SCRIPTED_JITTER);
-    let mut observation = vec![0.0; OBSERVATION_SIZE];
-    let feet = |env: &PlatformEnv| {
-        let f = env.character().feet;
-        [f.x, f.y, f.z]
-    };
-    let mut path = vec![feet(&env)];
+    let mut scripted = E::scripted(seed);
+    let mut observation = vec![0.0; E::OBSERVATION_SIZE];
+    let mut path = vec![env.marker()];
     loop {
         let action = match solver {
             Solver::Scripted => scripted.act(&env),
-            Solver::Random => random_action(&mut rng),
+            Solver::Random => E::random_action(&mut rng),
             Solver::Policy(policy) => {
                 env.observe(&mut observation);
                 policy.normalizer.normalize(&mut observation);
                 let action = policy
                     .policy
                     .choose(&observation, ActMode::Sample, &mut rng)
-                    .expect("a loaded policy acts on observations of its size");
-                PlatformAction::from_policy_row(&action)
+                    .expect("a policy checked for the level's game acts on its observations");
+                E::action_from_policy_row(&action)
             }
         };
         let outcome = env.step(action).outcome;
-        path.push(feet(&env));
+        path.push(env.marker());
         if let Some(outcome) = outcome {
-            return Ok(Recording {
+            return Recording {
                 path,
-                result: finish(&env, outcome),
-            });
+                result: env.trial_result(outcome),
+            };
         }
     }
 }
 
-fn finish(env: &PlatformEnv, outcome: crate::level::stats::Outcome) -> TrialResult {
-    TrialResult {
-        outcome,
-        progress: env.progress(),
-        target_piece: env.furthest(),
-        steps: env.steps(),
-        air_steps: None,
+/// Plays one run with the game's scripted player, seeded by `seed`.
+pub fn play_scripted<E: SolverEnv>(env: &mut E, seed: u64) -> TrialResult {
+    env.reset(seed);
+    let mut player = E::scripted(seed);
+    loop {
+        if let Some(outcome) = env.step(player.act(env)).outcome {
+            return env.trial_result(outcome);
+        }
     }
 }
 
-/// Uniformly random actions: the random baseline.
-fn random_action(rng: &mut ChaCha8Rng) -> PlatformAction {
-    PlatformAction {
-        forward: rng.random_range(-1.0..=1.0),
-        turn: rng.random_range(-1.0..=1.0),
-        jump: rng.random_bool(0.5),
-    }
-}
-
-fn play_random(env: &mut PlatformEnv, seed: u64) -> TrialResult {
+fn play_random<E: SolverEnv>(env: &mut E, seed: u64) -> TrialResult {
     env.reset(seed);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     loop {
-        if let Some(outcome) = env.step(random_action(&mut rng)).outcome {
-            return finish(env, outcome);
+        if let Some(outcome) = env.step(E::random_action(&mut rng)).outcome {
+            return env.trial_result(outcome);
         }
     }
 }
 
 /// Plays the trials `indices` together: parallel worlds, one forward pass per tick.
-fn play_policy(
-    track: &PlatformTrack,
-    goal: [f64; 3],
+fn play_policy<E: SolverEnv>(
+    new_env: &(dyn Fn() -> E + Sync),
     solver: &SolverPolicy,
     seed: u64,
     indices: &[u64],
     watch: &Watch,
 ) -> Option<Vec<TrialResult>> {
-    let mut envs: Vec<PlatformEnv> = indices
+    let size = E::OBSERVATION_SIZE;
+    let mut envs: Vec<E> = indices
         .par_iter()
         .map(|&i| {
-            let mut env = PlatformEnv::new(track, goal, SolverRewards::default());
+            let mut env = new_env();
             env.reset(seed.wrapping_add(i));
             env
         })
         .collect();
     let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(indices[0]).rotate_left(17));
     let mut results: Vec<Option<TrialResult>> = vec![None; envs.len()];
-    let mut observations = vec![0.0; envs.len() * OBSERVATION_SIZE];
+    let mut observations = vec![0.0; envs.len() * size];
     loop {
         let active: Vec<usize> = (0..envs.len()).filter(|&k| results[k].is_none()).collect();
         if active.is_empty() {
@@ -226,17 +262,17 @@ fn play_policy(
         if (watch.stop)() {
             return None;
         }
-        let rows = &mut observations[..active.len() * OBSERVATION_SIZE];
-        rows.par_chunks_mut(OBSERVATION_SIZE)
+        let rows = &mut observations[..active.len() * size];
+        rows.par_chunks_mut(size)
             .zip(&active)
             .for_each(|(row, &k)| envs[k].observe(row));
         solver.normalizer.normalize(rows);
         let actions = solver
             .policy
             .choose(rows, ActMode::Sample, &mut rng)
-            .expect("a loaded policy acts on observations of its size");
+            .expect("a policy checked for the level's game acts on its observations");
         let width = solver.policy.shape().action_size();
-        let mut stepping: Vec<(usize, &mut PlatformEnv)> = envs
+        let mut stepping: Vec<(usize, &mut E)> = envs
             .iter_mut()
             .enumerate()
             .filter(|(k, _)| results[*k].is_none())
@@ -245,9 +281,9 @@ fn play_policy(
             .par_iter_mut()
             .zip(actions.par_chunks(width))
             .filter_map(|((k, env), row)| {
-                env.step(PlatformAction::from_policy_row(row))
+                env.step(E::action_from_policy_row(row))
                     .outcome
-                    .map(|o| (*k, finish(env, o)))
+                    .map(|o| (*k, env.trial_result(o)))
             })
             .collect();
         for (k, result) in finished {

@@ -372,10 +372,27 @@ fn bad_arguments_are_usage_errors() {
         "{}",
         stderr(&out)
     );
-    let out = arlpcg(&["generate", "--rules", "--game", "racing", "--out", "x"]);
-    assert_eq!(out.status.code(), Some(1));
+    let out = arlpcg(&[
+        "generate",
+        "--game",
+        "racing",
+        "--policies",
+        "policies/platform",
+        "--aux",
+        "0",
+        "--out",
+        "x",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
     assert!(
-        stderr(&out).contains("only the platform game"),
+        stderr(&out).contains("no racing Generator is trained yet; use --rules"),
+        "{}",
+        stderr(&out)
+    );
+    let out = arlpcg(&["generate", "--rules", "--obstacles", "3", "--out", "x"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("--obstacles is for racing tracks"),
         "{}",
         stderr(&out)
     );

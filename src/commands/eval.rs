@@ -43,7 +43,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             .collect();
         files.sort();
         for path in files {
-            let (solver, card) = load_solver(&path)?;
+            let (solver, card) = load_solver(&path, Game::Platform)?;
             if let Some((mode, _)) = solvers.iter().find(|(m, _)| *m == card.training.mode) {
                 eprintln!(
                     "note: {} skipped: a {mode} Solver is already loaded",

@@ -103,11 +103,11 @@ pub fn write_level_files(level: &Level, files: &LevelFiles, overwrite: Overwrite
                 overwrite,
             )?,
             Format::Glb => {
-                fsio::write_atomic(&files.path("glb"), &gltf::to_glb(&scene()?), overwrite)?
+                fsio::write_atomic(&files.path("glb"), &gltf::to_glb(&scene()), overwrite)?
             }
             Format::Gltf => {
                 let bin_name = format!("{}.bin", files.stem);
-                let output = gltf::to_gltf(&scene()?, &bin_name);
+                let output = gltf::to_gltf(&scene(), &bin_name);
                 fsio::write_atomic(&files.path("bin"), &output.bin, overwrite)?;
                 fsio::write_atomic(&files.path("gltf"), &output.main, overwrite)?;
             }

@@ -1,27 +1,33 @@
 //! `arlpcg generate`: levels from a trained Generator or from the rules, optionally verified by
 //! the Solver, written as files named after game, seed and aux.
 
-use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 
 use super::export::{LevelFiles, write_level_files};
 use super::policies::{load_generator, load_solver, policy_paths};
-use crate::cli::{DEFAULT_SOLVER, GenerateArgs};
+use crate::cli::{GenerateArgs, default_solver};
 use crate::fsio::Overwrite;
-use crate::game::rules;
+use crate::game::{racing, rules};
 use crate::generation::{self, GeneratorPolicy};
+use crate::level::racing::RacingRulesConfig;
 use crate::level::{Game, Level, RulesConfig};
 use crate::verify::{Solver, SolverPolicy, verify};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
-    if args.game != Game::Platform {
-        bail!(
-            "--game {}: only the platform game is implemented so far",
-            args.game
-        );
+    if args.game == Game::Racing && args.policies.is_some() {
+        return Err(super::UsageError(
+            "--game racing --policies: no racing Generator is trained yet; use --rules".into(),
+        )
+        .into());
+    }
+    if args.obstacles > 0 && (args.game != Game::Racing || !args.rules) {
+        return Err(super::UsageError(
+            "--obstacles is for racing tracks from the rules (--game racing --rules)".into(),
+        )
+        .into());
     }
     let generator = match &args.policies {
         Some(dir) => {
@@ -35,12 +41,11 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         }
         None => None,
     };
+    let shipped = default_solver(args.game);
     let solver: Option<SolverPolicy> = match (args.verify, &args.policies) {
         (None, _) => None,
-        (Some(_), Some(dir)) => Some(load_solver(&policy_paths(dir).1)?.0),
-        (Some(_), None) if Path::new(DEFAULT_SOLVER).exists() => {
-            Some(load_solver(Path::new(DEFAULT_SOLVER))?.0)
-        }
+        (Some(_), Some(dir)) => Some(load_solver(&policy_paths(dir).1, args.game)?.0),
+        (Some(_), None) if shipped.exists() => Some(load_solver(&shipped, args.game)?.0),
         (Some(_), None) => None,
     };
     let seeds: Vec<u64> = (0..args.count as u64)
@@ -85,7 +90,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         if stop.load(Ordering::SeqCst) {
             break;
         }
-        let mut level = build(generator.as_ref(), *seed, args.aux, args.goal)
+        let mut level = build(args, generator.as_ref(), *seed)
             .with_context(|| format!("seed {seed} (nothing was written)"))?;
         if let Some(trials) = args.verify {
             let who = solver.as_ref().map_or(Solver::Scripted, Solver::Policy);
@@ -121,17 +126,20 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
 }
 
 /// Level `seed` from the Generator when there is one, else from the rules.
-fn build(
-    generator: Option<&GeneratorPolicy>,
-    seed: u64,
-    aux: Option<f64>,
-    goal: Option<[f64; 3]>,
-) -> Result<Level> {
-    Ok(match generator {
-        Some(generator) => {
+fn build(args: &GenerateArgs, generator: Option<&GeneratorPolicy>, seed: u64) -> Result<Level> {
+    let (aux, goal) = (args.aux, args.goal);
+    Ok(match (args.game, generator) {
+        (Game::Platform, Some(generator)) => {
             generation::platform_level(generator, seed, aux.unwrap_or_default(), goal)?
         }
-        None => rules::platform_level(seed, aux, goal, &RulesConfig::default())?,
+        (Game::Platform, None) => rules::platform_level(seed, aux, goal, &RulesConfig::default())?,
+        (Game::Racing, _) => {
+            let config = RacingRulesConfig {
+                obstacles: args.obstacles,
+                ..RacingRulesConfig::default()
+            };
+            racing::rules::racing_level(seed, aux, goal, &config)?
+        }
     })
 }
 

@@ -6,7 +6,6 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use sha2::{Digest, Sha256};
 
-use crate::game::platform::OBSERVATION_SIZE;
 use crate::game::platform::generator::{DEFAULT_MAX_BLOCKS, GENERATOR_OBSERVATION_SIZE};
 use crate::generation::GeneratorPolicy;
 use crate::level::{Game, PolicyRef};
@@ -17,9 +16,14 @@ use crate::verify::SolverPolicy;
 pub const GENERATOR_FILE: &str = "generator.safetensors";
 pub const SOLVER_FILE: &str = "solver.safetensors";
 
-fn load_pinned(path: &Path, role: Role, observation: usize) -> Result<(LoadedPolicy, PolicyRef)> {
+fn load_pinned(
+    path: &Path,
+    game: Game,
+    role: Role,
+    observation: usize,
+) -> Result<(LoadedPolicy, PolicyRef)> {
     let bytes = crate::fsio::read_limited(path, MAX_POLICY_BYTES, &format!("{role} policy"))?;
-    let loaded = load_policy(&bytes, Game::Platform, role, observation)
+    let loaded = load_policy(&bytes, game, role, observation)
         .with_context(|| format!("{}", path.display()))?;
     let sha256 = Sha256::digest(&bytes)
         .iter()
@@ -32,12 +36,17 @@ fn load_pinned(path: &Path, role: Role, observation: usize) -> Result<(LoadedPol
     Ok((loaded, reference))
 }
 
-/// Loads a platform Solver policy.
-pub fn load_solver(path: &Path) -> Result<(SolverPolicy, PolicyCard)> {
-    let (loaded, reference) = load_pinned(path, Role::Solver, OBSERVATION_SIZE)?;
+/// Loads a Solver policy of `game`.
+pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)> {
+    let observation = match game {
+        Game::Platform => crate::game::platform::OBSERVATION_SIZE,
+        Game::Racing => crate::game::racing::OBSERVATION_SIZE,
+    };
+    let (loaded, reference) = load_pinned(path, game, Role::Solver, observation)?;
     let card = loaded.card.clone();
     Ok((
         SolverPolicy {
+            game,
             policy: loaded.policy,
             normalizer: loaded.card.normalizer,
             reference,
@@ -48,7 +57,12 @@ pub fn load_solver(path: &Path) -> Result<(SolverPolicy, PolicyCard)> {
 
 /// Loads a platform Generator policy.
 pub fn load_generator(path: &Path) -> Result<(GeneratorPolicy, PolicyCard)> {
-    let (loaded, reference) = load_pinned(path, Role::Generator, GENERATOR_OBSERVATION_SIZE)?;
+    let (loaded, reference) = load_pinned(
+        path,
+        Game::Platform,
+        Role::Generator,
+        GENERATOR_OBSERVATION_SIZE,
+    )?;
     let card = loaded.card.clone();
     Ok((
         GeneratorPolicy {

@@ -1,63 +1,41 @@
 //! `arlpcg verify`: play each level many times and report the Solver's statistics, then a
 //! summary over all the levels.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use anyhow::Result;
 use serde_json::json;
 
 use super::policies::load_solver;
-use crate::cli::{DEFAULT_SOLVER, SolverChoice, VerifyArgs};
+use crate::cli::{SolverChoice, VerifyArgs, default_solver};
+use crate::level::Game;
 use crate::level::stats::SolverStats;
 use crate::level::yaml;
-use crate::verify::{Solver, Summary, verify};
+use crate::verify::{Solver, SolverPolicy, Summary, verify};
 
 pub fn run(args: &VerifyArgs) -> Result<()> {
-    let choice = args.solver.unwrap_or(
-        if args.policy.exists() || args.policy != Path::new(DEFAULT_SOLVER) {
-            SolverChoice::Policy
-        } else {
-            SolverChoice::Scripted
-        },
-    );
-    let loaded;
-    let solver = match choice {
-        SolverChoice::Policy => {
-            loaded = load_solver(&args.policy)?.0;
-            Solver::Policy(&loaded)
-        }
-        SolverChoice::Scripted => Solver::Scripted,
-        SolverChoice::Random => Solver::Random,
-    };
-    if !args.json {
-        let note = match (&solver, args.solver) {
-            (Solver::Scripted, None) => format!(" (no trained Solver at {DEFAULT_SOLVER})"),
-            _ => String::new(),
-        };
-        let who = match &solver {
-            Solver::Policy(p) => format!("policy {}", p.reference.path),
-            Solver::Scripted => "scripted controller".into(),
-            Solver::Random => "random actions".into(),
-        };
-        eprintln!("solver: {who}{note}");
-    }
+    let mut solvers = Solvers::default();
     let mut failed = 0;
     let mut all = Vec::new();
     for path in &args.levels {
         let outcome = yaml::load(path)
             .map_err(anyhow::Error::from)
             .and_then(|level| {
+                let game = level.game();
+                solvers.resolve(game, args)?;
+                let solver = solvers.get(game);
                 let bar = super::progress_bar(args.trials as u64, &path.display().to_string());
                 let stats = verify(&level, &solver, args.trials, args.seed, &|| bar.inc(1))?;
                 bar.finish_and_clear();
-                Ok(stats)
+                Ok((game, stats))
             });
         match outcome {
-            Ok(stats) => {
+            Ok((game, stats)) => {
                 if args.json {
-                    println!("{}", to_json(path, &stats));
+                    println!("{}", to_json(path, game, &stats));
                 } else {
-                    println!("{}", describe(path, &stats));
+                    println!("{}", describe(path, game, &stats));
                 }
                 all.push(stats);
             }
@@ -87,8 +65,65 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
     Ok(())
 }
 
-fn to_json(path: &Path, s: &SolverStats) -> serde_json::Value {
-    json!({
+/// The Solver of each game met so far, resolved from the arguments once per game.
+#[derive(Default)]
+struct Solvers {
+    resolved: HashMap<Game, Resolved>,
+}
+
+enum Resolved {
+    Policy(SolverPolicy),
+    Scripted,
+    Random,
+}
+
+impl Solvers {
+    /// Resolves the Solver for levels of `game` (once), and says who plays.
+    fn resolve(&mut self, game: Game, args: &VerifyArgs) -> Result<()> {
+        if self.resolved.contains_key(&game) {
+            return Ok(());
+        }
+        let shipped = default_solver(game);
+        let policy = args.policy.clone().unwrap_or_else(|| shipped.clone());
+        let choice = args
+            .solver
+            .unwrap_or(if args.policy.is_some() || shipped.exists() {
+                SolverChoice::Policy
+            } else {
+                SolverChoice::Scripted
+            });
+        let resolved = match choice {
+            SolverChoice::Policy => Resolved::Policy(load_solver(&policy, game)?.0),
+            SolverChoice::Scripted => Resolved::Scripted,
+            SolverChoice::Random => Resolved::Random,
+        };
+        if !args.json {
+            let who = match &resolved {
+                Resolved::Policy(p) => format!("policy {}", p.reference.path),
+                Resolved::Scripted if args.solver.is_none() => format!(
+                    "scripted player (no trained Solver at {})",
+                    shipped.display()
+                ),
+                Resolved::Scripted => "scripted player".into(),
+                Resolved::Random => "random actions".into(),
+            };
+            eprintln!("{game} solver: {who}");
+        }
+        self.resolved.insert(game, resolved);
+        Ok(())
+    }
+
+    fn get(&self, game: Game) -> Solver<'_> {
+        match &self.resolved[&game] {
+            Resolved::Policy(p) => Solver::Policy(p),
+            Resolved::Scripted => Solver::Scripted,
+            Resolved::Random => Solver::Random,
+        }
+    }
+}
+
+fn to_json(path: &Path, game: Game, s: &SolverStats) -> serde_json::Value {
+    let mut value = json!({
         "level": path.display().to_string(),
         "solver": s.solver.describe(),
         "seed": s.seed,
@@ -100,11 +135,20 @@ fn to_json(path: &Path, s: &SolverStats) -> serde_json::Value {
         "mean_success_steps": s.mean_success_steps,
         "fell": s.fell,
         "timed_out": s.timed_out,
-        "failures_by_block": s.failures_by_piece,
-    })
+    });
+    match game {
+        Game::Platform => value["failures_by_block"] = json!(s.failures_by_piece),
+        Game::Racing => {
+            value["off_road"] = json!(s.off_road);
+            value["flipped"] = json!(s.flipped);
+            value["mean_air_steps"] = json!(s.mean_air_steps);
+            value["failures_by_segment"] = json!(s.failures_by_piece);
+        }
+    }
+    value
 }
 
-fn describe(path: &Path, s: &SolverStats) -> String {
+fn describe(path: &Path, game: Game, s: &SolverStats) -> String {
     let mut text = format!(
         "{}: {}/{} succeeded, success ratio {:.2} (95% CI {:.2}-{:.2}), mean progress {:.2}",
         path.display(),
@@ -120,15 +164,30 @@ fn describe(path: &Path, s: &SolverStats) -> String {
         .iter()
         .enumerate()
         .filter(|(_, n)| **n > 0)
-        .map(|(i, n)| format!("block {i}: {n}"))
+        .map(|(i, n)| match game {
+            Game::Platform => format!("block {i}: {n}"),
+            Game::Racing => format!("segment {i}: {n}"),
+        })
         .collect();
-    if !failures.is_empty() {
+    if let Some(air) = s.mean_air_steps {
         text += &format!(
-            "\n  failed on the way to {} (fell {}, out of time {})",
-            failures.join(", "),
-            s.fell,
-            s.timed_out
+            ", mean air time {:.2} s",
+            air * f64::from(crate::game::racing::car::DECISION_DT)
         );
+    }
+    if !failures.is_empty() {
+        let causes = match game {
+            Game::Platform => format!("fell {}, out of time {}", s.fell, s.timed_out),
+            Game::Racing => format!(
+                "off the road {}, flipped {}, out of time {}",
+                s.off_road, s.flipped, s.timed_out
+            ),
+        };
+        let place = match game {
+            Game::Platform => "on the way to",
+            Game::Racing => "on",
+        };
+        text += &format!("\n  failed {place} {} ({causes})", failures.join(", "));
     }
     text
 }

@@ -15,7 +15,7 @@ use crate::commands::policies::{load_generator, load_solver, policy_paths};
 use crate::commands::{LevelFiles, write_level_files};
 use crate::fsio::Overwrite;
 use crate::generation::{self, GeneratorPolicy};
-use crate::level::{Level, RulesConfig};
+use crate::level::{Game, Level, RulesConfig};
 use crate::rl::checkpoint::PolicyError;
 use crate::verify::{self, Solver, SolverPolicy, Watch};
 
@@ -76,7 +76,7 @@ pub fn load(path: &Path) -> Result<(Policies, LoadedInfo)> {
             load_generator_at(&generator, &mut policies)?;
         }
         if solver.exists() {
-            let (policy, card) = load_solver(&solver)?;
+            let (policy, card) = load_solver(&solver, Game::Platform)?;
             policies.solver = Some(Arc::new(policy));
             info.solver = Some(PolicyInfo { path: solver, card });
         }
@@ -85,7 +85,7 @@ pub fn load(path: &Path) -> Result<(Policies, LoadedInfo)> {
     match load_generator_at(path, &mut policies) {
         Ok(()) => Ok((policies, info)),
         Err(e) if matches!(e.downcast_ref(), Some(PolicyError::WrongKind { .. })) => {
-            let (policy, card) = load_solver(path)?;
+            let (policy, card) = load_solver(path, Game::Platform)?;
             policies.solver = Some(Arc::new(policy));
             info.solver = Some(PolicyInfo {
                 path: path.to_path_buf(),

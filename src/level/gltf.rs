@@ -20,16 +20,16 @@ pub struct GltfOutput {
 
 /// The scene as a single `.glb`.
 pub fn to_glb(scene: &Scene) -> Vec<u8> {
-    let buffer = cube_buffer();
-    let root = document(scene, buffer.len(), None);
+    let (buffer, layout) = scene_buffer(scene);
+    let root = document(scene, buffer.len(), &layout, None);
     let json = json::serialize::to_vec(&root).expect("a glTF document always serializes");
     glb_container(json, buffer)
 }
 
 /// The scene as `.gltf` JSON whose buffer is the file `bin_uri` (a name relative to it).
 pub fn to_gltf(scene: &Scene, bin_uri: &str) -> GltfOutput {
-    let buffer = cube_buffer();
-    let root = document(scene, buffer.len(), Some(bin_uri.to_string()));
+    let (buffer, layout) = scene_buffer(scene);
+    let root = document(scene, buffer.len(), &layout, Some(bin_uri.to_string()));
     let json = json::serialize::to_vec_pretty(&root).expect("a glTF document always serializes");
     GltfOutput {
         main: json,
@@ -79,7 +79,68 @@ fn cube_buffer() -> Vec<u8> {
     bytes
 }
 
-fn document(scene: &Scene, buffer_length: usize, uri: Option<String>) -> json::Root {
+/// Where one primitive of a [`SceneMesh`](super::scene::SceneMesh) lies in the buffer.
+struct PrimitiveLayout {
+    vertices: usize,
+    triangles: usize,
+    positions: usize,
+    normals: usize,
+    uvs: usize,
+    indices: usize,
+    /// Bounds of its positions.
+    min: [f32; 3],
+    max: [f32; 3],
+}
+
+/// The unit cube, then each mesh primitive's positions, normals, UVs and u32 indices (every
+/// piece a multiple of 4 bytes, so each stays aligned).
+fn scene_buffer(scene: &Scene) -> (Vec<u8>, Vec<Vec<PrimitiveLayout>>) {
+    let mut bytes = cube_buffer();
+    let mut put = |values: &mut dyn Iterator<Item = [u8; 4]>| {
+        let start = bytes.len();
+        for v in values {
+            bytes.extend_from_slice(&v);
+        }
+        start
+    };
+    let layout = scene
+        .meshes
+        .iter()
+        .map(|mesh| {
+            mesh.primitives
+                .iter()
+                .map(|(m, _)| {
+                    let mut min = [f32::INFINITY; 3];
+                    let mut max = [f32::NEG_INFINITY; 3];
+                    for p in &m.positions {
+                        for k in 0..3 {
+                            min[k] = min[k].min(p[k]);
+                            max[k] = max[k].max(p[k]);
+                        }
+                    }
+                    PrimitiveLayout {
+                        vertices: m.positions.len(),
+                        triangles: m.triangles.len(),
+                        positions: put(&mut m.positions.iter().flatten().map(|v| v.to_le_bytes())),
+                        normals: put(&mut m.normals.iter().flatten().map(|v| v.to_le_bytes())),
+                        uvs: put(&mut m.uvs.iter().flatten().map(|v| v.to_le_bytes())),
+                        indices: put(&mut m.triangles.iter().flatten().map(|v| v.to_le_bytes())),
+                        min,
+                        max,
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    (bytes, layout)
+}
+
+fn document(
+    scene: &Scene,
+    buffer_length: usize,
+    layout: &[Vec<PrimitiveLayout>],
+    uri: Option<String>,
+) -> json::Root {
     let mut root = json::Root {
         asset: json::Asset {
             generator: Some(format!("arlpcg {}", env!("CARGO_PKG_VERSION"))),
@@ -89,7 +150,14 @@ fn document(scene: &Scene, buffer_length: usize, uri: Option<String>) -> json::R
     };
     let buffer = root.push(json::Buffer {
         byte_length: USize64::from(buffer_length),
-        name: Some("unit_cube".into()),
+        name: Some(
+            if scene.meshes.is_empty() {
+                "unit_cube"
+            } else {
+                "geometry"
+            }
+            .into(),
+        ),
         uri,
         extensions: None,
         extras: None,
@@ -168,12 +236,8 @@ fn document(scene: &Scene, buffer_length: usize, uri: Option<String>) -> json::R
         "indices",
     ));
 
-    let mut meshes = BTreeMap::new();
-    for material in Material::ALL {
-        if !scene.nodes.iter().any(|n| n.material == material) {
-            continue;
-        }
-        let material_index = root.push(json::Material {
+    let new_material = |root: &mut json::Root, material: Material| {
+        root.push(json::Material {
             name: Some(material.name().into()),
             pbr_metallic_roughness: json::material::PbrMetallicRoughness {
                 base_color_factor: json::material::PbrBaseColorFactor(material.colour()),
@@ -182,7 +246,16 @@ fn document(scene: &Scene, buffer_length: usize, uri: Option<String>) -> json::R
                 ..Default::default()
             },
             ..Default::default()
-        });
+        })
+    };
+    let mut materials = BTreeMap::new();
+    let mut meshes = BTreeMap::new();
+    for material in Material::ALL {
+        if !scene.nodes.iter().any(|n| n.material == material) {
+            continue;
+        }
+        let material_index = new_material(&mut root, material);
+        materials.insert(material, material_index);
         let mesh = root.push(json::Mesh {
             name: Some(material.name().into()),
             primitives: vec![json::mesh::Primitive {
@@ -204,7 +277,18 @@ fn document(scene: &Scene, buffer_length: usize, uri: Option<String>) -> json::R
         meshes.insert(material, mesh);
     }
 
-    let nodes = scene
+    for material in Material::ALL {
+        let used = scene
+            .meshes
+            .iter()
+            .any(|m| m.primitives.iter().any(|(_, pm)| *pm == material));
+        if used && !materials.contains_key(&material) {
+            let index = new_material(&mut root, material);
+            materials.insert(material, index);
+        }
+    }
+
+    let mut nodes: Vec<json::Index<json::Node>> = scene
         .nodes
         .iter()
         .map(|node| {
@@ -221,6 +305,96 @@ fn document(scene: &Scene, buffer_length: usize, uri: Option<String>) -> json::R
             })
         })
         .collect();
+    for (mesh, parts) in scene.meshes.iter().zip(layout) {
+        let primitives = mesh
+            .primitives
+            .iter()
+            .zip(parts)
+            .map(|((_, material), part)| {
+                let view =
+                    |root: &mut json::Root, offset: usize, length: usize, target, name: &str| {
+                        root.push(json::buffer::View {
+                            buffer,
+                            byte_length: USize64::from(length),
+                            byte_offset: Some(USize64::from(offset)),
+                            byte_stride: None,
+                            name: Some(format!("{}_{name}", mesh.name)),
+                            target: Some(Valid(target)),
+                            extensions: None,
+                            extras: None,
+                        })
+                    };
+                let vertex_target = json::buffer::Target::ArrayBuffer;
+                let n = part.vertices;
+                let positions_view = view(
+                    &mut root,
+                    part.positions,
+                    n * 12,
+                    vertex_target,
+                    "positions",
+                );
+                let normals_view = view(&mut root, part.normals, n * 12, vertex_target, "normals");
+                let uvs_view = view(&mut root, part.uvs, n * 8, vertex_target, "uvs");
+                let indices_view = view(
+                    &mut root,
+                    part.indices,
+                    part.triangles * 12,
+                    json::buffer::Target::ElementArrayBuffer,
+                    "indices",
+                );
+                let mut attribute = |view, count, component, type_, name: &str| {
+                    let mut a = accessor(view, count, component, type_, None, name);
+                    if name == "positions" {
+                        a.min = Some(json::Value::from(part.min.to_vec()));
+                        a.max = Some(json::Value::from(part.max.to_vec()));
+                    }
+                    root.push(a)
+                };
+                let positions = attribute(
+                    positions_view,
+                    n,
+                    ComponentType::F32,
+                    Type::Vec3,
+                    "positions",
+                );
+                let normals = attribute(normals_view, n, ComponentType::F32, Type::Vec3, "normals");
+                let uvs = attribute(uvs_view, n, ComponentType::F32, Type::Vec2, "uvs");
+                let indices = attribute(
+                    indices_view,
+                    3 * part.triangles,
+                    ComponentType::U32,
+                    Type::Scalar,
+                    "indices",
+                );
+                json::mesh::Primitive {
+                    attributes: BTreeMap::from([
+                        (Valid(json::mesh::Semantic::Positions), positions),
+                        (Valid(json::mesh::Semantic::Normals), normals),
+                        (Valid(json::mesh::Semantic::TexCoords(0)), uvs),
+                    ]),
+                    extensions: None,
+                    extras: None,
+                    indices: Some(indices),
+                    material: Some(materials[material]),
+                    mode: Valid(json::mesh::Mode::Triangles),
+                    targets: None,
+                }
+            })
+            .collect();
+        let mesh_index = root.push(json::Mesh {
+            name: Some(mesh.name.clone()),
+            primitives,
+            weights: None,
+            extensions: None,
+            extras: None,
+        });
+        nodes.push(root.push(json::Node {
+            name: Some(mesh.name.clone()),
+            mesh: Some(mesh_index),
+            extras: mesh.extras.as_ref().map(raw),
+            ..Default::default()
+        }));
+    }
     let scene_index = root.push(json::Scene {
         name: Some(scene.name.clone()),
         nodes,

@@ -136,9 +136,7 @@ pub enum Source {
     Rules { rules: RulesConfig },
     /// Drawn by the rule-based racing generator.
     #[serde(rename = "racing-rules")]
-    RacingRules {
-        rules: racing::RacingRulesConfig,
-    },
+    RacingRules { rules: racing::RacingRulesConfig },
     /// Built by a trained Generator policy.
     Policy { generator: PolicyRef },
 }
@@ -239,9 +237,7 @@ impl Level {
                     (count > max).then_some(InvalidLevel::TooMany { what, count, max })
                 };
                 if let Some(e) = too_many("segments", track.segments.len(), racing::MAX_SEGMENTS)
-                    .or_else(|| {
-                        too_many("obstacles", track.obstacles.len(), racing::MAX_OBSTACLES)
-                    })
+                    .or_else(|| too_many("obstacles", track.obstacles.len(), racing::MAX_OBSTACLES))
                 {
                     return Err(e);
                 }

@@ -245,7 +245,8 @@ impl RacingTrack {
         if let Some(e) = road.first_crossing(0) {
             return Err(e);
         }
-        road.first_obstacle_hit(&self.obstacles, 0).map_or(Ok(()), Err)
+        road.first_obstacle_hit(&self.obstacles, 0)
+            .map_or(Ok(()), Err)
     }
 }
 

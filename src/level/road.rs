@@ -138,14 +138,8 @@ impl Road {
                 bank: 0.0,
             });
         }
-        let (end, end_heading, _) = along(
-            origin,
-            heading,
-            curvature,
-            params.height,
-            length,
-            length,
-        );
+        let (end, end_heading, _) =
+            along(origin, heading, curvature, params.height, length, length);
         self.end = (end, end_heading);
         // Re-bank everything the new join can reach.
         let from = start_s - BANK_BLEND;
@@ -282,26 +276,39 @@ impl Road {
     /// The road's top surface as a triangle mesh: two vertices per cross-section, triangles
     /// counter-clockwise seen from above (their normals face up). UV: u across (0 left edge,
     /// 1 right edge), v along the road in road widths.
-    pub fn surface_mesh(&self) -> RoadMesh {
-        let mut mesh = RoadMesh::default();
-        for p in &self.samples {
+    pub fn surface_mesh(&self) -> TriangleMesh {
+        self.surface_between(0, self.samples.len() - 1)
+    }
+
+    /// The cross-sections of segment `i`, as an inclusive range of sample indices (the last is
+    /// the next segment's first, so the pieces join without a gap).
+    pub fn segment_samples(&self, i: usize) -> (usize, usize) {
+        let first = self.samples.partition_point(|p| p.segment < i);
+        let last = self.samples.partition_point(|p| p.segment <= i);
+        (first, last.min(self.samples.len() - 1))
+    }
+
+    /// The top surface between cross-sections `first` and `last` (inclusive).
+    pub fn surface_between(&self, first: usize, last: usize) -> TriangleMesh {
+        let mut mesh = TriangleMesh::default();
+        for p in &self.samples[first..=last] {
             let up = p.up().map(|c| c as f32);
             let v = (p.s / ROAD_WIDTH) as f32;
             mesh.vertex(p.across(0.5 * ROAD_WIDTH), up, [0.0, v]);
             mesh.vertex(p.across(-0.5 * ROAD_WIDTH), up, [1.0, v]);
         }
-        mesh.strip(self.samples.len(), 0, 1);
+        mesh.strip(0, last - first + 1, 0, 1);
         mesh
     }
 
-    /// The skirts that hang from both edges (what a player sees as the road's thickness), with
-    /// normals facing outward.
-    pub fn skirt_mesh(&self) -> RoadMesh {
-        let mut mesh = RoadMesh::default();
-        let n = self.samples.len();
+    /// The skirts that hang from both edges between cross-sections `first` and `last`
+    /// (inclusive): what a player sees as the road's thickness, normals facing outward.
+    pub fn skirts_between(&self, first: usize, last: usize) -> TriangleMesh {
+        let mut mesh = TriangleMesh::default();
+        let rows = last - first + 1;
         for side in [1.0, -1.0] {
             let base = mesh.positions.len() as u32;
-            for p in &self.samples {
+            for p in &self.samples[first..=last] {
                 let outward = p.left().map(|c| (side * c) as f32);
                 let top = p.across(side * 0.5 * ROAD_WIDTH);
                 let bottom = [top[0], top[1] - SKIRT_DEPTH, top[2]];
@@ -309,12 +316,12 @@ impl Road {
                 mesh.vertex(top, outward, [0.0, v]);
                 mesh.vertex(bottom, outward, [1.0, v]);
             }
-            // Left skirt: seen from the left, top-then-bottom runs counter-clockwise going
-            // forward; the right skirt is the mirror image.
+            // Left skirt: seen from the left, bottom → top → next top runs counter-clockwise;
+            // the right skirt is its mirror image.
             if side > 0.0 {
-                mesh.strip_at(base, n, 1, 0);
+                mesh.strip(base, rows, 1, 0);
             } else {
-                mesh.strip_at(base, n, 0, 1);
+                mesh.strip(base, rows, 0, 1);
             }
         }
         mesh
@@ -323,27 +330,24 @@ impl Road {
 
 /// An indexed triangle mesh, in f32 as glTF and rapier store it.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct RoadMesh {
+pub struct TriangleMesh {
     pub positions: Vec<[f32; 3]>,
     pub normals: Vec<[f32; 3]>,
     pub uvs: Vec<[f32; 2]>,
     pub triangles: Vec<[u32; 3]>,
 }
 
-impl RoadMesh {
-    fn vertex(&mut self, position: [f64; 3], normal: [f32; 3], uv: [f32; 2]) {
+impl TriangleMesh {
+    /// Adds a vertex.
+    pub fn vertex(&mut self, position: [f64; 3], normal: [f32; 3], uv: [f32; 2]) {
         self.positions.push(position.map(|c| c as f32));
         self.normals.push(normal);
         self.uvs.push(uv);
     }
 
-    fn strip(&mut self, rows: usize, a: u32, b: u32) {
-        self.strip_at(0, rows, a, b);
-    }
-
     /// Two triangles between each pair of consecutive rows of two vertices (`base + 2·row`
     /// and `+1`), wound so that `a → b → next b` is counter-clockwise.
-    fn strip_at(&mut self, base: u32, rows: usize, a: u32, b: u32) {
+    pub fn strip(&mut self, base: u32, rows: usize, a: u32, b: u32) {
         for row in 0..rows.saturating_sub(1) as u32 {
             let this = base + 2 * row;
             let next = this + 2;
@@ -380,11 +384,7 @@ fn along(
     let t = s / length;
     let y = rise * t * t * (3.0 - 2.0 * t);
     let slope = rise * 6.0 * t * (1.0 - t) / length;
-    (
-        [origin[0] + dx, origin[1] + y, origin[2] + dz],
-        h,
-        slope,
-    )
+    ([origin[0] + dx, origin[1] + y, origin[2] + dz], h, slope)
 }
 
 fn plan_distance(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -425,7 +425,10 @@ mod tests {
     fn a_straight_runs_along_x_and_a_left_curve_turns_to_minus_z() {
         let road = track(&[(20.0, 0.0, 0.0)]).road();
         let (end, heading) = road.end();
-        assert!((end[0] - 20.0).abs() < 1e-9 && end[2].abs() < 1e-9, "{end:?}");
+        assert!(
+            (end[0] - 20.0).abs() < 1e-9 && end[2].abs() < 1e-9,
+            "{end:?}"
+        );
         assert_eq!(heading, 0.0);
         let road = track(&[(30.0, 30.0, 0.0)]).road();
         let (end, heading) = road.end();
@@ -447,14 +450,21 @@ mod tests {
             assert!((b.heading - a.heading).abs() < 0.03 * ds, "{a:?} {b:?}");
             assert!((b.slope - a.slope).abs() < 0.1 * ds, "{a:?} {b:?}");
             let steepest_blend = MAX_BANK_DEGREES.to_radians() / BANK_BLEND;
-            assert!((b.bank - a.bank).abs() <= steepest_blend * ds + 1e-9, "{a:?} {b:?}");
+            assert!(
+                (b.bank - a.bank).abs() <= steepest_blend * ds + 1e-9,
+                "{a:?} {b:?}"
+            );
             let rise = b.centre[1] - a.centre[1];
             assert!((rise - 0.5 * (a.slope + b.slope) * ds).abs() < 0.01);
         }
         // A left turn banks into the turn: the left edge is lower.
         let mid = road.samples()[12];
         assert!(mid.bank > 0.0 && mid.across(4.0)[1] < mid.across(-4.0)[1]);
-        let steepest = road.samples().iter().map(|p| p.bank.abs()).fold(0.0, f64::max);
+        let steepest = road
+            .samples()
+            .iter()
+            .map(|p| p.bank.abs())
+            .fold(0.0, f64::max);
         assert!((steepest.to_degrees() - MAX_BANK_DEGREES).abs() < 1e-9);
     }
 
@@ -468,13 +478,16 @@ mod tests {
             // Steepest: a 20-degree slope (5 m over 20 m) on a 15-degree bank.
             assert!(n[1] > 0.85, "triangle {t} faces {n:?}");
         }
-        let skirts = road.skirt_mesh();
+        let skirts = road.skirts_between(0, road.samples().len() - 1);
         for t in 0..skirts.triangles.len() {
             let n = skirts.face_normal(t);
             let vertex = skirts.triangles[t][0] as usize;
             let stored = skirts.normals[vertex].map(f64::from);
             let agree = n[0] * stored[0] + n[1] * stored[1] + n[2] * stored[2];
-            assert!(agree > 0.9, "skirt triangle {t}: winding {n:?}, normal {stored:?}");
+            assert!(
+                agree > 0.9,
+                "skirt triangle {t}: winding {n:?}, normal {stored:?}"
+            );
         }
     }
 
@@ -493,7 +506,14 @@ mod tests {
         });
         let err = blocked.check_geometry().unwrap_err();
         assert!(
-            matches!(err, TrackError::HitsObstacle { segment: 1, obstacle: 0, .. }),
+            matches!(
+                err,
+                TrackError::HitsObstacle {
+                    segment: 1,
+                    obstacle: 0,
+                    ..
+                }
+            ),
             "{err}"
         );
     }

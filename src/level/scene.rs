@@ -3,7 +3,9 @@
 
 use serde_json::{Value, json};
 
-use super::platform::{BLOCK_THICKNESS, Platform};
+use super::platform::{BLOCK_THICKNESS, Platform, PlatformTrack};
+use super::racing::{Obstacle, RacingTrack};
+use super::road::{ROAD_WIDTH, TriangleMesh};
 use super::{Level, Track};
 
 /// What a node is, which picks its material.
@@ -14,15 +16,21 @@ pub enum Material {
     GoalBlock,
     StartMarker,
     GoalMarker,
+    Road,
+    RoadEdge,
+    Obstacle,
 }
 
 impl Material {
-    pub const ALL: [Material; 5] = [
+    pub const ALL: [Material; 8] = [
         Material::Block,
         Material::StartBlock,
         Material::GoalBlock,
         Material::StartMarker,
         Material::GoalMarker,
+        Material::Road,
+        Material::RoadEdge,
+        Material::Obstacle,
     ];
 
     pub fn name(self) -> &'static str {
@@ -32,6 +40,9 @@ impl Material {
             Material::GoalBlock => "goal_block",
             Material::StartMarker => "start_marker",
             Material::GoalMarker => "goal_marker",
+            Material::Road => "road",
+            Material::RoadEdge => "road_edge",
+            Material::Obstacle => "obstacle",
         }
     }
 
@@ -43,6 +54,9 @@ impl Material {
             Material::GoalBlock => [0.85, 0.65, 0.10, 1.0],
             Material::StartMarker => [0.10, 0.80, 0.20, 1.0],
             Material::GoalMarker => [0.95, 0.15, 0.10, 1.0],
+            Material::Road => [0.18, 0.18, 0.20, 1.0],
+            Material::RoadEdge => [0.45, 0.40, 0.35, 1.0],
+            Material::Obstacle => [0.60, 0.30, 0.20, 1.0],
         }
     }
 }
@@ -62,93 +76,220 @@ pub struct SceneNode {
     pub extras: Option<Value>,
 }
 
+/// A node of its own geometry (a piece of road, a cylinder), in world coordinates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneMesh {
+    pub name: String,
+    /// Its parts, each drawn with one material.
+    pub primitives: Vec<(TriangleMesh, Material)>,
+    /// Metadata carried into the file (the segment's generator parameters).
+    pub extras: Option<Value>,
+}
+
 /// A level ready to export.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
     pub name: String,
+    /// Boxes (blocks, markers, box obstacles).
     pub nodes: Vec<SceneNode>,
+    /// Nodes with their own geometry, after the boxes.
+    pub meshes: Vec<SceneMesh>,
     /// Metadata of the whole level (game, seed, aux).
     pub extras: Value,
 }
 
-/// Why a level cannot be turned into a scene yet.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error(
-    "exporting {0} levels is not supported yet: the racing game's road geometry lands with the racing game"
-)]
-pub struct UnsupportedGame(pub &'static str);
-
 impl Scene {
-    /// The scene of a level: every block, and start and goal markers.
-    pub fn of_level(level: &Level) -> Result<Scene, UnsupportedGame> {
-        let Track::Platform(track) = &level.track else {
-            return Err(UnsupportedGame("racing"));
-        };
-        let platforms = track.platforms();
-        let block_node = |name: String, p: &Platform, material, extras| SceneNode {
-            name,
-            centre: [
-                p.position[0],
-                p.position[1] - 0.5 * BLOCK_THICKNESS,
-                p.position[2],
-            ],
-            heading: p.heading,
-            extents: [p.size, BLOCK_THICKNESS, p.size],
-            material,
-            extras,
-        };
-        let mut nodes = vec![block_node(
-            "start_block".into(),
-            &platforms[0],
-            Material::StartBlock,
-            None,
-        )];
-        let last = track.block_count() - 1;
-        for (i, (params, placed)) in track.block_params().iter().zip(&platforms[1..]).enumerate() {
-            let material = if i == last {
-                Material::GoalBlock
-            } else {
-                Material::Block
-            };
-            let extras = json!({
-                "index": i,
-                "distance": params.distance,
-                "angle": params.angle,
-                "size": params.size,
-                "height": params.height,
-            });
-            nodes.push(block_node(
-                format!("block_{i:03}"),
-                placed,
-                material,
-                Some(extras),
-            ));
+    /// The scene of a level: every block or piece of road, obstacles, start and goal markers.
+    pub fn of_level(level: &Level) -> Scene {
+        match &level.track {
+            Track::Platform(track) => platform_scene(level, track),
+            Track::Racing(track) => racing_scene(level, track),
         }
-        let marker = |name: &str, base: [f64; 3], height: f64, material| SceneNode {
-            name: name.into(),
-            centre: [base[0], base[1] + 0.5 * height, base[2]],
-            heading: 0.0,
-            extents: [0.3, height, 0.3],
-            material,
-            extras: None,
-        };
-        nodes.push(marker(
-            "start",
-            platforms[0].position,
-            2.0,
-            Material::StartMarker,
-        ));
-        nodes.push(marker("goal", level.goal, 3.0, Material::GoalMarker));
-        Ok(Scene {
-            name: format!("{}_level", level.game()),
-            nodes,
-            extras: json!({
-                "format": super::yaml::FORMAT_NAME,
-                "game": level.game().name(),
-                "seed": level.seed,
-                "aux": level.aux,
-                "blocks": track.block_count(),
-            }),
-        })
     }
+}
+
+fn marker(name: &str, base: [f64; 3], height: f64, material: Material) -> SceneNode {
+    SceneNode {
+        name: name.into(),
+        centre: [base[0], base[1] + 0.5 * height, base[2]],
+        heading: 0.0,
+        extents: [0.3, height, 0.3],
+        material,
+        extras: None,
+    }
+}
+
+fn platform_scene(level: &Level, track: &PlatformTrack) -> Scene {
+    let platforms = track.platforms();
+    let block_node = |name: String, p: &Platform, material, extras| SceneNode {
+        name,
+        centre: [
+            p.position[0],
+            p.position[1] - 0.5 * BLOCK_THICKNESS,
+            p.position[2],
+        ],
+        heading: p.heading,
+        extents: [p.size, BLOCK_THICKNESS, p.size],
+        material,
+        extras,
+    };
+    let mut nodes = vec![block_node(
+        "start_block".into(),
+        &platforms[0],
+        Material::StartBlock,
+        None,
+    )];
+    let last = track.block_count() - 1;
+    for (i, (params, placed)) in track.block_params().iter().zip(&platforms[1..]).enumerate() {
+        let material = if i == last {
+            Material::GoalBlock
+        } else {
+            Material::Block
+        };
+        let extras = json!({
+            "index": i,
+            "distance": params.distance,
+            "angle": params.angle,
+            "size": params.size,
+            "height": params.height,
+        });
+        nodes.push(block_node(
+            format!("block_{i:03}"),
+            placed,
+            material,
+            Some(extras),
+        ));
+    }
+    nodes.push(marker(
+        "start",
+        platforms[0].position,
+        2.0,
+        Material::StartMarker,
+    ));
+    nodes.push(marker("goal", level.goal, 3.0, Material::GoalMarker));
+    Scene {
+        name: format!("{}_level", level.game()),
+        nodes,
+        meshes: Vec::new(),
+        extras: json!({
+            "format": super::yaml::FORMAT_NAME,
+            "game": level.game().name(),
+            "seed": level.seed,
+            "aux": level.aux,
+            "blocks": track.block_count(),
+        }),
+    }
+}
+
+fn racing_scene(level: &Level, track: &RacingTrack) -> Scene {
+    let road = track.road();
+    let mut nodes = vec![
+        marker("start", track.position, 2.0, Material::StartMarker),
+        marker("goal", level.goal, 3.0, Material::GoalMarker),
+    ];
+    let mut meshes: Vec<SceneMesh> = track
+        .segments
+        .iter()
+        .enumerate()
+        .map(|(i, params)| {
+            let (first, last) = road.segment_samples(i);
+            SceneMesh {
+                name: format!("segment_{i:03}"),
+                primitives: vec![
+                    (road.surface_between(first, last), Material::Road),
+                    (road.skirts_between(first, last), Material::RoadEdge),
+                ],
+                extras: Some(json!({
+                    "index": i,
+                    "length": params.length,
+                    "curve": params.curve,
+                    "height": params.height,
+                })),
+            }
+        })
+        .collect();
+    for (i, obstacle) in track.obstacles.iter().enumerate() {
+        let name = format!("obstacle_{i:03}");
+        match *obstacle {
+            Obstacle::Box {
+                position,
+                size,
+                heading,
+            } => nodes.push(SceneNode {
+                name,
+                centre: [position[0], position[1] + 0.5 * size[1], position[2]],
+                heading,
+                extents: size,
+                material: Material::Obstacle,
+                extras: Some(json!({"kind": "box"})),
+            }),
+            Obstacle::Cylinder {
+                position,
+                radius,
+                height,
+            } => meshes.push(SceneMesh {
+                name,
+                primitives: vec![(cylinder(position, radius, height), Material::Obstacle)],
+                extras: Some(json!({"kind": "cylinder", "radius": radius, "height": height})),
+            }),
+        }
+    }
+    Scene {
+        name: format!("{}_level", level.game()),
+        nodes,
+        meshes,
+        extras: json!({
+            "format": super::yaml::FORMAT_NAME,
+            "game": level.game().name(),
+            "seed": level.seed,
+            "aux": level.aux,
+            "segments": track.segments.len(),
+            "road_width": ROAD_WIDTH,
+            "road_length": road.length(),
+        }),
+    }
+}
+
+/// Sides of a cylinder's mesh.
+const CYLINDER_SIDES: usize = 24;
+
+/// An upright cylinder standing on `base`: side, top and bottom, normals outward.
+fn cylinder(base: [f64; 3], radius: f64, height: f64) -> TriangleMesh {
+    let mut mesh = TriangleMesh::default();
+    let angle = |k: usize| std::f64::consts::TAU * k as f64 / CYLINDER_SIDES as f64;
+    // Side: a strip of (bottom, top) pairs around, u around the cylinder.
+    for k in 0..=CYLINDER_SIDES {
+        let (s, c) = angle(k).sin_cos();
+        // Counter-clockwise seen from above is toward -z from +x: (cos a, -sin a).
+        let normal = [c as f32, 0.0, -s as f32];
+        let x = base[0] + radius * c;
+        let z = base[2] - radius * s;
+        let u = k as f32 / CYLINDER_SIDES as f32;
+        mesh.vertex([x, base[1], z], normal, [u, 1.0]);
+        mesh.vertex([x, base[1] + height, z], normal, [u, 0.0]);
+    }
+    mesh.strip(0, CYLINDER_SIDES + 1, 0, 1);
+    // Caps: a fan around a centre vertex each.
+    for (y, up) in [(base[1] + height, 1.0f32), (base[1], -1.0)] {
+        let centre = mesh.positions.len() as u32;
+        mesh.vertex([base[0], y, base[2]], [0.0, up, 0.0], [0.5, 0.5]);
+        for k in 0..CYLINDER_SIDES {
+            let (s, c) = angle(k).sin_cos();
+            mesh.vertex(
+                [base[0] + radius * c, y, base[2] - radius * s],
+                [0.0, up, 0.0],
+                [0.5 + 0.5 * c as f32, 0.5 - 0.5 * s as f32],
+            );
+        }
+        for k in 0..CYLINDER_SIDES as u32 {
+            let a = centre + 1 + k;
+            let b = centre + 1 + (k + 1) % CYLINDER_SIDES as u32;
+            mesh.triangles.push(if up > 0.0 {
+                [centre, a, b]
+            } else {
+                [centre, b, a]
+            });
+        }
+    }
+    mesh
 }

@@ -443,9 +443,7 @@ impl LevelFile {
                 if track.segments.len() <= super::racing::MAX_SEGMENTS {
                     let geometry = track.check_geometry().map_err(|e| {
                         let (field, index) = match e {
-                            super::racing::TrackError::Crosses { later, .. } => {
-                                ("segments", later)
-                            }
+                            super::racing::TrackError::Crosses { later, .. } => ("segments", later),
                             super::racing::TrackError::HitsObstacle { segment, .. } => {
                                 ("segments", segment)
                             }

@@ -333,3 +333,52 @@ impl PlatformEnv {
         self.outcome
     }
 }
+
+impl crate::game::SolverEnv for PlatformEnv {
+    type Action = PlatformAction;
+    type Scripted = super::ScriptedController;
+    const OBSERVATION_SIZE: usize = OBSERVATION_SIZE;
+
+    fn reset(&mut self, seed: u64) {
+        PlatformEnv::reset(self, seed);
+    }
+
+    fn step(&mut self, action: PlatformAction) -> Step {
+        PlatformEnv::step(self, action)
+    }
+
+    fn observe(&self, out: &mut [f32]) {
+        PlatformEnv::observe(self, out);
+    }
+
+    fn action_from_policy_row(row: &[f32]) -> PlatformAction {
+        PlatformAction::from_policy_row(row)
+    }
+
+    fn random_action(rng: &mut ChaCha8Rng) -> PlatformAction {
+        PlatformAction {
+            forward: rng.random_range(-1.0..=1.0),
+            turn: rng.random_range(-1.0..=1.0),
+            jump: rng.random_bool(0.5),
+        }
+    }
+
+    fn scripted(seed: u64) -> super::ScriptedController {
+        super::ScriptedController::new(seed, super::scripted::VERIFY_JITTER)
+    }
+
+    fn trial_result(&self, outcome: Outcome) -> crate::level::stats::TrialResult {
+        crate::level::stats::TrialResult {
+            outcome,
+            progress: self.progress(),
+            target_piece: self.furthest(),
+            steps: self.steps(),
+            air_steps: None,
+        }
+    }
+
+    fn marker(&self) -> [f32; 3] {
+        let f = self.character().feet;
+        [f.x, f.y, f.z]
+    }
+}

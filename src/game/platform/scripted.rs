@@ -13,6 +13,8 @@ use super::character::{
 use super::env::PlatformEnv;
 use super::world::PlatformBox;
 
+/// Take-off jitter of the scripted controller when it verifies levels, m.
+pub const VERIFY_JITTER: f32 = 0.3;
 /// Metres inside the next block's near edge the controller aims to land.
 const LANDING_DEPTH: f32 = 1.5;
 /// Largest heading error, degrees, at which it still runs and jumps.
@@ -129,5 +131,11 @@ fn wrap_radians(angle: f32) -> f32 {
         wrapped - tau
     } else {
         wrapped
+    }
+}
+
+impl crate::game::Scripted<PlatformEnv> for ScriptedController {
+    fn act(&mut self, env: &PlatformEnv) -> PlatformAction {
+        ScriptedController::act(self, env)
     }
 }

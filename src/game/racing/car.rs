@@ -42,7 +42,7 @@ pub const BRAKE_IMPULSE: f32 = MASS * 0.8 * GRAVITY * DECISION_DT / 4.0;
 /// Front wheels' steering at full lock, radians.
 pub const MAX_STEER: f32 = 0.5;
 /// Tyre friction coefficient (rapier's `friction_slip`).
-pub const FRICTION: f32 = 1.1;
+pub const FRICTION: f32 = 0.9;
 /// The car starts this far along the road, m, and this high above it.
 pub const START_S: f64 = 5.0;
 const START_LIFT: f32 = 0.25;

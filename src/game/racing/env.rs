@@ -270,7 +270,11 @@ impl RacingEnv {
         let yaw = (-forward.z).atan2(forward.x);
         let level = Rotation::from_rotation_y(yaw);
         let into_level = level.inverse();
-        let goal = Vector::new(self.goal[0] as f32, self.goal[1] as f32, self.goal[2] as f32);
+        let goal = Vector::new(
+            self.goal[0] as f32,
+            self.goal[1] as f32,
+            self.goal[2] as f32,
+        );
         let to_goal = into_level * (goal - position);
         let bearing = (-to_goal.z).atan2(to_goal.x);
         let sample = self.road.samples()[self.nearest];
@@ -296,9 +300,9 @@ impl RacingEnv {
         out[..values.len()].copy_from_slice(&values);
         let fan = &mut out[OBSERVATION_SIZE - FAN_SIZE..];
         let origins = FAN_FORWARD.iter().flat_map(|&f| {
-            FAN_LEFT.iter().map(move |&l| {
-                position + level * Vector::new(f, FAN_START_HEIGHT, -l)
-            })
+            FAN_LEFT
+                .iter()
+                .map(move |&l| position + level * Vector::new(f, FAN_START_HEIGHT, -l))
         });
         self.world.cast_down(origins, FAN_LENGTH, fan);
         for depth in fan.iter_mut() {
@@ -370,4 +374,74 @@ fn to_f64(v: Vector) -> [f64; 3] {
 
 fn to_f32(p: [f64; 3]) -> Vector {
     Vector::new(p[0] as f32, p[1] as f32, p[2] as f32)
+}
+
+impl Clone for RacingEnv {
+    /// The same track and goal, with the car back at the start (seed 0).
+    fn clone(&self) -> Self {
+        let mut env = Self {
+            road: self.road.clone(),
+            shapes: self.shapes.clone(),
+            goal: self.goal,
+            rewards: self.rewards,
+            world: RacingWorld::new(&self.shapes, Vector::ZERO, 0.0),
+            max_steps: self.max_steps,
+            nearest: 0,
+            along: 0.0,
+            steps: 0,
+            air_steps: 0,
+            loose_steps: 0,
+            flipped_steps: 0,
+            outcome: None,
+        };
+        env.reset(0);
+        env
+    }
+}
+
+impl crate::game::SolverEnv for RacingEnv {
+    type Action = CarAction;
+    type Scripted = super::ScriptedDriver;
+    const OBSERVATION_SIZE: usize = OBSERVATION_SIZE;
+
+    fn reset(&mut self, seed: u64) {
+        RacingEnv::reset(self, seed);
+    }
+
+    fn step(&mut self, action: CarAction) -> Step {
+        RacingEnv::step(self, action)
+    }
+
+    fn observe(&self, out: &mut [f32]) {
+        RacingEnv::observe(self, out);
+    }
+
+    fn action_from_policy_row(row: &[f32]) -> CarAction {
+        CarAction::from_policy_row(row)
+    }
+
+    fn random_action(rng: &mut ChaCha8Rng) -> CarAction {
+        CarAction {
+            throttle: rng.random_range(-1.0..=1.0),
+            steer: rng.random_range(-1.0..=1.0),
+        }
+    }
+
+    fn scripted(seed: u64) -> super::ScriptedDriver {
+        super::ScriptedDriver::new(seed, super::scripted::VERIFY_JITTER)
+    }
+
+    fn trial_result(&self, outcome: Outcome) -> crate::level::stats::TrialResult {
+        crate::level::stats::TrialResult {
+            outcome,
+            progress: self.progress(),
+            target_piece: self.segment(),
+            steps: self.steps(),
+            air_steps: Some(self.air_steps()),
+        }
+    }
+
+    fn marker(&self) -> [f32; 3] {
+        self.world.position().to_array()
+    }
 }

@@ -4,6 +4,7 @@
 
 pub mod car;
 pub mod env;
+pub mod feasibility;
 pub mod rules;
 pub mod scripted;
 

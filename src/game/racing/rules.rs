@@ -175,17 +175,20 @@ fn draw(
     goal: [f64; 3],
     config: &RacingRulesConfig,
 ) -> SegmentParams {
-    let length = quantize(rng.random_range(params::SEGMENT_LENGTH.min..=params::SEGMENT_LENGTH.max));
+    let length =
+        quantize(rng.random_range(params::SEGMENT_LENGTH.min..=params::SEGMENT_LENGTH.max));
     let to_goal = direction_heading(goal[0] - end[0], goal[2] - end[2]);
     let error = wrap_degrees(to_goal - heading);
     let max_curve = config.max_curve;
     let lean = (0.5 * error).clamp(-max_curve, max_curve);
-    let curve = quantize((lean + rng.random_range(-max_curve..=max_curve)).clamp(-max_curve, max_curve));
+    let curve =
+        quantize((lean + rng.random_range(-max_curve..=max_curve)).clamp(-max_curve, max_curve));
     let segments_left = (plan_distance(end, goal) / 25.0).max(1.0);
     let max_height = config.max_height;
     let climb = (goal[1] - end[1]) / segments_left;
-    let height =
-        quantize((climb + rng.random_range(-max_height..=max_height)).clamp(-max_height, max_height));
+    let height = quantize(
+        (climb + rng.random_range(-max_height..=max_height)).clamp(-max_height, max_height),
+    );
     SegmentParams {
         length,
         curve,

@@ -10,6 +10,8 @@ use rapier3d::math::Vector;
 use super::car::{CarAction, FRICTION, GRAVITY, MAX_STEER};
 use super::env::RacingEnv;
 
+/// Speed jitter of the scripted driver when it verifies tracks (±10%).
+pub const VERIFY_JITTER: f32 = 0.1;
 /// Distance between the front and rear axles, m.
 const WHEELBASE: f32 = 2.6;
 /// The fastest the driver goes on a straight, m/s.
@@ -25,6 +27,8 @@ const PLANNED_BRAKING: f32 = 4.0;
 pub struct ScriptedDriver {
     /// Speed factor of this run (1 ± jitter).
     pace: f32,
+    /// Hold this speed whatever the road ahead (to measure what the car can do).
+    hold: Option<f32>,
 }
 
 impl ScriptedDriver {
@@ -34,6 +38,16 @@ impl ScriptedDriver {
         let jitter = jitter.clamp(0.0, 0.9);
         Self {
             pace: 1.0 + rng.random_range(-jitter..=jitter),
+            hold: None,
+        }
+    }
+
+    /// A driver that steers as the scripted one but holds `speed` m/s (braking if it must),
+    /// blind to curves and crests ahead.
+    pub fn holding(speed: f32) -> Self {
+        Self {
+            pace: 1.0,
+            hold: Some(speed),
         }
     }
 
@@ -81,7 +95,8 @@ impl ScriptedDriver {
         let look = (4.0 + 0.6 * speed.max(0.0)).clamp(6.0, 20.0);
         let road = env.road();
         let target = road.samples()[road.nearest_along(env.along() + look as f64)].centre;
-        let to_target = Vector::new(target[0] as f32, target[1] as f32, target[2] as f32) - position;
+        let to_target =
+            Vector::new(target[0] as f32, target[1] as f32, target[2] as f32) - position;
         let yaw = (-forward.z).atan2(forward.x);
         let (s, c) = yaw.sin_cos();
         let ahead = to_target.x * c - to_target.z * s;
@@ -89,11 +104,20 @@ impl ScriptedDriver {
         let alpha = left.atan2(ahead);
         let distance = ahead.hypot(left).max(1.0);
         let steer = (2.0 * WHEELBASE * alpha.sin() / distance).atan() / MAX_STEER;
-        let wanted = self.pace * Self::safe_speed(env, env.along(), speed.max(0.0));
-        let throttle = (0.5 * (wanted - speed)).clamp(-1.0, 1.0);
+        let wanted = match self.hold {
+            Some(hold) => hold,
+            None => self.pace * Self::safe_speed(env, env.along(), speed.max(0.0)),
+        };
+        let throttle = (0.8 * (wanted - speed)).clamp(-1.0, 1.0);
         CarAction {
             throttle,
             steer: steer.clamp(-1.0, 1.0),
         }
+    }
+}
+
+impl crate::game::Scripted<RacingEnv> for ScriptedDriver {
+    fn act(&mut self, env: &RacingEnv) -> CarAction {
+        ScriptedDriver::act(self, env)
     }
 }

@@ -1,0 +1,154 @@
+//! What the car can do, measured in the real simulation with the scripted driver: top speed, the
+//! fastest constant speed through the tightest curve, and the air time crests give at speed.
+//! `docs/racing-physics.md` prints these figures; a test re-measures them.
+
+use super::car::{CarAction, DECISION_DT};
+use super::env::{RacingEnv, SolverRewards};
+use super::scripted::ScriptedDriver;
+use crate::level::racing::{RacingTrack, SegmentParams};
+use crate::level::stats::Outcome;
+
+/// The tightest curve the ranges allow: 30 degrees over 20 m (radius 38 m, banked 15 degrees).
+pub const TIGHTEST: SegmentParams = SegmentParams {
+    length: 20.0,
+    curve: 30.0,
+    height: 0.0,
+};
+
+/// A track of `lead` straight 30 m segments, then `middle`, then two straight 30 m segments.
+pub fn test_track(lead: usize, middle: &[SegmentParams]) -> RacingTrack {
+    let straight = SegmentParams {
+        length: 30.0,
+        curve: 0.0,
+        height: 0.0,
+    };
+    let mut track = RacingTrack::new([0.0; 3], 0.0);
+    track.segments = std::iter::repeat_n(straight, lead)
+        .chain(middle.iter().copied())
+        .chain([straight; 2])
+        .collect();
+    track
+}
+
+/// How one measured run went.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Run {
+    pub outcome: Outcome,
+    /// Seconds in the air.
+    pub air_s: f32,
+    /// Fastest speed reached, m/s.
+    pub top_speed: f32,
+}
+
+/// Drives `track` with `driver` until the run ends.
+pub fn drive(track: &RacingTrack, driver: &mut ScriptedDriver, seed: u64) -> Run {
+    let goal = track.road().end().0;
+    let mut env = RacingEnv::new(track, goal, SolverRewards::default());
+    env.reset(seed);
+    let mut top_speed: f32 = 0.0;
+    loop {
+        let action = driver.act(&env);
+        let step = env.step(action);
+        top_speed = top_speed.max(env.world().velocity().length());
+        if let Some(outcome) = step.outcome {
+            return Run {
+                outcome,
+                air_s: env.air_steps() as f32 * DECISION_DT,
+                top_speed,
+            };
+        }
+    }
+}
+
+/// Top speed at full throttle on a long straight, m/s.
+pub fn top_speed() -> f32 {
+    let track = test_track(12, &[]);
+    let goal = track.road().end().0;
+    let mut env = RacingEnv::new(&track, goal, SolverRewards::default());
+    let mut top: f32 = 0.0;
+    while env
+        .step(CarAction {
+            throttle: 1.0,
+            steer: 0.0,
+        })
+        .outcome
+        .is_none()
+    {
+        top = top.max(env.world().velocity().length());
+    }
+    top
+}
+
+/// The fastest speed (to 1 m/s) that the car holds through `curves` tightest curves in a row
+/// without leaving the road, over `seeds` seeded starts.
+pub fn cornering_speed(curves: usize, seeds: u64) -> f32 {
+    let track = test_track(12, &vec![TIGHTEST; curves]);
+    (8..=40)
+        .map(|v| v as f32)
+        .take_while(|&v| {
+            (0..seeds).all(|seed| {
+                drive(&track, &mut ScriptedDriver::holding(v), seed).outcome == Outcome::Success
+            })
+        })
+        .last()
+        .unwrap_or(0.0)
+}
+
+/// Air time (s) and outcome of a crest: `height` m up over one 20 m segment and down over the
+/// next, driven at a held `speed`.
+pub fn crest(height: f64, speed: f32) -> Run {
+    let up = SegmentParams {
+        length: 20.0,
+        curve: 0.0,
+        height,
+    };
+    let down = SegmentParams {
+        height: -height,
+        ..up
+    };
+    drive(
+        &test_track(12, &[up, down]),
+        &mut ScriptedDriver::holding(speed),
+        0,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    #[ignore = "prints the table of docs/racing-physics.md"]
+    fn print_table() {
+        println!("top speed {:.1}", top_speed());
+        for curves in [1, 2, 4] {
+            println!("cornering {curves}: {}", cornering_speed(curves, 3));
+        }
+        let track = test_track(12, &[TIGHTEST; 4]);
+        let run = drive(&track, &mut ScriptedDriver::new(0, 0.0), 0);
+        println!("scripted through 4 tightest: {run:?}");
+        for v in [15.0, 20.0, 25.0, 30.0] {
+            let up = SegmentParams {
+                length: 20.0,
+                curve: 0.0,
+                height: 5.0,
+            };
+            let down = SegmentParams {
+                length: 20.0,
+                curve: 30.0,
+                height: -5.0,
+            };
+            let run = drive(
+                &test_track(12, &[up, down, TIGHTEST]),
+                &mut ScriptedDriver::holding(v),
+                0,
+            );
+            println!("crest into curve at {v}: {run:?}");
+        }
+        for h in [1.0, 2.0, 3.0, 4.0, 5.0] {
+            for v in [15.0, 20.0, 25.0, 30.0] {
+                println!("crest {h} at {v}: {:?}", crest(h, v));
+            }
+        }
+    }
+}

@@ -117,38 +117,46 @@ pub fn crest(height: f64, speed: f32) -> Run {
 mod tests {
     use super::*;
 
+    /// Re-measures the figures docs/racing-physics.md states.
     #[test]
-    #[ignore = "prints the table of docs/racing-physics.md"]
-    fn print_table() {
-        println!("top speed {:.1}", top_speed());
-        for curves in [1, 2, 4] {
-            println!("cornering {curves}: {}", cornering_speed(curves, 3));
-        }
+    fn the_documented_feasibility_figures_hold() {
+        let top = top_speed();
+        assert!((27.0..=29.0).contains(&top), "top speed {top} m/s");
+        // One tightest curve at top speed; four in a row need braking to about 22 m/s.
+        assert!(cornering_speed(1, 2) >= 28.0);
+        let four = cornering_speed(4, 2);
+        assert!(
+            (20.0..=24.0).contains(&four),
+            "four tightest curves held at {four} m/s"
+        );
         let track = test_track(12, &[TIGHTEST; 4]);
-        let run = drive(&track, &mut ScriptedDriver::new(0, 0.0), 0);
-        println!("scripted through 4 tightest: {run:?}");
-        for v in [15.0, 20.0, 25.0, 30.0] {
-            let up = SegmentParams {
-                length: 20.0,
-                curve: 0.0,
-                height: 5.0,
-            };
-            let down = SegmentParams {
-                length: 20.0,
-                curve: 30.0,
-                height: -5.0,
-            };
-            let run = drive(
-                &test_track(12, &[up, down, TIGHTEST]),
-                &mut ScriptedDriver::holding(v),
-                0,
-            );
-            println!("crest into curve at {v}: {run:?}");
-        }
-        for h in [1.0, 2.0, 3.0, 4.0, 5.0] {
-            for v in [15.0, 20.0, 25.0, 30.0] {
-                println!("crest {h} at {v}: {:?}", crest(h, v));
-            }
-        }
+        let braking = drive(&track, &mut ScriptedDriver::new(0, 0.0), 0);
+        assert_eq!(braking.outcome, Outcome::Success, "{braking:?}");
+        // Crests: none at 15 m/s, air at speed, more the higher the crest.
+        assert_eq!(crest(5.0, 15.0).air_s, 0.0);
+        let low = crest(3.0, 25.0);
+        let high = crest(5.0, 25.0);
+        assert!(
+            low.air_s > 0.5 && high.air_s > low.air_s + 0.3,
+            "{low:?} {high:?}"
+        );
+        assert_eq!(high.outcome, Outcome::Success);
+        // What the car cannot do: a 5 m crest into the tightest curve at 20 m/s.
+        let up = SegmentParams {
+            length: 20.0,
+            curve: 0.0,
+            height: 5.0,
+        };
+        let down = SegmentParams {
+            length: 20.0,
+            curve: 30.0,
+            height: -5.0,
+        };
+        let jump = drive(
+            &test_track(12, &[up, down, TIGHTEST]),
+            &mut ScriptedDriver::holding(20.0),
+            0,
+        );
+        assert_eq!(jump.outcome, Outcome::OffRoad, "{jump:?}");
     }
 }

@@ -1,0 +1,279 @@
+//! The racing game as a user meets it: rule tracks the scripted driver clears, runs that repeat
+//! bit for bit, a car that stands on its four wheels, track files that round-trip and refuse
+//! broken roads with the field and line, and glTF that reads back with the `gltf` crate.
+
+use arlpcg::game::SolverEnv;
+use arlpcg::game::racing::car::CarAction;
+use arlpcg::game::racing::feasibility::test_track;
+use arlpcg::game::racing::{RacingEnv, ScriptedDriver, SolverRewards, rules};
+use arlpcg::level::racing::{RacingRulesConfig, RacingTrack, SegmentParams};
+use arlpcg::level::scene::Scene;
+use arlpcg::level::stats::Outcome;
+use arlpcg::level::{Level, Track, gltf as export, yaml};
+use arlpcg::verify::{Solver, Summary, verify};
+
+fn rule_level(seed: u64, obstacles: u32) -> Level {
+    let config = RacingRulesConfig {
+        obstacles,
+        ..RacingRulesConfig::default()
+    };
+    rules::racing_level(seed, None, None, &config).unwrap()
+}
+
+fn track(level: &Level) -> &RacingTrack {
+    match &level.track {
+        Track::Racing(track) => track,
+        Track::Platform(_) => panic!("a racing level"),
+    }
+}
+
+/// Positions and velocities of every step, as raw bits.
+fn trajectory(level: &Level, seed: u64) -> Vec<[u32; 6]> {
+    let mut env = RacingEnv::new(track(level), level.goal, SolverRewards::default());
+    env.reset(seed);
+    let mut driver = ScriptedDriver::new(seed, 0.1);
+    let mut out = Vec::new();
+    for step in 0.. {
+        // A wobble on top of the driver so that the run exercises slides and air.
+        let mut action = driver.act(&env);
+        action.steer += if step % 40 < 20 { 0.3 } else { -0.3 };
+        let done = env.step(action).outcome.is_some();
+        let p = env.world().position();
+        let v = env.world().velocity();
+        out.push([p.x, p.y, p.z, v.x, v.y, v.z].map(f32::to_bits));
+        if done {
+            break;
+        }
+    }
+    out
+}
+
+#[test]
+fn same_track_seed_and_actions_give_a_bitwise_identical_trajectory() {
+    let level = rule_level(5, 2);
+    let first = trajectory(&level, 3);
+    assert!(first.len() > 100, "the run lasted {} steps", first.len());
+    assert_eq!(first, trajectory(&level, 3));
+    // A different seed starts elsewhere: the check above can fail.
+    assert_ne!(first, trajectory(&level, 4));
+    // A clone of an environment that has run replays the same run too.
+    let mut env = RacingEnv::new(track(&level), level.goal, SolverRewards::default());
+    for _ in 0..50 {
+        env.step(CarAction {
+            throttle: 1.0,
+            steer: 0.2,
+        });
+    }
+    let mut clone = env.clone();
+    clone.reset(3);
+    let mut again = RacingEnv::new(track(&level), level.goal, SolverRewards::default());
+    again.reset(3);
+    for _ in 0..100 {
+        let action = CarAction {
+            throttle: 0.8,
+            steer: -0.1,
+        };
+        clone.step(action);
+        again.step(action);
+        assert_eq!(
+            clone.world().position().to_array().map(f32::to_bits),
+            again.world().position().to_array().map(f32::to_bits)
+        );
+    }
+}
+
+#[test]
+fn the_car_stands_on_four_wheels_on_a_straight_and_drives_it() {
+    let track = test_track(3, &[]);
+    let goal = track.road().end().0;
+    let mut env = RacingEnv::new(&track, goal, SolverRewards::default());
+    for _ in 0..60 {
+        env.step(CarAction::default());
+    }
+    assert_eq!(env.world().wheels_in_contact(), 4);
+    let still = env.world().velocity().length();
+    assert!(still < 0.2, "the car at rest moves at {still} m/s");
+    let up = env.world().rotation() * rapier3d::math::Vector::Y;
+    assert!(up.y > 0.99, "the car at rest tilts: up = {up:?}");
+    let mut outcome = None;
+    while outcome.is_none() {
+        outcome = env
+            .step(CarAction {
+                throttle: 1.0,
+                steer: 0.0,
+            })
+            .outcome;
+    }
+    assert_eq!(outcome, Some(Outcome::Success));
+    assert_eq!(env.air_steps(), 0, "a flat straight gives no air time");
+}
+
+#[test]
+fn rule_tracks_are_cleared_by_the_scripted_driver() {
+    let stats: Vec<_> = (0..8)
+        .map(|seed| {
+            let level = rule_level(seed, (seed % 3) as u32);
+            verify(&level, &Solver::Scripted, 10, 0, &|| {}).unwrap()
+        })
+        .collect();
+    let summary = Summary::of(&stats);
+    assert!(
+        summary.mean_success >= 0.9,
+        "scripted success {} over rule tracks: {stats:?}",
+        summary.mean_success
+    );
+    for s in &stats {
+        assert!(
+            s.mean_air_steps.is_some(),
+            "racing statistics carry air time"
+        );
+        assert_eq!(s.successes + s.off_road + s.flipped + s.timed_out, s.trials);
+    }
+}
+
+#[test]
+fn random_actions_rarely_finish_and_their_failures_are_counted() {
+    let level = rule_level(2, 0);
+    let stats = verify(&level, &Solver::Random, 12, 0, &|| {}).unwrap();
+    assert!(stats.success_ratio < 0.2, "{stats:?}");
+    assert_eq!(
+        stats.failures_by_piece.iter().sum::<u32>(),
+        stats.trials - stats.successes
+    );
+}
+
+#[test]
+fn rule_tracks_reach_their_goal_and_avoid_their_obstacles() {
+    for seed in 0..6 {
+        let level = rule_level(seed, 4);
+        let track = track(&level);
+        assert!(!track.obstacles.is_empty());
+        track.check_geometry().unwrap();
+        level.validate().unwrap();
+        // Same seed, same bytes.
+        assert_eq!(
+            yaml::to_string(&level),
+            yaml::to_string(&rule_level(seed, 4))
+        );
+    }
+}
+
+#[test]
+fn track_files_round_trip_and_broken_roads_are_named() {
+    let level = rule_level(7, 3);
+    let text = yaml::to_string(&level);
+    let back = yaml::parse(&text).unwrap();
+    assert_eq!(back, level);
+    assert_eq!(yaml::to_string(&back), text);
+
+    let hand = "\
+format: arlpcg-level
+version: 1
+game: racing
+start: {position: [0, 0, 0], heading: 0}
+segments:
+- {length: 30, curve: 30, height: 0}
+";
+    let level = yaml::parse(hand).unwrap();
+    assert_eq!(
+        level.goal,
+        track(&level)
+            .road()
+            .end()
+            .0
+            .map(arlpcg::level::params::quantize)
+    );
+    let problem = |text: &str| yaml::parse(text).unwrap_err().to_string();
+    let looping = hand.to_string() + &"- {length: 30, curve: 30, height: 0}\n".repeat(12);
+    let msg = problem(&looping);
+    assert!(
+        msg.contains("segments[") && msg.contains("crosses segment"),
+        "{msg}"
+    );
+    assert!(msg.contains("(line "), "{msg}");
+    let blocked = format!(
+        "{hand}obstacles:\n- {{kind: cylinder, position: [15, 0, -2], radius: 2, height: 4}}\n"
+    );
+    let msg = problem(&blocked);
+    assert!(
+        msg.contains("segments[0]: segment 0 runs into obstacle 0"),
+        "{msg}"
+    );
+    let far = format!("{hand}goal: [300, 0, 0]\n");
+    assert!(problem(&far).contains("does not reach the goal"));
+    let nan = format!(
+        "{hand}obstacles:\n- {{kind: cylinder, position: [100, .nan, 0], radius: 2, height: 4}}\n"
+    );
+    let msg = problem(&nan);
+    assert!(msg.contains("obstacles[0]: position"), "{msg}");
+    let odd = format!(
+        "{hand}obstacles:\n- {{kind: pyramid, position: [100, 0, 0], radius: 2, height: 4}}\n"
+    );
+    assert!(problem(&odd).contains("unknown variant `pyramid`"));
+    let steep = hand.replace("height: 0}", "height: 7}");
+    assert!(problem(&steep).contains("height 7 is out of range [-5, 5] m"));
+    let rules_mixup = format!(
+        "{hand}source: {{kind: rules, rules: {{max_blocks: 5, angle_spread: 5, reach_margin: 1}}}}\n"
+    );
+    assert!(problem(&rules_mixup).contains("racing-rules"));
+}
+
+#[test]
+fn racing_gltf_reads_back_with_a_mesh_per_segment_facing_up() {
+    let level = rule_level(3, 3);
+    let track = track(&level);
+    let glb = export::to_glb(&Scene::of_level(&level));
+    // Left for `.ci/run` to pass through the Khronos validator.
+    let exports = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("gltf-exports");
+    std::fs::create_dir_all(&exports).unwrap();
+    std::fs::write(exports.join("racing_rules_seed3.glb"), &glb).unwrap();
+    let (document, buffers, _) = gltf::import_slice(&glb).expect("the .glb imports");
+    let segments: Vec<gltf::Node> = document
+        .nodes()
+        .filter(|n| n.name().is_some_and(|name| name.starts_with("segment_")))
+        .collect();
+    assert_eq!(segments.len(), track.segments.len());
+    let obstacles = document
+        .nodes()
+        .filter(|n| n.name().is_some_and(|name| name.starts_with("obstacle_")))
+        .count();
+    assert_eq!(obstacles, track.obstacles.len());
+    let extras: serde_json::Value =
+        serde_json::from_str(segments[2].extras().as_ref().unwrap().get()).unwrap();
+    assert_eq!(extras["curve"], track.segments[2].curve);
+    for node in &segments {
+        let mesh = node.mesh().unwrap();
+        let surface = mesh.primitives().next().unwrap();
+        assert_eq!(surface.material().name(), Some("road"));
+        let reader = surface.reader(|b| Some(&buffers[b.index()]));
+        let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+        let uvs = reader.read_tex_coords(0).unwrap().into_f32().count();
+        assert_eq!(uvs, positions.len());
+        let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+        for t in indices.chunks(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
+            let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            let up = e1[2] * e2[0] - e1[0] * e2[2];
+            assert!(up > 0.0, "{:?}: a road triangle faces down", node.name());
+        }
+    }
+    // The road's end is where the track file says the road ends.
+    let last = segments.last().unwrap().mesh().unwrap();
+    let bounds = last.primitives().next().unwrap().bounding_box();
+    let (end, _) = track.road().end();
+    assert!(end[0] as f32 >= bounds.min[0] - 1e-3 && end[0] as f32 <= bounds.max[0] + 1e-3);
+}
+
+#[test]
+fn a_segment_can_be_built_from_the_generator_ranges_only() {
+    assert!(SegmentParams::new(31.0, 0.0, 0.0).is_err());
+    assert!(SegmentParams::new(25.0, f64::NAN, 0.0).is_err());
+    assert!(SegmentParams::new(25.0, -30.0, 5.0).is_ok());
+    // The environment's observation has the size its layout says, and finite values.
+    let level = rule_level(1, 2);
+    let env = RacingEnv::new(track(&level), level.goal, SolverRewards::default());
+    let mut observation = vec![f32::NAN; RacingEnv::OBSERVATION_SIZE];
+    env.observe(&mut observation);
+    assert!(observation.iter().all(|x| x.is_finite()), "{observation:?}");
+}

@@ -1,4 +1,4 @@
-//! The paper's evaluation on our platform game (SPEC 4), as pure functions of the policies and
+//! The paper's evaluation on our platform game (docs/spec.md §4), as pure functions of the policies and
 //! the budget: the same policies and budget give the same tables.
 //!
 //! - **Controllability**: Generator levels at λ ∈ {1, 0.5, 0, -0.5, -1} (the same goals at every

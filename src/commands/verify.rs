@@ -72,7 +72,7 @@ struct Solvers {
 }
 
 enum Resolved {
-    Policy(SolverPolicy),
+    Policy(Box<SolverPolicy>),
     Scripted,
     Random,
 }
@@ -93,7 +93,7 @@ impl Solvers {
                 SolverChoice::Scripted
             });
         let resolved = match choice {
-            SolverChoice::Policy => Resolved::Policy(load_solver(&policy, game)?.0),
+            SolverChoice::Policy => Resolved::Policy(Box::new(load_solver(&policy, game)?.0)),
             SolverChoice::Scripted => Resolved::Scripted,
             SolverChoice::Random => Resolved::Random,
         };

@@ -1,6 +1,6 @@
 //! `arlpcg design` (and `arlpcg` with no arguments): the designer's terminal UI.
 //!
-//! Three parts, as ARCHITECTURE.md asks: the state and its pure `update` ([`app`]), the drawing
+//! Three parts, as docs/architecture.md asks: the state and its pure `update` ([`app`]), the drawing
 //! that only reads it ([`view`], on the areas of [`layout`]), and this thin shell, which owns
 //! the terminal, turns terminal events and worker answers into messages, and hands the effects
 //! to the worker threads ([`worker`]).

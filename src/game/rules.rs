@@ -1,5 +1,5 @@
 //! Rule-based level generation: the paper's Rule-PCG baseline, and a level source that needs no
-//! trained policy. Parameters are drawn at random within the SPEC ranges, under rules that keep
+//! trained policy. Parameters are drawn at random within the range of docs/spec.md §1.1s, under rules that keep
 //! the level valid and playable: head (loosely) for the goal, never overlap an earlier block,
 //! keep every jump within the character's reach, end on a block that reaches the goal.
 

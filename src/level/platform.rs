@@ -136,7 +136,7 @@ impl Platform {
     }
 
     /// Signed distance between the facing edges of two consecutive blocks along the line joining
-    /// their centres, as the SPEC defines it: distance - (size_a + size_b) / 2.
+    /// their centres, as docs/spec.md §1.1 defines it: distance - (size_a + size_b) / 2.
     pub fn edge_gap(&self, next: &Platform) -> f64 {
         let distance =
             (next.position[0] - self.position[0]).hypot(next.position[2] - self.position[2]);

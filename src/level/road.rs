@@ -209,12 +209,16 @@ impl Road {
                 if later.s - earlier.s <= CROSSING_ARC {
                     break;
                 }
-                let distance = plan_distance(later.centre, earlier.centre);
-                if distance < MIN_SELF_DISTANCE {
+                let (dx, dz) = (
+                    later.centre[0] - earlier.centre[0],
+                    later.centre[2] - earlier.centre[2],
+                );
+                let squared = dx * dx + dz * dz;
+                if squared < MIN_SELF_DISTANCE * MIN_SELF_DISTANCE {
                     return Some(TrackError::Crosses {
                         earlier: earlier.segment,
                         later: later.segment,
-                        distance,
+                        distance: squared.sqrt(),
                     });
                 }
             }
@@ -385,10 +389,6 @@ fn along(
     let y = rise * t * t * (3.0 - 2.0 * t);
     let slope = rise * 6.0 * t * (1.0 - t) / length;
     ([origin[0] + dx, origin[1] + y, origin[2] + dz], h, slope)
-}
-
-fn plan_distance(a: [f64; 3], b: [f64; 3]) -> f64 {
-    (a[0] - b[0]).hypot(a[2] - b[2])
 }
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {

@@ -3,7 +3,7 @@
 //! this is a [`VecEnv`]: the Generator lives inside it and places blocks (one batched forward pass
 //! for every match that needs one) whenever Solvers reach their newest block.
 //!
-//! Training alternates phases (SPEC 3): while the Solver learns, the Generator only runs
+//! Training alternates phases (docs/spec.md §3): while the Solver learns, the Generator only runs
 //! inference; while the Generator learns, the Solver only runs inference and the Generator's
 //! decisions are recorded per match, to be learned from with PPO once enough have completed.
 //! Each match draws its goal, start heading and λ from its own seed (episode counter from

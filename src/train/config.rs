@@ -11,7 +11,7 @@ use super::platform::SolverMode;
 use crate::game::platform::generator::{DEFAULT_MAX_BLOCKS, GeneratorRewards};
 use crate::rl::ppo::PpoConfig;
 
-/// How the Solver is trained (the paper's baselines and its method, SPEC 3).
+/// How the Solver is trained (the paper's baselines and its method, docs/spec.md §3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum TrainMode {
@@ -71,7 +71,7 @@ pub struct GeneratorConfig {
     /// The Generator's PPO (the paper: learning rate 2e-4, γ 0.99). One Generator step is one
     /// block; a batch is `num_envs × num_steps` completed decisions.
     pub ppo: PpoConfig,
-    /// Reward terms and the weights of each aux input (paper eq. 1; SPEC 2).
+    /// Reward terms and the weights of each aux input (paper eq. 1; docs/spec.md §2).
     pub rewards: GeneratorRewards,
     /// λ of each match is drawn uniformly from these (`fixed-aux` holds λ = 1).
     pub aux_values: Vec<f32>,

@@ -1,5 +1,5 @@
 //! The Solver's platform environment: reset with a level and a seed, step with an action, read
-//! the observation (state vector + height map), the reward (SPEC 2) and how the run ended.
+//! the observation (state vector + height map), the reward (docs/spec.md §2) and how the run ended.
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -56,7 +56,7 @@ pub const OBSERVATION_SIZE: usize = {
     total
 };
 
-/// The Solver's reward weights (SPEC 2).
+/// The Solver's reward weights (docs/spec.md §2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverRewards {
     /// Per metre of progress along the track toward the goal (negative when moving back).

@@ -1,4 +1,4 @@
-//! The platform Generator's side of the game (SPEC 1.1 and 2): its observation, its action, its
+//! The platform Generator's side of the game (docs/spec.md §1.1 and §2): its observation, its action, its
 //! rewards, and a [`Match`]: one Generator building a level while one Solver plays it. The
 //! Generator places the next block only when the Solver stands on the newest one, and its episode
 //! ends with the Solver's.
@@ -8,7 +8,7 @@
 //! - progress: `progress_per_metre` for every metre the Solver's furthest block comes closer to
 //!   the goal, whatever λ;
 //! - the Solver fails: `failure · Σ βᵢ λᵢ` (with the default `failure = -10` and β = 1: -10·λ,
-//!   +10 at λ = -1, the SPEC's sign);
+//!   +10 at λ = -1, the sign docs/spec.md §2 decides);
 //! - each block placed: `step_penalty · Σ αᵢ min(λᵢ, 0)` (a small cost only when λ < 0: finish or
 //!   fail fast);
 //! - an invalid placement (overlap) or a track that runs out of blocks before the goal:
@@ -51,10 +51,10 @@ pub const GENERATOR_OBSERVATION_SIZE: usize = {
 };
 
 /// The Generator's action names, in the policy's order, each a value in [-1, 1] mapped onto its
-/// SPEC range. The turn is taken relative to the bearing of the goal (0 aims straight at it) and
+/// range of docs/spec.md §1.1. The turn is taken relative to the bearing of the goal (0 aims straight at it) and
 /// the height change relative to the climb that stays on course for the goal (0 keeps the slope
-/// from the last block to the goal); the level stores both as the SPEC defines them (turn
-/// relative to the last two blocks, height relative to the last block). With the SPEC's own
+/// from the last block to the goal); the level stores both as docs/spec.md §1.1 defines them (turn
+/// relative to the last two blocks, height relative to the last block). With docs/spec.md's own
 /// frames an untrained Generator wanders: in a first run 74-90% of its tracks overlapped
 /// themselves or ran out of blocks and none reached its goal in a million Solver steps, so the
 /// Solver never saw a success.
@@ -79,7 +79,7 @@ pub struct AuxWeights {
     pub beta: f32,
 }
 
-/// The Generator's reward terms (SPEC 2); see the module documentation.
+/// The Generator's reward terms (docs/spec.md §2); see the module documentation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct GeneratorRewards {
@@ -459,7 +459,10 @@ mod tests {
         );
         assert_eq!(block.height, 1.5, "4 m over 20 m, for 7.5 m");
         let steep = block_from_action(&track, [20.0, 40.0, 0.0], &[0.0, 0.0, 0.0, 1.0]);
-        assert_eq!(steep.height, 2.0, "clamped to the SPEC range");
+        assert_eq!(
+            steep.height, 2.0,
+            "clamped to the range of docs/spec.md §1.1"
+        );
     }
 
     #[test]

@@ -209,8 +209,10 @@ impl RacingWorld {
                 &tuning,
             );
         }
-        let mut params = IntegrationParameters::default();
-        params.dt = DECISION_DT;
+        let params = IntegrationParameters {
+            dt: DECISION_DT,
+            ..Default::default()
+        };
         let mut world = Self {
             gravity: Vector::new(0.0, -GRAVITY, 0.0),
             params,

@@ -1,6 +1,6 @@
 //! The Solver's racing environment: reset with a track and a seed, step with throttle and
 //! steering, read the observation (state + centre line ahead + a fan of downward rays), the
-//! reward (docs/rewards.md) and how the run ended: the goal, off the road, flipped or out of time.
+//! reward (docs/spec.md §2; values in docs/racing-physics.md) and how the run ended: the goal, off the road, flipped or out of time.
 //! It counts the steps the car spends in the air.
 
 use rand::{RngExt, SeedableRng};
@@ -72,7 +72,7 @@ pub const OBSERVATION_SIZE: usize = {
 };
 const FAN_SIZE: usize = FAN_FORWARD.len() * FAN_LEFT.len();
 
-/// The Solver's reward weights (docs/rewards.md).
+/// The Solver's reward weights (docs/spec.md §2; values in docs/racing-physics.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverRewards {
     /// Per metre of progress along the centre line (negative when going back).

@@ -117,6 +117,51 @@ pub fn crest(height: f64, speed: f32) -> Run {
 mod tests {
     use super::*;
 
+    #[test]
+    #[ignore = "prints the figures of docs/racing-physics.md"]
+    fn print_figures() {
+        println!("top speed {:.1} m/s", top_speed());
+        for curves in [1, 2, 3, 4, 6] {
+            println!(
+                "{curves} tightest curves: held at {} m/s",
+                cornering_speed(curves, 3)
+            );
+        }
+        for h in [1.0, 2.0, 3.0, 4.0, 5.0] {
+            let row: Vec<String> = [15.0, 20.0, 25.0, 28.0]
+                .iter()
+                .map(|&v| {
+                    let r = crest(h, v);
+                    format!("{:.2} s {:?}", r.air_s, r.outcome)
+                })
+                .collect();
+            println!("crest {h} m: {}", row.join(" | "));
+        }
+        for v in [15.0, 18.0, 20.0, 25.0] {
+            for h in [3.0, 5.0] {
+                let up = SegmentParams {
+                    length: 20.0,
+                    curve: 0.0,
+                    height: h,
+                };
+                let down = SegmentParams {
+                    length: 20.0,
+                    curve: 30.0,
+                    height: -h,
+                };
+                let run = drive(
+                    &test_track(12, &[up, down, TIGHTEST]),
+                    &mut ScriptedDriver::holding(v),
+                    0,
+                );
+                println!(
+                    "crest {h} m into the tightest curve at {v}: {:.2} s {:?}",
+                    run.air_s, run.outcome
+                );
+            }
+        }
+    }
+
     /// Re-measures the figures docs/racing-physics.md states.
     #[test]
     fn the_documented_feasibility_figures_hold() {

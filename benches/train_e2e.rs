@@ -6,11 +6,12 @@
 
 use std::time::Instant;
 
+use arlpcg::game::PlatformGame;
 use arlpcg::rl::policy::{ActorCritic, PolicyShape};
 use arlpcg::rl::ppo::Ppo;
 use arlpcg::rl::vec_env::Trainer;
 use arlpcg::train::TrainConfig;
-use arlpcg::train::platform::{PlatformSolverEnvs, SolverMode, SourceState};
+use arlpcg::train::solver_envs::{SolverEnvs, SolverMode, SourceState};
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
@@ -26,7 +27,7 @@ fn main() {
         binary: 1,
     };
     let ppo = Ppo::new(config.solver.clone(), ActorCritic::new(shape, 0).unwrap()).unwrap();
-    let envs = PlatformSolverEnvs::new(
+    let envs = SolverEnvs::<PlatformGame>::new(
         SolverMode::RulePcg,
         config.solver.num_envs,
         SourceState {

@@ -10,7 +10,7 @@
 //! - **Cross**: every Solver on the controllability levels, success ratio at each λ.
 //!
 //! Levels use seeds from [`EVAL_SEED_BASE`] up, far below the seeds training draws from
-//! ([`crate::train::platform::TRAINING_SEED_BASE`]): no evaluation level was trained on.
+//! ([`crate::train::solver_envs::TRAINING_SEED_BASE`]): no evaluation level was trained on.
 
 use serde::Serialize;
 

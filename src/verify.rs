@@ -10,11 +10,9 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::game::platform::{PlatformEnv, SolverRewards};
-use crate::game::racing::{self, RacingEnv};
-use crate::game::{Scripted, SolverEnv};
+use crate::game::{GameSpec, PlatformGame, RacingGame, Scripted, SolverEnv};
 use crate::level::stats::{SolverRef, SolverStats, TrialResult};
-use crate::level::{Game, Level, PolicyRef, Track};
+use crate::level::{Game, Level, PolicyRef};
 use crate::rl::normalizer::RunningNorm;
 use crate::rl::policy::{ActMode, ActorCritic};
 
@@ -108,29 +106,24 @@ pub fn verify_watched(
     watch: &Watch,
 ) -> Result<Option<SolverStats>, WrongGame> {
     solver.check_game(level.game())?;
-    let results = match &level.track {
-        Track::Platform(track) => {
-            let new_env = || PlatformEnv::new(track, level.goal, SolverRewards::default());
-            play_all(&new_env, solver, trials, seed, watch)
-        }
-        Track::Racing(track) => {
-            let template = RacingEnv::new(track, level.goal, racing::SolverRewards::default());
-            play_all(&|| template.clone(), solver, trials, seed, watch)
-        }
+    let results = match level.game() {
+        Game::Platform => play_all::<PlatformGame>(level, solver, trials, seed, watch),
+        Game::Racing => play_all::<RacingGame>(level, solver, trials, seed, watch),
     };
     Ok(results.map(|results| {
         SolverStats::from_trials(solver.reference(), seed, level.piece_count(), &results)
     }))
 }
 
-/// Plays the trials on environments made by `new_env`; `None` when told to stop.
-fn play_all<E: SolverEnv>(
-    new_env: &(dyn Fn() -> E + Sync),
+/// Plays the trials of a level of game `G`; `None` when told to stop.
+fn play_all<G: GameSpec>(
+    level: &Level,
     solver: &Solver,
     trials: u32,
     seed: u64,
     watch: &Watch,
 ) -> Option<Vec<TrialResult>> {
+    let new_env = &|| G::solver_env(level).expect("verification plays a level of its own game");
     let reported = |result: TrialResult| {
         (watch.on_trial)(&result);
         result
@@ -168,14 +161,15 @@ pub struct Recording {
 /// pass per step), so the run is not one of [`verify`]'s lockstep trials of the same seed.
 pub fn record(level: &Level, solver: &Solver, seed: u64) -> Result<Recording, WrongGame> {
     solver.check_game(level.game())?;
-    Ok(match &level.track {
-        Track::Platform(track) => record_env(
-            PlatformEnv::new(track, level.goal, SolverRewards::default()),
+    let unexpected = "a level's environment is of its own game";
+    Ok(match level.game() {
+        Game::Platform => record_env(
+            PlatformGame::solver_env(level).expect(unexpected),
             solver,
             seed,
         ),
-        Track::Racing(track) => record_env(
-            RacingEnv::new(track, level.goal, racing::SolverRewards::default()),
+        Game::Racing => record_env(
+            RacingGame::solver_env(level).expect(unexpected),
             solver,
             seed,
         ),

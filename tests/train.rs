@@ -577,3 +577,96 @@ fn a_resumed_run_takes_new_hyper_parameters_but_not_a_new_shape() {
     let now = std::fs::read_to_string(out.join("config.yaml")).unwrap();
     assert!(now.contains("learning_rate: 0.001"), "{now}");
 }
+
+/// A racing Solver trains through the same loop as the platform one: its card names the racing
+/// game and its observation, γ defaults to the racing value, it resumes, and `verify` plays it
+/// on racing tracks and refuses it on a platform level.
+#[test]
+fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.yaml");
+    std::fs::write(&config, TINY).unwrap();
+    let out = dir.path().join("run");
+    let out_s = out.to_str().unwrap();
+    let train = |steps: &str, resume: bool| {
+        let mut args = vec![
+            "train",
+            "--game",
+            "racing",
+            "--mode",
+            "rule-pcg",
+            "--steps",
+            steps,
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            out_s,
+        ];
+        if resume {
+            args.push("--resume");
+        }
+        let run = arlpcg(&args);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    };
+    train("256", false);
+    train("512", true);
+    assert_eq!(curve(&out).last().map(|r| r.1), Some(512));
+    let stored = std::fs::read_to_string(out.join("config.yaml")).unwrap();
+    assert!(stored.contains("gamma: 0.998"), "{stored}");
+    let bytes = std::fs::read(out.join("solver.safetensors")).unwrap();
+    let loaded = load_policy(
+        &bytes,
+        Game::Racing,
+        Role::Solver,
+        arlpcg::game::racing::OBSERVATION_SIZE,
+    )
+    .unwrap();
+    assert_eq!(loaded.card.continuous_actions, ["throttle", "steer"]);
+    assert!(loaded.card.binary_actions.is_empty());
+    assert!(load_policy(&bytes, Game::Platform, Role::Solver, OBSERVATION_SIZE).is_err());
+
+    let tracks = dir.path().join("tracks");
+    let made = arlpcg(&[
+        "generate",
+        "--game",
+        "racing",
+        "--rules",
+        "--out",
+        tracks.to_str().unwrap(),
+    ]);
+    assert!(made.status.success());
+    let policy = out.join("solver.safetensors");
+    let played = arlpcg(&[
+        "verify",
+        tracks.join("racing_seed0.yaml").to_str().unwrap(),
+        "--policy",
+        policy.to_str().unwrap(),
+        "--trials",
+        "4",
+        "--json",
+    ]);
+    assert!(
+        played.status.success(),
+        "{}",
+        String::from_utf8_lossy(&played.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&played.stdout).unwrap();
+    assert_eq!(report["trials"], 4);
+    let refused = arlpcg(&[
+        "verify",
+        "levels/hand/staircase.yaml",
+        "--policy",
+        policy.to_str().unwrap(),
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(stderr.contains("racing solver policy"), "{stderr}");
+    let adversarial = arlpcg(&[
+        "train", "--game", "racing", "--mode", "arlpcg", "--steps", "10", "--out", out_s,
+    ]);
+    assert_eq!(adversarial.status.code(), Some(2));
+}

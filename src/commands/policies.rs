@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use sha2::{Digest, Sha256};
 
 use crate::game::platform::generator::{DEFAULT_MAX_BLOCKS, GENERATOR_OBSERVATION_SIZE};
+use crate::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
 use crate::generation::GeneratorPolicy;
 use crate::level::{Game, PolicyRef};
 use crate::rl::checkpoint::{LoadedPolicy, MAX_POLICY_BYTES, PolicyCard, Role, load_policy};
@@ -39,8 +40,8 @@ fn load_pinned(
 /// Loads a Solver policy of `game`.
 pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)> {
     let observation = match game {
-        Game::Platform => crate::game::platform::OBSERVATION_SIZE,
-        Game::Racing => crate::game::racing::OBSERVATION_SIZE,
+        Game::Platform => <PlatformGame as GameSpec>::Env::OBSERVATION_SIZE,
+        Game::Racing => <RacingGame as GameSpec>::Env::OBSERVATION_SIZE,
     };
     let (loaded, reference) = load_pinned(path, game, Role::Solver, observation)?;
     let card = loaded.card.clone();

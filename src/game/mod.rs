@@ -51,3 +51,73 @@ pub trait SolverEnv: Send + Sync + Sized {
 pub trait Scripted<E: SolverEnv> {
     fn act(&mut self, env: &E) -> E::Action;
 }
+
+/// One game as the layers above `game` see it: its Solver environment, the Solver's inputs and
+/// outputs as a policy card names them, and its rule-based levels. `train`, `verify` and the
+/// commands are written once over `G: GameSpec`; the command layer picks [`PlatformGame`] or
+/// [`RacingGame`] from a level's or an argument's [`Game`](crate::level::Game), once.
+pub trait GameSpec: Send + Sync + 'static {
+    const GAME: crate::level::Game;
+    type Env: SolverEnv;
+    /// The Solver's observation, named parts in order.
+    const OBSERVATION_LAYOUT: &'static [(&'static str, usize)];
+    /// The Solver's continuous actions, in the policy's order...
+    const CONTINUOUS_ACTIONS: &'static [&'static str];
+    /// ...and its binary ones, after them.
+    const BINARY_ACTIONS: &'static [&'static str];
+
+    /// The Solver's environment on `level`, or `None` for a level of another game.
+    fn solver_env(level: &crate::level::Level) -> Option<Self::Env>;
+    /// The rule-based level of `seed` (its goal drawn from the seed), if the rules find one.
+    fn rule_level(seed: u64) -> Option<crate::level::Level>;
+}
+
+/// The platform game: blocks to jump across.
+pub struct PlatformGame;
+
+/// The racing game: a car on a banked road.
+pub struct RacingGame;
+
+impl GameSpec for PlatformGame {
+    const GAME: crate::level::Game = crate::level::Game::Platform;
+    type Env = platform::PlatformEnv;
+    const OBSERVATION_LAYOUT: &'static [(&'static str, usize)] = &platform::env::OBSERVATION_LAYOUT;
+    const CONTINUOUS_ACTIONS: &'static [&'static str] = &["forward", "turn"];
+    const BINARY_ACTIONS: &'static [&'static str] = &["jump"];
+
+    fn solver_env(level: &crate::level::Level) -> Option<platform::PlatformEnv> {
+        let track = level.platform()?;
+        Some(platform::PlatformEnv::new(
+            track,
+            level.goal,
+            platform::SolverRewards::default(),
+        ))
+    }
+
+    fn rule_level(seed: u64) -> Option<crate::level::Level> {
+        rules::platform_level(seed, None, None, &crate::level::RulesConfig::default()).ok()
+    }
+}
+
+impl GameSpec for RacingGame {
+    const GAME: crate::level::Game = crate::level::Game::Racing;
+    type Env = racing::RacingEnv;
+    const OBSERVATION_LAYOUT: &'static [(&'static str, usize)] = &racing::env::OBSERVATION_LAYOUT;
+    const CONTINUOUS_ACTIONS: &'static [&'static str] = &["throttle", "steer"];
+    const BINARY_ACTIONS: &'static [&'static str] = &[];
+
+    fn solver_env(level: &crate::level::Level) -> Option<racing::RacingEnv> {
+        let crate::level::Track::Racing(track) = &level.track else {
+            return None;
+        };
+        Some(racing::RacingEnv::new(
+            track,
+            level.goal,
+            racing::SolverRewards::default(),
+        ))
+    }
+
+    fn rule_level(seed: u64) -> Option<crate::level::Level> {
+        racing::rules::racing_level(seed, None, None, &Default::default()).ok()
+    }
+}

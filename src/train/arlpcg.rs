@@ -14,7 +14,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::platform::TRAINING_SEED_BASE;
+use super::solver_envs::TRAINING_SEED_BASE;
 use crate::game::platform::generator::{
     GENERATOR_OBSERVATION_SIZE, GeneratorRewards, Match, Placement,
 };

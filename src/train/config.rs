@@ -7,8 +7,9 @@ use std::path::Path;
 use anyhow::Result;
 use serde::{Deserialize, Serialize};
 
-use super::platform::SolverMode;
+use super::solver_envs::SolverMode;
 use crate::game::platform::generator::{DEFAULT_MAX_BLOCKS, GeneratorRewards};
+use crate::level::Game;
 use crate::rl::ppo::PpoConfig;
 
 /// How the Solver is trained (the paper's baselines and its method, docs/spec.md §3).
@@ -143,7 +144,7 @@ const MAX_HIDDEN_UNITS: usize = 4096;
 /// Limit on each phase length and the warm-up (10^12 steps: years of training).
 const MAX_PHASE_STEPS: u64 = 1_000_000_000_000;
 
-pub(super) fn load_config(path: &Path) -> Result<TrainConfig> {
+pub(super) fn load_config(path: &Path, game: Game) -> Result<TrainConfig> {
     let bytes = crate::fsio::read_limited(path, MAX_CONFIG_BYTES, "training configuration")?;
     let text = String::from_utf8(bytes).map_err(|e| {
         anyhow::anyhow!(
@@ -152,10 +153,38 @@ pub(super) fn load_config(path: &Path) -> Result<TrainConfig> {
             e.utf8_error().valid_up_to()
         )
     })?;
-    TrainConfig::parse(&text).map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))
+    TrainConfig::parse_for(&text, game)
+        .map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))
 }
 
+/// The racing Solver's discount (docs/spec.md §3: γ 0.998; its runs are hundreds of steps
+/// longer than a platform run).
+pub const RACING_SOLVER_GAMMA: f32 = 0.998;
+
 impl TrainConfig {
+    /// The defaults for training `game`: the paper's values, which differ only in the racing
+    /// Solver's γ.
+    pub fn for_game(game: Game) -> TrainConfig {
+        let mut config = TrainConfig::default();
+        if game == Game::Racing {
+            config.solver.gamma = RACING_SOLVER_GAMMA;
+        }
+        config
+    }
+
+    /// [`TrainConfig::parse`] for `game`: fields the text leaves out take that game's defaults.
+    pub fn parse_for(text: &str, game: Game) -> Result<TrainConfig, String> {
+        let mut config = Self::parse(text)?;
+        if game == Game::Racing {
+            let document: serde_yaml::Value = serde_yaml::from_str(text).unwrap_or_default();
+            let solver = document.get("solver").or_else(|| document.get("ppo"));
+            if solver.and_then(|s| s.get("gamma")).is_none() {
+                config.solver.gamma = RACING_SOLVER_GAMMA;
+            }
+        }
+        Ok(config)
+    }
+
     /// Parses and checks the text of a configuration file: `Err` names the field (and, for
     /// syntax and type errors, the line).
     pub fn parse(text: &str) -> Result<TrainConfig, String> {

@@ -10,7 +10,7 @@
 
 pub mod arlpcg;
 mod config;
-pub mod platform;
+pub mod solver_envs;
 
 pub use config::{GeneratorConfig, TrainConfig, TrainMode};
 
@@ -29,6 +29,7 @@ use crate::fsio::{self, Overwrite};
 use crate::game::platform::generator::{
     GENERATOR_ACTIONS, GENERATOR_OBSERVATION_LAYOUT, GENERATOR_OBSERVATION_SIZE,
 };
+use crate::game::{GameSpec, PlatformGame, RacingGame};
 use crate::level::Game;
 use crate::rl::checkpoint::{self, PolicyCard, Role, TrainingRecord, TrainingState};
 use crate::rl::normalizer::RunningNorm;
@@ -37,7 +38,7 @@ use crate::rl::ppo::{Ppo, UpdateStats};
 use crate::rl::vec_env::{RolloutStats, Trainer, VecEnv};
 use arlpcg::{AdversarialEnvs, AdversarialState, Generator, MatchRules, MatchStats, Phase};
 use config::{check_resumable_change, load_config};
-use platform::{PlatformSolverEnvs, SourceState};
+use solver_envs::{SolverEnvs, SourceState};
 
 const CHECKPOINT: &str = "checkpoint.safetensors";
 const GENERATOR_CHECKPOINT: &str = "generator-checkpoint.safetensors";
@@ -49,17 +50,19 @@ const GENERATOR_METRICS_HEADER: &str = "iteration,solver_step,generator_step,wal
 /// Runs `arlpcg train`.
 pub fn run(args: &TrainArgs) -> Result<()> {
     if args.print_config {
-        print!("{}", serde_yaml::to_string(&TrainConfig::default())?);
-        return Ok(());
-    }
-    if args.game != Game::Platform {
-        bail!(
-            "--game {}: only the platform game can be trained so far",
-            args.game
+        print!(
+            "{}",
+            serde_yaml::to_string(&TrainConfig::for_game(args.game))?
         );
+        return Ok(());
     }
     let mode = args.mode;
     let usage = |message: &str| anyhow::Error::from(crate::commands::UsageError(message.into()));
+    if args.game == Game::Racing && mode.solver_only().is_none() {
+        return Err(usage(
+            "--game racing trains with --mode rule-pcg or fixed-track so far: the racing Generator (for arlpcg and fixed-aux) is not built yet",
+        ));
+    }
     let out = args.out.as_ref().ok_or_else(|| {
         usage("--out DIR is required: where the run's checkpoint, metrics and policy go")
     })?;
@@ -72,7 +75,10 @@ pub fn run(args: &TrainArgs) -> Result<()> {
     pool.install(|| {
         // A new run's configuration, or a resumed run's replacement (None: keep its own).
         let config = if args.resume {
-            args.config.as_deref().map(load_config).transpose()?
+            args.config
+                .as_deref()
+                .map(|path| load_config(path, args.game))
+                .transpose()?
         } else {
             if out.join(CHECKPOINT).exists() {
                 bail!(
@@ -81,31 +87,18 @@ pub fn run(args: &TrainArgs) -> Result<()> {
                 );
             }
             Some(match &args.config {
-                Some(path) => load_config(path)?,
-                None => TrainConfig::default(),
+                Some(path) => load_config(path, args.game)?,
+                None => TrainConfig::for_game(args.game),
             })
         };
-        match mode.solver_only() {
-            Some(source) => {
-                let build = |config: &TrainConfig, state: Option<serde_json::Value>| {
-                    let state: SourceState = match state {
-                        Some(json) => serde_json::from_value(json).context("level source")?,
-                        None => SourceState::default(),
-                    };
-                    Ok(PlatformSolverEnvs::new(
-                        source,
-                        config.solver.num_envs,
-                        state,
-                    ))
-                };
-                let mut run = if args.resume {
-                    Run::resume(out, mode, config, build)?
-                } else {
-                    Run::start(out, mode, config.unwrap_or_default(), build)?
-                };
-                train_loop(&mut run, args)
+        match (mode.solver_only(), args.game) {
+            (Some(source), Game::Platform) => {
+                solver_run::<PlatformGame>(out, mode, source, config, args)
             }
-            None => {
+            (Some(source), Game::Racing) => {
+                solver_run::<RacingGame>(out, mode, source, config, args)
+            }
+            (None, _) => {
                 let mut run = if args.resume {
                     AdversarialRun::resume(out, mode, config)?
                 } else {
@@ -115,6 +108,30 @@ pub fn run(args: &TrainArgs) -> Result<()> {
             }
         }
     })
+}
+
+/// Trains a Solver of game `G` alone (the Solver-only modes), starting or resuming.
+fn solver_run<G: GameSpec>(
+    out: &Path,
+    mode: TrainMode,
+    source: solver_envs::SolverMode,
+    config: Option<TrainConfig>,
+    args: &TrainArgs,
+) -> Result<()> {
+    let build = |config: &TrainConfig, state: Option<serde_json::Value>| {
+        let state: SourceState = match state {
+            Some(json) => serde_json::from_value(json).context("level source")?,
+            None => SourceState::default(),
+        };
+        Ok(SolverEnvs::<G>::new(source, config.solver.num_envs, state))
+    };
+    let mut run = if args.resume {
+        Run::resume(out, mode, config, build)?
+    } else {
+        let config = config.unwrap_or_else(|| TrainConfig::for_game(G::GAME));
+        Run::start(out, mode, config, build)?
+    };
+    train_loop(&mut run, args)
 }
 
 /// What the training loop drives: one iteration at a time, checkpoints, the final policies.
@@ -269,28 +286,60 @@ fn write_learning_curve(out: &Path) -> Result<()> {
 
 /// Environments whose progress is saved in checkpoints.
 trait Resumable: VecEnv {
+    /// The game the environments play.
+    const GAME: Game;
     fn source_state(&self) -> serde_json::Value;
 }
 
-impl Resumable for PlatformSolverEnvs {
+impl<G: GameSpec> Resumable for SolverEnvs<G> {
+    const GAME: Game = G::GAME;
     fn source_state(&self) -> serde_json::Value {
         serde_json::to_value(self.state()).expect("source states serialize")
     }
 }
 
 impl Resumable for AdversarialEnvs {
+    const GAME: Game = Game::Platform;
     fn source_state(&self) -> serde_json::Value {
         serde_json::to_value(self.state).expect("source states serialize")
     }
 }
 
+/// What a game's Solver observes and does, as a policy card names it.
+struct SolverIo {
+    observation: &'static [(&'static str, usize)],
+    continuous: &'static [&'static str],
+    binary: &'static [&'static str],
+}
+
+impl SolverIo {
+    fn of(game: Game) -> Self {
+        fn io<G: GameSpec>() -> SolverIo {
+            SolverIo {
+                observation: G::OBSERVATION_LAYOUT,
+                continuous: G::CONTINUOUS_ACTIONS,
+                binary: G::BINARY_ACTIONS,
+            }
+        }
+        match game {
+            Game::Platform => io::<PlatformGame>(),
+            Game::Racing => io::<RacingGame>(),
+        }
+    }
+
+    fn observation_size(&self) -> usize {
+        self.observation.iter().map(|(_, k)| k).sum()
+    }
+}
+
 /// The Solver's policy shape.
-fn solver_shape(config: &TrainConfig) -> PolicyShape {
+fn solver_shape(config: &TrainConfig, game: Game) -> PolicyShape {
+    let io = SolverIo::of(game);
     PolicyShape {
-        observation: crate::game::platform::OBSERVATION_SIZE,
+        observation: io.observation_size(),
         hidden: config.hidden.clone(),
-        continuous: platform::CONTINUOUS_ACTIONS.len(),
-        binary: platform::BINARY_ACTIONS.len(),
+        continuous: io.continuous.len(),
+        binary: io.binary.len(),
     }
 }
 
@@ -306,6 +355,7 @@ fn generator_shape(config: &TrainConfig) -> PolicyShape {
 
 /// A policy card for a policy trained by this run.
 fn card(
+    game: Game,
     role: Role,
     mode: TrainMode,
     config: &TrainConfig,
@@ -320,12 +370,15 @@ fn card(
             .collect::<Vec<_>>()
     };
     let (observation, continuous_actions, binary_actions, network) = match role {
-        Role::Solver => (
-            platform::observation_layout(),
-            names(&platform::CONTINUOUS_ACTIONS),
-            names(&platform::BINARY_ACTIONS),
-            solver_shape(config),
-        ),
+        Role::Solver => {
+            let io = SolverIo::of(game);
+            (
+                layout(io.observation),
+                names(io.continuous),
+                names(io.binary),
+                solver_shape(config, game),
+            )
+        }
         Role::Generator => (
             layout(&GENERATOR_OBSERVATION_LAYOUT),
             names(&GENERATOR_ACTIONS),
@@ -336,7 +389,7 @@ fn card(
     PolicyCard {
         format: checkpoint::POLICY_FORMAT.into(),
         version: checkpoint::POLICY_VERSION,
-        game: Game::Platform,
+        game,
         role,
         observation,
         continuous_actions,
@@ -408,7 +461,7 @@ impl<E: Resumable> Run<E> {
             format!("{METRICS_HEADER}\n").as_bytes(),
             Overwrite::Allowed,
         )?;
-        let policy = ActorCritic::new(solver_shape(&config), config.seed)?;
+        let policy = ActorCritic::new(solver_shape(&config, E::GAME), config.seed)?;
         let ppo = Ppo::new(config.solver.clone(), policy)?;
         let envs = build(&config, None)?;
         let trainer = Trainer::new(ppo, envs, config.seed);
@@ -432,7 +485,7 @@ impl<E: Resumable> Run<E> {
         build: impl FnOnce(&TrainConfig, Option<serde_json::Value>) -> Result<E>,
     ) -> Result<Self> {
         let path = out.join(CHECKPOINT);
-        let (loaded, state) = read_checkpoint(&path, Role::Solver, mode)?;
+        let (loaded, state) = read_checkpoint(&path, E::GAME, Role::Solver, mode)?;
         let stored: TrainConfig = serde_json::from_value(state.config.clone())
             .with_context(|| format!("{}: configuration", path.display()))?;
         let config = match replacement {
@@ -499,6 +552,7 @@ impl<E: Resumable> Run<E> {
 
     fn solver_card(&self, wall_time_s: f64) -> PolicyCard {
         card(
+            E::GAME,
             Role::Solver,
             self.mode,
             &self.config,
@@ -559,16 +613,17 @@ fn open_append(path: &Path) -> Result<std::fs::File> {
 /// Reads a checkpoint of `role`, checking that it was trained in `mode`.
 fn read_checkpoint(
     path: &Path,
+    game: Game,
     role: Role,
     mode: TrainMode,
 ) -> Result<(checkpoint::LoadedPolicy, TrainingState)> {
     let bytes = crate::fsio::read_limited(path, checkpoint::MAX_POLICY_BYTES, "checkpoint")
         .context("cannot resume")?;
     let observation = match role {
-        Role::Solver => crate::game::platform::OBSERVATION_SIZE,
+        Role::Solver => SolverIo::of(game).observation_size(),
         Role::Generator => GENERATOR_OBSERVATION_SIZE,
     };
-    let loaded = checkpoint::load_policy(&bytes, Game::Platform, role, observation)
+    let loaded = checkpoint::load_policy(&bytes, game, role, observation)
         .with_context(|| format!("{}", path.display()))?;
     let state = loaded
         .training_state()
@@ -584,7 +639,7 @@ fn read_checkpoint(
     Ok((loaded, state))
 }
 
-impl Training for Run<PlatformSolverEnvs> {
+impl<G: GameSpec> Training for Run<SolverEnvs<G>> {
     fn solver_steps(&self) -> u64 {
         self.trainer.global_step
     }
@@ -680,9 +735,10 @@ impl AdversarialRun {
         let path = out.join(GENERATOR_CHECKPOINT);
         if !path.exists() && out.join(CHECKPOINT).exists() {
             // A Solver-only run: its checkpoint says which mode it was trained in.
-            read_checkpoint(&out.join(CHECKPOINT), Role::Solver, mode)?;
+            read_checkpoint(&out.join(CHECKPOINT), Game::Platform, Role::Solver, mode)?;
         }
-        let (loaded, generator_state) = read_checkpoint(&path, Role::Generator, mode)?;
+        let (loaded, generator_state) =
+            read_checkpoint(&path, Game::Platform, Role::Generator, mode)?;
         let generator_iteration = generator_state.iteration;
         let build = move |config: &TrainConfig, source: Option<serde_json::Value>| {
             let state: AdversarialState =
@@ -725,6 +781,7 @@ impl AdversarialRun {
     fn generator_card(&self, wall_time_s: f64) -> PolicyCard {
         let envs = &self.solver.trainer.env;
         card(
+            Game::Platform,
             Role::Generator,
             self.solver.mode,
             &self.solver.config,

@@ -1,6 +1,7 @@
-//! The platform Solver's training environments: many [`PlatformEnv`]s stepped in parallel on the
-//! rayon pool, each starting a new level when its episode ends. Levels come from the rules
-//! (`rule-pcg`: a fresh level every episode) or from a small fixed set (`fixed-track`).
+//! A Solver's training environments, for any game: many of the game's Solver environments
+//! stepped in parallel on the rayon pool, each starting a new level when its episode ends.
+//! Levels come from the rules (`rule-pcg`: a fresh level every episode) or from a small fixed
+//! set (`fixed-track`).
 //!
 //! Training levels use seeds from [`TRAINING_SEED_BASE`] up, so that evaluation on seeds below it
 //! always plays levels the Solver never trained on. New levels and reset seeds are handed out in
@@ -9,21 +10,15 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::game::platform::env::OBSERVATION_LAYOUT;
-use crate::game::platform::{OBSERVATION_SIZE, PlatformAction, PlatformEnv, SolverRewards};
-use crate::game::rules;
+use crate::game::{GameSpec, SolverEnv};
+use crate::level::Level;
 use crate::level::stats::Outcome;
-use crate::level::{Level, RulesConfig};
 use crate::rl::vec_env::{Transition, VecEnv};
 
 /// Rule levels used for training have seeds at or above this; evaluation uses seeds below it.
 pub const TRAINING_SEED_BASE: u64 = 1 << 40;
 /// How many levels `fixed-track` trains on.
 pub const FIXED_TRACK_COUNT: u64 = 8;
-
-/// The Solver's action names, in the policy's order.
-pub const CONTINUOUS_ACTIONS: [&str; 2] = ["forward", "turn"];
-pub const BINARY_ACTIONS: [&str; 1] = ["jump"];
 
 /// Where the training levels come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -53,30 +48,21 @@ pub struct SourceState {
     pub episodes_started: u64,
 }
 
-/// The observation layout as the policy card records it.
-pub fn observation_layout() -> Vec<(String, usize)> {
-    OBSERVATION_LAYOUT
-        .iter()
-        .map(|(n, s)| (n.to_string(), *s))
-        .collect()
-}
-
-/// Many platform environments with automatic reset onto new levels.
-pub struct PlatformSolverEnvs {
+/// Many environments of game `G` with automatic reset onto new levels.
+pub struct SolverEnvs<G: GameSpec> {
     mode: SolverMode,
-    envs: Vec<PlatformEnv>,
+    envs: Vec<G::Env>,
     fixed: Vec<Level>,
     state: SourceState,
-    rewards: SolverRewards,
 }
 
-impl PlatformSolverEnvs {
+impl<G: GameSpec> SolverEnvs<G> {
     /// `num_envs` environments, continuing from `state` (a fresh run starts from the default).
     pub fn new(mode: SolverMode, num_envs: usize, state: SourceState) -> Self {
         let fixed = match mode {
             SolverMode::RulePcg => Vec::new(),
             SolverMode::FixedTrack => (0..FIXED_TRACK_COUNT)
-                .map(|k| rule_level(TRAINING_SEED_BASE + k))
+                .map(|k| rule_level::<G>(TRAINING_SEED_BASE + k))
                 .collect(),
         };
         let mut this = Self {
@@ -84,7 +70,6 @@ impl PlatformSolverEnvs {
             envs: Vec::with_capacity(num_envs),
             fixed,
             state,
-            rewards: SolverRewards::default(),
         };
         let starts: Vec<(Level, u64)> = (0..num_envs).map(|_| this.next_episode()).collect();
         this.envs = starts
@@ -102,8 +87,9 @@ impl PlatformSolverEnvs {
     fn next_episode(&mut self) -> (Level, u64) {
         let level = match self.mode {
             SolverMode::RulePcg => {
-                let level =
-                    rule_level(TRAINING_SEED_BASE + FIXED_TRACK_COUNT + self.state.levels_drawn);
+                let level = rule_level::<G>(
+                    TRAINING_SEED_BASE + FIXED_TRACK_COUNT + self.state.levels_drawn,
+                );
                 self.state.levels_drawn += 1;
                 level
             }
@@ -118,45 +104,33 @@ impl PlatformSolverEnvs {
         (level, seed)
     }
 
-    fn start(&self, level: &Level, seed: u64) -> PlatformEnv {
-        let track = level
-            .platform()
-            .expect("training levels are platform levels");
-        let mut env = PlatformEnv::new(track, level.goal, self.rewards);
+    fn start(&self, level: &Level, seed: u64) -> G::Env {
+        let mut env = G::solver_env(level).expect("training levels are of the run's game");
         env.reset(seed);
         env
     }
 }
 
-fn rule_level(seed: u64) -> Level {
+fn rule_level<G: GameSpec>(seed: u64) -> Level {
     // The rules find a level for every seed in practice; if one ever fails, the next seed serves.
     (seed..)
-        .find_map(|s| rules::platform_level(s, None, None, &RulesConfig::default()).ok())
+        .find_map(G::rule_level)
         .expect("the rules produce levels")
 }
 
-/// A policy's action row as the character's input: continuous parts clipped to [-1, 1].
-pub fn platform_action(row: &[f32]) -> PlatformAction {
-    PlatformAction {
-        forward: row[0].clamp(-1.0, 1.0),
-        turn: row[1].clamp(-1.0, 1.0),
-        jump: row[2] > 0.5,
-    }
-}
-
-impl VecEnv for PlatformSolverEnvs {
+impl<G: GameSpec> VecEnv for SolverEnvs<G> {
     fn num_envs(&self) -> usize {
         self.envs.len()
     }
 
     fn observation_size(&self) -> usize {
-        OBSERVATION_SIZE
+        G::Env::OBSERVATION_SIZE
     }
 
     fn observe(&mut self, out: &mut [f32]) {
         self.envs
             .par_iter()
-            .zip(out.par_chunks_mut(OBSERVATION_SIZE))
+            .zip(out.par_chunks_mut(G::Env::OBSERVATION_SIZE))
             .for_each(|(env, row)| env.observe(row));
     }
 
@@ -167,7 +141,7 @@ impl VecEnv for PlatformSolverEnvs {
             .zip(actions.par_chunks(width))
             .zip(out.par_iter_mut())
             .for_each(|((env, row), t)| {
-                let step = env.step(PlatformAction::from_policy_row(row));
+                let step = env.step(G::Env::action_from_policy_row(row));
                 *t = Transition {
                     reward: step.reward,
                     ended: step.outcome.is_some(),
@@ -181,7 +155,7 @@ impl VecEnv for PlatformSolverEnvs {
                 (i, level, seed)
             })
             .collect();
-        let fresh: Vec<(usize, PlatformEnv)> = restarts
+        let fresh: Vec<(usize, G::Env)> = restarts
             .par_iter()
             .map(|(i, level, seed)| (*i, self.start(level, *seed)))
             .collect();

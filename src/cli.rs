@@ -7,7 +7,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::level::Game;
 use crate::level::params;
-use crate::train::TrainMode;
+use crate::train::{TrainMode, TrainRequest};
 
 #[derive(Debug, Parser)]
 #[command(
@@ -111,7 +111,7 @@ pub struct EvalArgs {
 
 /// Output file formats of `generate`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Format {
+pub enum FormatArg {
     /// The level file (source of truth; `arlpcg export` and `verify` read it).
     Yaml,
     /// glTF 2.0, one binary file.
@@ -156,7 +156,7 @@ pub struct GenerateArgs {
     pub out: PathBuf,
     /// File formats to write, comma-separated.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "yaml,glb")]
-    pub format: Vec<Format>,
+    pub format: Vec<FormatArg>,
     /// Play each level this many times with the Solver (with --policies the one beside the
     /// Generator, with --rules the shipped one) and store the statistics in the YAML.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
@@ -176,6 +176,56 @@ pub struct ExportArgs {
     /// Replace files that already exist.
     #[arg(long)]
     pub force: bool,
+}
+
+impl From<FormatArg> for crate::level_files::Format {
+    fn from(format: FormatArg) -> Self {
+        match format {
+            FormatArg::Yaml => Self::Yaml,
+            FormatArg::Glb => Self::Glb,
+            FormatArg::Gltf => Self::Gltf,
+        }
+    }
+}
+
+/// How a Solver is trained (`train --mode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TrainModeArg {
+    /// On a fresh rule-based level every episode (the Rule-PCG baseline).
+    RulePcg,
+    /// On a small fixed set of rule-based levels (the Fixed-Track baseline).
+    FixedTrack,
+    /// Against a Generator that always has λ = 1 (the ablation).
+    FixedAux,
+    /// Against a Generator with λ drawn per match (the full method).
+    Arlpcg,
+}
+
+impl From<TrainModeArg> for TrainMode {
+    fn from(mode: TrainModeArg) -> Self {
+        match mode {
+            TrainModeArg::RulePcg => Self::RulePcg,
+            TrainModeArg::FixedTrack => Self::FixedTrack,
+            TrainModeArg::FixedAux => Self::FixedAux,
+            TrainModeArg::Arlpcg => Self::Arlpcg,
+        }
+    }
+}
+
+impl From<TrainArgs> for TrainRequest {
+    fn from(args: TrainArgs) -> Self {
+        Self {
+            game: args.game,
+            mode: args.mode.into(),
+            steps: args.steps,
+            minutes: args.minutes,
+            config: args.config,
+            out: args.out,
+            resume: args.resume,
+            print_config: args.print_config,
+            threads: args.threads,
+        }
+    }
 }
 
 /// Who plays the verification trials.
@@ -234,7 +284,7 @@ pub struct TrainArgs {
     /// (`arlpcg`: λ drawn per match; `fixed-aux`: λ = 1). The adversarial modes train and save
     /// the Generator too.
     #[arg(long, value_enum, default_value = "rule-pcg")]
-    pub mode: TrainMode,
+    pub mode: TrainModeArg,
     /// Stop when the Solver has learned from this many environment steps in all (over every
     /// resume).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]

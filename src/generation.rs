@@ -1,4 +1,5 @@
-//! Levels from a trained Generator policy: it places block after block toward the goal at the
+//! Where levels come from: the rules of either game ([`rules_level`]), or a trained Generator
+//! policy. Levels from a trained Generator policy: it places block after block toward the goal at the
 //! chosen λ, as it learned to (sampling its actions from a generator seeded by the level's seed).
 //! An attempt that overlaps itself or runs out of blocks is dropped and the next one, drawn from
 //! the same seeded stream, is tried; so the same policy, seed, λ and goal give the same level.
@@ -9,9 +10,42 @@
 use crate::game::platform::generator::{GENERATOR_OBSERVATION_SIZE, block_from_action, observe};
 use crate::game::rules::goal_and_start;
 use crate::level::platform::PlatformTrack;
-use crate::level::{Level, PolicyRef, Source, Track};
+use crate::level::racing::RacingRulesConfig;
+use crate::level::{Game, Level, PolicyRef, RulesConfig, Source, Track};
 use crate::rl::normalizer::RunningNorm;
 use crate::rl::policy::{ActMode, ActorCritic};
+
+/// Why the rules built no level.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NoRuleLevel {
+    #[error(transparent)]
+    Platform(#[from] crate::game::rules::NoLevel),
+    #[error(transparent)]
+    Racing(#[from] crate::game::racing::rules::NoTrack),
+}
+
+/// A rule-based level of `game` for `seed` (its goal drawn from the seed unless given); racing
+/// tracks get `obstacles` obstacles. `aux` is recorded, not used.
+pub fn rules_level(
+    game: Game,
+    seed: u64,
+    aux: Option<f64>,
+    goal: Option<[f64; 3]>,
+    obstacles: u32,
+) -> Result<Level, NoRuleLevel> {
+    Ok(match game {
+        Game::Platform => {
+            crate::game::rules::platform_level(seed, aux, goal, &RulesConfig::default())?
+        }
+        Game::Racing => {
+            let config = RacingRulesConfig {
+                obstacles,
+                ..RacingRulesConfig::default()
+            };
+            crate::game::racing::rules::racing_level(seed, aux, goal, &config)?
+        }
+    })
+}
 
 /// Attempts before giving up on a level.
 pub const ATTEMPTS: usize = 64;

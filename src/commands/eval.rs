@@ -5,11 +5,11 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 
-use super::policies::{GENERATOR_FILE, load_generator, load_solver};
 use crate::cli::EvalArgs;
 use crate::eval::{self, Budget, NamedSolver};
 use crate::fsio::{self, Overwrite};
 use crate::level::Game;
+use crate::policies::{GENERATOR_FILE, load_generator, load_solver};
 use crate::verify::SolverPolicy;
 
 pub fn run(args: &EvalArgs) -> Result<()> {
@@ -96,7 +96,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     }
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let pool = super::thread_pool(args.threads)?;
+    let pool = crate::shell::thread_pool(args.threads)?;
     let named: Vec<NamedSolver> = solvers
         .iter()
         .map(|(mode, policy)| NamedSolver {
@@ -113,7 +113,8 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             .collect::<Vec<_>>()
             .join(", ")
     );
-    let bar = super::progress_bar(eval::levels_to_play(budget, named.len()), "levels played");
+    let bar =
+        crate::shell::progress_bar(eval::levels_to_play(budget, named.len()), "levels played");
     let results = pool.install(|| eval::evaluate(&generator, &named, budget, &|| bar.inc(1)))?;
     bar.finish_and_clear();
     let markdown = eval::markdown(&results);

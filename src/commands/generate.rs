@@ -6,25 +6,23 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result};
 
-use super::export::{LevelFiles, write_level_files};
-use super::policies::{load_generator, load_solver, policy_paths};
 use crate::cli::{GenerateArgs, default_solver};
 use crate::fsio::Overwrite;
-use crate::game::{racing, rules};
 use crate::generation::{self, GeneratorPolicy};
-use crate::level::racing::RacingRulesConfig;
-use crate::level::{Game, Level, RulesConfig};
+use crate::level::{Game, Level};
+use crate::level_files::{Format, LevelFiles, write_level_files};
+use crate::policies::{load_generator, load_solver, policy_paths};
 use crate::verify::{Solver, SolverPolicy, verify};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
     if args.game == Game::Racing && args.policies.is_some() {
-        return Err(super::UsageError(
+        return Err(crate::shell::UsageError(
             "--game racing --policies: no racing Generator is trained yet; use --rules".into(),
         )
         .into());
     }
     if args.obstacles > 0 && (args.game != Game::Racing || !args.rules) {
-        return Err(super::UsageError(
+        return Err(crate::shell::UsageError(
             "--obstacles is for racing tracks from the rules (--game racing --rules)".into(),
         )
         .into());
@@ -32,7 +30,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     let generator = match &args.policies {
         Some(dir) => {
             if args.aux.is_none() {
-                return Err(super::UsageError(
+                return Err(crate::shell::UsageError(
                     "--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard)".into(),
                 )
                 .into());
@@ -59,16 +57,13 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     } else {
         Overwrite::Never
     };
+    let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
     let plans: Vec<(u64, LevelFiles)> = seeds
         .iter()
         .map(|&seed| {
             (
                 seed,
-                LevelFiles::new(
-                    &args.out,
-                    &file_stem(args.game, seed, args.aux),
-                    &args.format,
-                ),
+                LevelFiles::new(&args.out, &file_stem(args.game, seed, args.aux), &formats),
             )
         })
         .collect();
@@ -84,7 +79,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     }
     // Every level is built (and verified) before the first file is written: a level that
     // cannot be built leaves the folder as it was, and --force replaces nothing.
-    let bar = super::progress_bar(plans.len() as u64, "generating");
+    let bar = crate::shell::progress_bar(plans.len() as u64, "generating");
     let mut levels = Vec::with_capacity(plans.len());
     for (seed, _) in &plans {
         if stop.load(Ordering::SeqCst) {
@@ -109,7 +104,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         .map(|(_, f)| f.paths().len())
         .sum();
     if levels.len() < plans.len() {
-        return Err(super::Interrupted(format!(
+        return Err(crate::shell::Interrupted(format!(
             "interrupted (Ctrl-C): wrote the {} of {} levels finished before it ({files} files) to {}",
             levels.len(),
             plans.len(),
@@ -132,14 +127,7 @@ fn build(args: &GenerateArgs, generator: Option<&GeneratorPolicy>, seed: u64) ->
         (Game::Platform, Some(generator)) => {
             generation::platform_level(generator, seed, aux.unwrap_or_default(), goal)?
         }
-        (Game::Platform, None) => rules::platform_level(seed, aux, goal, &RulesConfig::default())?,
-        (Game::Racing, _) => {
-            let config = RacingRulesConfig {
-                obstacles: args.obstacles,
-                ..RacingRulesConfig::default()
-            };
-            racing::rules::racing_level(seed, aux, goal, &config)?
-        }
+        (game, _) => generation::rules_level(game, seed, aux, goal, args.obstacles)?,
     })
 }
 

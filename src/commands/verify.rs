@@ -7,11 +7,11 @@ use std::path::Path;
 use anyhow::Result;
 use serde_json::json;
 
-use super::policies::load_solver;
 use crate::cli::{SolverChoice, VerifyArgs, default_solver};
 use crate::level::Game;
 use crate::level::stats::SolverStats;
 use crate::level::yaml;
+use crate::policies::load_solver;
 use crate::verify::{Solver, SolverPolicy, Summary, verify};
 
 pub fn run(args: &VerifyArgs) -> Result<()> {
@@ -25,7 +25,8 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
                 let game = level.game();
                 solvers.resolve(game, args)?;
                 let solver = solvers.get(game);
-                let bar = super::progress_bar(args.trials as u64, &path.display().to_string());
+                let bar =
+                    crate::shell::progress_bar(args.trials as u64, &path.display().to_string());
                 let stats = verify(&level, &solver, args.trials, args.seed, &|| bar.inc(1))?;
                 bar.finish_and_clear();
                 Ok((game, stats))

@@ -11,11 +11,11 @@ use std::sync::{Arc, Mutex};
 use anyhow::Result;
 
 use super::app::{Effect, ExportOutcome, LoadedInfo, PolicyInfo, Response, SweepPoint};
-use crate::commands::policies::{load_generator, load_solver, policy_paths};
-use crate::commands::{LevelFiles, write_level_files};
 use crate::fsio::Overwrite;
 use crate::generation::{self, GeneratorPolicy};
-use crate::level::{Game, Level, RulesConfig};
+use crate::level::{Game, Level};
+use crate::level_files::{Format, LevelFiles, write_level_files};
+use crate::policies::{load_generator, load_solver, policy_paths};
 use crate::rl::checkpoint::PolicyError;
 use crate::verify::{self, Solver, SolverPolicy, Watch};
 
@@ -40,10 +40,8 @@ impl Policies {
             Some(generator) => {
                 generation::platform_level(generator, seed, aux, goal).map_err(|e| e.to_string())
             }
-            None => {
-                crate::game::rules::platform_level(seed, Some(aux), goal, &RulesConfig::default())
-                    .map_err(|e| e.to_string())
-            }
+            None => generation::rules_level(Game::Platform, seed, Some(aux), goal, 0)
+                .map_err(|e| e.to_string()),
         }
     }
 }
@@ -68,8 +66,8 @@ pub fn load(path: &Path) -> Result<(Policies, LoadedInfo)> {
             anyhow::bail!(
                 "{} holds neither {} nor {}",
                 path.display(),
-                crate::commands::policies::GENERATOR_FILE,
-                crate::commands::policies::SOLVER_FILE
+                crate::policies::GENERATOR_FILE,
+                crate::policies::SOLVER_FILE
             );
         }
         if generator.exists() {
@@ -308,11 +306,7 @@ pub fn perform(
 /// Writes the level's YAML and `.glb` into `dir` as `stem.*`, unless one exists and `overwrite`
 /// is false.
 fn export(level: &Level, dir: &Path, stem: &str, overwrite: bool) -> ExportOutcome {
-    let files = LevelFiles::new(
-        dir,
-        stem,
-        &[crate::cli::Format::Yaml, crate::cli::Format::Glb],
-    );
+    let files = LevelFiles::new(dir, stem, &[Format::Yaml, Format::Glb]);
     let paths = files.paths();
     let existing: Vec<PathBuf> = paths.iter().filter(|p| p.exists()).cloned().collect();
     if !existing.is_empty() && !overwrite {

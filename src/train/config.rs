@@ -13,7 +13,7 @@ use crate::level::Game;
 use crate::rl::ppo::PpoConfig;
 
 /// How the Solver is trained (the paper's baselines and its method, docs/spec.md §3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum TrainMode {
     /// On a fresh rule-based level every episode (the Rule-PCG baseline).

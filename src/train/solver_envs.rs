@@ -21,7 +21,7 @@ pub const TRAINING_SEED_BASE: u64 = 1 << 40;
 pub const FIXED_TRACK_COUNT: u64 = 8;
 
 /// Where the training levels come from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SolverMode {
     /// A fresh rule-based level every episode (the paper's Rule-PCG baseline).

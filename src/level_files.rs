@@ -1,0 +1,94 @@
+//! A level's files: the YAML and glTF files of one level, named and written together,
+//! atomically, never replacing a file unless asked. `generate`, `export` and the designer share
+//! it.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+
+use crate::fsio::{self, Overwrite};
+use crate::level::scene::Scene;
+use crate::level::{Level, gltf, yaml};
+
+/// A level's file formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// The level file (source of truth; `arlpcg export` and `verify` read it).
+    Yaml,
+    /// glTF 2.0, one binary file.
+    Glb,
+    /// glTF 2.0 as JSON with a separate .bin buffer.
+    Gltf,
+}
+
+/// The files one level is written to: `<dir>/<stem>.<ext>` for each format.
+#[derive(Debug, Clone)]
+pub struct LevelFiles {
+    dir: PathBuf,
+    stem: String,
+    formats: Vec<Format>,
+}
+
+impl LevelFiles {
+    /// The files of a level; repeated formats are written once.
+    pub fn new(dir: &Path, stem: &str, formats: &[Format]) -> Self {
+        let mut unique = Vec::new();
+        for f in formats {
+            if !unique.contains(f) {
+                unique.push(*f);
+            }
+        }
+        Self {
+            dir: dir.to_path_buf(),
+            stem: stem.to_string(),
+            formats: unique,
+        }
+    }
+
+    fn path(&self, extension: &str) -> PathBuf {
+        self.dir.join(format!("{}.{extension}", self.stem))
+    }
+
+    /// Every path that will be written.
+    pub fn paths(&self) -> Vec<PathBuf> {
+        self.formats
+            .iter()
+            .flat_map(|f| match f {
+                Format::Yaml => vec![self.path("yaml")],
+                Format::Glb => vec![self.path("glb")],
+                Format::Gltf => vec![self.path("gltf"), self.path("bin")],
+            })
+            .collect()
+    }
+
+    /// Fails if any of the files exists and may not be replaced.
+    pub fn check_writable(&self, overwrite: Overwrite) -> Result<()> {
+        self.paths()
+            .iter()
+            .try_for_each(|p| fsio::check_writable(p, overwrite))
+    }
+}
+
+/// Writes the level in each format of `files`, atomically.
+pub fn write_level_files(level: &Level, files: &LevelFiles, overwrite: Overwrite) -> Result<()> {
+    let scene = || Scene::of_level(level);
+    for format in &files.formats {
+        match format {
+            Format::Yaml => fsio::write_atomic(
+                &files.path("yaml"),
+                yaml::to_string(level).as_bytes(),
+                overwrite,
+            )?,
+            Format::Glb => {
+                fsio::write_atomic(&files.path("glb"), &gltf::to_glb(&scene()), overwrite)?
+            }
+            Format::Gltf => {
+                let bin_name = format!("{}.bin", files.stem);
+                let output = gltf::to_gltf(&scene(), &bin_name);
+                fsio::write_atomic(&files.path("bin"), &output.bin, overwrite)?;
+                fsio::write_atomic(&files.path("gltf"), &output.main, overwrite)?;
+            }
+        }
+    }
+    Ok(())
+}

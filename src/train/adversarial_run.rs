@@ -1,0 +1,259 @@
+//! An adversarial run: the Solver's run, whose environments hold the Generator, and the
+//! Generator's own phases, counters, metrics and checkpoint.
+
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+use super::*;
+
+/// An adversarial run: the Solver's run, whose environments hold the Generator, and the
+/// Generator's own counters and metrics.
+pub(super) struct AdversarialRun {
+    pub(super) solver: Run<AdversarialEnvs>,
+    pub(super) generator_iteration: u64,
+    pub(super) generator_metrics: std::fs::File,
+}
+
+impl AdversarialRun {
+    pub(super) fn rules(mode: TrainMode, config: &TrainConfig) -> MatchRules {
+        MatchRules {
+            aux_values: match mode {
+                TrainMode::FixedAux => vec![1.0],
+                _ => config.generator.aux_values.clone(),
+            },
+            max_blocks: config.generator.max_blocks,
+            rewards: config.generator.rewards.clone(),
+        }
+    }
+
+    pub(super) fn start(out: &Path, mode: TrainMode, config: TrainConfig) -> Result<Self> {
+        let build = |config: &TrainConfig, _: Option<serde_json::Value>| {
+            let policy = ActorCritic::new(generator_shape(config), config.seed.wrapping_add(1))?;
+            policy.set_log_std(config.generator.initial_log_std)?;
+            let generator = Generator {
+                ppo: Ppo::new(config.generator.ppo.clone(), policy)?,
+                norm: RunningNorm::new(GENERATOR_OBSERVATION_SIZE),
+            };
+            let rng = ChaCha8Rng::seed_from_u64(config.seed.wrapping_add(1));
+            Ok(AdversarialEnvs::new(
+                config.solver.num_envs,
+                generator,
+                rng,
+                Self::rules(mode, config),
+                AdversarialState::default(),
+            )?)
+        };
+        let solver = Run::start(out, mode, config, build)?;
+        fsio::write_atomic(
+            &out.join(GENERATOR_METRICS),
+            format!("{GENERATOR_METRICS_HEADER}\n").as_bytes(),
+            Overwrite::Allowed,
+        )?;
+        Ok(Self {
+            solver,
+            generator_iteration: 0,
+            generator_metrics: open_append(&out.join(GENERATOR_METRICS))?,
+        })
+    }
+
+    pub(super) fn resume(
+        out: &Path,
+        mode: TrainMode,
+        replacement: Option<TrainConfig>,
+    ) -> Result<Self> {
+        let path = out.join(GENERATOR_CHECKPOINT);
+        if !path.exists() && out.join(CHECKPOINT).exists() {
+            // A Solver-only run: its checkpoint says which mode it was trained in.
+            read_checkpoint(&out.join(CHECKPOINT), Game::Platform, Role::Solver, mode)?;
+        }
+        let (loaded, generator_state) =
+            read_checkpoint(&path, Game::Platform, Role::Generator, mode)?;
+        let generator_iteration = generator_state.iteration;
+        let build = move |config: &TrainConfig, source: Option<serde_json::Value>| {
+            let state: AdversarialState =
+                serde_json::from_value(source.unwrap_or_default()).context("match source")?;
+            let vars = loaded.policy.named_vars();
+            let mut ppo = Ppo::new(config.generator.ppo.clone(), loaded.policy)?;
+            ppo.adam
+                .restore(&vars, &loaded.tensors, generator_state.adam_step)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            let generator = Generator {
+                ppo,
+                norm: loaded.card.normalizer.clone(),
+            };
+            // Unfinished matches are gone: the run goes on with fresh ones, in the same phase.
+            Ok(AdversarialEnvs::new(
+                config.solver.num_envs,
+                generator,
+                generator_state.rng,
+                Self::rules(mode, config),
+                state,
+            )?)
+        };
+        let solver = Run::resume(out, mode, replacement, build)?;
+        truncate_metrics(
+            &out.join(GENERATOR_METRICS),
+            GENERATOR_METRICS_HEADER,
+            generator_iteration,
+        )?;
+        Ok(Self {
+            solver,
+            generator_iteration,
+            generator_metrics: open_append(&out.join(GENERATOR_METRICS))?,
+        })
+    }
+
+    pub(super) fn envs(&mut self) -> &mut AdversarialEnvs {
+        &mut self.solver.trainer.env
+    }
+
+    pub(super) fn generator_card(&self, wall_time_s: f64) -> PolicyCard {
+        let envs = &self.solver.trainer.env;
+        card(
+            Game::Platform,
+            Role::Generator,
+            self.solver.mode,
+            &self.solver.config,
+            &envs.generator.norm,
+            envs.state.generator_steps,
+            wall_time_s,
+        )
+    }
+
+    /// Plays until a batch of Generator decisions is complete, and learns from it.
+    pub(super) fn generator_iteration(
+        &mut self,
+        lr_scale: f64,
+        wall: &dyn Fn() -> f64,
+    ) -> Result<String> {
+        let config = self.solver.config.generator.ppo.clone();
+        let learning_rate = if config.anneal_lr {
+            config.learning_rate * lr_scale
+        } else {
+            config.learning_rate
+        };
+        let t0 = Instant::now();
+        self.envs().take_stats();
+        while self.envs().completed_decisions() < config.batch_size() {
+            self.solver.trainer.play_tick()?;
+        }
+        let batch = self.envs().take_generator_batch();
+        let stats = self.envs().take_stats();
+        let t1 = Instant::now();
+        let envs = self.envs();
+        let update = envs
+            .generator
+            .ppo
+            .update(&batch, learning_rate, &mut envs.rng)?;
+        let t2 = Instant::now();
+        let decisions = batch.log_probs.len() as u64;
+        envs.state.generator_steps += decisions;
+        envs.state.phase_steps += decisions;
+        self.generator_iteration += 1;
+        let row = generator_row(&stats);
+        writeln!(
+            self.generator_metrics,
+            "{},{},{},{:.2},{:.3},{:.3},{:.3e},{row},{}",
+            self.generator_iteration,
+            self.solver.trainer.global_step,
+            self.solver.trainer.env.state.generator_steps,
+            wall(),
+            (t1 - t0).as_secs_f64(),
+            (t2 - t1).as_secs_f64(),
+            learning_rate,
+            update_columns(&update)
+        )?;
+        let ratio = |a: u32, b: u32| a as f64 / b.max(1) as f64;
+        Ok(format!(
+            "generator: success easy {:.2} / hard {:.2}, invalid {:.2}",
+            ratio(stats.successes[0], stats.judged[0]),
+            ratio(stats.successes[1], stats.judged[1]),
+            ratio(stats.invalid, stats.episodes)
+        ))
+    }
+}
+
+impl Training for AdversarialRun {
+    fn solver_steps(&self) -> u64 {
+        self.solver.trainer.global_step
+    }
+
+    fn wall_before(&self) -> f64 {
+        self.solver.wall_before
+    }
+
+    fn iterate(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String> {
+        let phases = self.solver.config.generator.clone();
+        match self.envs().state.phase {
+            Phase::Solver => {
+                let rollout = self.solver.solver_iteration(lr_scale, wall)?;
+                let envs = self.envs();
+                envs.state.phase_steps += rollout.steps;
+                let warm = self.solver.trainer.global_step >= phases.solver_warmup_steps;
+                let envs = self.envs();
+                if warm && envs.state.phase_steps >= phases.solver_phase_steps {
+                    envs.set_phase(Phase::Generator);
+                }
+                Ok(format!(
+                    "solver: return {:.2}, success {:.2}",
+                    rollout.mean_return, rollout.success_ratio
+                ))
+            }
+            Phase::Generator => {
+                let message = self.generator_iteration(lr_scale, wall)?;
+                let envs = self.envs();
+                if envs.state.phase_steps >= phases.generator_phase_steps {
+                    envs.set_phase(Phase::Solver);
+                }
+                Ok(message)
+            }
+        }
+    }
+
+    fn checkpoint_minutes(&self) -> f64 {
+        self.solver.config.checkpoint_minutes
+    }
+
+    fn save_checkpoint(&self, wall: f64) -> Result<()> {
+        let envs = &self.solver.trainer.env;
+        let state = TrainingState {
+            global_step: envs.state.generator_steps,
+            iteration: self.generator_iteration,
+            adam_step: envs.generator.ppo.adam.step,
+            wall_time_s: wall,
+            rng: envs.rng.clone(),
+            source: serde_json::Value::Null,
+            config: serde_json::to_value(&self.solver.config)?,
+        };
+        let bytes =
+            checkpoint::checkpoint_bytes(&envs.generator.ppo, &self.generator_card(wall), &state);
+        let out = &self.solver.out;
+        fsio::write_atomic(&out.join(GENERATOR_CHECKPOINT), &bytes, Overwrite::Allowed)?;
+        self.solver.save_solver_checkpoint(wall)
+    }
+
+    fn save_policies(&self, wall: f64) -> Result<()> {
+        let out = &self.solver.out;
+        save_policy_files(
+            out,
+            "generator",
+            &self.solver.trainer.env.generator.ppo.policy,
+            &self.generator_card(wall),
+        )?;
+        save_policy_files(
+            out,
+            "solver",
+            &self.solver.trainer.ppo.policy,
+            &self.solver.solver_card(wall),
+        )
+    }
+
+    fn out(&self) -> &Path {
+        &self.solver.out
+    }
+}

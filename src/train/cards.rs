@@ -1,0 +1,178 @@
+//! What a trained policy says about itself: its shape from the game and the configuration, its
+//! card (game, role, inputs and outputs, how it was trained, from which commit), the files it is
+//! saved as, and checkpoints read back for resuming.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+
+use super::*;
+
+/// What a game's Solver observes and does, as a policy card names it.
+pub(super) struct SolverIo {
+    observation: &'static [(&'static str, usize)],
+    continuous: &'static [&'static str],
+    binary: &'static [&'static str],
+}
+
+impl SolverIo {
+    fn of(game: Game) -> Self {
+        fn io<G: GameSpec>() -> SolverIo {
+            SolverIo {
+                observation: G::OBSERVATION_LAYOUT,
+                continuous: G::CONTINUOUS_ACTIONS,
+                binary: G::BINARY_ACTIONS,
+            }
+        }
+        match game {
+            Game::Platform => io::<PlatformGame>(),
+            Game::Racing => io::<RacingGame>(),
+        }
+    }
+
+    fn observation_size(&self) -> usize {
+        self.observation.iter().map(|(_, k)| k).sum()
+    }
+}
+
+/// The Solver's policy shape.
+pub(super) fn solver_shape(config: &TrainConfig, game: Game) -> PolicyShape {
+    let io = SolverIo::of(game);
+    PolicyShape {
+        observation: io.observation_size(),
+        hidden: config.hidden.clone(),
+        continuous: io.continuous.len(),
+        binary: io.binary.len(),
+    }
+}
+
+/// The Generator's policy shape.
+pub(super) fn generator_shape(config: &TrainConfig) -> PolicyShape {
+    PolicyShape {
+        observation: GENERATOR_OBSERVATION_SIZE,
+        hidden: config.hidden.clone(),
+        continuous: GENERATOR_ACTIONS.len(),
+        binary: 0,
+    }
+}
+
+/// A policy card for a policy trained by this run.
+pub(super) fn card(
+    game: Game,
+    role: Role,
+    mode: TrainMode,
+    config: &TrainConfig,
+    normalizer: &RunningNorm,
+    steps: u64,
+    wall_time_s: f64,
+) -> PolicyCard {
+    let names = |list: &[&str]| list.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let layout = |list: &[(&str, usize)]| {
+        list.iter()
+            .map(|(n, k)| (n.to_string(), *k))
+            .collect::<Vec<_>>()
+    };
+    let (observation, continuous_actions, binary_actions, network) = match role {
+        Role::Solver => {
+            let io = SolverIo::of(game);
+            (
+                layout(io.observation),
+                names(io.continuous),
+                names(io.binary),
+                solver_shape(config, game),
+            )
+        }
+        Role::Generator => (
+            layout(&GENERATOR_OBSERVATION_LAYOUT),
+            names(&GENERATOR_ACTIONS),
+            Vec::new(),
+            generator_shape(config),
+        ),
+    };
+    PolicyCard {
+        format: checkpoint::POLICY_FORMAT.into(),
+        version: checkpoint::POLICY_VERSION,
+        game,
+        role,
+        observation,
+        continuous_actions,
+        binary_actions,
+        network,
+        normalizer: normalizer.clone(),
+        training: TrainingRecord {
+            mode: mode.name().into(),
+            steps,
+            wall_time_s: (wall_time_s * 10.0).round() / 10.0,
+            seed: config.seed,
+            commit: git_commit(),
+            command: std::iter::once("arlpcg".to_string())
+                .chain(std::env::args().skip(1))
+                .collect::<Vec<_>>()
+                .join(" "),
+        },
+        results: Default::default(),
+        max_blocks: (role == Role::Generator).then_some(config.generator.max_blocks),
+    }
+}
+
+/// Writes a policy and its YAML card (`<name>.safetensors`, `<name>.yaml`) into `out`.
+pub(super) fn save_policy_files(
+    out: &Path,
+    name: &str,
+    policy: &ActorCritic,
+    card: &PolicyCard,
+) -> Result<()> {
+    fsio::write_atomic(
+        &out.join(format!("{name}.safetensors")),
+        &checkpoint::policy_bytes(policy, card),
+        Overwrite::Allowed,
+    )?;
+    fsio::write_atomic(
+        &out.join(format!("{name}.yaml")),
+        serde_yaml::to_string(card)?.as_bytes(),
+        Overwrite::Allowed,
+    )
+}
+
+/// Reads a checkpoint of `role`, checking that it was trained in `mode`.
+pub(super) fn read_checkpoint(
+    path: &Path,
+    game: Game,
+    role: Role,
+    mode: TrainMode,
+) -> Result<(checkpoint::LoadedPolicy, TrainingState)> {
+    let bytes = crate::fsio::read_limited(path, checkpoint::MAX_POLICY_BYTES, "checkpoint")
+        .context("cannot resume")?;
+    let observation = match role {
+        Role::Solver => SolverIo::of(game).observation_size(),
+        Role::Generator => GENERATOR_OBSERVATION_SIZE,
+    };
+    let loaded = checkpoint::load_policy(&bytes, game, role, observation)
+        .with_context(|| format!("{}", path.display()))?;
+    let state = loaded
+        .training_state()
+        .with_context(|| format!("{}", path.display()))?;
+    if loaded.card.training.mode != mode.name() {
+        bail!(
+            "{} was trained with --mode {}, not {}",
+            path.display(),
+            loaded.card.training.mode,
+            mode.name()
+        );
+    }
+    Ok((loaded, state))
+}
+
+/// The current commit, for policy cards, with `-dirty` when the working tree has changes that
+/// are not committed (so the card cannot name the code that trained it); "unknown" outside a
+/// git checkout.
+pub(super) fn git_commit() -> String {
+    std::process::Command::new("git")
+        .args(["describe", "--always", "--abbrev=7", "--dirty"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map_or("unknown".into(), |o| {
+            String::from_utf8_lossy(&o.stdout).trim().to_string()
+        })
+}

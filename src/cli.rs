@@ -161,9 +161,39 @@ pub struct GenerateArgs {
     /// Generator, with --rules the shipped one) and store the statistics in the YAML.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub verify: Option<u32>,
-    /// Replace files that already exist (by default nothing is overwritten).
+    /// Replace files that already exist (by default nothing is overwritten; files identical to
+    /// what this run makes are left as they are, so a re-run finishes an interrupted batch).
     #[arg(long)]
     pub force: bool,
+    /// Make only shard I of K of the batch (0 <= I < K): level i of the batch when i mod K = I.
+    /// K machines with I = 0..K-1 together write exactly the files of the whole batch.
+    #[arg(long, value_name = "I/K", value_parser = parse_shard)]
+    pub shard: Option<Shard>,
+}
+
+/// One of K equal shares of a batch (`--shard I/K`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    pub index: u64,
+    pub count: u64,
+}
+
+impl Shard {
+    /// Whether item `i` of the batch belongs to this shard.
+    pub fn owns(&self, i: u64) -> bool {
+        i % self.count == self.index
+    }
+}
+
+fn parse_shard(s: &str) -> Result<Shard, String> {
+    let bad = || format!("`{s}` is not I/K with 0 <= I < K (e.g. 0/4 .. 3/4)");
+    let (i, k) = s.split_once('/').ok_or_else(bad)?;
+    let index: u64 = i.trim().parse().map_err(|_| bad())?;
+    let count: u64 = k.trim().parse().map_err(|_| bad())?;
+    if count == 0 || index >= count {
+        return Err(bad());
+    }
+    Ok(Shard { index, count })
 }
 
 #[derive(Debug, Args)]

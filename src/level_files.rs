@@ -69,26 +69,31 @@ impl LevelFiles {
     }
 }
 
-/// Writes the level in each format of `files`, atomically.
-pub fn write_level_files(level: &Level, files: &LevelFiles, overwrite: Overwrite) -> Result<()> {
+/// The bytes of each file of `files` for `level`, in [`LevelFiles::paths`] order (the same
+/// level always gives the same bytes).
+pub fn render(level: &Level, files: &LevelFiles) -> Vec<(PathBuf, Vec<u8>)> {
     let scene = || Scene::of_level(level);
+    let mut out = Vec::new();
     for format in &files.formats {
         match format {
-            Format::Yaml => fsio::write_atomic(
-                &files.path("yaml"),
-                yaml::to_string(level).as_bytes(),
-                overwrite,
-            )?,
-            Format::Glb => {
-                fsio::write_atomic(&files.path("glb"), &gltf::to_glb(&scene()), overwrite)?
-            }
+            Format::Yaml => out.push((files.path("yaml"), yaml::to_string(level).into_bytes())),
+            Format::Glb => out.push((files.path("glb"), gltf::to_glb(&scene()))),
             Format::Gltf => {
                 let bin_name = format!("{}.bin", files.stem);
                 let output = gltf::to_gltf(&scene(), &bin_name);
-                fsio::write_atomic(&files.path("bin"), &output.bin, overwrite)?;
-                fsio::write_atomic(&files.path("gltf"), &output.main, overwrite)?;
+                out.push((files.path("gltf"), output.main));
+                out.push((files.path("bin"), output.bin));
             }
         }
+    }
+    out
+}
+
+/// Writes the level in each format of `files`, atomically.
+pub fn write_level_files(level: &Level, files: &LevelFiles, overwrite: Overwrite) -> Result<()> {
+    // The .bin before the .gltf that names it.
+    for (path, bytes) in render(level, files).iter().rev() {
+        fsio::write_atomic(path, bytes, overwrite)?;
     }
     Ok(())
 }

@@ -139,7 +139,27 @@ fn generate_names_files_by_game_seed_and_aux_and_never_overwrites() {
         ]
     );
     let before = files_of(dir.path());
-    // Seed 6 exists already: the run refuses before writing anything, seed 7 included.
+    // Run again: the files are there and identical, so nothing is rewritten.
+    let out = generate(
+        dir.path(),
+        &[
+            "--count", "2", "--seed", "5", "--aux", "-0.5", "--format", "yaml",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains("2 of them already there and identical"),
+        "{said}"
+    );
+    assert_eq!(files_of(dir.path()), before);
+    // Seed 6 exists with other contents: the run refuses before writing anything, seed 7
+    // included.
+    let seed6 = dir.path().join("platform_seed6_aux-0.50.yaml");
+    let mut edited = std::fs::read_to_string(&seed6).unwrap();
+    edited.push_str("# edited by hand\n");
+    std::fs::write(&seed6, edited).unwrap();
+    let before = files_of(dir.path());
     let out = generate(
         dir.path(),
         &[
@@ -148,7 +168,7 @@ fn generate_names_files_by_game_seed_and_aux_and_never_overwrites() {
     );
     assert_eq!(out.status.code(), Some(1));
     assert!(
-        stderr(&out).contains("already exists (use --force"),
+        stderr(&out).contains("already exists with other contents (use --force"),
         "{}",
         stderr(&out)
     );
@@ -161,6 +181,43 @@ fn generate_names_files_by_game_seed_and_aux_and_never_overwrites() {
     );
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(files_of(dir.path()).len(), 3);
+}
+
+/// K shards together write exactly the unsharded batch, and a shard re-run rewrites nothing.
+#[test]
+fn shards_of_a_batch_write_exactly_the_batch() {
+    let (whole, parts) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let batch = [
+        "--count", "10", "--seed", "1", "--format", "yaml,glb", "--verify", "4",
+    ];
+    let out = generate(whole.path(), &batch);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for shard in ["0/4", "1/4", "2/4", "3/4"] {
+        let mut args = batch.to_vec();
+        args.extend(["--shard", shard]);
+        let out = generate(parts.path(), &args);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    assert!(files_of(whole.path()) == files_of(parts.path()));
+    let mut args = batch.to_vec();
+    args.extend(["--shard", "1/4"]);
+    let out = generate(parts.path(), &args);
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains(
+            "wrote 3 levels (shard 1/4 of 10) (6 files, 6 of them already there and identical)"
+        ),
+        "{said}"
+    );
+    for bad in ["4/4", "1/0", "x/2", "3"] {
+        let mut args = batch.to_vec();
+        args.extend(["--shard", bad]);
+        assert_eq!(
+            generate(parts.path(), &args).status.code(),
+            Some(2),
+            "{bad}"
+        );
+    }
 }
 
 /// Where tests leave glTF files for `.ci/run` to pass through the Khronos validator.

@@ -4,13 +4,14 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
+use rayon::prelude::*;
 
 use crate::cli::{GenerateArgs, default_solver};
-use crate::fsio::Overwrite;
+use crate::fsio::{self, Overwrite};
 use crate::generation::{self, GeneratorPolicy};
 use crate::level::{Game, Level};
-use crate::level_files::{Format, LevelFiles, write_level_files};
+use crate::level_files::{Format, LevelFiles, render};
 use crate::policies::{load_generator, load_solver, policy_paths};
 use crate::verify::{Solver, SolverPolicy, verify};
 
@@ -47,16 +48,12 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         (Some(_), None) => None,
     };
     let seeds: Vec<u64> = (0..args.count as u64)
+        .filter(|&i| args.shard.is_none_or(|shard| shard.owns(i)))
         .map(|i| args.seed.checked_add(i))
         .collect::<Option<_>>()
         .context("--seed plus --count overflows a 64-bit seed")?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let overwrite = if args.force {
-        Overwrite::Allowed
-    } else {
-        Overwrite::Never
-    };
     let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
     let plans: Vec<(u64, LevelFiles)> = seeds
         .iter()
@@ -67,10 +64,6 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
             )
         })
         .collect();
-    // Refuse before writing anything, so that a refused run leaves the folder as it was.
-    for (_, files) in &plans {
-        files.check_writable(overwrite)?;
-    }
     // Ctrl-C stops generating; the levels finished so far are still written.
     let stop = Arc::new(AtomicBool::new(false));
     {
@@ -78,42 +71,77 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
     // Every level is built (and verified) before the first file is written: a level that
-    // cannot be built leaves the folder as it was, and --force replaces nothing.
+    // cannot be built leaves the folder as it was, and --force replaces nothing. Several
+    // levels are in flight at once; each depends only on its seed, so the files do not depend
+    // on the number of threads.
     let bar = crate::shell::progress_bar(plans.len() as u64, "generating");
-    let mut levels = Vec::with_capacity(plans.len());
-    for (seed, _) in &plans {
-        if stop.load(Ordering::SeqCst) {
-            break;
-        }
-        let mut level = build(args, generator.as_ref(), *seed)
-            .with_context(|| format!("seed {seed} (nothing was written)"))?;
-        if let Some(trials) = args.verify {
-            let who = solver.as_ref().map_or(Solver::Scripted, Solver::Policy);
-            level.stats = Some(verify(&level, &who, trials, *seed, &|| {})?);
-        }
-        levels.push(level);
-        bar.inc(1);
-    }
+    let who = solver.as_ref().map_or(Solver::Scripted, Solver::Policy);
+    let built: Vec<Option<Result<Level>>> = plans
+        .par_iter()
+        .map(|(seed, _)| {
+            if stop.load(Ordering::SeqCst) {
+                return None;
+            }
+            let level = build(args, generator.as_ref(), *seed).and_then(|mut level| {
+                if let Some(trials) = args.verify {
+                    level.stats = Some(verify(&level, &who, trials, *seed, &|| {})?);
+                }
+                Ok(level)
+            });
+            bar.inc(1);
+            Some(level.with_context(|| format!("seed {seed} (nothing was written)")))
+        })
+        .collect();
     bar.finish_and_clear();
-    for (written, (level, (_, files))) in levels.iter().zip(&plans).enumerate() {
-        write_level_files(level, files, overwrite)
-            .with_context(|| format!("after writing {written} of {} levels", plans.len()))?;
+    // The levels finished before a Ctrl-C: a prefix of the batch, so that a re-run resumes it.
+    let mut levels = Vec::with_capacity(plans.len());
+    for level in built {
+        match level {
+            Some(level) => levels.push(level?),
+            None => break,
+        }
     }
-    let files: usize = plans[..levels.len()]
-        .iter()
-        .map(|(_, f)| f.paths().len())
-        .sum();
+    // Files that exist already: identical ones are left alone (a re-run finishes a batch),
+    // others are refused unless --force, before anything is written.
+    let mut writes = Vec::new();
+    let mut kept = 0;
+    for (level, (_, files)) in levels.iter().zip(&plans) {
+        for (path, bytes) in render(level, files) {
+            match std::fs::read(&path) {
+                Ok(existing) if existing == bytes => kept += 1,
+                Ok(_) if !args.force => bail!(
+                    "{} already exists with other contents (use --force to overwrite it); nothing was written",
+                    path.display()
+                ),
+                _ => writes.push((path, bytes)),
+            }
+        }
+    }
+    // A .gltf is written after the .bin it names.
+    for (written, (path, bytes)) in writes.iter().rev().enumerate() {
+        fsio::write_atomic(path, bytes, Overwrite::Allowed)
+            .with_context(|| format!("after writing {written} of {} files", writes.len()))?;
+    }
+    let files = writes.len() + kept;
+    let unchanged = match kept {
+        0 => String::new(),
+        k => format!(", {k} of them already there and identical"),
+    };
     if levels.len() < plans.len() {
         return Err(crate::shell::Interrupted(format!(
-            "interrupted (Ctrl-C): wrote the {} of {} levels finished before it ({files} files) to {}",
+            "interrupted (Ctrl-C): wrote the {} of {} levels finished before it ({files} files{unchanged}) to {}; run the same command again to finish",
             levels.len(),
             plans.len(),
             args.out.display()
         ))
         .into());
     }
+    let share = match args.shard {
+        Some(shard) => format!(" (shard {}/{} of {})", shard.index, shard.count, args.count),
+        None => String::new(),
+    };
     println!(
-        "wrote {} levels ({files} files) to {}",
+        "wrote {} levels{share} ({files} files{unchanged}) to {}",
         plans.len(),
         args.out.display()
     );

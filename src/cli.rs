@@ -76,7 +76,9 @@ pub struct DesignArgs {
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     arlpcg eval --policies policies/platform --out results/platform\n  \
-    arlpcg eval --policies runs/platform-solver-arlpcg-reach runs/platform-solver-rule-pcg --full --out results/full")]
+    arlpcg eval --policies runs/platform-solver-arlpcg-reach runs/platform-solver-rule-pcg --full --out results/full\n  \
+    arlpcg eval --policies policies/platform --shard 0/3 --out parts/0   (and 1/3, 2/3 elsewhere)\n  \
+    arlpcg eval --merge parts/0 parts/1 parts/2 --out results/platform")]
 pub struct EvalArgs {
     /// Which game.
     #[arg(long, default_value = "platform", value_parser = parse_game)]
@@ -84,8 +86,16 @@ pub struct EvalArgs {
     /// Folders of trained policies: the Generator (generator.safetensors, from the first folder
     /// that has one) and every Solver (solver*.safetensors; each named by its card's training
     /// mode). One Solver must be the arlpcg one.
-    #[arg(long, num_args = 1.., required = true, value_name = "DIR")]
+    #[arg(long, num_args = 1.., required_unless_present = "merge", value_name = "DIR")]
     pub policies: Vec<PathBuf>,
+    /// Play only shard I of K of the evaluation (0 <= I < K) and write its raw per-level
+    /// statistics to --out as eval-part.json, for `--merge`.
+    #[arg(long, value_name = "I/K", value_parser = parse_shard, conflicts_with = "merge")]
+    pub shard: Option<Shard>,
+    /// Combine the parts written by `--shard 0/K` ... `--shard K-1/K` (their --out folders)
+    /// into the same tables, CSVs, results.json and chart as one unsharded run.
+    #[arg(long, num_args = 1.., value_name = "DIR", conflicts_with_all = ["policies", "full", "tracks", "trials", "validation_tracks"])]
+    pub merge: Vec<PathBuf>,
     /// Generator levels per λ (default 20; 50 with --full).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub tracks: Option<u32>,

@@ -16,6 +16,7 @@ use serde::Serialize;
 
 use crate::game::rules;
 use crate::generation::{self, GeneratorPolicy};
+use crate::level::stats::SolverStats;
 use crate::level::{Level, RulesConfig};
 use crate::verify::{Solver, SolverPolicy, Summary, verify};
 
@@ -28,7 +29,7 @@ pub const EVAL_SEED_BASE: u64 = 1 << 32;
 const SEED_TRIES: u64 = 4;
 
 /// How much to evaluate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct Budget {
     /// Levels per λ (controllability and cross tables).
     pub tracks: u32,
@@ -144,35 +145,230 @@ pub fn validation_levels(
     Ok(levels)
 }
 
-/// Plays `levels` with `solver`, `trials` runs each (run seeds from the level's seed). With no
-/// levels, every figure is NaN (shown as n/a, null in JSON).
-fn play(levels: &[Level], solver: &SolverPolicy, trials: u32, on_level: &dyn Fn()) -> Summary {
-    if levels.is_empty() {
-        return Summary {
-            levels: 0,
-            mean_success: f64::NAN,
-            std_success: f64::NAN,
-            completed_by_any: f64::NAN,
-            mean_progress: f64::NAN,
-            mean_success_steps: f64::NAN,
-        };
+/// What the tables are made of, without the levels themselves: how many levels each table
+/// has, the Solvers' names and the block statistics of the controllability levels. With it,
+/// the per-level statistics of every play make the tables ([`assemble`]), so shards of an
+/// evaluation can be played apart and merged.
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+pub struct Layout {
+    /// Levels per λ of [`AUX_VALUES`] (the Generator may build fewer than the budget asks).
+    pub levels_per_aux: Vec<usize>,
+    /// (mean block distance, mean block size) of the levels at each λ (`None`: no levels).
+    pub block_means: Vec<Option<(f64, f64)>>,
+    /// Levels in the validation set.
+    pub validation_levels: usize,
+    /// The Solvers' training modes, in table order.
+    pub solvers: Vec<String>,
+}
+
+/// One play of one level by one Solver: which table, which Solver and λ, which level.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Play {
+    /// The ARLPCG Solver on level `level` at λ number `aux`.
+    Controllability { aux: usize, level: usize },
+    /// Solver `solver` on validation level `level`.
+    Generalization { solver: usize, level: usize },
+    /// Solver `solver` on level `level` at λ number `aux`.
+    Cross {
+        solver: usize,
+        aux: usize,
+        level: usize,
+    },
+}
+
+impl Layout {
+    /// Every play of the evaluation, in a fixed order; shard I of K plays those whose index
+    /// modulo K is I.
+    pub fn plays(&self) -> Vec<Play> {
+        let mut plays = Vec::new();
+        for (aux, &n) in self.levels_per_aux.iter().enumerate() {
+            plays.extend((0..n).map(|level| Play::Controllability { aux, level }));
+        }
+        for solver in 0..self.solvers.len() {
+            plays.extend(
+                (0..self.validation_levels).map(|level| Play::Generalization { solver, level }),
+            );
+            for (aux, &n) in self.levels_per_aux.iter().enumerate() {
+                plays.extend((0..n).map(|level| Play::Cross { solver, aux, level }));
+            }
+        }
+        plays
     }
-    let stats: Vec<_> = levels
+}
+
+/// The levels of an evaluation and its layout.
+pub struct Levels {
+    pub by_aux: Vec<Vec<Level>>,
+    pub validation: Vec<Level>,
+    pub layout: Layout,
+}
+
+/// Builds every level the evaluation plays (deterministic: the same Generator and budget give
+/// the same levels on every machine).
+pub fn levels(
+    generator: &GeneratorPolicy,
+    solvers: &[NamedSolver],
+    budget: Budget,
+) -> Result<Levels, candle_core::Error> {
+    let by_aux: Vec<Vec<Level>> = AUX_VALUES
         .iter()
-        .map(|level| {
+        .map(|&aux| generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks))
+        .collect::<Result<_, _>>()?;
+    let validation = validation_levels(generator, budget.validation_tracks)?;
+    let block_means = by_aux
+        .iter()
+        .map(|levels| {
+            let blocks: Vec<_> = levels
+                .iter()
+                .filter_map(|l| l.platform())
+                .flat_map(|t| t.block_params().iter().copied())
+                .collect();
+            match blocks.len() {
+                0 => None,
+                n => Some((
+                    blocks.iter().map(|b| b.distance).sum::<f64>() / n as f64,
+                    blocks.iter().map(|b| b.size).sum::<f64>() / n as f64,
+                )),
+            }
+        })
+        .collect();
+    let layout = Layout {
+        levels_per_aux: by_aux.iter().map(Vec::len).collect(),
+        block_means,
+        validation_levels: validation.len(),
+        solvers: solvers.iter().map(|s| s.mode.clone()).collect(),
+    };
+    Ok(Levels {
+        by_aux,
+        validation,
+        layout,
+    })
+}
+
+/// The index of the ARLPCG Solver (it plays the controllability table), else the first.
+fn main_solver(solvers: &[String]) -> usize {
+    solvers.iter().position(|m| m == "arlpcg").unwrap_or(0)
+}
+
+/// Plays the plays numbered `indices` (into [`Layout::plays`]): each level `trials` runs (the
+/// validation levels `validation_trials`), run seeds from the level's seed.
+pub fn play(
+    levels: &Levels,
+    solvers: &[NamedSolver],
+    budget: Budget,
+    indices: &[usize],
+    on_level: &dyn Fn(),
+) -> Vec<SolverStats> {
+    let plays = levels.layout.plays();
+    let main = main_solver(&levels.layout.solvers);
+    indices
+        .iter()
+        .map(|&i| {
+            let (solver, level, trials) = match plays[i] {
+                Play::Controllability { aux, level } => {
+                    (main, &levels.by_aux[aux][level], budget.trials)
+                }
+                Play::Generalization { solver, level } => {
+                    (solver, &levels.validation[level], budget.validation_trials)
+                }
+                Play::Cross { solver, aux, level } => {
+                    (solver, &levels.by_aux[aux][level], budget.trials)
+                }
+            };
             let stats = verify(
                 level,
-                &Solver::Policy(solver),
+                &Solver::Policy(solvers[solver].policy),
                 trials,
                 level.seed.unwrap_or(0),
                 &|| {},
             )
-            .expect("evaluation levels are platform levels");
+            .expect("evaluation Solvers play the evaluation's game");
             on_level();
             stats
         })
+        .collect()
+}
+
+/// The tables from the layout and the statistics of every play (`stats[i]` of play `i`).
+pub fn assemble(
+    budget: Budget,
+    generator: &str,
+    layout: &Layout,
+    stats: &[SolverStats],
+) -> Results {
+    let plays = layout.plays();
+    assert_eq!(plays.len(), stats.len(), "one statistics entry per play");
+    let summary = |wanted: &dyn Fn(&Play) -> bool| {
+        let chosen: Vec<SolverStats> = plays
+            .iter()
+            .zip(stats)
+            .filter(|(p, _)| wanted(p))
+            .map(|(_, s)| s.clone())
+            .collect();
+        if chosen.is_empty() {
+            return Summary {
+                levels: 0,
+                mean_success: f64::NAN,
+                std_success: f64::NAN,
+                completed_by_any: f64::NAN,
+                mean_progress: f64::NAN,
+                mean_success_steps: f64::NAN,
+            };
+        }
+        Summary::of(&chosen)
+    };
+    let controllability = AUX_VALUES
+        .iter()
+        .enumerate()
+        .map(|(a, &aux)| {
+            let s = summary(&|p| matches!(p, Play::Controllability { aux, .. } if *aux == a));
+            ControllabilityRow {
+                aux,
+                success_ratio: s.mean_success,
+                success_std: s.std_success,
+                completed_by_any: s.completed_by_any,
+                avg_block_distance: layout.block_means[a].map_or(f64::NAN, |m| m.0),
+                avg_block_size: layout.block_means[a].map_or(f64::NAN, |m| m.1),
+                tracks: layout.levels_per_aux[a],
+            }
+        })
         .collect();
-    Summary::of(&stats)
+    let mut generalization = Vec::new();
+    let mut cross = Vec::new();
+    for (k, mode) in layout.solvers.iter().enumerate() {
+        let s = summary(&|p| matches!(p, Play::Generalization { solver, .. } if *solver == k));
+        generalization.push(GeneralizationRow {
+            mode: mode.clone(),
+            success_ratio: s.mean_success,
+            success_std: s.std_success,
+            completed_by_any: s.completed_by_any,
+            avg_steps: if s.completed_by_any > 0.0 {
+                s.mean_success_steps
+            } else {
+                f64::NAN
+            },
+            tracks: layout.validation_levels,
+        });
+        let success_ratio = (0..AUX_VALUES.len())
+            .map(|a| {
+                summary(
+                    &|p| matches!(p, Play::Cross { solver, aux, .. } if *solver == k && *aux == a),
+                )
+                .mean_success
+            })
+            .collect();
+        cross.push(CrossRow {
+            mode: mode.clone(),
+            success_ratio,
+        });
+    }
+    Results {
+        budget,
+        generator: generator.to_string(),
+        controllability,
+        generalization,
+        cross,
+    }
 }
 
 /// Runs the whole evaluation. `solvers` must include the `arlpcg` one (it plays the
@@ -183,79 +379,15 @@ pub fn evaluate(
     budget: Budget,
     on_level: &dyn Fn(),
 ) -> Result<Results, candle_core::Error> {
-    let by_aux: Vec<Vec<Level>> = AUX_VALUES
-        .iter()
-        .map(|&aux| generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks))
-        .collect::<Result<_, _>>()?;
-    let validation = validation_levels(generator, budget.validation_tracks)?;
-    let main = solvers
-        .iter()
-        .find(|s| s.mode == "arlpcg")
-        .or(solvers.first())
-        .expect("at least one Solver");
-    let controllability = AUX_VALUES
-        .iter()
-        .zip(&by_aux)
-        .map(|(&aux, levels)| {
-            let summary = play(levels, main.policy, budget.trials, on_level);
-            let blocks: Vec<_> = levels
-                .iter()
-                .filter_map(|l| l.platform())
-                .flat_map(|t| t.block_params().iter().copied())
-                .collect();
-            let mean = |f: &dyn Fn(&crate::level::platform::BlockParams) -> f64| match blocks.len()
-            {
-                0 => f64::NAN,
-                n => blocks.iter().map(f).sum::<f64>() / n as f64,
-            };
-            ControllabilityRow {
-                aux,
-                success_ratio: summary.mean_success,
-                success_std: summary.std_success,
-                completed_by_any: summary.completed_by_any,
-                avg_block_distance: mean(&|b| b.distance),
-                avg_block_size: mean(&|b| b.size),
-                tracks: levels.len(),
-            }
-        })
-        .collect();
-    let mut generalization = Vec::new();
-    let mut cross = Vec::new();
-    for solver in solvers {
-        let summary = play(
-            &validation,
-            solver.policy,
-            budget.validation_trials,
-            on_level,
-        );
-        generalization.push(GeneralizationRow {
-            mode: solver.mode.clone(),
-            success_ratio: summary.mean_success,
-            success_std: summary.std_success,
-            completed_by_any: summary.completed_by_any,
-            avg_steps: if summary.completed_by_any > 0.0 {
-                summary.mean_success_steps
-            } else {
-                f64::NAN
-            },
-            tracks: validation.len(),
-        });
-        let success_ratio = by_aux
-            .iter()
-            .map(|levels| play(levels, solver.policy, budget.trials, on_level).mean_success)
-            .collect();
-        cross.push(CrossRow {
-            mode: solver.mode.clone(),
-            success_ratio,
-        });
-    }
-    Ok(Results {
+    let levels = levels(generator, solvers, budget)?;
+    let all: Vec<usize> = (0..levels.layout.plays().len()).collect();
+    let stats = play(&levels, solvers, budget, &all, on_level);
+    Ok(assemble(
         budget,
-        generator: generator.reference.path.clone(),
-        controllability,
-        generalization,
-        cross,
-    })
+        &generator.reference.path,
+        &levels.layout,
+        &stats,
+    ))
 }
 
 /// Levels `evaluate` plays in all (for a progress bar).

@@ -702,3 +702,87 @@ fn ctrl_c_in_a_batch_keeps_finished_levels_and_no_temporaries() {
         assert!(check.status.success(), "{name}: {}", stderr(&check));
     }
 }
+
+/// `eval --shard I/K` then `--merge` gives the unsharded results byte for byte; a missing
+/// shard is named, and parts of different evaluations are refused.
+#[test]
+fn sharded_eval_merges_into_the_unsharded_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let at = |name: &str| dir.path().join(name).display().to_string();
+    let budget = [
+        "--policies",
+        "policies/platform",
+        "--tracks",
+        "2",
+        "--trials",
+        "3",
+        "--validation-tracks",
+        "4",
+    ];
+    let run = |extra: &[&str]| {
+        let mut args = vec!["eval"];
+        args.extend_from_slice(&budget);
+        args.extend_from_slice(extra);
+        arlpcg(&args)
+    };
+    let out = run(&["--out", &at("whole")]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for i in 0..3 {
+        let shard = format!("{i}/3");
+        let out = run(&["--shard", &shard, "--out", &at(&format!("part{i}"))]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let merge = |parts: &[&str], out_dir: &str| {
+        let mut args = vec!["eval", "--merge"];
+        let paths: Vec<String> = parts.iter().map(|p| at(p)).collect();
+        args.extend(paths.iter().map(String::as_str));
+        let out_path = at(out_dir);
+        args.extend(["--out", out_path.as_str()]);
+        arlpcg(&args)
+    };
+    let out = merge(&["part2", "part0", "part1"], "merged");
+    assert!(out.status.success(), "{}", stderr(&out));
+    for file in [
+        "results.json",
+        "results.md",
+        "controllability.csv",
+        "cross.csv",
+    ] {
+        assert_eq!(
+            std::fs::read(dir.path().join("whole").join(file)).unwrap(),
+            std::fs::read(dir.path().join("merged").join(file)).unwrap(),
+            "{file} differs"
+        );
+    }
+    let out = merge(&["part0", "part2"], "short");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("shard 1/3 is missing"),
+        "{}",
+        stderr(&out)
+    );
+    let other_dir = at("other");
+    let made = arlpcg(&[
+        "eval",
+        "--policies",
+        "policies/platform",
+        "--tracks",
+        "2",
+        "--trials",
+        "2",
+        "--validation-tracks",
+        "4",
+        "--shard",
+        "1/3",
+        "--out",
+        &other_dir,
+    ]);
+    assert!(made.status.success(), "{}", stderr(&made));
+    let out = merge(&["part0", "other", "part2"], "mixed");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("their budget differ"),
+        "{}",
+        stderr(&out)
+    );
+}

@@ -12,6 +12,7 @@
 //! Levels use seeds from [`EVAL_SEED_BASE`] up, far below the seeds training draws from
 //! ([`crate::train::solver_envs::TRAINING_SEED_BASE`]): no evaluation level was trained on.
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::game::rules;
@@ -257,12 +258,14 @@ pub fn play(
     solvers: &[NamedSolver],
     budget: Budget,
     indices: &[usize],
-    on_level: &dyn Fn(),
+    on_level: &(dyn Fn() + Sync),
 ) -> Vec<SolverStats> {
     let plays = levels.layout.plays();
     let main = main_solver(&levels.layout.solvers);
+    // Several plays in flight at once; each depends only on its level and Solver, so the
+    // statistics do not depend on the number of threads.
     indices
-        .iter()
+        .par_iter()
         .map(|&i| {
             let (solver, level, trials) = match plays[i] {
                 Play::Controllability { aux, level } => {
@@ -377,7 +380,7 @@ pub fn evaluate(
     generator: &GeneratorPolicy,
     solvers: &[NamedSolver],
     budget: Budget,
-    on_level: &dyn Fn(),
+    on_level: &(dyn Fn() + Sync),
 ) -> Result<Results, candle_core::Error> {
     let levels = levels(generator, solvers, budget)?;
     let all: Vec<usize> = (0..levels.layout.plays().len()).collect();

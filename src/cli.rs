@@ -175,6 +175,11 @@ pub struct GenerateArgs {
     /// what this run makes are left as they are, so a re-run finishes an interrupted batch).
     #[arg(long)]
     pub force: bool,
+    /// With --verify, keep a level that no run completed. By default it is redrawn (the next
+    /// level of the seed, toward the same goal), and each level records one successful run's
+    /// seed as its certificate (`verify --replay` re-runs it).
+    #[arg(long, requires = "verify")]
+    pub allow_unsolved: bool,
     /// Make only shard I of K of the batch (0 <= I < K): level i of the batch when i mod K = I.
     /// K machines with I = 0..K-1 together write exactly the files of the whole batch.
     #[arg(long, value_name = "I/K", value_parser = parse_shard)]
@@ -307,6 +312,10 @@ pub struct VerifyArgs {
     /// Print one JSON object per level instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Instead of new trials, re-run each level's certificate (the successful run its
+    /// statistics record) with the Solver that recorded it, and check that it succeeds again.
+    #[arg(long, conflicts_with_all = ["solver", "policy", "trials", "json"])]
+    pub replay: bool,
 }
 
 #[derive(Debug, Args)]

@@ -33,16 +33,29 @@ pub fn rules_level(
     goal: Option<[f64; 3]>,
     obstacles: u32,
 ) -> Result<Level, NoRuleLevel> {
+    rules_level_draw(game, seed, aux, goal, obstacles, 0)
+}
+
+/// Draw number `draw` of [`rules_level`]: the next valid level of the seed's stream, toward the
+/// same goal (what `generate --verify` hands out when no run completed the earlier draws).
+pub fn rules_level_draw(
+    game: Game,
+    seed: u64,
+    aux: Option<f64>,
+    goal: Option<[f64; 3]>,
+    obstacles: u32,
+    draw: u32,
+) -> Result<Level, NoRuleLevel> {
     Ok(match game {
         Game::Platform => {
-            crate::game::rules::platform_level(seed, aux, goal, &RulesConfig::default())?
+            crate::game::rules::platform_level_draw(seed, aux, goal, &RulesConfig::default(), draw)?
         }
         Game::Racing => {
             let config = RacingRulesConfig {
                 obstacles,
                 ..RacingRulesConfig::default()
             };
-            crate::game::racing::rules::racing_level(seed, aux, goal, &config)?
+            crate::game::racing::rules::racing_level_draw(seed, aux, goal, &config, draw)?
         }
     })
 }
@@ -78,7 +91,20 @@ pub fn platform_level(
     aux: f64,
     goal: Option<[f64; 3]>,
 ) -> Result<Level, GenerationError> {
+    platform_level_draw(generator, seed, aux, goal, 0)
+}
+
+/// Draw number `draw` of [`platform_level`]: the `draw`-th valid level (from 0) the Generator
+/// builds from the seed's stream, toward the same goal.
+pub fn platform_level_draw(
+    generator: &GeneratorPolicy,
+    seed: u64,
+    aux: f64,
+    goal: Option<[f64; 3]>,
+    draw: u32,
+) -> Result<Level, GenerationError> {
     let (goal, start, mut rng) = goal_and_start(seed, goal);
+    let mut skip = draw;
     let aux_input = [aux as f32];
     let mut observation = vec![0.0; GENERATOR_OBSERVATION_SIZE];
     for _ in 0..ATTEMPTS {
@@ -100,6 +126,10 @@ pub fn platform_level(
                 break;
             }
             if track.last().reaches(goal) {
+                if skip > 0 {
+                    skip -= 1;
+                    break;
+                }
                 return Ok(Level {
                     seed: Some(seed),
                     aux: Some(aux),

@@ -207,6 +207,21 @@ fn record_env<E: SolverEnv>(mut env: E, solver: &Solver, seed: u64) -> Recording
     }
 }
 
+/// The seed of a successful run played alone ([`record`]), searching `seeds`; `None` when none
+/// of them succeeds. With `verify --replay`, the certificate a level file carries.
+pub fn certify(
+    level: &Level,
+    solver: &Solver,
+    seeds: impl Iterator<Item = u64>,
+) -> Result<Option<u64>, WrongGame> {
+    for seed in seeds {
+        if record(level, solver, seed)?.result.outcome == crate::level::stats::Outcome::Success {
+            return Ok(Some(seed));
+        }
+    }
+    Ok(None)
+}
+
 /// Plays one run with the game's scripted player, seeded by `seed`.
 pub fn play_scripted<E: SolverEnv>(env: &mut E, seed: u64) -> TrialResult {
     env.reset(seed);

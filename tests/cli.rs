@@ -787,3 +787,65 @@ fn sharded_eval_merges_into_the_unsharded_results() {
         stderr(&out)
     );
 }
+
+/// With --verify no level that no run completed is handed out: such draws are replaced by the
+/// seed's next draw, and every level carries a certificate that `verify --replay` re-runs.
+#[test]
+fn verified_levels_are_completable_and_their_certificates_replay() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = arlpcg(&[
+        "generate",
+        "--policies",
+        "policies/platform",
+        "--aux",
+        "-1",
+        "--count",
+        "12",
+        "--verify",
+        "20",
+        "--format",
+        "yaml",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let said = String::from_utf8_lossy(&out.stdout);
+    let mut levels = Vec::new();
+    let mut redraws = 0;
+    for (name, _) in files_of(dir.path()) {
+        let path = dir.path().join(&name);
+        let level = arlpcg::level::yaml::load(&path).unwrap();
+        let stats = level.stats.clone().unwrap();
+        assert!(stats.successes > 0, "{name}: no run completed it");
+        assert!(stats.certificate.is_some(), "{name} has no certificate");
+        redraws += stats.redraws;
+        levels.push(path.display().to_string());
+    }
+    // At λ = -1 some first draws are completed by no run of 20 (about one in ten).
+    assert!(redraws > 0, "nothing was redrawn: {said}");
+    assert!(said.contains("redrew"), "{said}");
+    let mut args = vec!["verify", "--replay"];
+    args.extend(levels.iter().map(String::as_str));
+    let out = arlpcg(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let replayed = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(replayed.matches("succeeds again").count(), 12, "{replayed}");
+    // A certificate recorded by another policy is refused by name.
+    let first = &levels[0];
+    let text = std::fs::read_to_string(first).unwrap();
+    let at = text.rfind("sha256: ").unwrap() + "sha256: ".len();
+    let forged = format!("{}{}{}", &text[..at], "0".repeat(64), &text[at + 64..]);
+    std::fs::write(first, forged).unwrap();
+    let out = arlpcg(&["verify", "--replay", first]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("is not the policy that recorded the certificate"),
+        "{}",
+        stderr(&out)
+    );
+    let out = arlpcg(&["verify", "--replay", "levels/hand/staircase.yaml"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("no statistics"), "{}", stderr(&out));
+    let out = arlpcg(&["generate", "--rules", "--allow-unsolved", "--out", "x"]);
+    assert_eq!(out.status.code(), Some(2));
+}

@@ -13,7 +13,7 @@ use crate::generation::{self, GeneratorPolicy};
 use crate::level::{Game, Level};
 use crate::level_files::{Format, LevelFiles, render};
 use crate::policies::{load_generator, load_solver, policy_paths};
-use crate::verify::{Solver, SolverPolicy, verify};
+use crate::verify::{self, Solver, SolverPolicy, verify};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
     if args.game == Game::Racing && args.policies.is_some() {
@@ -82,12 +82,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
             if stop.load(Ordering::SeqCst) {
                 return None;
             }
-            let level = build(args, generator.as_ref(), *seed).and_then(|mut level| {
-                if let Some(trials) = args.verify {
-                    level.stats = Some(verify(&level, &who, trials, *seed, &|| {})?);
-                }
-                Ok(level)
-            });
+            let level = build_verified(args, generator.as_ref(), &who, *seed);
             bar.inc(1);
             Some(level.with_context(|| format!("seed {seed} (nothing was written)")))
         })
@@ -145,18 +140,83 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         plans.len(),
         args.out.display()
     );
+    let stats: Vec<_> = levels.iter().filter_map(|l| l.stats.as_ref()).collect();
+    let redrawn: Vec<u32> = stats.iter().map(|s| s.redraws).filter(|&r| r > 0).collect();
+    if !redrawn.is_empty() {
+        println!(
+            "redrew {} levels that no run completed ({} draws replaced)",
+            redrawn.len(),
+            redrawn.iter().sum::<u32>()
+        );
+    }
+    let unsolved = stats.iter().filter(|s| s.successes == 0).count();
+    if unsolved > 0 {
+        println!("kept {unsolved} levels that no run completed (--allow-unsolved)");
+    }
+    let uncertified = stats
+        .iter()
+        .filter(|s| s.successes > 0 && s.certificate.is_none())
+        .count();
+    if uncertified > 0 {
+        println!(
+            "{uncertified} levels have no certificate: no single run succeeded within the search (their success ratio is tiny)"
+        );
+    }
     Ok(())
 }
 
-/// Level `seed` from the Generator when there is one, else from the rules.
-fn build(args: &GenerateArgs, generator: Option<&GeneratorPolicy>, seed: u64) -> Result<Level> {
+/// Draws of one seed tried before `generate --verify` gives up on finding a level that some
+/// run completes.
+pub const MAX_DRAWS: u32 = 10;
+
+/// Level `seed` (its `draw`-th draw) from the Generator when there is one, else from the rules.
+fn build(
+    args: &GenerateArgs,
+    generator: Option<&GeneratorPolicy>,
+    seed: u64,
+    draw: u32,
+) -> Result<Level> {
     let (aux, goal) = (args.aux, args.goal);
     Ok(match (args.game, generator) {
         (Game::Platform, Some(generator)) => {
-            generation::platform_level(generator, seed, aux.unwrap_or_default(), goal)?
+            generation::platform_level_draw(generator, seed, aux.unwrap_or_default(), goal, draw)?
         }
-        (game, _) => generation::rules_level(game, seed, aux, goal, args.obstacles)?,
+        (game, _) => generation::rules_level_draw(game, seed, aux, goal, args.obstacles, draw)?,
     })
+}
+
+/// Level `seed`, verified when asked: a draw that no run completes is replaced by the seed's
+/// next draw (unless --allow-unsolved), and a kept level carries a certificate.
+fn build_verified(
+    args: &GenerateArgs,
+    generator: Option<&GeneratorPolicy>,
+    solver: &Solver,
+    seed: u64,
+) -> Result<Level> {
+    let Some(trials) = args.verify else {
+        return build(args, generator, seed, 0);
+    };
+    for draw in 0..MAX_DRAWS {
+        let mut level = build(args, generator, seed, draw)?;
+        let mut stats = verify(&level, solver, trials, seed, &|| {})?;
+        if stats.successes == 0 && !args.allow_unsolved {
+            continue;
+        }
+        stats.redraws = draw;
+        // Single runs from the trials' seeds on: a level some trial completed is certified
+        // within a few runs unless its success ratio is tiny.
+        let seeds = (0..2 * trials as u64).map(|k| seed.wrapping_add(k));
+        stats.certificate = if stats.successes > 0 {
+            verify::certify(&level, solver, seeds)?
+        } else {
+            None
+        };
+        level.stats = Some(stats);
+        return Ok(level);
+    }
+    bail!(
+        "none of the {MAX_DRAWS} levels drawn for this seed was completed by any of {trials} runs (--allow-unsolved keeps the first anyway)"
+    )
 }
 
 /// `platform_seed7` or, with an aux value, `platform_seed7_aux-0.50`.

@@ -4,17 +4,20 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use serde_json::json;
 
 use crate::cli::{SolverChoice, VerifyArgs, default_solver};
 use crate::level::Game;
-use crate::level::stats::SolverStats;
+use crate::level::stats::{Outcome, SolverRef, SolverStats};
 use crate::level::yaml;
 use crate::policies::load_solver;
 use crate::verify::{Solver, SolverPolicy, Summary, verify};
 
 pub fn run(args: &VerifyArgs) -> Result<()> {
+    if args.replay {
+        return replay(args);
+    }
     let mut solvers = Solvers::default();
     let mut failed = 0;
     let mut all = Vec::new();
@@ -64,6 +67,72 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// `verify --replay`: each level's certificate run, again, with the Solver that recorded it.
+fn replay(args: &VerifyArgs) -> Result<()> {
+    let mut failed = 0;
+    for path in &args.levels {
+        let outcome = yaml::load(path)
+            .map_err(anyhow::Error::from)
+            .and_then(|level| replay_one(&level));
+        match outcome {
+            Ok(said) => println!("{}: {said}", path.display()),
+            Err(err) => {
+                failed += 1;
+                eprintln!(
+                    "error: {}: {}",
+                    path.display(),
+                    one_line(&format!("{err:#}"))
+                );
+            }
+        }
+    }
+    if failed > 0 {
+        anyhow::bail!(
+            "{failed} of {} certificates did not replay",
+            args.levels.len()
+        );
+    }
+    Ok(())
+}
+
+fn replay_one(level: &crate::level::Level) -> Result<String> {
+    let stats = level
+        .stats
+        .as_ref()
+        .context("no statistics: verify the level first (generate --verify N)")?;
+    let seed = stats
+        .certificate
+        .context("its statistics record no certificate (no successful run was found)")?;
+    let loaded;
+    let solver = match &stats.solver {
+        SolverRef::Scripted => Solver::Scripted,
+        SolverRef::Random => Solver::Random,
+        SolverRef::Policy { policy } => {
+            loaded = load_solver(Path::new(&policy.path), level.game())?.0;
+            if loaded.reference.sha256 != policy.sha256 {
+                anyhow::bail!(
+                    "{} is not the policy that recorded the certificate (its SHA-256 differs)",
+                    policy.path
+                );
+            }
+            Solver::Policy(&loaded)
+        }
+    };
+    let run = crate::verify::record(level, &solver, seed)?;
+    if run.result.outcome != Outcome::Success {
+        anyhow::bail!(
+            "the certificate run (seed {seed}) did not succeed with the {}: it {}",
+            stats.solver.describe(),
+            run.result.outcome.describe()
+        );
+    }
+    Ok(format!(
+        "the certificate run (seed {seed}) succeeds again with the {} in {} decisions",
+        stats.solver.describe(),
+        run.result.steps
+    ))
 }
 
 /// The Solver of each game met so far, resolved from the arguments once per game.

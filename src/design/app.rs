@@ -579,7 +579,7 @@ impl App {
                     Ok(recording) => {
                         self.say(format!(
                             "replay: {} after {} steps",
-                            describe_outcome(recording.result.outcome),
+                            recording.result.outcome.describe(),
                             recording.result.steps
                         ));
                         self.replay = Some(Replay {
@@ -683,14 +683,4 @@ pub fn next_seed(seed: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     (z ^ (z >> 31)) % 1_000_000
-}
-
-pub fn describe_outcome(outcome: Outcome) -> &'static str {
-    match outcome {
-        Outcome::Success => "reached the goal",
-        Outcome::Fell => "fell",
-        Outcome::TimedOut => "ran out of time",
-        Outcome::OffRoad => "left the road",
-        Outcome::Flipped => "turned over",
-    }
 }

@@ -65,9 +65,26 @@ pub fn platform_level(
     goal: Option<[f64; 3]>,
     config: &RulesConfig,
 ) -> Result<Level, NoLevel> {
+    platform_level_draw(seed, aux, goal, config, 0)
+}
+
+/// Draw number `draw` of level `seed`: the `draw`-th valid level (from 0) of the seed's stream,
+/// toward the same goal. Draw 0 is [`platform_level`].
+pub fn platform_level_draw(
+    seed: u64,
+    aux: Option<f64>,
+    goal: Option<[f64; 3]>,
+    config: &RulesConfig,
+    draw: u32,
+) -> Result<Level, NoLevel> {
     let (goal, start, mut rng) = goal_and_start(seed, goal);
+    let mut skip = draw;
     for _ in 0..ATTEMPTS {
         if let Some(track) = attempt(&mut rng, start, goal, config) {
+            if skip > 0 {
+                skip -= 1;
+                continue;
+            }
             return Ok(Level {
                 seed: Some(seed),
                 aux,

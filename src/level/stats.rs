@@ -43,6 +43,19 @@ pub enum Outcome {
     Flipped,
 }
 
+impl Outcome {
+    /// How a run that ended this way is told: "reached the goal", "fell", ...
+    pub fn describe(self) -> &'static str {
+        match self {
+            Outcome::Success => "reached the goal",
+            Outcome::Fell => "fell",
+            Outcome::TimedOut => "ran out of time",
+            Outcome::OffRoad => "left the road",
+            Outcome::Flipped => "turned over",
+        }
+    }
+}
+
 /// One finished Solver run, as verification records it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrialResult {
@@ -87,6 +100,13 @@ pub struct SolverStats {
     /// Mean decisions per run with the car in the air (racing).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mean_air_steps: Option<f64>,
+    /// The seed of one successful run played alone (`verify --replay` re-runs it): proof that
+    /// the level can be completed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub certificate: Option<u64>,
+    /// Earlier draws of this seed that no run completed, replaced by this one.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub redraws: u32,
 }
 
 fn is_zero(count: &u32) -> bool {
@@ -137,6 +157,8 @@ impl SolverStats {
                 .sum::<Option<f64>>()
                 .filter(|_| !trials.is_empty())
                 .map(|sum| round4(sum / n as f64)),
+            certificate: None,
+            redraws: 0,
         }
     }
 

@@ -97,9 +97,26 @@ pub fn racing_level(
     goal: Option<[f64; 3]>,
     config: &RacingRulesConfig,
 ) -> Result<Level, NoTrack> {
+    racing_level_draw(seed, aux, goal, config, 0)
+}
+
+/// Draw number `draw` of track `seed`: the `draw`-th valid track (from 0) of the seed's
+/// stream, toward the same goal around the same obstacles. Draw 0 is [`racing_level`].
+pub fn racing_level_draw(
+    seed: u64,
+    aux: Option<f64>,
+    goal: Option<[f64; 3]>,
+    config: &RacingRulesConfig,
+    draw: u32,
+) -> Result<Level, NoTrack> {
     let (goal, heading, obstacles, mut rng) = goal_and_start(seed, goal, config.obstacles);
+    let mut skip = draw;
     for _ in 0..ATTEMPTS {
         if let Some(mut track) = attempt(&mut rng, heading, goal, &obstacles, config) {
+            if skip > 0 {
+                skip -= 1;
+                continue;
+            }
             track.obstacles = obstacles;
             return Ok(Level {
                 seed: Some(seed),

@@ -175,6 +175,12 @@ pub struct GenerateArgs {
     /// what this run makes are left as they are, so a re-run finishes an interrupted batch).
     #[arg(long)]
     pub force: bool,
+    /// Ask for a success rate instead of λ (0 < P < 1, with --policies): each level is searched
+    /// (λ and draws) until its measured success is within ±0.1 of P; the λ used is recorded.
+    /// Verifies with 100 runs unless --verify says otherwise. The policies' λ→success curve is
+    /// measured once and kept as difficulty-curve.yaml beside them.
+    #[arg(long, value_name = "P", value_parser = parse_target, conflicts_with = "aux")]
+    pub target_success: Option<f64>,
     /// With --verify, keep a level that no run completed. By default it is redrawn (the next
     /// level of the seed, toward the same goal), and each level records one successful run's
     /// seed as its certificate (`verify --replay` re-runs it).
@@ -197,6 +203,15 @@ impl Shard {
     /// Whether item `i` of the batch belongs to this shard.
     pub fn owns(&self, i: u64) -> bool {
         i % self.count == self.index
+    }
+}
+
+fn parse_target(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(p) if p > 0.0 && p < 1.0 => Ok(p),
+        _ => Err(format!(
+            "`{s}` is not a success ratio strictly between 0 and 1"
+        )),
     }
 }
 

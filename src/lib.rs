@@ -16,6 +16,7 @@ pub mod chart;
 pub mod cli;
 pub mod commands;
 pub mod design;
+pub mod difficulty;
 pub mod eval;
 pub mod fsio;
 pub mod game;

@@ -849,3 +849,74 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
     let out = arlpcg(&["generate", "--rules", "--allow-unsolved", "--out", "x"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// `--target-success P` hands out levels whose measured success is within ±0.1 of P, recording
+/// the λ it used; the curve it starts from is the one kept beside the shipped policies.
+#[test]
+fn target_success_levels_measure_within_the_band() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = arlpcg(&[
+        "generate",
+        "--policies",
+        "policies/platform",
+        "--target-success",
+        "0.6",
+        "--count",
+        "3",
+        "--verify",
+        "50",
+        "--format",
+        "yaml",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        !stderr(&out).contains("measuring"),
+        "the shipped policies' curve is current: {}",
+        stderr(&out)
+    );
+    let files = files_of(dir.path());
+    assert_eq!(files.len(), 3);
+    let mut auxes = Vec::new();
+    for (name, _) in &files {
+        assert!(name.ends_with("_success0.60.yaml"), "{name}");
+        let level = arlpcg::level::yaml::load(&dir.path().join(name)).unwrap();
+        let stats = level.stats.unwrap();
+        assert!(
+            (stats.success_ratio - 0.6).abs() <= 0.1 + 1e-9,
+            "{name}: success {}",
+            stats.success_ratio
+        );
+        assert!(stats.certificate.is_some());
+        auxes.push(level.aux.unwrap());
+    }
+    // The λ used is recorded; the shipped policies' curve is 0.98 at λ = 0.5, so on average a
+    // 0.6 level comes from well below it.
+    assert!(auxes.iter().sum::<f64>() / 3.0 < 0.25, "{auxes:?}");
+    for bad in ["0", "1", "1.5", "nan"] {
+        let out = arlpcg(&[
+            "generate",
+            "--policies",
+            "policies/platform",
+            "--target-success",
+            bad,
+            "--out",
+            "x",
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+    }
+    let out = arlpcg(&[
+        "generate",
+        "--rules",
+        "--target-success",
+        "0.5",
+        "--out",
+        "x",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "--target-success needs --policies"
+    );
+}

@@ -1,6 +1,7 @@
 //! `arlpcg generate`: levels from a trained Generator or from the rules, optionally verified by
 //! the Solver, written as files named after game, seed and aux.
 
+use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -8,6 +9,7 @@ use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 
 use crate::cli::{GenerateArgs, default_solver};
+use crate::difficulty;
 use crate::fsio::{self, Overwrite};
 use crate::generation::{self, GeneratorPolicy};
 use crate::level::{Game, Level};
@@ -22,6 +24,12 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         )
         .into());
     }
+    if args.target_success.is_some() && args.policies.is_none() {
+        return Err(crate::shell::UsageError(
+            "--target-success needs --policies: a Generator that λ steers".into(),
+        )
+        .into());
+    }
     if args.obstacles > 0 && (args.game != Game::Racing || !args.rules) {
         return Err(crate::shell::UsageError(
             "--obstacles is for racing tracks from the rules (--game racing --rules)".into(),
@@ -30,9 +38,10 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     }
     let generator = match &args.policies {
         Some(dir) => {
-            if args.aux.is_none() {
+            if args.aux.is_none() && args.target_success.is_none() {
                 return Err(crate::shell::UsageError(
-                    "--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard)".into(),
+                    "--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard) or --target-success P"
+                        .into(),
                 )
                 .into());
             }
@@ -40,8 +49,9 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         }
         None => None,
     };
+    let verify_trials = args.verify.or(args.target_success.map(|_| TARGET_TRIALS));
     let shipped = default_solver(args.game);
-    let solver: Option<SolverPolicy> = match (args.verify, &args.policies) {
+    let solver: Option<SolverPolicy> = match (verify_trials, &args.policies) {
         (None, _) => None,
         (Some(_), Some(dir)) => Some(load_solver(&policy_paths(dir).1, args.game)?.0),
         (Some(_), None) if shipped.exists() => Some(load_solver(&shipped, args.game)?.0),
@@ -60,7 +70,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         .map(|&seed| {
             (
                 seed,
-                LevelFiles::new(&args.out, &file_stem(args.game, seed, args.aux), &formats),
+                LevelFiles::new(&args.out, &stem(args, seed), &formats),
             )
         })
         .collect();
@@ -74,15 +84,34 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     // cannot be built leaves the folder as it was, and --force replaces nothing. Several
     // levels are in flight at once; each depends only on its seed, so the files do not depend
     // on the number of threads.
-    let bar = crate::shell::progress_bar(plans.len() as u64, "generating");
     let who = solver.as_ref().map_or(Solver::Scripted, Solver::Policy);
+    let curve = match (args.target_success, &generator, &solver, &args.policies) {
+        (Some(_), Some(generator), Some(solver), Some(dir)) => {
+            Some(difficulty_curve(dir, generator, solver)?)
+        }
+        _ => None,
+    };
+    let bar = crate::shell::progress_bar(plans.len() as u64, "generating");
     let built: Vec<Option<Result<Level>>> = plans
         .par_iter()
         .map(|(seed, _)| {
             if stop.load(Ordering::SeqCst) {
                 return None;
             }
-            let level = build_verified(args, generator.as_ref(), &who, *seed);
+            let level = match (args.target_success, &curve, &generator) {
+                (Some(target), Some(curve), Some(generator)) => difficulty::level_for(
+                    generator,
+                    &who,
+                    curve,
+                    *seed,
+                    args.goal,
+                    target,
+                    verify_trials.unwrap_or(TARGET_TRIALS),
+                )
+                .map_err(anyhow::Error::from)
+                .and_then(|level| certified(level, &who, *seed)),
+                _ => build_verified(args, generator.as_ref(), &who, *seed),
+            };
             bar.inc(1);
             Some(level.with_context(|| format!("seed {seed} (nothing was written)")))
         })
@@ -165,6 +194,67 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     Ok(())
 }
 
+/// Runs per candidate of `--target-success` without `--verify`.
+const TARGET_TRIALS: u32 = 100;
+
+/// The level with a certificate in its statistics: single runs from the trials' seeds on, so a
+/// level some trial completed is certified within a few runs unless its success ratio is tiny.
+fn certified(mut level: Level, solver: &Solver, seed: u64) -> Result<Level> {
+    if let Some(stats) = &level.stats
+        && stats.successes > 0
+    {
+        let seeds = (0..2 * stats.trials as u64).map(|k| seed.wrapping_add(k));
+        let certificate = verify::certify(&level, solver, seeds)?;
+        if let Some(stats) = &mut level.stats {
+            stats.certificate = certificate;
+        }
+    }
+    Ok(level)
+}
+
+/// The λ→success curve of the policies in `dir`: read from `difficulty-curve.yaml` when it was
+/// measured with these very policies, else measured now and kept there.
+fn difficulty_curve(
+    dir: &Path,
+    generator: &GeneratorPolicy,
+    solver: &SolverPolicy,
+) -> Result<difficulty::Curve> {
+    let path = dir.join(CURVE_FILE);
+    let current = |c: &difficulty::Curve| {
+        c.generator_sha256 == generator.reference.sha256
+            && c.solver_sha256 == solver.reference.sha256
+    };
+    if let Ok(bytes) = fsio::read_limited(&path, 1 << 20, "difficulty curve")
+        && let Ok(curve) = serde_yaml::from_slice::<difficulty::Curve>(&bytes)
+        && current(&curve)
+    {
+        return Ok(curve);
+    }
+    eprintln!(
+        "measuring the policies' λ→success curve ({} λ values × {} levels × {} runs), once",
+        difficulty::CURVE_AUX.len(),
+        difficulty::CURVE_LEVELS,
+        difficulty::CURVE_TRIALS
+    );
+    let curve = difficulty::measure(generator, &Solver::Policy(solver), &solver.reference.sha256)?;
+    let text = serde_yaml::to_string(&curve)?;
+    if let Err(e) = fsio::write_atomic(&path, text.as_bytes(), Overwrite::Allowed) {
+        eprintln!("note: could not keep the curve beside the policies: {e:#}");
+    }
+    Ok(curve)
+}
+
+/// The file beside a policies folder's Generator that holds its λ→success curve.
+pub const CURVE_FILE: &str = "difficulty-curve.yaml";
+
+/// A level's file name: game, seed and λ, or the success rate asked for.
+fn stem(args: &GenerateArgs, seed: u64) -> String {
+    match args.target_success {
+        Some(target) => format!("{}_seed{seed}_success{target:.2}", args.game),
+        None => file_stem(args.game, seed, args.aux),
+    }
+}
+
 /// Draws of one seed tried before `generate --verify` gives up on finding a level that some
 /// run completes.
 pub const MAX_DRAWS: u32 = 10;
@@ -203,16 +293,8 @@ fn build_verified(
             continue;
         }
         stats.redraws = draw;
-        // Single runs from the trials' seeds on: a level some trial completed is certified
-        // within a few runs unless its success ratio is tiny.
-        let seeds = (0..2 * trials as u64).map(|k| seed.wrapping_add(k));
-        stats.certificate = if stats.successes > 0 {
-            verify::certify(&level, solver, seeds)?
-        } else {
-            None
-        };
         level.stats = Some(stats);
-        return Ok(level);
+        return certified(level, solver, seed);
     }
     bail!(
         "none of the {MAX_DRAWS} levels drawn for this seed was completed by any of {trials} runs (--allow-unsolved keeps the first anyway)"

@@ -1,0 +1,177 @@
+//! Difficulty a designer can trust: a Generator's λ → success curve with a given Solver, and
+//! the search that turns a wanted success rate into a level (`generate --target-success P`).
+//!
+//! One level's success at a λ varies a lot from seed to seed (the curve is an average), so the
+//! search starts at the λ the curve gives for `P` and then moves λ by how far each verified
+//! candidate missed, drawing a new level of the same seed and goal each time, until one
+//! measures within [`BAND`] of `P`.
+
+use serde::{Deserialize, Serialize};
+
+use crate::generation::{self, GenerationError, GeneratorPolicy};
+use crate::level::Level;
+use crate::verify::{Solver, WrongGame, verify};
+
+/// A kept level measures within this of the wanted success ratio.
+pub const BAND: f64 = 0.1;
+/// Candidates tried per level before giving up.
+pub const MAX_CANDIDATES: u32 = 24;
+/// The λ values the curve is measured at, easy to hard.
+pub const CURVE_AUX: [f64; 9] = [1.0, 0.75, 0.5, 0.25, 0.0, -0.25, -0.5, -0.75, -1.0];
+/// Levels per λ and runs per level when measuring the curve.
+pub const CURVE_LEVELS: u32 = 8;
+pub const CURVE_TRIALS: u32 = 20;
+/// Seeds of the levels the curve is measured on (apart from eval's and training's).
+const CURVE_SEED_BASE: u64 = 3 << 32;
+
+/// Mean success ratio of a Solver on a Generator's levels at each λ of [`CURVE_AUX`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Curve {
+    /// SHA-256 of the Generator and of the Solver it was measured with.
+    pub generator_sha256: String,
+    pub solver_sha256: String,
+    /// (λ, mean success ratio), easy to hard.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// Why no level was found.
+#[derive(Debug, thiserror::Error)]
+pub enum TargetError {
+    #[error(
+        "no level within ±{BAND} of success {target} in {MAX_CANDIDATES} candidates (closest: {closest:.2} at λ {aux:+.2})"
+    )]
+    Missed { target: f64, closest: f64, aux: f64 },
+    #[error(transparent)]
+    Generation(#[from] GenerationError),
+    #[error(transparent)]
+    WrongGame(#[from] WrongGame),
+}
+
+/// Measures the curve: [`CURVE_LEVELS`] levels at each λ, [`CURVE_TRIALS`] runs each.
+pub fn measure(
+    generator: &GeneratorPolicy,
+    solver: &Solver,
+    solver_sha256: &str,
+) -> Result<Curve, TargetError> {
+    let mut points = Vec::with_capacity(CURVE_AUX.len());
+    for aux in CURVE_AUX {
+        let mut total = 0.0;
+        let mut count = 0;
+        for k in 0..CURVE_LEVELS as u64 {
+            let seed = CURVE_SEED_BASE + k;
+            match generation::platform_level(generator, seed, aux, None) {
+                Ok(level) => {
+                    total += verify(&level, solver, CURVE_TRIALS, seed, &|| {})?.success_ratio;
+                    count += 1;
+                }
+                Err(GenerationError::NoLevel { .. }) => {}
+                Err(e) => return Err(e.into()),
+            }
+        }
+        if count > 0 {
+            points.push((aux, (total / count as f64 * 1e4).round() / 1e4));
+        }
+    }
+    Ok(Curve {
+        generator_sha256: generator.reference.sha256.clone(),
+        solver_sha256: solver_sha256.to_string(),
+        points,
+    })
+}
+
+impl Curve {
+    /// The λ at which the curve passes `target` (linear between its points; the end λ when the
+    /// target is beyond what the curve spans). Where the curve is not monotone, the easiest
+    /// crossing wins.
+    pub fn aux_for(&self, target: f64) -> f64 {
+        let p = &self.points;
+        match p.len() {
+            0 => 0.0,
+            1 => p[0].0,
+            _ => {
+                for pair in p.windows(2) {
+                    let [(a0, s0), (a1, s1)] = [pair[0], pair[1]];
+                    let (lo, hi) = (s0.min(s1), s0.max(s1));
+                    if (lo..=hi).contains(&target) && hi > lo {
+                        return a0 + (target - s0) / (s1 - s0) * (a1 - a0);
+                    }
+                }
+                // Beyond the curve: the nearer end.
+                let first = p[0];
+                let last = p[p.len() - 1];
+                if (target - first.1).abs() <= (target - last.1).abs() {
+                    first.0
+                } else {
+                    last.0
+                }
+            }
+        }
+    }
+}
+
+/// A level of `seed` whose success, verified with `trials` runs, is within [`BAND`] of
+/// `target`: the search starts at the curve's λ and moves λ against each miss, each candidate
+/// a new draw of the seed. A candidate that no run completed is never kept.
+pub fn level_for(
+    generator: &GeneratorPolicy,
+    solver: &Solver,
+    curve: &Curve,
+    seed: u64,
+    goal: Option<[f64; 3]>,
+    target: f64,
+    trials: u32,
+) -> Result<Level, TargetError> {
+    let mut aux = curve.aux_for(target);
+    let mut closest = (f64::INFINITY, f64::NAN, aux);
+    for draw in 0..MAX_CANDIDATES {
+        let quantized = (aux * 1000.0).round() / 1000.0;
+        let mut level =
+            match generation::platform_level_draw(generator, seed, quantized, goal, draw) {
+                Ok(level) => level,
+                Err(GenerationError::NoLevel { .. }) => continue,
+                Err(e) => return Err(e.into()),
+            };
+        let stats = verify(&level, solver, trials, seed, &|| {})?;
+        let miss = stats.success_ratio - target;
+        if miss.abs() < closest.0 {
+            closest = (miss.abs(), stats.success_ratio, quantized);
+        }
+        if miss.abs() <= BAND + 1e-9 && stats.successes > 0 {
+            level.stats = Some(stats);
+            return Ok(level);
+        }
+        // Too easy (success above the target): lower λ; too hard: raise it.
+        aux = (aux - 1.2 * miss).clamp(-1.0, 1.0);
+    }
+    Err(TargetError::Missed {
+        target,
+        closest: closest.1,
+        aux: closest.2,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn curve(points: &[(f64, f64)]) -> Curve {
+        Curve {
+            generator_sha256: String::new(),
+            solver_sha256: String::new(),
+            points: points.to_vec(),
+        }
+    }
+
+    #[test]
+    fn aux_for_inverts_the_curve_and_clamps_beyond_it() {
+        let c = curve(&[(1.0, 0.95), (0.0, 0.75), (-1.0, 0.35)]);
+        assert!((c.aux_for(0.85) - 0.5).abs() < 1e-9);
+        assert!((c.aux_for(0.55) + 0.5).abs() < 1e-9);
+        assert_eq!(c.aux_for(0.99), 1.0);
+        assert_eq!(c.aux_for(0.1), -1.0);
+        // Not monotone: the easiest crossing.
+        let zigzag = curve(&[(1.0, 0.9), (0.0, 0.5), (-1.0, 0.7)]);
+        assert!((zigzag.aux_for(0.6) - 0.25).abs() < 1e-9);
+    }
+}

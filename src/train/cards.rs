@@ -163,16 +163,8 @@ pub(super) fn read_checkpoint(
     Ok((loaded, state))
 }
 
-/// The current commit, for policy cards, with `-dirty` when the working tree has changes that
-/// are not committed (so the card cannot name the code that trained it); "unknown" outside a
-/// git checkout.
+/// The commit the binary was built from (build.rs): `-dirty` when its code differed from it,
+/// "unknown" when built outside a git checkout.
 pub(super) fn git_commit() -> String {
-    std::process::Command::new("git")
-        .args(["describe", "--always", "--abbrev=7", "--dirty"])
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .map_or("unknown".into(), |o| {
-            String::from_utf8_lossy(&o.stdout).trim().to_string()
-        })
+    env!("ARLPCG_COMMIT").to_string()
 }

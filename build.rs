@@ -13,8 +13,15 @@ fn git(args: &[&str]) -> Option<String> {
 
 fn main() {
     let commit = git(&["rev-parse", "--short=7", "HEAD"]);
-    let dirty = git(&["status", "--porcelain", "--", "src", "Cargo.toml", "Cargo.lock"])
-        .is_some_and(|changes| !changes.is_empty());
+    let dirty = git(&[
+        "status",
+        "--porcelain",
+        "--",
+        "src",
+        "Cargo.toml",
+        "Cargo.lock",
+    ])
+    .is_some_and(|changes| !changes.is_empty());
     let described = match commit {
         Some(c) if dirty => format!("{c}-dirty"),
         Some(c) => c,

@@ -121,3 +121,29 @@ fn every_shipped_platform_policy_loads_and_its_card_matches() {
         }
     }
 }
+
+/// The shipped racing Solver loads as a racing Solver, its card matches the file, it is trained
+/// to its budget, and it drives a held-out rule track to the end.
+#[test]
+fn the_shipped_racing_solver_loads_and_drives() {
+    use arlpcg::game::racing::OBSERVATION_SIZE;
+    use arlpcg::level::Game;
+    use arlpcg::verify::{Solver, verify};
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/racing/solver-rule-pcg.safetensors");
+    let (solver, card) = arlpcg::policies::load_solver(&path, Game::Racing).unwrap();
+    assert_eq!(card.training.mode, "rule-pcg");
+    assert_eq!(
+        card.observation.iter().map(|(_, k)| k).sum::<usize>(),
+        OBSERVATION_SIZE
+    );
+    assert!((10_000_000..10_100_000).contains(&card.training.steps));
+    // Its card names the repository's state when it was saved (7dc72e7-dirty, from runs/ files
+    // changed meanwhile), not the build; the README says which commit built it. Cards now
+    // record the build's commit, and no other shipped policy may be -dirty.
+    assert_eq!(card.training.commit, "7dc72e7-dirty");
+    let level =
+        arlpcg::game::racing::rules::racing_level(3, None, None, &Default::default()).unwrap();
+    let stats = verify(&level, &Solver::Policy(&solver), 8, 0, &|| {}).unwrap();
+    assert!(stats.success_ratio >= 0.75, "{stats:?}");
+}

@@ -80,6 +80,10 @@ pub struct ControllabilityRow {
 pub struct GeneralizationRow {
     pub mode: String,
     pub success_ratio: f64,
+    /// Mean success on the validation set's rule levels (no Solver trained on these)...
+    pub success_rule_levels: f64,
+    /// ...and on its Generator levels (the ARLPCG Solver's own training distribution).
+    pub success_generator_levels: f64,
     pub success_std: f64,
     pub completed_by_any: f64,
     /// Mean decisions of the successful runs.
@@ -156,8 +160,10 @@ pub struct Layout {
     pub levels_per_aux: Vec<usize>,
     /// (mean block distance, mean block size) of the levels at each λ (`None`: no levels).
     pub block_means: Vec<Option<(f64, f64)>>,
-    /// Levels in the validation set.
+    /// Levels in the validation set: its rule levels first, then the Generator's.
     pub validation_levels: usize,
+    /// How many of them are rule levels.
+    pub validation_rule_levels: usize,
     /// The Solvers' training modes, in table order.
     pub solvers: Vec<String>,
 }
@@ -237,6 +243,10 @@ pub fn levels(
         levels_per_aux: by_aux.iter().map(Vec::len).collect(),
         block_means,
         validation_levels: validation.len(),
+        validation_rule_levels: validation
+            .iter()
+            .filter(|l| matches!(l.source, crate::level::Source::Rules { .. }))
+            .count(),
         solvers: solvers.iter().map(|s| s.mode.clone()).collect(),
     };
     Ok(Levels {
@@ -340,8 +350,17 @@ pub fn assemble(
     let mut cross = Vec::new();
     for (k, mode) in layout.solvers.iter().enumerate() {
         let s = summary(&|p| matches!(p, Play::Generalization { solver, .. } if *solver == k));
+        let rules = layout.validation_rule_levels;
+        let on_rules = summary(&|p| {
+            matches!(p, Play::Generalization { solver, level } if *solver == k && *level < rules)
+        });
+        let on_generator = summary(&|p| {
+            matches!(p, Play::Generalization { solver, level } if *solver == k && *level >= rules)
+        });
         generalization.push(GeneralizationRow {
             mode: mode.clone(),
+            success_rule_levels: on_rules.mean_success,
+            success_generator_levels: on_generator.mean_success,
             success_ratio: s.mean_success,
             success_std: s.std_success,
             completed_by_any: s.completed_by_any,
@@ -433,8 +452,7 @@ pub fn markdown(results: &Results) -> String {
         );
     }
     md += "\n## Solver generalization (held-out validation levels)\n\n";
-    md +=
-        "| mode | success ratio | completed by any | avg steps | paper |\n|---|---|---|---|---|\n";
+    md += "| mode | success ratio | on rule levels | on Generator levels | completed by any | avg steps | paper |\n|---|---|---|---|---|---|---|\n";
     for row in &results.generalization {
         let paper = match row.mode.as_str() {
             "fixed-track" => "0.081 ± 0.205, 0.20 (54 steps)",
@@ -444,10 +462,12 @@ pub fn markdown(results: &Results) -> String {
             _ => "",
         };
         md += &format!(
-            "| {} | {} ± {} | {} | {} | {paper} |\n",
+            "| {} | {} ± {} | {} | {} | {} | {} | {paper} |\n",
             row.mode,
             num(row.success_ratio, 3),
             num(row.success_std, 3),
+            num(row.success_rule_levels, 3),
+            num(row.success_generator_levels, 3),
             num(row.completed_by_any, 2),
             num(row.avg_steps, 0)
         );
@@ -516,12 +536,20 @@ pub fn csv_tables(results: &Results) -> Vec<(&'static str, String)> {
             r.tracks
         );
     }
-    let mut generalization =
-        String::from("mode,success_ratio,success_std,completed_by_any,avg_steps,tracks\n");
+    let mut generalization = String::from(
+        "mode,success_ratio,success_std,success_rule_levels,success_generator_levels,completed_by_any,avg_steps,tracks\n",
+    );
     for r in &results.generalization {
         generalization += &format!(
-            "{},{:.4},{:.4},{:.4},{:.1},{}\n",
-            r.mode, r.success_ratio, r.success_std, r.completed_by_any, r.avg_steps, r.tracks
+            "{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.1},{}\n",
+            r.mode,
+            r.success_ratio,
+            r.success_std,
+            r.success_rule_levels,
+            r.success_generator_levels,
+            r.completed_by_any,
+            r.avg_steps,
+            r.tracks
         );
     }
     let mut cross = String::from("mode");

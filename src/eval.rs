@@ -351,12 +351,12 @@ pub fn assemble(
     for (k, mode) in layout.solvers.iter().enumerate() {
         let s = summary(&|p| matches!(p, Play::Generalization { solver, .. } if *solver == k));
         let rules = layout.validation_rule_levels;
-        let on_rules = summary(&|p| {
-            matches!(p, Play::Generalization { solver, level } if *solver == k && *level < rules)
-        });
-        let on_generator = summary(&|p| {
-            matches!(p, Play::Generalization { solver, level } if *solver == k && *level >= rules)
-        });
+        let on_rules = summary(
+            &|p| matches!(p, Play::Generalization { solver, level } if *solver == k && *level < rules),
+        );
+        let on_generator = summary(
+            &|p| matches!(p, Play::Generalization { solver, level } if *solver == k && *level >= rules),
+        );
         generalization.push(GeneralizationRow {
             mode: mode.clone(),
             success_rule_levels: on_rules.mean_success,

@@ -104,15 +104,15 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     } else {
         Overwrite::Never
     };
+    let pool = crate::shell::thread_pool(args.threads)?;
+    let named: Vec<NamedSolver> = solvers
+        .iter()
+        .map(|(mode, policy)| NamedSolver {
+            mode: mode.clone(),
+            policy,
+        })
+        .collect();
     if let Some(shard) = args.shard {
-        let pool = crate::shell::thread_pool(args.threads)?;
-        let named: Vec<NamedSolver> = solvers
-            .iter()
-            .map(|(mode, policy)| NamedSolver {
-                mode: mode.clone(),
-                policy,
-            })
-            .collect();
         let part = pool.install(|| -> Result<Part> {
             let levels = eval::levels(&generator, &named, budget)?;
             let indices: Vec<usize> = (0..levels.layout.plays().len())
@@ -170,14 +170,6 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     }
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let pool = crate::shell::thread_pool(args.threads)?;
-    let named: Vec<NamedSolver> = solvers
-        .iter()
-        .map(|(mode, policy)| NamedSolver {
-            mode: mode.clone(),
-            policy,
-        })
-        .collect();
     eprintln!(
         "generator {}; solvers: {}",
         generator_path.display(),

@@ -19,6 +19,19 @@ pub struct Step {
     pub outcome: Option<Outcome>,
 }
 
+impl Step {
+    /// The step that ends a run with `outcome`: a time-out truncates it (a value to bootstrap
+    /// remains), every other ending terminates it.
+    pub fn finished(outcome: Outcome, reward: f32) -> Self {
+        Self {
+            reward,
+            terminated: outcome != Outcome::TimedOut,
+            truncated: outcome == Outcome::TimedOut,
+            outcome: Some(outcome),
+        }
+    }
+}
+
 /// What verification and the designer need from a game's Solver environment. Code written
 /// once over `E: SolverEnv` is compiled per game: nothing is dispatched per step.
 pub trait SolverEnv: Send + Sync + Sized {

@@ -181,7 +181,7 @@ impl PlatformEnv {
     pub fn step(&mut self, action: PlatformAction) -> Step {
         if let Some(outcome) = self.outcome {
             // A finished run stays finished.
-            return self.finished_step(outcome, 0.0);
+            return Step::finished(outcome, 0.0);
         }
         self.character.step(&self.world, action);
         self.steps += 1;
@@ -210,7 +210,7 @@ impl PlatformEnv {
                     }
                 };
                 self.outcome = Some(outcome);
-                self.finished_step(outcome, reward)
+                Step::finished(outcome, reward)
             }
             None => Step {
                 reward,
@@ -218,15 +218,6 @@ impl PlatformEnv {
                 truncated: false,
                 outcome: None,
             },
-        }
-    }
-
-    fn finished_step(&self, outcome: Outcome, reward: f32) -> Step {
-        Step {
-            reward,
-            terminated: outcome != Outcome::TimedOut,
-            truncated: outcome == Outcome::TimedOut,
-            outcome: Some(outcome),
         }
     }
 

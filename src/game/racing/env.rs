@@ -117,6 +117,11 @@ impl RacingEnv {
     pub fn new(track: &RacingTrack, goal: [f64; 3], rewards: SolverRewards) -> Self {
         let road = track.road();
         let shapes = TrackShapes::new(&road, &track.obstacles);
+        Self::from_parts(road, shapes, goal, rewards)
+    }
+
+    /// The environment of a resolved road and its shapes, with the car at the start.
+    fn from_parts(road: Road, shapes: TrackShapes, goal: [f64; 3], rewards: SolverRewards) -> Self {
         let world = RacingWorld::new(&shapes, Vector::ZERO, 0.0);
         let max_steps =
             ((TIME_BASE_S + road.length() / TIME_SPEED) / DECISION_DT as f64).ceil() as u32;
@@ -167,7 +172,7 @@ impl RacingEnv {
     /// Advances one decision.
     pub fn step(&mut self, action: CarAction) -> Step {
         if let Some(outcome) = self.outcome {
-            return finished_step(outcome, 0.0);
+            return Step::finished(outcome, 0.0);
         }
         self.world.step(action);
         self.steps += 1;
@@ -216,7 +221,7 @@ impl RacingEnv {
                     self.rewards.failure
                 };
                 self.outcome = Some(outcome);
-                finished_step(outcome, reward)
+                Step::finished(outcome, reward)
             }
             None => Step {
                 reward,
@@ -355,15 +360,6 @@ impl RacingEnv {
     }
 }
 
-fn finished_step(outcome: Outcome, reward: f32) -> Step {
-    Step {
-        reward,
-        terminated: outcome != Outcome::TimedOut,
-        truncated: outcome == Outcome::TimedOut,
-        outcome: Some(outcome),
-    }
-}
-
 fn wrap(angle: f32) -> f32 {
     (angle + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI
 }
@@ -379,23 +375,12 @@ fn to_f32(p: [f64; 3]) -> Vector {
 impl Clone for RacingEnv {
     /// The same track and goal, with the car back at the start (seed 0).
     fn clone(&self) -> Self {
-        let mut env = Self {
-            road: self.road.clone(),
-            shapes: self.shapes.clone(),
-            goal: self.goal,
-            rewards: self.rewards,
-            world: RacingWorld::new(&self.shapes, Vector::ZERO, 0.0),
-            max_steps: self.max_steps,
-            nearest: 0,
-            along: 0.0,
-            steps: 0,
-            air_steps: 0,
-            loose_steps: 0,
-            flipped_steps: 0,
-            outcome: None,
-        };
-        env.reset(0);
-        env
+        Self::from_parts(
+            self.road.clone(),
+            self.shapes.clone(),
+            self.goal,
+            self.rewards,
+        )
     }
 }
 

@@ -14,9 +14,10 @@ use crate::train::{TrainMode, TrainRequest};
     name = "arlpcg",
     version,
     about = "Generate 3D game levels with a difficulty knob, prove them playable, export them.",
-    long_about = "arlpcg generates levels for a 3D platform game (blocks to jump across), checks \
-        each one by playing it many times, and exports it as YAML (the source of truth) and glTF \
-        (for Blender, Godot, Unity).\n\n\
+    long_about = "arlpcg generates levels for two 3D games, a platform game (blocks to jump \
+        across) and a racing game (a banked road to drive, around obstacles), checks each one by \
+        playing it many times, and exports it as YAML (the source of truth) and glTF (for \
+        Blender, Godot, Unity).\n\n\
         Levels come from a Generator trained against a Solver (ARLPCG, EA SEED 2021) and \
         steered by one knob, the aux input λ (+1 easy, -1 hard), or from rule-based generation.",
     after_help = "Examples:\n  \

@@ -351,7 +351,7 @@ fn racing_is_selectable_but_not_yet_available() {
     assert_eq!(h.app.game, Game::Racing);
     assert!(
         h.screen(80, 24)
-            .contains("Racing: the game selector is ready")
+            .contains("Racing: no racing Generator is trained yet")
     );
     h.key(KeyCode::Left);
     assert!(h.pending.is_empty(), "nothing to generate for racing");

@@ -61,8 +61,10 @@ pub fn render(app: &App, frame: &mut Frame) {
     controls(app, frame, &areas);
     match (app.game, app.level.as_deref()) {
         (Game::Racing, _) => {
-            let text = "Racing: the game selector is ready, but no racing Generator or Solver is \
-                        trained yet. Press Tab to return to the platform game.";
+            let text = "Racing: no racing Generator is trained yet, so the designer has no racing \
+                        view. Racing tracks are generated, verified and exported from the command \
+                        line: arlpcg generate --game racing --rules --verify 20 --out DIR (see the \
+                        README). Press Tab to return to the platform game.";
             frame.render_widget(
                 Paragraph::new(text)
                     .wrap(Wrap { trim: true })

@@ -54,9 +54,7 @@ impl App {
                     Game::Racing => Game::Platform,
                 };
                 if platform {
-                    self.complain(
-                        "racing: no Generator or Solver is trained for it yet; Tab goes back",
-                    );
+                    self.complain("racing: no racing Generator is trained yet; Tab goes back");
                     Vec::new()
                 } else {
                     self.generate()

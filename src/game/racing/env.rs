@@ -287,22 +287,27 @@ impl RacingEnv {
         let velocity = into_car * self.world.velocity();
         let spin = into_car * self.world.angular_velocity();
         let up = into_car * Vector::Y;
-        let mut values = Vec::with_capacity(OBSERVATION_SIZE);
-        values.extend((to_goal / 100.0).to_array());
-        values.extend([bearing.sin(), bearing.cos()]);
-        values.extend((velocity / 20.0).to_array());
-        values.extend(spin.to_array());
-        values.extend(up.to_array());
-        values.push((self.along / self.road.length()) as f32);
-        values.push(self.lateral_offset(to_f64(position)) as f32 / (0.5 * ROAD_WIDTH as f32));
-        values.extend([road_bearing.sin(), road_bearing.cos()]);
-        for ahead in LOOK_AHEAD {
+        let ahead = LOOK_AHEAD.map(|ahead| {
             let point = self.road.samples()[self.road.nearest_along(self.along + ahead)].centre;
             let local = into_level * (to_f32(point) - position);
-            values.extend([local.x / 60.0, local.z / 20.0]);
+            [local.x / 60.0, local.z / 20.0]
+        });
+        // Written straight into `out`: no allocation per decision.
+        let state = (to_goal / 100.0)
+            .to_array()
+            .into_iter()
+            .chain([bearing.sin(), bearing.cos()])
+            .chain((velocity / 20.0).to_array())
+            .chain(spin.to_array())
+            .chain(up.to_array())
+            .chain([(self.along / self.road.length()) as f32])
+            .chain([self.lateral_offset(to_f64(position)) as f32 / (0.5 * ROAD_WIDTH as f32)])
+            .chain([road_bearing.sin(), road_bearing.cos()])
+            .chain(ahead.into_iter().flatten())
+            .chain([1.0 - self.steps as f32 / self.max_steps as f32]);
+        for (slot, value) in out[..OBSERVATION_SIZE - FAN_SIZE].iter_mut().zip(state) {
+            *slot = value;
         }
-        values.push(1.0 - self.steps as f32 / self.max_steps as f32);
-        out[..values.len()].copy_from_slice(&values);
         let fan = &mut out[OBSERVATION_SIZE - FAN_SIZE..];
         let origins = FAN_FORWARD.iter().flat_map(|&f| {
             FAN_LEFT
@@ -314,13 +319,6 @@ impl RacingEnv {
             // Height of what the ray hit relative to the chassis; nothing hit reads -12 m.
             *depth = (FAN_START_HEIGHT - *depth) / 6.0;
         }
-    }
-
-    /// The observation as a new vector.
-    pub fn observation(&self) -> Vec<f32> {
-        let mut out = vec![0.0; OBSERVATION_SIZE];
-        self.observe(&mut out);
-        out
     }
 
     pub fn road(&self) -> &Road {

@@ -60,7 +60,7 @@ pub fn measure(
         let mut count = 0;
         for k in 0..CURVE_LEVELS as u64 {
             let seed = CURVE_SEED_BASE + k;
-            match generation::platform_level(generator, seed, aux, None) {
+            match generation::generator_level(generator, seed, aux, None, 0) {
                 Ok(level) => {
                     total += verify(&level, solver, CURVE_TRIALS, seed, &|| {})?.success_ratio;
                     count += 1;
@@ -127,7 +127,7 @@ pub fn level_for(
     for draw in 0..MAX_CANDIDATES {
         let quantized = (aux * 1000.0).round() / 1000.0;
         let mut level =
-            match generation::platform_level_draw(generator, seed, quantized, goal, draw) {
+            match generation::generator_level_draw(generator, seed, quantized, goal, 0, draw) {
                 Ok(level) => level,
                 Err(GenerationError::NoLevel { .. }) => continue,
                 Err(e) => return Err(e.into()),

@@ -121,7 +121,7 @@ pub fn generator_levels(
         if levels.len() == count as usize {
             break;
         }
-        match generation::platform_level(generator, seed, aux, None) {
+        match generation::generator_level(generator, seed, aux, None, 0) {
             Ok(level) => levels.push(level),
             Err(generation::GenerationError::NoLevel { .. }) => {}
             Err(generation::GenerationError::Network(e)) => return Err(e),

@@ -1,17 +1,17 @@
 //! Where levels come from: the rules of either game ([`rules_level`]), or a trained Generator
-//! policy. Levels from a trained Generator policy: it places block after block toward the goal at the
-//! chosen λ, as it learned to (sampling its actions from a generator seeded by the level's seed).
-//! An attempt that overlaps itself or runs out of blocks is dropped and the next one, drawn from
-//! the same seeded stream, is tried; so the same policy, seed, λ and goal give the same level.
+//! policy ([`generator_level`]): it places piece after piece toward the goal at the chosen λ, as
+//! it learned to (sampling its actions from a generator seeded by the level's seed). An attempt
+//! that overlaps or crosses itself, hits an obstacle or runs out of pieces is dropped and the
+//! next one, drawn from the same seeded stream, is tried; so the same policy, seed, λ and goal
+//! give the same level.
 //!
 //! The goal and start heading are drawn from the seed exactly as the rules draw them, so a rule
 //! level and a Generator level of the same seed lead to the same goal.
 
-use crate::game::platform::generator::{GENERATOR_OBSERVATION_SIZE, block_from_action, observe};
-use crate::game::rules::goal_and_start;
-use crate::level::platform::PlatformTrack;
+use crate::game::generator::{GeneratorGame, Placement, TrackBuild, observation_size};
+use crate::game::{PlatformGame, RacingGame};
 use crate::level::racing::RacingRulesConfig;
-use crate::level::{Game, Level, PolicyRef, RulesConfig, Source, Track};
+use crate::level::{Game, Level, PolicyRef, RulesConfig, Source};
 use crate::rl::normalizer::RunningNorm;
 use crate::rl::policy::{ActMode, ActorCritic};
 
@@ -65,81 +65,94 @@ pub const ATTEMPTS: usize = 64;
 
 /// A trained Generator, ready to build levels.
 pub struct GeneratorPolicy {
+    /// The game it builds levels of.
+    pub game: Game,
     pub policy: ActorCritic,
     pub normalizer: RunningNorm,
     pub reference: PolicyRef,
-    /// The block budget it was trained with (its observation counts down from it).
-    pub max_blocks: usize,
+    /// The piece budget it was trained with (its observation counts down from it).
+    pub max_pieces: usize,
 }
 
 /// Why the Generator built no level.
 #[derive(Debug, thiserror::Error)]
 pub enum GenerationError {
     #[error(
-        "the Generator built no valid level toward goal {goal:?} at aux {aux} in {ATTEMPTS} attempts (each overlapped itself or ran out of blocks); try another seed or goal"
+        "the Generator built no valid level toward goal {goal:?} at aux {aux} in {ATTEMPTS} attempts (each overlapped or crossed itself, hit an obstacle or ran out of pieces); try another seed or goal"
     )]
     NoLevel { goal: [f64; 3], aux: f64 },
     #[error("the Generator's network failed: {0}")]
     Network(#[from] candle_core::Error),
 }
 
-/// A platform level built by the Generator at aux `aux` toward `goal` (drawn from `seed` when
-/// not given).
-pub fn platform_level(
+/// A level of the Generator's game built at aux `aux` toward `goal` (drawn from `seed` when not
+/// given); racing scenes get `obstacles` obstacles, drawn from the seed.
+pub fn generator_level(
     generator: &GeneratorPolicy,
     seed: u64,
     aux: f64,
     goal: Option<[f64; 3]>,
+    obstacles: u32,
 ) -> Result<Level, GenerationError> {
-    platform_level_draw(generator, seed, aux, goal, 0)
+    generator_level_draw(generator, seed, aux, goal, obstacles, 0)
 }
 
-/// Draw number `draw` of [`platform_level`]: the `draw`-th valid level (from 0) the Generator
+/// Draw number `draw` of [`generator_level`]: the `draw`-th valid level (from 0) the Generator
 /// builds from the seed's stream, toward the same goal.
-pub fn platform_level_draw(
+pub fn generator_level_draw(
     generator: &GeneratorPolicy,
     seed: u64,
     aux: f64,
     goal: Option<[f64; 3]>,
+    obstacles: u32,
     draw: u32,
 ) -> Result<Level, GenerationError> {
-    let (goal, start, mut rng) = goal_and_start(seed, goal);
+    match generator.game {
+        Game::Platform => build_level::<PlatformGame>(generator, seed, aux, goal, obstacles, draw),
+        Game::Racing => build_level::<RacingGame>(generator, seed, aux, goal, obstacles, draw),
+    }
+}
+
+fn build_level<G: GeneratorGame>(
+    generator: &GeneratorPolicy,
+    seed: u64,
+    aux: f64,
+    goal: Option<[f64; 3]>,
+    obstacles: u32,
+    draw: u32,
+) -> Result<Level, GenerationError> {
+    let (empty, mut rng) = G::new_build(seed, goal, generator.max_pieces, obstacles);
+    let goal = empty.goal();
     let mut skip = draw;
     let aux_input = [aux as f32];
-    let mut observation = vec![0.0; GENERATOR_OBSERVATION_SIZE];
+    let mut observation = vec![0.0; observation_size::<G>()];
     for _ in 0..ATTEMPTS {
-        let mut track = PlatformTrack::new(start);
-        while track.block_count() < generator.max_blocks {
-            observe(
-                &track,
-                goal,
-                &aux_input,
-                generator.max_blocks,
-                &mut observation,
-            );
+        let mut build = empty.clone();
+        while build.piece_count() < generator.max_pieces {
+            build.observe(&aux_input, &mut observation);
             generator.normalizer.normalize(&mut observation);
             let action = generator
                 .policy
                 .choose(&observation, ActMode::Sample, &mut rng)?;
-            let block = block_from_action(&track, goal, &action);
-            if track.push(block).is_err() {
-                break;
-            }
-            if track.last().reaches(goal) {
-                if skip > 0 {
+            match build.place(&action) {
+                Placement::Placed => continue,
+                Placement::Invalid | Placement::OutOfPieces => break,
+                Placement::Completed if skip > 0 => {
                     skip -= 1;
                     break;
                 }
-                return Ok(Level {
-                    seed: Some(seed),
-                    aux: Some(aux),
-                    goal,
-                    track: Track::Platform(track),
-                    source: Source::Policy {
-                        generator: generator.reference.clone(),
-                    },
-                    stats: None,
-                });
+                Placement::Completed => {
+                    return Ok(Level {
+                        seed: Some(seed),
+                        aux: Some(aux),
+                        goal,
+                        track: build.into_track(),
+                        source: Source::Policy {
+                            generator: generator.reference.clone(),
+                        },
+                        stats: None,
+                    });
+                }
             }
         }
     }
@@ -149,7 +162,8 @@ pub fn platform_level_draw(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::game::platform::generator::GENERATOR_ACTIONS;
+    use crate::game::platform::generator::{GENERATOR_ACTIONS, GENERATOR_OBSERVATION_SIZE};
+    use crate::game::rules::goal_and_start;
     use crate::level::platform::heading_direction;
     use crate::rl::policy::PolicyShape;
 
@@ -161,13 +175,14 @@ mod tests {
             binary: 0,
         };
         GeneratorPolicy {
+            game: Game::Platform,
             policy: ActorCritic::new(shape, 3).unwrap(),
             normalizer: RunningNorm::new(GENERATOR_OBSERVATION_SIZE),
             reference: PolicyRef {
                 path: "generator.safetensors".into(),
                 sha256: "0".repeat(64),
             },
-            max_blocks: 30,
+            max_pieces: 30,
         }
     }
 
@@ -178,13 +193,13 @@ mod tests {
         let (_, start, _) = goal_and_start(5, None);
         let [x, z] = heading_direction(start.heading);
         let goal = [7.5 * x, 0.0, 7.5 * z];
-        let a = platform_level(&generator, 5, -1.0, Some(goal)).unwrap();
-        let b = platform_level(&generator, 5, -1.0, Some(goal)).unwrap();
+        let a = generator_level(&generator, 5, -1.0, Some(goal), 0).unwrap();
+        let b = generator_level(&generator, 5, -1.0, Some(goal), 0).unwrap();
         assert_eq!(a, b);
         a.validate().unwrap();
         assert_eq!(a.aux, Some(-1.0));
         assert!(matches!(a.source, Source::Policy { .. }));
-        let other = platform_level(&generator, 6, -1.0, Some(goal)).unwrap();
+        let other = generator_level(&generator, 6, -1.0, Some(goal), 0).unwrap();
         assert_ne!(
             a.platform(),
             other.platform(),
@@ -195,8 +210,8 @@ mod tests {
     #[test]
     fn an_unreachable_goal_is_a_clear_error() {
         let mut generator = untrained();
-        generator.max_blocks = 1;
-        let err = platform_level(&generator, 1, 0.5, Some([500.0, 0.0, 0.0])).unwrap_err();
+        generator.max_pieces = 1;
+        let err = generator_level(&generator, 1, 0.5, Some([500.0, 0.0, 0.0]), 0).unwrap_err();
         assert!(err.to_string().contains("no valid level"), "{err}");
     }
 }

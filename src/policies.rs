@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use sha2::{Digest, Sha256};
 
-use crate::game::platform::generator::{DEFAULT_MAX_BLOCKS, GENERATOR_OBSERVATION_SIZE};
+use crate::game::generator::{GeneratorGame, observation_size};
 use crate::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
 use crate::generation::GeneratorPolicy;
 use crate::level::{Game, PolicyRef};
@@ -56,19 +56,25 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
     ))
 }
 
-/// Loads a platform Generator policy.
-pub fn load_generator(path: &Path) -> Result<(GeneratorPolicy, PolicyCard)> {
-    let (loaded, reference) = load_pinned(
-        path,
-        Game::Platform,
-        Role::Generator,
-        GENERATOR_OBSERVATION_SIZE,
-    )?;
+/// Loads a Generator policy of `game`.
+pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, PolicyCard)> {
+    let (observation, default_max_pieces) = match game {
+        Game::Platform => (
+            observation_size::<PlatformGame>(),
+            PlatformGame::DEFAULT_MAX_PIECES,
+        ),
+        Game::Racing => (
+            observation_size::<RacingGame>(),
+            RacingGame::DEFAULT_MAX_PIECES,
+        ),
+    };
+    let (loaded, reference) = load_pinned(path, game, Role::Generator, observation)?;
     let card = loaded.card.clone();
     Ok((
         GeneratorPolicy {
+            game,
             policy: loaded.policy,
-            max_blocks: card.max_blocks.unwrap_or(DEFAULT_MAX_BLOCKS),
+            max_pieces: card.max_pieces.unwrap_or(default_max_pieces),
             normalizer: loaded.card.normalizer,
             reference,
         },

@@ -57,7 +57,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         .map(|dir| dir.join(GENERATOR_FILE))
         .find(|p| p.exists())
         .with_context(|| format!("no {GENERATOR_FILE} in any --policies folder"))?;
-    let (generator, _) = load_generator(&generator_path)?;
+    let (generator, _) = load_generator(&generator_path, Game::Platform)?;
     let mut solvers: Vec<(String, SolverPolicy)> = Vec::new();
     for dir in &args.policies {
         let entries = std::fs::read_dir(dir)

@@ -30,9 +30,9 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         )
         .into());
     }
-    if args.obstacles > 0 && (args.game != Game::Racing || !args.rules) {
+    if args.obstacles > 0 && args.game != Game::Racing {
         return Err(crate::shell::UsageError(
-            "--obstacles is for racing tracks from the rules (--game racing --rules)".into(),
+            "--obstacles is for racing tracks (--game racing)".into(),
         )
         .into());
     }
@@ -45,7 +45,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
                 )
                 .into());
             }
-            Some(load_generator(&policy_paths(dir).0)?.0)
+            Some(load_generator(&policy_paths(dir).0, args.game)?.0)
         }
         None => None,
     };
@@ -268,10 +268,15 @@ fn build(
 ) -> Result<Level> {
     let (aux, goal) = (args.aux, args.goal);
     Ok(match (args.game, generator) {
-        (Game::Platform, Some(generator)) => {
-            generation::platform_level_draw(generator, seed, aux.unwrap_or_default(), goal, draw)?
-        }
-        (game, _) => generation::rules_level_draw(game, seed, aux, goal, args.obstacles, draw)?,
+        (_, Some(generator)) => generation::generator_level_draw(
+            generator,
+            seed,
+            aux.unwrap_or_default(),
+            goal,
+            args.obstacles,
+            draw,
+        )?,
+        (game, None) => generation::rules_level_draw(game, seed, aux, goal, args.obstacles, draw)?,
     })
 }
 

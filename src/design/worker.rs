@@ -37,9 +37,8 @@ impl Policies {
     /// A level at `aux` for `seed` toward `goal`: the Generator's, or the rules' without one.
     pub fn level(&self, seed: u64, aux: f64, goal: Option<[f64; 3]>) -> Result<Level, String> {
         match &self.generator {
-            Some(generator) => {
-                generation::platform_level(generator, seed, aux, goal).map_err(|e| e.to_string())
-            }
+            Some(generator) => generation::generator_level(generator, seed, aux, goal, 0)
+                .map_err(|e| e.to_string()),
             None => generation::rules_level(Game::Platform, seed, Some(aux), goal, 0)
                 .map_err(|e| e.to_string()),
         }
@@ -52,7 +51,7 @@ pub fn load(path: &Path) -> Result<(Policies, LoadedInfo)> {
     let mut policies = Policies::default();
     let mut info = LoadedInfo::default();
     let mut load_generator_at = |p: &Path, policies: &mut Policies| -> Result<()> {
-        let (generator, card) = load_generator(p)?;
+        let (generator, card) = load_generator(p, Game::Platform)?;
         policies.generator = Some(Arc::new(generator));
         info.generator = Some(PolicyInfo {
             path: p.to_path_buf(),

@@ -26,7 +26,7 @@ pub const BANK_BLEND: f64 = 6.0;
 /// Distance between cross-sections of the mesh along the centre line, at most, m.
 pub const SAMPLE_SPACING: f64 = 1.0;
 /// Two parts of the road further apart along it than this must not come near each other, m.
-const CROSSING_ARC: f64 = 4.0 * ROAD_WIDTH;
+pub const CROSSING_ARC: f64 = 4.0 * ROAD_WIDTH;
 /// The least horizontal distance between two such parts' centre lines, m.
 pub const MIN_SELF_DISTANCE: f64 = ROAD_WIDTH + 3.0;
 /// The least horizontal distance from the centre line to an obstacle, m.

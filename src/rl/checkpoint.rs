@@ -58,10 +58,11 @@ pub struct PolicyCard {
     /// Measured results, filled in by evaluation.
     #[serde(default)]
     pub results: HashMap<String, f64>,
-    /// Generators only: the block budget its `blocks_left` observation counts down from
-    /// (absent: the default of `train`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub max_blocks: Option<usize>,
+    /// Generators only: the piece budget its `blocks_left` / `segments_left` observation counts
+    /// down from (absent: the default of `train`; platform cards before racing call it
+    /// `max_blocks`).
+    #[serde(default, alias = "max_blocks", skip_serializing_if = "Option::is_none")]
+    pub max_pieces: Option<usize>,
 }
 
 /// How a policy was trained.
@@ -307,7 +308,7 @@ mod tests {
                 command: String::new(),
             },
             results: HashMap::new(),
-            max_blocks: None,
+            max_pieces: None,
         }
     }
 

@@ -13,31 +13,35 @@ use super::*;
 
 /// An adversarial run: the Solver's run, whose environments hold the Generator, and the
 /// Generator's own counters and metrics.
-pub(super) struct AdversarialRun {
-    pub(super) solver: Run<AdversarialEnvs>,
+pub(super) struct AdversarialRun<G: GeneratorGame> {
+    pub(super) solver: Run<AdversarialEnvs<G>>,
     pub(super) generator_iteration: u64,
     pub(super) generator_metrics: std::fs::File,
 }
 
-impl AdversarialRun {
+impl<G: GeneratorGame> AdversarialRun<G> {
     pub(super) fn rules(mode: TrainMode, config: &TrainConfig) -> MatchRules {
         MatchRules {
             aux_values: match mode {
                 TrainMode::FixedAux => vec![1.0],
                 _ => config.generator.aux_values.clone(),
             },
-            max_blocks: config.generator.max_blocks,
+            max_pieces: config.generator.max_pieces,
+            obstacles: config.generator.obstacles,
             rewards: config.generator.rewards.clone(),
         }
     }
 
     pub(super) fn start(out: &Path, mode: TrainMode, config: TrainConfig) -> Result<Self> {
         let build = |config: &TrainConfig, _: Option<serde_json::Value>| {
-            let policy = ActorCritic::new(generator_shape(config), config.seed.wrapping_add(1))?;
+            let policy = ActorCritic::new(
+                generator_shape(config, G::GAME),
+                config.seed.wrapping_add(1),
+            )?;
             policy.set_log_std(config.generator.initial_log_std)?;
             let generator = Generator {
                 ppo: Ppo::new(config.generator.ppo.clone(), policy)?,
-                norm: RunningNorm::new(GENERATOR_OBSERVATION_SIZE),
+                norm: RunningNorm::new(observation_size::<G>()),
             };
             let rng = ChaCha8Rng::seed_from_u64(config.seed.wrapping_add(1));
             Ok(AdversarialEnvs::new(
@@ -51,7 +55,7 @@ impl AdversarialRun {
         let solver = Run::start(out, mode, config, build)?;
         fsio::write_atomic(
             &out.join(GENERATOR_METRICS),
-            format!("{GENERATOR_METRICS_HEADER}\n").as_bytes(),
+            format!("{}\n", generator_metrics_header::<G>()).as_bytes(),
             Overwrite::Allowed,
         )?;
         Ok(Self {
@@ -69,10 +73,9 @@ impl AdversarialRun {
         let path = out.join(GENERATOR_CHECKPOINT);
         if !path.exists() && out.join(CHECKPOINT).exists() {
             // A Solver-only run: its checkpoint says which mode it was trained in.
-            read_checkpoint(&out.join(CHECKPOINT), Game::Platform, Role::Solver, mode)?;
+            read_checkpoint(&out.join(CHECKPOINT), G::GAME, Role::Solver, mode)?;
         }
-        let (loaded, generator_state) =
-            read_checkpoint(&path, Game::Platform, Role::Generator, mode)?;
+        let (loaded, generator_state) = read_checkpoint(&path, G::GAME, Role::Generator, mode)?;
         let generator_iteration = generator_state.iteration;
         let build = move |config: &TrainConfig, source: Option<serde_json::Value>| {
             let state: AdversarialState =
@@ -98,7 +101,7 @@ impl AdversarialRun {
         let solver = Run::resume(out, mode, replacement, build)?;
         truncate_metrics(
             &out.join(GENERATOR_METRICS),
-            GENERATOR_METRICS_HEADER,
+            &generator_metrics_header::<G>(),
             generator_iteration,
         )?;
         Ok(Self {
@@ -108,14 +111,14 @@ impl AdversarialRun {
         })
     }
 
-    pub(super) fn envs(&mut self) -> &mut AdversarialEnvs {
+    pub(super) fn envs(&mut self) -> &mut AdversarialEnvs<G> {
         &mut self.solver.trainer.env
     }
 
     pub(super) fn generator_card(&self, wall_time_s: f64) -> PolicyCard {
         let envs = &self.solver.trainer.env;
         card(
-            Game::Platform,
+            G::GAME,
             Role::Generator,
             self.solver.mode,
             &self.solver.config,
@@ -178,7 +181,7 @@ impl AdversarialRun {
     }
 }
 
-impl Training for AdversarialRun {
+impl<G: GeneratorGame> Training for AdversarialRun<G> {
     fn solver_steps(&self) -> u64 {
         self.solver.trainer.global_step
     }

@@ -1,13 +1,13 @@
-//! The adversarial loop (ARLPCG) on the platform game: many [`Match`]es, each a Generator
+//! The adversarial loop (ARLPCG), written once for both games: many [`Match`]es, each a Generator
 //! building a level while a Solver plays it, stepped together. Seen from the Solver's trainer
-//! this is a [`VecEnv`]: the Generator lives inside it and places blocks (one batched forward pass
-//! for every match that needs one) whenever Solvers reach their newest block.
+//! this is a [`VecEnv`]: the Generator lives inside it and places pieces (one batched forward
+//! pass for every match that needs one) whenever Solvers come close to their newest piece.
 //!
 //! Training alternates phases (docs/spec.md §3): while the Solver learns, the Generator only runs
 //! inference; while the Generator learns, the Solver only runs inference and the Generator's
 //! decisions are recorded per match, to be learned from with PPO once enough have completed.
-//! Each match draws its goal, start heading and λ from its own seed (episode counter from
-//! [`TRAINING_SEED_BASE`]), so runs are reproducible and resumable.
+//! Each match draws its goal, start (and racing obstacles) and λ from its own seed (episode
+//! counter from [`TRAINING_SEED_BASE`]), so runs are reproducible and resumable.
 
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
@@ -15,11 +15,10 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::solver_envs::TRAINING_SEED_BASE;
-use crate::game::platform::generator::{
-    GENERATOR_OBSERVATION_SIZE, GeneratorRewards, Match, Placement,
+use crate::game::SolverEnv;
+use crate::game::generator::{
+    GeneratorGame, GeneratorRewards, Match, TrackBuild, observation_size,
 };
-use crate::game::platform::{OBSERVATION_SIZE, PlatformAction};
-use crate::game::rules;
 use crate::level::stats::Outcome;
 use crate::rl::normalizer::RunningNorm;
 use crate::rl::policy::ActMode;
@@ -62,7 +61,9 @@ impl Default for AdversarialState {
 pub struct MatchRules {
     /// λ is drawn uniformly from these for each match.
     pub aux_values: Vec<f32>,
-    pub max_blocks: usize,
+    pub max_pieces: usize,
+    /// Obstacles drawn into each racing match's scene.
+    pub obstacles: u32,
     pub rewards: GeneratorRewards,
 }
 
@@ -91,18 +92,19 @@ pub struct MatchStats {
     pub episodes: u32,
     pub invalid: u32,
     pub generator_return_sum: f64,
-    /// [easy (λ > 0), hard (λ < 0)]: finished (valid) matches, Solver successes, blocks placed,
-    /// and the sums of their distances and sizes.
+    /// [easy (λ > 0), hard (λ < 0)]: finished (valid) matches, Solver successes, pieces placed,
+    /// the sums of the pieces' two features (`GeneratorGame::PIECE_FEATURES`), and the Solver's
+    /// steps in the air.
     pub judged: [u32; 2],
     pub successes: [u32; 2],
-    pub blocks: [u32; 2],
-    pub distance_sum: [f64; 2],
-    pub size_sum: [f64; 2],
+    pub pieces: [u32; 2],
+    pub feature_sums: [[f64; 2]; 2],
+    pub air_steps: [u64; 2],
 }
 
 /// Many matches of the Generator against the Solver, as the Solver's environments.
-pub struct AdversarialEnvs {
-    matches: Vec<Match>,
+pub struct AdversarialEnvs<G: GeneratorGame> {
+    matches: Vec<Match<G>>,
     pub generator: Generator,
     /// Samples the Generator's actions and shuffles its minibatches.
     pub rng: ChaCha8Rng,
@@ -114,7 +116,7 @@ pub struct AdversarialEnvs {
     pub stats: MatchStats,
 }
 
-impl AdversarialEnvs {
+impl<G: GeneratorGame> AdversarialEnvs<G> {
     /// `num_matches` matches, continuing from `state`; every match gets its first block.
     pub fn new(
         num_matches: usize,
@@ -137,10 +139,21 @@ impl AdversarialEnvs {
             let fresh = this.next_match();
             this.matches.push(fresh);
         }
-        let all: Vec<usize> = (0..num_matches).collect();
-        let ended = this.decide(&all)?;
-        debug_assert!(ended.is_empty(), "a first block is always valid");
+        this.first_pieces((0..num_matches).collect())?;
         Ok(this)
+    }
+
+    /// Lets the Generator place the first piece of the fresh matches `indices`; a match whose
+    /// first piece is invalid (a racing segment into an obstacle) is replaced by the next.
+    fn first_pieces(&mut self, mut indices: Vec<usize>) -> candle_core::Result<()> {
+        while !indices.is_empty() {
+            let invalid = self.decide(&indices)?;
+            for &i in &invalid {
+                self.restart(i, None);
+            }
+            indices = invalid;
+        }
+        Ok(())
     }
 
     pub fn learning(&self) -> bool {
@@ -156,22 +169,23 @@ impl AdversarialEnvs {
         }
     }
 
-    fn next_match(&mut self) -> Match {
+    fn next_match(&mut self) -> Match<G> {
         let seed = TRAINING_SEED_BASE + self.state.episodes_started;
         self.state.episodes_started += 1;
-        let (goal, start, mut rng) = rules::goal_and_start(seed, None);
+        let (build, mut rng) =
+            G::new_build(seed, None, self.rules.max_pieces, self.rules.obstacles);
         let values = &self.rules.aux_values;
         let aux = values[rng.random_range(0..values.len())];
-        Match::new(start, goal, vec![aux], self.rules.max_blocks, seed)
+        Match::new(build, vec![aux], seed)
     }
 
-    /// Lets the Generator place a block in each of the matches `indices`; returns the matches
+    /// Lets the Generator place a piece in each of the matches `indices`; returns the matches
     /// that ended because the placement was invalid.
     fn decide(&mut self, indices: &[usize]) -> candle_core::Result<Vec<usize>> {
         if indices.is_empty() {
             return Ok(Vec::new());
         }
-        let d = GENERATOR_OBSERVATION_SIZE;
+        let d = observation_size::<G>();
         let mut observations = vec![0.0; indices.len() * d];
         for (&i, row) in indices.iter().zip(observations.chunks_mut(d)) {
             self.matches[i].observe_generator(row);
@@ -191,9 +205,8 @@ impl AdversarialEnvs {
         for (k, &i) in indices.iter().enumerate() {
             let action = &acted.actions[k * width..(k + 1) * width];
             let game = &mut self.matches[i];
-            let placement = game.place(action);
-            let invalid = matches!(placement, Placement::Overlap | Placement::OutOfBlocks);
-            let mut reward = self.rules.rewards.per_block(&game.aux);
+            let invalid = game.place(action).is_invalid();
+            let mut reward = self.rules.rewards.per_piece(&game.aux);
             if invalid {
                 reward += self.rules.rewards.invalid;
                 ended.push(i);
@@ -227,11 +240,12 @@ impl AdversarialEnvs {
                 let side = usize::from(aux < 0.0);
                 stats.judged[side] += 1;
                 stats.successes[side] += u32::from(outcome == Outcome::Success);
-                for block in game.track().block_params() {
-                    stats.blocks[side] += 1;
-                    stats.distance_sum[side] += block.distance;
-                    stats.size_sum[side] += block.size;
+                for features in game.build().piece_features() {
+                    stats.pieces[side] += 1;
+                    stats.feature_sums[side][0] += features[0];
+                    stats.feature_sums[side][1] += features[1];
                 }
+                stats.air_steps[side] += u64::from(G::air_steps(game.env()));
             }
             Some(_) => {}
         }
@@ -300,19 +314,19 @@ impl AdversarialEnvs {
     }
 }
 
-impl VecEnv for AdversarialEnvs {
+impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
     fn num_envs(&self) -> usize {
         self.matches.len()
     }
 
     fn observation_size(&self) -> usize {
-        OBSERVATION_SIZE
+        G::Env::OBSERVATION_SIZE
     }
 
     fn observe(&mut self, out: &mut [f32]) {
         self.matches
             .par_iter()
-            .zip(out.par_chunks_mut(OBSERVATION_SIZE))
+            .zip(out.par_chunks_mut(G::Env::OBSERVATION_SIZE))
             .for_each(|(game, row)| game.env().observe(row));
     }
 
@@ -323,7 +337,7 @@ impl VecEnv for AdversarialEnvs {
             .matches
             .par_iter_mut()
             .zip(actions.par_chunks(width))
-            .map(|(game, row)| game.step_solver(PlatformAction::from_policy_row(row), rewards))
+            .map(|(game, row)| game.step_solver(G::Env::action_from_policy_row(row), rewards))
             .collect();
         let mut finished = Vec::new();
         let mut turns = Vec::new();
@@ -339,7 +353,7 @@ impl VecEnv for AdversarialEnvs {
             };
             match step.outcome {
                 Some(outcome) => finished.push((i, Some(outcome))),
-                None if self.matches[i].needs_block() => turns.push(i),
+                None if self.matches[i].needs_piece() => turns.push(i),
                 None => {}
             }
         }
@@ -359,9 +373,7 @@ impl VecEnv for AdversarialEnvs {
         for (i, outcome) in finished {
             self.restart(i, outcome);
         }
-        let ended = self
-            .decide(&restarted)
+        self.first_pieces(restarted)
             .expect("the Generator's forward pass runs on the CPU");
-        debug_assert!(ended.is_empty(), "a first block is always valid");
     }
 }

@@ -46,12 +46,38 @@ pub(super) fn solver_shape(config: &TrainConfig, game: Game) -> PolicyShape {
     }
 }
 
+/// What a game's Generator observes and does, as a policy card names it.
+pub(super) struct GeneratorIo {
+    observation: &'static [(&'static str, usize)],
+    actions: &'static [&'static str],
+}
+
+impl GeneratorIo {
+    fn of(game: Game) -> Self {
+        fn io<G: GeneratorGame>() -> GeneratorIo {
+            GeneratorIo {
+                observation: G::GENERATOR_OBSERVATION_LAYOUT,
+                actions: G::GENERATOR_ACTIONS,
+            }
+        }
+        match game {
+            Game::Platform => io::<PlatformGame>(),
+            Game::Racing => io::<RacingGame>(),
+        }
+    }
+
+    fn observation_size(&self) -> usize {
+        self.observation.iter().map(|(_, k)| k).sum()
+    }
+}
+
 /// The Generator's policy shape.
-pub(super) fn generator_shape(config: &TrainConfig) -> PolicyShape {
+pub(super) fn generator_shape(config: &TrainConfig, game: Game) -> PolicyShape {
+    let io = GeneratorIo::of(game);
     PolicyShape {
-        observation: GENERATOR_OBSERVATION_SIZE,
+        observation: io.observation_size(),
         hidden: config.hidden.clone(),
-        continuous: GENERATOR_ACTIONS.len(),
+        continuous: io.actions.len(),
         binary: 0,
     }
 }
@@ -82,12 +108,15 @@ pub(super) fn card(
                 solver_shape(config, game),
             )
         }
-        Role::Generator => (
-            layout(&GENERATOR_OBSERVATION_LAYOUT),
-            names(&GENERATOR_ACTIONS),
-            Vec::new(),
-            generator_shape(config),
-        ),
+        Role::Generator => {
+            let io = GeneratorIo::of(game);
+            (
+                layout(io.observation),
+                names(io.actions),
+                Vec::new(),
+                generator_shape(config, game),
+            )
+        }
     };
     PolicyCard {
         format: checkpoint::POLICY_FORMAT.into(),
@@ -111,7 +140,7 @@ pub(super) fn card(
                 .join(" "),
         },
         results: Default::default(),
-        max_blocks: (role == Role::Generator).then_some(config.generator.max_blocks),
+        max_pieces: (role == Role::Generator).then_some(config.generator.max_pieces),
     }
 }
 
@@ -145,7 +174,7 @@ pub(super) fn read_checkpoint(
         .context("cannot resume")?;
     let observation = match role {
         Role::Solver => SolverIo::of(game).observation_size(),
-        Role::Generator => GENERATOR_OBSERVATION_SIZE,
+        Role::Generator => GeneratorIo::of(game).observation_size(),
     };
     let loaded = checkpoint::load_policy(&bytes, game, role, observation)
         .with_context(|| format!("{}", path.display()))?;

@@ -8,7 +8,8 @@ use anyhow::Result;
 use serde::{Deserialize, Serialize};
 
 use super::solver_envs::SolverMode;
-use crate::game::platform::generator::{DEFAULT_MAX_BLOCKS, GeneratorRewards};
+use crate::game::generator::{GeneratorGame, GeneratorRewards};
+use crate::game::{PlatformGame, RacingGame};
 use crate::level::Game;
 use crate::rl::ppo::PpoConfig;
 
@@ -76,8 +77,13 @@ pub struct GeneratorConfig {
     pub rewards: GeneratorRewards,
     /// λ of each match is drawn uniformly from these (`fixed-aux` holds λ = 1).
     pub aux_values: Vec<f32>,
-    /// A track that has not reached its goal in this many blocks ends as invalid.
-    pub max_blocks: usize,
+    /// A track that has not reached its goal in this many pieces (blocks, segments) ends as
+    /// invalid.
+    #[serde(alias = "max_blocks")]
+    pub max_pieces: usize,
+    /// Racing: obstacles drawn into each match's scene (some draws fall too near the start or
+    /// the goal and are dropped); the platform game has none.
+    pub obstacles: u32,
     /// Log standard deviation of the new Generator's actions (in [-1, 1] units). At 0 (std 1)
     /// its turns span ±180° and almost no track reaches its goal; -1.6 (std 0.2) starts it at
     /// ±36°, ±0.5 m of distance, ±0.4 m of height, and lets PPO widen what pays.
@@ -127,7 +133,8 @@ impl Default for GeneratorConfig {
             },
             rewards: GeneratorRewards::default(),
             aux_values: vec![-1.0, -1.0, -0.5, 0.5, 1.0, 1.0],
-            max_blocks: DEFAULT_MAX_BLOCKS,
+            max_pieces: PlatformGame::DEFAULT_MAX_PIECES,
+            obstacles: 0,
             initial_log_std: -1.6,
             solver_warmup_steps: 500_000,
             solver_phase_steps: 100_000,
@@ -162,36 +169,69 @@ pub(super) fn load_config(path: &Path, game: Game) -> Result<TrainConfig> {
 pub const RACING_SOLVER_GAMMA: f32 = 0.998;
 
 impl TrainConfig {
-    /// The defaults for training `game`: the paper's values, which differ only in the racing
-    /// Solver's γ.
+    /// The defaults for training `game`: the paper's values; the racing game differs in the
+    /// Solver's γ, the Generator's rewards and the obstacles of its scenes.
     pub fn for_game(game: Game) -> TrainConfig {
         let mut config = TrainConfig::default();
         if game == Game::Racing {
             config.solver.gamma = RACING_SOLVER_GAMMA;
+            config.generator.rewards = RacingGame::default_rewards();
+            config.generator.max_pieces = RacingGame::DEFAULT_MAX_PIECES;
+            config.generator.obstacles = crate::game::racing::generator::MATCH_OBSTACLES;
         }
         config
     }
 
-    /// [`TrainConfig::parse`] for `game`: fields the text leaves out take that game's defaults.
+    /// Parses and checks the text of a configuration file for `game`: fields the text leaves
+    /// out take that game's defaults ([`TrainConfig::for_game`]); `Err` names the field (and,
+    /// for syntax and type errors, the line).
     pub fn parse_for(text: &str, game: Game) -> Result<TrainConfig, String> {
-        let mut config = Self::parse(text)?;
-        if game == Game::Racing {
-            let document: serde_yaml::Value = serde_yaml::from_str(text).unwrap_or_default();
-            let solver = document.get("solver").or_else(|| document.get("ppo"));
-            if solver.and_then(|s| s.get("gamma")).is_none() {
-                config.solver.gamma = RACING_SOLVER_GAMMA;
-            }
-        }
+        crate::level::yaml_limits::check(text)?;
+        // Parsed once as written, for errors with their line...
+        let _: TrainConfig = serde_yaml::from_str(text).map_err(|e| e.to_string())?;
+        // ...then laid over the game's defaults.
+        let given: serde_yaml::Value = serde_yaml::from_str(text).map_err(|e| e.to_string())?;
+        let given = match given {
+            serde_yaml::Value::Null => serde_yaml::Value::Mapping(Default::default()),
+            other => other,
+        };
+        let defaults = serde_yaml::to_value(Self::for_game(game)).map_err(|e| e.to_string())?;
+        let config: TrainConfig =
+            serde_yaml::from_value(overlay(defaults, given)).map_err(|e| e.to_string())?;
+        check_config(&config, game)?;
         Ok(config)
     }
+}
 
-    /// Parses and checks the text of a configuration file: `Err` names the field (and, for
-    /// syntax and type errors, the line).
+impl TrainConfig {
+    /// [`TrainConfig::parse_for`] the platform game.
     pub fn parse(text: &str) -> Result<TrainConfig, String> {
-        crate::level::yaml_limits::check(text)?;
-        let config: TrainConfig = serde_yaml::from_str(text).map_err(|e| e.to_string())?;
-        check_config(&config)?;
-        Ok(config)
+        Self::parse_for(text, Game::Platform)
+    }
+}
+
+/// `given` laid over `defaults`: mappings merge key by key (recursively), anything else given
+/// replaces the default. Aliases (`ppo` for `solver`, `max_blocks` for `max_pieces`) are
+/// renamed first, so they replace their default.
+fn overlay(defaults: serde_yaml::Value, given: serde_yaml::Value) -> serde_yaml::Value {
+    use serde_yaml::Value;
+    match (defaults, given) {
+        (Value::Mapping(mut base), Value::Mapping(top)) => {
+            for (key, value) in top {
+                let key = match key.as_str() {
+                    Some("ppo") => Value::from("solver"),
+                    Some("max_blocks") => Value::from("max_pieces"),
+                    _ => key,
+                };
+                let merged = match base.remove(&key) {
+                    Some(old) => overlay(old, value),
+                    None => value,
+                };
+                base.insert(key, merged);
+            }
+            Value::Mapping(base)
+        }
+        (_, given) => given,
     }
 }
 
@@ -207,8 +247,8 @@ pub(super) fn check_resumable_change(old: &TrainConfig, new: &TrainConfig) -> Re
             old.solver.num_envs == new.solver.num_envs,
         ),
         (
-            "generator.max_blocks",
-            old.generator.max_blocks == new.generator.max_blocks,
+            "generator.max_pieces",
+            old.generator.max_pieces == new.generator.max_pieces,
         ),
     ];
     match fixed.iter().find(|(_, same)| !same) {
@@ -220,7 +260,7 @@ pub(super) fn check_resumable_change(old: &TrainConfig, new: &TrainConfig) -> Re
 }
 
 /// Checks the values serde cannot: sizes, ranges, finite numbers.
-fn check_config(config: &TrainConfig) -> Result<(), String> {
+fn check_config(config: &TrainConfig, game: Game) -> Result<(), String> {
     if config.hidden.is_empty()
         || config.hidden.len() > MAX_HIDDEN_LAYERS
         || !config
@@ -253,23 +293,38 @@ fn check_config(config: &TrainConfig) -> Result<(), String> {
     }
     if g.rewards.aux.len() != 1 {
         return Err(format!(
-            "generator.rewards.aux: the platform game has 1 aux input, so give 1 weight pair, not {}",
+            "generator.rewards.aux: the {game} game has 1 aux input, so give 1 weight pair, not {}",
             g.rewards.aux.len()
         ));
     }
     let r = &g.rewards;
     let weights = r.aux.iter().flat_map(|w| [w.alpha, w.beta]);
-    if ![r.progress_per_metre, r.failure, r.step_penalty, r.invalid]
-        .into_iter()
-        .chain(weights)
-        .all(f32::is_finite)
+    if ![
+        r.progress_per_metre,
+        r.failure,
+        r.step_penalty,
+        r.air_step,
+        r.invalid,
+    ]
+    .into_iter()
+    .chain(weights)
+    .all(f32::is_finite)
     {
         return Err("generator.rewards: every weight must be a finite number".into());
     }
-    if !(1..=crate::level::platform::MAX_BLOCKS).contains(&g.max_blocks) {
+    let max_pieces = match game {
+        Game::Platform => PlatformGame::MAX_PIECES,
+        Game::Racing => RacingGame::MAX_PIECES,
+    };
+    if !(1..=max_pieces).contains(&g.max_pieces) {
         return Err(format!(
-            "generator.max_blocks must be within [1, {}]",
-            crate::level::platform::MAX_BLOCKS
+            "generator.max_pieces must be within [1, {max_pieces}]"
+        ));
+    }
+    if g.obstacles > crate::level::racing::MAX_OBSTACLES as u32 {
+        return Err(format!(
+            "generator.obstacles must be at most {}",
+            crate::level::racing::MAX_OBSTACLES
         ));
     }
     if !(-10.0..=2.0).contains(&g.initial_log_std) {

@@ -88,16 +88,27 @@ pub(super) fn open_append(path: &Path) -> Result<std::fs::File> {
 pub(super) fn generator_row(s: &MatchStats) -> String {
     let ratio = |a: f64, b: u32| if b == 0 { f64::NAN } else { a / b as f64 };
     format!(
-        "{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}",
+        "{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.2},{:.2}",
         s.episodes,
         ratio(s.generator_return_sum, s.episodes),
         ratio(s.invalid as f64, s.episodes),
         ratio(s.successes[0] as f64, s.judged[0]),
         ratio(s.successes[1] as f64, s.judged[1]),
-        ratio(s.distance_sum[0], s.blocks[0]),
-        ratio(s.distance_sum[1], s.blocks[1]),
-        ratio(s.size_sum[0], s.blocks[0]),
-        ratio(s.size_sum[1], s.blocks[1]),
+        ratio(s.feature_sums[0][0], s.pieces[0]),
+        ratio(s.feature_sums[1][0], s.pieces[1]),
+        ratio(s.feature_sums[0][1], s.pieces[0]),
+        ratio(s.feature_sums[1][1], s.pieces[1]),
+        ratio(s.air_steps[0] as f64, s.judged[0]),
+        ratio(s.air_steps[1] as f64, s.judged[1]),
+    )
+}
+
+/// The header of `generator-metrics.csv` for game `G`: its piece features by name, and the
+/// Solver's mean steps in the air per match (0 on the platform game).
+pub(super) fn generator_metrics_header<G: GeneratorGame>() -> String {
+    let [a, b] = G::PIECE_FEATURES;
+    format!(
+        "iteration,solver_step,generator_step,wall_time_s,rollout_s,update_s,learning_rate,episodes,mean_return,invalid_ratio,success_easy,success_hard,{a}_easy,{a}_hard,{b}_easy,{b}_hard,air_steps_easy,air_steps_hard,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance"
     )
 }
 

@@ -26,9 +26,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 
 use crate::fsio::{self, Overwrite};
-use crate::game::platform::generator::{
-    GENERATOR_ACTIONS, GENERATOR_OBSERVATION_LAYOUT, GENERATOR_OBSERVATION_SIZE,
-};
+use crate::game::generator::{GeneratorGame, observation_size};
 use crate::game::{GameSpec, PlatformGame, RacingGame};
 use crate::level::Game;
 use crate::rl::checkpoint::{self, PolicyCard, Role, TrainingRecord, TrainingState};
@@ -49,7 +47,6 @@ pub(super) const GENERATOR_CHECKPOINT: &str = "generator-checkpoint.safetensors"
 pub(super) const METRICS: &str = "metrics.csv";
 pub(super) const GENERATOR_METRICS: &str = "generator-metrics.csv";
 pub(super) const METRICS_HEADER: &str = "iteration,global_step,wall_time_s,steps_per_s,rollout_s,update_s,learning_rate,episodes,mean_return,success_ratio,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance";
-pub(super) const GENERATOR_METRICS_HEADER: &str = "iteration,solver_step,generator_step,wall_time_s,rollout_s,update_s,learning_rate,episodes,mean_return,invalid_ratio,success_easy,success_hard,distance_easy,distance_hard,size_easy,size_hard,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance";
 
 /// What a training run is asked to do (the command line's `train`, resolved).
 #[derive(Debug, Clone, PartialEq)]
@@ -82,11 +79,6 @@ pub fn run(args: &TrainRequest) -> Result<()> {
     }
     let mode = args.mode;
     let usage = |message: &str| anyhow::Error::from(crate::shell::UsageError(message.into()));
-    if args.game == Game::Racing && mode.solver_only().is_none() {
-        return Err(usage(
-            "--game racing trains with --mode rule-pcg or fixed-track so far: the racing Generator (for arlpcg and fixed-aux) is not built yet",
-        ));
-    }
     let out = args.out.as_ref().ok_or_else(|| {
         usage("--out DIR is required: where the run's checkpoint, metrics and policy go")
     })?;
@@ -122,16 +114,27 @@ pub fn run(args: &TrainRequest) -> Result<()> {
             (Some(source), Game::Racing) => {
                 solver_run::<RacingGame>(out, mode, source, config, args)
             }
-            (None, _) => {
-                let mut run = if args.resume {
-                    AdversarialRun::resume(out, mode, config)?
-                } else {
-                    AdversarialRun::start(out, mode, config.unwrap_or_default())?
-                };
-                train_loop(&mut run, args)
-            }
+            (None, Game::Platform) => adversarial_run::<PlatformGame>(out, mode, config, args),
+            (None, Game::Racing) => adversarial_run::<RacingGame>(out, mode, config, args),
         }
     })
+}
+
+/// Trains a Generator of game `G` against its Solver (the adversarial modes), starting or
+/// resuming.
+fn adversarial_run<G: GeneratorGame>(
+    out: &Path,
+    mode: TrainMode,
+    config: Option<TrainConfig>,
+    args: &TrainRequest,
+) -> Result<()> {
+    let mut run = if args.resume {
+        AdversarialRun::<G>::resume(out, mode, config)?
+    } else {
+        let config = config.unwrap_or_else(|| TrainConfig::for_game(G::GAME));
+        AdversarialRun::<G>::start(out, mode, config)?
+    };
+    train_loop(&mut run, args)
 }
 
 /// Trains a Solver of game `G` alone (the Solver-only modes), starting or resuming.

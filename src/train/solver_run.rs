@@ -23,8 +23,8 @@ impl<G: GameSpec> Resumable for SolverEnvs<G> {
     }
 }
 
-impl Resumable for AdversarialEnvs {
-    const GAME: Game = Game::Platform;
+impl<G: GeneratorGame> Resumable for AdversarialEnvs<G> {
+    const GAME: Game = G::GAME;
     fn source_state(&self) -> serde_json::Value {
         serde_json::to_value(self.state).expect("source states serialize")
     }

@@ -1,30 +1,19 @@
-//! The platform Generator's side of the game (docs/spec.md §1.1 and §2): its observation, its action, its
-//! rewards, and a [`Match`]: one Generator building a level while one Solver plays it. The
-//! Generator places the next block only when the Solver stands on the newest one, and its episode
-//! ends with the Solver's.
-//!
-//! Rewards follow the paper's eq. 1 with a vector of aux inputs λᵢ, each with weights αᵢ (on the
-//! Generator's own, internal reward) and βᵢ (on the reward from the Solver's behaviour):
-//! - progress: `progress_per_metre` for every metre the Solver's furthest block comes closer to
-//!   the goal, whatever λ;
-//! - the Solver fails: `failure · Σ βᵢ λᵢ` (with the default `failure = -10` and β = 1: -10·λ,
-//!   +10 at λ = -1, the sign docs/spec.md §2 decides);
-//! - each block placed: `step_penalty · Σ αᵢ min(λᵢ, 0)` (a small cost only when λ < 0: finish or
-//!   fail fast);
-//! - an invalid placement (overlap) or a track that runs out of blocks before the goal:
-//!   `invalid`, and the match ends.
+//! The platform Generator (docs/spec.md §1.1 and §2): its observation, its action (a block,
+//! framed relative to the goal), and the platform game's side of the Generator abstraction
+//! ([`PlatformBuild`], [`GeneratorGame`] for [`PlatformGame`]). The rewards and the match of a
+//! Generator against a Solver are written once for both games in `crate::game::generator`; the
+//! platform Generator places the next block when the Solver stands on the newest one.
 
-use serde::{Deserialize, Serialize};
+use rand_chacha::ChaCha8Rng;
 
-use super::PlatformAction;
 use super::env::{PlatformEnv, SolverRewards};
 use super::reach;
-use crate::game::Step;
+use crate::game::PlatformGame;
+use crate::game::generator::{GeneratorGame, GeneratorRewards, Placement, TrackBuild};
+use crate::game::rules::goal_and_start;
+use crate::level::Track;
 use crate::level::params::{self, quantize};
-use crate::level::platform::{
-    BlockParams, Platform, PlatformTrack, Start, direction_heading, wrap_degrees,
-};
-use crate::level::stats::Outcome;
+use crate::level::platform::{BlockParams, PlatformTrack, direction_heading, wrap_degrees};
 
 /// The named parts of the Generator's observation, in order, with their lengths (one aux input).
 pub const GENERATOR_OBSERVATION_LAYOUT: [(&str, usize); 9] = [
@@ -68,71 +57,6 @@ pub const GENERATOR_ACTIONS: [&str; 4] = [
 /// The block budget of a Generator's track by default: a track that has not reached its goal
 /// within it is invalid (goals are at most 70 m away, blocks 5-10 m apart).
 pub const DEFAULT_MAX_BLOCKS: usize = 30;
-
-/// The weights of one aux input in the Generator's reward (paper eq. 1).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct AuxWeights {
-    /// α: weight on the Generator's internal reward (the per-block cost when λ < 0).
-    pub alpha: f32,
-    /// β: weight on the external reward (the Solver's failure).
-    pub beta: f32,
-}
-
-/// The Generator's reward terms (docs/spec.md §2); see the module documentation.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct GeneratorRewards {
-    /// Per metre the Solver's furthest block comes closer to the goal.
-    pub progress_per_metre: f32,
-    /// Scaled by Σ βᵢ λᵢ when the Solver fails (falls or times out).
-    pub failure: f32,
-    /// Scaled by Σ αᵢ min(λᵢ, 0) for each block placed.
-    pub step_penalty: f32,
-    /// An overlapping block, or no goal within `max_blocks`: the match ends.
-    pub invalid: f32,
-    /// The weights of each aux input (the platform game uses one).
-    pub aux: Vec<AuxWeights>,
-}
-
-impl Default for GeneratorRewards {
-    fn default() -> Self {
-        Self {
-            progress_per_metre: 0.1,
-            failure: -10.0,
-            step_penalty: 0.1,
-            invalid: -10.0,
-            aux: vec![AuxWeights {
-                alpha: 1.0,
-                beta: 1.0,
-            }],
-        }
-    }
-}
-
-impl GeneratorRewards {
-    /// The reward when the Solver fails, at aux inputs `aux`.
-    pub fn on_failure(&self, aux: &[f32]) -> f32 {
-        self.failure
-            * self
-                .aux
-                .iter()
-                .zip(aux)
-                .map(|(w, l)| w.beta * l)
-                .sum::<f32>()
-    }
-
-    /// The reward for placing a block, at aux inputs `aux`.
-    pub fn per_block(&self, aux: &[f32]) -> f32 {
-        self.step_penalty
-            * self
-                .aux
-                .iter()
-                .zip(aux)
-                .map(|(w, l)| w.alpha * l.min(0.0))
-                .sum::<f32>()
-    }
-}
 
 /// A policy's action row (unbounded Gaussian samples) as the next block of `track` toward
 /// `goal`: each value is clipped to [-1, 1] and mapped onto its range (NaN becomes the middle),
@@ -213,127 +137,125 @@ pub fn observe(
     debug_assert_eq!(written, GENERATOR_OBSERVATION_SIZE);
 }
 
-/// What a Generator's placement led to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Placement {
-    /// Placed; the track goes on.
-    Placed,
-    /// Placed, and it reaches the goal: the track is complete.
-    Completed,
-    /// It overlaps an earlier block (other than the previous one): the match ends.
-    Overlap,
-    /// The track already holds `max_blocks` blocks without reaching the goal: the match ends.
-    OutOfBlocks,
-}
-
-/// One Generator building a level while one Solver plays it.
-pub struct Match {
+/// A platform track the Generator is building toward its goal, within its block budget.
+#[derive(Debug, Clone)]
+pub struct PlatformBuild {
+    pub track: PlatformTrack,
     pub goal: [f64; 3],
-    pub aux: Vec<f32>,
-    track: PlatformTrack,
-    env: PlatformEnv,
-    max_blocks: usize,
-    complete: bool,
-    /// Index of the furthest platform the Solver has stood on, as the Generator was last paid.
-    paid_up_to: usize,
+    pub max_blocks: usize,
 }
 
-impl Match {
-    /// A new match: only the start block stands; the Generator places the first block next.
-    pub fn new(
-        start: Start,
-        goal: [f64; 3],
-        aux: Vec<f32>,
-        max_blocks: usize,
-        solver_seed: u64,
-    ) -> Self {
-        let track = PlatformTrack::new(start);
-        let mut env = PlatformEnv::open(&track, goal, SolverRewards::default());
-        env.reset(solver_seed);
-        Self {
-            goal,
-            aux,
-            track,
-            env,
-            max_blocks,
-            complete: false,
-            paid_up_to: 0,
-        }
+impl TrackBuild for PlatformBuild {
+    fn goal(&self) -> [f64; 3] {
+        self.goal
     }
 
-    pub fn track(&self) -> &PlatformTrack {
-        &self.track
+    fn piece_count(&self) -> usize {
+        self.track.block_count()
     }
 
-    pub fn env(&self) -> &PlatformEnv {
-        &self.env
+    fn observe(&self, aux: &[f32], out: &mut [f32]) {
+        observe(&self.track, self.goal, aux, self.max_blocks, out);
     }
 
-    /// Whether it is the Generator's turn: at the start, and whenever the Solver stands on the
-    /// newest block of an unfinished track.
-    pub fn needs_block(&self) -> bool {
-        !self.complete && (self.track.block_count() == 0 || self.env.awaits_platform())
-    }
-
-    /// The Generator's observation, into `out`.
-    pub fn observe_generator(&self, out: &mut [f32]) {
-        observe(&self.track, self.goal, &self.aux, self.max_blocks, out);
-    }
-
-    /// Places the Generator's block (action row of [`GENERATOR_ACTIONS`]).
-    pub fn place(&mut self, row: &[f32]) -> Placement {
+    fn place(&mut self, row: &[f32]) -> Placement {
         if self.track.block_count() >= self.max_blocks {
-            return Placement::OutOfBlocks;
+            return Placement::OutOfPieces;
         }
         let block = block_from_action(&self.track, self.goal, row);
         if self.track.push(block).is_err() {
-            return Placement::Overlap;
+            return Placement::Invalid;
         }
-        let last: Platform = *self.track.last();
-        self.complete = last.reaches(self.goal);
-        self.env.push_platform(&last, self.complete);
-        if self.complete {
+        if self.track.last().reaches(self.goal) {
             Placement::Completed
         } else {
             Placement::Placed
         }
     }
 
-    /// Steps the Solver; returns its step and the Generator's reward from it (progress toward
-    /// the goal, and the failure term when the run failed).
-    pub fn step_solver(
-        &mut self,
-        action: PlatformAction,
-        rewards: &GeneratorRewards,
-    ) -> (Step, f32) {
-        let step = self.env.step(action);
-        let mut generator = 0.0;
-        let furthest = self.env.furthest();
-        if furthest > self.paid_up_to {
-            let platforms = self.track.platforms();
-            let to_goal = |p: &Platform| {
-                let d = [
-                    self.goal[0] - p.position[0],
-                    self.goal[1] - p.position[1],
-                    self.goal[2] - p.position[2],
-                ];
-                (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
-            };
-            let gained = to_goal(&platforms[self.paid_up_to]) - to_goal(&platforms[furthest]);
-            generator += rewards.progress_per_metre * gained as f32;
-            self.paid_up_to = furthest;
-        }
-        if matches!(step.outcome, Some(Outcome::Fell | Outcome::TimedOut)) {
-            generator += rewards.on_failure(&self.aux);
-        }
-        (step, generator)
+    fn distance_to_goal(&self, k: usize) -> f64 {
+        let p = self.track.platforms()[k].position;
+        let d = [
+            self.goal[0] - p[0],
+            self.goal[1] - p[1],
+            self.goal[2] - p[2],
+        ];
+        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+    }
+
+    fn piece_features(&self) -> Vec<[f64; 2]> {
+        self.track
+            .block_params()
+            .iter()
+            .map(|b| [b.distance, b.size])
+            .collect()
+    }
+
+    fn into_track(self) -> Track {
+        Track::Platform(self.track)
+    }
+}
+
+impl GeneratorGame for PlatformGame {
+    type Build = PlatformBuild;
+    const GENERATOR_OBSERVATION_LAYOUT: &'static [(&'static str, usize)] =
+        &GENERATOR_OBSERVATION_LAYOUT;
+    const GENERATOR_ACTIONS: &'static [&'static str] = &GENERATOR_ACTIONS;
+    const DEFAULT_MAX_PIECES: usize = DEFAULT_MAX_BLOCKS;
+    const MAX_PIECES: usize = crate::level::platform::MAX_BLOCKS;
+    const PIECE: &'static str = "block";
+    const PIECE_FEATURES: [&'static str; 2] = ["distance", "size"];
+
+    fn default_rewards() -> GeneratorRewards {
+        GeneratorRewards::default()
+    }
+
+    fn new_build(
+        seed: u64,
+        goal: Option<[f64; 3]>,
+        max_pieces: usize,
+        _obstacles: u32,
+    ) -> (PlatformBuild, ChaCha8Rng) {
+        let (goal, start, rng) = goal_and_start(seed, goal);
+        let build = PlatformBuild {
+            track: PlatformTrack::new(start),
+            goal,
+            max_blocks: max_pieces,
+        };
+        (build, rng)
+    }
+
+    fn open_env(build: &PlatformBuild, complete: bool) -> PlatformEnv {
+        let start = PlatformTrack::new(*build.track.start());
+        let mut env = PlatformEnv::open(&start, build.goal, SolverRewards::default());
+        env.push_platform(build.track.last(), complete);
+        env
+    }
+
+    fn extend_env(env: &mut PlatformEnv, build: &PlatformBuild, complete: bool) {
+        env.push_platform(build.track.last(), complete);
+    }
+
+    fn wants_piece(env: &PlatformEnv) -> bool {
+        env.awaits_platform()
+    }
+
+    fn furthest_piece(env: &PlatformEnv) -> usize {
+        env.furthest()
+    }
+
+    fn air_steps(_: &PlatformEnv) -> u32 {
+        0
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::game::generator::Match;
     use crate::level::params::{BLOCK_DISTANCE, BLOCK_HEIGHT, BLOCK_SIZE};
+    use crate::level::platform::Start;
+    use crate::level::stats::Outcome;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -348,31 +270,6 @@ mod tests {
             BLOCK_HEIGHT.to_unit((goal[1] - last.position[1]).clamp(-1.0, 1.0)),
         ]
         .map(|x| x as f32)
-    }
-
-    #[test]
-    fn failure_and_block_rewards_follow_the_sign_of_aux() {
-        let r = GeneratorRewards::default();
-        assert_eq!(r.on_failure(&[-1.0]), 10.0);
-        assert_eq!(r.on_failure(&[1.0]), -10.0);
-        assert_eq!(r.on_failure(&[0.0]), 0.0);
-        assert_eq!(r.per_block(&[1.0]), 0.0);
-        assert_eq!(r.per_block(&[0.5]), 0.0);
-        assert!((r.per_block(&[-0.5]) + 0.05).abs() < 1e-6);
-        let two = GeneratorRewards {
-            aux: vec![
-                AuxWeights {
-                    alpha: 1.0,
-                    beta: 1.0,
-                },
-                AuxWeights {
-                    alpha: 0.0,
-                    beta: 0.5,
-                },
-            ],
-            ..GeneratorRewards::default()
-        };
-        assert_eq!(two.on_failure(&[1.0, -1.0]), -10.0 + 5.0);
     }
 
     #[test]
@@ -405,14 +302,19 @@ mod tests {
     #[test]
     fn a_match_grows_its_track_as_the_solver_advances_and_ends_at_the_goal() {
         let goal = [30.0, 2.0, 0.0];
-        let mut game = Match::new(Start::default(), goal, vec![1.0], 30, 7);
+        let build = PlatformBuild {
+            track: PlatformTrack::new(Start::default()),
+            goal,
+            max_blocks: 30,
+        };
+        let mut game = Match::<PlatformGame>::new(build, vec![1.0], 7);
         let rewards = GeneratorRewards::default();
         let mut controller = crate::game::platform::ScriptedController::new(7, 0.0);
         let mut generator_return = 0.0;
         let mut placements = 0;
         for _ in 0..10_000 {
-            if game.needs_block() {
-                let row = aimed(game.track(), goal);
+            if game.needs_piece() {
+                let row = aimed(&game.build().track, goal);
                 let placed = game.place(&row);
                 assert!(
                     matches!(placed, Placement::Placed | Placement::Completed),
@@ -436,7 +338,7 @@ mod tests {
             placements >= 5,
             "{placements} blocks for 30 m in steps of at most 6 m"
         );
-        assert!(game.track().last().reaches(goal));
+        assert!(game.build().track.last().reaches(goal));
         // Paid 0.1 per metre for the whole way: from the start block (30.07 m from the goal) to
         // within 3 m of it.
         assert!(
@@ -496,16 +398,21 @@ mod tests {
     #[test]
     fn overlaps_and_running_out_of_blocks_end_the_match() {
         let goal = [60.0, 0.0, 0.0];
-        let mut game = Match::new(Start::default(), goal, vec![-1.0], 2, 1);
+        let build = PlatformBuild {
+            track: PlatformTrack::new(Start::default()),
+            goal,
+            max_blocks: 2,
+        };
+        let mut game = Match::<PlatformGame>::new(build, vec![-1.0], 1);
         let ahead = [-1.0, 0.0, 0.0, 0.0];
         assert_eq!(game.place(&ahead), Placement::Placed);
         let back = [-1.0, 1.0, 0.0, 0.0];
         assert_eq!(
             game.place(&back),
-            Placement::Overlap,
+            Placement::Invalid,
             "a U-turn onto the start block"
         );
         assert_eq!(game.place(&ahead), Placement::Placed);
-        assert_eq!(game.place(&ahead), Placement::OutOfBlocks);
+        assert_eq!(game.place(&ahead), Placement::OutOfPieces);
     }
 }

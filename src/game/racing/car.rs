@@ -76,18 +76,7 @@ pub struct TrackShapes {
 impl TrackShapes {
     /// The road surface of `road` and the obstacles of `track` as rapier shapes.
     pub fn new(road: &Road, obstacles: &[Obstacle]) -> Self {
-        let mesh = road.surface_mesh();
-        let vertices = mesh
-            .positions
-            .iter()
-            .map(|p| Vector::new(p[0], p[1], p[2]))
-            .collect();
-        let road = SharedShape::trimesh_with_flags(
-            vertices,
-            mesh.triangles,
-            TriMeshFlags::FIX_INTERNAL_EDGES,
-        )
-        .expect("a road of at least one segment is a valid triangle mesh");
+        let road = Self::road_shape(road);
         let obstacles = obstacles
             .iter()
             .map(|o| match *o {
@@ -127,9 +116,26 @@ impl TrackShapes {
         Self { road, obstacles }
     }
 
+    /// Rebuilds the road's shape after `road` grew.
+    pub fn set_road(&mut self, road: &Road) {
+        self.road = Self::road_shape(road);
+    }
+
     /// The shapes of a whole track.
     pub fn of_track(track: &RacingTrack) -> Self {
         Self::new(&track.road(), &track.obstacles)
+    }
+
+    /// The road's surface as one triangle mesh.
+    fn road_shape(road: &Road) -> SharedShape {
+        let mesh = road.surface_mesh();
+        let vertices = mesh
+            .positions
+            .iter()
+            .map(|p| Vector::new(p[0], p[1], p[2]))
+            .collect();
+        SharedShape::trimesh_with_flags(vertices, mesh.triangles, TriMeshFlags::FIX_INTERNAL_EDGES)
+            .expect("a road of at least one segment is a valid triangle mesh")
     }
 }
 
@@ -149,6 +155,7 @@ pub struct RacingWorld {
     ccd: CCDSolver,
     vehicle: DynamicRayCastVehicleController,
     chassis: RigidBodyHandle,
+    road: ColliderHandle,
 }
 
 impl RacingWorld {
@@ -157,7 +164,7 @@ impl RacingWorld {
     pub fn new(shapes: &TrackShapes, position: Vector, heading: f32) -> Self {
         let mut bodies = RigidBodySet::new();
         let mut colliders = ColliderSet::new();
-        colliders.insert(ColliderBuilder::new(shapes.road.clone()).friction(1.0));
+        let road = colliders.insert(Self::road_collider(shapes));
         for (pose, shape) in &shapes.obstacles {
             colliders.insert(ColliderBuilder::new(shape.clone()).position(*pose));
         }
@@ -228,6 +235,7 @@ impl RacingWorld {
             ccd: CCDSolver::new(),
             vehicle,
             chassis,
+            road,
         };
         // Queries see the colliders only after collision detection has run once.
         world.pipeline.step(
@@ -249,6 +257,24 @@ impl RacingWorld {
             &(),
         );
         world
+    }
+
+    fn road_collider(shapes: &TrackShapes) -> ColliderBuilder {
+        ColliderBuilder::new(shapes.road.clone()).friction(1.0)
+    }
+
+    /// Swaps the road for the longer one of `shapes` (a Generator added a segment), the car
+    /// where it is. The new surface is seen by queries from the next step on; until then the
+    /// old road's bounding box still culls them, which only the far end of the ray fan notices.
+    pub fn replace_road(&mut self, shapes: &TrackShapes) {
+        self.colliders.remove(
+            self.road,
+            &mut self.islands,
+            &mut self.bodies,
+            &mut self.soft_bodies,
+            false,
+        );
+        self.road = self.colliders.insert(Self::road_collider(shapes));
     }
 
     /// One decision: set the controls, update the wheels, step the physics.

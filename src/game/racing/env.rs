@@ -9,7 +9,7 @@ use rapier3d::math::{Rotation, Vector};
 
 use super::car::{CarAction, DECISION_DT, RacingWorld, START_S, TrackShapes};
 use crate::game::Step;
-use crate::level::racing::RacingTrack;
+use crate::level::racing::{RacingTrack, SegmentParams};
 use crate::level::road::{ROAD_WIDTH, Road};
 use crate::level::stats::Outcome;
 
@@ -110,6 +110,9 @@ pub struct RacingEnv {
     loose_steps: u32,
     flipped_steps: u32,
     outcome: Option<Outcome>,
+    /// The road reaches the goal (false while a Generator is still building it): only then does
+    /// its end count as success.
+    complete: bool,
 }
 
 impl RacingEnv {
@@ -123,8 +126,7 @@ impl RacingEnv {
     /// The environment of a resolved road and its shapes, with the car at the start.
     fn from_parts(road: Road, shapes: TrackShapes, goal: [f64; 3], rewards: SolverRewards) -> Self {
         let world = RacingWorld::new(&shapes, Vector::ZERO, 0.0);
-        let max_steps =
-            ((TIME_BASE_S + road.length() / TIME_SPEED) / DECISION_DT as f64).ceil() as u32;
+        let max_steps = Self::time_limit(&road);
         let mut env = Self {
             road,
             shapes,
@@ -139,9 +141,44 @@ impl RacingEnv {
             loose_steps: 0,
             flipped_steps: 0,
             outcome: None,
+            complete: true,
         };
         env.reset(0);
         env
+    }
+
+    /// The environment of a track a Generator is still building: it starts with `track` (at
+    /// least one segment) and grows with [`RacingEnv::push_segment`]; `complete`: it already
+    /// reaches the goal.
+    pub fn open(
+        track: &RacingTrack,
+        goal: [f64; 3],
+        rewards: SolverRewards,
+        complete: bool,
+    ) -> Self {
+        let mut env = Self::new(track, goal, rewards);
+        env.complete = complete;
+        env
+    }
+
+    /// Adds the Generator's next segment; `closes`: it reaches the goal, so the road's end is
+    /// success. The run goes on where it was; its time limit grows with the road.
+    pub fn push_segment(&mut self, segment: SegmentParams, closes: bool) {
+        self.road.push(segment);
+        self.shapes.set_road(&self.road);
+        self.world.replace_road(&self.shapes);
+        self.max_steps = Self::time_limit(&self.road);
+        self.complete = closes;
+    }
+
+    /// Steps allowed on `road`.
+    fn time_limit(road: &Road) -> u32 {
+        ((TIME_BASE_S + road.length() / TIME_SPEED) / DECISION_DT as f64).ceil() as u32
+    }
+
+    /// Distance left to the end of the road as built so far, m.
+    pub fn road_left(&self) -> f64 {
+        self.road.length() - self.along
     }
 
     /// Starts a new run: the car at rest [`START_S`] m along the road, shifted and turned at
@@ -200,19 +237,20 @@ impl RacingEnv {
         } else {
             0
         };
-        let outcome = if along >= self.road.length() - FINISH_MARGIN && !beyond_edge {
-            Some(Outcome::Success)
-        } else if position[1] < sample.centre[1] - BELOW_ROAD
-            || self.loose_steps as f32 * DECISION_DT >= OFF_ROAD_S
-        {
-            Some(Outcome::OffRoad)
-        } else if self.flipped_steps as f32 * DECISION_DT >= FLIP_S {
-            Some(Outcome::Flipped)
-        } else if self.steps >= self.max_steps {
-            Some(Outcome::TimedOut)
-        } else {
-            None
-        };
+        let outcome =
+            if self.complete && along >= self.road.length() - FINISH_MARGIN && !beyond_edge {
+                Some(Outcome::Success)
+            } else if position[1] < sample.centre[1] - BELOW_ROAD
+                || self.loose_steps as f32 * DECISION_DT >= OFF_ROAD_S
+            {
+                Some(Outcome::OffRoad)
+            } else if self.flipped_steps as f32 * DECISION_DT >= FLIP_S {
+                Some(Outcome::Flipped)
+            } else if self.steps >= self.max_steps {
+                Some(Outcome::TimedOut)
+            } else {
+                None
+            };
         match outcome {
             Some(outcome) => {
                 reward += if outcome == Outcome::Success {
@@ -373,12 +411,14 @@ fn to_f32(p: [f64; 3]) -> Vector {
 impl Clone for RacingEnv {
     /// The same track and goal, with the car back at the start (seed 0).
     fn clone(&self) -> Self {
-        Self::from_parts(
+        let mut env = Self::from_parts(
             self.road.clone(),
             self.shapes.clone(),
             self.goal,
             self.rewards,
-        )
+        );
+        env.complete = self.complete;
+        env
     }
 }
 

@@ -5,6 +5,7 @@
 pub mod car;
 pub mod env;
 pub mod feasibility;
+pub mod generator;
 pub mod rules;
 pub mod scripted;
 

@@ -1,0 +1,312 @@
+//! The Generator's side of either game (docs/spec.md §1 and §2): a track under construction
+//! ([`TrackBuild`]: what the Generator sees, what its action places), its rewards, and a
+//! [`Match`]: one Generator building a level while one Solver plays it, written once for both
+//! games. The platform Generator places the next block when the Solver stands on the newest one;
+//! the racing Generator places the next segment when the car comes within 15 m of the road's
+//! end. The Generator's episode ends with the Solver's.
+//!
+//! Rewards follow the paper's eq. 1 with a vector of aux inputs λᵢ, each with weights αᵢ (on the
+//! Generator's own, internal reward) and βᵢ (on the reward from the Solver's behaviour):
+//! - progress: `progress_per_metre` for every metre the Solver's furthest piece comes closer to
+//!   the goal, whatever λ;
+//! - the Solver fails: `failure · Σ βᵢ λᵢ` (with the default `failure = -10` and β = 1: -10·λ,
+//!   +10 at λ = -1, the sign docs/spec.md §2 decides);
+//! - each piece placed: `step_penalty · Σ αᵢ min(λᵢ, 0)` (a small cost only when λ < 0: finish or
+//!   fail fast);
+//! - racing: each Solver step with the car in the air, `air_step · Σ βᵢ max(-λᵢ, 0)` (only when
+//!   λ < 0);
+//! - an invalid placement (overlap, crossing, obstacle) or a track that runs out of pieces before
+//!   the goal: `invalid`, and the match ends.
+
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use super::{GameSpec, SolverEnv, Step};
+use crate::level::Track;
+use crate::level::stats::Outcome;
+
+/// The weights of one aux input in the Generator's reward (paper eq. 1).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AuxWeights {
+    /// α: weight on the Generator's internal reward (the per-piece cost when λ < 0).
+    pub alpha: f32,
+    /// β: weight on the external reward (the Solver's failure, its air time).
+    pub beta: f32,
+}
+
+/// The Generator's reward terms (docs/spec.md §2); see the module documentation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GeneratorRewards {
+    /// Per metre the Solver's furthest piece comes closer to the goal.
+    pub progress_per_metre: f32,
+    /// Scaled by Σ βᵢ λᵢ when the Solver fails.
+    pub failure: f32,
+    /// Scaled by Σ αᵢ min(λᵢ, 0) for each piece placed.
+    pub step_penalty: f32,
+    /// Scaled by Σ βᵢ max(-λᵢ, 0) for each Solver step in the air (racing; 0 turns it off).
+    pub air_step: f32,
+    /// An invalid piece, or no goal within the piece budget: the match ends.
+    pub invalid: f32,
+    /// The weights of each aux input (both games use one).
+    pub aux: Vec<AuxWeights>,
+}
+
+impl Default for GeneratorRewards {
+    fn default() -> Self {
+        Self {
+            progress_per_metre: 0.1,
+            failure: -10.0,
+            step_penalty: 0.1,
+            air_step: 0.0,
+            invalid: -10.0,
+            aux: vec![AuxWeights {
+                alpha: 1.0,
+                beta: 1.0,
+            }],
+        }
+    }
+}
+
+impl GeneratorRewards {
+    /// The reward when the Solver fails, at aux inputs `aux`.
+    pub fn on_failure(&self, aux: &[f32]) -> f32 {
+        self.failure * self.weighted(aux, |w, l| w.beta * l)
+    }
+
+    /// The reward for placing a piece, at aux inputs `aux`.
+    pub fn per_piece(&self, aux: &[f32]) -> f32 {
+        self.step_penalty * self.weighted(aux, |w, l| w.alpha * l.min(0.0))
+    }
+
+    /// The reward for one Solver step in the air, at aux inputs `aux`.
+    pub fn per_air_step(&self, aux: &[f32]) -> f32 {
+        self.air_step * self.weighted(aux, |w, l| w.beta * (-l).max(0.0))
+    }
+
+    fn weighted(&self, aux: &[f32], term: impl Fn(&AuxWeights, f32) -> f32) -> f32 {
+        self.aux.iter().zip(aux).map(|(w, &l)| term(w, l)).sum()
+    }
+}
+
+/// What a Generator's placement led to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Placement {
+    /// Placed; the track goes on.
+    Placed,
+    /// Placed, and it reaches the goal: the track is complete.
+    Completed,
+    /// It overlaps or crosses the track, or runs into an obstacle: the match ends.
+    Invalid,
+    /// The track already holds its budget of pieces without reaching the goal: the match ends.
+    OutOfPieces,
+}
+
+impl Placement {
+    /// Whether the placement ends the Generator's episode as invalid.
+    pub fn is_invalid(self) -> bool {
+        matches!(self, Placement::Invalid | Placement::OutOfPieces)
+    }
+}
+
+/// A track the Generator is building, with its goal and piece budget.
+pub trait TrackBuild: Clone + Send + Sync {
+    /// The point the track must reach.
+    fn goal(&self) -> [f64; 3];
+    /// Pieces placed so far.
+    fn piece_count(&self) -> usize;
+    /// Writes the Generator's observation at aux inputs `aux` into `out`.
+    fn observe(&self, aux: &[f32], out: &mut [f32]);
+    /// Places the piece a policy's action row (unbounded samples, clipped here) stands for.
+    fn place(&mut self, row: &[f32]) -> Placement;
+    /// Distance from where piece `k` leaves the Solver (0: the start) to the goal, m.
+    fn distance_to_goal(&self, k: usize) -> f64;
+    /// Two numbers per piece that the training metrics average ([`GeneratorGame::PIECE_FEATURES`]).
+    fn piece_features(&self) -> Vec<[f64; 2]>;
+    /// The finished track.
+    fn into_track(self) -> Track;
+}
+
+/// A game whose levels a Generator builds: its track under construction, the Generator's
+/// observation and actions as a policy card names them, and how the Solver's environment grows
+/// with the track.
+pub trait GeneratorGame: GameSpec {
+    type Build: TrackBuild;
+    /// The Generator's observation, named parts in order.
+    const GENERATOR_OBSERVATION_LAYOUT: &'static [(&'static str, usize)];
+    /// The Generator's actions, in the policy's order.
+    const GENERATOR_ACTIONS: &'static [&'static str];
+    /// The piece budget of a Generator's track by default.
+    const DEFAULT_MAX_PIECES: usize;
+    /// The most pieces a level of the game may hold.
+    const MAX_PIECES: usize;
+    /// What a piece is called in messages ("block", "segment").
+    const PIECE: &'static str;
+    /// The names of the two [`TrackBuild::piece_features`], as the metrics columns call them.
+    const PIECE_FEATURES: [&'static str; 2];
+    /// The Generator reward defaults of the game.
+    fn default_rewards() -> GeneratorRewards;
+    /// The empty track of `seed`: goal (drawn unless given), start and scene drawn from the seed
+    /// as the rules draw them, and the stream the Generator's sampling continues from. Racing
+    /// scenes get `obstacles` obstacles.
+    fn new_build(
+        seed: u64,
+        goal: Option<[f64; 3]>,
+        max_pieces: usize,
+        obstacles: u32,
+    ) -> (Self::Build, ChaCha8Rng);
+    /// The Solver's environment on a track with its first piece placed, still growing unless
+    /// `complete` (the first piece reaches the goal).
+    fn open_env(build: &Self::Build, complete: bool) -> Self::Env;
+    /// Adds the newest piece of `build` to the environment; `complete`: it reaches the goal.
+    fn extend_env(env: &mut Self::Env, build: &Self::Build, complete: bool);
+    /// Whether the Solver has come close enough to the newest piece to ask for the next.
+    fn wants_piece(env: &Self::Env) -> bool;
+    /// The index of the furthest piece the Solver has left behind (0: the start), as
+    /// [`TrackBuild::distance_to_goal`] counts.
+    fn furthest_piece(env: &Self::Env) -> usize;
+    /// Steps the Solver has spent in the air in this run.
+    fn air_steps(env: &Self::Env) -> u32;
+}
+
+/// Length of the Generator's observation vector of game `G`.
+pub fn observation_size<G: GeneratorGame>() -> usize {
+    G::GENERATOR_OBSERVATION_LAYOUT.iter().map(|(_, k)| k).sum()
+}
+
+/// One Generator building a level while one Solver plays it.
+pub struct Match<G: GeneratorGame> {
+    pub aux: Vec<f32>,
+    build: G::Build,
+    /// The Solver's run, from the first piece on.
+    env: Option<G::Env>,
+    solver_seed: u64,
+    complete: bool,
+    /// The furthest piece the Solver had left behind when the Generator was last paid.
+    paid_up_to: usize,
+    air_paid: u32,
+}
+
+impl<G: GeneratorGame> Match<G> {
+    /// A new match on an empty track; the Generator places the first piece next, and the
+    /// Solver's run (seeded `solver_seed`) starts on it.
+    pub fn new(build: G::Build, aux: Vec<f32>, solver_seed: u64) -> Self {
+        Self {
+            aux,
+            build,
+            env: None,
+            solver_seed,
+            complete: false,
+            paid_up_to: 0,
+            air_paid: 0,
+        }
+    }
+
+    pub fn build(&self) -> &G::Build {
+        &self.build
+    }
+
+    /// The Solver's run (once the first piece is placed).
+    pub fn env(&self) -> &G::Env {
+        self.env
+            .as_ref()
+            .expect("the Solver plays once the first piece is placed")
+    }
+
+    /// Whether it is the Generator's turn: at the start, and whenever the Solver has come close
+    /// to the newest piece of an unfinished track.
+    pub fn needs_piece(&self) -> bool {
+        !self.complete && self.env.as_ref().is_none_or(|env| G::wants_piece(env))
+    }
+
+    /// The Generator's observation, into `out`.
+    pub fn observe_generator(&self, out: &mut [f32]) {
+        self.build.observe(&self.aux, out);
+    }
+
+    /// Places the Generator's piece (one action row).
+    pub fn place(&mut self, row: &[f32]) -> Placement {
+        let placement = self.build.place(row);
+        if placement.is_invalid() {
+            return placement;
+        }
+        self.complete = placement == Placement::Completed;
+        match &mut self.env {
+            Some(env) => G::extend_env(env, &self.build, self.complete),
+            None => {
+                let mut env = G::open_env(&self.build, self.complete);
+                env.reset(self.solver_seed);
+                self.env = Some(env);
+            }
+        }
+        placement
+    }
+
+    /// Steps the Solver; returns its step and the Generator's reward from it (progress toward
+    /// the goal, air time, and the failure term when the run failed).
+    pub fn step_solver(
+        &mut self,
+        action: <G::Env as SolverEnv>::Action,
+        rewards: &GeneratorRewards,
+    ) -> (Step, f32) {
+        let env = self
+            .env
+            .as_mut()
+            .expect("the Solver plays once the first piece is placed");
+        let step = env.step(action);
+        let mut generator = 0.0;
+        let furthest = G::furthest_piece(env);
+        if furthest > self.paid_up_to {
+            let gained = self.build.distance_to_goal(self.paid_up_to)
+                - self.build.distance_to_goal(furthest);
+            generator += rewards.progress_per_metre * gained as f32;
+            self.paid_up_to = furthest;
+        }
+        let air = G::air_steps(env);
+        if air > self.air_paid {
+            generator += rewards.per_air_step(&self.aux) * (air - self.air_paid) as f32;
+            self.air_paid = air;
+        }
+        if step.outcome.is_some_and(|o| o != Outcome::Success) {
+            generator += rewards.on_failure(&self.aux);
+        }
+        (step, generator)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn failure_piece_and_air_rewards_follow_the_sign_of_aux() {
+        let r = GeneratorRewards {
+            air_step: 0.05,
+            ..GeneratorRewards::default()
+        };
+        assert_eq!(r.on_failure(&[-1.0]), 10.0);
+        assert_eq!(r.on_failure(&[1.0]), -10.0);
+        assert_eq!(r.on_failure(&[0.0]), 0.0);
+        assert_eq!(r.per_piece(&[1.0]), 0.0);
+        assert_eq!(r.per_piece(&[0.5]), 0.0);
+        assert!((r.per_piece(&[-0.5]) + 0.05).abs() < 1e-6);
+        assert_eq!(r.per_air_step(&[0.5]), 0.0, "air pays only when λ < 0");
+        assert!((r.per_air_step(&[-1.0]) - 0.05).abs() < 1e-6);
+        assert!((r.per_air_step(&[-0.5]) - 0.025).abs() < 1e-6);
+        let two = GeneratorRewards {
+            aux: vec![
+                AuxWeights {
+                    alpha: 1.0,
+                    beta: 1.0,
+                },
+                AuxWeights {
+                    alpha: 0.0,
+                    beta: 0.5,
+                },
+            ],
+            ..GeneratorRewards::default()
+        };
+        assert_eq!(two.on_failure(&[1.0, -1.0]), -10.0 + 5.0);
+    }
+}

@@ -191,10 +191,11 @@ impl TrainConfig {
         let _: TrainConfig = serde_yaml::from_str(text).map_err(|e| e.to_string())?;
         // ...then laid over the game's defaults.
         let given: serde_yaml::Value = serde_yaml::from_str(text).map_err(|e| e.to_string())?;
-        let given = match given {
+        let mut given = match given {
             serde_yaml::Value::Null => serde_yaml::Value::Mapping(Default::default()),
             other => other,
         };
+        rename_aliases(&mut given);
         let defaults = serde_yaml::to_value(Self::for_game(game)).map_err(|e| e.to_string())?;
         let config: TrainConfig =
             serde_yaml::from_value(overlay(defaults, given)).map_err(|e| e.to_string())?;
@@ -210,19 +211,29 @@ impl TrainConfig {
     }
 }
 
+/// The old names a configuration may use (`ppo` for `solver`, `generator.max_blocks` for
+/// `generator.max_pieces`), renamed to the current ones.
+fn rename_aliases(given: &mut serde_yaml::Value) {
+    fn rename(map: &mut serde_yaml::Mapping, old: &str, new: &str) {
+        if let Some(value) = map.remove(old) {
+            map.insert(new.into(), value);
+        }
+    }
+    if let serde_yaml::Value::Mapping(top) = given {
+        rename(top, "ppo", "solver");
+        if let Some(serde_yaml::Value::Mapping(generator)) = top.get_mut("generator") {
+            rename(generator, "max_blocks", "max_pieces");
+        }
+    }
+}
+
 /// `given` laid over `defaults`: mappings merge key by key (recursively), anything else given
-/// replaces the default. Aliases (`ppo` for `solver`, `max_blocks` for `max_pieces`) are
-/// renamed first, so they replace their default.
+/// replaces the default.
 fn overlay(defaults: serde_yaml::Value, given: serde_yaml::Value) -> serde_yaml::Value {
     use serde_yaml::Value;
     match (defaults, given) {
         (Value::Mapping(mut base), Value::Mapping(top)) => {
             for (key, value) in top {
-                let key = match key.as_str() {
-                    Some("ppo") => Value::from("solver"),
-                    Some("max_blocks") => Value::from("max_pieces"),
-                    _ => key,
-                };
                 let merged = match base.remove(&key) {
                     Some(old) => overlay(old, value),
                     None => value,
@@ -339,4 +350,37 @@ fn check_config(config: &TrainConfig, game: Game) -> Result<(), String> {
         ));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_partial_file_takes_its_games_defaults_and_old_names_still_read() {
+        let text = "generator:\n  ppo:\n    ent_coef: 0.001\n  generator_phase_steps: 20000\n";
+        let racing = TrainConfig::parse_for(text, Game::Racing).unwrap();
+        let mut expected = TrainConfig::for_game(Game::Racing);
+        expected.generator.ppo.ent_coef = 0.001;
+        expected.generator.generator_phase_steps = 20_000;
+        assert_eq!(racing, expected);
+        assert_eq!(racing.generator.rewards.air_step, 0.05);
+        assert_eq!(racing.solver.gamma, RACING_SOLVER_GAMMA);
+        let platform = TrainConfig::parse_for(text, Game::Platform).unwrap();
+        assert_eq!(platform.generator.rewards.air_step, 0.0);
+        assert_eq!(platform.solver.gamma, 0.99);
+        let old = "ppo:\n  gamma: 0.95\ngenerator:\n  max_blocks: 12\n";
+        let read = TrainConfig::parse_for(old, Game::Racing).unwrap();
+        assert_eq!((read.solver.gamma, read.generator.max_pieces), (0.95, 12));
+        assert_eq!(
+            TrainConfig::parse_for("", Game::Racing).unwrap(),
+            TrainConfig::for_game(Game::Racing)
+        );
+        let err =
+            TrainConfig::parse_for("generator:\n  max_pieces: 500\n", Game::Racing).unwrap_err();
+        assert!(
+            err.contains("generator.max_pieces must be within [1, 400]"),
+            "{err}"
+        );
+    }
 }

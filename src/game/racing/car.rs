@@ -264,17 +264,11 @@ impl RacingWorld {
     }
 
     /// Swaps the road for the longer one of `shapes` (a Generator added a segment), the car
-    /// where it is. The new surface is seen by queries from the next step on; until then the
-    /// old road's bounding box still culls them, which only the far end of the ray fan notices.
+    /// where it is. The road stays one collider whose shape changes (the broad phase refits it
+    /// on the next step); queries see the new surface from the next step on, which only the far
+    /// end of the ray fan notices.
     pub fn replace_road(&mut self, shapes: &TrackShapes) {
-        self.colliders.remove(
-            self.road,
-            &mut self.islands,
-            &mut self.bodies,
-            &mut self.soft_bodies,
-            false,
-        );
-        self.road = self.colliders.insert(Self::road_collider(shapes));
+        self.colliders[self.road].set_shape(shapes.road.clone());
     }
 
     /// One decision: set the controls, update the wheels, step the physics.

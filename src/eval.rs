@@ -1,9 +1,10 @@
-//! The paper's evaluation on our platform game (docs/spec.md §4), as pure functions of the policies and
-//! the budget: the same policies and budget give the same tables.
+//! The paper's evaluation on either game (docs/spec.md §4), as pure functions of the policies
+//! and the budget: the same policies and budget give the same tables.
 //!
 //! - **Controllability**: Generator levels at λ ∈ {1, 0.5, 0, -0.5, -1} (the same goals at every
 //!   λ), played by the ARLPCG Solver: success ratio ± std over levels, the fraction completed by
-//!   at least one run, the mean block distance and size.
+//!   at least one run, the pieces' mean parameters (platform: block distance and size; racing:
+//!   segment curve, length and height change) and, racing, the car's time in the air per run.
 //! - **Generalization**: every Solver on one held-out validation set (half rule levels, half
 //!   Generator levels cycling through the λ values), success ± std, completed by any, mean steps
 //!   of successful runs.
@@ -15,10 +16,11 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::game::rules;
+use std::collections::BTreeMap;
+
 use crate::generation::{self, GeneratorPolicy};
 use crate::level::stats::SolverStats;
-use crate::level::{Level, RulesConfig};
+use crate::level::{Game, Level, Track};
 use crate::verify::{Solver, SolverPolicy, Summary, verify};
 
 /// The λ values of the tables, easy to hard.
@@ -71,8 +73,12 @@ pub struct ControllabilityRow {
     pub success_ratio: f64,
     pub success_std: f64,
     pub completed_by_any: f64,
-    pub avg_block_distance: f64,
-    pub avg_block_size: f64,
+    /// The pieces' mean parameters, named by [`piece_columns`] (`avg_block_distance`, ...).
+    #[serde(flatten)]
+    pub pieces: BTreeMap<String, f64>,
+    /// Racing: mean seconds per run with the car in the air.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub air_time: Option<f64>,
     pub tracks: usize,
 }
 
@@ -101,6 +107,9 @@ pub struct CrossRow {
 /// Everything `eval` measures.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Results {
+    /// The game evaluated (the tables' columns and the paper's figures depend on it).
+    #[serde(skip)]
+    pub game: Game,
     pub budget: Budget,
     pub generator: String,
     pub controllability: Vec<ControllabilityRow>,
@@ -121,7 +130,13 @@ pub fn generator_levels(
         if levels.len() == count as usize {
             break;
         }
-        match generation::generator_level(generator, seed, aux, None, 0) {
+        match generation::generator_level(
+            generator,
+            seed,
+            aux,
+            None,
+            scene_obstacles(generator.game),
+        ) {
             Ok(level) => levels.push(level),
             Err(generation::GenerationError::NoLevel { .. }) => {}
             Err(generation::GenerationError::Network(e)) => return Err(e),
@@ -138,8 +153,11 @@ pub fn validation_levels(
 ) -> Result<Vec<Level>, candle_core::Error> {
     let base = 2 * EVAL_SEED_BASE;
     let rule_count = count / 2;
+    let game = generator.game;
     let mut levels: Vec<Level> = (0..rule_count as u64)
-        .filter_map(|k| rules::platform_level(base + k, None, None, &RulesConfig::default()).ok())
+        .filter_map(|k| {
+            generation::rules_level(game, base + k, None, None, scene_obstacles(game)).ok()
+        })
         .collect();
     let per_aux = (count - rule_count).div_ceil(AUX_VALUES.len() as u32);
     for (k, &aux) in AUX_VALUES.iter().enumerate() {
@@ -150,16 +168,56 @@ pub fn validation_levels(
     Ok(levels)
 }
 
-/// What the tables are made of, without the levels themselves: how many levels each table
-/// has, the Solvers' names and the block statistics of the controllability levels. With it,
-/// the per-level statistics of every play make the tables ([`assemble`]), so shards of an
+/// Obstacles in each evaluation scene: racing tracks are built around as many as the racing
+/// Generator trained with (some draws are dropped near the start or goal).
+pub fn scene_obstacles(game: Game) -> u32 {
+    match game {
+        Game::Platform => 0,
+        Game::Racing => crate::game::racing::generator::MATCH_OBSTACLES,
+    }
+}
+
+/// The names of the controllability table's piece columns of `game`, in the order
+/// [`piece_values`] gives them.
+pub fn piece_columns(game: Game) -> &'static [&'static str] {
+    match game {
+        Game::Platform => &["avg_block_distance", "avg_block_size"],
+        Game::Racing => &[
+            "avg_segment_curve",
+            "avg_segment_length",
+            "avg_segment_height",
+        ],
+    }
+}
+
+/// Each piece's parameters, as [`piece_columns`] names them (racing: the curve's and the
+/// height change's size, whatever their sign).
+fn piece_values(level: &Level) -> Vec<Vec<f64>> {
+    match &level.track {
+        Track::Platform(track) => track
+            .block_params()
+            .iter()
+            .map(|b| vec![b.distance, b.size])
+            .collect(),
+        Track::Racing(track) => track
+            .segments
+            .iter()
+            .map(|s| vec![s.curve.abs(), s.length, s.height.abs()])
+            .collect(),
+    }
+}
+
+/// What the tables are made of, without the levels themselves: the game, how many levels each
+/// table has, the Solvers' names and the piece statistics of the controllability levels. With
+/// it, the per-level statistics of every play make the tables ([`assemble`]), so shards of an
 /// evaluation can be played apart and merged.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct Layout {
+    pub game: Game,
     /// Levels per λ of [`AUX_VALUES`] (the Generator may build fewer than the budget asks).
     pub levels_per_aux: Vec<usize>,
-    /// (mean block distance, mean block size) of the levels at each λ (`None`: no levels).
-    pub block_means: Vec<Option<(f64, f64)>>,
+    /// The pieces' mean parameters ([`piece_columns`]) at each λ (`None`: no levels).
+    pub piece_means: Vec<Option<Vec<f64>>>,
     /// Levels in the validation set: its rule levels first, then the Generator's.
     pub validation_levels: usize,
     /// How many of them are rule levels.
@@ -222,30 +280,31 @@ pub fn levels(
         .map(|&aux| generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks))
         .collect::<Result<_, _>>()?;
     let validation = validation_levels(generator, budget.validation_tracks)?;
-    let block_means = by_aux
+    let game = generator.game;
+    let piece_means = by_aux
         .iter()
         .map(|levels| {
-            let blocks: Vec<_> = levels
-                .iter()
-                .filter_map(|l| l.platform())
-                .flat_map(|t| t.block_params().iter().copied())
-                .collect();
-            match blocks.len() {
-                0 => None,
-                n => Some((
-                    blocks.iter().map(|b| b.distance).sum::<f64>() / n as f64,
-                    blocks.iter().map(|b| b.size).sum::<f64>() / n as f64,
-                )),
-            }
+            let pieces: Vec<Vec<f64>> = levels.iter().flat_map(piece_values).collect();
+            (!pieces.is_empty()).then(|| {
+                (0..piece_columns(game).len())
+                    .map(|k| pieces.iter().map(|p| p[k]).sum::<f64>() / pieces.len() as f64)
+                    .collect()
+            })
         })
         .collect();
     let layout = Layout {
+        game,
         levels_per_aux: by_aux.iter().map(Vec::len).collect(),
-        block_means,
+        piece_means,
         validation_levels: validation.len(),
         validation_rule_levels: validation
             .iter()
-            .filter(|l| matches!(l.source, crate::level::Source::Rules { .. }))
+            .filter(|l| {
+                matches!(
+                    l.source,
+                    crate::level::Source::Rules { .. } | crate::level::Source::RacingRules { .. }
+                )
+            })
             .count(),
         solvers: solvers.iter().map(|s| s.mode.clone()).collect(),
     };
@@ -335,13 +394,31 @@ pub fn assemble(
         .enumerate()
         .map(|(a, &aux)| {
             let s = summary(&|p| matches!(p, Play::Controllability { aux, .. } if *aux == a));
+            let pieces = piece_columns(layout.game)
+                .iter()
+                .enumerate()
+                .map(|(k, name)| {
+                    let mean = layout.piece_means[a].as_ref().map_or(f64::NAN, |m| m[k]);
+                    (name.to_string(), mean)
+                })
+                .collect();
+            let air: Vec<f64> = plays
+                .iter()
+                .zip(stats)
+                .filter(|(p, _)| matches!(p, Play::Controllability { aux, .. } if *aux == a))
+                .filter_map(|(_, s)| s.mean_air_steps)
+                .collect();
+            let air_time = (layout.game == Game::Racing).then(|| {
+                let dt = f64::from(crate::game::racing::car::DECISION_DT);
+                dt * air.iter().sum::<f64>() / air.len().max(1) as f64
+            });
             ControllabilityRow {
                 aux,
                 success_ratio: s.mean_success,
                 success_std: s.std_success,
                 completed_by_any: s.completed_by_any,
-                avg_block_distance: layout.block_means[a].map_or(f64::NAN, |m| m.0),
-                avg_block_size: layout.block_means[a].map_or(f64::NAN, |m| m.1),
+                pieces,
+                air_time,
                 tracks: layout.levels_per_aux[a],
             }
         })
@@ -385,6 +462,7 @@ pub fn assemble(
         });
     }
     Results {
+        game: layout.game,
         budget,
         generator: generator.to_string(),
         controllability,
@@ -427,40 +505,82 @@ fn num(x: f64, decimals: usize) -> String {
     }
 }
 
+/// The paper's controllability figures for `game` at each λ of [`AUX_VALUES`] (docs/spec.md §4).
+fn paper_controllability(game: Game) -> [&'static str; 5] {
+    match game {
+        Game::Platform => [
+            "0.97, 6.73 m, 5.95 m",
+            "0.92, 6.98 m, 5.77 m",
+            "0.88, 7.15 m, 5.42 m",
+            "0.74, 7.11 m, 4.52 m",
+            "0.69, 7.46 m, 4.01 m",
+        ],
+        Game::Racing => [
+            "0.99, 14.4°, 28.4 m, 1.5 m",
+            "0.89, 14.7°, 27.1 m, 2.0 m",
+            "0.77, 15.1°, 25.1 m, 2.5 m",
+            "0.64, 15.3°, 23.0 m, 3.1 m",
+            "0.61, 16.8°, 21.8 m, 3.9 m",
+        ],
+    }
+}
+
+/// The paper's generalization figure for a Solver of `game` trained in `mode` (docs/spec.md §4).
+fn paper_generalization(game: Game, mode: &str) -> &'static str {
+    match (game, mode) {
+        (Game::Platform, "fixed-track") => "0.081 ± 0.205, 0.20 (54 steps)",
+        (Game::Platform, "rule-pcg") => "0.233 ± 0.200, 0.95 (451 steps)",
+        (Game::Platform, "fixed-aux") => "0.173 ± 0.195, 0.90 (442 steps)",
+        (Game::Platform, "arlpcg") => "0.457 ± 0.211, 1.00 (467 steps)",
+        (Game::Racing, "fixed-track") => "0.219 ± 0.280, 0.7 (431 m)",
+        (Game::Racing, "rule-pcg") => "0.174 ± 0.160, 0.9 (355 m)",
+        (Game::Racing, "fixed-aux") => "0.163 ± 0.138, 0.8 (382 m)",
+        (Game::Racing, "arlpcg") => "0.331 ± 0.225, 1.0 (507 m)",
+        _ => "",
+    }
+}
+
 /// The three tables as markdown, beside the paper's figures.
 pub fn markdown(results: &Results) -> String {
+    let game = results.game;
     let mut md =
         String::from("## Generator controllability (ARLPCG Solver on Generator levels)\n\n");
-    md += "| λ | success ratio | completed by any | avg block distance | avg block size | levels | paper: success, distance, size |\n|---|---|---|---|---|---|---|\n";
-    let paper = [
-        (0.97, 6.73, 5.95),
-        (0.92, 6.98, 5.77),
-        (0.88, 7.15, 5.42),
-        (0.74, 7.11, 4.52),
-        (0.69, 7.46, 4.01),
-    ];
-    for (row, (ps, pd, pz)) in results.controllability.iter().zip(paper) {
+    md += match game {
+        Game::Platform => {
+            "| λ | success ratio | completed by any | avg block distance | avg block size | levels | paper: success, distance, size |\n|---|---|---|---|---|---|---|\n"
+        }
+        Game::Racing => {
+            "| λ | success ratio | completed by any | air time per run | avg segment curve | avg segment length | avg segment height change | tracks | paper: success, angle, length, height |\n|---|---|---|---|---|---|---|---|---|\n"
+        }
+    };
+    let units: &[&str] = match game {
+        Game::Platform => &[" m", " m"],
+        Game::Racing => &["°", " m", " m"],
+    };
+    for (row, paper) in results
+        .controllability
+        .iter()
+        .zip(paper_controllability(game))
+    {
         md += &format!(
-            "| {:+.1} | {} ± {} | {} | {} m | {} m | {} | {ps}, {pd} m, {pz} m |\n",
+            "| {:+.1} | {} ± {} | {} |",
             row.aux,
             num(row.success_ratio, 3),
             num(row.success_std, 3),
             num(row.completed_by_any, 2),
-            num(row.avg_block_distance, 2),
-            num(row.avg_block_size, 2),
-            row.tracks
         );
+        if let Some(air) = row.air_time {
+            md += &format!(" {} s |", num(air, 2));
+        }
+        for (name, unit) in piece_columns(game).iter().zip(units) {
+            md += &format!(" {}{unit} |", num(row.pieces[*name], 2));
+        }
+        md += &format!(" {} | {paper} |\n", row.tracks);
     }
     md += "\n## Solver generalization (held-out validation levels)\n\n";
     md += "| mode | success ratio | on rule levels | on Generator levels | completed by any | avg steps | paper |\n|---|---|---|---|---|---|---|\n";
     for row in &results.generalization {
-        let paper = match row.mode.as_str() {
-            "fixed-track" => "0.081 ± 0.205, 0.20 (54 steps)",
-            "rule-pcg" => "0.233 ± 0.200, 0.95 (451 steps)",
-            "fixed-aux" => "0.173 ± 0.195, 0.90 (442 steps)",
-            "arlpcg" => "0.457 ± 0.211, 1.00 (467 steps)",
-            _ => "",
-        };
+        let paper = paper_generalization(game, &row.mode);
         md += &format!(
             "| {} | {} ± {} | {} | {} | {} | {} | {paper} |\n",
             row.mode,
@@ -521,20 +641,25 @@ pub fn chart(results: &Results) -> crate::chart::LineChart {
 
 /// The three tables as CSV files: (file name, contents).
 pub fn csv_tables(results: &Results) -> Vec<(&'static str, String)> {
-    let mut controllability = String::from(
-        "aux,success_ratio,success_std,completed_by_any,avg_block_distance,avg_block_size,tracks\n",
+    let columns = piece_columns(results.game);
+    let air = results.game == Game::Racing;
+    let mut controllability = format!(
+        "aux,success_ratio,success_std,completed_by_any,{}{},tracks\n",
+        if air { "air_time," } else { "" },
+        columns.join(",")
     );
     for r in &results.controllability {
         controllability += &format!(
-            "{},{:.4},{:.4},{:.4},{:.4},{:.4},{}\n",
-            r.aux,
-            r.success_ratio,
-            r.success_std,
-            r.completed_by_any,
-            r.avg_block_distance,
-            r.avg_block_size,
-            r.tracks
+            "{},{:.4},{:.4},{:.4},",
+            r.aux, r.success_ratio, r.success_std, r.completed_by_any,
         );
+        if let Some(time) = r.air_time {
+            controllability += &format!("{time:.4},");
+        }
+        for name in columns {
+            controllability += &format!("{:.4},", r.pieces[*name]);
+        }
+        controllability += &format!("{}\n", r.tracks);
     }
     let mut generalization = String::from(
         "mode,success_ratio,success_std,success_rule_levels,success_generator_levels,completed_by_any,avg_steps,tracks\n",

@@ -10,8 +10,8 @@ use anyhow::{Context, Result, bail};
 use crate::cli::EvalArgs;
 use crate::eval::{self, Budget, Layout, NamedSolver};
 use crate::fsio::{self, Overwrite};
+use crate::level::PolicyRef;
 use crate::level::stats::SolverStats;
-use crate::level::{Game, PolicyRef};
 use crate::policies::{GENERATOR_FILE, load_generator, load_solver};
 use crate::verify::SolverPolicy;
 
@@ -19,7 +19,7 @@ use crate::verify::SolverPolicy;
 const PART_FILE: &str = "eval-part.json";
 /// What an eval part file says it is.
 const PART_FORMAT: &str = "arlpcg-eval-part";
-const PART_VERSION: u32 = 1;
+const PART_VERSION: u32 = 2;
 
 /// One shard's raw results: enough to rebuild the tables with the other shards.
 #[derive(Debug, Serialize, Deserialize)]
@@ -42,12 +42,6 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     if !args.merge.is_empty() {
         return merge(args);
     }
-    if args.game != Game::Platform {
-        bail!(
-            "--game {}: only the platform game can be evaluated so far",
-            args.game
-        );
-    }
     if let Some(missing) = args.policies.iter().find(|dir| !dir.is_dir()) {
         bail!("--policies {}: no such folder", missing.display());
     }
@@ -57,7 +51,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         .map(|dir| dir.join(GENERATOR_FILE))
         .find(|p| p.exists())
         .with_context(|| format!("no {GENERATOR_FILE} in any --policies folder"))?;
-    let (generator, _) = load_generator(&generator_path, Game::Platform)?;
+    let (generator, _) = load_generator(&generator_path, args.game)?;
     let mut solvers: Vec<(String, SolverPolicy)> = Vec::new();
     for dir in &args.policies {
         let entries = std::fs::read_dir(dir)
@@ -72,7 +66,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             .collect();
         files.sort();
         for path in files {
-            let (solver, card) = load_solver(&path, Game::Platform)?;
+            let (solver, card) = load_solver(&path, args.game)?;
             if let Some((mode, _)) = solvers.iter().find(|(m, _)| *m == card.training.mode) {
                 eprintln!(
                     "note: {} skipped: a {mode} Solver is already loaded",

@@ -18,12 +18,6 @@ use crate::policies::{load_generator, load_solver, policy_paths};
 use crate::verify::{self, Solver, SolverPolicy, verify};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
-    if args.game == Game::Racing && args.policies.is_some() {
-        return Err(crate::shell::UsageError(
-            "--game racing --policies: no racing Generator is trained yet; use --rules".into(),
-        )
-        .into());
-    }
     if args.target_success.is_some() && args.policies.is_none() {
         return Err(crate::shell::UsageError(
             "--target-success needs --policies: a Generator that λ steers".into(),

@@ -205,6 +205,13 @@ impl Level {
         }
     }
 
+    pub fn racing(&self) -> Option<&racing::RacingTrack> {
+        match &self.track {
+            Track::Racing(track) => Some(track),
+            Track::Platform(_) => None,
+        }
+    }
+
     /// How many pieces (blocks or segments) the level has.
     pub fn piece_count(&self) -> usize {
         match &self.track {

@@ -1,9 +1,10 @@
 //! The designer's latencies, through its real path (pure update, worker threads, drawing on an
-//! 80×24 TestBackend), on the shipped policies: from the key that asks for a new level
-//! to the level drawn, to the first Solver statistics, and to 100 trials done.
+//! 80×24 TestBackend), on the shipped policies of each game (rules and the scripted player where
+//! a game ships none): from the key that asks for a new level to the level drawn, to the first
+//! Solver statistics, and to 100 trials done.
 //!
-//! Run with `cargo bench --bench designer`. Targets (issue 5): level on screen < 100 ms, first
-//! statistics < 300 ms, 100 trials < 2 s on 2 cores.
+//! Run with `cargo bench --bench designer`. Targets (issues 5 and 16): level on screen < 100 ms,
+//! first statistics < 300 ms, 100 trials < 2 s on 2 cores.
 
 use std::path::Path;
 use std::sync::mpsc::channel;
@@ -26,10 +27,18 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn main() {
     // SAFETY: first thing in main, before any other thread exists.
     unsafe { arlpcg::rl::threads::fix_thread_count() };
-    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
-    let (policies, info) = worker::load(&shipped).expect("the shipped policies load");
+    for game in [Game::Platform, Game::Racing] {
+        measure(game);
+    }
+}
+
+fn measure(game: Game) {
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("policies")
+        .join(game.name());
+    let (policies, info) = worker::load(&shipped, game).unwrap_or_default();
     println!(
-        "policies: Generator {}, Solver {}",
+        "{game}: Generator {}, Solver {}",
         info.generator
             .as_ref()
             .map_or("none (rules)", |p| p.card.training.mode.as_str()),
@@ -38,9 +47,11 @@ fn main() {
             .map_or("none (scripted)", |p| p.card.training.mode.as_str()),
     );
     let (tx, rx) = channel();
-    let workers = worker::Workers::start(policies, tx);
+    let mut shelf = worker::GamePolicies::default();
+    *shelf.of_mut(game) = policies;
+    let workers = worker::Workers::start(shelf, tx);
     let out = tempfile::tempdir().expect("a temporary folder");
-    let mut app = App::new(Game::Platform, info, 1, out.path().to_path_buf());
+    let mut app = App::new(game, info, 1, out.path().to_path_buf());
     let mut terminal = Terminal::new(TestBackend::new(80, 24)).expect("a test terminal");
     let (mut to_screen, mut to_stats, mut to_done) = (Vec::new(), Vec::new(), Vec::new());
     for round in 0..=LEVELS {

@@ -471,14 +471,7 @@ fn a_missing_level_file_is_named() {
 }
 
 #[test]
-fn bad_arguments_are_usage_errors() {
-    let out = arlpcg(&["generate", "--rules", "--out", "x", "--aux", "3"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(
-        stderr(&out).contains("aux 3 is out of range [-1, 1]"),
-        "{}",
-        stderr(&out)
-    );
+fn a_generator_of_the_other_game_is_refused_by_name() {
     let out = arlpcg(&[
         "generate",
         "--game",
@@ -490,9 +483,21 @@ fn bad_arguments_are_usage_errors() {
         "--out",
         "x",
     ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out)
+            .contains("this is a platform generator policy, expected a racing generator one"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn bad_arguments_are_usage_errors() {
+    let out = arlpcg(&["generate", "--rules", "--out", "x", "--aux", "3"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(
-        stderr(&out).contains("no racing Generator is trained yet; use --rules"),
+        stderr(&out).contains("aux 3 is out of range [-1, 1]"),
         "{}",
         stderr(&out)
     );

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use arlpcg::design::app::{self, App, Effect, GoalSetting, LoadedInfo, Message, Overlay, Response};
 use arlpcg::design::layout::Areas;
 use arlpcg::design::view;
-use arlpcg::design::worker::{self, Policies, Workers};
+use arlpcg::design::worker::{self, GamePolicies, Policies, Workers};
 use arlpcg::level::{Game, yaml};
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
@@ -20,17 +20,21 @@ use ratatui::crossterm::event::{
 /// A designer whose effects run inline, on `policies`.
 struct Harness {
     app: App,
-    policies: Mutex<Policies>,
+    policies: Mutex<GamePolicies>,
     pending: Vec<Effect>,
 }
 
 impl Harness {
+    /// A designer on the platform game with `policies` (racing: rules and the scripted driver).
     fn new(policies: Policies, info: LoadedInfo, out: &Path) -> Self {
         let mut app = App::new(Game::Platform, info, 1, out.to_path_buf());
         let pending = app.start();
         Self {
             app,
-            policies: Mutex::new(policies),
+            policies: Mutex::new(GamePolicies {
+                platform: policies,
+                racing: Policies::default(),
+            }),
             pending,
         }
     }
@@ -342,21 +346,73 @@ fn loading_a_wrong_file_is_a_message_not_a_crash() {
     assert_eq!(h.app.policies, LoadedInfo::default());
 }
 
+/// Tab switches to racing: a track of the same seed, its Solver statistics with the racing
+/// outcomes and air time, the top-down road and its elevation, a selected segment, a replayed
+/// run, the λ sweep, and an export that loads; Tab goes back to the platform level.
 #[test]
-fn racing_is_selectable_but_not_yet_available() {
+fn racing_tracks_are_designed_like_platform_levels() {
     let dir = tempfile::tempdir().unwrap();
     let mut h = Harness::rules(dir.path());
     h.settle();
+    let platform_level = h.app.level.clone();
     h.key(KeyCode::Tab);
     assert_eq!(h.app.game, Game::Racing);
+    h.settle();
+    let level = h.app.level.clone().expect("a racing track at once");
+    let expected = arlpcg::generation::rules_level(
+        Game::Racing,
+        1,
+        Some(1.0),
+        None,
+        arlpcg::eval::scene_obstacles(Game::Racing),
+    )
+    .unwrap();
+    assert_eq!(*level, expected, "the rules' track of the seed");
+    let trials = h.app.trials.as_ref().unwrap();
+    assert_eq!(trials.stats.as_ref().unwrap().trials, app::DEFAULT_TRIALS);
+    let screen = h.screen(100, 32);
+    for part in [
+        "top-down: ",
+        " segments, ",
+        "elevation: ",
+        "off road ",
+        "flipped ",
+        "air time ",
+        "Solver: scripted driver",
+        "failures per segment",
+    ] {
+        assert!(screen.contains(part), "{part} missing from\n{screen}");
+    }
+    h.key(KeyCode::Down);
+    assert_eq!(h.app.selected, Some(0));
+    assert!(h.screen(100, 32).contains("segment 0: "));
+    h.key(KeyCode::Char('r'));
+    h.settle();
+    let replay = h.app.replay.as_ref().expect("a recorded run");
+    assert!(replay.recording.path.len() > 10);
+    h.key(KeyCode::Char('w'));
+    h.settle();
+    let sweep = h.app.sweep.as_ref().unwrap();
     assert!(
-        h.screen(80, 24)
-            .contains("Racing: no racing Generator is trained yet")
+        sweep
+            .points
+            .iter()
+            .all(|(_, p)| matches!(p, app::SweepPoint::Success(_))),
+        "{:?}",
+        sweep.points
     );
-    h.key(KeyCode::Left);
-    assert!(h.pending.is_empty(), "nothing to generate for racing");
+    h.key(KeyCode::Char('x'));
+    h.settle();
+    let exported = yaml::load(&dir.path().join("racing/racing-seed1-aux+1.00.yaml")).unwrap();
+    assert_eq!(exported.racing(), level.racing());
+    gltf::Gltf::open(dir.path().join("racing/racing-seed1-aux+1.00.glb")).expect("a valid glb");
     h.key(KeyCode::Tab);
+    h.settle();
     assert_eq!(h.app.game, Game::Platform);
+    assert_eq!(
+        h.app.level, platform_level,
+        "the same platform level as before"
+    );
     h.key(KeyCode::Char('q'));
     assert!(h.app.quit);
 }
@@ -370,7 +426,7 @@ fn newer_requests_supersede_older_ones() {
     h.settle();
     let level = h.app.level.clone().unwrap();
     let (tx, rx) = std::sync::mpsc::channel();
-    let workers = Workers::start(Policies::default(), tx);
+    let workers = Workers::start(GamePolicies::default(), tx);
     workers.submit(Effect::Trials {
         id: 100,
         level,
@@ -380,6 +436,7 @@ fn newer_requests_supersede_older_ones() {
     std::thread::sleep(Duration::from_millis(50));
     workers.submit(Effect::Generate {
         id: 101,
+        game: Game::Platform,
         seed: 2,
         aux: 0.0,
         goal: None,
@@ -408,7 +465,8 @@ fn newer_requests_supersede_older_ones() {
 #[test]
 fn scripted_session_on_the_shipped_policies() {
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
-    let (policies, info) = worker::load(&shipped).expect("the shipped policies load");
+    let (policies, info) =
+        worker::load(&shipped, Game::Platform).expect("the shipped policies load");
     assert!(info.solver.is_some(), "a Solver is shipped");
     let dir = tempfile::tempdir().unwrap();
     let mut h = Harness::new(policies, info, dir.path());

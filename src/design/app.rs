@@ -157,6 +157,16 @@ impl Trials {
         (n > 0).then(|| self.results.iter().map(|r| r.progress).sum::<f64>() / n as f64)
     }
 
+    /// Racing: mean seconds per run with the car in the air so far (`None` on platform levels
+    /// and before the first trial).
+    pub fn mean_air_seconds(&self) -> Option<f64> {
+        let air: Vec<u32> = self.results.iter().filter_map(|r| r.air_steps).collect();
+        (!air.is_empty()).then(|| {
+            let dt = f64::from(crate::game::racing::car::DECISION_DT);
+            dt * air.iter().map(|&a| f64::from(a)).sum::<f64>() / air.len() as f64
+        })
+    }
+
     pub fn count(&self, outcome: Outcome) -> u32 {
         self.results.iter().filter(|r| r.outcome == outcome).count() as u32
     }
@@ -257,6 +267,7 @@ pub enum ExportOutcome {
 pub enum Effect {
     Generate {
         id: u64,
+        game: Game,
         seed: u64,
         aux: f64,
         goal: Option<[f64; 3]>,
@@ -274,6 +285,7 @@ pub enum Effect {
     },
     Sweep {
         id: u64,
+        game: Game,
         seed: u64,
         goal: Option<[f64; 3]>,
         auxes: Vec<f64>,
@@ -285,16 +297,18 @@ pub enum Effect {
         stem: String,
         overwrite: bool,
     },
-    Load {
-        path: PathBuf,
-    },
+    /// Policies of `game` from a folder or one file.
+    Load { path: PathBuf, game: Game },
 }
 
 /// Everything the designer shows and remembers.
 #[derive(Debug, Clone, PartialEq)]
 pub struct App {
     pub game: Game,
+    /// The policies of the game on screen...
     pub policies: LoadedInfo,
+    /// ...and of the other game (Tab swaps them).
+    pub other_policies: LoadedInfo,
     pub aux: f64,
     pub seed: u64,
     pub goal: GoalSetting,
@@ -331,6 +345,7 @@ impl App {
         Self {
             game,
             policies,
+            other_policies: LoadedInfo::default(),
             aux: 1.0,
             seed,
             goal: GoalSetting::FromSeed,
@@ -373,19 +388,34 @@ impl App {
     }
 
     fn generate(&mut self) -> Vec<Effect> {
-        if self.game != Game::Platform {
-            return Vec::new();
-        }
         let id = self.id();
         self.requested = id;
         self.replay = None;
         self.recording = None;
         vec![Effect::Generate {
             id,
+            game: self.game,
             seed: self.seed,
             aux: self.aux,
             goal: self.goal.position(),
         }]
+    }
+
+    /// Tab: the other game, with its own policies, from the same seed and λ (a goal set by hand
+    /// goes back to the seed's: the games' goals lie at different distances).
+    pub(super) fn switch_game(&mut self) -> Vec<Effect> {
+        self.game = match self.game {
+            Game::Platform => Game::Racing,
+            Game::Racing => Game::Platform,
+        };
+        std::mem::swap(&mut self.policies, &mut self.other_policies);
+        self.goal = GoalSetting::FromSeed;
+        self.level = None;
+        self.trials = None;
+        self.sweep = None;
+        self.selected = None;
+        self.generation_error = None;
+        self.generate()
     }
 
     fn set_aux(&mut self, aux: f64) -> Vec<Effect> {
@@ -457,6 +487,7 @@ impl App {
         self.panel = Panel::Sweep;
         vec![Effect::Sweep {
             id,
+            game: self.game,
             seed: self.seed,
             goal: self.goal.position(),
             auxes: SWEEP_AUX.to_vec(),
@@ -474,10 +505,25 @@ impl App {
             self.complain("the goal is drawn from the seed: press g to set it by hand");
             return Vec::new();
         };
-        use crate::game::rules::{GOAL_DISTANCE, GOAL_HEIGHT};
+        // Within the ranges the game's rules draw goals from.
+        let (distances, heights) = match self.game {
+            Game::Platform => (
+                crate::game::rules::GOAL_DISTANCE,
+                crate::game::rules::GOAL_HEIGHT,
+            ),
+            Game::Racing => (
+                crate::game::racing::rules::GOAL_DISTANCE,
+                crate::game::racing::rules::GOAL_HEIGHT,
+            ),
+        };
+        // Racing goals lie farther: its distance keys move 20 m, not 5.
+        let d_distance = match self.game {
+            Game::Platform => d_distance,
+            Game::Racing => 4.0 * d_distance,
+        };
         self.goal = GoalSetting::Custom {
-            distance: (distance + d_distance).clamp(GOAL_DISTANCE.0, GOAL_DISTANCE.1),
-            height: (height + d_height).clamp(GOAL_HEIGHT.0, GOAL_HEIGHT.1),
+            distance: (distance + d_distance).clamp(distances.0, distances.1),
+            height: (height + d_height).clamp(heights.0, heights.1),
             direction: crate::level::platform::wrap_degrees(direction + d_direction),
         };
         self.generate()

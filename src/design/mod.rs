@@ -21,7 +21,7 @@ use ratatui::crossterm::execute;
 
 use crate::level::Game;
 use app::{App, LoadedInfo, Message, Response};
-use worker::{Policies, Workers};
+use worker::{GamePolicies, Policies, Workers};
 
 /// Time between animation ticks.
 const TICK: Duration = Duration::from_millis(33);
@@ -36,18 +36,22 @@ pub struct DesignOptions {
     pub seed: u64,
 }
 
-/// The policies the designer starts on, and a note when it falls back to rules and the
-/// scripted controller.
-fn starting_policies(options: &DesignOptions) -> Result<(Policies, LoadedInfo, Option<String>)> {
-    match &options.policies {
+/// The policies the designer starts on for `game`, and a note when it falls back to rules and
+/// the scripted player. `--policies` is for the game the designer opens on; the other game
+/// starts on its shipped policies.
+fn starting_policies(
+    options: &DesignOptions,
+    game: Game,
+) -> Result<(Policies, LoadedInfo, Option<String>)> {
+    match options.policies.as_ref().filter(|_| game == options.game) {
         Some(path) => {
-            let (policies, info) =
-                worker::load(path).with_context(|| format!("--policies {}", path.display()))?;
+            let (policies, info) = worker::load(path, game)
+                .with_context(|| format!("--policies {}", path.display()))?;
             Ok((policies, info, None))
         }
         None => {
-            let shipped = PathBuf::from("policies").join(options.game.name());
-            match worker::load(&shipped) {
+            let shipped = PathBuf::from("policies").join(game.name());
+            match worker::load(&shipped, game) {
                 Ok((policies, info)) => Ok((policies, info, None)),
                 Err(e) => Ok((
                     Policies::default(),
@@ -63,10 +67,19 @@ fn starting_policies(options: &DesignOptions) -> Result<(Policies, LoadedInfo, O
 
 /// Runs the designer until the user quits.
 pub fn run(options: DesignOptions) -> Result<()> {
-    let (policies, info, note) = starting_policies(&options)?;
+    let (policies, info, note) = starting_policies(&options, options.game)?;
+    let other_game = match options.game {
+        Game::Platform => Game::Racing,
+        Game::Racing => Game::Platform,
+    };
+    let (other_policies, other_info, _) = starting_policies(&options, other_game)?;
+    let mut shelf = GamePolicies::default();
+    *shelf.of_mut(options.game) = policies;
+    *shelf.of_mut(other_game) = other_policies;
     let (answers, responses) = channel();
-    let workers = Workers::start(policies, answers);
+    let workers = Workers::start(shelf, answers);
     let mut app = App::new(options.game, info, options.seed, options.out);
+    app.other_policies = other_info;
     if let Some(note) = note {
         app.status = Some((note, true));
     }

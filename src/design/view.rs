@@ -13,8 +13,10 @@ use ratatui::widgets::{
 use super::app::{App, GoalSetting, Overlay, Panel, PolicyInfo, SweepPoint};
 use super::layout::{Areas, SLIDER_LEFT, SLIDER_RIGHT, fits};
 use crate::level::platform::{Platform, PlatformTrack, heading_direction};
+use crate::level::racing::{Obstacle, RacingTrack};
+use crate::level::road::{ROAD_WIDTH, Road};
 use crate::level::stats::Outcome;
-use crate::level::{Game, Level};
+use crate::level::{Game, Level, Track};
 use crate::rl::checkpoint::Role;
 
 /// The key map, as the help overlay and the README show it.
@@ -28,14 +30,14 @@ pub const KEYS: [(&str, &str); 20] = [
     ("n", "draw a new seed"),
     ("s", "type a seed"),
     ("g", "goal: from the seed / set by hand"),
-    ("d D", "goal distance -5 / +5 m (goal set by hand)"),
+    ("d D", "goal distance -5 / +5 m, racing 20 (goal by hand)"),
     ("h H", "goal height -1 / +1 m"),
     ("a A", "goal direction -15° / +15°"),
-    ("↑ ↓", "select a block (its parameters in the stats)"),
+    ("↑ ↓", "select a block/segment: its parameters in stats"),
     ("t", "Solver trials per level (default 100)"),
     ("r", "replay one Solver run on the map"),
     ("w", "λ sweep: success against λ for this seed and goal"),
-    ("v", "bottom-right panel: failures per block / λ sweep"),
+    ("v", "bottom-right panel: failures per piece / λ sweep"),
     ("x", "export YAML (with the Solver statistics) + .glb"),
     ("p", "load policies (a folder or one .safetensors file)"),
     ("c", "show the loaded policies' cards"),
@@ -59,26 +61,19 @@ pub fn render(app: &App, frame: &mut Frame) {
     let areas = Areas::of(screen);
     header(app, frame, areas.header);
     controls(app, frame, &areas);
-    match (app.game, app.level.as_deref()) {
-        (Game::Racing, _) => {
-            let text = "Racing: no racing Generator is trained yet, so the designer has no racing \
-                        view. Racing tracks are generated, verified and exported from the command \
-                        line: arlpcg generate --game racing --rules --verify 20 --out DIR (see the \
-                        README). Press Tab to return to the platform game.";
-            frame.render_widget(
-                Paragraph::new(text)
-                    .wrap(Wrap { trim: true })
-                    .block(Block::bordered().title(" racing ")),
-                areas.map,
-            );
-        }
-        (Game::Platform, Some(level)) => {
-            if let Some(track) = level.platform() {
+    match app.level.as_deref() {
+        Some(level) => match &level.track {
+            Track::Platform(track) => {
                 map(app, level, track, frame, areas.map);
                 profile(app, level, track, frame, areas.profile);
             }
-        }
-        (Game::Platform, None) => {
+            Track::Racing(track) => {
+                let road = track.road();
+                racing_map(app, level, track, &road, frame, areas.map);
+                racing_profile(app, level, &road, frame, areas.profile);
+            }
+        },
+        None => {
             let text = match &app.generation_error {
                 Some(problem) => problem.clone(),
                 None => "generating…".to_string(),
@@ -119,11 +114,21 @@ fn millions(steps: u64) -> String {
     }
 }
 
-/// What a policy's training budget counts: the Solver's steps, the Generator's blocks.
-fn budget_unit(role: Role) -> &'static str {
+/// What a policy's training budget counts: the Solver's steps, the Generator's pieces.
+fn budget_unit(role: Role, game: Game) -> &'static str {
     match role {
         Role::Solver => "steps",
-        Role::Generator => "blocks",
+        Role::Generator => piece_name(game, true),
+    }
+}
+
+/// What a piece of `game` is called.
+fn piece_name(game: Game, plural: bool) -> &'static str {
+    match (game, plural) {
+        (Game::Platform, false) => "block",
+        (Game::Platform, true) => "blocks",
+        (Game::Racing, false) => "segment",
+        (Game::Racing, true) => "segments",
     }
 }
 
@@ -145,7 +150,11 @@ fn header(app: &App, frame: &mut Frame, area: Rect) {
     let mode = |info: &Option<PolicyInfo>, none: &str| match info {
         Some(p) => {
             let t = &p.card.training;
-            let budget = format!(" {} {}", millions(t.steps), budget_unit(p.card.role));
+            let budget = format!(
+                " {} {}",
+                millions(t.steps),
+                budget_unit(p.card.role, p.card.game)
+            );
             (t.mode.clone(), budget)
         }
         None => (none.to_string(), String::new()),
@@ -386,7 +395,11 @@ fn profile(app: &App, level: &Level, track: &PlatformTrack, frame: &mut Frame, a
 }
 
 fn stats(app: &App, frame: &mut Frame, area: Rect) {
-    let solver = policy_label(&app.policies.solver, "scripted controller");
+    let scripted = match app.game {
+        Game::Platform => "scripted controller",
+        Game::Racing => "scripted driver",
+    };
+    let solver = policy_label(&app.policies.solver, scripted);
     let mut lines = Vec::new();
     match &app.trials {
         Some(t) => {
@@ -406,18 +419,33 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
                 None => lines.push(Line::from("success …")),
             }
             if let Some(progress) = t.mean_progress() {
-                lines.push(Line::from(format!(
-                    "progress {:.2}  fell {}  timeout {}",
-                    progress,
-                    t.count(Outcome::Fell),
-                    t.count(Outcome::TimedOut)
-                )));
+                lines.push(Line::from(match app.game {
+                    Game::Platform => format!(
+                        "progress {:.2}  fell {}  timeout {}",
+                        progress,
+                        t.count(Outcome::Fell),
+                        t.count(Outcome::TimedOut)
+                    ),
+                    Game::Racing => format!(
+                        "progress {:.2}  off road {}  flipped {}  timeout {}",
+                        progress,
+                        t.count(Outcome::OffRoad),
+                        t.count(Outcome::Flipped),
+                        t.count(Outcome::TimedOut)
+                    ),
+                }));
+            }
+            if let Some(air) = t.mean_air_seconds() {
+                lines.push(Line::from(format!("air time {air:.2} s per run")));
             }
         }
         None => lines.push(Line::from("no trials yet")),
     }
     if let Some(level) = &app.level {
         lines.push(Line::from(source_line(level)).dim());
+        if let Some(track) = level.racing() {
+            racing_stats(app, track, &mut lines);
+        }
         if let Some(track) = level.platform() {
             let blocks = track.block_params();
             let n = blocks.len().max(1) as f64;
@@ -458,6 +486,211 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
     );
 }
 
+/// The racing track's statistics and the selected segment, for the stats panel.
+fn racing_stats(app: &App, track: &RacingTrack, lines: &mut Vec<Line>) {
+    let segments = &track.segments;
+    let n = segments.len().max(1) as f64;
+    lines.push(Line::from(format!(
+        "mean curve {:.1}°, length {:.1} m, height {:.1} m",
+        segments.iter().map(|s| s.curve.abs()).sum::<f64>() / n,
+        segments.iter().map(|s| s.length).sum::<f64>() / n,
+        segments.iter().map(|s| s.height.abs()).sum::<f64>() / n,
+    )));
+    if let Some((i, s)) = app.selected.and_then(|i| segments.get(i).map(|s| (i, s))) {
+        let failures = app
+            .trials
+            .as_ref()
+            .map_or(0, |t| t.failures_by_block(segments.len())[i]);
+        lines.push(
+            Line::from(format!(
+                "segment {i}: {:.1} m, curve {:+.0}°, up {:+.1} m",
+                s.length, s.curve, s.height
+            ))
+            .cyan(),
+        );
+        lines.push(Line::from(format!("  {failures} runs failed on it")).cyan());
+    }
+}
+
+/// The colour of every racing segment: the selected one cyan, the others by their share of the
+/// failures so far.
+fn segment_colours(app: &App, segments: usize) -> Vec<Color> {
+    let failures = app
+        .trials
+        .as_ref()
+        .map(|t| t.failures_by_block(segments))
+        .unwrap_or_else(|| vec![0; segments]);
+    let most = failures.iter().copied().max().unwrap_or(0);
+    failures
+        .iter()
+        .enumerate()
+        .map(|(i, &f)| {
+            if app.selected == Some(i) {
+                Color::Cyan
+            } else if f == 0 {
+                Color::White
+            } else if f * 2 >= most {
+                Color::Red
+            } else {
+                Color::Yellow
+            }
+        })
+        .collect()
+}
+
+/// The footprint of an obstacle, `[x, z]` corners (a cylinder as a 12-gon).
+fn obstacle_outline(obstacle: &Obstacle) -> Vec<[f64; 2]> {
+    match *obstacle {
+        Obstacle::Box {
+            position,
+            size,
+            heading,
+        } => {
+            let [fx, fz] = heading_direction(heading);
+            let (hx, hz) = (size[0] / 2.0, size[2] / 2.0);
+            [(-hx, -hz), (hx, -hz), (hx, hz), (-hx, hz)]
+                .map(|(a, b)| [position[0] + a * fx - b * fz, position[2] + a * fz + b * fx])
+                .to_vec()
+        }
+        Obstacle::Cylinder {
+            position, radius, ..
+        } => (0..12)
+            .map(|k| {
+                let t = k as f64 * std::f64::consts::TAU / 12.0;
+                [
+                    position[0] + radius * t.cos(),
+                    position[2] + radius * t.sin(),
+                ]
+            })
+            .collect(),
+    }
+}
+
+/// The racing track from above: the road's edges (coloured by the failures on each segment),
+/// its banked stretches (blue dots on the centre line: the steeper the bank, the denser),
+/// obstacles, start, goal and a replayed run.
+fn racing_map(
+    app: &App,
+    level: &Level,
+    track: &RacingTrack,
+    road: &Road,
+    frame: &mut Frame,
+    area: Rect,
+) {
+    let colours = segment_colours(app, track.segments.len());
+    let half = 0.5 * ROAD_WIDTH;
+    let edges: Vec<([f64; 3], [f64; 3], usize, f64)> = road
+        .samples()
+        .iter()
+        .map(|p| (p.across(half), p.across(-half), p.segment, p.bank))
+        .collect();
+    let mut points: Vec<[f64; 2]> = edges
+        .iter()
+        .flat_map(|(l, r, ..)| [[l[0], l[2]], [r[0], r[2]]])
+        .collect();
+    points.push([level.goal[0], level.goal[2]]);
+    let outlines: Vec<Vec<[f64; 2]>> = track.obstacles.iter().map(obstacle_outline).collect();
+    points.extend(outlines.iter().flatten());
+    let (x_bounds, y_bounds) = bounds(&points, area, 5.0);
+    let title = format!(
+        " top-down: {} segments, {:.0} m of road, goal {:.0} m ",
+        track.segments.len(),
+        road.length(),
+        level.goal[0].hypot(level.goal[2])
+    );
+    let canvas = Canvas::default()
+        .block(Block::bordered().title(title))
+        .marker(Marker::Braille)
+        .x_bounds(x_bounds)
+        .y_bounds(y_bounds)
+        .paint(|ctx| {
+            for outline in &outlines {
+                for k in 0..outline.len() {
+                    let (a, b) = (outline[k], outline[(k + 1) % outline.len()]);
+                    ctx.draw(&CanvasLine::new(a[0], a[1], b[0], b[1], Color::DarkGray));
+                }
+            }
+            for pair in edges.windows(2) {
+                let (a, b) = (&pair[0], &pair[1]);
+                let colour = colours.get(b.2).copied().unwrap_or(Color::White);
+                ctx.draw(&CanvasLine::new(a.0[0], a.0[2], b.0[0], b.0[2], colour));
+                ctx.draw(&CanvasLine::new(a.1[0], a.1[2], b.1[0], b.1[2], colour));
+            }
+            let banked: Vec<(f64, f64)> = road
+                .samples()
+                .iter()
+                .enumerate()
+                .filter(|(i, p)| {
+                    let degrees = p.bank.abs().to_degrees();
+                    degrees >= 10.0 || (degrees >= 4.0 && i % 2 == 0)
+                })
+                .map(|(_, p)| (p.centre[0], p.centre[2]))
+                .collect();
+            ctx.draw(&Points {
+                coords: &banked,
+                color: Color::LightBlue,
+            });
+            draw_replay(app, ctx, |f| [f[0] as f64, f[2] as f64]);
+            ctx.print(level.goal[0], level.goal[2], "G".green().bold());
+            ctx.print(track.position[0], track.position[2], "S".blue().bold());
+        });
+    frame.render_widget(canvas, area);
+}
+
+/// The road's elevation along its length, coloured by the failures on each segment, with its
+/// crests marked `^` (where the car may leave the ground).
+fn racing_profile(app: &App, level: &Level, road: &Road, frame: &mut Frame, area: Rect) {
+    let samples = road.samples();
+    let colours = segment_colours(app, road.segment_count());
+    let length = road.length();
+    let (mut lo, mut hi) = (level.goal[1].min(0.0), level.goal[1].max(0.0));
+    for p in samples {
+        lo = lo.min(p.centre[1]);
+        hi = hi.max(p.centre[1]);
+    }
+    // A crest: the slope turns from climbing to falling, and the road drops at least 1 m within
+    // 15 m either side.
+    let crests: Vec<&crate::level::road::RoadSample> = samples
+        .windows(2)
+        .filter(|w| w[0].slope > 0.0 && w[1].slope <= 0.0)
+        .map(|w| &w[1])
+        .filter(|p| {
+            let near = samples.iter().filter(|q| (q.s - p.s).abs() <= 15.0);
+            near.map(|q| p.centre[1] - q.centre[1]).fold(0.0, f64::max) >= 1.0
+        })
+        .collect();
+    let canvas = Canvas::default()
+        .block(Block::bordered().title(format!(
+            " elevation: {length:.0} m of road, {:+.0} m to climb, {} crests ",
+            level.goal[1],
+            crests.len()
+        )))
+        .marker(Marker::Braille)
+        .x_bounds([-5.0, length + 5.0])
+        .y_bounds([lo - 2.0, hi + 2.0])
+        .paint(|ctx| {
+            for w in samples.windows(2) {
+                let colour = colours.get(w[1].segment).copied().unwrap_or(Color::White);
+                ctx.draw(&CanvasLine::new(
+                    w[0].s,
+                    w[0].centre[1],
+                    w[1].s,
+                    w[1].centre[1],
+                    colour,
+                ));
+            }
+            draw_replay(app, ctx, |f| {
+                let at = [f[0] as f64, f[1] as f64, f[2] as f64];
+                [samples[road.nearest(at, None, 0)].s, f[1] as f64]
+            });
+            for p in &crests {
+                ctx.print(p.s, p.centre[1] + 0.8, "^".yellow());
+            }
+            ctx.print(length, level.goal[1] + 1.0, "G".green().bold());
+        });
+    frame.render_widget(canvas, area);
+}
+
 fn source_line(level: &Level) -> String {
     match &level.source {
         crate::level::Source::Policy { .. } => "Generator level".into(),
@@ -469,7 +702,10 @@ fn source_line(level: &Level) -> String {
 }
 
 fn failures(app: &App, frame: &mut Frame, area: Rect) {
-    let block = Block::bordered().title(" failures per block (v: sweep) ");
+    let block = Block::bordered().title(format!(
+        " failures per {} (v: sweep) ",
+        piece_name(app.game, false)
+    ));
     let (Some(level), Some(trials)) = (&app.level, &app.trials) else {
         frame.render_widget(block, area);
         return;
@@ -609,7 +845,7 @@ fn overlay(app: &App, frame: &mut Frame, screen: Rect) {
                             p.card.role,
                             t.mode,
                             t.steps,
-                            budget_unit(p.card.role),
+                            budget_unit(p.card.role, p.card.game),
                             t.wall_time_s / 60.0,
                             t.seed
                         )));

@@ -19,11 +19,34 @@ use crate::policies::{load_generator, load_solver, policy_paths};
 use crate::rl::checkpoint::PolicyError;
 use crate::verify::{self, Solver, SolverPolicy, Watch};
 
-/// The policies in use; either may be missing (rule levels; the scripted controller).
+/// The policies of one game in use; either may be missing (rule levels; the scripted player).
 #[derive(Default, Clone)]
 pub struct Policies {
     pub generator: Option<Arc<GeneratorPolicy>>,
     pub solver: Option<Arc<SolverPolicy>>,
+}
+
+/// The policies of each game.
+#[derive(Default, Clone)]
+pub struct GamePolicies {
+    pub platform: Policies,
+    pub racing: Policies,
+}
+
+impl GamePolicies {
+    pub fn of(&self, game: Game) -> &Policies {
+        match game {
+            Game::Platform => &self.platform,
+            Game::Racing => &self.racing,
+        }
+    }
+
+    pub fn of_mut(&mut self, game: Game) -> &mut Policies {
+        match game {
+            Game::Platform => &mut self.platform,
+            Game::Racing => &mut self.racing,
+        }
+    }
 }
 
 impl Policies {
@@ -34,24 +57,33 @@ impl Policies {
         }
     }
 
-    /// A level at `aux` for `seed` toward `goal`: the Generator's, or the rules' without one.
-    pub fn level(&self, seed: u64, aux: f64, goal: Option<[f64; 3]>) -> Result<Level, String> {
+    /// A level of `game` at `aux` for `seed` toward `goal`: the Generator's, or the rules'
+    /// without one; racing scenes hold the obstacles evaluation scenes hold.
+    pub fn level(
+        &self,
+        game: Game,
+        seed: u64,
+        aux: f64,
+        goal: Option<[f64; 3]>,
+    ) -> Result<Level, String> {
+        let obstacles = crate::eval::scene_obstacles(game);
         match &self.generator {
-            Some(generator) => generation::generator_level(generator, seed, aux, goal, 0)
+            Some(generator) => generation::generator_level(generator, seed, aux, goal, obstacles)
                 .map_err(|e| e.to_string()),
-            None => generation::rules_level(Game::Platform, seed, Some(aux), goal, 0)
+            None => generation::rules_level(game, seed, Some(aux), goal, obstacles)
                 .map_err(|e| e.to_string()),
         }
     }
 }
 
-/// Loads the policies at `path`: a folder (its generator.safetensors and solver.safetensors,
-/// whichever exist) or one policy file (a Generator or a Solver, from its card).
-pub fn load(path: &Path) -> Result<(Policies, LoadedInfo)> {
+/// Loads the policies of `game` at `path`: a folder (its generator.safetensors and
+/// solver.safetensors, whichever exist) or one policy file (a Generator or a Solver, from its
+/// card).
+pub fn load(path: &Path, game: Game) -> Result<(Policies, LoadedInfo)> {
     let mut policies = Policies::default();
     let mut info = LoadedInfo::default();
     let mut load_generator_at = |p: &Path, policies: &mut Policies| -> Result<()> {
-        let (generator, card) = load_generator(p, Game::Platform)?;
+        let (generator, card) = load_generator(p, game)?;
         policies.generator = Some(Arc::new(generator));
         info.generator = Some(PolicyInfo {
             path: p.to_path_buf(),
@@ -73,7 +105,7 @@ pub fn load(path: &Path) -> Result<(Policies, LoadedInfo)> {
             load_generator_at(&generator, &mut policies)?;
         }
         if solver.exists() {
-            let (policy, card) = load_solver(&solver, Game::Platform)?;
+            let (policy, card) = load_solver(&solver, game)?;
             policies.solver = Some(Arc::new(policy));
             info.solver = Some(PolicyInfo { path: solver, card });
         }
@@ -82,7 +114,7 @@ pub fn load(path: &Path) -> Result<(Policies, LoadedInfo)> {
     match load_generator_at(path, &mut policies) {
         Ok(()) => Ok((policies, info)),
         Err(e) if matches!(e.downcast_ref(), Some(PolicyError::WrongKind { .. })) => {
-            let (policy, card) = load_solver(path, Game::Platform)?;
+            let (policy, card) = load_solver(path, game)?;
             policies.solver = Some(Arc::new(policy));
             info.solver = Some(PolicyInfo {
                 path: path.to_path_buf(),
@@ -134,7 +166,7 @@ pub struct Workers {
 
 impl Workers {
     /// Starts the workers on `policies`; their answers go to `answers`.
-    pub fn start(policies: Policies, answers: Sender<Response>) -> Self {
+    pub fn start(policies: GamePolicies, answers: Sender<Response>) -> Self {
         let policies = Arc::new(Mutex::new(policies));
         let latest = Arc::new(Latest::default());
         let spawn = |name: &str| {
@@ -168,7 +200,7 @@ impl Workers {
     }
 }
 
-type SharedPolicies = Mutex<Policies>;
+type SharedPolicies = Mutex<GamePolicies>;
 
 fn serve(
     requests: Receiver<Effect>,
@@ -197,20 +229,21 @@ fn serve(
 /// says so. The worker threads call it; tests call it inline.
 pub fn perform(
     effect: Effect,
-    policies: &Mutex<Policies>,
+    policies: &Mutex<GamePolicies>,
     stop: &(dyn Fn() -> bool + Sync),
     send: &(dyn Fn(Response) + Sync),
 ) {
-    let current = policies.lock().map(|p| p.clone()).unwrap_or_default();
+    let shelf = policies.lock().map(|p| p.clone()).unwrap_or_default();
     match effect {
         Effect::Generate {
             id,
+            game,
             seed,
             aux,
             goal,
         } => send(Response::Level {
             id,
-            result: current.level(seed, aux, goal).map(Arc::new),
+            result: shelf.of(game).level(game, seed, aux, goal).map(Arc::new),
         }),
         Effect::Trials {
             id,
@@ -228,6 +261,7 @@ pub fn perform(
                 on_trial: &on_trial,
                 stop,
             };
+            let current = shelf.of(level.game());
             match verify::verify_watched(&level, &current.solver(), trials, seed, &watch) {
                 Ok(Some(stats)) => send(Response::TrialsDone {
                     id,
@@ -242,22 +276,24 @@ pub fn perform(
         }
         Effect::Record { id, level, seed } => send(Response::Recorded {
             id,
-            result: verify::record(&level, &current.solver(), seed)
+            result: verify::record(&level, &shelf.of(level.game()).solver(), seed)
                 .map(Box::new)
                 .map_err(|e| e.to_string()),
         }),
         Effect::Sweep {
             id,
+            game,
             seed,
             goal,
             auxes,
             trials,
         } => {
+            let current = shelf.of(game);
             for (index, aux) in auxes.into_iter().enumerate() {
                 if stop() {
                     return;
                 }
-                let point = match current.level(seed, aux, goal) {
+                let point = match current.level(game, seed, aux, goal) {
                     Ok(level) => {
                         let watch = Watch {
                             on_trial: &|_| {},
@@ -286,13 +322,14 @@ pub fn perform(
             stem,
             overwrite,
         } => send(Response::Exported(export(&level, &dir, &stem, overwrite))),
-        Effect::Load { path } => send(Response::Loaded(match load(&path) {
+        Effect::Load { path, game } => send(Response::Loaded(match load(&path, game) {
             Ok((loaded, info)) => {
                 // A single file replaces only its own role.
                 if let Ok(mut shared) = policies.lock() {
-                    *shared = Policies {
-                        generator: loaded.generator.or(shared.generator.clone()),
-                        solver: loaded.solver.or(shared.solver.clone()),
+                    let old = shared.of_mut(game);
+                    *old = Policies {
+                        generator: loaded.generator.or(old.generator.clone()),
+                        solver: loaded.solver.or(old.solver.clone()),
                     };
                 }
                 Ok(Box::new(info))

@@ -34,7 +34,6 @@ impl App {
             }
         }
         self.status = None;
-        let platform = self.game == Game::Platform;
         match key.code {
             KeyCode::Char('q') | KeyCode::Esc => {
                 self.quit = true;
@@ -48,22 +47,7 @@ impl App {
                 self.overlay = Overlay::Cards;
                 Vec::new()
             }
-            KeyCode::Tab => {
-                self.game = match self.game {
-                    Game::Platform => Game::Racing,
-                    Game::Racing => Game::Platform,
-                };
-                if platform {
-                    self.complain("racing: no racing Generator is trained yet; Tab goes back");
-                    Vec::new()
-                } else {
-                    self.generate()
-                }
-            }
-            _ if !platform => {
-                self.complain("racing is not available yet: Tab returns to the platform game");
-                Vec::new()
-            }
+            KeyCode::Tab => self.switch_game(),
             KeyCode::Left => self.set_aux(self.aux - AUX_STEP),
             KeyCode::Right => self.set_aux(self.aux + AUX_STEP),
             KeyCode::Home => self.set_aux(-1.0),
@@ -158,6 +142,7 @@ impl App {
                 self.say(format!("loading {text}"));
                 vec![Effect::Load {
                     path: PathBuf::from(text),
+                    game: self.game,
                 }]
             }
         }

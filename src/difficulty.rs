@@ -60,7 +60,8 @@ pub fn measure(
         let mut count = 0;
         for k in 0..CURVE_LEVELS as u64 {
             let seed = CURVE_SEED_BASE + k;
-            match generation::generator_level(generator, seed, aux, None, 0) {
+            let obstacles = crate::eval::scene_obstacles(generator.game);
+            match generation::generator_level(generator, seed, aux, None, obstacles) {
                 Ok(level) => {
                     total += verify(&level, solver, CURVE_TRIALS, seed, &|| {})?.success_ratio;
                     count += 1;
@@ -124,14 +125,16 @@ pub fn level_for(
 ) -> Result<Level, TargetError> {
     let mut aux = curve.aux_for(target);
     let mut closest = (f64::INFINITY, f64::NAN, aux);
+    let obstacles = crate::eval::scene_obstacles(generator.game);
     for draw in 0..MAX_CANDIDATES {
         let quantized = (aux * 1000.0).round() / 1000.0;
-        let mut level =
-            match generation::generator_level_draw(generator, seed, quantized, goal, 0, draw) {
-                Ok(level) => level,
-                Err(GenerationError::NoLevel { .. }) => continue,
-                Err(e) => return Err(e.into()),
-            };
+        let mut level = match generation::generator_level_draw(
+            generator, seed, quantized, goal, obstacles, draw,
+        ) {
+            Ok(level) => level,
+            Err(GenerationError::NoLevel { .. }) => continue,
+            Err(e) => return Err(e.into()),
+        };
         let stats = verify(&level, solver, trials, seed, &|| {})?;
         let miss = stats.success_ratio - target;
         if miss.abs() < closest.0 {

@@ -82,6 +82,44 @@ pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, Polic
     ))
 }
 
+/// The file beside a policies folder's Generator that holds its λ→success curve.
+pub const CURVE_FILE: &str = "difficulty-curve.yaml";
+
+/// The λ→success curve of `generator` with `solver`, kept in `dir` ([`CURVE_FILE`]): read when
+/// it was measured with these two policies (by SHA-256), else measured (`on_measure` is told
+/// first: it takes a while) and kept there when the folder can be written.
+pub fn difficulty_curve(
+    dir: &Path,
+    generator: &GeneratorPolicy,
+    solver: &SolverPolicy,
+    on_measure: impl FnOnce(),
+) -> Result<crate::difficulty::Curve> {
+    let path = dir.join(CURVE_FILE);
+    let current = |c: &crate::difficulty::Curve| {
+        c.generator_sha256 == generator.reference.sha256
+            && c.solver_sha256 == solver.reference.sha256
+    };
+    if let Ok(bytes) = crate::fsio::read_limited(&path, 1 << 20, "difficulty curve")
+        && let Ok(curve) = serde_yaml::from_slice::<crate::difficulty::Curve>(&bytes)
+        && current(&curve)
+    {
+        return Ok(curve);
+    }
+    on_measure();
+    let curve = crate::difficulty::measure(
+        generator,
+        &crate::verify::Solver::Policy(solver),
+        &solver.reference.sha256,
+    )?;
+    // A folder that cannot be written only costs a new measurement next time.
+    let _ = crate::fsio::write_atomic(
+        &path,
+        serde_yaml::to_string(&curve)?.as_bytes(),
+        crate::fsio::Overwrite::Allowed,
+    );
+    Ok(curve)
+}
+
 /// The paths of the Generator and the Solver in a policies folder.
 pub fn policy_paths(dir: &Path) -> (PathBuf, PathBuf) {
     (dir.join(GENERATOR_FILE), dir.join(SOLVER_FILE))

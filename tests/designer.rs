@@ -506,3 +506,42 @@ fn scripted_session_on_the_shipped_policies() {
     assert_eq!(level.seed, Some(1));
     assert!(matches!(h.app.status, Some((ref t, false)) if t.contains("exported")));
 }
+
+/// Target-success mode: the designer asks for 60%, the search finds a level, the slider shows
+/// the λ it used, and the Solver's measured success on screen is within ±0.1 of the target;
+/// moving the slider leaves the mode. Without a Generator the mode is refused with a reason.
+#[test]
+fn target_success_mode_finds_a_level_in_band() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rules = Harness::rules(dir.path());
+    rules.settle();
+    rules.key(KeyCode::Char('T'));
+    rules.keys("0.6");
+    rules.key(KeyCode::Enter);
+    assert!(rules.pending.is_empty());
+    let (text, is_error) = rules.app.status.clone().unwrap();
+    assert!(is_error && text.contains("needs a Generator"), "{text}");
+
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    let (policies, info) = worker::load(&shipped, Game::Platform).unwrap();
+    let mut h = Harness::new(policies, info, dir.path());
+    h.settle();
+    h.key(KeyCode::Char('T'));
+    h.keys("0.6");
+    h.key(KeyCode::Enter);
+    assert!(matches!(h.pending[..], [Effect::Target { target, .. }] if target == 0.6));
+    h.settle();
+    let level = h.app.level.clone().expect("a level in the band");
+    assert_eq!(
+        h.app.aux,
+        level.aux.unwrap(),
+        "the slider shows the λ found"
+    );
+    let trials = h.app.trials.as_ref().unwrap();
+    let (success, _) = trials.success().unwrap();
+    assert!((success - 0.6).abs() <= 0.1 + 1e-9, "measured {success}");
+    assert!(h.screen(80, 24).contains("for success 0.60"));
+    h.key(KeyCode::Right);
+    assert_eq!(h.app.target, None, "the slider leaves target mode");
+    assert!(matches!(h.pending[..], [Effect::Generate { .. }]));
+}

@@ -1,7 +1,6 @@
 //! `arlpcg generate`: levels from a trained Generator or from the rules, optionally verified by
 //! the Solver, written as files named after game, seed and aux.
 
-use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -80,9 +79,16 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     // on the number of threads.
     let who = solver.as_ref().map_or(Solver::Scripted, Solver::Policy);
     let curve = match (args.target_success, &generator, &solver, &args.policies) {
-        (Some(_), Some(generator), Some(solver), Some(dir)) => {
-            Some(difficulty_curve(dir, generator, solver)?)
-        }
+        (Some(_), Some(generator), Some(solver), Some(dir)) => Some(
+            crate::policies::difficulty_curve(dir, generator, solver, || {
+                eprintln!(
+                    "measuring the policies' λ→success curve ({} λ values × {} levels × {} runs), once",
+                    difficulty::CURVE_AUX.len(),
+                    difficulty::CURVE_LEVELS,
+                    difficulty::CURVE_TRIALS
+                )
+            })?,
+        ),
         _ => None,
     };
     let bar = crate::shell::progress_bar(plans.len() as u64, "generating");
@@ -205,41 +211,6 @@ fn certified(mut level: Level, solver: &Solver, seed: u64) -> Result<Level> {
     }
     Ok(level)
 }
-
-/// The λ→success curve of the policies in `dir`: read from `difficulty-curve.yaml` when it was
-/// measured with these very policies, else measured now and kept there.
-fn difficulty_curve(
-    dir: &Path,
-    generator: &GeneratorPolicy,
-    solver: &SolverPolicy,
-) -> Result<difficulty::Curve> {
-    let path = dir.join(CURVE_FILE);
-    let current = |c: &difficulty::Curve| {
-        c.generator_sha256 == generator.reference.sha256
-            && c.solver_sha256 == solver.reference.sha256
-    };
-    if let Ok(bytes) = fsio::read_limited(&path, 1 << 20, "difficulty curve")
-        && let Ok(curve) = serde_yaml::from_slice::<difficulty::Curve>(&bytes)
-        && current(&curve)
-    {
-        return Ok(curve);
-    }
-    eprintln!(
-        "measuring the policies' λ→success curve ({} λ values × {} levels × {} runs), once",
-        difficulty::CURVE_AUX.len(),
-        difficulty::CURVE_LEVELS,
-        difficulty::CURVE_TRIALS
-    );
-    let curve = difficulty::measure(generator, &Solver::Policy(solver), &solver.reference.sha256)?;
-    let text = serde_yaml::to_string(&curve)?;
-    if let Err(e) = fsio::write_atomic(&path, text.as_bytes(), Overwrite::Allowed) {
-        eprintln!("note: could not keep the curve beside the policies: {e:#}");
-    }
-    Ok(curve)
-}
-
-/// The file beside a policies folder's Generator that holds its λ→success curve.
-pub const CURVE_FILE: &str = "difficulty-curve.yaml";
 
 /// A level's file name: game, seed and λ, or the success rate asked for.
 fn stem(args: &GenerateArgs, seed: u64) -> String {

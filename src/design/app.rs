@@ -85,6 +85,7 @@ pub enum PromptKind {
     Seed,
     Trials,
     Policies,
+    Target,
 }
 
 impl PromptKind {
@@ -92,6 +93,7 @@ impl PromptKind {
         match self {
             PromptKind::Seed => "seed",
             PromptKind::Trials => "Solver trials per level",
+            PromptKind::Target => "target success rate, 0.05-0.95 (empty: back to the λ slider)",
             PromptKind::Policies => "policies folder, or a Generator/Solver .safetensors file",
         }
     }
@@ -299,6 +301,16 @@ pub enum Effect {
     },
     /// Policies of `game` from a folder or one file.
     Load { path: PathBuf, game: Game },
+    /// A level of `game` whose success, measured with `trials` runs, is within ±0.1 of `target`
+    /// (the search of `generate --target-success`).
+    Target {
+        id: u64,
+        game: Game,
+        seed: u64,
+        goal: Option<[f64; 3]>,
+        target: f64,
+        trials: u32,
+    },
 }
 
 /// Everything the designer shows and remembers.
@@ -310,6 +322,8 @@ pub struct App {
     /// ...and of the other game (Tab swaps them).
     pub other_policies: LoadedInfo,
     pub aux: f64,
+    /// Target-success mode: the success rate asked for (λ follows the level found).
+    pub target: Option<f64>,
     pub seed: u64,
     pub goal: GoalSetting,
     pub trials_wanted: u32,
@@ -347,6 +361,7 @@ impl App {
             policies,
             other_policies: LoadedInfo::default(),
             aux: 1.0,
+            target: None,
             seed,
             goal: GoalSetting::FromSeed,
             trials_wanted: DEFAULT_TRIALS,
@@ -392,6 +407,16 @@ impl App {
         self.requested = id;
         self.replay = None;
         self.recording = None;
+        if let Some(target) = self.target {
+            return vec![Effect::Target {
+                id,
+                game: self.game,
+                seed: self.seed,
+                goal: self.goal.position(),
+                target,
+                trials: self.trials_wanted,
+            }];
+        }
         vec![Effect::Generate {
             id,
             game: self.game,
@@ -420,10 +445,30 @@ impl App {
 
     fn set_aux(&mut self, aux: f64) -> Vec<Effect> {
         let aux = (aux.clamp(-1.0, 1.0) * 100.0).round() / 100.0;
-        if aux == self.aux {
+        if aux == self.aux && self.target.is_none() {
             return Vec::new();
         }
+        // Moving the slider leaves target-success mode.
+        self.target = None;
         self.aux = aux;
+        self.generate()
+    }
+
+    /// Target-success mode on (`Some`) or off: a Generator is needed to steer.
+    pub(super) fn set_target(&mut self, target: Option<f64>) -> Vec<Effect> {
+        if target.is_some() && self.policies.generator.is_none() {
+            self.complain(
+                "a success target needs a Generator (p loads one): rule levels have no λ to steer",
+            );
+            return Vec::new();
+        }
+        self.target = target;
+        if let Some(p) = target {
+            self.say(format!(
+                "searching λ for success {p:.2} ± 0.1 ({} runs a candidate)",
+                self.trials_wanted
+            ));
+        }
         self.generate()
     }
 
@@ -592,6 +637,10 @@ impl App {
                     Ok(level) => {
                         self.generation_error = None;
                         self.selected = self.selected.filter(|&i| i < level.piece_count());
+                        // In target-success mode the slider shows the λ the search found.
+                        if let (Some(_), Some(aux)) = (self.target, level.aux) {
+                            self.aux = aux;
+                        }
                         self.level = Some(level);
                         self.start_trials()
                     }

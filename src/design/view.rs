@@ -20,7 +20,7 @@ use crate::level::{Game, Level, Track};
 use crate::rl::checkpoint::Role;
 
 /// The key map, as the help overlay and the README show it.
-pub const KEYS: [(&str, &str); 20] = [
+pub const KEYS: [(&str, &str); 21] = [
     (
         "← →  (mouse: click/drag)",
         "λ down/up by 0.1 (-1 hard ... +1 easy)",
@@ -35,6 +35,7 @@ pub const KEYS: [(&str, &str); 20] = [
     ("a A", "goal direction -15° / +15°"),
     ("↑ ↓", "select a block/segment: its parameters in stats"),
     ("t", "Solver trials per level (default 100)"),
+    ("T", "target success rate: λ is searched for it"),
     ("r", "replay one Solver run on the map"),
     ("w", "λ sweep: success against λ for this seed and goal"),
     ("v", "bottom-right panel: failures per piece / λ sweep"),
@@ -186,12 +187,18 @@ fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
             std::cmp::Ordering::Greater => '─',
         })
         .collect();
-    let slider = Line::from(vec![
+    let mut slider = Line::from(vec![
         Span::raw(SLIDER_LEFT).red(),
         Span::styled(track, Style::new().fg(Color::Cyan)),
         Span::raw(SLIDER_RIGHT).green(),
         Span::styled(format!("  λ {:+.2}", app.aux), Style::new().bold()),
     ]);
+    if let Some(target) = app.target {
+        slider.push_span(Span::styled(
+            format!(" for success {target:.2}"),
+            Style::new().fg(Color::Cyan),
+        ));
+    }
     let row = Rect {
         width: areas.controls.width.saturating_sub(2),
         x: areas.controls.x + 1,

@@ -139,7 +139,9 @@ enum Slot {
 
 fn slot(effect: &Effect) -> (Slot, u64) {
     match effect {
-        Effect::Generate { id, .. } | Effect::Trials { id, .. } => (Slot::Level, *id),
+        Effect::Generate { id, .. } | Effect::Target { id, .. } | Effect::Trials { id, .. } => {
+            (Slot::Level, *id)
+        }
         Effect::Record { id, .. } => (Slot::Record, *id),
         Effect::Sweep { id, .. } => (Slot::Sweep, *id),
         Effect::Export { .. } | Effect::Load { .. } => (Slot::Always, 0),
@@ -322,6 +324,17 @@ pub fn perform(
             stem,
             overwrite,
         } => send(Response::Exported(export(&level, &dir, &stem, overwrite))),
+        Effect::Target {
+            id,
+            game,
+            seed,
+            goal,
+            target,
+            trials,
+        } => send(Response::Level {
+            id,
+            result: target_level(shelf.of(game), seed, goal, target, trials).map(Arc::new),
+        }),
         Effect::Load { path, game } => send(Response::Loaded(match load(&path, game) {
             Ok((loaded, info)) => {
                 // A single file replaces only its own role.
@@ -337,6 +350,40 @@ pub fn perform(
             Err(e) => Err(format!("{e:#}")),
         })),
     }
+}
+
+/// The target-success search of `generate --target-success` with the designer's policies: the
+/// λ→success curve is read from (or, the first time, measured into) the Generator's folder.
+fn target_level(
+    policies: &Policies,
+    seed: u64,
+    goal: Option<[f64; 3]>,
+    target: f64,
+    trials: u32,
+) -> Result<Level, String> {
+    let generator = policies
+        .generator
+        .as_deref()
+        .ok_or("a success target needs a Generator")?;
+    let solver = policies
+        .solver
+        .as_deref()
+        .ok_or("a success target needs a trained Solver to measure success with (p loads one)")?;
+    let folder = Path::new(&generator.reference.path)
+        .parent()
+        .unwrap_or(Path::new("."));
+    let curve = crate::policies::difficulty_curve(folder, generator, solver, || {})
+        .map_err(|e| format!("{e:#}"))?;
+    crate::difficulty::level_for(
+        generator,
+        &Solver::Policy(solver),
+        &curve,
+        seed,
+        goal,
+        target,
+        trials,
+    )
+    .map_err(|e| e.to_string())
 }
 
 /// Writes the level's YAML and `.glb` into `dir` as `stem.*`, unless one exists and `overwrite`

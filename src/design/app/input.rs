@@ -59,6 +59,7 @@ impl App {
             }
             KeyCode::Char('s') => self.open_prompt(PromptKind::Seed),
             KeyCode::Char('t') => self.open_prompt(PromptKind::Trials),
+            KeyCode::Char('T') => self.open_prompt(PromptKind::Target),
             KeyCode::Char('p') => self.open_prompt(PromptKind::Policies),
             KeyCode::Char('g') => self.toggle_goal(),
             KeyCode::Char('d') => self.adjust_goal(-5.0, 0.0, 0.0),
@@ -93,6 +94,7 @@ impl App {
         let text = match kind {
             PromptKind::Seed => self.seed.to_string(),
             PromptKind::Trials => self.trials_wanted.to_string(),
+            PromptKind::Target => self.target.map_or(String::new(), |t| format!("{t}")),
             PromptKind::Policies => String::new(),
         };
         self.overlay = Overlay::Prompt { kind, text };
@@ -133,6 +135,22 @@ impl App {
                 _ => {
                     self.complain(format!(
                         "trials `{text}`: give a number from 1 to {MAX_TRIALS}"
+                    ));
+                    Vec::new()
+                }
+            },
+            PromptKind::Target if text.trim().is_empty() => {
+                if self.target.is_none() {
+                    return Vec::new();
+                }
+                self.say("back to the λ slider");
+                self.set_target(None)
+            }
+            PromptKind::Target => match text.trim().parse::<f64>() {
+                Ok(p) if (0.05..=0.95).contains(&p) => self.set_target(Some(p)),
+                _ => {
+                    self.complain(format!(
+                        "target `{text}`: give a success rate from 0.05 to 0.95 (e.g. 0.6)"
                     ));
                     Vec::new()
                 }

@@ -54,6 +54,7 @@ fn measure(game: Game) {
     let mut app = App::new(game, info, 1, out.path().to_path_buf());
     let mut terminal = Terminal::new(TestBackend::new(80, 24)).expect("a test terminal");
     let (mut to_screen, mut to_stats, mut to_done) = (Vec::new(), Vec::new(), Vec::new());
+    let mut no_level = 0;
     for round in 0..=LEVELS {
         let pressed = Instant::now();
         let key = KeyEvent::new(KeyCode::Char('n'), KeyModifiers::NONE);
@@ -65,6 +66,11 @@ fn measure(game: Game) {
             let response = rx
                 .recv_timeout(Duration::from_secs(120))
                 .expect("the worker answers");
+            // A seed whose level the Generator cannot build is shown as an error: no trials.
+            if matches!(response, Response::Level { result: Err(_), .. }) {
+                no_level += 1;
+                break;
+            }
             let done = matches!(response, Response::TrialsDone { .. });
             let level = matches!(response, Response::Level { .. });
             let trial = matches!(response, Response::Trial { .. });
@@ -94,8 +100,13 @@ fn measure(game: Game) {
             }
         }
     }
+    if to_done.is_empty() {
+        println!("no level built ({no_level} seeds without one)");
+        return;
+    }
     println!(
-        "{LEVELS} levels, median (max): level on screen {:.1} ms ({:.1}), first statistics {:.0} ms ({:.0}), 100 trials {:.2} s ({:.2})",
+        "{} levels ({no_level} seeds without one), median (max): level on screen {:.1} ms ({:.1}), first statistics {:.0} ms ({:.0}), 100 trials {:.2} s ({:.2})",
+        to_done.len(),
         median(to_screen.clone()) * 1e3,
         to_screen.iter().copied().fold(0.0, f64::max) * 1e3,
         median(to_stats.clone()) * 1e3,

@@ -267,24 +267,9 @@ fn corners(p: &Platform) -> [[f64; 2]; 4] {
 /// The colour of every platform (0 is the start block; `i + 1` is block `i`): the selected
 /// block cyan, the others by their share of the failures so far.
 fn platform_colours(app: &App, blocks: usize) -> Vec<Color> {
-    let failures = app
-        .trials
-        .as_ref()
-        .map(|t| t.failures_by_block(blocks))
-        .unwrap_or_else(|| vec![0; blocks]);
-    let most = failures.iter().copied().max().unwrap_or(0);
-    let block = failures.iter().enumerate().map(|(i, &f)| {
-        if app.selected == Some(i) {
-            Color::Cyan
-        } else if f == 0 {
-            Color::White
-        } else if f * 2 >= most {
-            Color::Red
-        } else {
-            Color::Yellow
-        }
-    });
-    std::iter::once(Color::Blue).chain(block).collect()
+    std::iter::once(Color::Blue)
+        .chain(piece_colours(app, blocks))
+        .collect()
 }
 
 fn map(app: &App, level: &Level, track: &PlatformTrack, frame: &mut Frame, area: Rect) {
@@ -519,14 +504,14 @@ fn racing_stats(app: &App, track: &RacingTrack, lines: &mut Vec<Line>) {
     }
 }
 
-/// The colour of every racing segment: the selected one cyan, the others by their share of the
-/// failures so far.
-fn segment_colours(app: &App, segments: usize) -> Vec<Color> {
+/// The colour of each of `pieces` pieces (blocks, segments): the selected one cyan, the others by
+/// their share of the failures so far.
+fn piece_colours(app: &App, pieces: usize) -> Vec<Color> {
     let failures = app
         .trials
         .as_ref()
-        .map(|t| t.failures_by_block(segments))
-        .unwrap_or_else(|| vec![0; segments]);
+        .map(|t| t.failures_by_block(pieces))
+        .unwrap_or_else(|| vec![0; pieces]);
     let most = failures.iter().copied().max().unwrap_or(0);
     failures
         .iter()
@@ -584,7 +569,7 @@ fn racing_map(
     frame: &mut Frame,
     area: Rect,
 ) {
-    let colours = segment_colours(app, track.segments.len());
+    let colours = piece_colours(app, track.segments.len());
     let half = 0.5 * ROAD_WIDTH;
     let edges: Vec<([f64; 3], [f64; 3], usize, f64)> = road
         .samples()
@@ -648,7 +633,7 @@ fn racing_map(
 /// crests marked `^` (where the car may leave the ground).
 fn racing_profile(app: &App, level: &Level, road: &Road, frame: &mut Frame, area: Rect) {
     let samples = road.samples();
-    let colours = segment_colours(app, road.segment_count());
+    let colours = piece_colours(app, road.segment_count());
     let length = road.length();
     let (mut lo, mut hi) = (level.goal[1].min(0.0), level.goal[1].max(0.0));
     for p in samples {

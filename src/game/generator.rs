@@ -141,8 +141,6 @@ pub trait GeneratorGame: GameSpec {
     const DEFAULT_MAX_PIECES: usize;
     /// The most pieces a level of the game may hold.
     const MAX_PIECES: usize;
-    /// What a piece is called in messages ("block", "segment").
-    const PIECE: &'static str;
     /// The names of the two [`TrackBuild::piece_features`], as the metrics columns call them.
     const PIECE_FEATURES: [&'static str; 2];
     /// The Generator reward defaults of the game.
@@ -168,6 +166,12 @@ pub trait GeneratorGame: GameSpec {
     fn furthest_piece(env: &Self::Env) -> usize;
     /// Steps the Solver has spent in the air in this run.
     fn air_steps(env: &Self::Env) -> u32;
+}
+
+/// Straight-line distance between two points, m (progress toward a goal).
+pub fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
 }
 
 /// Length of the Generator's observation vector of game `G`.

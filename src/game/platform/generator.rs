@@ -175,12 +175,7 @@ impl TrackBuild for PlatformBuild {
 
     fn distance_to_goal(&self, k: usize) -> f64 {
         let p = self.track.platforms()[k].position;
-        let d = [
-            self.goal[0] - p[0],
-            self.goal[1] - p[1],
-            self.goal[2] - p[2],
-        ];
-        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+        crate::game::generator::distance(self.goal, p)
     }
 
     fn piece_features(&self) -> Vec<[f64; 2]> {
@@ -203,7 +198,6 @@ impl GeneratorGame for PlatformGame {
     const GENERATOR_ACTIONS: &'static [&'static str] = &GENERATOR_ACTIONS;
     const DEFAULT_MAX_PIECES: usize = DEFAULT_MAX_BLOCKS;
     const MAX_PIECES: usize = crate::level::platform::MAX_BLOCKS;
-    const PIECE: &'static str = "block";
     const PIECE_FEATURES: [&'static str; 2] = ["distance", "size"];
 
     fn default_rewards() -> GeneratorRewards {

@@ -222,12 +222,7 @@ impl TrackBuild for RacingBuild {
 
     fn distance_to_goal(&self, k: usize) -> f64 {
         let p = self.road.samples()[self.road.nearest_along(self.road.segment_start(k))].centre;
-        let d = [
-            self.goal[0] - p[0],
-            self.goal[1] - p[1],
-            self.goal[2] - p[2],
-        ];
-        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+        crate::game::generator::distance(self.goal, p)
     }
 
     fn piece_features(&self) -> Vec<[f64; 2]> {
@@ -250,7 +245,6 @@ impl GeneratorGame for RacingGame {
     const GENERATOR_ACTIONS: &'static [&'static str] = &GENERATOR_ACTIONS;
     const DEFAULT_MAX_PIECES: usize = DEFAULT_MAX_SEGMENTS;
     const MAX_PIECES: usize = racing::MAX_SEGMENTS;
-    const PIECE: &'static str = "segment";
     const PIECE_FEATURES: [&'static str; 2] = ["curve", "height"];
 
     /// Progress pays 0.02 per metre (a racing goal is 220-360 m away, so a whole track pays

@@ -147,13 +147,27 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
     /// first piece is invalid (a racing segment into an obstacle) is replaced by the next.
     fn first_pieces(&mut self, mut indices: Vec<usize>) -> candle_core::Result<()> {
         while !indices.is_empty() {
-            let invalid = self.decide(&indices)?;
+            let invalid = self.place_while_needed(indices)?;
             for &i in &invalid {
                 self.restart(i, None);
             }
             indices = invalid;
         }
         Ok(())
+    }
+
+    /// Lets the Generator place pieces in the matches `indices` until none wants another (a
+    /// racing road is built [`crate::game::racing::generator::REQUEST_DISTANCE`] ahead of the
+    /// car, which can take more than one segment at the start); returns the matches that ended
+    /// because a placement was invalid.
+    fn place_while_needed(&mut self, mut indices: Vec<usize>) -> candle_core::Result<Vec<usize>> {
+        let mut ended = Vec::new();
+        while !indices.is_empty() {
+            let invalid = self.decide(&indices)?;
+            indices.retain(|i| !invalid.contains(i) && self.matches[*i].needs_piece());
+            ended.extend(invalid);
+        }
+        Ok(ended)
     }
 
     pub fn learning(&self) -> bool {
@@ -359,7 +373,7 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
         }
         // A failed placement ends the match: the Solver's run is cut, not failed.
         let invalid = self
-            .decide(&turns)
+            .place_while_needed(turns)
             .expect("the Generator's forward pass runs on the CPU");
         for i in invalid {
             out[i] = Transition {

@@ -264,11 +264,15 @@ impl RacingWorld {
     }
 
     /// Swaps the road for the longer one of `shapes` (a Generator added a segment), the car
-    /// where it is. The road stays one collider whose shape changes (the broad phase refits it
-    /// on the next step); queries see the new surface from the next step on, which only the far
-    /// end of the ray fan notices.
+    /// where it is. The road stays one collider whose shape changes; its bounding box in the
+    /// broad phase is refitted at once, so the ray fan sees the new surface before the next step.
     pub fn replace_road(&mut self, shapes: &TrackShapes) {
-        self.colliders[self.road].set_shape(shapes.road.clone());
+        let road = &mut self.colliders[self.road];
+        road.set_shape(shapes.road.clone());
+        // The scene queries (the Solver's ray fan) see the new shape now, not after the next
+        // physics step.
+        let aabb = road.compute_aabb();
+        self.broad_phase.set_aabb(&self.params, self.road, aabb);
     }
 
     /// One decision: set the controls, update the wheels, step the physics.

@@ -15,6 +15,11 @@ use crate::level::stats::Outcome;
 
 /// Centre-line points the observation looks ahead to, m along the road from the car.
 pub const LOOK_AHEAD: [f64; 5] = [8.0, 16.0, 26.0, 40.0, 60.0];
+/// How far along the road ahead the Solver's observation reaches (its furthest look-ahead
+/// point; the ray fan reaches less far), m. A Generator building the road during a run keeps at
+/// least this much road ahead of the car, so the Solver sees the same things in a match as on a
+/// finished track.
+pub const SIGHT: f64 = LOOK_AHEAD[LOOK_AHEAD.len() - 1];
 /// Ray fan, metres ahead of the car (its heading, level)...
 const FAN_FORWARD: [f32; 4] = [5.0, 11.0, 19.0, 30.0];
 /// ...and to its left.
@@ -45,18 +50,18 @@ const START_JITTER_M: f64 = 1.0;
 /// ...and turned up to this much, degrees.
 const START_JITTER_DEG: f64 = 4.0;
 
-/// The named parts of the observation vector, in order, with their lengths.
-pub const OBSERVATION_LAYOUT: [(&str, usize); 11] = [
+/// The named parts of the observation vector, in order, with their lengths. Nothing in it
+/// depends on how long the road is beyond [`SIGHT`] (no fraction of the road done, no fraction
+/// of the time limit left): a road a Generator is still building reads as a finished one.
+pub const OBSERVATION_LAYOUT: [(&str, usize); 9] = [
     ("goal_relative_position", 3),
     ("goal_bearing_sin_cos", 2),
     ("velocity", 3),
     ("angular_velocity", 3),
     ("world_up_in_car_frame", 3),
-    ("progress", 1),
     ("lateral_offset", 1),
     ("road_bearing_sin_cos", 2),
     ("centre_line_ahead", 2 * LOOK_AHEAD.len()),
-    ("time_left", 1),
     ("ray_fan", FAN_FORWARD.len() * FAN_LEFT.len()),
 ];
 
@@ -338,11 +343,9 @@ impl RacingEnv {
             .chain((velocity / 20.0).to_array())
             .chain(spin.to_array())
             .chain(up.to_array())
-            .chain([(self.along / self.road.length()) as f32])
             .chain([self.lateral_offset(to_f64(position)) as f32 / (0.5 * ROAD_WIDTH as f32)])
             .chain([road_bearing.sin(), road_bearing.cos()])
-            .chain(ahead.into_iter().flatten())
-            .chain([1.0 - self.steps as f32 / self.max_steps as f32]);
+            .chain(ahead.into_iter().flatten());
         for (slot, value) in out[..OBSERVATION_SIZE - FAN_SIZE].iter_mut().zip(state) {
             *slot = value;
         }

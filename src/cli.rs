@@ -172,6 +172,10 @@ pub struct GenerateArgs {
     /// Generator, with --rules the shipped one) and store the statistics in the YAML.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub verify: Option<u32>,
+    /// Play --verify and --target-success with this Solver policy (.safetensors) instead of the
+    /// one beside the Generator or the shipped one.
+    #[arg(long, value_name = "FILE")]
+    pub solver_policy: Option<PathBuf>,
     /// Replace files that already exist (by default nothing is overwritten; files identical to
     /// what this run makes are left as they are, so a re-run finishes an interrupted batch).
     #[arg(long)]

@@ -925,3 +925,52 @@ fn target_success_levels_measure_within_the_band() {
         "--target-success needs --policies"
     );
 }
+
+/// `--solver-policy` verifies a Generator's levels with another Solver than the one beside it,
+/// and the level records which; without --verify it is refused.
+#[test]
+fn generate_verifies_with_the_solver_policy_it_is_given() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let policies = root.join("policies/platform");
+    let other = policies.join("solver-rule-pcg.safetensors");
+    let output = arlpcg(&[
+        "generate",
+        "--policies",
+        policies.to_str().unwrap(),
+        "--aux",
+        "1",
+        "--verify",
+        "4",
+        "--solver-policy",
+        other.to_str().unwrap(),
+        "--format",
+        "yaml",
+        "--out",
+        out,
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let yaml = std::fs::read_to_string(dir.path().join("platform_seed0_aux+1.00.yaml")).unwrap();
+    let stats = &yaml[yaml.find("stats:").expect("verified")..];
+    assert!(stats.contains("solver-rule-pcg.safetensors"), "{stats}");
+    assert!(!stats.contains("solver.safetensors"), "{stats}");
+
+    let refused = arlpcg(&[
+        "generate",
+        "--policies",
+        policies.to_str().unwrap(),
+        "--aux",
+        "1",
+        "--solver-policy",
+        other.to_str().unwrap(),
+        "--out",
+        out,
+    ]);
+    assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
+    assert!(
+        stderr(&refused).contains("--solver-policy"),
+        "{}",
+        stderr(&refused)
+    );
+}

@@ -44,11 +44,18 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     };
     let verify_trials = args.verify.or(args.target_success.map(|_| TARGET_TRIALS));
     let shipped = default_solver(args.game);
-    let solver: Option<SolverPolicy> = match (verify_trials, &args.policies) {
-        (None, _) => None,
-        (Some(_), Some(dir)) => Some(load_solver(&policy_paths(dir).1, args.game)?.0),
-        (Some(_), None) if shipped.exists() => Some(load_solver(&shipped, args.game)?.0),
-        (Some(_), None) => None,
+    if args.solver_policy.is_some() && verify_trials.is_none() {
+        return Err(crate::shell::UsageError(
+            "--solver-policy plays --verify N or --target-success P; give one of them".into(),
+        )
+        .into());
+    }
+    let solver: Option<SolverPolicy> = match (verify_trials, &args.solver_policy, &args.policies) {
+        (None, _, _) => None,
+        (Some(_), Some(path), _) => Some(load_solver(path, args.game)?.0),
+        (Some(_), None, Some(dir)) => Some(load_solver(&policy_paths(dir).1, args.game)?.0),
+        (Some(_), None, None) if shipped.exists() => Some(load_solver(&shipped, args.game)?.0),
+        (Some(_), None, None) => None,
     };
     let seeds: Vec<u64> = (0..args.count as u64)
         .filter(|&i| args.shard.is_none_or(|shard| shard.owns(i)))

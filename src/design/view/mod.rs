@@ -5,16 +5,16 @@ use ratatui::layout::{Constraint, Flex, Layout, Rect};
 use ratatui::style::{Color, Modifier, Style, Stylize};
 use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
-use ratatui::widgets::canvas::{Canvas, Context, Line as CanvasLine, Points};
+use ratatui::widgets::canvas::{Context, Points};
 use ratatui::widgets::{
     Axis, Bar, BarChart, BarGroup, Block, Chart, Clear, Dataset, GraphType, Paragraph, Wrap,
 };
 
+mod platform;
+mod racing;
+
 use super::app::{App, GoalSetting, Overlay, Panel, PolicyInfo, SweepPoint};
 use super::layout::{Areas, SLIDER_LEFT, SLIDER_RIGHT, fits};
-use crate::level::platform::{Platform, PlatformTrack, heading_direction};
-use crate::level::racing::{Obstacle, RacingTrack};
-use crate::level::road::{ROAD_WIDTH, Road};
 use crate::level::stats::Outcome;
 use crate::level::{Game, Level, Track};
 use crate::rl::checkpoint::Role;
@@ -65,13 +65,13 @@ pub fn render(app: &App, frame: &mut Frame) {
     match app.level.as_deref() {
         Some(level) => match &level.track {
             Track::Platform(track) => {
-                map(app, level, track, frame, areas.map);
-                profile(app, level, track, frame, areas.profile);
+                platform::map(app, level, track, frame, areas.map);
+                platform::profile(app, level, track, frame, areas.profile);
             }
             Track::Racing(track) => {
                 let road = track.road();
-                racing_map(app, level, track, &road, frame, areas.map);
-                racing_profile(app, level, &road, frame, areas.profile);
+                racing::map(app, level, track, &road, frame, areas.map);
+                racing::profile(app, level, &road, frame, areas.profile);
             }
         },
         None => {
@@ -252,58 +252,6 @@ fn bounds(points: &[[f64; 2]], area: Rect, pad: f64) -> ([f64; 2], [f64; 2]) {
     )
 }
 
-/// The corners of a block's top, `[x, z]`, in order around it.
-fn corners(p: &Platform) -> [[f64; 2]; 4] {
-    let [fx, fz] = heading_direction(p.heading);
-    let h = p.size / 2.0;
-    [(-h, -h), (h, -h), (h, h), (-h, h)].map(|(along, across)| {
-        [
-            p.position[0] + along * fx - across * fz,
-            p.position[2] + along * fz + across * fx,
-        ]
-    })
-}
-
-/// The colour of every platform (0 is the start block; `i + 1` is block `i`): the selected
-/// block cyan, the others by their share of the failures so far.
-fn platform_colours(app: &App, blocks: usize) -> Vec<Color> {
-    std::iter::once(Color::Blue)
-        .chain(piece_colours(app, blocks))
-        .collect()
-}
-
-fn map(app: &App, level: &Level, track: &PlatformTrack, frame: &mut Frame, area: Rect) {
-    let platforms = track.platforms();
-    let colours = platform_colours(app, track.block_count());
-    let mut points: Vec<[f64; 2]> = platforms.iter().flat_map(corners).collect();
-    points.push([level.goal[0], level.goal[2]]);
-    let (x_bounds, y_bounds) = bounds(&points, area, 2.0);
-    let title = format!(
-        " top-down: {} blocks, goal {:.0} m ",
-        track.block_count(),
-        level.goal[0].hypot(level.goal[2])
-    );
-    let canvas = Canvas::default()
-        .block(Block::bordered().title(title))
-        .marker(Marker::Braille)
-        .x_bounds(x_bounds)
-        .y_bounds(y_bounds)
-        .paint(|ctx| {
-            for (p, &colour) in platforms.iter().zip(&colours) {
-                let c = corners(p);
-                for k in 0..4 {
-                    let (a, b) = (c[k], c[(k + 1) % 4]);
-                    ctx.draw(&CanvasLine::new(a[0], a[1], b[0], b[1], colour));
-                }
-            }
-            draw_replay(app, ctx, |f| [f[0] as f64, f[2] as f64]);
-            ctx.print(level.goal[0], level.goal[2], "G".green().bold());
-            let start = platforms[0].position;
-            ctx.print(start[0], start[2], "S".blue().bold());
-        });
-    frame.render_widget(canvas, area);
-}
-
 fn draw_replay(app: &App, ctx: &mut Context, project: impl Fn(&[f32; 3]) -> [f64; 2]) {
     let Some(replay) = &app.replay else {
         return;
@@ -324,66 +272,6 @@ fn draw_replay(app: &App, ctx: &mut Context, project: impl Fn(&[f32; 3]) -> [f64
     if let Some(&(x, y)) = trail.last() {
         ctx.print(x, y, "@".magenta().bold());
     }
-}
-
-/// Horizontal distance along the track of each platform centre.
-fn stations(platforms: &[Platform]) -> Vec<f64> {
-    let mut s = vec![0.0];
-    for w in platforms.windows(2) {
-        let d = (w[1].position[0] - w[0].position[0]).hypot(w[1].position[2] - w[0].position[2]);
-        s.push(s.last().copied().unwrap_or(0.0) + d);
-    }
-    s
-}
-
-/// Where `(x, z)` lies along the track, as a distance from the start (nearest point of the
-/// polyline through the platform centres).
-fn along(platforms: &[Platform], stations: &[f64], x: f64, z: f64) -> f64 {
-    let mut best = (f64::INFINITY, 0.0);
-    for (i, w) in platforms.windows(2).enumerate() {
-        let (a, b) = (w[0].position, w[1].position);
-        let (dx, dz) = (b[0] - a[0], b[2] - a[2]);
-        let len2 = (dx * dx + dz * dz).max(1e-9);
-        let t = (((x - a[0]) * dx + (z - a[2]) * dz) / len2).clamp(0.0, 1.0);
-        let (px, pz) = (a[0] + t * dx, a[2] + t * dz);
-        let d = (x - px).hypot(z - pz);
-        if d < best.0 {
-            best = (d, stations[i] + t * (stations[i + 1] - stations[i]));
-        }
-    }
-    best.1
-}
-
-fn profile(app: &App, level: &Level, track: &PlatformTrack, frame: &mut Frame, area: Rect) {
-    let platforms = track.platforms();
-    let colours = platform_colours(app, track.block_count());
-    let s = stations(platforms);
-    let last = *s.last().unwrap_or(&0.0);
-    let mut lo = level.goal[1].min(0.0);
-    let mut hi = level.goal[1].max(0.0);
-    for p in platforms {
-        lo = lo.min(p.position[1]);
-        hi = hi.max(p.position[1]);
-    }
-    let canvas = Canvas::default()
-        .block(Block::bordered().title(format!(
-            " side profile: {:.0} m of track, {:+.0} m to climb ",
-            last, level.goal[1]
-        )))
-        .marker(Marker::Braille)
-        .x_bounds([-4.0, last + 4.0])
-        .y_bounds([lo - 2.0, hi + 2.0])
-        .paint(|ctx| {
-            for ((p, &at), &colour) in platforms.iter().zip(&s).zip(&colours) {
-                let (y, h) = (p.position[1], p.size / 2.0);
-                ctx.draw(&CanvasLine::new(at - h, y, at + h, y, colour));
-            }
-            draw_replay(app, ctx, |f| {
-                [along(platforms, &s, f[0] as f64, f[2] as f64), f[1] as f64]
-            });
-            ctx.print(last, level.goal[1] + 1.0, "G".green().bold());
-        });
-    frame.render_widget(canvas, area);
 }
 
 fn stats(app: &App, frame: &mut Frame, area: Rect) {
@@ -436,7 +324,7 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
     if let Some(level) = &app.level {
         lines.push(Line::from(source_line(level)).dim());
         if let Some(track) = level.racing() {
-            racing_stats(app, track, &mut lines);
+            racing::stats(app, track, &mut lines);
         }
         if let Some(track) = level.platform() {
             let blocks = track.block_params();
@@ -478,32 +366,6 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
     );
 }
 
-/// The racing track's statistics and the selected segment, for the stats panel.
-fn racing_stats(app: &App, track: &RacingTrack, lines: &mut Vec<Line>) {
-    let segments = &track.segments;
-    let n = segments.len().max(1) as f64;
-    lines.push(Line::from(format!(
-        "mean curve {:.1}°, length {:.1} m, height {:.1} m",
-        segments.iter().map(|s| s.curve.abs()).sum::<f64>() / n,
-        segments.iter().map(|s| s.length).sum::<f64>() / n,
-        segments.iter().map(|s| s.height.abs()).sum::<f64>() / n,
-    )));
-    if let Some((i, s)) = app.selected.and_then(|i| segments.get(i).map(|s| (i, s))) {
-        let failures = app
-            .trials
-            .as_ref()
-            .map_or(0, |t| t.failures_by_block(segments.len())[i]);
-        lines.push(
-            Line::from(format!(
-                "segment {i}: {:.1} m, curve {:+.0}°, up {:+.1} m",
-                s.length, s.curve, s.height
-            ))
-            .cyan(),
-        );
-        lines.push(Line::from(format!("  {failures} runs failed on it")).cyan());
-    }
-}
-
 /// The colour of each of `pieces` pieces (blocks, segments): the selected one cyan, the others by
 /// their share of the failures so far.
 fn piece_colours(app: &App, pieces: usize) -> Vec<Color> {
@@ -528,159 +390,6 @@ fn piece_colours(app: &App, pieces: usize) -> Vec<Color> {
             }
         })
         .collect()
-}
-
-/// The footprint of an obstacle, `[x, z]` corners (a cylinder as a 12-gon).
-fn obstacle_outline(obstacle: &Obstacle) -> Vec<[f64; 2]> {
-    match *obstacle {
-        Obstacle::Box {
-            position,
-            size,
-            heading,
-        } => {
-            let [fx, fz] = heading_direction(heading);
-            let (hx, hz) = (size[0] / 2.0, size[2] / 2.0);
-            [(-hx, -hz), (hx, -hz), (hx, hz), (-hx, hz)]
-                .map(|(a, b)| [position[0] + a * fx - b * fz, position[2] + a * fz + b * fx])
-                .to_vec()
-        }
-        Obstacle::Cylinder {
-            position, radius, ..
-        } => (0..12)
-            .map(|k| {
-                let t = k as f64 * std::f64::consts::TAU / 12.0;
-                [
-                    position[0] + radius * t.cos(),
-                    position[2] + radius * t.sin(),
-                ]
-            })
-            .collect(),
-    }
-}
-
-/// The racing track from above: the road's edges (coloured by the failures on each segment),
-/// its banked stretches (blue dots on the centre line: the steeper the bank, the denser),
-/// obstacles, start, goal and a replayed run.
-fn racing_map(
-    app: &App,
-    level: &Level,
-    track: &RacingTrack,
-    road: &Road,
-    frame: &mut Frame,
-    area: Rect,
-) {
-    let colours = piece_colours(app, track.segments.len());
-    let half = 0.5 * ROAD_WIDTH;
-    let edges: Vec<([f64; 3], [f64; 3], usize, f64)> = road
-        .samples()
-        .iter()
-        .map(|p| (p.across(half), p.across(-half), p.segment, p.bank))
-        .collect();
-    let mut points: Vec<[f64; 2]> = edges
-        .iter()
-        .flat_map(|(l, r, ..)| [[l[0], l[2]], [r[0], r[2]]])
-        .collect();
-    points.push([level.goal[0], level.goal[2]]);
-    let outlines: Vec<Vec<[f64; 2]>> = track.obstacles.iter().map(obstacle_outline).collect();
-    points.extend(outlines.iter().flatten());
-    let (x_bounds, y_bounds) = bounds(&points, area, 5.0);
-    let title = format!(
-        " top-down: {} segments, {:.0} m of road, goal {:.0} m ",
-        track.segments.len(),
-        road.length(),
-        level.goal[0].hypot(level.goal[2])
-    );
-    let canvas = Canvas::default()
-        .block(Block::bordered().title(title))
-        .marker(Marker::Braille)
-        .x_bounds(x_bounds)
-        .y_bounds(y_bounds)
-        .paint(|ctx| {
-            for outline in &outlines {
-                for k in 0..outline.len() {
-                    let (a, b) = (outline[k], outline[(k + 1) % outline.len()]);
-                    ctx.draw(&CanvasLine::new(a[0], a[1], b[0], b[1], Color::DarkGray));
-                }
-            }
-            for pair in edges.windows(2) {
-                let (a, b) = (&pair[0], &pair[1]);
-                let colour = colours.get(b.2).copied().unwrap_or(Color::White);
-                ctx.draw(&CanvasLine::new(a.0[0], a.0[2], b.0[0], b.0[2], colour));
-                ctx.draw(&CanvasLine::new(a.1[0], a.1[2], b.1[0], b.1[2], colour));
-            }
-            let banked: Vec<(f64, f64)> = road
-                .samples()
-                .iter()
-                .enumerate()
-                .filter(|(i, p)| {
-                    let degrees = p.bank.abs().to_degrees();
-                    degrees >= 10.0 || (degrees >= 4.0 && i % 2 == 0)
-                })
-                .map(|(_, p)| (p.centre[0], p.centre[2]))
-                .collect();
-            ctx.draw(&Points {
-                coords: &banked,
-                color: Color::LightBlue,
-            });
-            draw_replay(app, ctx, |f| [f[0] as f64, f[2] as f64]);
-            ctx.print(level.goal[0], level.goal[2], "G".green().bold());
-            ctx.print(track.position[0], track.position[2], "S".blue().bold());
-        });
-    frame.render_widget(canvas, area);
-}
-
-/// The road's elevation along its length, coloured by the failures on each segment, with its
-/// crests marked `^` (where the car may leave the ground).
-fn racing_profile(app: &App, level: &Level, road: &Road, frame: &mut Frame, area: Rect) {
-    let samples = road.samples();
-    let colours = piece_colours(app, road.segment_count());
-    let length = road.length();
-    let (mut lo, mut hi) = (level.goal[1].min(0.0), level.goal[1].max(0.0));
-    for p in samples {
-        lo = lo.min(p.centre[1]);
-        hi = hi.max(p.centre[1]);
-    }
-    // A crest: the slope turns from climbing to falling, and the road drops at least 1 m within
-    // 15 m either side.
-    let crests: Vec<&crate::level::road::RoadSample> = samples
-        .windows(2)
-        .filter(|w| w[0].slope > 0.0 && w[1].slope <= 0.0)
-        .map(|w| &w[1])
-        .filter(|p| {
-            let near = samples.iter().filter(|q| (q.s - p.s).abs() <= 15.0);
-            near.map(|q| p.centre[1] - q.centre[1]).fold(0.0, f64::max) >= 1.0
-        })
-        .collect();
-    let canvas = Canvas::default()
-        .block(Block::bordered().title(format!(
-            " elevation: {length:.0} m of road, {:+.0} m to climb, {} crests ",
-            level.goal[1],
-            crests.len()
-        )))
-        .marker(Marker::Braille)
-        .x_bounds([-5.0, length + 5.0])
-        .y_bounds([lo - 2.0, hi + 2.0])
-        .paint(|ctx| {
-            for w in samples.windows(2) {
-                let colour = colours.get(w[1].segment).copied().unwrap_or(Color::White);
-                ctx.draw(&CanvasLine::new(
-                    w[0].s,
-                    w[0].centre[1],
-                    w[1].s,
-                    w[1].centre[1],
-                    colour,
-                ));
-            }
-            draw_replay(app, ctx, |f| {
-                let at = [f[0] as f64, f[1] as f64, f[2] as f64];
-                [samples[road.nearest(at, None, 0)].s, f[1] as f64]
-            });
-            for p in &crests {
-                ctx.print(p.s, p.centre[1] + 0.8, "^".yellow());
-            }
-            ctx.print(length, level.goal[1] + 1.0, "G".green().bold());
-        });
-    frame.render_widget(canvas, area);
 }
 
 fn source_line(level: &Level) -> String {

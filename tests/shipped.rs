@@ -122,39 +122,46 @@ fn every_shipped_platform_policy_loads_and_its_card_matches() {
     }
 }
 
-/// The shipped racing Solver loads as a racing Solver, its card matches the file, it is trained
-/// to its budget, and it drives a held-out rule track to the end.
+/// The shipped racing Solvers (the default ARLPCG one and rule-pcg) load as racing Solvers, their
+/// cards match the files, they are trained to the budget from committed code, and each drives a
+/// held-out rule track to the end.
 #[test]
-fn the_shipped_racing_solver_loads_and_drives() {
+fn the_shipped_racing_solvers_load_and_drive() {
     use arlpcg::game::racing::OBSERVATION_SIZE;
     use arlpcg::level::Game;
     use arlpcg::verify::{Solver, verify};
-    let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/racing/solver-rule-pcg.safetensors");
-    let (solver, card) = arlpcg::policies::load_solver(&path, Game::Racing).unwrap();
-    assert_eq!(card.training.mode, "rule-pcg");
-    assert_eq!(
-        card.observation.iter().map(|(_, k)| k).sum::<usize>(),
-        OBSERVATION_SIZE
-    );
-    assert!((10_000_000..10_100_000).contains(&card.training.steps));
-    // A policy trained from uncommitted code cannot be reproduced: none ships.
-    assert!(
-        !card.training.commit.ends_with("-dirty"),
-        "trained on uncommitted code ({})",
-        card.training.commit
-    );
-    // The card inside the file and the card beside it agree.
-    let beside: arlpcg::rl::checkpoint::PolicyCard =
-        serde_yaml::from_str(&std::fs::read_to_string(path.with_extension("yaml")).unwrap())
-            .unwrap();
-    let record = |c: &arlpcg::rl::checkpoint::PolicyCard| {
-        let t = &c.training;
-        (t.mode.clone(), t.steps, t.commit.clone(), t.command.clone())
-    };
-    assert_eq!(record(&beside), record(&card));
     let level =
         arlpcg::game::racing::rules::racing_level(3, None, None, &Default::default()).unwrap();
-    let stats = verify(&level, &Solver::Policy(&solver), 8, 0, &|| {}).unwrap();
-    assert!(stats.success_ratio >= 0.75, "{stats:?}");
+    for (file, mode) in [
+        ("solver.safetensors", "arlpcg"),
+        ("solver-rule-pcg.safetensors", "rule-pcg"),
+    ] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("policies/racing")
+            .join(file);
+        let (solver, card) = arlpcg::policies::load_solver(&path, Game::Racing).unwrap();
+        assert_eq!(card.training.mode, mode);
+        assert_eq!(
+            card.observation.iter().map(|(_, k)| k).sum::<usize>(),
+            OBSERVATION_SIZE
+        );
+        assert!((10_000_000..10_100_000).contains(&card.training.steps));
+        // A policy trained from uncommitted code cannot be reproduced: none ships.
+        assert!(
+            !card.training.commit.ends_with("-dirty"),
+            "{file} trained on uncommitted code ({})",
+            card.training.commit
+        );
+        // The card inside the file and the card beside it agree.
+        let beside: arlpcg::rl::checkpoint::PolicyCard =
+            serde_yaml::from_str(&std::fs::read_to_string(path.with_extension("yaml")).unwrap())
+                .unwrap();
+        let record = |c: &arlpcg::rl::checkpoint::PolicyCard| {
+            let t = &c.training;
+            (t.mode.clone(), t.steps, t.commit.clone(), t.command.clone())
+        };
+        assert_eq!(record(&beside), record(&card));
+        let stats = verify(&level, &Solver::Policy(&solver), 8, 0, &|| {}).unwrap();
+        assert!(stats.success_ratio >= 0.75, "{file}: {stats:?}");
+    }
 }

@@ -4,7 +4,8 @@
 //!
 //! A trained policy plays trials in lockstep, up to [`LOCKSTEP`] at a time: all their worlds step
 //! in parallel and one batched forward pass picks every action. It samples its actions (the
-//! stochastic policy it was trained as).
+//! stochastic policy it was trained as), each trial from its own random stream, so a trial played
+//! in the pool is the run [`record`] plays alone from the same seed.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -18,6 +19,9 @@ use crate::rl::policy::{ActMode, ActorCritic};
 
 /// Trials a policy plays at once.
 pub const LOCKSTEP: usize = 64;
+
+/// Trials a policy plays at once until the first one ends (the designer's first statistics).
+pub const FIRST_POOL: usize = 4;
 
 /// A trained Solver, ready to play.
 pub struct SolverPolicy {
@@ -141,12 +145,7 @@ fn play_all<G: GameSpec>(
                 (!(watch.stop)()).then(|| reported(play_random(env, seed.wrapping_add(i))))
             })
             .collect(),
-        Solver::Policy(policy) => (0..trials as u64)
-            .collect::<Vec<_>>()
-            .chunks(LOCKSTEP)
-            .map(|chunk| play_policy(new_env, policy, seed, chunk, watch))
-            .collect::<Option<Vec<Vec<TrialResult>>>>()
-            .map(|chunks| chunks.concat()),
+        Solver::Policy(policy) => play_policy(new_env, policy, seed, trials as u64, watch),
     }
 }
 
@@ -157,8 +156,8 @@ pub struct Recording {
     pub result: TrialResult,
 }
 
-/// Plays one run of the level with `seed` and records it. A policy plays it alone (one forward
-/// pass per step), so the run is not one of [`verify`]'s lockstep trials of the same seed.
+/// Plays one run of the level with `seed` and records it: the run that trial `i` of a
+/// verification from seed `seed - i` plays in its pool, here alone (one forward pass per step).
 pub fn record(level: &Level, solver: &Solver, seed: u64) -> Result<Recording, WrongGame> {
     solver.check_game(level.game())?;
     let unexpected = "a level's environment is of its own game";
@@ -243,61 +242,78 @@ fn play_random<E: SolverEnv>(env: &mut E, seed: u64) -> TrialResult {
     }
 }
 
-/// Plays the trials `indices` together: parallel worlds, one forward pass per tick.
+/// Plays trials `0..trials` in a pool of parallel worlds, one batched forward pass per tick; a
+/// world whose trial ends starts the next one. Trial `i` resets its world with `seed + i` and
+/// draws its actions from its own stream seeded `seed + i`, as [`record`] does, so its result
+/// does not depend on which trials share the pool. The pool starts with [`FIRST_POOL`] worlds,
+/// so the first statistics come soon, and grows to [`LOCKSTEP`] once a trial has ended.
 fn play_policy<E: SolverEnv>(
     new_env: &(dyn Fn() -> E + Sync),
     solver: &SolverPolicy,
     seed: u64,
-    indices: &[u64],
+    trials: u64,
     watch: &Watch,
 ) -> Option<Vec<TrialResult>> {
     let size = E::OBSERVATION_SIZE;
-    let mut envs: Vec<E> = indices
-        .par_iter()
-        .map(|&i| {
-            let mut env = new_env();
-            env.reset(seed.wrapping_add(i));
-            env
-        })
-        .collect();
-    let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(indices[0]).rotate_left(17));
-    let mut results: Vec<Option<TrialResult>> = vec![None; envs.len()];
-    let mut observations = vec![0.0; envs.len() * size];
+    let width = solver.policy.shape().action_size();
+    let mut results: Vec<Option<TrialResult>> = vec![None; trials as usize];
+    let (mut envs, mut playing, mut rngs) = (Vec::<E>::new(), Vec::<u64>::new(), Vec::new());
+    let mut idle: Vec<E> = Vec::new();
+    let mut pool = FIRST_POOL;
+    let mut next = 0;
+    let mut observations = vec![0.0; LOCKSTEP * size];
     loop {
-        let active: Vec<usize> = (0..envs.len()).filter(|&k| results[k].is_none()).collect();
-        if active.is_empty() {
+        let starting: Vec<u64> = (next..trials).take(pool - envs.len()).collect();
+        next += starting.len() as u64;
+        let mut fresh: Vec<(E, u64)> = starting
+            .iter()
+            .map(|&i| (idle.pop(), i))
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .map(|(env, i)| {
+                let mut env = env.unwrap_or_else(new_env);
+                env.reset(seed.wrapping_add(i));
+                (env, i)
+            })
+            .collect();
+        for (env, i) in fresh.drain(..) {
+            envs.push(env);
+            playing.push(i);
+            rngs.push(ChaCha8Rng::seed_from_u64(seed.wrapping_add(i)));
+        }
+        if envs.is_empty() {
             break;
         }
         if (watch.stop)() {
             return None;
         }
-        let rows = &mut observations[..active.len() * size];
+        let rows = &mut observations[..envs.len() * size];
         rows.par_chunks_mut(size)
-            .zip(&active)
-            .for_each(|(row, &k)| envs[k].observe(row));
+            .zip(&envs)
+            .for_each(|(row, env)| env.observe(row));
         solver.normalizer.normalize(rows);
         let actions = solver
             .policy
-            .choose(rows, ActMode::Sample, &mut rng)
+            .choose_per_row(rows, ActMode::Sample, &mut rngs)
             .expect("a policy checked for the level's game acts on its observations");
-        let width = solver.policy.shape().action_size();
-        let mut stepping: Vec<(usize, &mut E)> = envs
-            .iter_mut()
-            .enumerate()
-            .filter(|(k, _)| results[*k].is_none())
-            .collect();
-        let finished: Vec<(usize, TrialResult)> = stepping
+        let mut finished: Vec<(usize, TrialResult)> = envs
             .par_iter_mut()
             .zip(actions.par_chunks(width))
-            .filter_map(|((k, env), row)| {
+            .enumerate()
+            .filter_map(|(k, (env, row))| {
                 env.step(E::action_from_policy_row(row))
                     .outcome
-                    .map(|o| (*k, env.trial_result(o)))
+                    .map(|o| (k, env.trial_result(o)))
             })
             .collect();
+        finished.sort_by_key(|&(k, _)| std::cmp::Reverse(k));
         for (k, result) in finished {
             (watch.on_trial)(&result);
-            results[k] = Some(result);
+            results[playing[k] as usize] = Some(result);
+            idle.push(envs.swap_remove(k));
+            playing.swap_remove(k);
+            rngs.swap_remove(k);
+            pool = LOCKSTEP;
         }
     }
     Some(

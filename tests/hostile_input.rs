@@ -222,7 +222,7 @@ proptest! {
             prop_assert!(c.hidden.iter().all(|&h| (1..=4096).contains(&h)));
             prop_assert!((0.0..=1440.0).contains(&c.checkpoint_minutes));
             for p in [&c.solver, &c.generator.ppo] {
-                prop_assert!(p.learning_rate > 0.0 && p.learning_rate <= 1.0);
+                prop_assert!((0.0..=1.0).contains(&p.learning_rate));
                 prop_assert!((0.0..=1.0).contains(&p.gamma) && (0.0..=1.0).contains(&p.gae_lambda));
                 prop_assert!(p.clip_coef > 0.0 && p.clip_coef <= 1.0);
                 prop_assert!((0.0..=1.0).contains(&p.ent_coef) && (0.0..=100.0).contains(&p.vf_coef));

@@ -165,3 +165,49 @@ fn the_shipped_racing_solvers_load_and_drive() {
         assert!(stats.success_ratio >= 0.75, "{file}: {stats:?}");
     }
 }
+
+/// Each trial of a verification is the run `record` plays alone from the same seed: its own
+/// world, its own random stream, whatever else shares the pool (a small first pool, then up
+/// to 64 worlds, each starting the next trial when its own ends). So verification's statistics
+/// and a level's certificate replay agree run for run.
+#[test]
+fn each_verification_trial_is_the_run_recorded_from_its_seed() {
+    use arlpcg::game::{GameSpec, PlatformGame, RacingGame};
+    use arlpcg::level::Game;
+    use arlpcg::level::stats::TrialResult;
+    use arlpcg::verify::{Solver, Watch, record, verify_watched};
+    use std::sync::Mutex;
+    for (game, level) in [
+        (Game::Platform, PlatformGame::rule_level(7).unwrap()),
+        (Game::Racing, RacingGame::rule_level(7).unwrap()),
+    ] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("policies")
+            .join(game.name())
+            .join("solver.safetensors");
+        let (policy, _) = arlpcg::policies::load_solver(&path, game).unwrap();
+        let solver = Solver::Policy(&policy);
+        let (trials, seed) = (12, 40);
+        let played = Mutex::new(Vec::<TrialResult>::new());
+        let on_trial = |r: &TrialResult| played.lock().unwrap().push(r.clone());
+        let watch = Watch {
+            on_trial: &on_trial,
+            stop: &|| false,
+        };
+        let stats = verify_watched(&level, &solver, trials, seed, &watch)
+            .unwrap()
+            .unwrap();
+        let mut played = played.into_inner().unwrap();
+        assert_eq!(played.len(), trials as usize);
+        let mut successes = 0;
+        for i in 0..trials as u64 {
+            let alone = record(&level, &solver, seed + i).unwrap().result;
+            successes += u32::from(alone.outcome == arlpcg::level::stats::Outcome::Success);
+            let at = played.iter().position(|r| *r == alone).unwrap_or_else(|| {
+                panic!("{game}: trial {i} played alone ({alone:?}) is none of the pool's runs")
+            });
+            played.swap_remove(at);
+        }
+        assert_eq!(stats.successes, successes, "{game}");
+    }
+}

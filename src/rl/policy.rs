@@ -15,6 +15,23 @@ use serde::{Deserialize, Serialize};
 /// ln(2π) / 2
 pub(super) const HALF_LN_TAU: f32 = 0.918_938_5;
 
+/// Where a batch's random numbers come from.
+enum Draws<'a> {
+    /// One stream for the whole batch, row after row.
+    Shared(&'a mut ChaCha8Rng),
+    /// One stream per row.
+    PerRow(&'a mut [ChaCha8Rng]),
+}
+
+impl Draws<'_> {
+    fn row(&mut self, i: usize) -> &mut ChaCha8Rng {
+        match self {
+            Draws::Shared(rng) => rng,
+            Draws::PerRow(rngs) => &mut rngs[i],
+        }
+    }
+}
+
 /// The sizes of a policy.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -179,7 +196,7 @@ impl ActorCritic {
         rng: &mut ChaCha8Rng,
     ) -> candle_core::Result<Acted> {
         let obs = self.observation_tensor(observations)?;
-        let (actions, log_probs) = self.sample(&obs, mode, rng)?;
+        let (actions, log_probs) = self.sample(&obs, mode, Draws::Shared(rng))?;
         Ok(Acted {
             actions,
             log_probs,
@@ -208,7 +225,19 @@ impl ActorCritic {
         rng: &mut ChaCha8Rng,
     ) -> candle_core::Result<Vec<f32>> {
         let obs = self.observation_tensor(observations)?;
-        Ok(self.sample(&obs, mode, rng)?.0)
+        Ok(self.sample(&obs, mode, Draws::Shared(rng))?.0)
+    }
+
+    /// [`Self::choose`] with one random stream per row: row `k` draws from `rngs[k]` only, so
+    /// each row's actions do not depend on which other rows share its batch.
+    pub fn choose_per_row(
+        &self,
+        observations: &[f32],
+        mode: ActMode,
+        rngs: &mut [ChaCha8Rng],
+    ) -> candle_core::Result<Vec<f32>> {
+        let obs = self.observation_tensor(observations)?;
+        Ok(self.sample(&obs, mode, Draws::PerRow(rngs))?.0)
     }
 
     fn observation_tensor(&self, observations: &[f32]) -> candle_core::Result<Tensor> {
@@ -221,14 +250,15 @@ impl ActorCritic {
         &self,
         obs: &Tensor,
         mode: ActMode,
-        rng: &mut ChaCha8Rng,
+        mut draws: Draws<'_>,
     ) -> candle_core::Result<(Vec<f32>, Vec<f32>)> {
         let head = self.actor.forward(obs, false)?.to_vec2::<f32>()?;
         let log_std = self.log_std.as_tensor().flatten_all()?.to_vec1::<f32>()?;
         let (c, b) = (self.shape.continuous, self.shape.binary);
         let mut actions = Vec::with_capacity(head.len() * (c + b));
         let mut log_probs = Vec::with_capacity(head.len());
-        for row in &head {
+        for (i, row) in head.iter().enumerate() {
+            let rng = draws.row(i);
             let mut log_prob = 0.0;
             for k in 0..c {
                 let (mean, std) = (row[k], log_std[k].exp());

@@ -14,7 +14,8 @@ use super::policy::ActorCritic;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PpoConfig {
-    /// Adam step size.
+    /// Adam step size; 0 keeps the policy as it is (it plays but does not learn: a Generator
+    /// trained on against a finished Solver).
     pub learning_rate: f64,
     /// Decay the learning rate linearly to 0 over the run.
     pub anneal_lr: bool,
@@ -79,9 +80,9 @@ impl PpoConfig {
             (
                 "learning_rate",
                 self.learning_rate.is_finite()
-                    && self.learning_rate > 0.0
+                    && self.learning_rate >= 0.0
                     && self.learning_rate <= 1.0,
-                "a number in (0, 1]".to_string(),
+                "a number in [0, 1]".to_string(),
             ),
             ("gamma", unit(self.gamma), "a number in [0, 1]".into()),
             (
@@ -467,8 +468,9 @@ mod tests {
         }
     }
 
-    /// The parameters after two updates of a 2 × 64 policy on a random batch of 600 rows.
-    fn parameters_after_updates(threads: usize) -> Vec<f32> {
+    /// The parameters after two updates at `learning_rate` of a 2 × 512 policy on a random
+    /// batch of 600 rows.
+    fn parameters_after_updates(threads: usize, learning_rate: f64) -> Vec<f32> {
         use rand::{RngExt, SeedableRng};
         let shape = small_shape();
         let mut rng = ChaCha8Rng::seed_from_u64(4);
@@ -501,7 +503,7 @@ mod tests {
             .install(|| {
                 let mut rng = ChaCha8Rng::seed_from_u64(2);
                 for _ in 0..2 {
-                    ppo.update(&batch, 1e-3, &mut rng).unwrap();
+                    ppo.update(&batch, learning_rate, &mut rng).unwrap();
                 }
             });
         ppo.policy.flat_parameters().unwrap()
@@ -509,11 +511,20 @@ mod tests {
 
     #[test]
     fn updates_are_deterministic_and_do_not_depend_on_the_thread_count() {
-        let one = parameters_after_updates(1);
+        let one = parameters_after_updates(1, 1e-3);
         let initial = ActorCritic::new(small_shape(), 1).unwrap();
         assert_ne!(one, initial.flat_parameters().unwrap());
-        assert_eq!(one, parameters_after_updates(1));
-        assert_eq!(one, parameters_after_updates(3));
+        assert_eq!(one, parameters_after_updates(1, 1e-3));
+        assert_eq!(one, parameters_after_updates(3, 1e-3));
+    }
+
+    #[test]
+    fn a_zero_learning_rate_keeps_every_parameter() {
+        let initial = ActorCritic::new(small_shape(), 1).unwrap();
+        assert_eq!(
+            parameters_after_updates(2, 0.0),
+            initial.flat_parameters().unwrap()
+        );
     }
 
     #[test]

@@ -189,7 +189,7 @@ fn each_verification_trial_is_the_run_recorded_from_its_seed() {
         let solver = Solver::Policy(&policy);
         let (trials, seed) = (12, 40);
         let played = Mutex::new(Vec::<TrialResult>::new());
-        let on_trial = |r: &TrialResult| played.lock().unwrap().push(r.clone());
+        let on_trial = |r: &TrialResult| played.lock().unwrap().push(*r);
         let watch = Watch {
             on_trial: &on_trial,
             stop: &|| false,

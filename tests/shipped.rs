@@ -122,9 +122,8 @@ fn every_shipped_platform_policy_loads_and_its_card_matches() {
     }
 }
 
-/// The shipped racing Solvers (the default ARLPCG one and rule-pcg) load as racing Solvers, their
-/// cards match the files, they are trained to the budget from committed code, and each drives a
-/// held-out rule track to the end.
+/// The four shipped racing Solvers load as racing Solvers, their cards match the files, they are
+/// trained to the budget from committed code, and each drives a held-out rule track to the end.
 #[test]
 fn the_shipped_racing_solvers_load_and_drive() {
     use arlpcg::game::racing::OBSERVATION_SIZE;
@@ -135,6 +134,8 @@ fn the_shipped_racing_solvers_load_and_drive() {
     for (file, mode) in [
         ("solver.safetensors", "arlpcg"),
         ("solver-rule-pcg.safetensors", "rule-pcg"),
+        ("solver-fixed-track.safetensors", "fixed-track"),
+        ("solver-fixed-aux.safetensors", "fixed-aux"),
     ] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("policies/racing")

@@ -4,18 +4,23 @@
 //! One level's success at a λ varies a lot from seed to seed (the curve is an average), so the
 //! search starts at the λ the curve gives for `P` and then moves λ by how far each verified
 //! candidate missed, drawing a new level of the same seed and goal each time, until one
-//! measures within [`BAND`] of `P`.
+//! measures within [`BAND`] of `P`. Each candidate plays [`SCREEN_TRIALS`] runs first and the
+//! rest only if their 95% interval still meets the band: a kept level's statistics are those of
+//! all its runs, the same as one verification of them all.
 
 use serde::{Deserialize, Serialize};
 
 use crate::generation::{self, GenerationError, GeneratorPolicy};
 use crate::level::Level;
-use crate::verify::{Solver, WrongGame, verify};
+use crate::level::stats::{Outcome, wilson_interval};
+use crate::verify::{Solver, Watch, WrongGame, stats_of, trial_results, verify};
 
 /// A kept level measures within this of the wanted success ratio.
 pub const BAND: f64 = 0.1;
 /// Candidates tried per level before giving up.
-pub const MAX_CANDIDATES: u32 = 24;
+pub const MAX_CANDIDATES: u32 = 48;
+/// Runs a candidate plays before the search decides whether to play the rest.
+pub const SCREEN_TRIALS: u32 = 20;
 /// The λ values the curve is measured at, easy to hard.
 pub const CURVE_AUX: [f64; 9] = [1.0, 0.75, 0.5, 0.25, 0.0, -0.25, -0.5, -0.75, -1.0];
 /// Levels per λ and runs per level when measuring the curve.
@@ -135,7 +140,7 @@ pub fn level_for(
             Err(GenerationError::NoLevel { .. }) => continue,
             Err(e) => return Err(e.into()),
         };
-        let stats = verify(&level, solver, trials, seed, &|| {})?;
+        let stats = screened_stats(&level, solver, trials, seed, target)?;
         let miss = stats.success_ratio - target;
         if miss.abs() < closest.0 {
             closest = (miss.abs(), stats.success_ratio, quantized);
@@ -152,6 +157,36 @@ pub fn level_for(
         closest: closest.1,
         aux: closest.2,
     })
+}
+
+/// The statistics of `trials` runs of a candidate, or of its first [`SCREEN_TRIALS`] alone when
+/// their 95% interval lies outside [`BAND`] of `target` (the rest cannot bring it in, bar a
+/// 1-in-40 chance).
+fn screened_stats(
+    level: &Level,
+    solver: &Solver,
+    trials: u32,
+    seed: u64,
+    target: f64,
+) -> Result<crate::level::stats::SolverStats, WrongGame> {
+    let watch = Watch {
+        on_trial: &|_| {},
+        stop: &|| false,
+    };
+    let unstopped = "a search without a stop condition plays every run";
+    let screen = SCREEN_TRIALS.min(trials);
+    let mut results =
+        trial_results(level, solver, 0..screen as u64, seed, &watch)?.expect(unstopped);
+    let successes = results
+        .iter()
+        .filter(|r| r.outcome == Outcome::Success)
+        .count() as u32;
+    let [low, high] = wilson_interval(successes, screen);
+    if high >= target - BAND && low <= target + BAND {
+        let rest = trial_results(level, solver, screen as u64..trials as u64, seed, &watch)?;
+        results.extend(rest.expect(unstopped));
+    }
+    Ok(stats_of(level, solver, seed, &results))
 }
 
 #[cfg(test)]

@@ -7,6 +7,8 @@
 //! stochastic policy it was trained as), each trial from its own random stream, so a trial played
 //! in the pool is the run [`record`] plays alone from the same seed.
 
+use std::ops::Range;
+
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -109,21 +111,37 @@ pub fn verify_watched(
     seed: u64,
     watch: &Watch,
 ) -> Result<Option<SolverStats>, WrongGame> {
-    solver.check_game(level.game())?;
-    let results = match level.game() {
-        Game::Platform => play_all::<PlatformGame>(level, solver, trials, seed, watch),
-        Game::Racing => play_all::<RacingGame>(level, solver, trials, seed, watch),
-    };
-    Ok(results.map(|results| {
-        SolverStats::from_trials(solver.reference(), seed, level.piece_count(), &results)
-    }))
+    let results = trial_results(level, solver, 0..trials as u64, seed, watch)?;
+    Ok(results.map(|results| stats_of(level, solver, seed, &results)))
 }
 
-/// Plays the trials of a level of game `G`; `None` when told to stop.
+/// The results of a verification's trials `range` alone, in order (trial `i` seeded `seed + i`,
+/// whatever the range), so a verification can be played in parts: trials `0..20`, then
+/// `20..100`, give the results of trials `0..100`. `None` when `watch.stop` says to stop.
+pub fn trial_results(
+    level: &Level,
+    solver: &Solver,
+    range: Range<u64>,
+    seed: u64,
+    watch: &Watch,
+) -> Result<Option<Vec<TrialResult>>, WrongGame> {
+    solver.check_game(level.game())?;
+    Ok(match level.game() {
+        Game::Platform => play_all::<PlatformGame>(level, solver, range, seed, watch),
+        Game::Racing => play_all::<RacingGame>(level, solver, range, seed, watch),
+    })
+}
+
+/// The statistics of a verification from `seed` whose trials gave `results` (trials `0..n`).
+pub fn stats_of(level: &Level, solver: &Solver, seed: u64, results: &[TrialResult]) -> SolverStats {
+    SolverStats::from_trials(solver.reference(), seed, level.piece_count(), results)
+}
+
+/// Plays the trials `range` of a level of game `G`; `None` when told to stop.
 fn play_all<G: GameSpec>(
     level: &Level,
     solver: &Solver,
-    trials: u32,
+    range: Range<u64>,
     seed: u64,
     watch: &Watch,
 ) -> Option<Vec<TrialResult>> {
@@ -133,19 +151,19 @@ fn play_all<G: GameSpec>(
         result
     };
     match solver {
-        Solver::Scripted => (0..trials as u64)
+        Solver::Scripted => range
             .into_par_iter()
             .map_init(new_env, |env, i| {
                 (!(watch.stop)()).then(|| reported(play_scripted(env, seed.wrapping_add(i))))
             })
             .collect(),
-        Solver::Random => (0..trials as u64)
+        Solver::Random => range
             .into_par_iter()
             .map_init(new_env, |env, i| {
                 (!(watch.stop)()).then(|| reported(play_random(env, seed.wrapping_add(i))))
             })
             .collect(),
-        Solver::Policy(policy) => play_policy(new_env, policy, seed, trials as u64, watch),
+        Solver::Policy(policy) => play_policy(new_env, policy, seed, range, watch),
     }
 }
 
@@ -242,7 +260,7 @@ fn play_random<E: SolverEnv>(env: &mut E, seed: u64) -> TrialResult {
     }
 }
 
-/// Plays trials `0..trials` in a pool of parallel worlds, one batched forward pass per tick; a
+/// Plays trials `range` in a pool of parallel worlds, one batched forward pass per tick; a
 /// world whose trial ends starts the next one. Trial `i` resets its world with `seed + i` and
 /// draws its actions from its own stream seeded `seed + i`, as [`record`] does, so its result
 /// does not depend on which trials share the pool. The pool starts with [`FIRST_POOL`] worlds,
@@ -251,19 +269,20 @@ fn play_policy<E: SolverEnv>(
     new_env: &(dyn Fn() -> E + Sync),
     solver: &SolverPolicy,
     seed: u64,
-    trials: u64,
+    range: Range<u64>,
     watch: &Watch,
 ) -> Option<Vec<TrialResult>> {
     let size = E::OBSERVATION_SIZE;
     let width = solver.policy.shape().action_size();
-    let mut results: Vec<Option<TrialResult>> = vec![None; trials as usize];
+    let first = range.start;
+    let mut results: Vec<Option<TrialResult>> = vec![None; range.clone().count()];
     let (mut envs, mut playing, mut rngs) = (Vec::<E>::new(), Vec::<u64>::new(), Vec::new());
     let mut idle: Vec<E> = Vec::new();
     let mut pool = FIRST_POOL;
-    let mut next = 0;
+    let mut next = range.start;
     let mut observations = vec![0.0; LOCKSTEP * size];
     loop {
-        let starting: Vec<u64> = (next..trials).take(pool - envs.len()).collect();
+        let starting: Vec<u64> = (next..range.end).take(pool - envs.len()).collect();
         next += starting.len() as u64;
         let mut fresh: Vec<(E, u64)> = starting
             .iter()
@@ -309,7 +328,7 @@ fn play_policy<E: SolverEnv>(
         finished.sort_by_key(|&(k, _)| std::cmp::Reverse(k));
         for (k, result) in finished {
             (watch.on_trial)(&result);
-            results[playing[k] as usize] = Some(result);
+            results[(playing[k] - first) as usize] = Some(result);
             idle.push(envs.swap_remove(k));
             playing.swap_remove(k);
             rngs.swap_remove(k);

@@ -170,13 +170,14 @@ fn the_shipped_racing_solvers_load_and_drive() {
 /// Each trial of a verification is the run `record` plays alone from the same seed: its own
 /// world, its own random stream, whatever else shares the pool (a small first pool, then up
 /// to 64 worlds, each starting the next trial when its own ends). So verification's statistics
-/// and a level's certificate replay agree run for run.
+/// and a level's certificate replay agree run for run, and a verification played in parts
+/// (`generate --target-success` screens each candidate with its first 20 runs) is the whole.
 #[test]
 fn each_verification_trial_is_the_run_recorded_from_its_seed() {
     use arlpcg::game::{GameSpec, PlatformGame, RacingGame};
     use arlpcg::level::Game;
     use arlpcg::level::stats::TrialResult;
-    use arlpcg::verify::{Solver, Watch, record, verify_watched};
+    use arlpcg::verify::{Solver, Watch, record, stats_of, trial_results, verify_watched};
     use std::sync::Mutex;
     for (game, level) in [
         (Game::Platform, PlatformGame::rule_level(7).unwrap()),
@@ -210,5 +211,19 @@ fn each_verification_trial_is_the_run_recorded_from_its_seed() {
             played.swap_remove(at);
         }
         assert_eq!(stats.successes, successes, "{game}");
+        // Played in parts, the trials give the same results in the same order.
+        let quiet = Watch {
+            on_trial: &|_| {},
+            stop: &|| false,
+        };
+        let part = |range| {
+            trial_results(&level, &solver, range, seed, &quiet)
+                .unwrap()
+                .unwrap()
+        };
+        let mut parts = part(0..5);
+        parts.extend(part(5..trials as u64));
+        assert_eq!(parts, part(0..trials as u64), "{game}");
+        assert_eq!(stats_of(&level, &solver, seed, &parts), stats, "{game}");
     }
 }

@@ -8,7 +8,7 @@
 //! The goal and start heading are drawn from the seed exactly as the rules draw them, so a rule
 //! level and a Generator level of the same seed lead to the same goal.
 
-use crate::game::generator::{GeneratorGame, Placement, TrackBuild, observation_size};
+use crate::game::generator::{BuildLimits, GeneratorGame, Placement, TrackBuild, observation_size};
 use crate::game::{PlatformGame, RacingGame};
 use crate::level::racing::RacingRulesConfig;
 use crate::level::{Game, Level, PolicyRef, RulesConfig, Source};
@@ -70,8 +70,8 @@ pub struct GeneratorPolicy {
     pub policy: ActorCritic,
     pub normalizer: RunningNorm,
     pub reference: PolicyRef,
-    /// The piece budget it was trained with (its observation counts down from it).
-    pub max_pieces: usize,
+    /// The piece budget and curve offset it was trained with.
+    pub limits: BuildLimits,
 }
 
 /// Why the Generator built no level.
@@ -121,14 +121,14 @@ fn build_level<G: GeneratorGame>(
     obstacles: u32,
     draw: u32,
 ) -> Result<Level, GenerationError> {
-    let (empty, mut rng) = G::new_build(seed, goal, generator.max_pieces, obstacles);
+    let (empty, mut rng) = G::new_build(seed, goal, generator.limits, obstacles);
     let goal = empty.goal();
     let mut skip = draw;
     let aux_input = [aux as f32];
     let mut observation = vec![0.0; observation_size::<G>()];
     for _ in 0..ATTEMPTS {
         let mut build = empty.clone();
-        while build.piece_count() < generator.max_pieces {
+        while build.piece_count() < generator.limits.max_pieces {
             build.observe(&aux_input, &mut observation);
             generator.normalizer.normalize(&mut observation);
             let action = generator
@@ -182,7 +182,7 @@ mod tests {
                 path: "generator.safetensors".into(),
                 sha256: "0".repeat(64),
             },
-            max_pieces: 30,
+            limits: BuildLimits::default_for::<crate::game::PlatformGame>(),
         }
     }
 
@@ -210,7 +210,7 @@ mod tests {
     #[test]
     fn an_unreachable_goal_is_a_clear_error() {
         let mut generator = untrained();
-        generator.max_pieces = 1;
+        generator.limits.max_pieces = 1;
         let err = generator_level(&generator, 1, 0.5, Some([500.0, 0.0, 0.0]), 0).unwrap_err();
         assert!(err.to_string().contains("no valid level"), "{err}");
     }

@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use sha2::{Digest, Sha256};
 
-use crate::game::generator::{GeneratorGame, observation_size};
+use crate::game::generator::{BuildLimits, GeneratorGame, observation_size};
+use crate::game::racing::generator::DEFAULT_CURVE_OFFSET;
 use crate::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
 use crate::generation::GeneratorPolicy;
 use crate::level::{Game, PolicyRef};
@@ -58,23 +59,43 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
 
 /// Loads a Generator policy of `game`.
 pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, PolicyCard)> {
-    let (observation, default_max_pieces) = match game {
+    let (observation, default_max_pieces, most_pieces) = match game {
         Game::Platform => (
             observation_size::<PlatformGame>(),
             PlatformGame::DEFAULT_MAX_PIECES,
+            PlatformGame::MAX_PIECES,
         ),
         Game::Racing => (
             observation_size::<RacingGame>(),
             RacingGame::DEFAULT_MAX_PIECES,
+            RacingGame::MAX_PIECES,
         ),
     };
     let (loaded, reference) = load_pinned(path, game, Role::Generator, observation)?;
     let card = loaded.card.clone();
+    let limits = BuildLimits {
+        max_pieces: card.max_pieces.unwrap_or(default_max_pieces),
+        curve_offset: card.curve_offset.unwrap_or(DEFAULT_CURVE_OFFSET),
+    };
+    if !(1..=most_pieces).contains(&limits.max_pieces) {
+        anyhow::bail!(
+            "{}: card field max_pieces is {}, outside [1, {most_pieces}]",
+            path.display(),
+            limits.max_pieces
+        );
+    }
+    if !(0.0..=180.0).contains(&limits.curve_offset) {
+        anyhow::bail!(
+            "{}: card field curve_offset is {}, not a number of degrees in [0, 180]",
+            path.display(),
+            limits.curve_offset
+        );
+    }
     Ok((
         GeneratorPolicy {
             game,
             policy: loaded.policy,
-            max_pieces: card.max_pieces.unwrap_or(default_max_pieces),
+            limits,
             normalizer: loaded.card.normalizer,
             reference,
         },

@@ -151,7 +151,7 @@ pub trait GeneratorGame: GameSpec {
     fn new_build(
         seed: u64,
         goal: Option<[f64; 3]>,
-        max_pieces: usize,
+        limits: BuildLimits,
         obstacles: u32,
     ) -> (Self::Build, ChaCha8Rng);
     /// The Solver's environment on a track with its first piece placed, still growing unless
@@ -166,6 +166,26 @@ pub trait GeneratorGame: GameSpec {
     fn furthest_piece(env: &Self::Env) -> usize;
     /// Steps the Solver has spent in the air in this run.
     fn air_steps(env: &Self::Env) -> u32;
+}
+
+/// What bounds a Generator's track besides its actions (a Generator's card records both).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BuildLimits {
+    /// The piece budget (the Generator's observation counts down from it).
+    pub max_pieces: usize,
+    /// Racing: how far, in degrees, the curve action may ask to turn from the goal's bearing
+    /// (`segment_from_action` in `src/game/racing/generator.rs`); the platform game ignores it.
+    pub curve_offset: f64,
+}
+
+impl BuildLimits {
+    /// The defaults of game `G`.
+    pub fn default_for<G: GeneratorGame>() -> Self {
+        Self {
+            max_pieces: G::DEFAULT_MAX_PIECES,
+            curve_offset: crate::game::racing::generator::DEFAULT_CURVE_OFFSET,
+        }
+    }
 }
 
 /// Straight-line distance between two points, m (progress toward a goal).

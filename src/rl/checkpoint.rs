@@ -63,6 +63,10 @@ pub struct PolicyCard {
     /// `max_blocks`).
     #[serde(default, alias = "max_blocks", skip_serializing_if = "Option::is_none")]
     pub max_pieces: Option<usize>,
+    /// Racing Generators only: how far its curve action may turn from the goal's bearing,
+    /// degrees (absent: 30, as every racing Generator before it was trained).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curve_offset: Option<f64>,
 }
 
 /// How a policy was trained.
@@ -309,6 +313,7 @@ mod tests {
             },
             results: HashMap::new(),
             max_pieces: None,
+            curve_offset: None,
         }
     }
 

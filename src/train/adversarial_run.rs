@@ -26,7 +26,10 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 TrainMode::FixedAux => vec![1.0],
                 _ => config.generator.aux_values.clone(),
             },
-            max_pieces: config.generator.max_pieces,
+            limits: BuildLimits {
+                max_pieces: config.generator.max_pieces,
+                curve_offset: config.generator.curve_offset,
+            },
             obstacles: config.generator.obstacles,
             rewards: config.generator.rewards.clone(),
         }

@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 use super::solver_envs::TRAINING_SEED_BASE;
 use crate::game::SolverEnv;
 use crate::game::generator::{
-    GeneratorGame, GeneratorRewards, Match, TrackBuild, observation_size,
+    BuildLimits, GeneratorGame, GeneratorRewards, Match, TrackBuild, observation_size,
 };
 use crate::level::stats::Outcome;
 use crate::rl::normalizer::RunningNorm;
@@ -61,7 +61,7 @@ impl Default for AdversarialState {
 pub struct MatchRules {
     /// λ is drawn uniformly from these for each match.
     pub aux_values: Vec<f32>,
-    pub max_pieces: usize,
+    pub limits: BuildLimits,
     /// Obstacles drawn into each racing match's scene.
     pub obstacles: u32,
     pub rewards: GeneratorRewards,
@@ -186,8 +186,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
     fn next_match(&mut self) -> Match<G> {
         let seed = TRAINING_SEED_BASE + self.state.episodes_started;
         self.state.episodes_started += 1;
-        let (build, mut rng) =
-            G::new_build(seed, None, self.rules.max_pieces, self.rules.obstacles);
+        let (build, mut rng) = G::new_build(seed, None, self.rules.limits, self.rules.obstacles);
         let values = &self.rules.aux_values;
         let aux = values[rng.random_range(0..values.len())];
         Match::new(build, vec![aux], seed)

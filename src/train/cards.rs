@@ -141,6 +141,8 @@ pub(super) fn card(
         },
         results: Default::default(),
         max_pieces: (role == Role::Generator).then_some(config.generator.max_pieces),
+        curve_offset: (role == Role::Generator && game == Game::Racing)
+            .then_some(config.generator.curve_offset),
     }
 }
 

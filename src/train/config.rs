@@ -84,6 +84,11 @@ pub struct GeneratorConfig {
     /// Racing: obstacles drawn into each match's scene (some draws fall too near the start or
     /// the goal and are dropped); the platform game has none.
     pub obstacles: u32,
+    /// Racing: how far, in degrees, the Generator's curve action may ask to turn from the goal's
+    /// bearing, in [0, 180] (the segment's curve stays within ±30°). 30 keeps the road within
+    /// about 30° of the bearing; 90 lets it bend away from the goal and back. The platform game
+    /// has no curve: there it stays 30.
+    pub curve_offset: f64,
     /// Log standard deviation of the new Generator's actions (in [-1, 1] units). At 0 (std 1)
     /// its turns span ±180° and almost no track reaches its goal; -1.6 (std 0.2) starts it at
     /// ±36°, ±0.5 m of distance, ±0.4 m of height, and lets PPO widen what pays.
@@ -135,6 +140,7 @@ impl Default for GeneratorConfig {
             aux_values: vec![-1.0, -1.0, -0.5, 0.5, 1.0, 1.0],
             max_pieces: PlatformGame::DEFAULT_MAX_PIECES,
             obstacles: 0,
+            curve_offset: crate::game::racing::generator::DEFAULT_CURVE_OFFSET,
             initial_log_std: -1.6,
             solver_warmup_steps: 500_000,
             solver_phase_steps: 100_000,
@@ -261,6 +267,10 @@ pub(super) fn check_resumable_change(old: &TrainConfig, new: &TrainConfig) -> Re
             "generator.max_pieces",
             old.generator.max_pieces == new.generator.max_pieces,
         ),
+        (
+            "generator.curve_offset",
+            old.generator.curve_offset == new.generator.curve_offset,
+        ),
     ];
     match fixed.iter().find(|(_, same)| !same) {
         Some((name, _)) => Err(format!(
@@ -332,6 +342,15 @@ fn check_config(config: &TrainConfig, game: Game) -> Result<(), String> {
             "generator.max_pieces must be within [1, {max_pieces}]"
         ));
     }
+    let default_offset = crate::game::racing::generator::DEFAULT_CURVE_OFFSET;
+    if !(0.0..=180.0).contains(&g.curve_offset) {
+        return Err("generator.curve_offset must be a number of degrees in [0, 180]".into());
+    }
+    if game == Game::Platform && g.curve_offset != default_offset {
+        return Err(format!(
+            "generator.curve_offset is the racing Generator's: the platform game has no curve (leave it at {default_offset})"
+        ));
+    }
     if g.obstacles > crate::level::racing::MAX_OBSTACLES as u32 {
         return Err(format!(
             "generator.obstacles must be at most {}",
@@ -376,6 +395,29 @@ mod tests {
             TrainConfig::parse_for("", Game::Racing).unwrap(),
             TrainConfig::for_game(Game::Racing)
         );
+        let wide =
+            TrainConfig::parse_for("generator:\n  curve_offset: 90\n", Game::Racing).unwrap();
+        assert_eq!(wide.generator.curve_offset, 90.0);
+        for (text, game, says) in [
+            (
+                "generator:\n  curve_offset: 200\n",
+                Game::Racing,
+                "in [0, 180]",
+            ),
+            (
+                "generator:\n  curve_offset: .nan\n",
+                Game::Racing,
+                "in [0, 180]",
+            ),
+            (
+                "generator:\n  curve_offset: 90\n",
+                Game::Platform,
+                "platform game has no curve",
+            ),
+        ] {
+            let err = TrainConfig::parse_for(text, game).unwrap_err();
+            assert!(err.to_string().contains(says), "{text}: {err}");
+        }
         let err =
             TrainConfig::parse_for("generator:\n  max_pieces: 500\n", Game::Racing).unwrap_err();
         assert!(

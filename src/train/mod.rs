@@ -26,7 +26,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 
 use crate::fsio::{self, Overwrite};
-use crate::game::generator::{GeneratorGame, observation_size};
+use crate::game::generator::{BuildLimits, GeneratorGame, observation_size};
 use crate::game::{GameSpec, PlatformGame, RacingGame};
 use crate::level::Game;
 use crate::rl::checkpoint::{self, PolicyCard, Role, TrainingRecord, TrainingState};

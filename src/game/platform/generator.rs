@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use super::env::{PlatformEnv, SolverRewards};
 use super::reach;
 use crate::game::PlatformGame;
-use crate::game::generator::{GeneratorGame, GeneratorRewards, Placement, TrackBuild};
+use crate::game::generator::{BuildLimits, GeneratorGame, GeneratorRewards, Placement, TrackBuild};
 use crate::game::rules::goal_and_start;
 use crate::level::Track;
 use crate::level::params::{self, quantize};
@@ -207,14 +207,14 @@ impl GeneratorGame for PlatformGame {
     fn new_build(
         seed: u64,
         goal: Option<[f64; 3]>,
-        max_pieces: usize,
+        limits: BuildLimits,
         _obstacles: u32,
     ) -> (PlatformBuild, ChaCha8Rng) {
         let (goal, start, rng) = goal_and_start(seed, goal);
         let build = PlatformBuild {
             track: PlatformTrack::new(start),
             goal,
-            max_blocks: max_pieces,
+            max_blocks: limits.max_pieces,
         };
         (build, rng)
     }

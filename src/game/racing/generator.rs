@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::env::{RacingEnv, SIGHT, SolverRewards};
 use crate::game::RacingGame;
-use crate::game::generator::{GeneratorGame, GeneratorRewards, Placement, TrackBuild};
+use crate::game::generator::{BuildLimits, GeneratorGame, GeneratorRewards, Placement, TrackBuild};
 use crate::level::Track;
 use crate::level::params::{SEGMENT_CURVE, SEGMENT_HEIGHT, SEGMENT_LENGTH, quantize};
 use crate::level::platform::{direction_heading, heading_direction, wrap_degrees};
@@ -32,6 +32,10 @@ const RAY_STEP: f64 = 4.0;
 /// The segment budget of a Generator's track by default (goals are at most 360 m away,
 /// segments 20-30 m long).
 pub const DEFAULT_MAX_SEGMENTS: usize = 30;
+/// How far, in degrees, the Generator's curve action may ask to turn from the goal's bearing by
+/// default: with 30 (the segment's own ±30° limit) the road keeps within about 30° of the
+/// bearing and cannot bend away from the goal and back. A Generator's card records its own.
+pub const DEFAULT_CURVE_OFFSET: f64 = 30.0;
 /// Obstacles drawn into each training match's scene (some draws fall too near the start or the
 /// goal and are dropped).
 pub const MATCH_OBSTACLES: u32 = 3;
@@ -63,8 +67,14 @@ pub const GENERATOR_ACTIONS: [&str; 3] = [
 
 /// A policy's action row (unbounded Gaussian samples) as the next segment of `road` toward
 /// `goal`: each value clipped to [-1, 1] (NaN becomes the middle) and mapped onto its range, the
-/// curve added to the goal's bearing, the height change to the on-course climb.
-pub fn segment_from_action(road: &Road, goal: [f64; 3], row: &[f32]) -> SegmentParams {
+/// curve the goal's bearing plus up to ±`curve_offset` degrees (then clipped to the segment's
+/// ±30°), the height change added to the on-course climb.
+pub fn segment_from_action(
+    road: &Road,
+    goal: [f64; 3],
+    row: &[f32],
+    curve_offset: f64,
+) -> SegmentParams {
     let unit = |v: f32| {
         if v.is_nan() {
             0.0
@@ -75,7 +85,7 @@ pub fn segment_from_action(road: &Road, goal: [f64; 3], row: &[f32]) -> SegmentP
     let (end, heading) = road.end();
     let length = quantize(SEGMENT_LENGTH.from_unit(unit(row[0])));
     let bearing = wrap_degrees(direction_heading(goal[0] - end[0], goal[2] - end[2]) - heading);
-    let curve = quantize(SEGMENT_CURVE.clamp(bearing + SEGMENT_CURVE.max * unit(row[1])));
+    let curve = quantize(SEGMENT_CURVE.clamp(bearing + curve_offset * unit(row[1])));
     let plan = (goal[0] - end[0]).hypot(goal[2] - end[2]).max(1e-6);
     let on_course = (goal[1] - end[1]) * (length / plan).min(1.0);
     let height = quantize(SEGMENT_HEIGHT.clamp(on_course + SEGMENT_HEIGHT.max * unit(row[2])));
@@ -94,10 +104,13 @@ pub struct RacingBuild {
     pub road: Road,
     pub goal: [f64; 3],
     pub max_segments: usize,
+    /// See [`segment_from_action`].
+    pub curve_offset: f64,
 }
 
 impl RacingBuild {
-    /// An empty road at the origin heading `heading` degrees, among `obstacles`.
+    /// An empty road at the origin heading `heading` degrees, among `obstacles`, with the
+    /// default [`DEFAULT_CURVE_OFFSET`].
     pub fn new(
         heading: f64,
         goal: [f64; 3],
@@ -112,6 +125,7 @@ impl RacingBuild {
             road,
             goal,
             max_segments,
+            curve_offset: DEFAULT_CURVE_OFFSET,
         }
     }
 
@@ -205,7 +219,7 @@ impl TrackBuild for RacingBuild {
         if index >= self.max_segments {
             return Placement::OutOfPieces;
         }
-        let segment = segment_from_action(&self.road, self.goal, row);
+        let segment = segment_from_action(&self.road, self.goal, row, self.curve_offset);
         self.road.push(segment);
         self.track.segments.push(segment);
         if self.road.first_crossing(index).is_some()
@@ -264,11 +278,13 @@ impl GeneratorGame for RacingGame {
     fn new_build(
         seed: u64,
         goal: Option<[f64; 3]>,
-        max_pieces: usize,
+        limits: BuildLimits,
         obstacles: u32,
     ) -> (RacingBuild, ChaCha8Rng) {
         let (goal, heading, obstacles, rng) = super::rules::goal_and_start(seed, goal, obstacles);
-        (RacingBuild::new(heading, goal, obstacles, max_pieces), rng)
+        let mut build = RacingBuild::new(heading, goal, obstacles, limits.max_pieces);
+        build.curve_offset = limits.curve_offset;
+        (build, rng)
     }
 
     fn open_env(build: &RacingBuild, complete: bool) -> RacingEnv {
@@ -308,17 +324,43 @@ mod tests {
     use crate::game::racing::{OBSERVATION_SIZE, ScriptedDriver};
 
     #[test]
+    fn a_wider_curve_offset_lets_the_road_bend_away_from_its_goal() {
+        // The road's end points 40° to the right of the goal (straight ahead along +x, the goal
+        // at 40° to the left).
+        let road = Road::start([0.0; 3], 0.0);
+        let angle = 40f64.to_radians();
+        let goal = [300.0 * angle.cos(), 0.0, -300.0 * angle.sin()];
+        let away = [0.0, -1.0, 0.0];
+        let default = segment_from_action(&road, goal, &away, DEFAULT_CURVE_OFFSET);
+        assert!(default.curve > 0.0, "30°: still turns toward the goal");
+        let wide = segment_from_action(&road, goal, &away, 90.0);
+        assert_eq!(wide.curve, -30.0, "90°: turns away as far as a segment may");
+        let toward = segment_from_action(&road, goal, &[0.0; 3], 90.0);
+        assert_eq!(toward.curve, 30.0, "0 still heads for the goal");
+    }
+
+    #[test]
     fn a_zero_action_turns_and_climbs_toward_the_goal() {
         let road = Road::start([0.0; 3], 0.0);
         // Heading 0 runs along +x; a goal off to the left (−z) at 45°.
-        let segment = segment_from_action(&road, [100.0, 10.0, -100.0], &[0.0; 3]);
+        let segment = segment_from_action(
+            &road,
+            [100.0, 10.0, -100.0],
+            &[0.0; 3],
+            DEFAULT_CURVE_OFFSET,
+        );
         assert_eq!(segment.length, 25.0);
         assert_eq!(segment.curve, 30.0, "45° to the goal, clipped to the range");
         assert!(
             (segment.height - 10.0 * 25.0 / 141.42).abs() < 0.01,
             "{segment:?}"
         );
-        let straight = segment_from_action(&road, [200.0, 0.0, 0.0], &[1.0, -1.0, f32::NAN]);
+        let straight = segment_from_action(
+            &road,
+            [200.0, 0.0, 0.0],
+            &[1.0, -1.0, f32::NAN],
+            DEFAULT_CURVE_OFFSET,
+        );
         assert_eq!(
             (straight.length, straight.curve, straight.height),
             (30.0, -30.0, 0.0)
@@ -363,7 +405,12 @@ mod tests {
 
     #[test]
     fn a_match_grows_the_road_ahead_of_the_car_and_ends_at_the_goal() {
-        let (build, _) = RacingGame::new_build(11, Some([150.0, 0.0, 40.0]), 30, 0);
+        let (build, _) = RacingGame::new_build(
+            11,
+            Some([150.0, 0.0, 40.0]),
+            BuildLimits::default_for::<RacingGame>(),
+            0,
+        );
         let mut game = Match::<RacingGame>::new(build, vec![1.0], 3);
         let rewards = RacingGame::default_rewards();
         let mut driver = ScriptedDriver::new(3, 0.0);

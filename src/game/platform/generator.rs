@@ -368,10 +368,10 @@ mod tests {
             ..Start::default()
         });
         // Longest, smallest, steepest up: 10 m between 4 m blocks would be a 6 m gap 2 m up,
-        // where the reach table allows 5 m.
+        // where the reach table allows 4.25 m.
         let far_up = block_from_action(&track, [60.0, 30.0, 0.0], &[1.0, 0.0, -1.0, 1.0]);
         assert_eq!(far_up.height, 2.0);
-        assert_eq!(far_up.distance, 5.0 + 0.5 * (4.0 + 4.0));
+        assert_eq!(far_up.distance, 4.25 + 0.5 * (4.0 + 4.0));
         let far_flat = block_from_action(&track, [60.0, 0.0, 0.0], &[1.0, 0.0, -1.0, 0.0]);
         assert_eq!(far_flat.distance, 10.0, "a flat 6 m gap is within reach");
         let mut rng = ChaCha8Rng::seed_from_u64(4);

@@ -94,6 +94,9 @@ fn the_documented_reach_table_is_what_the_simulation_measures() {
     assert_eq!(reach::successes(&single_jump(5.0, 2.0), 16, 0.3), 16);
     assert_eq!(reach::successes(&single_jump(5.75, 2.0), 16, 0.3), 0);
     assert!(reach::successes(&reach::chained_jump(5.0, 2.0, 45.0), 16, 0.3) < 16);
+    // Beyond the largest turn the table's own gap is not made every time.
+    let sharp = reach::chained_jump(REACH_TABLE[4], 2.0, reach::MAX_TURN + 45.0);
+    assert!(reach::successes(&sharp, 16, 0.3) < 16);
 }
 
 #[test]

@@ -60,9 +60,10 @@ pub const DEFAULT_MAX_BLOCKS: usize = 30;
 
 /// A policy's action row (unbounded Gaussian samples) as the next block of `track` toward
 /// `goal`: each value is clipped to [-1, 1] and mapped onto its range (NaN becomes the middle),
-/// the turn added to the goal's bearing from the last block, the height change to the climb
-/// that keeps the slope toward the goal (see [`GENERATOR_ACTIONS`]), the distance shortened to
-/// keep the edge gap within the reach table ([`reach::max_gap`]) for that height change.
+/// the turn added to the goal's bearing from the last block and kept within
+/// [`reach::MAX_TURN`] of the last jump's direction, the height change to the climb that keeps
+/// the slope toward the goal (see [`GENERATOR_ACTIONS`]), the distance shortened to keep the
+/// edge gap within the reach table ([`reach::max_gap`]) for that height change.
 pub fn block_from_action(track: &PlatformTrack, goal: [f64; 3], row: &[f32]) -> BlockParams {
     let unit = |v: f32| if v.is_nan() { 0.0 } else { v as f64 };
     let mut block =
@@ -70,7 +71,9 @@ pub fn block_from_action(track: &PlatformTrack, goal: [f64; 3], row: &[f32]) -> 
     let last = track.last();
     let (dx, dz) = (goal[0] - last.position[0], goal[2] - last.position[2]);
     let bearing = direction_heading(dx, dz);
-    block.angle = quantize(wrap_degrees(bearing - last.heading + block.angle));
+    block.angle = quantize(
+        wrap_degrees(bearing - last.heading + block.angle).clamp(-reach::MAX_TURN, reach::MAX_TURN),
+    );
     let rise = goal[1] - last.position[1];
     let on_course = rise * (block.distance / dx.hypot(dz).max(1e-6)).min(1.0);
     block.height = quantize(params::BLOCK_HEIGHT.clamp(on_course + block.height));
@@ -362,7 +365,7 @@ mod tests {
     }
 
     #[test]
-    fn no_action_places_a_block_beyond_reach() {
+    fn no_action_places_a_block_beyond_reach_or_turns_back() {
         let track = PlatformTrack::new(Start {
             size: 4.0,
             ..Start::default()
@@ -385,28 +388,35 @@ mod tests {
                 gap <= reach::max_gap(block.height) + 1e-3,
                 "{block:?}: gap {gap}"
             );
+            assert!(block.angle.abs() <= reach::MAX_TURN, "{block:?}");
             assert!(BLOCK_DISTANCE.check(block.distance).is_ok(), "{block:?}");
         }
     }
 
     #[test]
     fn overlaps_and_running_out_of_blocks_end_the_match() {
-        let goal = [60.0, 0.0, 0.0];
+        // Three sides of a square (5 m jumps, two left turns of 90°); the goal lies on to the
+        // left, so heading for it puts the fourth block onto the start block.
+        let start = Start {
+            size: 4.0,
+            ..Start::default()
+        };
+        let side = |angle| BlockParams::new(5.0, angle, 4.0, 0.0).unwrap();
+        let track = PlatformTrack::from_params(start, &[side(0.0), side(90.0), side(90.0)]).unwrap();
         let build = PlatformBuild {
-            track: PlatformTrack::new(Start::default()),
-            goal,
-            max_blocks: 2,
+            track,
+            goal: [0.0, 0.0, 30.0],
+            max_blocks: 4,
         };
         let mut game = Match::<PlatformGame>::new(build, vec![-1.0], 1);
-        let ahead = [-1.0, 0.0, 0.0, 0.0];
-        assert_eq!(game.place(&ahead), Placement::Placed);
-        let back = [-1.0, 1.0, 0.0, 0.0];
+        let toward_goal = [-1.0, 0.0, 0.0, 0.0];
         assert_eq!(
-            game.place(&back),
+            game.place(&toward_goal),
             Placement::Invalid,
-            "a U-turn onto the start block"
+            "a 90° turn onto the start block"
         );
-        assert_eq!(game.place(&ahead), Placement::Placed);
-        assert_eq!(game.place(&ahead), Placement::OutOfPieces);
+        let away = [-1.0, 1.0, 0.0, 0.0];
+        assert_eq!(game.place(&away), Placement::Placed);
+        assert_eq!(game.place(&away), Placement::OutOfPieces);
     }
 }

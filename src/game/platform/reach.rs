@@ -12,6 +12,10 @@ use crate::level::stats::{Outcome, TrialResult};
 pub const REACH_HEIGHTS: [f64; 5] = [-2.0, -1.0, 0.0, 1.0, 2.0];
 /// The turns, degrees, of the second jump of a [`chained_jump`] that the table must clear.
 pub const REACH_TURNS: [f64; 5] = [-90.0, -45.0, 0.0, 45.0, 90.0];
+/// The sharpest turn, degrees off the direction of the last jump, that stays within reach: after
+/// a fast landing a sharper one means stopping and turning back on the block, and the scripted
+/// controller fails it even across short gaps (`docs/platform-physics.md`, "Chained jumps").
+pub const MAX_TURN: f64 = 90.0;
 /// Largest edge gap, m, that the scripted controller (take-off jitter `REACH_JITTER`) clears in
 /// every one of `REACH_TRIALS` seeded runs of a [`chained_jump`] at every turn of `REACH_TURNS`,
 /// for each height change of `REACH_HEIGHTS`, measured in steps of `REACH_STEP` from 1 m up to

@@ -857,6 +857,72 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
 
 /// `--target-success P` hands out levels whose measured success is within ±0.1 of P, recording
 /// the λ it used; the curve it starts from is the one kept beside the shipped policies.
+/// A seed whose goal rules the band out (seed 4's scene: no λ or draw of the shipped Generator
+/// measures under 0.65) gets a level of another seed's scene, which it records.
+#[test]
+fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = arlpcg(&[
+        "generate",
+        "--policies",
+        "policies/platform",
+        "--target-success",
+        "0.3",
+        "--seed",
+        "4",
+        "--verify",
+        "100",
+        "--format",
+        "yaml",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let files = files_of(dir.path());
+    assert_eq!(files.len(), 1);
+    let (name, _) = &files[0];
+    assert!(name.starts_with("platform_seed4_"), "{name}");
+    let level = arlpcg::level::yaml::load(&dir.path().join(name)).unwrap();
+    assert_ne!(level.seed, Some(4), "{name} was built from seed 4's own scene");
+    let stats = level.stats.unwrap();
+    assert!((stats.success_ratio - 0.3).abs() <= 0.1 + 1e-9, "{}", stats.success_ratio);
+    // Given the goal, the search keeps to it, and seed 4's goal rules 0.3 out.
+    let own = dir.path().join("own");
+    let out = arlpcg(&[
+        "generate",
+        "--policies",
+        "policies/platform",
+        "--aux",
+        "-1",
+        "--seed",
+        "4",
+        "--format",
+        "yaml",
+        "--out",
+        own.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let goal = arlpcg::level::yaml::load(&own.join("platform_seed4_aux-1.00.yaml"))
+        .unwrap()
+        .goal;
+    let goal = format!("{},{},{}", goal[0], goal[1], goal[2]);
+    let out = arlpcg(&[
+        "generate",
+        "--policies",
+        "policies/platform",
+        "--target-success",
+        "0.3",
+        "--seed",
+        "4",
+        "--goal",
+        &goal,
+        "--out",
+        dir.path().join("given").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("no level within ±0.1 of success 0.3"), "{}", stderr(&out));
+}
+
 #[test]
 fn target_success_levels_measure_within_the_band() {
     let dir = tempfile::tempdir().unwrap();

@@ -4,11 +4,12 @@
 //! One level's success at a λ varies a lot from seed to seed (the curve is an average), so the
 //! search starts at the λ the curve gives for `P` and then moves λ by how far each verified
 //! candidate missed, drawing a new level of the same seed and goal each time, until one
-//! measures within [`BAND`] of `P`. A seed's goal can rule a band out (a goal far below the
-//! start makes every level easy), so after [`OWN_GOAL_CANDIDATES`] misses, unless the goal was
-//! given, each candidate is built from another seed's scene (the level records that seed). Each candidate plays [`SCREEN_TRIALS`] runs first and the
-//! rest only if their 95% interval still meets the band: a kept level's statistics are those of
-//! all its runs, the same as one verification of them all.
+//! measures within [`BAND`] of `P`. A seed's scene can rule a band out (seed 1's goal: no level
+//! of the shipped platform policies under 0.31), so after [`OWN_SCENE_CANDIDATES`] misses,
+//! unless the goal was given, each candidate is built from another seed's scene (the level
+//! records that seed). Each candidate plays [`SCREEN_TRIALS`] runs first and the rest only if
+//! their 95% interval still meets the band: a kept level's statistics are those of all its
+//! runs, the same as one verification of them all.
 
 use serde::{Deserialize, Serialize};
 
@@ -21,8 +22,8 @@ use crate::verify::{Solver, Watch, WrongGame, stats_of, trial_results, verify};
 pub const BAND: f64 = 0.1;
 /// Candidates tried per level before giving up.
 pub const MAX_CANDIDATES: u32 = 48;
-/// Candidates toward the seed's own goal before the search tries other seeds' scenes.
-pub const OWN_GOAL_CANDIDATES: u32 = 24;
+/// Candidates from the seed's own scene before the search tries other seeds' scenes.
+pub const OWN_SCENE_CANDIDATES: u32 = 24;
 /// Runs a candidate plays before the search decides whether to play the rest.
 pub const SCREEN_TRIALS: u32 = 20;
 /// The λ values the curve is measured at, easy to hard.
@@ -122,7 +123,7 @@ impl Curve {
 
 /// A level of `seed` whose success, verified with `trials` runs, is within [`BAND`] of
 /// `target`: the search starts at the curve's λ and moves λ against each miss, each candidate
-/// a new draw of the seed, or of another seed after [`OWN_GOAL_CANDIDATES`] (unless `goal`
+/// a new draw of the seed, or of another seed after [`OWN_SCENE_CANDIDATES`] (unless `goal`
 /// is given). A candidate that no run completed is never kept.
 pub fn level_for(
     generator: &GeneratorPolicy,
@@ -140,7 +141,7 @@ pub fn level_for(
         let quantized = (aux * 1000.0).round() / 1000.0;
         // Another seed supplies the whole scene (start, goal, obstacles), so it stays one the
         // Generator was trained on; the level records that seed.
-        let candidate_seed = if goal.is_none() && draw >= OWN_GOAL_CANDIDATES {
+        let candidate_seed = if goal.is_none() && draw >= OWN_SCENE_CANDIDATES {
             seed ^ (u64::from(draw) << 48)
         } else {
             seed

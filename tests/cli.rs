@@ -807,7 +807,7 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
         "--count",
         "12",
         "--verify",
-        "20",
+        "3",
         "--format",
         "yaml",
         "--out",
@@ -826,7 +826,7 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
         redraws += stats.redraws;
         levels.push(path.display().to_string());
     }
-    // At λ = -1 some first draws are completed by no run of 20 (about one in ten).
+    // At λ = -1 (success about 0.4) a level verified with 3 runs is often completed by none.
     assert!(redraws > 0, "nothing was redrawn: {said}");
     assert!(said.contains("redrew"), "{said}");
     let mut args = vec!["verify", "--replay"];
@@ -857,8 +857,8 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
 
 /// `--target-success P` hands out levels whose measured success is within ±0.1 of P, recording
 /// the λ it used; the curve it starts from is the one kept beside the shipped policies.
-/// A seed whose goal rules the band out (seed 4's scene: no λ or draw of the shipped Generator
-/// measures under 0.65) gets a level of another seed's scene, which it records.
+/// A seed whose goal rules the band out (seed 1's scene: no λ or draw of the shipped Generator
+/// measures under 0.31) gets a level of another seed's scene, which it records.
 #[test]
 fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band() {
     let dir = tempfile::tempdir().unwrap();
@@ -867,9 +867,9 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
         "--policies",
         "policies/platform",
         "--target-success",
-        "0.3",
+        "0.2",
         "--seed",
-        "4",
+        "1",
         "--verify",
         "100",
         "--format",
@@ -881,12 +881,20 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
     let files = files_of(dir.path());
     assert_eq!(files.len(), 1);
     let (name, _) = &files[0];
-    assert!(name.starts_with("platform_seed4_"), "{name}");
+    assert!(name.starts_with("platform_seed1_"), "{name}");
     let level = arlpcg::level::yaml::load(&dir.path().join(name)).unwrap();
-    assert_ne!(level.seed, Some(4), "{name} was built from seed 4's own scene");
+    assert_ne!(
+        level.seed,
+        Some(1),
+        "{name} was built from seed 1's own scene"
+    );
     let stats = level.stats.unwrap();
-    assert!((stats.success_ratio - 0.3).abs() <= 0.1 + 1e-9, "{}", stats.success_ratio);
-    // Given the goal, the search keeps to it, and seed 4's goal rules 0.3 out.
+    assert!(
+        (stats.success_ratio - 0.2).abs() <= 0.1 + 1e-9,
+        "{}",
+        stats.success_ratio
+    );
+    // Given the goal, the search keeps to it, and seed 1's goal rules 0.2 out (closest 0.31).
     let own = dir.path().join("own");
     let out = arlpcg(&[
         "generate",
@@ -895,14 +903,14 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
         "--aux",
         "-1",
         "--seed",
-        "4",
+        "1",
         "--format",
         "yaml",
         "--out",
         own.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let goal = arlpcg::level::yaml::load(&own.join("platform_seed4_aux-1.00.yaml"))
+    let goal = arlpcg::level::yaml::load(&own.join("platform_seed1_aux-1.00.yaml"))
         .unwrap()
         .goal;
     let goal = format!("{},{},{}", goal[0], goal[1], goal[2]);
@@ -911,16 +919,19 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
         "--policies",
         "policies/platform",
         "--target-success",
-        "0.3",
+        "0.2",
         "--seed",
-        "4",
-        "--goal",
-        &goal,
+        "1",
+        &format!("--goal={goal}"),
         "--out",
         dir.path().join("given").to_str().unwrap(),
     ]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert!(stderr(&out).contains("no level within ±0.1 of success 0.3"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("no level within ±0.1 of success 0.2"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]

@@ -402,7 +402,8 @@ mod tests {
             ..Start::default()
         };
         let side = |angle| BlockParams::new(5.0, angle, 4.0, 0.0).unwrap();
-        let track = PlatformTrack::from_params(start, &[side(0.0), side(90.0), side(90.0)]).unwrap();
+        let track =
+            PlatformTrack::from_params(start, &[side(0.0), side(90.0), side(90.0)]).unwrap();
         let build = PlatformBuild {
             track,
             goal: [0.0, 0.0, 30.0],

@@ -19,8 +19,8 @@ pub const MAX_TURN: f64 = 90.0;
 /// Largest edge gap, m, that the scripted controller (take-off jitter `REACH_JITTER`) clears in
 /// every one of `REACH_TRIALS` seeded runs of a [`chained_jump`] at every turn of `REACH_TURNS`,
 /// for each height change of `REACH_HEIGHTS`, measured in steps of `REACH_STEP` from 1 m up to
-/// the largest gap the parameter ranges allow (6 m). A jump right after a landing has less
-/// run-up than one from standstill on the start block, so this is the reach anywhere in a level.
+/// the largest gap the parameter ranges allow (6 m). A jump right after a landing is harder
+/// than one from standstill on the start block, so this is the reach anywhere in a level.
 pub const REACH_TABLE: [f64; 5] = [6.0, 6.0, 6.0, 6.0, 4.25];
 /// Resolution of the table, m.
 pub const REACH_STEP: f64 = 0.25;

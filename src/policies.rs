@@ -103,19 +103,48 @@ pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, Polic
     ))
 }
 
-/// The file beside a policies folder's Generator that holds its λ→success curve.
+/// The file beside a policies folder's Generator that holds its λ→success curve with the
+/// Solver beside it.
 pub const CURVE_FILE: &str = "difficulty-curve.yaml";
 
-/// The λ→success curve of `generator` with `solver`, kept in `dir` ([`CURVE_FILE`]): read when
-/// it was measured with these two policies (by SHA-256), else measured (`on_measure` is told
-/// first: it takes a while) and kept there when the folder can be written.
+/// Where the λ→success curve of the Generator in `dir` with the Solver at `solver_path` is kept:
+/// [`CURVE_FILE`] for the folder's own Solver, else a file named after the other Solver and its
+/// SHA-256, so that measuring with another Solver never replaces the folder's own curve.
+pub fn curve_path(dir: &Path, solver_path: &Path, solver_sha256: &str) -> PathBuf {
+    let own = dir.join(SOLVER_FILE);
+    let same = match (own.canonicalize(), solver_path.canonicalize()) {
+        (Ok(own), Ok(solver)) => own == solver,
+        _ => own == solver_path,
+    };
+    if same {
+        return dir.join(CURVE_FILE);
+    }
+    let stem = solver_path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .filter(|s| {
+            s.chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        })
+        .unwrap_or("solver");
+    let short = solver_sha256.get(..12).unwrap_or(solver_sha256);
+    dir.join(format!("difficulty-curve-{stem}-{short}.yaml"))
+}
+
+/// The λ→success curve of `generator` with `solver`, kept in `dir` (see [`curve_path`]): read
+/// when it was measured with these two policies (by SHA-256), else measured (`on_measure` is
+/// told first: it takes a while) and kept there when the folder can be written.
 pub fn difficulty_curve(
     dir: &Path,
     generator: &GeneratorPolicy,
     solver: &SolverPolicy,
     on_measure: impl FnOnce(),
 ) -> Result<crate::difficulty::Curve> {
-    let path = dir.join(CURVE_FILE);
+    let path = curve_path(
+        dir,
+        Path::new(&solver.reference.path),
+        &solver.reference.sha256,
+    );
     let current = |c: &crate::difficulty::Curve| {
         c.generator_sha256 == generator.reference.sha256
             && c.solver_sha256 == solver.reference.sha256
@@ -144,4 +173,49 @@ pub fn difficulty_curve(
 /// The paths of the Generator and the Solver in a policies folder.
 pub fn policy_paths(dir: &Path) -> (PathBuf, PathBuf) {
     (dir.join(GENERATOR_FILE), dir.join(SOLVER_FILE))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_the_folders_own_solver_uses_the_folders_curve_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let other = tempfile::tempdir().unwrap();
+        for path in [
+            dir.path().join(SOLVER_FILE),
+            dir.path().join("solver-rule-pcg.safetensors"),
+            other.path().join(SOLVER_FILE),
+        ] {
+            std::fs::write(path, b"weights").unwrap();
+        }
+        let own = curve_path(dir.path(), &dir.path().join(SOLVER_FILE), "ab12");
+        assert_eq!(own, dir.path().join(CURVE_FILE));
+        let spelled_otherwise = dir.path().join(".").join(SOLVER_FILE);
+        assert_eq!(
+            curve_path(dir.path(), &spelled_otherwise, "ab12"),
+            dir.path().join(CURVE_FILE)
+        );
+        let baseline = curve_path(
+            dir.path(),
+            &dir.path().join("solver-rule-pcg.safetensors"),
+            "0123456789abcdef",
+        );
+        assert_eq!(
+            baseline,
+            dir.path()
+                .join("difficulty-curve-solver-rule-pcg-0123456789ab.yaml")
+        );
+        // Another folder's Solver of the same file name: its own curve file, told apart by hash.
+        let foreign = curve_path(
+            dir.path(),
+            &other.path().join(SOLVER_FILE),
+            "fedcba9876543210",
+        );
+        assert_eq!(
+            foreign,
+            dir.path().join("difficulty-curve-solver-fedcba987654.yaml")
+        );
+    }
 }

@@ -703,6 +703,40 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
     train("1024", true);
     assert_eq!(curve(&out).last().unwrap().1, 1024);
     assert!(generator_rows(&out) > generator_before);
+    // The curve offset belongs to the Generator's weights: a resumed run cannot change it.
+    let wider = dir.path().join("wider.yaml");
+    std::fs::write(
+        &wider,
+        TINY_ADVERSARIAL.replace("generator:\n", "generator:\n  curve_offset: 90\n"),
+    )
+    .unwrap();
+    let refused = arlpcg(&[
+        "train",
+        "--game",
+        "racing",
+        "--mode",
+        "arlpcg",
+        "--steps",
+        "1536",
+        "--out",
+        out_s,
+        "--resume",
+        "--config",
+        wider.to_str().unwrap(),
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    let message = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        message.contains("generator-checkpoint.safetensors")
+            && message
+                .contains("trained with generator.curve_offset 30, the configuration says 90"),
+        "{message}"
+    );
+    assert_eq!(
+        curve(&out).last().unwrap().1,
+        1024,
+        "the refused run left the run as it was"
+    );
     let header = std::fs::read_to_string(out.join("generator-metrics.csv")).unwrap();
     assert!(
         header.starts_with("iteration,")

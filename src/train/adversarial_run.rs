@@ -81,6 +81,17 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         let (loaded, generator_state) = read_checkpoint(&path, G::GAME, Role::Generator, mode)?;
         let generator_iteration = generator_state.iteration;
         let build = move |config: &TrainConfig, source: Option<serde_json::Value>| {
+            if let Some(trained) = loaded.card.curve_offset
+                && trained != config.generator.curve_offset
+            {
+                anyhow::bail!(
+                    "{}: this Generator was trained with generator.curve_offset {trained}, the \
+                     configuration says {}; it maps its actions to curves by that offset, so it \
+                     cannot change",
+                    path.display(),
+                    config.generator.curve_offset
+                );
+            }
             let state: AdversarialState =
                 serde_json::from_value(source.unwrap_or_default()).context("match source")?;
             let vars = loaded.policy.named_vars();

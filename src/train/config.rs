@@ -254,7 +254,9 @@ fn overlay(defaults: serde_yaml::Value, given: serde_yaml::Value) -> serde_yaml:
 
 /// Checks that `new` may replace `old` in a resumed run: the fields that fix the networks'
 /// shapes, the number of matches and the seed stream stay; learning rates, coefficients,
-/// rewards and the phase schedule may change.
+/// rewards and the phase schedule may change. The racing Generator's curve offset belongs to
+/// its weights and is checked against the Generator checkpoint's card instead (a run may pair
+/// a Solver checkpoint with another run's Generator).
 pub(super) fn check_resumable_change(old: &TrainConfig, new: &TrainConfig) -> Result<(), String> {
     let fixed = [
         ("seed", old.seed == new.seed),
@@ -266,10 +268,6 @@ pub(super) fn check_resumable_change(old: &TrainConfig, new: &TrainConfig) -> Re
         (
             "generator.max_pieces",
             old.generator.max_pieces == new.generator.max_pieces,
-        ),
-        (
-            "generator.curve_offset",
-            old.generator.curve_offset == new.generator.curve_offset,
         ),
     ];
     match fixed.iter().find(|(_, same)| !same) {

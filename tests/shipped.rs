@@ -147,7 +147,18 @@ fn the_shipped_racing_solvers_load_and_drive() {
             card.observation.iter().map(|(_, k)| k).sum::<usize>(),
             OBSERVATION_SIZE
         );
-        assert!((10_000_000..10_100_000).contains(&card.training.steps));
+        // Every racing Solver learns for 10M steps; the ARLPCG one then 0.31M more against the
+        // Generator with the 90° curve offset (README, "Racing results").
+        let budget = if mode == "arlpcg" {
+            10_300_000..10_320_000
+        } else {
+            10_000_000..10_100_000
+        };
+        assert!(
+            budget.contains(&card.training.steps),
+            "{file}: {} steps",
+            card.training.steps
+        );
         // A policy trained from uncommitted code cannot be reproduced: none ships.
         assert!(
             !card.training.commit.ends_with("-dirty"),

@@ -7,7 +7,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::level::Game;
 use crate::level::params;
-use crate::train::{TrainMode, TrainRequest};
+use crate::train::TrainMode;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -273,22 +273,6 @@ impl From<TrainModeArg> for TrainMode {
             TrainModeArg::FixedTrack => Self::FixedTrack,
             TrainModeArg::FixedAux => Self::FixedAux,
             TrainModeArg::Arlpcg => Self::Arlpcg,
-        }
-    }
-}
-
-impl From<TrainArgs> for TrainRequest {
-    fn from(args: TrainArgs) -> Self {
-        Self {
-            game: args.game,
-            mode: args.mode.into(),
-            steps: args.steps,
-            minutes: args.minutes,
-            config: args.config,
-            out: args.out,
-            resume: args.resume,
-            print_config: args.print_config,
-            threads: args.threads,
         }
     }
 }

@@ -31,8 +31,6 @@ pub const CURVE_AUX: [f64; 9] = [1.0, 0.75, 0.5, 0.25, 0.0, -0.25, -0.5, -0.75, 
 /// Levels per λ and runs per level when measuring the curve.
 pub const CURVE_LEVELS: u32 = 8;
 pub const CURVE_TRIALS: u32 = 20;
-/// Seeds of the levels the curve is measured on (apart from eval's and training's).
-const CURVE_SEED_BASE: u64 = 3 << 32;
 
 /// Mean success ratio of a Solver on a Generator's levels at each λ of [`CURVE_AUX`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -69,8 +67,8 @@ pub fn measure(
         let mut total = 0.0;
         let mut count = 0;
         for k in 0..CURVE_LEVELS as u64 {
-            let seed = CURVE_SEED_BASE + k;
-            let obstacles = crate::eval::scene_obstacles(generator.game);
+            let seed = crate::seeds::CURVE_SEED_BASE + k;
+            let obstacles = crate::game::facts::facts(generator.game).scene_obstacles;
             match generation::generator_level(generator, seed, aux, None, obstacles) {
                 Ok(level) => {
                     total += verify(&level, solver, CURVE_TRIALS, seed, &|| {})?.success_ratio;
@@ -136,7 +134,7 @@ pub fn level_for(
 ) -> Result<Level, TargetError> {
     let mut aux = curve.aux_for(target);
     let mut closest = (f64::INFINITY, f64::NAN, aux);
-    let obstacles = crate::eval::scene_obstacles(generator.game);
+    let obstacles = crate::game::facts::facts(generator.game).scene_obstacles;
     for draw in 0..MAX_CANDIDATES {
         let quantized = (aux * 1000.0).round() / 1000.0;
         // Another seed supplies the whole scene (start, goal, obstacles), so it stays one the

@@ -25,6 +25,7 @@ pub mod level;
 pub mod level_files;
 pub mod policies;
 pub mod rl;
+pub mod seeds;
 pub mod shell;
 pub mod train;
 pub mod verify;

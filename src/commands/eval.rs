@@ -3,40 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::{Deserialize, Serialize};
-
 use anyhow::{Context, Result, bail};
 
 use crate::cli::EvalArgs;
-use crate::eval::{self, Budget, Layout, NamedSolver};
+use crate::eval::{self, Budget, NamedSolver, PART_FILE, Part};
 use crate::fsio::{self, Overwrite};
-use crate::level::PolicyRef;
-use crate::level::stats::SolverStats;
 use crate::policies::{GENERATOR_FILE, load_generator, load_solver};
 use crate::verify::SolverPolicy;
-
-/// The file a shard writes (`--shard`) and `--merge` reads.
-const PART_FILE: &str = "eval-part.json";
-/// What an eval part file says it is.
-const PART_FORMAT: &str = "arlpcg-eval-part";
-const PART_VERSION: u32 = 2;
-
-/// One shard's raw results: enough to rebuild the tables with the other shards.
-#[derive(Debug, Serialize, Deserialize)]
-struct Part {
-    format: String,
-    version: u32,
-    /// The arlpcg version that played it.
-    arlpcg: String,
-    shard: [u64; 2],
-    budget: Budget,
-    generator: PolicyRef,
-    /// Each Solver's mode and file, in table order.
-    solvers: Vec<(String, PolicyRef)>,
-    layout: Layout,
-    /// (play index, its statistics) for this shard's plays.
-    plays: Vec<(usize, SolverStats)>,
-}
 
 pub fn run(args: &EvalArgs) -> Result<()> {
     if !args.merge.is_empty() {
@@ -115,20 +88,17 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             let bar = crate::shell::progress_bar(indices.len() as u64, "levels played");
             let stats = eval::play(&levels, &named, budget, &indices, &|| bar.inc(1));
             bar.finish_and_clear();
-            Ok(Part {
-                format: PART_FORMAT.into(),
-                version: PART_VERSION,
-                arlpcg: env!("CARGO_PKG_VERSION").into(),
-                shard: [shard.index, shard.count],
+            Ok(Part::new(
+                [shard.index, shard.count],
                 budget,
-                generator: generator.reference.clone(),
-                solvers: solvers
+                generator.reference.clone(),
+                solvers
                     .iter()
                     .map(|(mode, p)| (mode.clone(), p.reference.clone()))
                     .collect(),
-                layout: levels.layout,
-                plays: indices.into_iter().zip(stats).collect(),
-            })
+                levels.layout,
+                indices.into_iter().zip(stats).collect(),
+            ))
         })?;
         std::fs::create_dir_all(&args.out)
             .with_context(|| format!("cannot create {}", args.out.display()))?;
@@ -207,90 +177,9 @@ fn merge(args: &EvalArgs) -> Result<()> {
         let bytes = fsio::read_limited(&path, 1 << 30, "eval part")?;
         let part: Part = serde_json::from_slice(&bytes)
             .with_context(|| format!("{}: not an eval part file", path.display()))?;
-        if part.format != PART_FORMAT || part.version != PART_VERSION {
-            bail!(
-                "{}: format {} version {}, expected {PART_FORMAT} version {PART_VERSION}",
-                path.display(),
-                part.format,
-                part.version
-            );
-        }
         parts.push((path, part));
     }
-    let (first_path, first) = &parts[0];
-    let count = first.shard[1];
-    for (path, part) in &parts[1..] {
-        let differs = if part.arlpcg != first.arlpcg {
-            Some("arlpcg version")
-        } else if part.budget != first.budget {
-            Some("budget")
-        } else if part.generator.sha256 != first.generator.sha256 {
-            Some("Generator")
-        } else if part.solvers.len() != first.solvers.len()
-            || part
-                .solvers
-                .iter()
-                .zip(&first.solvers)
-                .any(|(a, b)| a.0 != b.0 || a.1.sha256 != b.1.sha256)
-        {
-            Some("Solvers")
-        } else if part.layout != first.layout {
-            Some("levels")
-        } else if part.shard[1] != count {
-            Some("shard count")
-        } else {
-            None
-        };
-        if let Some(what) = differs {
-            bail!(
-                "{} and {} come from different evaluations: their {what} differ",
-                first_path.display(),
-                path.display()
-            );
-        }
-    }
-    let mut seen = vec![false; count as usize];
-    for (path, part) in &parts {
-        let index = part.shard[0] as usize;
-        if std::mem::replace(&mut seen[index], true) {
-            bail!(
-                "shard {index}/{count} is given twice (again in {})",
-                path.display()
-            );
-        }
-    }
-    let missing: Vec<String> = (0..count as usize)
-        .filter(|&i| !seen[i])
-        .map(|i| i.to_string())
-        .collect();
-    match missing.len() {
-        0 => {}
-        1 => bail!(
-            "shard {}/{count} is missing: merge needs every --shard I/{count}",
-            missing[0]
-        ),
-        _ => bail!(
-            "shards {} (of {count}) are missing: merge needs every --shard I/{count}",
-            missing.join(", ")
-        ),
-    }
-    let total = first.layout.plays().len();
-    let mut stats: Vec<Option<SolverStats>> = vec![None; total];
-    for (path, part) in parts.iter_mut() {
-        for (i, s) in std::mem::take(&mut part.plays) {
-            if i >= total || i as u64 % count != part.shard[0] {
-                bail!("{}: play {i} does not belong to its shard", path.display());
-            }
-            stats[i] = Some(s);
-        }
-    }
-    let stats: Vec<SolverStats> = stats
-        .into_iter()
-        .enumerate()
-        .map(|(i, s)| s.with_context(|| format!("play {i} is missing from its shard's part")))
-        .collect::<Result<_>>()?;
-    let first = &parts[0].1;
-    let results = eval::assemble(first.budget, &first.generator.path, &first.layout, &stats);
+    let results = eval::merge(parts)?;
     let overwrite = if args.force {
         Overwrite::Allowed
     } else {

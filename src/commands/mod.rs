@@ -5,6 +5,7 @@
 mod eval;
 mod export;
 mod generate;
+mod train;
 mod verify;
 
 pub use crate::shell::{Interrupted, UsageError, exit_code};
@@ -21,7 +22,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Export(args)) => export::run(&args),
         Some(Command::Verify(args)) => verify::run(&args),
         Some(Command::Eval(args)) => eval::run(&args),
-        Some(Command::Train(args)) => crate::train::run(&args.into()),
+        Some(Command::Train(args)) => train::run(&args),
         Some(Command::Design(args)) => design(args),
         None => {
             use std::io::IsTerminal;

@@ -131,6 +131,8 @@ pub struct Trials {
     pub results: Vec<TrialResult>,
     /// The final statistics (the same as `arlpcg verify` gives), once all trials are in.
     pub stats: Option<SolverStats>,
+    /// Why the trials stopped before they were all in, if they could not be played.
+    pub error: Option<String>,
 }
 
 impl Trials {
@@ -242,6 +244,11 @@ pub enum Response {
     TrialsDone {
         id: u64,
         stats: Box<SolverStats>,
+    },
+    /// The trials could not be played (the Solver does not fit the level, say).
+    TrialsFailed {
+        id: u64,
+        problem: String,
     },
     Recorded {
         id: u64,
@@ -617,6 +624,7 @@ impl App {
             wanted: self.trials_wanted,
             results: Vec::new(),
             stats: None,
+            error: None,
         });
         vec![Effect::Trials {
             id,
@@ -662,6 +670,13 @@ impl App {
             Response::TrialsDone { id, stats } => {
                 if let Some(trials) = self.trials.as_mut().filter(|t| t.id == id) {
                     trials.stats = Some(*stats);
+                }
+                Vec::new()
+            }
+            Response::TrialsFailed { id, problem } => {
+                if let Some(trials) = self.trials.as_mut().filter(|t| t.id == id) {
+                    trials.error = Some(problem.clone());
+                    self.complain(format!("the trials stopped: {problem}"));
                 }
                 Vec::new()
             }

@@ -66,7 +66,7 @@ impl Policies {
         aux: f64,
         goal: Option<[f64; 3]>,
     ) -> Result<Level, String> {
-        let obstacles = crate::eval::scene_obstacles(game);
+        let obstacles = crate::game::facts::facts(game).scene_obstacles;
         match &self.generator {
             Some(generator) => generation::generator_level(generator, seed, aux, goal, obstacles)
                 .map_err(|e| e.to_string()),
@@ -270,9 +270,9 @@ pub fn perform(
                     stats: Box::new(stats),
                 }),
                 Ok(None) => {}
-                Err(e) => send(Response::Level {
+                Err(e) => send(Response::TrialsFailed {
                     id,
-                    result: Err(e.to_string()),
+                    problem: e.to_string(),
                 }),
             }
         }

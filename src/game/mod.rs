@@ -1,6 +1,7 @@
 //! The games as deterministic simulations over rapier3d: the same level, seed and actions give
 //! the same trajectory, bit for bit. Nothing here prints, reads the clock or uses a global RNG.
 
+pub mod facts;
 pub mod generator;
 pub mod platform;
 pub mod racing;

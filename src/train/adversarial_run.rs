@@ -3,7 +3,6 @@
 
 use std::io::Write;
 use std::path::Path;
-use std::time::Instant;
 
 use anyhow::{Context, Result};
 use rand::SeedableRng;
@@ -154,20 +153,20 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         } else {
             config.learning_rate
         };
-        let t0 = Instant::now();
+        let t0 = wall();
         self.envs().take_stats();
         while self.envs().completed_decisions() < config.batch_size() {
             self.solver.trainer.play_tick()?;
         }
         let batch = self.envs().take_generator_batch();
         let stats = self.envs().take_stats();
-        let t1 = Instant::now();
+        let t1 = wall();
         let envs = self.envs();
         let update = envs
             .generator
             .ppo
             .update(&batch, learning_rate, &mut envs.rng)?;
-        let t2 = Instant::now();
+        let t2 = wall();
         let decisions = batch.log_probs.len() as u64;
         envs.state.generator_steps += decisions;
         envs.state.phase_steps += decisions;
@@ -180,8 +179,8 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             self.solver.trainer.global_step,
             self.solver.trainer.env.state.generator_steps,
             wall(),
-            (t1 - t0).as_secs_f64(),
-            (t2 - t1).as_secs_f64(),
+            t1 - t0,
+            t2 - t1,
             learning_rate,
             update_columns(&update)
         )?;

@@ -14,7 +14,6 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::solver_envs::TRAINING_SEED_BASE;
 use crate::game::SolverEnv;
 use crate::game::generator::{
     BuildLimits, GeneratorGame, GeneratorRewards, Match, TrackBuild, observation_size,
@@ -24,6 +23,7 @@ use crate::rl::normalizer::RunningNorm;
 use crate::rl::policy::ActMode;
 use crate::rl::ppo::{Batch, Ppo, gae};
 use crate::rl::vec_env::{Transition, VecEnv};
+use crate::seeds::TRAINING_SEED_BASE;
 
 /// Which agent is learning.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

@@ -38,7 +38,7 @@ pub(super) fn metric_series(text: &str, x: &str, name: &str, window: usize) -> V
 
 /// `learning-curve.png`: the Solver's training success ratio against its steps (and, in the
 /// adversarial modes, its success on easy and hard Generator levels), smoothed over 10 updates.
-pub(super) fn write_learning_curve(out: &Path) -> Result<()> {
+pub fn write_learning_curve(out: &Path) -> Result<()> {
     let read = |name: &str| std::fs::read_to_string(out.join(name)).unwrap_or_default();
     let solver = read(METRICS);
     let generator = read(GENERATOR_METRICS);

@@ -15,8 +15,7 @@ use crate::level::Level;
 use crate::level::stats::Outcome;
 use crate::rl::vec_env::{Transition, VecEnv};
 
-/// Rule levels used for training have seeds at or above this; evaluation uses seeds below it.
-pub const TRAINING_SEED_BASE: u64 = 1 << 40;
+use crate::seeds::TRAINING_SEED_BASE;
 /// How many levels `fixed-track` trains on.
 pub const FIXED_TRACK_COUNT: u64 = 8;
 

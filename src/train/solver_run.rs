@@ -3,7 +3,6 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use anyhow::{Context, Result};
 
@@ -172,13 +171,13 @@ impl<E: Resumable> Run<E> {
         } else {
             self.config.solver.learning_rate
         };
-        let t0 = Instant::now();
+        let t0 = wall();
         let (batch, rollout) = self.trainer.collect()?;
-        let t1 = Instant::now();
+        let t1 = wall();
         let update = self.trainer.learn(&batch, learning_rate)?;
-        let t2 = Instant::now();
+        let t2 = wall();
         self.iteration += 1;
-        let (rollout_s, update_s) = ((t1 - t0).as_secs_f64(), (t2 - t1).as_secs_f64());
+        let (rollout_s, update_s) = (t1 - t0, t2 - t1);
         writeln!(
             self.metrics,
             "{},{},{:.2},{:.1},{:.3},{:.3},{:.3e},{},{:.4},{:.4},{}",
@@ -208,13 +207,13 @@ impl<G: GameSpec> Training for Run<SolverEnvs<G>> {
     }
 
     fn iterate(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String> {
-        let t0 = Instant::now();
+        let t0 = wall();
         let rollout = self.solver_iteration(lr_scale, wall)?;
         Ok(format!(
             "return {:.2}, success {:.2}, {:.0} steps/s",
             rollout.mean_return,
             rollout.success_ratio,
-            rollout.steps as f64 / t0.elapsed().as_secs_f64()
+            rollout.steps as f64 / (wall() - t0)
         ))
     }
 

@@ -283,7 +283,11 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
     let mut lines = Vec::new();
     match &app.trials {
         Some(t) => {
-            let running = if t.stats.is_some() { "" } else { " …" };
+            let running = if t.stats.is_some() || t.error.is_some() {
+                ""
+            } else {
+                " …"
+            };
             lines.push(Line::from(format!(
                 "trials {}/{}  successes {}{running}",
                 t.done(),
@@ -317,6 +321,9 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
             }
             if let Some(air) = t.mean_air_seconds() {
                 lines.push(Line::from(format!("air time {air:.2} s per run")));
+            }
+            if let Some(problem) = &t.error {
+                lines.push(Line::from(format!("stopped: {problem}").red()));
             }
         }
         None => lines.push(Line::from("no trials yet")),

@@ -174,7 +174,7 @@ fn mutated(text: &'static str) -> impl Strategy<Value = String> {
     })
 }
 
-const SHIPPED_LEVEL: &str = include_str!("../levels/platform/platform_seed7_aux-0.50.yaml");
+const SHIPPED_LEVEL: &str = include_str!("../../levels/platform/platform_seed7_aux-0.50.yaml");
 
 fn default_config() -> &'static str {
     static TEXT: std::sync::OnceLock<String> = std::sync::OnceLock::new();

@@ -4,16 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn arlpcg(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_arlpcg"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
+use crate::common::{arlpcg, stderr};
 
 fn generate(dir: &Path, extra: &[&str]) -> Output {
     let mut args = vec![

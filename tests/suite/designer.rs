@@ -364,7 +364,7 @@ fn racing_tracks_are_designed_like_platform_levels() {
         1,
         Some(1.0),
         None,
-        arlpcg::eval::scene_obstacles(Game::Racing),
+        arlpcg::game::facts::facts(Game::Racing).scene_obstacles,
     )
     .unwrap();
     assert_eq!(*level, expected, "the rules' track of the seed");
@@ -418,7 +418,7 @@ fn racing_tracks_are_designed_like_platform_levels() {
 }
 
 /// The workers answer the newest request of a kind: trials of a level the slider has moved
-/// away from stop, and never report final statistics.
+/// away from stop, and never report final statistics or another trial after the newer answer.
 #[test]
 fn newer_requests_supersede_older_ones() {
     let dir = tempfile::tempdir().unwrap();
@@ -427,37 +427,48 @@ fn newer_requests_supersede_older_ones() {
     let level = h.app.level.clone().unwrap();
     let (tx, rx) = std::sync::mpsc::channel();
     let workers = Workers::start(GamePolicies::default(), tx);
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let next = || {
+        rx.recv_timeout(deadline.saturating_duration_since(Instant::now()))
+            .expect("an answer within a minute")
+    };
     workers.submit(Effect::Trials {
         id: 100,
         level,
         trials: 100_000,
         seed: 1,
     });
-    std::thread::sleep(Duration::from_millis(50));
-    workers.submit(Effect::Generate {
-        id: 101,
+    // The first trial's answer: the long run of trials is under way.
+    match next() {
+        Response::Trial { id: 100, .. } => {}
+        other => panic!("expected a trial of request 100, got {other:?}"),
+    }
+    let generate = |id| Effect::Generate {
+        id,
         game: Game::Platform,
-        seed: 2,
+        seed: id,
         aux: 0.0,
         goal: None,
-    });
-    let deadline = Instant::now() + Duration::from_secs(60);
-    let mut old_trials = 0;
+    };
+    workers.submit(generate(101));
     loop {
-        match rx
-            .recv_timeout(deadline - Instant::now())
-            .expect("an answer")
-        {
+        match next() {
             Response::Level { id: 101, result } => {
                 assert!(result.is_ok());
                 break;
             }
-            Response::Trial { id: 100, .. } => old_trials += 1,
+            Response::Trial { id: 100, .. } => {}
             Response::TrialsDone { id: 100, .. } => panic!("superseded trials finished"),
             other => panic!("unexpected {other:?}"),
         }
     }
-    assert!(old_trials < 100_000);
+    // Once the newer level is answered, the superseded trials say nothing more: the next
+    // answer is the one asked for after it.
+    workers.submit(generate(102));
+    match next() {
+        Response::Level { id: 102, result } => assert!(result.is_ok()),
+        other => panic!("after the superseding answer, expected level 102, got {other:?}"),
+    }
 }
 
 /// The newcomer's session on the shipped policies: start, move λ, generate, trials, export;
@@ -544,4 +555,49 @@ fn target_success_mode_finds_a_level_in_band() {
     h.key(KeyCode::Right);
     assert_eq!(h.app.target, None, "the slider leaves target mode");
     assert!(matches!(h.pending[..], [Effect::Generate { .. }]));
+}
+
+/// Trials that cannot be played (here a racing Solver put on the platform game) say why, on the
+/// stats panel and the status line, instead of vanishing.
+#[test]
+fn trials_that_fail_say_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let racing = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/racing");
+    let (racing, _) =
+        worker::load(&racing, Game::Racing).expect("the shipped racing policies load");
+    let wrong = Policies {
+        generator: None,
+        solver: racing.solver.clone(),
+    };
+    let mut h = Harness::new(wrong, LoadedInfo::default(), dir.path());
+    h.settle();
+    assert!(h.app.level.is_some(), "the rule level is on screen");
+    let trials = h.app.trials.as_ref().expect("trials were started");
+    let problem = trials
+        .error
+        .as_deref()
+        .expect("the trials' failure is kept");
+    assert!(problem.contains("racing"), "{problem}");
+    let screen = h.screen(100, 30);
+    assert!(screen.contains("stopped:"), "{screen}");
+}
+
+/// The README's key table is the designer's key map (`view::KEYS`), row for row.
+#[test]
+fn the_readme_key_table_is_the_key_map() {
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    let start = readme
+        .find("<!-- keys:")
+        .expect("the README marks its key table");
+    let end = readme.find("<!-- /keys -->").expect("the key table ends");
+    let table: Vec<&str> = readme[start..end].lines().skip(3).collect();
+    let expected: Vec<String> = view::KEYS
+        .iter()
+        .map(|(keys, what)| format!("| `{keys}` | {what} |"))
+        .collect();
+    assert_eq!(
+        table, expected,
+        "README.md's key table differs from view::KEYS"
+    );
 }

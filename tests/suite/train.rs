@@ -3,13 +3,15 @@
 //! trained policy loads with its card.
 
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use arlpcg::game::platform::OBSERVATION_SIZE;
 use arlpcg::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
 use arlpcg::level::Game;
 use arlpcg::rl::checkpoint::{Role, load_policy};
+
+use crate::common::arlpcg;
 
 const TINY: &str = "\
 seed: 3
@@ -21,13 +23,6 @@ ppo:
   update_epochs: 2
   num_minibatches: 2
 ";
-
-fn arlpcg(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_arlpcg"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
 
 /// (iteration, global_step) of every metrics row.
 fn curve(dir: &Path) -> Vec<(u64, u64)> {
@@ -255,8 +250,16 @@ fn out_of_range_training_configs_are_refused_before_anything_is_written() {
     }
 }
 
+/// Ctrl-C, and SIGTERM as Slurm and Kubernetes stop a job, save a checkpoint and the policy,
+/// then exit 130.
 #[test]
-fn ctrl_c_saves_a_checkpoint_and_the_policy_and_exits_cleanly() {
+fn a_signal_saves_a_checkpoint_and_the_policy_and_exits_130() {
+    for signal in ["-INT", "-TERM"] {
+        stopped_by(signal);
+    }
+}
+
+fn stopped_by(signal: &str) {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("tiny.yaml");
     // Checkpoints only at the end: Ctrl-C must write one itself.
@@ -290,13 +293,17 @@ fn ctrl_c_saves_a_checkpoint_and_the_policy_and_exits_cleanly() {
     }
     assert!(!out.join("checkpoint.safetensors").exists());
     let interrupted = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([signal, &child.id().to_string()])
         .status()
         .unwrap();
     assert!(interrupted.success());
     let output = child.wait_with_output().unwrap();
-    assert!(output.status.success());
-    assert!(String::from_utf8_lossy(&output.stdout).contains("stopped (Ctrl-C)"));
+    assert_eq!(
+        output.status.code(),
+        Some(130),
+        "{signal}: interrupted, after saving"
+    );
+    assert!(String::from_utf8_lossy(&output.stdout).contains("stopped (Ctrl-C"));
     let checkpoint = std::fs::read(out.join("checkpoint.safetensors")).unwrap();
     let state = load_policy(&checkpoint, Game::Platform, Role::Solver, OBSERVATION_SIZE)
         .unwrap()
@@ -471,8 +478,7 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
         "{}",
         String::from_utf8_lossy(&evaluated.stderr)
     );
-    let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(results.join("results.json")).unwrap()).unwrap();
+    let json: serde_json::Value = crate::common::results_json(&results);
     let rows = json["controllability"].as_array().unwrap();
     assert_eq!(rows.len(), 5);
     for key in [
@@ -825,8 +831,7 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
         "{}",
         String::from_utf8_lossy(&evaluated.stderr)
     );
-    let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(results.join("results.json")).unwrap()).unwrap();
+    let json: serde_json::Value = crate::common::results_json(&results);
     let rows = json["controllability"].as_array().unwrap();
     assert_eq!(rows.len(), 5);
     for key in [

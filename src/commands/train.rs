@@ -1,0 +1,118 @@
+//! `arlpcg train`: the shell around the training core ([`crate::train`]). It owns what the core
+//! must not touch: the clock, signals (Ctrl-C, and SIGTERM and SIGHUP as schedulers send them:
+//! each saves a checkpoint and stops), the progress bar and what is printed.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+
+use crate::cli::TrainArgs;
+use crate::shell::{Interrupted, UsageError};
+use crate::train::{self, TrainConfig, Training};
+
+pub fn run(args: &TrainArgs) -> Result<()> {
+    if args.print_config {
+        print!(
+            "{}",
+            serde_yaml::to_string(&TrainConfig::for_game(args.game))?
+        );
+        return Ok(());
+    }
+    let usage = |message: &str| anyhow::Error::from(UsageError(message.into()));
+    let out = args.out.as_ref().ok_or_else(|| {
+        usage("--out DIR is required: where the run's checkpoint, metrics and policy go")
+    })?;
+    if args.steps.is_none() && args.minutes.is_none() {
+        return Err(usage(
+            "give a budget: --steps N (total Solver environment steps) or --minutes M (this session)",
+        ));
+    }
+    let pool = crate::shell::thread_pool(args.threads)?;
+    pool.install(|| {
+        let mut run = train::open(
+            args.game,
+            args.mode.into(),
+            out,
+            args.config.as_deref(),
+            args.resume,
+        )?;
+        train_loop(run.as_mut(), args.steps, args.minutes)
+    })
+}
+
+/// Iterates `run` until `steps` Solver steps in all or `minutes` of this session, or a signal;
+/// checkpoints on the run's interval and at the end, then writes the final policies.
+fn train_loop(run: &mut dyn Training, steps: Option<u64>, minutes: Option<f64>) -> Result<()> {
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        // A second handler cannot be installed (tests run several runs in one process).
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    let session = Instant::now();
+    let wall_before = run.wall_before();
+    let wall = || wall_before + session.elapsed().as_secs_f64();
+    let mut last_checkpoint = Instant::now();
+    let bar = match steps {
+        Some(total) => crate::shell::progress_bar(total, "training"),
+        None => {
+            crate::shell::progress_bar(minutes.map_or(0, |m| (m * 60.0) as u64), "training (s)")
+        }
+    };
+    bar.set_position(match steps {
+        Some(_) => run.solver_steps(),
+        None => 0,
+    });
+    loop {
+        let done_by_steps = steps.is_some_and(|t| run.solver_steps() >= t);
+        let done_by_time = minutes.is_some_and(|m| session.elapsed().as_secs_f64() >= m * 60.0);
+        if done_by_steps || done_by_time || stop.load(Ordering::SeqCst) {
+            break;
+        }
+        let lr_scale = match steps {
+            Some(total) => (1.0 - run.solver_steps() as f64 / total as f64).max(0.0),
+            None => 1.0,
+        };
+        let message = run.iterate(lr_scale, &wall).with_context(|| {
+            format!(
+                "training stopped at {} Solver steps; the last checkpoint in {} is kept \
+                 (--resume, with --config for a smaller learning rate, continues from it)",
+                run.solver_steps(),
+                run.out().display()
+            )
+        })?;
+        bar.set_message(message);
+        match steps {
+            Some(_) => bar.set_position(run.solver_steps()),
+            None => bar.set_position(session.elapsed().as_secs()),
+        }
+        if last_checkpoint.elapsed().as_secs_f64() >= run.checkpoint_minutes() * 60.0 {
+            run.save_checkpoint(wall())?;
+            train::write_learning_curve(run.out())?;
+            last_checkpoint = Instant::now();
+        }
+    }
+    bar.finish_and_clear();
+    let wall = wall();
+    run.save_checkpoint(wall)?;
+    run.save_policies(wall)?;
+    train::write_learning_curve(run.out())?;
+    let summary = format!(
+        "at {} Solver steps after {:.1} min in all; checkpoints and policies in {}",
+        run.solver_steps(),
+        wall / 60.0,
+        run.out().display()
+    );
+    if stop.load(Ordering::SeqCst) {
+        println!("stopped (Ctrl-C or a termination signal) {summary}");
+        return Err(Interrupted(format!(
+            "training interrupted; its checkpoint is saved: --resume continues it ({})",
+            run.out().display()
+        ))
+        .into());
+    }
+    println!("finished {summary}");
+    Ok(())
+}

@@ -1,0 +1,118 @@
+//! The levels an evaluation plays: Generator levels at each λ, the validation set, and the
+//! [`Layout`] that describes them without the levels themselves.
+
+use crate::game::facts::{facts, piece_values};
+use crate::generation::{self, GeneratorPolicy};
+use crate::level::Level;
+use crate::seeds::{EVAL_SEED_BASE, VALIDATION_AUX_STRIDE, VALIDATION_SEED_BASE};
+
+use super::{AUX_VALUES, Budget, Layout, NamedSolver};
+
+/// Seeds tried per wanted level before the table notes a shortfall (the Generator may fail to
+/// reach a goal).
+const SEED_TRIES: u64 = 4;
+
+/// Generator levels at `aux`: `count` of them from seeds `base`, `base + 1`, ... (a seed whose
+/// level the Generator cannot build is skipped, within `SEED_TRIES` seeds per level).
+pub fn generator_levels(
+    generator: &GeneratorPolicy,
+    aux: f64,
+    base: u64,
+    count: u32,
+) -> Result<Vec<Level>, candle_core::Error> {
+    let mut levels = Vec::with_capacity(count as usize);
+    for seed in base..base + count as u64 * SEED_TRIES {
+        if levels.len() == count as usize {
+            break;
+        }
+        match generation::generator_level(
+            generator,
+            seed,
+            aux,
+            None,
+            facts(generator.game).scene_obstacles,
+        ) {
+            Ok(level) => levels.push(level),
+            Err(generation::GenerationError::NoLevel { .. }) => {}
+            Err(generation::GenerationError::Network(e)) => return Err(e),
+        }
+    }
+    Ok(levels)
+}
+
+/// The validation set: rule levels and Generator levels (λ cycling through [`AUX_VALUES`]),
+/// half each.
+pub fn validation_levels(
+    generator: &GeneratorPolicy,
+    count: u32,
+) -> Result<Vec<Level>, candle_core::Error> {
+    let base = VALIDATION_SEED_BASE;
+    let rule_count = count / 2;
+    let game = generator.game;
+    let mut levels: Vec<Level> = (0..rule_count as u64)
+        .filter_map(|k| {
+            generation::rules_level(game, base + k, None, None, facts(game).scene_obstacles).ok()
+        })
+        .collect();
+    let per_aux = (count - rule_count).div_ceil(AUX_VALUES.len() as u32);
+    for (k, &aux) in AUX_VALUES.iter().enumerate() {
+        let seeds = base + (1 + k as u64) * VALIDATION_AUX_STRIDE;
+        let wanted = per_aux.min(count - levels.len() as u32);
+        levels.extend(generator_levels(generator, aux, seeds, wanted)?);
+    }
+    Ok(levels)
+}
+
+/// The levels of an evaluation and its layout.
+pub struct Levels {
+    pub by_aux: Vec<Vec<Level>>,
+    pub validation: Vec<Level>,
+    pub layout: Layout,
+}
+
+/// Builds every level the evaluation plays (deterministic: the same Generator and budget give
+/// the same levels on every machine).
+pub fn levels(
+    generator: &GeneratorPolicy,
+    solvers: &[NamedSolver],
+    budget: Budget,
+) -> Result<Levels, candle_core::Error> {
+    let by_aux: Vec<Vec<Level>> = AUX_VALUES
+        .iter()
+        .map(|&aux| generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks))
+        .collect::<Result<_, _>>()?;
+    let validation = validation_levels(generator, budget.validation_tracks)?;
+    let game = generator.game;
+    let piece_means = by_aux
+        .iter()
+        .map(|levels| {
+            let pieces: Vec<Vec<f64>> = levels.iter().flat_map(piece_values).collect();
+            (!pieces.is_empty()).then(|| {
+                (0..facts(game).piece_columns.len())
+                    .map(|k| pieces.iter().map(|p| p[k]).sum::<f64>() / pieces.len() as f64)
+                    .collect()
+            })
+        })
+        .collect();
+    let layout = Layout {
+        game,
+        levels_per_aux: by_aux.iter().map(Vec::len).collect(),
+        piece_means,
+        validation_levels: validation.len(),
+        validation_rule_levels: validation
+            .iter()
+            .filter(|l| {
+                matches!(
+                    l.source,
+                    crate::level::Source::Rules { .. } | crate::level::Source::RacingRules { .. }
+                )
+            })
+            .count(),
+        solvers: solvers.iter().map(|s| s.mode.clone()).collect(),
+    };
+    Ok(Levels {
+        by_aux,
+        validation,
+        layout,
+    })
+}

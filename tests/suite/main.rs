@@ -1,0 +1,16 @@
+//! The integration tests, in one binary: the dependencies (rapier3d, candle, ratatui) are linked
+//! once rather than once per file. Each module is one area; `common` holds what they share.
+
+mod common;
+
+mod architecture;
+mod cli;
+mod designer;
+mod gltf_export;
+mod hostile_input;
+mod level_format;
+mod platform_game;
+mod ppo_learns;
+mod racing_game;
+mod shipped;
+mod train;

@@ -8,7 +8,7 @@ use anyhow::Result;
 
 use crate::fsio::{self, Overwrite};
 use crate::level::scene::Scene;
-use crate::level::{Level, gltf, yaml};
+use crate::level::{Game, Level, gltf, yaml};
 
 /// A level's file formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -96,4 +96,14 @@ pub fn write_level_files(level: &Level, files: &LevelFiles, overwrite: Overwrite
         fsio::write_atomic(path, bytes, overwrite)?;
     }
     Ok(())
+}
+
+/// A level's file name without extension, the same for every writer (`generate`, the
+/// designer): `platform_seed7` or, with an aux value, `platform_seed7_aux-0.50`.
+pub fn file_stem(game: Game, seed: u64, aux: Option<f64>) -> String {
+    match aux {
+        // `+ 0.0` turns -0 into +0: `--aux=-0` names its files as `--aux 0` does.
+        Some(aux) => format!("{game}_seed{seed}_aux{:+.2}", aux + 0.0),
+        None => format!("{game}_seed{seed}"),
+    }
 }

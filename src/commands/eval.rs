@@ -8,6 +8,7 @@ use anyhow::{Context, Result, bail};
 use crate::cli::EvalArgs;
 use crate::eval::{self, Budget, NamedSolver, PART_FILE, Part};
 use crate::fsio::{self, Overwrite};
+use crate::generation::GeneratorPolicy;
 use crate::policies::{GENERATOR_FILE, load_generator, load_solver};
 use crate::verify::SolverPolicy;
 
@@ -25,36 +26,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         .find(|p| p.exists())
         .with_context(|| format!("no {GENERATOR_FILE} in any --policies folder"))?;
     let (generator, _) = load_generator(&generator_path, args.game)?;
-    let mut solvers: Vec<(String, SolverPolicy)> = Vec::new();
-    for dir in &args.policies {
-        let entries = std::fs::read_dir(dir)
-            .with_context(|| format!("cannot read the policies folder {}", dir.display()))?;
-        let mut files: Vec<PathBuf> = entries
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| {
-                p.file_name()
-                    .and_then(|n| n.to_str())
-                    .is_some_and(|n| n.starts_with("solver") && n.ends_with(".safetensors"))
-            })
-            .collect();
-        files.sort();
-        for path in files {
-            let (solver, card) = load_solver(&path, args.game)?;
-            if let Some((mode, _)) = solvers.iter().find(|(m, _)| *m == card.training.mode) {
-                eprintln!(
-                    "note: {} skipped: a {mode} Solver is already loaded",
-                    path.display()
-                );
-                continue;
-            }
-            solvers.push((card.training.mode.clone(), solver));
-        }
-    }
-    if !solvers.iter().any(|(mode, _)| mode == "arlpcg") {
-        bail!(
-            "no arlpcg Solver (a solver*.safetensors whose card says mode arlpcg) in the --policies folders: it plays the controllability table"
-        );
-    }
+    let solvers = load_solvers(args)?;
     let base = if args.full {
         Budget::FULL
     } else {
@@ -80,38 +52,9 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         })
         .collect();
     if let Some(shard) = args.shard {
-        let part = pool.install(|| -> Result<Part> {
-            let levels = eval::levels(&generator, &named, budget)?;
-            let indices: Vec<usize> = (0..levels.layout.plays().len())
-                .filter(|&i| shard.owns(i as u64))
-                .collect();
-            let bar = crate::shell::progress_bar(indices.len() as u64, "levels played");
-            let stats = eval::play(&levels, &named, budget, &indices, &|| bar.inc(1));
-            bar.finish_and_clear();
-            Ok(Part::new(
-                [shard.index, shard.count],
-                budget,
-                generator.reference.clone(),
-                solvers
-                    .iter()
-                    .map(|(mode, p)| (mode.clone(), p.reference.clone()))
-                    .collect(),
-                levels.layout,
-                indices.into_iter().zip(stats).collect(),
-            ))
-        })?;
-        std::fs::create_dir_all(&args.out)
-            .with_context(|| format!("cannot create {}", args.out.display()))?;
-        let path = args.out.join(PART_FILE);
-        fsio::write_atomic(&path, &serde_json::to_vec(&part)?, overwrite)?;
-        println!(
-            "wrote shard {}/{} ({} of the evaluation's plays) to {}",
-            shard.index,
-            shard.count,
-            part.plays.len(),
-            path.display()
+        return write_shard(
+            args, shard, &pool, &generator, &solvers, &named, budget, overwrite,
         );
-        return Ok(());
     }
     let names = [
         "results.md",
@@ -188,4 +131,86 @@ fn merge(args: &EvalArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     write_results(&results, &args.out, overwrite)
+}
+
+/// Every `solver*.safetensors` in the `--policies` folders, named by its card's training mode
+/// (the first of each mode wins); the ARLPCG one must be among them.
+fn load_solvers(args: &EvalArgs) -> Result<Vec<(String, SolverPolicy)>> {
+    let mut solvers: Vec<(String, SolverPolicy)> = Vec::new();
+    for dir in &args.policies {
+        let entries = std::fs::read_dir(dir)
+            .with_context(|| format!("cannot read the policies folder {}", dir.display()))?;
+        let mut files: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| {
+                p.file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(|n| n.starts_with("solver") && n.ends_with(".safetensors"))
+            })
+            .collect();
+        files.sort();
+        for path in files {
+            let (solver, card) = load_solver(&path, args.game)?;
+            if let Some((mode, _)) = solvers.iter().find(|(m, _)| *m == card.training.mode) {
+                eprintln!(
+                    "note: {} skipped: a {mode} Solver is already loaded",
+                    path.display()
+                );
+                continue;
+            }
+            solvers.push((card.training.mode.clone(), solver));
+        }
+    }
+    if !solvers.iter().any(|(mode, _)| mode == "arlpcg") {
+        bail!(
+            "no arlpcg Solver (a solver*.safetensors whose card says mode arlpcg) in the --policies folders: it plays the controllability table"
+        );
+    }
+    Ok(solvers)
+}
+
+/// `eval --shard I/K`: plays this shard's share of the evaluation and writes its part.
+#[allow(clippy::too_many_arguments)]
+fn write_shard(
+    args: &EvalArgs,
+    shard: crate::cli::Shard,
+    pool: &rayon::ThreadPool,
+    generator: &GeneratorPolicy,
+    solvers: &[(String, SolverPolicy)],
+    named: &[NamedSolver],
+    budget: Budget,
+    overwrite: Overwrite,
+) -> Result<()> {
+    let part = pool.install(|| -> Result<Part> {
+        let levels = eval::levels(generator, named, budget)?;
+        let indices: Vec<usize> = (0..levels.layout.plays().len())
+            .filter(|&i| shard.owns(i as u64))
+            .collect();
+        let bar = crate::shell::progress_bar(indices.len() as u64, "levels played");
+        let stats = eval::play(&levels, named, budget, &indices, &|| bar.inc(1));
+        bar.finish_and_clear();
+        Ok(Part::new(
+            [shard.index, shard.count],
+            budget,
+            generator.reference.clone(),
+            solvers
+                .iter()
+                .map(|(mode, p)| (mode.clone(), p.reference.clone()))
+                .collect(),
+            levels.layout,
+            indices.into_iter().zip(stats).collect(),
+        ))
+    })?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let path = args.out.join(PART_FILE);
+    fsio::write_atomic(&path, &serde_json::to_vec(&part)?, overwrite)?;
+    println!(
+        "wrote shard {}/{} ({} of the evaluation's plays) to {}",
+        shard.index,
+        shard.count,
+        part.plays.len(),
+        path.display()
+    );
+    Ok(())
 }

@@ -12,7 +12,7 @@ use crate::difficulty;
 use crate::fsio::{self, Overwrite};
 use crate::generation::{self, GeneratorPolicy};
 use crate::level::{Game, Level};
-use crate::level_files::{Format, LevelFiles, render};
+use crate::level_files::{Format, LevelFiles, file_stem, render};
 use crate::policies::{load_generator, load_solver, policy_paths};
 use crate::verify::{self, Solver, SolverPolicy, verify};
 
@@ -276,13 +276,4 @@ fn build_verified(
     bail!(
         "none of the {MAX_DRAWS} levels drawn for this seed was completed by any of {trials} runs (--allow-unsolved keeps the first anyway)"
     )
-}
-
-/// `platform_seed7` or, with an aux value, `platform_seed7_aux-0.50`.
-pub fn file_stem(game: Game, seed: u64, aux: Option<f64>) -> String {
-    match aux {
-        // `+ 0.0` turns -0 into +0: `--aux=-0` names its files as `--aux 0` does.
-        Some(aux) => format!("{game}_seed{seed}_aux{:+.2}", aux + 0.0),
-        None => format!("{game}_seed{seed}"),
-    }
 }

@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use serde_json::json;
 
 use crate::cli::{SolverChoice, VerifyArgs, default_solver};
+use crate::game::facts::facts;
 use crate::level::Game;
 use crate::level::stats::{Outcome, SolverRef, SolverStats};
 use crate::level::yaml;
@@ -234,10 +235,7 @@ fn describe(path: &Path, game: Game, s: &SolverStats) -> String {
         .iter()
         .enumerate()
         .filter(|(_, n)| **n > 0)
-        .map(|(i, n)| match game {
-            Game::Platform => format!("block {i}: {n}"),
-            Game::Racing => format!("segment {i}: {n}"),
-        })
+        .map(|(i, n)| format!("{} {i}: {n}", facts(game).piece))
         .collect();
     if let Some(air) = s.mean_air_steps {
         text += &format!(
@@ -253,11 +251,11 @@ fn describe(path: &Path, game: Game, s: &SolverStats) -> String {
                 s.off_road, s.flipped, s.timed_out
             ),
         };
-        let place = match game {
-            Game::Platform => "on the way to",
-            Game::Racing => "on",
-        };
-        text += &format!("\n  failed {place} {} ({causes})", failures.join(", "));
+        text += &format!(
+            "\n  failed {} {} ({causes})",
+            facts(game).failed_at,
+            failures.join(", ")
+        );
     }
     text
 }

@@ -489,7 +489,7 @@ impl App {
 
     /// The file stem exports use: game, seed and λ.
     pub fn export_stem(&self) -> String {
-        format!("{}-seed{}-aux{:+.2}", self.game.name(), self.seed, self.aux)
+        crate::level_files::file_stem(self.game, self.seed, Some(self.aux))
     }
 
     fn export(&mut self, overwrite: bool) -> Vec<Effect> {

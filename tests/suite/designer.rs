@@ -293,7 +293,7 @@ fn export_asks_before_overwriting() {
     let Some(Effect::Export { stem, .. }) = h.pending.first().cloned() else {
         panic!("an export effect");
     };
-    assert_eq!(stem, "platform-seed1-aux+1.00");
+    assert_eq!(stem, "platform_seed1_aux+1.00");
     h.settle();
     let yaml_path = dir.path().join("platform").join(format!("{stem}.yaml"));
     let glb_path = dir.path().join("platform").join(format!("{stem}.glb"));
@@ -403,9 +403,9 @@ fn racing_tracks_are_designed_like_platform_levels() {
     );
     h.key(KeyCode::Char('x'));
     h.settle();
-    let exported = yaml::load(&dir.path().join("racing/racing-seed1-aux+1.00.yaml")).unwrap();
+    let exported = yaml::load(&dir.path().join("racing/racing_seed1_aux+1.00.yaml")).unwrap();
     assert_eq!(exported.racing(), level.racing());
-    gltf::Gltf::open(dir.path().join("racing/racing-seed1-aux+1.00.glb")).expect("a valid glb");
+    gltf::Gltf::open(dir.path().join("racing/racing_seed1_aux+1.00.glb")).expect("a valid glb");
     h.key(KeyCode::Tab);
     h.settle();
     assert_eq!(h.app.game, Game::Platform);
@@ -500,7 +500,7 @@ fn scripted_session_on_the_shipped_policies() {
     assert!(h.screen(80, 24).contains("trials 100/100  successes"));
     h.key(KeyCode::Char('x'));
     h.settle();
-    let yaml_path = dir.path().join("platform/platform-seed1-aux+0.80.yaml");
+    let yaml_path = dir.path().join("platform/platform_seed1_aux+0.80.yaml");
     let level = yaml::load(&yaml_path).expect("the export loads");
     assert_eq!(level.aux, Some(0.8));
     // The exported statistics are the ones on screen.
@@ -508,7 +508,7 @@ fn scripted_session_on_the_shipped_policies() {
         level.stats.as_ref(),
         h.app.trials.as_ref().and_then(|t| t.stats.as_ref())
     );
-    let glb = dir.path().join("platform/platform-seed1-aux+0.80.glb");
+    let glb = dir.path().join("platform/platform_seed1_aux+0.80.glb");
     gltf::Gltf::open(&glb).expect("a valid glb");
     // Left for `.ci/run` to pass through the Khronos validator.
     let exports = Path::new(env!("CARGO_TARGET_TMPDIR")).join("gltf-exports");

@@ -125,12 +125,7 @@ fn budget_unit(role: Role, game: Game) -> &'static str {
 
 /// What a piece of `game` is called.
 fn piece_name(game: Game, plural: bool) -> &'static str {
-    match (game, plural) {
-        (Game::Platform, false) => "block",
-        (Game::Platform, true) => "blocks",
-        (Game::Racing, false) => "segment",
-        (Game::Racing, true) => "segments",
-    }
+    crate::game::facts::facts(game).piece_name(plural)
 }
 
 fn header(app: &App, frame: &mut Frame, area: Rect) {
@@ -275,10 +270,7 @@ fn draw_replay(app: &App, ctx: &mut Context, project: impl Fn(&[f32; 3]) -> [f64
 }
 
 fn stats(app: &App, frame: &mut Frame, area: Rect) {
-    let scripted = match app.game {
-        Game::Platform => "scripted controller",
-        Game::Racing => "scripted driver",
-    };
+    let scripted = crate::game::facts::facts(app.game).scripted_player;
     let solver = policy_label(&app.policies.solver, scripted);
     let mut lines = Vec::new();
     match &app.trials {

@@ -52,9 +52,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         })
         .collect();
     if let Some(shard) = args.shard {
-        return write_shard(
-            args, shard, &pool, &generator, &solvers, &named, budget, overwrite,
-        );
+        return write_shard(args, shard, &pool, &generator, &named, budget, overwrite);
     }
     let names = [
         "results.md",
@@ -170,13 +168,11 @@ fn load_solvers(args: &EvalArgs) -> Result<Vec<(String, SolverPolicy)>> {
 }
 
 /// `eval --shard I/K`: plays this shard's share of the evaluation and writes its part.
-#[allow(clippy::too_many_arguments)]
 fn write_shard(
     args: &EvalArgs,
     shard: crate::cli::Shard,
     pool: &rayon::ThreadPool,
     generator: &GeneratorPolicy,
-    solvers: &[(String, SolverPolicy)],
     named: &[NamedSolver],
     budget: Budget,
     overwrite: Overwrite,
@@ -193,9 +189,9 @@ fn write_shard(
             [shard.index, shard.count],
             budget,
             generator.reference.clone(),
-            solvers
+            named
                 .iter()
-                .map(|(mode, p)| (mode.clone(), p.reference.clone()))
+                .map(|s| (s.mode.clone(), s.policy.reference.clone()))
                 .collect(),
             levels.layout,
             indices.into_iter().zip(stats).collect(),

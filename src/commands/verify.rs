@@ -237,11 +237,8 @@ fn describe(path: &Path, game: Game, s: &SolverStats) -> String {
         .filter(|(_, n)| **n > 0)
         .map(|(i, n)| format!("{} {i}: {n}", facts(game).piece))
         .collect();
-    if let Some(air) = s.mean_air_steps {
-        text += &format!(
-            ", mean air time {:.2} s",
-            air * f64::from(crate::game::racing::car::DECISION_DT)
-        );
+    if let (Some(air), Some(dt)) = (s.mean_air_steps, facts(game).air_time_step) {
+        text += &format!(", mean air time {:.2} s", air * dt);
     }
     if !failures.is_empty() {
         let causes = match game {

@@ -2,6 +2,7 @@
 //! every part as strictly as a command-line argument (parts come from disk and may be damaged or
 //! tampered with) and assembles the tables of the whole evaluation from them.
 
+use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 use anyhow::{Result, bail, ensure};
@@ -43,8 +44,7 @@ pub struct Part {
 }
 
 impl Part {
-    /// A new part of shard `index` of `count`.
-    #[allow(clippy::too_many_arguments)]
+    /// A new part of shard `shard[0]` of `shard[1]`.
     pub fn new(
         shard: [u64; 2],
         budget: Budget,
@@ -180,21 +180,17 @@ pub fn merge(parts: Vec<(PathBuf, Part)>) -> Result<Results> {
             );
         }
     }
-    // Each index is below the count (checked), so a count above the number of parts means a
-    // shard is missing, and `seen` below is no larger than the parts given.
-    let mut seen = vec![false; count.min(parts.len() as u64) as usize];
+    // As many indices as parts at most: nothing here is sized by the (checked, but large) count.
+    let mut given = BTreeSet::new();
     for (path, part) in &parts {
         let index = part.shard[0];
-        if let Some(seen) = seen.get_mut(index as usize)
-            && std::mem::replace(seen, true)
-        {
+        if !given.insert(index) {
             bail!(
                 "shard {index}/{count} is given twice (again in {})",
                 path.display()
             );
         }
     }
-    let given: Vec<u64> = parts.iter().map(|(_, p)| p.shard[0]).collect();
     let missing: Vec<String> = (0..count)
         .filter(|i| !given.contains(i))
         .take(10)

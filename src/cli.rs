@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::level::Game;
+use crate::level::pacing::AuxCurve;
 use crate::level::params;
 use crate::train::TrainMode;
 
@@ -159,6 +160,12 @@ pub struct GenerateArgs {
     /// generator only records it.
     #[arg(long, allow_hyphen_values = true, value_parser = parse_aux)]
     pub aux: Option<f64>,
+    /// λ along the level instead of one λ (with --policies): control points `fraction:λ`,
+    /// where fraction is the share of the start-to-goal distance covered (0 start, 1 goal),
+    /// linear between points. "0:1, 0.5:1, 0.6:-1, 1:-1" is easy up to halfway, then hard.
+    /// Each piece records the λ it was built at.
+    #[arg(long, value_name = "CURVE", allow_hyphen_values = true, value_parser = AuxCurve::parse, conflicts_with_all = ["aux", "target_success"])]
+    pub aux_curve: Option<AuxCurve>,
     /// Goal position x,y,z in metres (default: drawn from the seed).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_point)]
     pub goal: Option<[f64; 3]>,

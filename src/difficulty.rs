@@ -13,7 +13,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::generation::{self, GenerationError, GeneratorPolicy};
+use crate::generation::{self, GenerationError, GeneratorPolicy, LevelRequest};
 use crate::level::Level;
 use crate::level::stats::{Outcome, wilson_interval};
 use crate::verify::{Solver, Watch, WrongGame, stats_of, trial_results, verify};
@@ -69,7 +69,8 @@ pub fn measure(
         for k in 0..CURVE_LEVELS as u64 {
             let seed = crate::seeds::CURVE_SEED_BASE + k;
             let obstacles = crate::game::facts::facts(generator.game).scene_obstacles;
-            match generation::generator_level(generator, seed, aux, None, obstacles) {
+            let request = LevelRequest::new(seed, Some(aux)).obstacles(obstacles);
+            match generation::generator_level(generator, &request) {
                 Ok(level) => {
                     total += verify(&level, solver, CURVE_TRIALS, seed, &|| {})?.success_ratio;
                     count += 1;
@@ -144,14 +145,11 @@ pub fn level_for(
         } else {
             seed
         };
-        let mut level = match generation::generator_level_draw(
-            generator,
-            candidate_seed,
-            quantized,
-            goal,
-            obstacles,
-            draw,
-        ) {
+        let request = LevelRequest::new(candidate_seed, Some(quantized))
+            .goal(goal)
+            .obstacles(obstacles)
+            .draw(draw);
+        let mut level = match generation::generator_level(generator, &request) {
             Ok(level) => level,
             Err(GenerationError::NoLevel { .. }) => continue,
             Err(e) => return Err(e.into()),

@@ -10,6 +10,7 @@
 
 use crate::game::generator::{BuildLimits, GeneratorGame, Placement, TrackBuild, observation_size};
 use crate::game::{PlatformGame, RacingGame};
+use crate::level::pacing::{AuxCurve, Pacing, covered, round_aux};
 use crate::level::racing::RacingRulesConfig;
 use crate::level::{Game, Level, PolicyRef, RulesConfig, Source};
 use crate::rl::normalizer::RunningNorm;
@@ -24,35 +25,83 @@ pub enum NoRuleLevel {
     Racing(#[from] crate::game::racing::rules::NoTrack),
 }
 
-/// A rule-based level of `game` for `seed` (its goal drawn from the seed unless given); racing
-/// tracks get `obstacles` obstacles. `aux` is recorded, not used.
-pub fn rules_level(
-    game: Game,
-    seed: u64,
-    aux: Option<f64>,
-    goal: Option<[f64; 3]>,
-    obstacles: u32,
-) -> Result<Level, NoRuleLevel> {
-    rules_level_draw(game, seed, aux, goal, obstacles, 0)
+/// λ for a level: one value for the whole level, or a curve along it (docs/designer.md,
+/// pacing).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Lambda {
+    Flat(f64),
+    Curve(AuxCurve),
 }
 
-/// Draw number `draw` of [`rules_level`]: the next valid level of the seed's stream, toward the
-/// same goal (what `generate --verify` hands out when no run completed the earlier draws).
-pub fn rules_level_draw(
-    game: Game,
-    seed: u64,
-    aux: Option<f64>,
-    goal: Option<[f64; 3]>,
-    obstacles: u32,
-    draw: u32,
-) -> Result<Level, NoRuleLevel> {
+/// Which level to build: the seed its goal and the Generator's samples are drawn from, λ, and
+/// what the seed would otherwise draw.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LevelRequest {
+    pub seed: u64,
+    /// λ; none for rule levels that record none (a Generator then builds at λ = 0).
+    pub lambda: Option<Lambda>,
+    /// The goal; drawn from the seed when none.
+    pub goal: Option<[f64; 3]>,
+    /// Obstacles of a racing scene, drawn from the seed.
+    pub obstacles: u32,
+    /// Which valid level of the seed's stream (0: the first; `generate --verify` moves on to the
+    /// next when no run completed the earlier ones).
+    pub draw: u32,
+}
+
+impl LevelRequest {
+    /// The first level of `seed` at one λ, toward the goal the seed draws, without obstacles.
+    pub fn new(seed: u64, aux: Option<f64>) -> Self {
+        Self {
+            seed,
+            lambda: aux.map(Lambda::Flat),
+            goal: None,
+            obstacles: 0,
+            draw: 0,
+        }
+    }
+
+    pub fn goal(self, goal: Option<[f64; 3]>) -> Self {
+        Self { goal, ..self }
+    }
+
+    pub fn obstacles(self, obstacles: u32) -> Self {
+        Self { obstacles, ..self }
+    }
+
+    pub fn draw(self, draw: u32) -> Self {
+        Self { draw, ..self }
+    }
+
+    pub fn lambda(self, lambda: Lambda) -> Self {
+        Self {
+            lambda: Some(lambda),
+            ..self
+        }
+    }
+
+    /// The one λ of the whole level, if it has one.
+    fn flat_aux(&self) -> Option<f64> {
+        match self.lambda {
+            Some(Lambda::Flat(aux)) => Some(aux),
+            _ => None,
+        }
+    }
+}
+
+/// A rule-based level of `game` (λ is recorded, not used; the rules know no curve).
+pub fn rules_level(game: Game, request: &LevelRequest) -> Result<Level, NoRuleLevel> {
+    let LevelRequest {
+        seed, goal, draw, ..
+    } = *request;
+    let aux = request.flat_aux();
     Ok(match game {
         Game::Platform => {
             crate::game::rules::platform_level_draw(seed, aux, goal, &RulesConfig::default(), draw)?
         }
         Game::Racing => {
             let config = RacingRulesConfig {
-                obstacles,
+                obstacles: request.obstacles,
                 ..RacingRulesConfig::default()
             };
             crate::game::racing::rules::racing_level_draw(seed, aux, goal, &config, draw)?
@@ -78,58 +127,59 @@ pub struct GeneratorPolicy {
 #[derive(Debug, thiserror::Error)]
 pub enum GenerationError {
     #[error(
-        "the Generator built no valid level toward goal {goal:?} at aux {aux} in {ATTEMPTS} attempts (each overlapped or crossed itself, hit an obstacle or ran out of pieces); try another seed or goal"
+        "the Generator built no valid level toward goal {goal:?} at aux {lambda} in {ATTEMPTS} attempts (each overlapped or crossed itself, hit an obstacle or ran out of pieces); try another seed or goal"
     )]
-    NoLevel { goal: [f64; 3], aux: f64 },
+    NoLevel { goal: [f64; 3], lambda: String },
     #[error("the Generator's network failed: {0}")]
     Network(#[from] candle_core::Error),
 }
 
-/// A level of the Generator's game built at aux `aux` toward `goal` (drawn from `seed` when not
-/// given); racing scenes get `obstacles` obstacles, drawn from the seed.
+/// A level of the Generator's game, built as `request` asks.
 pub fn generator_level(
     generator: &GeneratorPolicy,
-    seed: u64,
-    aux: f64,
-    goal: Option<[f64; 3]>,
-    obstacles: u32,
-) -> Result<Level, GenerationError> {
-    generator_level_draw(generator, seed, aux, goal, obstacles, 0)
-}
-
-/// Draw number `draw` of [`generator_level`]: the `draw`-th valid level (from 0) the Generator
-/// builds from the seed's stream, toward the same goal.
-pub fn generator_level_draw(
-    generator: &GeneratorPolicy,
-    seed: u64,
-    aux: f64,
-    goal: Option<[f64; 3]>,
-    obstacles: u32,
-    draw: u32,
+    request: &LevelRequest,
 ) -> Result<Level, GenerationError> {
     match generator.game {
-        Game::Platform => build_level::<PlatformGame>(generator, seed, aux, goal, obstacles, draw),
-        Game::Racing => build_level::<RacingGame>(generator, seed, aux, goal, obstacles, draw),
+        Game::Platform => build_level::<PlatformGame>(generator, request),
+        Game::Racing => build_level::<RacingGame>(generator, request),
+    }
+}
+
+/// λ for the next piece of `build`: the level's one λ, or the curve's value at the fraction of
+/// the start-to-goal distance the track has covered.
+fn piece_aux<B: TrackBuild>(lambda: Option<&Lambda>, build: &B) -> f64 {
+    match lambda {
+        None => 0.0,
+        Some(Lambda::Flat(aux)) => *aux,
+        Some(Lambda::Curve(curve)) => {
+            let whole = build.distance_to_goal(0);
+            let left = build.distance_to_goal(build.piece_count());
+            round_aux(curve.at(covered(whole, left)))
+        }
     }
 }
 
 fn build_level<G: GeneratorGame>(
     generator: &GeneratorPolicy,
-    seed: u64,
-    aux: f64,
-    goal: Option<[f64; 3]>,
-    obstacles: u32,
-    draw: u32,
+    request: &LevelRequest,
 ) -> Result<Level, GenerationError> {
-    let (empty, mut rng) = G::new_build(seed, goal, generator.limits, obstacles);
+    let (empty, mut rng) = G::new_build(
+        request.seed,
+        request.goal,
+        generator.limits,
+        request.obstacles,
+    );
     let goal = empty.goal();
-    let mut skip = draw;
-    let aux_input = [aux as f32];
+    let mut skip = request.draw;
+    let lambda = request.lambda.as_ref();
     let mut observation = vec![0.0; observation_size::<G>()];
     for _ in 0..ATTEMPTS {
         let mut build = empty.clone();
+        let mut piece_auxes = Vec::new();
         while build.piece_count() < generator.limits.max_pieces {
-            build.observe(&aux_input, &mut observation);
+            let aux = piece_aux(lambda, &build);
+            piece_auxes.push(aux);
+            build.observe(&[aux as f32], &mut observation);
             generator.normalizer.normalize(&mut observation);
             let action = generator
                 .policy
@@ -142,23 +192,37 @@ fn build_level<G: GeneratorGame>(
                     break;
                 }
                 Placement::Completed => {
+                    let pacing = match lambda {
+                        Some(Lambda::Curve(curve)) => Some(Pacing {
+                            curve: curve.clone(),
+                            piece_aux: piece_auxes,
+                        }),
+                        _ => None,
+                    };
                     return Ok(Level {
-                        seed: Some(seed),
-                        aux: Some(aux),
+                        seed: Some(request.seed),
+                        aux: request.flat_aux(),
                         goal,
                         track: build.into_track(),
                         source: Source::Policy {
                             generator: generator.reference.clone(),
                         },
                         stats: None,
+                        pacing,
                     });
                 }
             }
         }
     }
-    Err(GenerationError::NoLevel { goal, aux })
+    Err(GenerationError::NoLevel {
+        goal,
+        lambda: match lambda {
+            None => "0".into(),
+            Some(Lambda::Flat(aux)) => aux.to_string(),
+            Some(Lambda::Curve(curve)) => format!("curve `{curve}`"),
+        },
+    })
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -193,13 +257,25 @@ mod tests {
         let (_, start, _) = goal_and_start(5, None);
         let [x, z] = heading_direction(start.heading);
         let goal = [7.5 * x, 0.0, 7.5 * z];
-        let a = generator_level(&generator, 5, -1.0, Some(goal), 0).unwrap();
-        let b = generator_level(&generator, 5, -1.0, Some(goal), 0).unwrap();
+        let a = generator_level(
+            &generator,
+            &LevelRequest::new(5, Some(-1.0)).goal(Some(goal)),
+        )
+        .unwrap();
+        let b = generator_level(
+            &generator,
+            &LevelRequest::new(5, Some(-1.0)).goal(Some(goal)),
+        )
+        .unwrap();
         assert_eq!(a, b);
         a.validate().unwrap();
         assert_eq!(a.aux, Some(-1.0));
         assert!(matches!(a.source, Source::Policy { .. }));
-        let other = generator_level(&generator, 6, -1.0, Some(goal), 0).unwrap();
+        let other = generator_level(
+            &generator,
+            &LevelRequest::new(6, Some(-1.0)).goal(Some(goal)),
+        )
+        .unwrap();
         assert_ne!(
             a.platform(),
             other.platform(),
@@ -211,7 +287,11 @@ mod tests {
     fn an_unreachable_goal_is_a_clear_error() {
         let mut generator = untrained();
         generator.limits.max_pieces = 1;
-        let err = generator_level(&generator, 1, 0.5, Some([500.0, 0.0, 0.0]), 0).unwrap_err();
+        let err = generator_level(
+            &generator,
+            &LevelRequest::new(1, Some(0.5)).goal(Some([500.0, 0.0, 0.0])),
+        )
+        .unwrap_err();
         assert!(err.to_string().contains("no valid level"), "{err}");
     }
 }

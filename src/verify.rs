@@ -376,3 +376,52 @@ impl Summary {
         }
     }
 }
+
+/// Where runs fail along levels: failures and pieces before the halfway point (pieces that
+/// begin less than half the start-to-goal distance in) and past it.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct HalfwaySplit {
+    /// Failures on pieces before the halfway point, and past it.
+    pub failures: [u64; 2],
+    /// Pieces before the halfway point, and past it.
+    pub pieces: [u64; 2],
+}
+
+impl HalfwaySplit {
+    /// Adds a level's per-piece failures, each piece on the side where it begins.
+    pub fn add(&mut self, level: &Level, stats: &SolverStats) {
+        for (fraction, &failures) in level
+            .piece_start_fractions()
+            .iter()
+            .zip(&stats.failures_by_piece)
+        {
+            let side = usize::from(*fraction >= 0.5);
+            self.failures[side] += u64::from(failures);
+            self.pieces[side] += 1;
+        }
+    }
+
+    /// The share of all failures that fall past the halfway point (NaN without failures).
+    pub fn share_past(&self) -> f64 {
+        self.failures[1] as f64 / (self.failures[0] + self.failures[1]) as f64
+    }
+
+    /// Failures per piece before the halfway point and past it (NaN for a side without pieces).
+    pub fn per_piece(&self) -> [f64; 2] {
+        [0, 1].map(|k| self.failures[k] as f64 / self.pieces[k] as f64)
+    }
+}
+
+/// The share of runs that got past each piece: `1 - failures up to and including it / trials`
+/// (what a player feels as the difficulty along the level).
+pub fn passed_by_piece(stats: &SolverStats) -> Vec<f64> {
+    let mut failed = 0u64;
+    stats
+        .failures_by_piece
+        .iter()
+        .map(|&f| {
+            failed += u64::from(f);
+            1.0 - failed as f64 / f64::from(stats.trials.max(1))
+        })
+        .collect()
+}

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use crate::cli::{GenerateArgs, default_solver};
 use crate::difficulty;
 use crate::fsio::{self, Overwrite};
-use crate::generation::{self, GeneratorPolicy};
+use crate::generation::{self, GeneratorPolicy, Lambda, LevelRequest};
 use crate::level::{Game, Level};
 use crate::level_files::{Format, LevelFiles, file_stem, render};
 use crate::policies::{load_generator, load_solver, policy_paths};
@@ -29,11 +29,17 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         )
         .into());
     }
+    if args.aux_curve.is_some() && args.policies.is_none() {
+        return Err(crate::shell::UsageError(
+            "--aux-curve needs --policies: the rules know no λ, a Generator follows it".into(),
+        )
+        .into());
+    }
     let generator = match &args.policies {
         Some(dir) => {
-            if args.aux.is_none() && args.target_success.is_none() {
+            if args.aux.is_none() && args.aux_curve.is_none() && args.target_success.is_none() {
                 return Err(crate::shell::UsageError(
-                    "--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard) or --target-success P"
+                    "--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard), --aux-curve CURVE or --target-success P"
                         .into(),
                 )
                 .into());
@@ -219,11 +225,18 @@ fn certified(mut level: Level, solver: &Solver, seed: u64) -> Result<Level> {
     Ok(level)
 }
 
-/// A level's file name: game, seed and λ, or the success rate asked for.
+/// A level's file name: game, seed and λ, or the success rate asked for, or `curve` and a
+/// short hash of the aux curve (its text is in the file).
 fn stem(args: &GenerateArgs, seed: u64) -> String {
-    match args.target_success {
-        Some(target) => format!("{}_seed{seed}_success{target:.2}", args.game),
-        None => file_stem(args.game, seed, args.aux),
+    match (args.target_success, &args.aux_curve) {
+        (Some(target), _) => format!("{}_seed{seed}_success{target:.2}", args.game),
+        (None, Some(curve)) => {
+            use sha2::Digest;
+            let hash = sha2::Sha256::digest(curve.to_string().as_bytes());
+            let short: String = hash[..4].iter().map(|b| format!("{b:02x}")).collect();
+            format!("{}_seed{seed}_curve-{short}", args.game)
+        }
+        (None, None) => file_stem(args.game, seed, args.aux),
     }
 }
 
@@ -238,17 +251,16 @@ fn build(
     seed: u64,
     draw: u32,
 ) -> Result<Level> {
-    let (aux, goal) = (args.aux, args.goal);
-    Ok(match (args.game, generator) {
-        (_, Some(generator)) => generation::generator_level_draw(
-            generator,
-            seed,
-            aux.unwrap_or_default(),
-            goal,
-            args.obstacles,
-            draw,
-        )?,
-        (game, None) => generation::rules_level_draw(game, seed, aux, goal, args.obstacles, draw)?,
+    let mut request = LevelRequest::new(seed, args.aux)
+        .goal(args.goal)
+        .obstacles(args.obstacles)
+        .draw(draw);
+    if let Some(curve) = &args.aux_curve {
+        request = request.lambda(Lambda::Curve(curve.clone()));
+    }
+    Ok(match generator {
+        Some(generator) => generation::generator_level(generator, &request)?,
+        None => generation::rules_level(args.game, &request)?,
     })
 }
 

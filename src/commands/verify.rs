@@ -9,11 +9,11 @@ use serde_json::json;
 
 use crate::cli::{SolverChoice, VerifyArgs, default_solver};
 use crate::game::facts::facts;
-use crate::level::Game;
 use crate::level::stats::{Outcome, SolverRef, SolverStats};
 use crate::level::yaml;
+use crate::level::{Game, Level};
 use crate::policies::load_solver;
-use crate::verify::{Solver, SolverPolicy, Summary, verify};
+use crate::verify::{HalfwaySplit, Solver, SolverPolicy, Summary, passed_by_piece, verify};
 
 pub fn run(args: &VerifyArgs) -> Result<()> {
     if args.replay {
@@ -22,6 +22,7 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
     let mut solvers = Solvers::default();
     let mut failed = 0;
     let mut all = Vec::new();
+    let mut halfway = HalfwaySplit::default();
     for path in &args.levels {
         let outcome = yaml::load(path)
             .map_err(anyhow::Error::from)
@@ -33,15 +34,16 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
                     crate::shell::progress_bar(args.trials as u64, &path.display().to_string());
                 let stats = verify(&level, &solver, args.trials, args.seed, &|| bar.inc(1))?;
                 bar.finish_and_clear();
-                Ok((game, stats))
+                Ok((level, stats))
             });
         match outcome {
-            Ok((game, stats)) => {
+            Ok((level, stats)) => {
                 if args.json {
-                    println!("{}", to_json(path, game, &stats));
+                    println!("{}", to_json(path, &level, &stats));
                 } else {
-                    println!("{}", describe(path, game, &stats));
+                    println!("{}", describe(path, &level, &stats));
                 }
+                halfway.add(&level, &stats);
                 all.push(stats);
             }
             Err(err) => {
@@ -60,6 +62,16 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
             "{} levels: success ratio {:.3} ± {:.3} (mean ± std over levels), completed by at least one run {:.2}, mean progress {:.2}, mean steps of successful runs {steps}",
             s.levels, s.mean_success, s.std_success, s.completed_by_any, s.mean_progress
         );
+        let [before, past] = halfway.per_piece();
+        if halfway.failures.iter().sum::<u64>() > 0 {
+            println!(
+                "failures per piece {before:.2} before the halfway point ({} pieces), {past:.2} past it ({} pieces): {:.0}% of the {} failures fall past it",
+                halfway.pieces[0],
+                halfway.pieces[1],
+                100.0 * halfway.share_past(),
+                halfway.failures.iter().sum::<u64>()
+            );
+        }
     }
     if failed > 0 {
         anyhow::bail!(
@@ -193,7 +205,8 @@ impl Solvers {
     }
 }
 
-fn to_json(path: &Path, game: Game, s: &SolverStats) -> serde_json::Value {
+fn to_json(path: &Path, level: &Level, s: &SolverStats) -> serde_json::Value {
+    let game = level.game();
     let mut value = json!({
         "level": path.display().to_string(),
         "solver": s.solver.describe(),
@@ -216,10 +229,25 @@ fn to_json(path: &Path, game: Game, s: &SolverStats) -> serde_json::Value {
             value["failures_by_segment"] = json!(s.failures_by_piece);
         }
     }
+    if let Some(pacing) = &level.pacing {
+        value["aux_curve"] = json!(pacing.curve.to_string());
+        value["aux_by_piece"] = json!(pacing.piece_aux);
+        value["passed_by_piece"] = json!(
+            passed_by_piece(s)
+                .iter()
+                .map(|p| round2(*p))
+                .collect::<Vec<_>>()
+        );
+    }
     value
 }
 
-fn describe(path: &Path, game: Game, s: &SolverStats) -> String {
+fn round2(x: f64) -> f64 {
+    (x * 100.0).round() / 100.0
+}
+
+fn describe(path: &Path, level: &Level, s: &SolverStats) -> String {
+    let game = level.game();
     let mut text = format!(
         "{}: {}/{} succeeded, success ratio {:.2} (95% CI {:.2}-{:.2}), mean progress {:.2}",
         path.display(),
@@ -252,6 +280,19 @@ fn describe(path: &Path, game: Game, s: &SolverStats) -> String {
             "\n  failed {} {} ({causes})",
             facts(game).failed_at,
             failures.join(", ")
+        );
+    }
+    if let Some(pacing) = &level.pacing {
+        let passed: Vec<String> = passed_by_piece(s)
+            .iter()
+            .zip(&pacing.piece_aux)
+            .map(|(p, aux)| format!("{p:.2} (λ {aux:+.2})"))
+            .collect();
+        text += &format!(
+            "\n  aux curve {}; runs past each {}: {}",
+            pacing.curve,
+            facts(game).piece,
+            passed.join(", ")
         );
     }
     text

@@ -12,7 +12,7 @@ use anyhow::Result;
 
 use super::app::{Effect, ExportOutcome, LoadedInfo, PolicyInfo, Response, SweepPoint};
 use crate::fsio::Overwrite;
-use crate::generation::{self, GeneratorPolicy};
+use crate::generation::{self, GeneratorPolicy, LevelRequest};
 use crate::level::{Game, Level};
 use crate::level_files::{Format, LevelFiles, write_level_files};
 use crate::policies::{load_generator, load_solver, policy_paths};
@@ -66,12 +66,14 @@ impl Policies {
         aux: f64,
         goal: Option<[f64; 3]>,
     ) -> Result<Level, String> {
-        let obstacles = crate::game::facts::facts(game).scene_obstacles;
+        let request = LevelRequest::new(seed, Some(aux))
+            .goal(goal)
+            .obstacles(crate::game::facts::facts(game).scene_obstacles);
         match &self.generator {
-            Some(generator) => generation::generator_level(generator, seed, aux, goal, obstacles)
-                .map_err(|e| e.to_string()),
-            None => generation::rules_level(game, seed, Some(aux), goal, obstacles)
-                .map_err(|e| e.to_string()),
+            Some(generator) => {
+                generation::generator_level(generator, &request).map_err(|e| e.to_string())
+            }
+            None => generation::rules_level(game, &request).map_err(|e| e.to_string()),
         }
     }
 }

@@ -2,7 +2,7 @@
 //! [`Layout`] that describes them without the levels themselves.
 
 use crate::game::facts::{facts, piece_values};
-use crate::generation::{self, GeneratorPolicy};
+use crate::generation::{self, GeneratorPolicy, LevelRequest};
 use crate::level::Level;
 use crate::seeds::{EVAL_SEED_BASE, VALIDATION_AUX_STRIDE, VALIDATION_SEED_BASE};
 
@@ -25,13 +25,9 @@ pub fn generator_levels(
         if levels.len() == count as usize {
             break;
         }
-        match generation::generator_level(
-            generator,
-            seed,
-            aux,
-            None,
-            facts(generator.game).scene_obstacles,
-        ) {
+        let request =
+            LevelRequest::new(seed, Some(aux)).obstacles(facts(generator.game).scene_obstacles);
+        match generation::generator_level(generator, &request) {
             Ok(level) => levels.push(level),
             Err(generation::GenerationError::NoLevel { .. }) => {}
             Err(generation::GenerationError::Network(e)) => return Err(e),
@@ -51,7 +47,8 @@ pub fn validation_levels(
     let game = generator.game;
     let mut levels: Vec<Level> = (0..rule_count as u64)
         .filter_map(|k| {
-            generation::rules_level(game, base + k, None, None, facts(game).scene_obstacles).ok()
+            let request = LevelRequest::new(base + k, None).obstacles(facts(game).scene_obstacles);
+            generation::rules_level(game, &request).ok()
         })
         .collect();
     let per_aux = (count - rule_count).div_ceil(AUX_VALUES.len() as u32);

@@ -188,12 +188,6 @@ impl BuildLimits {
     }
 }
 
-/// Straight-line distance between two points, m (progress toward a goal).
-pub fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
-    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
-}
-
 /// Length of the Generator's observation vector of game `G`.
 pub fn observation_size<G: GeneratorGame>() -> usize {
     G::GENERATOR_OBSERVATION_LAYOUT.iter().map(|(_, k)| k).sum()

@@ -92,6 +92,7 @@ pub fn platform_level_draw(
                 track: Track::Platform(track),
                 source: Source::Rules { rules: *config },
                 stats: None,
+                pacing: None,
             });
         }
     }

@@ -3,6 +3,7 @@
 //! nothing here touches the disk.
 
 pub mod gltf;
+pub mod pacing;
 pub mod params;
 pub mod platform;
 pub mod racing;
@@ -154,6 +155,14 @@ pub struct Level {
     pub source: Source,
     /// What the Solver measured on it, when it has been verified.
     pub stats: Option<SolverStats>,
+    /// λ along the level, when it was built with an aux curve (then `aux` is none).
+    pub pacing: Option<pacing::Pacing>,
+}
+
+/// Straight-line distance between two points, m.
+pub fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
 }
 
 /// A level that breaks a rule of its game.
@@ -187,6 +196,8 @@ pub enum InvalidLevel {
     Stats(String),
     #[error("{0}")]
     Source(String),
+    #[error("{0}")]
+    Pacing(String),
 }
 
 impl Level {
@@ -218,6 +229,31 @@ impl Level {
             Track::Platform(track) => track.block_count(),
             Track::Racing(track) => track.segments.len(),
         }
+    }
+
+    /// Where each piece begins, as the fraction of the start-to-goal distance covered there
+    /// (straight-line distances to the goal, 0 at the start): where an aux curve is read.
+    pub fn piece_start_fractions(&self) -> Vec<f64> {
+        let starts: Vec<[f64; 3]> = match &self.track {
+            Track::Platform(track) => track.platforms()[..track.block_count()]
+                .iter()
+                .map(|p| p.position)
+                .collect(),
+            Track::Racing(track) => {
+                let road = track.road();
+                (0..track.segments.len())
+                    .map(|i| match i {
+                        0 => track.position,
+                        i => road.samples()[road.nearest_along(road.segment_start(i))].centre,
+                    })
+                    .collect()
+            }
+        };
+        let whole = starts.first().map_or(0.0, |&s| distance(s, self.goal));
+        starts
+            .iter()
+            .map(|&s| pacing::covered(whole, distance(s, self.goal)))
+            .collect()
     }
 
     /// Checks the rules that span the whole level (ranges and overlaps are checked as pieces are
@@ -279,6 +315,16 @@ impl Level {
             stats
                 .check(self.piece_count())
                 .map_err(InvalidLevel::Stats)?;
+        }
+        if let Some(pacing) = &self.pacing {
+            if self.aux.is_some() {
+                return Err(InvalidLevel::Pacing(
+                    "a level has one λ (`aux`) or a curve (`aux_curve`), not both".into(),
+                ));
+            }
+            pacing
+                .check(self.piece_count())
+                .map_err(InvalidLevel::Pacing)?;
         }
         Ok(())
     }

@@ -101,10 +101,15 @@ pub struct Scene {
 impl Scene {
     /// The scene of a level: every block or piece of road, obstacles, start and goal markers.
     pub fn of_level(level: &Level) -> Scene {
-        match &level.track {
+        let mut scene = match &level.track {
             Track::Platform(track) => platform_scene(level, track),
             Track::Racing(track) => racing_scene(level, track),
+        };
+        if let Some(pacing) = &level.pacing {
+            scene.extras["aux_curve"] = json!(pacing.curve.to_string());
+            scene.extras["aux_by_piece"] = json!(pacing.piece_aux);
         }
+        scene
     }
 }
 

@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
+use super::pacing::{AuxCurve, Pacing};
 use super::params::{self, ParamRange};
 use super::platform::{self, BlockParams, PlatformTrack, Start};
 use super::racing::{Obstacle, RacingTrack, SegmentParams};
@@ -215,6 +216,9 @@ struct LevelFile {
     seed: Option<u64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     aux: Option<Bounded<Aux>>,
+    /// λ along the level (then each block or segment carries its own `aux`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    aux_curve: Option<AuxCurve>,
     start: StartFile,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     goal: Option<Point>,
@@ -248,6 +252,9 @@ struct BlockFile {
     angle: Bounded<Angle>,
     size: Bounded<Size>,
     height: Bounded<BlockHeight>,
+    /// The λ the block was placed at (levels built with an `aux_curve`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    aux: Option<Bounded<Aux>>,
     /// Resolved top centre (written by arlpcg; optional and checked when read).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     position: Option<Point>,
@@ -262,10 +269,20 @@ struct SegmentFile {
     length: Bounded<Length>,
     curve: Bounded<Curve>,
     height: Bounded<SegmentHeight>,
+    /// The λ the segment was placed at (levels built with an `aux_curve`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    aux: Option<Bounded<Aux>>,
 }
 
 impl LevelFile {
     fn from_level(level: &Level) -> Self {
+        let piece_aux = |i: usize| {
+            level
+                .pacing
+                .as_ref()
+                .and_then(|p| p.piece_aux.get(i))
+                .map(|&a| Bounded::new(a))
+        };
         let (start, blocks, segments, obstacles) = match &level.track {
             Track::Platform(track) => {
                 let s = track.start();
@@ -278,11 +295,13 @@ impl LevelFile {
                     .block_params()
                     .iter()
                     .zip(&track.platforms()[1..])
-                    .map(|(p, placed)| BlockFile {
+                    .enumerate()
+                    .map(|(i, (p, placed))| BlockFile {
                         distance: Bounded::new(p.distance),
                         angle: Bounded::new(p.angle),
                         size: Bounded::new(p.size),
                         height: Bounded::new(p.height),
+                        aux: piece_aux(i),
                         position: Some(write_point(placed.position)),
                         heading: Some(Bounded::new((placed.heading * 1000.0).round() / 1000.0)),
                     })
@@ -298,10 +317,12 @@ impl LevelFile {
                 let segments = track
                     .segments
                     .iter()
-                    .map(|s| SegmentFile {
+                    .enumerate()
+                    .map(|(i, s)| SegmentFile {
                         length: Bounded::new(s.length),
                         curve: Bounded::new(s.curve),
                         height: Bounded::new(s.height),
+                        aux: piece_aux(i),
                     })
                     .collect();
                 (start, None, Some(segments), track.obstacles.clone())
@@ -313,6 +334,7 @@ impl LevelFile {
             game: level.game(),
             seed: level.seed,
             aux: level.aux.map(Bounded::new),
+            aux_curve: level.pacing.as_ref().map(|p| p.curve.clone()),
             start,
             goal: Some(level.goal.map(Bounded::new)),
             blocks,
@@ -329,6 +351,7 @@ impl LevelFile {
             line,
             message,
         };
+        let pacing = self.pacing(text)?;
         let (track, default_goal) = match self.game {
             Game::Platform => {
                 if self.segments.is_some() {
@@ -470,6 +493,7 @@ impl LevelFile {
             track,
             source: self.source,
             stats: self.stats,
+            pacing,
         };
         level.validate().map_err(|e| {
             let key = |key: &str| (key.to_string(), line_of_key(text, key));
@@ -482,6 +506,7 @@ impl LevelFile {
                 super::InvalidLevel::GoalNotReached { .. }
                 | super::InvalidLevel::RoadShort { .. } => key("goal"),
                 super::InvalidLevel::Road(_) => key("segments"),
+                super::InvalidLevel::Pacing(_) => key("aux_curve"),
                 super::InvalidLevel::Obstacle { index, problem } => {
                     return invalid(
                         format!("obstacles[{index}]"),
@@ -493,6 +518,57 @@ impl LevelFile {
             invalid(field, line, e.to_string())
         })?;
         Ok(level)
+    }
+}
+
+impl LevelFile {
+    /// λ along the level: with `aux_curve`, every piece carries its `aux`; without, none does.
+    fn pacing(&self, text: &str) -> Result<Option<Pacing>, Problem> {
+        let (key, piece_aux): (&str, Vec<Option<f64>>) = match (&self.blocks, &self.segments) {
+            (Some(blocks), _) => (
+                "blocks",
+                blocks.iter().map(|b| b.aux.map(|a| a.0)).collect(),
+            ),
+            (None, Some(segments)) => (
+                "segments",
+                segments.iter().map(|s| s.aux.map(|a| a.0)).collect(),
+            ),
+            (None, None) => ("blocks", Vec::new()),
+        };
+        let invalid = |index: usize, message: String| Problem::Invalid {
+            field: format!("{key}[{index}].aux"),
+            line: line_of_item(text, key, index),
+            message,
+        };
+        let Some(curve) = &self.aux_curve else {
+            return match piece_aux.iter().position(Option::is_some) {
+                Some(i) => Err(invalid(
+                    i,
+                    "a piece's own λ needs `aux_curve` at the top of the file (the curve it was placed along)".into(),
+                )),
+                None => Ok(None),
+            };
+        };
+        if self.aux.is_some() {
+            return Err(Problem::Invalid {
+                field: "aux".into(),
+                line: line_of_key(text, "aux"),
+                message: "a level has one λ (`aux`) or a curve (`aux_curve`), not both".into(),
+            });
+        }
+        let piece_aux = piece_aux
+            .iter()
+            .enumerate()
+            .map(|(i, aux)| {
+                aux.ok_or_else(|| {
+                    invalid(i, "missing: with `aux_curve` every piece has its λ".into())
+                })
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Some(Pacing {
+            curve: curve.clone(),
+            piece_aux,
+        }))
     }
 }
 

@@ -10,6 +10,7 @@ use arlpcg::design::app::{self, App, Effect, GoalSetting, LoadedInfo, Message, O
 use arlpcg::design::layout::Areas;
 use arlpcg::design::view;
 use arlpcg::design::worker::{self, GamePolicies, Policies, Workers};
+use arlpcg::generation::LevelRequest;
 use arlpcg::level::{Game, yaml};
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
@@ -92,10 +93,7 @@ fn starts_with_a_level_and_its_statistics() {
     // Without policies the level on screen is the rule level of the designer's seed and λ.
     let expected = arlpcg::generation::rules_level(
         arlpcg::level::Game::Platform,
-        h.app.seed,
-        Some(h.app.aux),
-        None,
-        0,
+        &LevelRequest::new(h.app.seed, Some(h.app.aux)),
     )
     .unwrap();
     assert_eq!(level.track, expected.track);
@@ -359,14 +357,9 @@ fn racing_tracks_are_designed_like_platform_levels() {
     assert_eq!(h.app.game, Game::Racing);
     h.settle();
     let level = h.app.level.clone().expect("a racing track at once");
-    let expected = arlpcg::generation::rules_level(
-        Game::Racing,
-        1,
-        Some(1.0),
-        None,
-        arlpcg::game::facts::facts(Game::Racing).scene_obstacles,
-    )
-    .unwrap();
+    let request = LevelRequest::new(1, Some(1.0))
+        .obstacles(arlpcg::game::facts::facts(Game::Racing).scene_obstacles);
+    let expected = arlpcg::generation::rules_level(Game::Racing, &request).unwrap();
     assert_eq!(*level, expected, "the rules' track of the seed");
     let trials = h.app.trials.as_ref().unwrap();
     assert_eq!(trials.stats.as_ref().unwrap().trials, app::DEFAULT_TRIALS);

@@ -43,6 +43,7 @@ fn level() -> impl Strategy<Value = Level> {
                     track: Track::Platform(track),
                     source: Source::Hand,
                     stats: None,
+                    pacing: None,
                 })
             },
         )

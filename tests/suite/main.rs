@@ -9,6 +9,7 @@ mod designer;
 mod gltf_export;
 mod hostile_input;
 mod level_format;
+mod pacing;
 mod platform_game;
 mod ppo_learns;
 mod racing_game;

@@ -178,7 +178,7 @@ impl TrackBuild for PlatformBuild {
 
     fn distance_to_goal(&self, k: usize) -> f64 {
         let p = self.track.platforms()[k].position;
-        crate::game::generator::distance(self.goal, p)
+        crate::level::distance(self.goal, p)
     }
 
     fn piece_features(&self) -> Vec<[f64; 2]> {

@@ -238,8 +238,11 @@ impl TrackBuild for RacingBuild {
     }
 
     fn distance_to_goal(&self, k: usize) -> f64 {
-        let p = self.road.samples()[self.road.nearest_along(self.road.segment_start(k))].centre;
-        crate::game::generator::distance(self.goal, p)
+        let p = match k {
+            0 => self.track.position,
+            k => self.road.samples()[self.road.nearest_along(self.road.segment_start(k))].centre,
+        };
+        crate::level::distance(self.goal, p)
     }
 
     fn piece_features(&self) -> Vec<[f64; 2]> {

@@ -125,6 +125,7 @@ pub fn racing_level_draw(
                 track: Track::Racing(track),
                 source: Source::RacingRules { rules: *config },
                 stats: None,
+                pacing: None,
             });
         }
     }

@@ -1,0 +1,139 @@
+//! Pacing: λ along a level (`generate --aux-curve`). Each piece is built at the curve's value
+//! where it begins and records it; the shipped platform Generator follows a λ that changes
+//! within a level; bad curves are refused with the reason.
+
+use std::path::Path;
+
+use arlpcg::generation::{Lambda, LevelRequest, generator_level};
+use arlpcg::level::pacing::{AuxCurve, round_aux};
+use arlpcg::level::{Game, yaml};
+use arlpcg::policies::{load_generator, load_solver, policy_paths};
+use arlpcg::verify::{HalfwaySplit, Solver, verify};
+
+use crate::common::{arlpcg, stderr};
+
+const EASY_THEN_HARD: &str = "0:1, 0.5:1, 0.5001:-1, 1:-1";
+
+fn shipped(game: Game) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("policies")
+        .join(game.name())
+}
+
+#[test]
+fn each_piece_is_built_at_the_curves_value_where_it_begins_and_records_it() {
+    let curve = AuxCurve::parse(EASY_THEN_HARD).unwrap();
+    for game in [Game::Platform, Game::Racing] {
+        let (generator, _) = load_generator(&policy_paths(&shipped(game)).0, game).unwrap();
+        let request = LevelRequest::new(3, None)
+            .obstacles(arlpcg::game::facts::facts(game).scene_obstacles)
+            .lambda(Lambda::Curve(curve.clone()));
+        let level = generator_level(&generator, &request).unwrap();
+        let pacing = level
+            .pacing
+            .as_ref()
+            .expect("a curve level records its pacing");
+        assert_eq!(level.aux, None, "{game}: one λ or a curve, not both");
+        let expected: Vec<f64> = level
+            .piece_start_fractions()
+            .iter()
+            .map(|&f| round_aux(curve.at(f)))
+            .collect();
+        assert_eq!(pacing.piece_aux, expected, "{game}");
+        assert!(
+            expected.contains(&1.0) && expected.contains(&-1.0),
+            "{game}: both halves of the curve are in the level: {expected:?}"
+        );
+        let text = yaml::to_string(&level);
+        assert!(
+            text.contains(&format!("aux_curve: {EASY_THEN_HARD}")),
+            "{text}"
+        );
+        assert_eq!(
+            yaml::parse(&text).unwrap(),
+            level,
+            "{game}: reads back equal"
+        );
+    }
+}
+
+#[test]
+fn the_shipped_platform_generator_puts_the_failures_where_the_curve_is_hard() {
+    let dir = shipped(Game::Platform);
+    let (generator, _) = load_generator(&policy_paths(&dir).0, Game::Platform).unwrap();
+    let (solver, _) = load_solver(&policy_paths(&dir).1, Game::Platform).unwrap();
+    let split = |curve: &str| {
+        let mut split = HalfwaySplit::default();
+        for seed in 100..106 {
+            let request = LevelRequest::new(seed, None)
+                .lambda(Lambda::Curve(AuxCurve::parse(curve).unwrap()));
+            let level = generator_level(&generator, &request).unwrap();
+            let stats = verify(&level, &Solver::Policy(&solver), 40, seed, &|| {}).unwrap();
+            split.add(&level, &stats);
+        }
+        split
+    };
+    let easy_then_hard = split(EASY_THEN_HARD);
+    let hard_then_easy = split("0:-1, 0.5:-1, 0.5001:1, 1:1");
+    assert!(
+        easy_then_hard.share_past() >= 0.75,
+        "easy then hard: {easy_then_hard:?}"
+    );
+    assert!(
+        hard_then_easy.share_past() <= 0.4,
+        "hard then easy: {hard_then_easy:?}"
+    );
+}
+
+#[test]
+fn bad_curves_are_refused_with_the_reason() {
+    let out_dir = tempfile::tempdir().unwrap();
+    let out = out_dir.path().to_str().unwrap();
+    let policies = shipped(Game::Platform);
+    let policies = policies.to_str().unwrap();
+    let cases: [(&[&str], &str); 4] = [
+        (
+            &["--policies", policies, "--aux-curve", "0:1, 0.5"],
+            "not `fraction:λ`",
+        ),
+        (
+            &["--policies", policies, "--aux-curve", "0:1, 0.5:3"],
+            "out of range",
+        ),
+        (
+            &["--policies", policies, "--aux-curve=0:1", "--aux", "1"],
+            "cannot be used with",
+        ),
+        (
+            &["--rules", "--aux-curve", "0:1"],
+            "--aux-curve needs --policies",
+        ),
+    ];
+    for (args, expected) in cases {
+        let mut all = vec!["generate", "--game", "platform", "--out", out];
+        all.extend_from_slice(args);
+        let output = arlpcg(&all);
+        let err = stderr(&output);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(expected), "{args:?}: {err}");
+    }
+    assert_eq!(
+        std::fs::read_dir(out).unwrap().count(),
+        0,
+        "nothing written"
+    );
+}
+
+#[test]
+fn a_piece_aux_without_a_curve_names_the_field() {
+    let level = arlpcg::game::rules::platform_level(5, None, None, &Default::default()).unwrap();
+    let text = yaml::to_string(&level).replacen("  height:", "  aux: -1.0\n  height:", 1);
+    let err = yaml::parse(&text).unwrap_err().to_string();
+    assert!(
+        err.starts_with("blocks[0].aux: a piece's own λ needs `aux_curve`"),
+        "{err}"
+    );
+    let with_curve = text.replacen("start:", "aux_curve: 0:1\nstart:", 1);
+    let err = yaml::parse(&with_curve).unwrap_err().to_string();
+    assert!(err.starts_with("blocks[1].aux: missing"), "{err}");
+}

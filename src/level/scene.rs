@@ -273,7 +273,9 @@ fn cylinder(base: [f64; 3], radius: f64, height: f64) -> TriangleMesh {
         mesh.vertex([x, base[1], z], normal, [u, 1.0]);
         mesh.vertex([x, base[1] + height, z], normal, [u, 0.0]);
     }
-    mesh.strip(0, CYLINDER_SIDES + 1, 0, 1);
+    // Top before bottom: seen from outside, top → bottom → next bottom turns counter-clockwise
+    // (engines cull the other side).
+    mesh.strip(0, CYLINDER_SIDES + 1, 1, 0);
     // Caps: a fan around a centre vertex each.
     for (y, up) in [(base[1] + height, 1.0f32), (base[1], -1.0)] {
         let centre = mesh.positions.len() as u32;

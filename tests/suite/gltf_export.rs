@@ -122,3 +122,96 @@ fn export_is_deterministic_and_gltf_matches_glb() {
         root["buffers"][0]["byteLength"].as_u64().unwrap() as usize
     );
 }
+
+/// Each triangle of `primitive`: its three positions and three normals.
+fn triangles(
+    primitive: &gltf::Primitive,
+    buffers: &[gltf::buffer::Data],
+) -> Vec<[([f32; 3], [f32; 3]); 3]> {
+    let reader = primitive.reader(|b| Some(&buffers[b.index()]));
+    let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+    let normals: Vec<[f32; 3]> = reader.read_normals().unwrap().collect();
+    let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+    indices
+        .chunks(3)
+        .map(|t| [0, 1, 2].map(|k| (positions[t[k] as usize], normals[t[k] as usize])))
+        .collect()
+}
+
+fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Engines cull back faces: every triangle of every mesh must be wound counter-clockwise seen
+/// from the side its stored normals point to, and every closed mesh (blocks, boxes, markers,
+/// cylinders: all but the road's open surface and skirts) must enclose a positive volume, that
+/// is face outward.
+#[test]
+fn every_mesh_faces_outward_and_its_winding_agrees_with_its_normals() {
+    let platform = level(4);
+    let racing = arlpcg::game::racing::rules::racing_level(
+        9,
+        Some(0.0),
+        None,
+        &arlpcg::level::racing::RacingRulesConfig {
+            obstacles: 6,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let track = racing.racing().unwrap();
+    let kinds = |kind: &str| {
+        track
+            .obstacles
+            .iter()
+            .filter(|o| format!("{o:?}").starts_with(kind))
+            .count()
+    };
+    assert!(
+        kinds("Box") > 0 && kinds("Cylinder") > 0,
+        "{:?}",
+        track.obstacles
+    );
+    for level in [platform, racing] {
+        let glb = export::to_glb(&Scene::of_level(&level));
+        let (document, buffers, _) = gltf::import_slice(&glb).unwrap();
+        let mut closed_meshes = 0;
+        for mesh in document.meshes() {
+            let name = mesh.name().unwrap_or("?").to_string();
+            let mut volume = 0.0f64;
+            for primitive in mesh.primitives() {
+                for (i, [a, b, c]) in triangles(&primitive, &buffers).into_iter().enumerate() {
+                    let face = cross(sub(b.0, a.0), sub(c.0, a.0));
+                    let stored = [0, 1, 2].map(|k| a.1[k] + b.1[k] + c.1[k]);
+                    assert!(
+                        dot(face, stored) > 0.0,
+                        "{}: mesh {name}, triangle {i} is wound against its normals",
+                        level.game()
+                    );
+                    volume += f64::from(dot(a.0, cross(b.0, c.0))) / 6.0;
+                }
+            }
+            if !name.starts_with("segment_") {
+                closed_meshes += 1;
+                assert!(
+                    volume > 0.0,
+                    "{}: mesh {name} faces inward (volume {volume})",
+                    level.game()
+                );
+            }
+        }
+        assert!(closed_meshes > 0, "{}", level.game());
+    }
+}

@@ -25,10 +25,25 @@ pub fn check_writable(path: &Path, overwrite: Overwrite) -> Result<()> {
     Ok(())
 }
 
+/// Fails unless `path` is a regular file (or a link to one): a FIFO would block the opening
+/// forever, a device never end, a folder not read. Checked before a path is opened.
+pub fn check_regular(path: &Path, what: &str) -> Result<()> {
+    let meta = std::fs::metadata(path)
+        .with_context(|| format!("cannot read {what} {}", path.display()))?;
+    if !meta.is_file() {
+        bail!(
+            "{what} {} is not a regular file (a folder, FIFO, socket or device)",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 /// Reads a whole regular file of at most `limit` bytes; `what` names it in errors (devices,
-/// folders and larger files are refused before anything large is read).
+/// FIFOs, folders and larger files are refused before anything is read).
 pub fn read_limited(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>> {
     use std::io::Read;
+    check_regular(path, what)?;
     let file = std::fs::File::open(path)
         .with_context(|| format!("cannot read {what} {}", path.display()))?;
     let meta = file
@@ -80,6 +95,64 @@ pub fn write_atomic(path: &Path, bytes: &[u8], overwrite: Overwrite) -> Result<(
     .with_context(|| format!("cannot write {}", path.display()))
 }
 
+/// Temporary files this tool writes before renaming them into place: `.arlpcg-*.tmp`.
+fn is_our_temp(name: &str) -> bool {
+    name.starts_with(".arlpcg-") && name.ends_with(".tmp")
+}
+
+/// How old a temporary file must be to count as left by a killed run: a live writer renames
+/// its temporaries within seconds.
+pub const STALE_TEMP_AGE: std::time::Duration = std::time::Duration::from_secs(600);
+
+/// Removes the temporary files a killed run left in `dir` (older than [`STALE_TEMP_AGE`],
+/// so another run's file being written is never touched); returns how many went. `now` is the
+/// caller's clock.
+pub fn remove_stale_temps(dir: &Path, now: std::time::SystemTime) -> Result<usize> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(0);
+    };
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else { continue };
+        let Ok(meta) = entry.metadata() else { continue };
+        let old = meta
+            .modified()
+            .ok()
+            .and_then(|m| now.duration_since(m).ok())
+            .is_some_and(|age| age >= STALE_TEMP_AGE);
+        if is_our_temp(name) && meta.is_file() && old {
+            std::fs::remove_file(entry.path()).with_context(|| {
+                format!(
+                    "cannot remove the stale temporary file {}",
+                    entry.path().display()
+                )
+            })?;
+            removed += 1;
+        }
+    }
+    Ok(removed)
+}
+
+/// The first entry of `dir` besides this tool's temporary files, if it exists and has one.
+pub fn first_entry(dir: &Path) -> Result<Option<String>> {
+    let entries = match std::fs::read_dir(dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => {
+            return Err(e).with_context(|| format!("cannot read the folder {}", dir.display()));
+        }
+    };
+    for entry in entries {
+        let entry = entry.with_context(|| format!("cannot read the folder {}", dir.display()))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if !is_our_temp(&name) {
+            return Ok(Some(name));
+        }
+    }
+    Ok(None)
+}
+
 /// Temporary files are created private (0600); the files we deliver are ordinary (0644).
 #[cfg(unix)]
 fn readable_by_all(file: &std::fs::File) -> std::io::Result<()> {
@@ -111,6 +184,56 @@ mod tests {
             .map(|e| e.unwrap().file_name())
             .collect();
         assert_eq!(names, vec!["level.yaml"]);
+    }
+
+    #[test]
+    fn only_old_temporary_files_of_ours_count_as_stale() {
+        let dir = tempfile::tempdir().unwrap();
+        for name in [
+            ".arlpcg-old.tmp",
+            ".arlpcg-new.tmp",
+            "old.tmp",
+            "level.yaml",
+        ] {
+            std::fs::write(dir.path().join(name), b"x").unwrap();
+        }
+        let hour_ago = std::time::SystemTime::now() - std::time::Duration::from_secs(3600);
+        for name in [".arlpcg-old.tmp", "old.tmp"] {
+            let file = std::fs::File::options()
+                .write(true)
+                .open(dir.path().join(name))
+                .unwrap();
+            file.set_modified(hour_ago).unwrap();
+        }
+        let removed = remove_stale_temps(dir.path(), std::time::SystemTime::now()).unwrap();
+        assert_eq!(removed, 1);
+        let mut names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        assert_eq!(names, [".arlpcg-new.tmp", "level.yaml", "old.tmp"]);
+        assert_eq!(first_entry(dir.path()).unwrap().is_some(), true);
+        std::fs::remove_file(dir.path().join("level.yaml")).unwrap();
+        std::fs::remove_file(dir.path().join("old.tmp")).unwrap();
+        assert_eq!(
+            first_entry(dir.path()).unwrap(),
+            None,
+            "our temporaries do not count"
+        );
+    }
+
+    #[test]
+    fn a_fifo_is_refused_without_being_opened() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("policy.safetensors");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if !made.is_ok_and(|s| s.success()) {
+            eprintln!("skipped: mkfifo is not available here");
+            return;
+        }
+        let err = read_limited(&fifo, 100, "Solver policy").unwrap_err();
+        assert!(err.to_string().contains("not a regular file"), "{err}");
     }
 
     #[test]

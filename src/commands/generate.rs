@@ -70,6 +70,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         .context("--seed plus --count overflows a 64-bit seed")?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
+    crate::fsio::remove_stale_temps(&args.out, std::time::SystemTime::now())?;
     let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
     let plans: Vec<(u64, LevelFiles)> = seeds
         .iter()
@@ -144,19 +145,28 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     let mut kept = 0;
     for (level, (_, files)) in levels.iter().zip(&plans) {
         for (path, bytes) in render(level, files) {
+            if std::fs::symlink_metadata(&path).is_ok_and(|m| !m.is_file()) {
+                bail!(
+                    "{} is in the way: it is not a regular file (a folder, link, FIFO or device), and is never replaced; nothing was written",
+                    path.display()
+                );
+            }
             match std::fs::read(&path) {
                 Ok(existing) if existing == bytes => kept += 1,
                 Ok(_) if !args.force => bail!(
                     "{} already exists with other contents (use --force to overwrite it); nothing was written",
                     path.display()
                 ),
-                _ => writes.push((path, bytes)),
+                Ok(_) => writes.push((path, bytes, Overwrite::Allowed)),
+                // Absent when checked: written only if still absent (another run may get there
+                // first, and its file is not replaced).
+                Err(_) => writes.push((path, bytes, Overwrite::Never)),
             }
         }
     }
     // A .gltf is written after the .bin it names.
-    for (written, (path, bytes)) in writes.iter().rev().enumerate() {
-        fsio::write_atomic(path, bytes, Overwrite::Allowed)
+    for (written, (path, bytes, overwrite)) in writes.iter().rev().enumerate() {
+        fsio::write_atomic(path, bytes, *overwrite)
             .with_context(|| format!("after writing {written} of {} files", writes.len()))?;
     }
     let files = writes.len() + kept;

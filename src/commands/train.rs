@@ -29,6 +29,14 @@ pub fn run(args: &TrainArgs) -> Result<()> {
             "give a budget: --steps N (total Solver environment steps) or --minutes M (this session)",
         ));
     }
+    // Temporary files a killed session left (a checkpoint half written) go first.
+    let stale = crate::fsio::remove_stale_temps(out, std::time::SystemTime::now())?;
+    if stale > 0 {
+        eprintln!(
+            "removed {stale} temporary files a stopped run left in {}",
+            out.display()
+        );
+    }
     let pool = crate::shell::thread_pool(args.threads)?;
     pool.install(|| {
         let mut run = train::open(

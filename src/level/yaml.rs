@@ -40,6 +40,8 @@ pub enum Problem {
     Io(#[from] std::io::Error),
     #[error("the file is empty")]
     Empty,
+    #[error("not a regular file (a folder, FIFO, socket or device)")]
+    NotAFile,
     #[error("the file is larger than {} MiB; a level file is a few kB", MAX_FILE_BYTES >> 20)]
     TooLarge,
     #[error("not a text file (invalid UTF-8 at byte {0})")]
@@ -66,6 +68,10 @@ pub fn load(path: &Path) -> Result<Level, LoadError> {
         path: path.to_path_buf(),
         problem,
     };
+    let meta = std::fs::metadata(path).map_err(|e| fail(e.into()))?;
+    if !meta.is_file() {
+        return Err(fail(Problem::NotAFile));
+    }
     let file = std::fs::File::open(path).map_err(|e| fail(e.into()))?;
     let mut bytes = Vec::new();
     file.take(MAX_FILE_BYTES + 1)

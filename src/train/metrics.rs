@@ -39,7 +39,7 @@ pub(super) fn metric_series(text: &str, x: &str, name: &str, window: usize) -> V
 /// `learning-curve.png`: the Solver's training success ratio against its steps (and, in the
 /// adversarial modes, its success on easy and hard Generator levels), smoothed over 10 updates.
 pub fn write_learning_curve(out: &Path) -> Result<()> {
-    let read = |name: &str| std::fs::read_to_string(out.join(name)).unwrap_or_default();
+    let read = |name: &str| read_text(&out.join(name)).unwrap_or_default();
     let solver = read(METRICS);
     let generator = read(GENERATOR_METRICS);
     let mut series = vec![crate::chart::Series {
@@ -112,10 +112,16 @@ pub(super) fn generator_metrics_header<G: GeneratorGame>() -> String {
     )
 }
 
+/// A metrics file's text, if it is a regular file that reads as text (never blocks on a FIFO).
+fn read_text(path: &Path) -> Option<String> {
+    crate::fsio::check_regular(path, "metrics file").ok()?;
+    std::fs::read_to_string(path).ok()
+}
+
 /// Drops metric rows written after the checkpoint a run resumes from, so the curve continues
 /// without a gap or a repeat.
 pub(super) fn truncate_metrics(path: &Path, header: &str, last_iteration: u64) -> Result<()> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|_| format!("{header}\n"));
+    let text = read_text(path).unwrap_or_else(|| format!("{header}\n"));
     let kept: Vec<&str> = text
         .lines()
         .enumerate()

@@ -70,6 +70,15 @@ pub fn open(
                 out.display()
             );
         }
+        if out.exists() && !out.is_dir() {
+            bail!("--out {} is not a folder", out.display());
+        }
+        if let Some(name) = fsio::first_entry(out)? {
+            bail!(
+                "{} is not empty (it holds {name}): a new run starts in a new or empty folder, so that no policy or card is replaced; choose another --out",
+                out.display()
+            );
+        }
         Some(match config {
             Some(path) => load_config(path, game)?,
             None => TrainConfig::for_game(game),

@@ -1,0 +1,120 @@
+//! Paths that are not what they seem, and runs that would replace others' files: a FIFO where a
+//! level, a policy, a configuration or an output file should be is refused at once (opening it
+//! would block forever), and nothing is overwritten without `--force`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// Runs the binary, killed after `limit` (so that a hang fails the test instead of stalling it).
+fn arlpcg_within(args: &[&str], limit: Duration) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > limit {
+            child.kill().unwrap();
+            let _ = child.wait();
+            panic!("{args:?} still ran after {limit:?}: it hangs");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// A FIFO at `path`, or `None` (and a message) where `mkfifo` is not available.
+fn fifo(path: &Path) -> Option<PathBuf> {
+    let made = Command::new("mkfifo").arg(path).status();
+    if made.is_ok_and(|s| s.success()) {
+        Some(path.to_path_buf())
+    } else {
+        eprintln!("skipped: mkfifo is not available here");
+        None
+    }
+}
+
+fn shipped_level() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("levels/platform/platform_seed7_aux+0.50.yaml")
+        .display()
+        .to_string()
+}
+
+#[test]
+fn a_fifo_is_refused_wherever_a_file_is_read_or_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(pipe) = fifo(&dir.path().join("pipe.yaml")) else {
+        return;
+    };
+    let pipe = pipe.to_str().unwrap();
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    let level = shipped_level();
+    let cases: [(&str, Vec<&str>); 4] = [
+        ("level", vec!["verify", "--trials", "1", pipe]),
+        (
+            "policy",
+            vec!["verify", "--trials", "1", "--policy", pipe, &level],
+        ),
+        (
+            "config",
+            vec!["train", "--steps", "10", "--config", pipe, "--out", out_s],
+        ),
+        ("export", vec!["export", &level, "--out", pipe]),
+    ];
+    for (what, args) in cases {
+        let output = arlpcg_within(&args, Duration::from_secs(20));
+        let err = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            matches!(output.status.code(), Some(1 | 2)),
+            "{what}: {:?} {err}",
+            output.status
+        );
+        assert!(err.contains("pipe.yaml"), "{what}: names the file: {err}");
+    }
+}
+
+#[test]
+fn generate_leaves_a_fifo_where_its_file_should_go_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(_) = fifo(&dir.path().join("platform_seed3.yaml")) else {
+        return;
+    };
+    let out = dir.path().to_str().unwrap();
+    let args = [
+        "generate", "--rules", "--game", "platform", "--seed", "3", "--out", out,
+    ];
+    let output = arlpcg_within(&args, Duration::from_secs(20));
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{err}");
+    assert!(err.contains("not a regular file"), "{err}");
+    let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(names.len(), 1, "nothing written beside it");
+}
+
+#[test]
+fn a_new_training_run_never_starts_in_a_folder_holding_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("policies");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("solver.safetensors"), b"a designer's policy").unwrap();
+    let args = ["train", "--steps", "100", "--out", out.to_str().unwrap()];
+    let output = arlpcg_within(&args, Duration::from_secs(20));
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("is not empty (it holds solver.safetensors)"),
+        "{err}"
+    );
+    let names: Vec<_> = std::fs::read_dir(&out).unwrap().collect();
+    assert_eq!(names.len(), 1);
+    assert_eq!(
+        std::fs::read(out.join("solver.safetensors")).unwrap(),
+        b"a designer's policy"
+    );
+}

@@ -213,7 +213,7 @@ mod tests {
             .collect();
         names.sort();
         assert_eq!(names, [".arlpcg-new.tmp", "level.yaml", "old.tmp"]);
-        assert_eq!(first_entry(dir.path()).unwrap().is_some(), true);
+        assert!(first_entry(dir.path()).unwrap().is_some());
         std::fs::remove_file(dir.path().join("level.yaml")).unwrap();
         std::fs::remove_file(dir.path().join("old.tmp")).unwrap();
         assert_eq!(

@@ -43,6 +43,33 @@ pub struct Curve {
     pub points: Vec<(f64, f64)>,
 }
 
+impl Curve {
+    /// Checks a curve read back from a file: at least one point, their λ among [`CURVE_AUX`]
+    /// in its order (a λ where no level was built has none), each success a number within
+    /// [0, 1]. `Err("points[i]: ...")`.
+    pub fn check(&self) -> Result<(), String> {
+        if self.points.is_empty() {
+            return Err("points: none; a curve has a point per λ it was measured at".into());
+        }
+        let mut allowed = CURVE_AUX.iter();
+        for (i, &(aux, success)) in self.points.iter().enumerate() {
+            if !allowed.any(|&a| a == aux) {
+                return Err(format!(
+                    "points[{i}]: λ {} is not the next of {CURVE_AUX:?}",
+                    crate::level::params::show_number(aux)
+                ));
+            }
+            if !(0.0..=1.0).contains(&success) {
+                return Err(format!(
+                    "points[{i}]: success {} must be a number within [0, 1]",
+                    crate::level::params::show_number(success)
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Why no level was found.
 #[derive(Debug, thiserror::Error)]
 pub enum TargetError {
@@ -206,6 +233,27 @@ fn screened_stats(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_damaged_curve_is_named_by_its_point() {
+        let curve = |points: Vec<(f64, f64)>| Curve {
+            generator_sha256: String::new(),
+            solver_sha256: String::new(),
+            points,
+        };
+        curve(vec![(1.0, 1.0), (0.0, 0.8), (-1.0, 0.3)]).check().unwrap();
+        let cases = [
+            (vec![], "points: none"),
+            (vec![(1.0, 1.0), (0.5, f64::NAN)], "points[1]: success NaN"),
+            (vec![(1.0, 1.0), (0.5, 7.5)], "points[1]: success 7.5"),
+            (vec![(0.0, 1.0), (0.5, 0.5)], "points[1]: λ 0.5 is not the next"),
+            (vec![(f64::NAN, 1.0)], "points[0]: λ NaN"),
+        ];
+        for (points, expected) in cases {
+            let err = curve(points).check().unwrap_err();
+            assert!(err.starts_with(expected), "{err}");
+        }
+    }
 
     fn curve(points: &[(f64, f64)]) -> Curve {
         Curve {

@@ -153,6 +153,13 @@ pub fn difficulty_curve(
         && let Ok(curve) = serde_yaml::from_slice::<crate::difficulty::Curve>(&bytes)
         && current(&curve)
     {
+        // The curve of these very policies, damaged: say so rather than aim with it.
+        curve.check().map_err(|problem| {
+            anyhow::anyhow!(
+                "{}: {problem} (delete the file and it is measured again)",
+                path.display()
+            )
+        })?;
         return Ok(curve);
     }
     on_measure();

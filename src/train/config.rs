@@ -279,7 +279,7 @@ pub(super) fn check_resumable_change(old: &TrainConfig, new: &TrainConfig) -> Re
 }
 
 /// Checks the values serde cannot: sizes, ranges, finite numbers.
-fn check_config(config: &TrainConfig, game: Game) -> Result<(), String> {
+pub(super) fn check_config(config: &TrainConfig, game: Game) -> Result<(), String> {
     if config.hidden.is_empty()
         || config.hidden.len() > MAX_HIDDEN_LAYERS
         || !config

@@ -38,7 +38,7 @@ use crate::rl::vec_env::{RolloutStats, Trainer, VecEnv};
 use adversarial_run::AdversarialRun;
 use arlpcg::{AdversarialEnvs, AdversarialState, Generator, MatchRules, MatchStats, Phase};
 use cards::*;
-use config::{check_resumable_change, load_config};
+use config::{check_config, check_resumable_change, load_config};
 pub use metrics::write_learning_curve;
 use metrics::*;
 use solver_envs::{SolverEnvs, SourceState};

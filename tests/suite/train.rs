@@ -857,3 +857,51 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
         "{markdown}"
     );
 }
+
+/// Rewrites the training state stored in a checkpoint's safetensors metadata.
+fn tamper_training_state(path: &Path, change: impl Fn(&mut serde_json::Value)) {
+    let bytes = std::fs::read(path).unwrap();
+    let n = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+    let mut header: serde_json::Value = serde_json::from_slice(&bytes[8..8 + n]).unwrap();
+    let text = header["__metadata__"]["training_state"].as_str().unwrap();
+    let mut state: serde_json::Value = serde_json::from_str(text).unwrap();
+    change(&mut state);
+    header["__metadata__"]["training_state"] = state.to_string().into();
+    let header = serde_json::to_vec(&header).unwrap();
+    let mut out = (header.len() as u64).to_le_bytes().to_vec();
+    out.extend_from_slice(&header);
+    out.extend_from_slice(&bytes[8 + n..]);
+    std::fs::write(path, out).unwrap();
+}
+
+#[test]
+fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.yaml");
+    std::fs::write(&config, TINY).unwrap();
+    let out = dir.path().join("run");
+    let out_s = out.to_str().unwrap();
+    let trained = arlpcg(&[
+        "train", "--mode", "fixed-track", "--steps", "128", "--config",
+        config.to_str().unwrap(), "--out", out_s,
+    ]);
+    assert!(trained.status.success(), "{}", String::from_utf8_lossy(&trained.stderr));
+    let checkpoint = out.join("checkpoint.safetensors");
+    let cases: [(&str, serde_json::Value, &str); 2] = [
+        ("num_envs", serde_json::json!(100_000_000), "num_envs"),
+        ("num_minibatches", serde_json::json!(0), "num_minibatches"),
+    ];
+    let original = std::fs::read(&checkpoint).unwrap();
+    for (field, value, expected) in cases {
+        std::fs::write(&checkpoint, &original).unwrap();
+        tamper_training_state(&checkpoint, |state| state["config"]["solver"][field] = value.clone());
+        let tampered = std::fs::read(&checkpoint).unwrap();
+        let resumed = arlpcg(&[
+            "train", "--mode", "fixed-track", "--steps", "512", "--out", out_s, "--resume",
+        ]);
+        let err = String::from_utf8_lossy(&resumed.stderr);
+        assert_eq!(resumed.status.code(), Some(1), "{field}: {err}");
+        assert!(err.contains("stored configuration") && err.contains(expected), "{field}: {err}");
+        assert_eq!(std::fs::read(&checkpoint).unwrap(), tampered, "{field}: left as it was");
+    }
+}

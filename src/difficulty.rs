@@ -241,12 +241,17 @@ mod tests {
             solver_sha256: String::new(),
             points,
         };
-        curve(vec![(1.0, 1.0), (0.0, 0.8), (-1.0, 0.3)]).check().unwrap();
+        curve(vec![(1.0, 1.0), (0.0, 0.8), (-1.0, 0.3)])
+            .check()
+            .unwrap();
         let cases = [
             (vec![], "points: none"),
             (vec![(1.0, 1.0), (0.5, f64::NAN)], "points[1]: success NaN"),
             (vec![(1.0, 1.0), (0.5, 7.5)], "points[1]: success 7.5"),
-            (vec![(0.0, 1.0), (0.5, 0.5)], "points[1]: λ 0.5 is not the next"),
+            (
+                vec![(0.0, 1.0), (0.5, 0.5)],
+                "points[1]: λ 0.5 is not the next",
+            ),
             (vec![(f64::NAN, 1.0)], "points[0]: λ NaN"),
         ];
         for (points, expected) in cases {

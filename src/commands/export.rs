@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 
 use crate::cli::ExportArgs;
 use crate::fsio::Overwrite;
@@ -10,15 +10,18 @@ use crate::level::yaml;
 use crate::level_files::{Format, LevelFiles, write_level_files};
 
 pub fn run(args: &ExportArgs) -> Result<()> {
-    let level = yaml::load(&args.level)?;
     let format = match args.out.extension().and_then(|e| e.to_str()) {
         Some("glb") => Format::Glb,
         Some("gltf") => Format::Gltf,
-        _ => bail!(
-            "--out {}: the file name must end in .glb or .gltf",
-            args.out.display()
-        ),
+        _ => {
+            return Err(crate::shell::UsageError(format!(
+                "--out {}: the file name must end in .glb or .gltf",
+                args.out.display()
+            ))
+            .into());
+        }
     };
+    let level = yaml::load(&args.level)?;
     let stem = args
         .out
         .file_stem()

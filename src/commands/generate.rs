@@ -35,6 +35,19 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         )
         .into());
     }
+    if args.out.exists() && !args.out.is_dir() {
+        anyhow::bail!("--out {} is not a folder", args.out.display());
+    }
+    let seeds: Vec<u64> = (0..args.count as u64)
+        .filter(|&i| args.shard.is_none_or(|shard| shard.owns(i)))
+        .map(|i| args.seed.checked_add(i))
+        .collect::<Option<_>>()
+        .ok_or_else(|| {
+            crate::shell::UsageError(format!(
+                "--seed {} plus --count {} overflows a 64-bit seed",
+                args.seed, args.count
+            ))
+        })?;
     let generator = match &args.policies {
         Some(dir) => {
             if args.aux.is_none() && args.aux_curve.is_none() && args.target_success.is_none() {
@@ -63,14 +76,6 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         (Some(_), None, None) if shipped.exists() => Some(load_solver(&shipped, args.game)?.0),
         (Some(_), None, None) => None,
     };
-    let seeds: Vec<u64> = (0..args.count as u64)
-        .filter(|&i| args.shard.is_none_or(|shard| shard.owns(i)))
-        .map(|i| args.seed.checked_add(i))
-        .collect::<Option<_>>()
-        .context("--seed plus --count overflows a 64-bit seed")?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
-    crate::fsio::remove_stale_temps(&args.out, std::time::SystemTime::now())?;
     let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
     let plans: Vec<(u64, LevelFiles)> = seeds
         .iter()
@@ -163,6 +168,12 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
                 Err(_) => writes.push((path, bytes, Overwrite::Never)),
             }
         }
+    }
+    // The folder is made only now: a batch that fails leaves no empty folder behind.
+    if !writes.is_empty() {
+        std::fs::create_dir_all(&args.out)
+            .with_context(|| format!("cannot create {}", args.out.display()))?;
+        crate::fsio::remove_stale_temps(&args.out, std::time::SystemTime::now())?;
     }
     // A .gltf is written after the .bin it names.
     for (written, (path, bytes, overwrite)) in writes.iter().rev().enumerate() {

@@ -87,6 +87,8 @@ pub fn load(path: &Path) -> Result<Level, LoadError> {
 
 /// Parses and validates the text of a level file.
 pub fn parse(text: &str) -> Result<Level, Problem> {
+    // A byte-order mark (some Windows editors write one) is not part of the document.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     if text.trim().is_empty() {
         return Err(Problem::Empty);
     }
@@ -454,7 +456,7 @@ impl LevelFile {
                         "missing: a racing level needs its segments".into(),
                     )
                 })?;
-                let segments = segments
+                let segments: Vec<SegmentParams> = segments
                     .iter()
                     .map(|s| SegmentParams {
                         length: s.length.0,
@@ -462,6 +464,34 @@ impl LevelFile {
                         height: s.height.0,
                     })
                     .collect();
+                // Counts and each obstacle first: the geometry below is costly on a huge list,
+                // and meaningless around a NaN obstacle.
+                for (key, count, max) in [
+                    ("segments", segments.len(), super::racing::MAX_SEGMENTS),
+                    (
+                        "obstacles",
+                        self.obstacles.len(),
+                        super::racing::MAX_OBSTACLES,
+                    ),
+                ] {
+                    if count > max {
+                        return Err(invalid(
+                            key.into(),
+                            line_of_key(text, key),
+                            format!("the level has {count} {key}: at most {max} are allowed"),
+                        ));
+                    }
+                }
+                for (index, obstacle) in self.obstacles.iter().enumerate() {
+                    obstacle.check().map_err(|problem| {
+                        let (field, message) = problem.split_once(": ").unwrap_or(("", &problem));
+                        invalid(
+                            format!("obstacles[{index}].{field}"),
+                            line_of_item(text, "obstacles", index),
+                            message.to_string(),
+                        )
+                    })?;
+                }
                 let track = RacingTrack {
                     position: point(&self.start.position),
                     heading: self.start.heading.0,

@@ -87,8 +87,9 @@ impl<E: Resumable> Run<E> {
         let stored: TrainConfig = serde_json::from_value(state.config.clone())
             .with_context(|| format!("{}: configuration", path.display()))?;
         // As strict as --config: a tampered checkpoint must not allocate or divide by its numbers.
-        check_config(&stored, E::GAME)
-            .map_err(|problem| anyhow::anyhow!("{}: stored configuration: {problem}", path.display()))?;
+        check_config(&stored, E::GAME).map_err(|problem| {
+            anyhow::anyhow!("{}: stored configuration: {problem}", path.display())
+        })?;
         let config = match replacement {
             None => stored,
             Some(new) => {

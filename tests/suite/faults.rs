@@ -118,3 +118,76 @@ fn a_new_training_run_never_starts_in_a_folder_holding_files() {
         b"a designer's policy"
     );
 }
+
+#[test]
+fn messages_name_the_field_and_exit_codes_tell_arguments_from_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let nan_obstacle = dir.path().join("nan-obstacle.yaml");
+    std::fs::write(
+        &nan_obstacle,
+        "format: arlpcg-level\nversion: 1\ngame: racing\nstart: {position: [0, 0, 0], heading: 0}\n\
+         segments:\n  - {length: 20, curve: 0, height: 0}\n\
+         obstacles:\n  - {kind: box, position: [.nan, 0, 0], size: [2, 2, 2], heading: 0}\n",
+    )
+    .unwrap();
+    let err = yaml_error(&nan_obstacle);
+    assert!(
+        err.contains("obstacles[0].position: coordinate must be a number, not NaN (line 8)"),
+        "{err}"
+    );
+
+    // A byte-order mark before the first key is read past.
+    let staircase = Path::new(env!("CARGO_MANIFEST_DIR")).join("levels/hand/staircase.yaml");
+    let mut with_bom = b"\xef\xbb\xbf".to_vec();
+    with_bom.extend(std::fs::read(&staircase).unwrap());
+    assert_eq!(
+        arlpcg::level::yaml::parse(std::str::from_utf8(&with_bom).unwrap()).unwrap(),
+        arlpcg::level::yaml::load(&staircase).unwrap()
+    );
+
+    let out = dir.path().join("never-made");
+    let out_s = out.to_str().unwrap();
+    let staircase = staircase.to_str().unwrap();
+    let png = dir.path().join("x.png");
+    let cases: [(Vec<&str>, i32, &str); 3] = [
+        (
+            vec!["export", staircase, "--out", png.to_str().unwrap()],
+            2,
+            "must end in .glb or .gltf",
+        ),
+        (
+            vec![
+                "generate",
+                "--rules",
+                "--seed",
+                "18446744073709551610",
+                "--count",
+                "10",
+                "--out",
+                out_s,
+            ],
+            2,
+            "overflows a 64-bit seed",
+        ),
+        (
+            vec!["generate", "--rules", "--goal", "5000,0,0", "--out", out_s],
+            1,
+            "seed 0",
+        ),
+    ];
+    for (args, code, expected) in cases {
+        let output = arlpcg_within(&args, Duration::from_secs(20));
+        let err = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(code), "{args:?}: {err}");
+        assert!(err.contains(expected), "{args:?}: {err}");
+    }
+    assert!(
+        !out.exists(),
+        "a failed generate leaves no empty folder behind"
+    );
+    assert!(!png.exists());
+}
+
+fn yaml_error(path: &Path) -> String {
+    arlpcg::level::yaml::load(path).unwrap_err().to_string()
+}

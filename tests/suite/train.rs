@@ -882,10 +882,21 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
     let out = dir.path().join("run");
     let out_s = out.to_str().unwrap();
     let trained = arlpcg(&[
-        "train", "--mode", "fixed-track", "--steps", "128", "--config",
-        config.to_str().unwrap(), "--out", out_s,
+        "train",
+        "--mode",
+        "fixed-track",
+        "--steps",
+        "128",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out_s,
     ]);
-    assert!(trained.status.success(), "{}", String::from_utf8_lossy(&trained.stderr));
+    assert!(
+        trained.status.success(),
+        "{}",
+        String::from_utf8_lossy(&trained.stderr)
+    );
     let checkpoint = out.join("checkpoint.safetensors");
     let cases: [(&str, serde_json::Value, &str); 2] = [
         ("num_envs", serde_json::json!(100_000_000), "num_envs"),
@@ -894,14 +905,30 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
     let original = std::fs::read(&checkpoint).unwrap();
     for (field, value, expected) in cases {
         std::fs::write(&checkpoint, &original).unwrap();
-        tamper_training_state(&checkpoint, |state| state["config"]["solver"][field] = value.clone());
+        tamper_training_state(&checkpoint, |state| {
+            state["config"]["solver"][field] = value.clone()
+        });
         let tampered = std::fs::read(&checkpoint).unwrap();
         let resumed = arlpcg(&[
-            "train", "--mode", "fixed-track", "--steps", "512", "--out", out_s, "--resume",
+            "train",
+            "--mode",
+            "fixed-track",
+            "--steps",
+            "512",
+            "--out",
+            out_s,
+            "--resume",
         ]);
         let err = String::from_utf8_lossy(&resumed.stderr);
         assert_eq!(resumed.status.code(), Some(1), "{field}: {err}");
-        assert!(err.contains("stored configuration") && err.contains(expected), "{field}: {err}");
-        assert_eq!(std::fs::read(&checkpoint).unwrap(), tampered, "{field}: left as it was");
+        assert!(
+            err.contains("stored configuration") && err.contains(expected),
+            "{field}: {err}"
+        );
+        assert_eq!(
+            std::fs::read(&checkpoint).unwrap(),
+            tampered,
+            "{field}: left as it was"
+        );
     }
 }

@@ -166,6 +166,12 @@ pub struct GenerateArgs {
     /// Each piece records the λ it was built at.
     #[arg(long, value_name = "CURVE", allow_hyphen_values = true, value_parser = AuxCurve::parse, conflicts_with_all = ["aux", "target_success"])]
     pub aux_curve: Option<AuxCurve>,
+    /// Keep the first K pieces of an existing level (generated or hand-written) and let the
+    /// Generator build the rest from there, with --aux or --aux-curve and this run's seed. The
+    /// kept pieces are written exactly as they were; the file's `source` names the level kept
+    /// from (path and SHA-256) and how many pieces.
+    #[arg(long, value_name = "LEVEL.yaml:K", value_parser = parse_keep, requires = "policies", conflicts_with_all = ["goal", "target_success"])]
+    pub keep: Option<KeepArg>,
     /// Goal position x,y,z in metres (default: drawn from the seed).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_point)]
     pub goal: Option<[f64; 3]>,
@@ -225,6 +231,29 @@ fn parse_target(s: &str) -> Result<f64, String> {
             "`{s}` is not a success ratio strictly between 0 and 1"
         )),
     }
+}
+
+/// `--keep LEVEL.yaml:K`: the level file and how many of its pieces to keep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeepArg {
+    pub level: PathBuf,
+    pub pieces: usize,
+}
+
+fn parse_keep(s: &str) -> Result<KeepArg, String> {
+    let (path, pieces) = s.rsplit_once(':').ok_or_else(|| {
+        format!("`{s}` is not LEVEL.yaml:K (the level file, then how many of its pieces to keep)")
+    })?;
+    let pieces = pieces.trim().parse().map_err(|_| {
+        format!("`{s}`: after the last `:` comes the number of pieces to keep, not `{pieces}`")
+    })?;
+    if path.is_empty() {
+        return Err(format!("`{s}`: the level file is missing before `:`"));
+    }
+    Ok(KeepArg {
+        level: PathBuf::from(path),
+        pieces,
+    })
 }
 
 fn parse_shard(s: &str) -> Result<Shard, String> {

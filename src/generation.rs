@@ -47,6 +47,17 @@ pub struct LevelRequest {
     /// Which valid level of the seed's stream (0: the first; `generate --verify` moves on to the
     /// next when no run completed the earlier ones).
     pub draw: u32,
+    /// Pieces to keep from another level: the Generator continues after them (its start, goal
+    /// and obstacles are that level's).
+    pub keep: Option<KeptPrefix>,
+}
+
+/// The first `pieces` pieces of `level`, read from the file `from` (`generate --keep`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeptPrefix {
+    pub level: Level,
+    pub pieces: usize,
+    pub from: PolicyRef,
 }
 
 impl LevelRequest {
@@ -58,6 +69,7 @@ impl LevelRequest {
             goal: None,
             obstacles: 0,
             draw: 0,
+            keep: None,
         }
     }
 
@@ -71,6 +83,13 @@ impl LevelRequest {
 
     pub fn draw(self, draw: u32) -> Self {
         Self { draw, ..self }
+    }
+
+    pub fn keep(self, keep: KeptPrefix) -> Self {
+        Self {
+            keep: Some(keep),
+            ..self
+        }
     }
 
     pub fn lambda(self, lambda: Lambda) -> Self {
@@ -130,6 +149,8 @@ pub enum GenerationError {
         "the Generator built no valid level toward goal {goal:?} at aux {lambda} in {ATTEMPTS} attempts (each overlapped or crossed itself, hit an obstacle or ran out of pieces); try another seed or goal"
     )]
     NoLevel { goal: [f64; 3], lambda: String },
+    #[error("cannot keep that prefix: {problem}")]
+    Keep { problem: String },
     #[error("the Generator's network failed: {0}")]
     Network(#[from] candle_core::Error),
 }
@@ -143,6 +164,15 @@ pub fn generator_level(
         Game::Platform => build_level::<PlatformGame>(generator, request),
         Game::Racing => build_level::<RacingGame>(generator, request),
     }
+}
+
+/// The λ piece `i` of a kept level records (only a paced level's pieces record one), so that
+/// the kept piece is written exactly as it was.
+fn kept_piece_aux(level: &Level, i: usize) -> Option<f64> {
+    level
+        .pacing
+        .as_ref()
+        .and_then(|pacing| pacing.piece_aux.get(i).copied().flatten())
 }
 
 /// λ for the next piece of `build`: the level's one λ, or the curve's value at the fraction of
@@ -169,16 +199,33 @@ fn build_level<G: GeneratorGame>(
         generator.limits,
         request.obstacles,
     );
+    // A kept prefix replaces the seed's scene; the seed still drives the Generator's samples.
+    let (empty, kept_aux) = match &request.keep {
+        None => (empty, Vec::new()),
+        Some(keep) => {
+            let build = G::kept_build(
+                &keep.level.track,
+                keep.level.goal,
+                keep.pieces,
+                generator.limits,
+            )
+            .map_err(|problem| GenerationError::Keep { problem })?;
+            let aux = (0..keep.pieces)
+                .map(|i| kept_piece_aux(&keep.level, i))
+                .collect();
+            (build, aux)
+        }
+    };
     let goal = empty.goal();
     let mut skip = request.draw;
     let lambda = request.lambda.as_ref();
     let mut observation = vec![0.0; observation_size::<G>()];
     for _ in 0..ATTEMPTS {
         let mut build = empty.clone();
-        let mut piece_auxes = Vec::new();
+        let mut piece_auxes = kept_aux.clone();
         while build.piece_count() < generator.limits.max_pieces {
             let aux = piece_aux(lambda, &build);
-            piece_auxes.push(aux);
+            piece_auxes.push(Some(aux));
             build.observe(&[aux as f32], &mut observation);
             generator.normalizer.normalize(&mut observation);
             let action = generator
@@ -192,23 +239,40 @@ fn build_level<G: GeneratorGame>(
                     break;
                 }
                 Placement::Completed => {
-                    let pacing = match lambda {
-                        Some(Lambda::Curve(curve)) => Some(Pacing {
-                            curve: curve.clone(),
-                            piece_aux: piece_auxes,
-                        }),
+                    let kept_pacing = request
+                        .keep
+                        .as_ref()
+                        .is_some_and(|keep| keep.level.pacing.is_some());
+                    // Pieces that record their own λ need a curve beside them: a flat λ after
+                    // a kept paced prefix is the flat curve `0:λ`.
+                    let curve = match lambda {
+                        Some(Lambda::Curve(curve)) => Some(curve.clone()),
+                        Some(Lambda::Flat(aux)) if kept_pacing => {
+                            AuxCurve::new(vec![(0.0, *aux)]).ok()
+                        }
                         _ => None,
+                    };
+                    let source = match &request.keep {
+                        None => Source::Policy {
+                            generator: generator.reference.clone(),
+                        },
+                        Some(keep) => Source::Kept {
+                            pieces: keep.pieces as u32,
+                            from: keep.from.clone(),
+                            generator: generator.reference.clone(),
+                        },
                     };
                     return Ok(Level {
                         seed: Some(request.seed),
-                        aux: request.flat_aux(),
+                        aux: request.flat_aux().filter(|_| curve.is_none()),
                         goal,
                         track: build.into_track(),
-                        source: Source::Policy {
-                            generator: generator.reference.clone(),
-                        },
+                        source,
                         stats: None,
-                        pacing,
+                        pacing: curve.map(|curve| Pacing {
+                            curve,
+                            piece_aux: piece_auxes,
+                        }),
                     });
                 }
             }

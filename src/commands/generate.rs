@@ -7,11 +7,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 
-use crate::cli::{GenerateArgs, default_solver};
+use crate::cli::{GenerateArgs, KeepArg, default_solver};
 use crate::difficulty;
 use crate::fsio::{self, Overwrite};
-use crate::generation::{self, GeneratorPolicy, Lambda, LevelRequest};
-use crate::level::{Game, Level};
+use crate::generation::{self, GeneratorPolicy, KeptPrefix, Lambda, LevelRequest};
+use crate::level::{Game, Level, PolicyRef};
 use crate::level_files::{Format, LevelFiles, file_stem, render};
 use crate::policies::{load_generator, load_solver, policy_paths};
 use crate::verify::{self, Solver, SolverPolicy, verify};
@@ -35,6 +35,17 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         )
         .into());
     }
+    if args.keep.is_some() && args.obstacles > 0 {
+        return Err(crate::shell::UsageError(
+            "--obstacles with --keep: the kept level's scene (start, goal, obstacles) stays".into(),
+        )
+        .into());
+    }
+    let keep = args
+        .keep
+        .as_ref()
+        .map(|keep| kept_prefix(keep, args.game))
+        .transpose()?;
     if args.out.exists() && !args.out.is_dir() {
         anyhow::bail!("--out {} is not a folder", args.out.display());
     }
@@ -129,7 +140,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
                 )
                 .map_err(anyhow::Error::from)
                 .and_then(|level| certified(level, &who, *seed)),
-                _ => build_verified(args, generator.as_ref(), &who, *seed),
+                _ => build_verified(args, keep.as_ref(), generator.as_ref(), &who, *seed),
             };
             bar.inc(1);
             Some(level.with_context(|| format!("seed {seed} (nothing was written)")))
@@ -246,9 +257,53 @@ fn certified(mut level: Level, solver: &Solver, seed: u64) -> Result<Level> {
     Ok(level)
 }
 
+/// The level `--keep` names, read and checked, and the pieces to keep of it.
+fn kept_prefix(keep: &KeepArg, game: Game) -> Result<KeptPrefix> {
+    use sha2::Digest;
+    let level = crate::level::yaml::load(&keep.level)?;
+    if level.game() != game {
+        anyhow::bail!(
+            "{}: a {} level, but this run generates {game} levels (--game {})",
+            keep.level.display(),
+            level.game(),
+            level.game()
+        );
+    }
+    if keep.pieces > level.piece_count() {
+        anyhow::bail!(
+            "{}: --keep asks for {} pieces, but the level has {}",
+            keep.level.display(),
+            keep.pieces,
+            level.piece_count()
+        );
+    }
+    let bytes = std::fs::read(&keep.level)
+        .with_context(|| format!("cannot read {}", keep.level.display()))?;
+    let sha256 = sha2::Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    Ok(KeptPrefix {
+        level,
+        pieces: keep.pieces,
+        from: PolicyRef {
+            path: keep.level.display().to_string(),
+            sha256,
+        },
+    })
+}
+
 /// A level's file name: game, seed and λ, or the success rate asked for, or `curve` and a
-/// short hash of the aux curve (its text is in the file).
+/// short hash of the aux curve (its text is in the file); `_keepK` when K pieces were kept.
 fn stem(args: &GenerateArgs, seed: u64) -> String {
+    let kept = match &args.keep {
+        Some(keep) => format!("_keep{}", keep.pieces),
+        None => String::new(),
+    };
+    stem_of_lambda(args, seed) + &kept
+}
+
+fn stem_of_lambda(args: &GenerateArgs, seed: u64) -> String {
     match (args.target_success, &args.aux_curve) {
         (Some(target), _) => format!("{}_seed{seed}_success{target:.2}", args.game),
         (None, Some(curve)) => {
@@ -268,6 +323,7 @@ pub const MAX_DRAWS: u32 = 10;
 /// Level `seed` (its `draw`-th draw) from the Generator when there is one, else from the rules.
 fn build(
     args: &GenerateArgs,
+    keep: Option<&KeptPrefix>,
     generator: Option<&GeneratorPolicy>,
     seed: u64,
     draw: u32,
@@ -279,6 +335,9 @@ fn build(
     if let Some(curve) = &args.aux_curve {
         request = request.lambda(Lambda::Curve(curve.clone()));
     }
+    if let Some(keep) = keep {
+        request = request.keep(keep.clone());
+    }
     Ok(match generator {
         Some(generator) => generation::generator_level(generator, &request)?,
         None => generation::rules_level(args.game, &request)?,
@@ -289,15 +348,16 @@ fn build(
 /// next draw (unless --allow-unsolved), and a kept level carries a certificate.
 fn build_verified(
     args: &GenerateArgs,
+    keep: Option<&KeptPrefix>,
     generator: Option<&GeneratorPolicy>,
     solver: &Solver,
     seed: u64,
 ) -> Result<Level> {
     let Some(trials) = args.verify else {
-        return build(args, generator, seed, 0);
+        return build(args, keep, generator, seed, 0);
     };
     for draw in 0..MAX_DRAWS {
-        let mut level = build(args, generator, seed, draw)?;
+        let mut level = build(args, keep, generator, seed, draw)?;
         let mut stats = verify(&level, solver, trials, seed, &|| {})?;
         if stats.successes == 0 && !args.allow_unsolved {
             continue;

@@ -286,7 +286,10 @@ fn describe(path: &Path, level: &Level, s: &SolverStats) -> String {
         let passed: Vec<String> = passed_by_piece(s)
             .iter()
             .zip(&pacing.piece_aux)
-            .map(|(p, aux)| format!("{p:.2} (λ {aux:+.2})"))
+            .map(|(p, aux)| match aux {
+                Some(aux) => format!("{p:.2} (λ {aux:+.2})"),
+                None => format!("{p:.2} (kept)"),
+            })
             .collect();
         text += &format!(
             "\n  aux curve {}; runs past each {}: {}",

@@ -29,7 +29,11 @@ pub fn generator_levels(
             LevelRequest::new(seed, Some(aux)).obstacles(facts(generator.game).scene_obstacles);
         match generation::generator_level(generator, &request) {
             Ok(level) => levels.push(level),
-            Err(generation::GenerationError::NoLevel { .. }) => {}
+            // (No prefix is kept here, so `Keep` does not occur.)
+            Err(
+                generation::GenerationError::NoLevel { .. }
+                | generation::GenerationError::Keep { .. },
+            ) => {}
             Err(generation::GenerationError::Network(e)) => return Err(e),
         }
     }

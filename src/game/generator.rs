@@ -154,6 +154,15 @@ pub trait GeneratorGame: GameSpec {
         limits: BuildLimits,
         obstacles: u32,
     ) -> (Self::Build, ChaCha8Rng);
+    /// A track holding the first `pieces` pieces of `track` (its start, goal and obstacles too),
+    /// for the Generator to continue; `Err` says why it cannot (not this game, too many pieces,
+    /// the prefix already reaches the goal).
+    fn kept_build(
+        track: &Track,
+        goal: [f64; 3],
+        pieces: usize,
+        limits: BuildLimits,
+    ) -> Result<Self::Build, String>;
     /// The Solver's environment on a track with its first piece placed, still growing unless
     /// `complete` (the first piece reaches the goal).
     fn open_env(build: &Self::Build, complete: bool) -> Self::Env;
@@ -186,6 +195,26 @@ impl BuildLimits {
             curve_offset: crate::game::racing::generator::DEFAULT_CURVE_OFFSET,
         }
     }
+}
+
+/// Checks a kept prefix of `pieces` of a level's `of` pieces: they exist, and leave the
+/// Generator a piece to place.
+pub(crate) fn check_kept(pieces: usize, of: usize, limits: BuildLimits) -> Result<(), String> {
+    if pieces > of {
+        return Err(format!("the level has only {of} pieces, not {pieces}"));
+    }
+    if pieces >= limits.max_pieces {
+        return Err(format!(
+            "the Generator places at most {} pieces in all, so it cannot continue after {pieces}",
+            limits.max_pieces
+        ));
+    }
+    Ok(())
+}
+
+/// The error of a kept prefix that already reaches its goal.
+pub(crate) fn prefix_reaches_goal(pieces: usize) -> String {
+    format!("its first {pieces} pieces already reach the goal: keep fewer")
 }
 
 /// Length of the Generator's observation vector of game `G`.

@@ -67,7 +67,8 @@ pub enum Track {
     Racing(RacingTrack),
 }
 
-/// A trained policy file a level depends on, pinned by the hash of its contents.
+/// A file a level depends on (a trained policy, or the level a prefix was kept from), pinned by
+/// the hash of its contents.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PolicyRef {
@@ -140,6 +141,23 @@ pub enum Source {
     RacingRules { rules: racing::RacingRulesConfig },
     /// Built by a trained Generator policy.
     Policy { generator: PolicyRef },
+    /// The first `pieces` pieces kept from the level file `from`, the rest built by a trained
+    /// Generator (`generate --keep`); `aux` or `aux_curve` is the λ of the rest.
+    Kept {
+        pieces: u32,
+        from: PolicyRef,
+        generator: PolicyRef,
+    },
+}
+
+impl Source {
+    /// How many pieces were kept from another level (0 unless [`Source::Kept`]).
+    pub fn kept_pieces(&self) -> usize {
+        match self {
+            Source::Kept { pieces, .. } => *pieces as usize,
+            _ => 0,
+        }
+    }
 }
 
 /// A level of either game.
@@ -308,6 +326,12 @@ impl Level {
             (Source::RacingRules { .. }, Game::Platform) => {
                 Err("kind `racing-rules` is for racing levels; platform levels use `rules`".into())
             }
+            (Source::Kept { pieces, .. }, _) if *pieces as usize > self.piece_count() => {
+                return Err(InvalidLevel::Source(format!(
+                    "pieces: {pieces} kept, but the level has {} pieces",
+                    self.piece_count()
+                )));
+            }
             _ => Ok(()),
         }
         .map_err(|problem| InvalidLevel::Source(format!("rules.{problem}")))?;
@@ -323,7 +347,7 @@ impl Level {
                 ));
             }
             pacing
-                .check(self.piece_count())
+                .check(self.piece_count(), self.source.kept_pieces())
                 .map_err(InvalidLevel::Pacing)?;
         }
         Ok(())

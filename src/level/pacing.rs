@@ -150,22 +150,36 @@ impl<'de> Deserialize<'de> for AuxCurve {
 /// λ along a built level: the curve it was built with and the λ each piece was built at.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pacing {
+    /// The curve the Generator followed (after a kept prefix: the curve of the rest).
     pub curve: AuxCurve,
-    /// `piece_aux[i]`: the λ piece `i` was placed at (the curve's value where it begins).
-    pub piece_aux: Vec<f64>,
+    /// `piece_aux[i]`: the λ piece `i` was placed at (the curve's value where it begins); none
+    /// only for a kept piece whose level recorded none.
+    pub piece_aux: Vec<Option<f64>>,
 }
 
 impl Pacing {
-    /// Checks that there is one λ within [-1, 1] per piece of a level of `pieces` pieces.
-    pub fn check(&self, pieces: usize) -> Result<(), String> {
+    /// Checks that a level of `pieces` pieces, the first `kept` kept from another level, has
+    /// a λ within [-1, 1] for each piece (kept pieces may have none).
+    pub fn check(&self, pieces: usize, kept: usize) -> Result<(), String> {
         if self.piece_aux.len() != pieces {
             return Err(format!(
-                "{} pieces carry an aux value, but the level has {pieces}: with `aux_curve` every piece has one",
+                "{} λ values for {pieces} pieces: with `aux_curve` every piece has one",
                 self.piece_aux.len()
             ));
         }
-        for (i, &aux) in self.piece_aux.iter().enumerate() {
-            AUX.check(aux).map_err(|e| format!("piece {i}: {e}"))?;
+        for (i, aux) in self.piece_aux.iter().enumerate() {
+            match aux {
+                Some(aux) => AUX
+                    .check(*aux)
+                    .map(drop)
+                    .map_err(|e| format!("piece {i}: {e}"))?,
+                None if i < kept => {}
+                None => {
+                    return Err(format!(
+                        "piece {i}: missing: with `aux_curve` every piece the Generator placed has its λ"
+                    ));
+                }
+            }
         }
         Ok(())
     }
@@ -241,14 +255,29 @@ mod tests {
     fn pacing_needs_one_aux_value_per_piece_in_range() {
         let pacing = Pacing {
             curve: AuxCurve::parse("0:1").unwrap(),
-            piece_aux: vec![1.0, 0.5],
+            piece_aux: vec![Some(1.0), Some(0.5)],
         };
-        pacing.check(2).unwrap();
-        assert!(pacing.check(3).unwrap_err().contains("level has 3"));
+        pacing.check(2, 0).unwrap();
+        assert!(
+            pacing
+                .check(3, 0)
+                .unwrap_err()
+                .contains("2 λ values for 3 pieces")
+        );
         let bad = Pacing {
-            piece_aux: vec![1.0, f64::NAN],
+            piece_aux: vec![Some(1.0), Some(f64::NAN)],
+            ..pacing.clone()
+        };
+        assert!(bad.check(2, 0).unwrap_err().starts_with("piece 1:"));
+        let kept = Pacing {
+            piece_aux: vec![None, Some(0.5)],
             ..pacing
         };
-        assert!(bad.check(2).unwrap_err().starts_with("piece 1:"));
+        kept.check(2, 1).unwrap();
+        assert!(
+            kept.check(2, 0)
+                .unwrap_err()
+                .starts_with("piece 0: missing")
+        );
     }
 }

@@ -288,8 +288,8 @@ impl LevelFile {
             level
                 .pacing
                 .as_ref()
-                .and_then(|p| p.piece_aux.get(i))
-                .map(|&a| Bounded::new(a))
+                .and_then(|p| p.piece_aux.get(i).copied().flatten())
+                .map(Bounded::new)
         };
         let (start, blocks, segments, obstacles) = match &level.track {
             Track::Platform(track) => {
@@ -558,7 +558,8 @@ impl LevelFile {
 }
 
 impl LevelFile {
-    /// λ along the level: with `aux_curve`, every piece carries its `aux`; without, none does.
+    /// λ along the level: with `aux_curve`, every piece carries its `aux` (but pieces kept
+    /// from a level that recorded none); without, none does.
     fn pacing(&self, text: &str) -> Result<Option<Pacing>, Problem> {
         let (key, piece_aux): (&str, Vec<Option<f64>>) = match (&self.blocks, &self.segments) {
             (Some(blocks), _) => (
@@ -592,15 +593,14 @@ impl LevelFile {
                 message: "a level has one λ (`aux`) or a curve (`aux_curve`), not both".into(),
             });
         }
-        let piece_aux = piece_aux
-            .iter()
-            .enumerate()
-            .map(|(i, aux)| {
-                aux.ok_or_else(|| {
-                    invalid(i, "missing: with `aux_curve` every piece has its λ".into())
-                })
-            })
-            .collect::<Result<_, _>>()?;
+        // Pieces kept from a level that recorded no λ have none.
+        let kept = self.source.kept_pieces();
+        if let Some(i) = piece_aux.iter().skip(kept).position(Option::is_none) {
+            return Err(invalid(
+                kept + i,
+                "missing: with `aux_curve` every piece the Generator placed has its λ".into(),
+            ));
+        }
         Ok(Some(Pacing {
             curve: curve.clone(),
             piece_aux,

@@ -34,14 +34,14 @@ fn each_piece_is_built_at_the_curves_value_where_it_begins_and_records_it() {
             .as_ref()
             .expect("a curve level records its pacing");
         assert_eq!(level.aux, None, "{game}: one λ or a curve, not both");
-        let expected: Vec<f64> = level
+        let expected: Vec<Option<f64>> = level
             .piece_start_fractions()
             .iter()
-            .map(|&f| round_aux(curve.at(f)))
+            .map(|&f| Some(round_aux(curve.at(f))))
             .collect();
         assert_eq!(pacing.piece_aux, expected, "{game}");
         assert!(
-            expected.contains(&1.0) && expected.contains(&-1.0),
+            expected.contains(&Some(1.0)) && expected.contains(&Some(-1.0)),
             "{game}: both halves of the curve are in the level: {expected:?}"
         );
         let text = yaml::to_string(&level);
@@ -136,4 +136,169 @@ fn a_piece_aux_without_a_curve_names_the_field() {
     let with_curve = text.replacen("start:", "aux_curve: 0:1\nstart:", 1);
     let err = yaml::parse(&with_curve).unwrap_err().to_string();
     assert!(err.starts_with("blocks[1].aux: missing"), "{err}");
+}
+
+/// The text of each item of the top-level list `key` of a level file, as written.
+fn items(text: &str, key: &str) -> Vec<String> {
+    let body = text.split(&format!("\n{key}:\n")).nth(1).unwrap();
+    let mut items: Vec<String> = Vec::new();
+    for line in body.lines() {
+        if line.starts_with("- ") {
+            items.push(String::new());
+        } else if !line.starts_with("  ") {
+            break;
+        }
+        items.last_mut().unwrap().push_str(line);
+        items.last_mut().unwrap().push('\n');
+    }
+    items
+}
+
+#[test]
+fn a_kept_prefix_is_written_byte_for_byte_and_the_generator_builds_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    for (game, key, obstacles) in [
+        (Game::Platform, "blocks", "0"),
+        (Game::Racing, "segments", "3"),
+    ] {
+        let policies = shipped(game);
+        let policies = policies.to_str().unwrap();
+        let first = dir.path().join(format!("{game}-first"));
+        let output = arlpcg(&[
+            "generate",
+            "--game",
+            game.name(),
+            "--policies",
+            policies,
+            "--aux-curve",
+            EASY_THEN_HARD,
+            "--obstacles",
+            obstacles,
+            "--seed",
+            "3",
+            "--format",
+            "yaml",
+            "--out",
+            first.to_str().unwrap(),
+        ]);
+        assert!(output.status.success(), "{}", stderr(&output));
+        let first_file = std::fs::read_dir(&first)
+            .unwrap()
+            .next()
+            .unwrap()
+            .unwrap()
+            .path();
+        let first_text = std::fs::read_to_string(&first_file).unwrap();
+        let first_items = items(&first_text, key);
+        let keep = first_items.len() / 2;
+        assert!(keep >= 1, "{first_text}");
+        let second = dir.path().join(format!("{game}-second"));
+        let output = arlpcg(&[
+            "generate",
+            "--game",
+            game.name(),
+            "--policies",
+            policies,
+            "--aux=-1",
+            "--keep",
+            &format!("{}:{keep}", first_file.display()),
+            "--seed",
+            "11",
+            "--verify",
+            "5",
+            "--format",
+            "yaml",
+            "--out",
+            second.to_str().unwrap(),
+        ]);
+        assert!(output.status.success(), "{game}: {}", stderr(&output));
+        let second_file = std::fs::read_dir(&second)
+            .unwrap()
+            .next()
+            .unwrap()
+            .unwrap()
+            .path();
+        assert!(
+            second_file
+                .to_str()
+                .unwrap()
+                .ends_with(&format!("_keep{keep}.yaml"))
+        );
+        let second_text = std::fs::read_to_string(&second_file).unwrap();
+        let second_items = items(&second_text, key);
+        assert_eq!(
+            second_items[..keep],
+            first_items[..keep],
+            "{game}: the kept pieces"
+        );
+        assert_ne!(
+            second_items[keep..],
+            first_items[keep..],
+            "{game}: a new rest"
+        );
+        let level = yaml::load(&second_file).unwrap();
+        assert!(
+            matches!(&level.source, arlpcg::level::Source::Kept { pieces, .. } if *pieces as usize == keep),
+            "{game}: {:?}",
+            level.source
+        );
+        // The kept pieces keep their λ; the rest was built at -1 (a flat λ after a paced prefix
+        // is the flat curve `0:-1`).
+        let pacing = level.pacing.unwrap();
+        assert_eq!(pacing.curve.to_string(), "0:-1");
+        assert!(
+            pacing.piece_aux[keep..].iter().all(|a| *a == Some(-1.0)),
+            "{game}"
+        );
+        assert!(level.stats.is_some(), "{game}: verified as usual");
+    }
+}
+
+#[test]
+fn a_prefix_that_cannot_be_kept_is_refused_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let out = out.to_str().unwrap();
+    let staircase = Path::new(env!("CARGO_MANIFEST_DIR")).join("levels/hand/staircase.yaml");
+    let staircase = staircase.to_str().unwrap();
+    let policies = shipped(Game::Platform);
+    let policies = policies.to_str().unwrap();
+    let keep_all = format!("{staircase}:7");
+    let keep_many = format!("{staircase}:99");
+    let cases: [(&[&str], i32, &str); 4] = [
+        (&["--keep", staircase], 2, "is not LEVEL.yaml:K"),
+        (
+            &["--keep", &keep_many],
+            1,
+            "asks for 99 pieces, but the level has 7",
+        ),
+        (&["--keep", &keep_all], 1, "already reach the goal"),
+        (
+            &["--keep", &keep_all, "--game", "racing"],
+            1,
+            "a platform level, but this run generates racing",
+        ),
+    ];
+    for (args, code, expected) in cases {
+        let mut all = vec![
+            "generate",
+            "--policies",
+            policies,
+            "--aux",
+            "1",
+            "--out",
+            out,
+        ];
+        all.extend_from_slice(args);
+        if !args.contains(&"--game") {
+            all.extend(["--game", "platform"]);
+        } else {
+            all[2] = "policies/racing";
+        }
+        let output = arlpcg(&all);
+        let err = stderr(&output);
+        assert_eq!(output.status.code(), Some(code), "{args:?}: {err}");
+        assert!(err.contains(expected), "{args:?}: {err}");
+    }
+    assert!(!Path::new(out).exists(), "nothing written");
 }

@@ -205,7 +205,10 @@ segments:
         "{hand}obstacles:\n- {{kind: cylinder, position: [100, .nan, 0], radius: 2, height: 4}}\n"
     );
     let msg = problem(&nan);
-    assert!(msg.contains("obstacles[0]: position"), "{msg}");
+    assert!(
+        msg.contains("obstacles[0].position: coordinate must be a number"),
+        "{msg}"
+    );
     let odd = format!(
         "{hand}obstacles:\n- {{kind: pyramid, position: [100, 0, 0], radius: 2, height: 4}}\n"
     );

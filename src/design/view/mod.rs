@@ -398,6 +398,9 @@ fn source_line(level: &Level) -> String {
             "rule level (no Generator)".into()
         }
         crate::level::Source::Hand => "made by hand".into(),
+        crate::level::Source::Kept { pieces, .. } => {
+            format!("{pieces} pieces kept, the rest by the Generator")
+        }
     }
 }
 

@@ -222,6 +222,30 @@ impl GeneratorGame for PlatformGame {
         (build, rng)
     }
 
+    fn kept_build(
+        track: &Track,
+        goal: [f64; 3],
+        pieces: usize,
+        limits: BuildLimits,
+    ) -> Result<PlatformBuild, String> {
+        let Track::Platform(kept) = track else {
+            return Err("it is not a platform level".into());
+        };
+        crate::game::generator::check_kept(pieces, kept.block_count(), limits)?;
+        let mut build = PlatformBuild {
+            track: PlatformTrack::new(*kept.start()),
+            goal,
+            max_blocks: limits.max_pieces,
+        };
+        for params in &kept.block_params()[..pieces] {
+            build.track.push(*params).map_err(|e| e.to_string())?;
+        }
+        if pieces > 0 && build.track.last().reaches(goal) {
+            return Err(crate::game::generator::prefix_reaches_goal(pieces));
+        }
+        Ok(build)
+    }
+
     fn open_env(build: &PlatformBuild, complete: bool) -> PlatformEnv {
         let start = PlatformTrack::new(*build.track.start());
         let mut env = PlatformEnv::open(&start, build.goal, SolverRewards::default());

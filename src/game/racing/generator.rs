@@ -290,6 +290,31 @@ impl GeneratorGame for RacingGame {
         (build, rng)
     }
 
+    fn kept_build(
+        track: &Track,
+        goal: [f64; 3],
+        pieces: usize,
+        limits: BuildLimits,
+    ) -> Result<RacingBuild, String> {
+        let Track::Racing(kept) = track else {
+            return Err("it is not a racing level".into());
+        };
+        crate::game::generator::check_kept(pieces, kept.segments.len(), limits)?;
+        let mut prefix = kept.clone();
+        prefix.segments.truncate(pieces);
+        let build = RacingBuild {
+            road: prefix.road(),
+            track: prefix,
+            goal,
+            max_segments: limits.max_pieces,
+            curve_offset: limits.curve_offset,
+        };
+        if pieces > 0 && racing::reaches(build.road.end().0, goal) {
+            return Err(crate::game::generator::prefix_reaches_goal(pieces));
+        }
+        Ok(build)
+    }
+
     fn open_env(build: &RacingBuild, complete: bool) -> RacingEnv {
         RacingEnv::open(&build.track, build.goal, SolverRewards::default(), complete)
     }

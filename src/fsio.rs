@@ -3,7 +3,7 @@
 //! existing file is never replaced unless the caller allows it.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
@@ -75,10 +75,127 @@ pub fn read_limited(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>> {
 /// Writes `bytes` to `path` atomically.
 pub fn write_atomic(path: &Path, bytes: &[u8], overwrite: Overwrite) -> Result<()> {
     check_writable(path, overwrite)?;
-    let dir = match path.parent() {
+    let temp = synced_temp(path, bytes)?;
+    match overwrite {
+        Overwrite::Never => temp.persist_noclobber(path).map(drop).map_err(|e| e.error),
+        Overwrite::Allowed => temp.persist(path).map(drop).map_err(|e| e.error),
+    }
+    .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Files written all or nothing: each is staged as a synced temporary file beside its target
+/// (nothing is held in memory), then [`Batch::commit`] renames them all into place. If staging
+/// or any rename fails, every target is left as it was before: files the batch created are
+/// removed, files it replaced are put back, and the temporaries go (also when the batch is
+/// dropped uncommitted).
+#[derive(Default)]
+pub struct Batch {
+    staged: Vec<(tempfile::NamedTempFile, PathBuf, Overwrite)>,
+}
+
+impl Batch {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Stages `bytes` for `path`: refused at once if `path` exists and may not be replaced, or
+    /// is not a regular file (a folder or FIFO is never replaced).
+    pub fn stage(&mut self, path: &Path, bytes: &[u8], overwrite: Overwrite) -> Result<()> {
+        check_writable(path, overwrite)?;
+        if std::fs::symlink_metadata(path).is_ok_and(|m| !m.is_file()) {
+            bail!(
+                "{} is in the way: it is not a regular file (a folder, link, FIFO or device), and is never replaced",
+                path.display()
+            );
+        }
+        let temp = synced_temp(path, bytes)?;
+        self.staged.push((temp, path.to_path_buf(), overwrite));
+        Ok(())
+    }
+
+    /// How many files are staged.
+    pub fn len(&self) -> usize {
+        self.staged.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.staged.is_empty()
+    }
+
+    /// Renames every staged file into place, in the order staged; on a failure undoes the
+    /// renames done so far and says which file failed.
+    pub fn commit(self) -> Result<()> {
+        // (target, its previous contents moved aside, if it had any)
+        let mut done: Vec<(PathBuf, Option<tempfile::TempPath>)> = Vec::new();
+        let mut failure = None;
+        for (temp, path, overwrite) in self.staged {
+            let backup = match overwrite {
+                Overwrite::Allowed if path.exists() => match move_aside(&path) {
+                    Ok(backup) => Some(backup),
+                    Err(e) => {
+                        failure = Some(e);
+                        break;
+                    }
+                },
+                _ => None,
+            };
+            // Never replaces: a file that appeared since the check (another run's) stays.
+            match temp.persist_noclobber(&path) {
+                Ok(_) => done.push((path, backup)),
+                Err(e) => {
+                    if let Some(backup) = backup {
+                        let _ = std::fs::rename(&backup, &path);
+                        let _ = backup.keep();
+                    }
+                    failure = Some(
+                        anyhow::Error::from(e.error)
+                            .context(format!("cannot write {}", path.display())),
+                    );
+                    break;
+                }
+            }
+        }
+        let Some(failure) = failure else {
+            return Ok(()); // backups are removed as they drop
+        };
+        for (path, backup) in done.into_iter().rev() {
+            match backup {
+                Some(backup) => {
+                    let _ = std::fs::rename(&backup, &path);
+                    let _ = backup.keep();
+                }
+                None => {
+                    let _ = std::fs::remove_file(&path);
+                }
+            }
+        }
+        Err(failure.context("nothing was written (the files written before it were taken back)"))
+    }
+}
+
+/// Moves the file at `path` to a fresh temporary name beside it (removed when dropped).
+fn move_aside(path: &Path) -> Result<tempfile::TempPath> {
+    let backup = tempfile::Builder::new()
+        .prefix(".arlpcg-")
+        .suffix(".tmp")
+        .tempfile_in(parent_dir(path))
+        .with_context(|| format!("cannot set {} aside", path.display()))?
+        .into_temp_path();
+    std::fs::rename(path, &backup)
+        .with_context(|| format!("cannot set {} aside", path.display()))?;
+    Ok(backup)
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
         Some(dir) if !dir.as_os_str().is_empty() => dir,
         _ => Path::new("."),
-    };
+    }
+}
+
+/// `bytes` in a synced, world-readable temporary file beside `path`.
+fn synced_temp(path: &Path, bytes: &[u8]) -> Result<tempfile::NamedTempFile> {
+    let dir = parent_dir(path);
     let mut temp = tempfile::Builder::new()
         .prefix(".arlpcg-")
         .suffix(".tmp")
@@ -88,11 +205,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8], overwrite: Overwrite) -> Result<(
         .and_then(|()| readable_by_all(temp.as_file()))
         .and_then(|()| temp.as_file().sync_all())
         .with_context(|| format!("cannot write {}", path.display()))?;
-    match overwrite {
-        Overwrite::Never => temp.persist_noclobber(path).map(drop).map_err(|e| e.error),
-        Overwrite::Allowed => temp.persist(path).map(drop).map_err(|e| e.error),
-    }
-    .with_context(|| format!("cannot write {}", path.display()))
+    Ok(temp)
 }
 
 /// Temporary files this tool writes before renaming them into place: `.arlpcg-*.tmp`.
@@ -233,6 +346,68 @@ mod tests {
             return;
         }
         let err = read_limited(&fifo, 100, "Solver policy").unwrap_err();
+        assert!(err.to_string().contains("not a regular file"), "{err}");
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        names
+    }
+
+    #[test]
+    fn a_batch_is_written_whole_or_not_at_all() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = |name: &str| dir.path().join(name);
+        std::fs::write(path("old.yaml"), b"old").unwrap();
+        // Whole: a new file and a replaced one.
+        let mut batch = Batch::new();
+        batch
+            .stage(&path("a.yaml"), b"a", Overwrite::Never)
+            .unwrap();
+        batch
+            .stage(&path("old.yaml"), b"new", Overwrite::Allowed)
+            .unwrap();
+        batch.commit().unwrap();
+        assert_eq!(names(dir.path()), ["a.yaml", "old.yaml"]);
+        assert_eq!(std::fs::read(path("old.yaml")).unwrap(), b"new");
+        // Not at all: the third file appears (another run) between staging and commit.
+        let mut batch = Batch::new();
+        batch
+            .stage(&path("b.yaml"), b"b", Overwrite::Never)
+            .unwrap();
+        batch
+            .stage(&path("old.yaml"), b"newer", Overwrite::Allowed)
+            .unwrap();
+        batch
+            .stage(&path("c.yaml"), b"c", Overwrite::Never)
+            .unwrap();
+        std::fs::write(path("c.yaml"), b"theirs").unwrap();
+        let err = batch.commit().unwrap_err();
+        assert!(format!("{err:#}").contains("c.yaml"), "{err:#}");
+        assert_eq!(names(dir.path()), ["a.yaml", "c.yaml", "old.yaml"]);
+        assert_eq!(std::fs::read(path("old.yaml")).unwrap(), b"new", "put back");
+        assert_eq!(
+            std::fs::read(path("c.yaml")).unwrap(),
+            b"theirs",
+            "never replaced"
+        );
+        // Dropped uncommitted: nothing stays.
+        let mut batch = Batch::new();
+        batch
+            .stage(&path("d.yaml"), b"d", Overwrite::Never)
+            .unwrap();
+        drop(batch);
+        assert_eq!(names(dir.path()), ["a.yaml", "c.yaml", "old.yaml"]);
+        // A folder where a file should go is refused at staging.
+        std::fs::create_dir(path("e.yaml")).unwrap();
+        let mut batch = Batch::new();
+        let err = batch
+            .stage(&path("e.yaml"), b"e", Overwrite::Allowed)
+            .unwrap_err();
         assert!(err.to_string().contains("not a regular file"), "{err}");
     }
 

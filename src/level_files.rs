@@ -91,11 +91,12 @@ pub fn render(level: &Level, files: &LevelFiles) -> Vec<(PathBuf, Vec<u8>)> {
 
 /// Writes the level in each format of `files`, atomically.
 pub fn write_level_files(level: &Level, files: &LevelFiles, overwrite: Overwrite) -> Result<()> {
+    let mut batch = fsio::Batch::new();
     // The .bin before the .gltf that names it.
     for (path, bytes) in render(level, files).iter().rev() {
-        fsio::write_atomic(path, bytes, overwrite)?;
+        batch.stage(path, bytes, overwrite)?;
     }
-    Ok(())
+    batch.commit()
 }
 
 /// A level's file name without extension, the same for every writer (`generate`, the

@@ -102,9 +102,11 @@ fn write_results(results: &eval::Results, out: &Path, overwrite: Overwrite) -> R
     for (name, text) in eval::csv_tables(results) {
         files.push((name.into(), text.into_bytes()));
     }
+    let mut batch = fsio::Batch::new();
     for (name, bytes) in &files {
-        fsio::write_atomic(&out.join(name), bytes, overwrite)?;
+        batch.stage(&out.join(name), bytes, overwrite)?;
     }
+    batch.commit()?;
     println!("{markdown}");
     println!("wrote {} files to {}", files.len(), out.display());
     Ok(())
@@ -177,6 +179,12 @@ fn write_shard(
     budget: Budget,
     overwrite: Overwrite,
 ) -> Result<()> {
+    // The target is checked before the evaluation, not after it.
+    let path = args.out.join(PART_FILE);
+    if args.out.exists() && !args.out.is_dir() {
+        bail!("--out {} is not a folder", args.out.display());
+    }
+    fsio::check_writable(&path, overwrite)?;
     let part = pool.install(|| -> Result<Part> {
         let levels = eval::levels(generator, named, budget)?;
         let indices: Vec<usize> = (0..levels.layout.plays().len())
@@ -199,7 +207,6 @@ fn write_shard(
     })?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let path = args.out.join(PART_FILE);
     fsio::write_atomic(&path, &serde_json::to_vec(&part)?, overwrite)?;
     println!(
         "wrote shard {}/{} ({} of the evaluation's plays) to {}",

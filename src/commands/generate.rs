@@ -155,43 +155,16 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
             None => break,
         }
     }
-    // Files that exist already: identical ones are left alone (a re-run finishes a batch),
-    // others are refused unless --force, before anything is written.
-    let mut writes = Vec::new();
-    let mut kept = 0;
-    for (level, (_, files)) in levels.iter().zip(&plans) {
-        for (path, bytes) in render(level, files) {
-            if std::fs::symlink_metadata(&path).is_ok_and(|m| !m.is_file()) {
-                bail!(
-                    "{} is in the way: it is not a regular file (a folder, link, FIFO or device), and is never replaced; nothing was written",
-                    path.display()
-                );
-            }
-            match std::fs::read(&path) {
-                Ok(existing) if existing == bytes => kept += 1,
-                Ok(_) if !args.force => bail!(
-                    "{} already exists with other contents (use --force to overwrite it); nothing was written",
-                    path.display()
-                ),
-                Ok(_) => writes.push((path, bytes, Overwrite::Allowed)),
-                // Absent when checked: written only if still absent (another run may get there
-                // first, and its file is not replaced).
-                Err(_) => writes.push((path, bytes, Overwrite::Never)),
-            }
-        }
+    // The folder is made only now, and removed again if the batch fails.
+    let made_folder = !args.out.exists();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let written = write_batch(args, &levels, &plans);
+    if written.is_err() && made_folder {
+        let _ = std::fs::remove_dir(&args.out); // only if empty
     }
-    // The folder is made only now: a batch that fails leaves no empty folder behind.
-    if !writes.is_empty() {
-        std::fs::create_dir_all(&args.out)
-            .with_context(|| format!("cannot create {}", args.out.display()))?;
-        crate::fsio::remove_stale_temps(&args.out, std::time::SystemTime::now())?;
-    }
-    // A .gltf is written after the .bin it names.
-    for (written, (path, bytes, overwrite)) in writes.iter().rev().enumerate() {
-        fsio::write_atomic(path, bytes, *overwrite)
-            .with_context(|| format!("after writing {written} of {} files", writes.len()))?;
-    }
-    let files = writes.len() + kept;
+    let (staged, kept) = written?;
+    let files = staged + kept;
     let unchanged = match kept {
         0 => String::new(),
         k => format!(", {k} of them already there and identical"),
@@ -237,6 +210,52 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Writes the files of `levels`, all or none: each level is rendered and staged beside its
+/// target one at a time (memory stays bounded), then all are renamed into place. Files that
+/// exist already and are identical are left alone (a re-run finishes a batch); others are
+/// refused unless --force. Returns (files written, files left as they were).
+fn write_batch(
+    args: &GenerateArgs,
+    levels: &[Level],
+    plans: &[(u64, LevelFiles)],
+) -> Result<(usize, usize)> {
+    fsio::remove_stale_temps(&args.out, std::time::SystemTime::now())?;
+    let mut batch = fsio::Batch::new();
+    let mut kept = 0;
+    let nothing = "nothing was written";
+    for (level, (_, files)) in levels.iter().zip(plans) {
+        // A .gltf after the .bin it names.
+        for (path, bytes) in render(level, files).into_iter().rev() {
+            if std::fs::symlink_metadata(&path).is_ok_and(|m| !m.is_file()) {
+                bail!(
+                    "{} is in the way: it is not a regular file (a folder, link, FIFO or device), and is never replaced; {nothing}",
+                    path.display()
+                );
+            }
+            let overwrite = match std::fs::read(&path) {
+                Ok(existing) if existing == bytes => {
+                    kept += 1;
+                    continue;
+                }
+                Ok(_) if !args.force => bail!(
+                    "{} already exists with other contents (use --force to overwrite it); {nothing}",
+                    path.display()
+                ),
+                Ok(_) => Overwrite::Allowed,
+                // Absent when checked: written only if still absent (another run may get there
+                // first, and its file is not replaced).
+                Err(_) => Overwrite::Never,
+            };
+            batch
+                .stage(&path, &bytes, overwrite)
+                .with_context(|| nothing.to_string())?;
+        }
+    }
+    let staged = batch.len();
+    batch.commit()?;
+    Ok((staged, kept))
 }
 
 /// Runs per candidate of `--target-success` without `--verify`.

@@ -191,3 +191,98 @@ fn messages_name_the_field_and_exit_codes_tell_arguments_from_input() {
 fn yaml_error(path: &Path) -> String {
     arlpcg::level::yaml::load(path).unwrap_err().to_string()
 }
+
+/// Runs the binary with files limited to `kib` KiB (writes past it fail with "File too large",
+/// as on a full disk), or `None` where bash cannot set the limit.
+fn arlpcg_with_file_limit(kib: u32, args: &[&str]) -> Option<Output> {
+    let quoted: Vec<String> = args.iter().map(|a| format!("'{a}'")).collect();
+    let script = format!(
+        "ulimit -f {kib} && trap '' XFSZ && exec '{}' {}",
+        env!("CARGO_BIN_EXE_arlpcg"),
+        quoted.join(" ")
+    );
+    let output = Command::new("bash").args(["-c", &script]).output().ok()?;
+    if String::from_utf8_lossy(&output.stderr).contains("ulimit") {
+        eprintln!("skipped: cannot limit file sizes here");
+        return None;
+    }
+    Some(output)
+}
+
+fn folder(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (
+                e.file_name().into_string().unwrap(),
+                std::fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+/// A batch whose glTF files do not fit (a full disk) leaves every folder as it was: a new folder
+/// is not made, an old batch replaced with --force stays whole, no temporary file stays behind.
+#[test]
+fn a_batch_that_cannot_be_written_whole_leaves_the_folder_as_it_was() {
+    let dir = tempfile::tempdir().unwrap();
+    let fresh = dir.path().join("fresh");
+    let batch = |out: &Path, aux: &str, extra: &[&str]| {
+        let mut args = vec![
+            "generate",
+            "--rules",
+            "--game",
+            "platform",
+            "--count",
+            "6",
+            "--seed",
+            "1",
+            "--aux",
+            aux,
+            "--format",
+            "yaml,glb",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        args.into_iter().map(String::from).collect::<Vec<_>>()
+    };
+    let args = batch(&fresh, "0.5", &[]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    // The .yaml files (about 1 KiB) fit in 4 KiB, the .glb files (about 5.5 KiB) do not.
+    let Some(output) = arlpcg_with_file_limit(4, &args) else {
+        return;
+    };
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("nothing was written") && err.contains("File too large"),
+        "{err}"
+    );
+    assert!(!fresh.exists(), "no folder made");
+
+    let old = dir.path().join("old");
+    let args = batch(&old, "1", &[]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let output = crate::common::arlpcg(&args);
+    assert!(output.status.success());
+    let before = folder(&old);
+    assert_eq!(before.len(), 12);
+    let args = batch(&old, "-1", &["--force"]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let output = arlpcg_with_file_limit(4, &args).unwrap();
+    assert_eq!(
+        output.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert_eq!(
+        folder(&old),
+        before,
+        "the old batch, whole, and nothing else"
+    );
+}

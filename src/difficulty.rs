@@ -77,23 +77,31 @@ pub enum TargetError {
         "no level within ±{BAND} of success {target} in {MAX_CANDIDATES} candidates (closest: {closest:.2} at λ {aux:+.2})"
     )]
     Missed { target: f64, closest: f64, aux: f64 },
+    #[error("stopped while the λ→success curve was measured")]
+    Stopped,
     #[error(transparent)]
     Generation(#[from] GenerationError),
     #[error(transparent)]
     WrongGame(#[from] WrongGame),
 }
 
-/// Measures the curve: [`CURVE_LEVELS`] levels at each λ, [`CURVE_TRIALS`] runs each.
+/// Measures the curve: [`CURVE_LEVELS`] levels at each λ, [`CURVE_TRIALS`] runs each;
+/// `stopped` is asked before each level (a Ctrl-C ends the measurement with
+/// [`TargetError::Stopped`]).
 pub fn measure(
     generator: &GeneratorPolicy,
     solver: &Solver,
     solver_sha256: &str,
+    stopped: &dyn Fn() -> bool,
 ) -> Result<Curve, TargetError> {
     let mut points = Vec::with_capacity(CURVE_AUX.len());
     for aux in CURVE_AUX {
         let mut total = 0.0;
         let mut count = 0;
         for k in 0..CURVE_LEVELS as u64 {
+            if stopped() {
+                return Err(TargetError::Stopped);
+            }
             let seed = crate::seeds::CURVE_SEED_BASE + k;
             let obstacles = crate::game::facts::facts(generator.game).scene_obstacles;
             let request = LevelRequest::new(seed, Some(aux)).obstacles(obstacles);

@@ -133,12 +133,14 @@ pub fn curve_path(dir: &Path, solver_path: &Path, solver_sha256: &str) -> PathBu
 
 /// The λ→success curve of `generator` with `solver`, kept in `dir` (see [`curve_path`]): read
 /// when it was measured with these two policies (by SHA-256), else measured (`on_measure` is
-/// told first: it takes a while) and kept there when the folder can be written.
+/// told first: it takes a while; `stopped` can end it) and kept there when the folder can be
+/// written.
 pub fn difficulty_curve(
     dir: &Path,
     generator: &GeneratorPolicy,
     solver: &SolverPolicy,
     on_measure: impl FnOnce(),
+    stopped: &dyn Fn() -> bool,
 ) -> Result<crate::difficulty::Curve> {
     let path = curve_path(
         dir,
@@ -167,6 +169,7 @@ pub fn difficulty_curve(
         generator,
         &crate::verify::Solver::Policy(solver),
         &solver.reference.sha256,
+        stopped,
     )?;
     // A folder that cannot be written only costs a new measurement next time.
     let _ = crate::fsio::write_atomic(

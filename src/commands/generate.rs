@@ -117,6 +117,13 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
                     difficulty::CURVE_LEVELS,
                     difficulty::CURVE_TRIALS
                 )
+            }, &|| stop.load(Ordering::SeqCst))
+            .map_err(|e| match e.downcast_ref::<difficulty::TargetError>() {
+                Some(difficulty::TargetError::Stopped) => crate::shell::Interrupted(
+                    "interrupted (Ctrl-C) while the λ→success curve was measured; nothing was written".into(),
+                )
+                .into(),
+                _ => e,
             })?,
         ),
         _ => None,

@@ -130,9 +130,32 @@ fn check_header(text: &str) -> Result<(), Problem> {
         }
     }
     match fields.get("version") {
-        Some(serde_yaml::Value::Number(n)) if n.as_u64() == Some(FORMAT_VERSION as u64) => Ok(()),
-        Some(other) => Err(Problem::UnsupportedVersion(describe_value(other))),
-        None => Err(Problem::NotALevel("missing field `version`".into())),
+        Some(serde_yaml::Value::Number(n)) if n.as_u64() == Some(FORMAT_VERSION as u64) => {}
+        Some(other) => return Err(Problem::UnsupportedVersion(describe_value(other))),
+        None => return Err(Problem::NotALevel("missing field `version`".into())),
+    }
+    check_source_fields(fields.get("source"), text)
+}
+
+/// The fields each `source.kind` needs, named with their path and line (serde's message for a
+/// tagged variant has neither).
+fn check_source_fields(source: Option<&serde_yaml::Value>, text: &str) -> Result<(), Problem> {
+    let Some(serde_yaml::Value::Mapping(source)) = source else {
+        return Ok(());
+    };
+    let needed: &[&str] = match source.get("kind").and_then(|k| k.as_str()) {
+        Some("rules" | "racing-rules") => &["rules"],
+        Some("policy") => &["generator"],
+        Some("kept") => &["pieces", "from", "generator"],
+        _ => &[],
+    };
+    match needed.iter().find(|field| !source.contains_key(**field)) {
+        Some(field) => Err(Problem::Invalid {
+            field: format!("source.{field}"),
+            line: line_of_key(text, "source"),
+            message: "missing".into(),
+        }),
+        None => Ok(()),
     }
 }
 

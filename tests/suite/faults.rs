@@ -136,6 +136,19 @@ fn messages_name_the_field_and_exit_codes_tell_arguments_from_input() {
         "{err}"
     );
 
+    let no_rules = dir.path().join("no-rules.yaml");
+    std::fs::write(
+        &no_rules,
+        "format: arlpcg-level\nversion: 1\ngame: platform\nstart: {position: [0, 0, 0], heading: 0}\n\
+         blocks:\n  - {distance: 7, angle: 0, size: 5, height: 0}\nsource:\n  kind: rules\n",
+    )
+    .unwrap();
+    let err = yaml_error(&no_rules);
+    assert!(
+        err.ends_with("no-rules.yaml: source.rules: missing (line 7)"),
+        "{err}"
+    );
+
     // A byte-order mark before the first key is read past.
     let staircase = Path::new(env!("CARGO_MANIFEST_DIR")).join("levels/hand/staircase.yaml");
     let mut with_bom = b"\xef\xbb\xbf".to_vec();
@@ -284,5 +297,73 @@ fn a_batch_that_cannot_be_written_whole_leaves_the_folder_as_it_was() {
         folder(&old),
         before,
         "the old batch, whole, and nothing else"
+    );
+}
+
+/// Ctrl-C while `generate --target-success` measures the policies' λ→success curve (tens of
+/// seconds) stops it at once: exit 130, nothing written.
+#[test]
+fn ctrl_c_stops_the_difficulty_curve_measurement_at_once() {
+    use std::io::{BufRead, BufReader};
+    let dir = tempfile::tempdir().unwrap();
+    let policies = dir.path().join("policies");
+    std::fs::create_dir(&policies).unwrap();
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    for name in [
+        "generator.safetensors",
+        "generator.yaml",
+        "solver.safetensors",
+        "solver.yaml",
+    ] {
+        std::fs::copy(shipped.join(name), policies.join(name)).unwrap();
+    }
+    let out = dir.path().join("out");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+        .args([
+            "generate",
+            "--policies",
+            policies.to_str().unwrap(),
+            "--target-success",
+            "0.5",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    while !line.contains("measuring") {
+        line.clear();
+        assert!(
+            stderr.read_line(&mut line).unwrap() > 0,
+            "ended before measuring"
+        );
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    let sent = Instant::now();
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut stderr, &mut rest).unwrap();
+    let status = child.wait().unwrap();
+    assert!(
+        sent.elapsed() < Duration::from_secs(10),
+        "took {:?}",
+        sent.elapsed()
+    );
+    assert_eq!(status.code(), Some(130), "{rest}");
+    assert!(
+        rest.contains("while the λ→success curve was measured"),
+        "{rest}"
+    );
+    assert!(!out.exists());
+    assert!(
+        !policies.join("difficulty-curve.yaml").exists(),
+        "no partial curve kept"
     );
 }

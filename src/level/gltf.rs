@@ -395,6 +395,22 @@ fn document(
             ..Default::default()
         }));
     }
+    for point in &scene.points {
+        // Turned so that local +Z (glTF's forward) points along the heading.
+        let half = ((point.heading + 90.0).to_radians() / 2.0) as f32;
+        nodes.push(root.push(json::Node {
+            name: Some(point.name.clone()),
+            translation: Some(point.position.map(|c| c as f32)),
+            rotation: Some(json::scene::UnitQuaternion([
+                0.0,
+                half.sin(),
+                0.0,
+                half.cos(),
+            ])),
+            extras: Some(raw(&point.extras)),
+            ..Default::default()
+        }));
+    }
     let scene_index = root.push(json::Scene {
         name: Some(scene.name.clone()),
         nodes,

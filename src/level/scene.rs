@@ -86,6 +86,17 @@ pub struct SceneMesh {
     pub extras: Option<Value>,
 }
 
+/// A place without geometry (where to spawn, where the finish is), in world coordinates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScenePoint {
+    pub name: String,
+    pub position: [f64; 3],
+    /// The level's heading there, degrees: the node is turned so that its local +Z (glTF's
+    /// forward) points along it.
+    pub heading: f64,
+    pub extras: Value,
+}
+
 /// A level ready to export.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
@@ -94,6 +105,8 @@ pub struct Scene {
     pub nodes: Vec<SceneNode>,
     /// Nodes with their own geometry, after the boxes.
     pub meshes: Vec<SceneMesh>,
+    /// Empty nodes (spawn, finish), after the meshes.
+    pub points: Vec<ScenePoint>,
     /// Metadata of the whole level (game, seed, aux).
     pub extras: Value,
 }
@@ -109,8 +122,68 @@ impl Scene {
             scene.extras["aux_curve"] = json!(pacing.curve.to_string());
             scene.extras["aux_by_piece"] = json!(pacing.piece_aux);
         }
+        if let Some(stats) = &level.stats {
+            scene.extras["success_ratio"] = json!(stats.success_ratio);
+            scene.extras["success_ci95"] = json!(stats.ci95);
+            scene.extras["trials"] = json!(stats.trials);
+            scene.extras["certificate"] = json!(stats.certificate);
+        }
+        scene.points = spawn_and_finish(level);
         scene
     }
+}
+
+/// Where a player starts (position and heading) and the finish: the goal, with the distances
+/// within which reaching it counts (docs/spec.md §1: the goal reach of each game).
+fn spawn_and_finish(level: &Level) -> Vec<ScenePoint> {
+    let (start, start_heading, finish, finish_heading, horizontal, vertical, finish_kind) =
+        match &level.track {
+            Track::Platform(track) => {
+                let start = track.start();
+                let goal_block = track.last();
+                (
+                    start.position,
+                    start.heading,
+                    goal_block.position,
+                    goal_block.heading,
+                    super::platform::GOAL_REACH_HORIZONTAL,
+                    super::platform::GOAL_REACH_VERTICAL,
+                    "on the goal block: stand within reach of the goal",
+                )
+            }
+            Track::Racing(track) => {
+                let (end, end_heading) = track.road().end();
+                (
+                    track.position,
+                    track.heading,
+                    end,
+                    end_heading,
+                    super::racing::GOAL_REACH_HORIZONTAL,
+                    super::racing::GOAL_REACH_VERTICAL,
+                    "across the road's end: drive within reach of the goal",
+                )
+            }
+        };
+    vec![
+        ScenePoint {
+            name: "spawn".into(),
+            position: start,
+            heading: start_heading,
+            extras: json!({"kind": "spawn", "heading_degrees": start_heading, "forward": "+Z"}),
+        },
+        ScenePoint {
+            name: "finish".into(),
+            position: finish,
+            heading: finish_heading,
+            extras: json!({
+                "kind": "finish",
+                "where": finish_kind,
+                "goal": level.goal,
+                "reach_horizontal_m": horizontal,
+                "reach_vertical_m": vertical,
+            }),
+        },
+    ]
 }
 
 fn marker(name: &str, base: [f64; 3], height: f64, material: Material) -> SceneNode {
@@ -120,7 +193,8 @@ fn marker(name: &str, base: [f64; 3], height: f64, material: Material) -> SceneN
         heading: 0.0,
         extents: [0.3, height, 0.3],
         material,
-        extras: None,
+        // A post to see, not to collide with (it may stand in the road).
+        extras: Some(json!({"collides": false})),
     }
 }
 
@@ -176,6 +250,7 @@ fn platform_scene(level: &Level, track: &PlatformTrack) -> Scene {
         name: format!("{}_level", level.game()),
         nodes,
         meshes: Vec::new(),
+        points: Vec::new(),
         extras: json!({
             "format": super::yaml::FORMAT_NAME,
             "game": level.game().name(),
@@ -243,6 +318,7 @@ fn racing_scene(level: &Level, track: &RacingTrack) -> Scene {
         name: format!("{}_level", level.game()),
         nodes,
         meshes,
+        points: Vec::new(),
         extras: json!({
             "format": super::yaml::FORMAT_NAME,
             "game": level.game().name(),

@@ -59,13 +59,14 @@ fn glb_reads_back_with_one_node_per_block_and_matching_bounds() {
         std::fs::write(exports.join(format!("rules_seed{seed}.glb")), &glb).unwrap();
         let (document, buffers, _) = gltf::import_slice(&glb).expect("the .glb imports");
         let nodes: Vec<gltf::Node> = document.nodes().collect();
-        // start block, every block, start and goal markers
-        assert_eq!(nodes.len(), track.block_count() + 3);
+        // start block, every block, start and goal markers, spawn and finish
+        assert_eq!(nodes.len(), track.block_count() + 5);
         assert_eq!(nodes[0].name(), Some("start_block"));
         assert_eq!(nodes[1].name(), Some("block_000"));
         let last_name = format!("block_{:03}", track.block_count() - 1);
         assert_eq!(nodes[track.block_count()].name(), Some(last_name.as_str()));
-        assert_eq!(nodes[nodes.len() - 1].name(), Some("goal"));
+        assert_eq!(nodes[nodes.len() - 3].name(), Some("goal"));
+        assert_eq!(nodes[nodes.len() - 1].name(), Some("finish"));
         // Block nodes sit where the level says: top face at the block's height, centred on it.
         for (node, platform) in nodes.iter().zip(track.platforms()) {
             let (lo, hi) = node_bounds(node);
@@ -114,7 +115,7 @@ fn export_is_deterministic_and_gltf_matches_glb() {
     assert_eq!(root["buffers"][0]["uri"], "level.bin");
     assert_eq!(
         root["nodes"].as_array().unwrap().len(),
-        level.piece_count() + 3
+        level.piece_count() + 5
     );
     assert_eq!(root["scenes"][0]["extras"]["aux"], -1.0);
     assert_eq!(
@@ -213,5 +214,96 @@ fn every_mesh_faces_outward_and_its_winding_agrees_with_its_normals() {
             }
         }
         assert!(closed_meshes > 0, "{}", level.game());
+    }
+}
+
+fn rotate_z(rotation: [f32; 4]) -> [f32; 3] {
+    let [x, y, z, w] = rotation;
+    let u = [x, y, z];
+    let v = [0.0, 0.0, 1.0];
+    let uv = cross(u, v);
+    let uuv = cross(u, uv);
+    [0, 1, 2].map(|k| v[k] + 2.0 * (w * uv[k] + uuv[k]))
+}
+
+/// An engine finds where to spawn (position, and +Z along the start heading) and the finish
+/// (the goal block, or across the road's end, with the reach that counts as success).
+#[test]
+fn spawn_and_finish_nodes_carry_start_heading_and_goal_reach() {
+    use arlpcg::level::platform::heading_direction;
+    let platform = level(6);
+    let racing =
+        arlpcg::game::racing::rules::racing_level(6, None, None, &Default::default()).unwrap();
+    for level in [platform, racing] {
+        let glb = export::to_glb(&Scene::of_level(&level));
+        let (document, _, _) = gltf::import_slice(&glb).unwrap();
+        let node = |name: &str| {
+            document
+                .nodes()
+                .find(|n| n.name() == Some(name))
+                .unwrap_or_else(|| panic!("{}: no {name} node", level.game()))
+        };
+        let (start, heading, end, end_direction) = match level.racing() {
+            Some(track) => {
+                let road = track.road();
+                let samples = road.samples();
+                let [a, b] = [
+                    samples[samples.len() - 2].centre,
+                    samples[samples.len() - 1].centre,
+                ];
+                let d = [b[0] - a[0], b[2] - a[2]];
+                let n = (d[0] * d[0] + d[1] * d[1]).sqrt();
+                (
+                    track.position,
+                    track.heading,
+                    road.end().0,
+                    [d[0] / n, d[1] / n],
+                )
+            }
+            None => {
+                let track = level.platform().unwrap();
+                let last = track.last();
+                (
+                    track.start().position,
+                    track.start().heading,
+                    last.position,
+                    heading_direction(last.heading),
+                )
+            }
+        };
+        let (t, r, _) = node("spawn").transform().decomposed();
+        assert!(
+            (0..3).all(|k| (t[k] as f64 - start[k]).abs() < 1e-3),
+            "{}: {t:?}",
+            level.game()
+        );
+        let forward = rotate_z(r);
+        let [x, z] = heading_direction(heading);
+        assert!(
+            (forward[0] as f64 - x).abs() < 1e-4 && (forward[2] as f64 - z).abs() < 1e-4,
+            "{}: spawn +Z {forward:?}, heading {heading}",
+            level.game()
+        );
+        let finish = node("finish");
+        let (t, r, _) = finish.transform().decomposed();
+        assert!(
+            (0..3).all(|k| (t[k] as f64 - end[k]).abs() < 1e-3),
+            "{}: {t:?} {end:?}",
+            level.game()
+        );
+        let forward = rotate_z(r);
+        assert!(
+            (forward[0] as f64 - end_direction[0]).abs() < 0.02
+                && (forward[2] as f64 - end_direction[1]).abs() < 0.02,
+            "{}: finish +Z {forward:?}, along {end_direction:?}",
+            level.game()
+        );
+        let extras: serde_json::Value =
+            serde_json::from_str(finish.extras().as_ref().unwrap().get()).unwrap();
+        assert!(
+            extras["reach_horizontal_m"].as_f64().unwrap() > 0.0,
+            "{extras}"
+        );
+        assert_eq!(extras["goal"], serde_json::json!(level.goal));
     }
 }

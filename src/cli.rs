@@ -352,6 +352,10 @@ pub struct VerifyArgs {
     /// Print one JSON object per level instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Draw the level's difficulty along the way as a PNG: the share of runs that get past
+    /// each piece, and the difficulty its λ asked for (one level only).
+    #[arg(long, value_name = "FILE.png", conflicts_with = "replay")]
+    pub chart: Option<PathBuf>,
     /// Instead of new trials, re-run each level's certificate (the successful run its
     /// statistics record) with the Solver that recorded it, and check that it succeeds again.
     #[arg(long, conflicts_with_all = ["solver", "policy", "trials", "json"])]

@@ -55,7 +55,7 @@ pub struct LevelRequest {
 /// The first `pieces` pieces of `level`, read from the file `from` (`generate --keep`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct KeptPrefix {
-    pub level: Level,
+    pub level: std::sync::Arc<Level>,
     pub pieces: usize,
     pub from: PolicyRef,
 }

@@ -412,6 +412,35 @@ impl HalfwaySplit {
     }
 }
 
+/// The difficulty along a level: the share of runs past each piece against the fraction of the
+/// way where the piece begins, and, on a paced level, the difficulty its λ asked for
+/// (`(1 - λ) / 2`: 0 easy, 1 hard).
+pub fn pacing_chart(name: &str, level: &Level, stats: &SolverStats) -> crate::chart::LineChart {
+    let fractions = level.piece_start_fractions();
+    let passed = passed_by_piece(stats);
+    let mut series = vec![crate::chart::Series {
+        name: "runs past the piece".into(),
+        points: fractions.iter().copied().zip(passed).collect(),
+    }];
+    if let Some(pacing) = &level.pacing {
+        series.push(crate::chart::Series {
+            name: "asked: (1-λ)/2".into(),
+            points: fractions
+                .iter()
+                .zip(&pacing.piece_aux)
+                .map(|(&f, aux)| (f, aux.map_or(f64::NAN, |a| (1.0 - a) / 2.0)))
+                .collect(),
+        });
+    }
+    crate::chart::LineChart {
+        title: format!("{name}: {} runs", stats.trials),
+        x_label: "fraction of the way to the goal where the piece begins".into(),
+        y_label: "share".into(),
+        series,
+        y_range: Some((0.0, 1.0)),
+    }
+}
+
 /// The share of runs that got past each piece: `1 - failures up to and including it / trials`
 /// (what a player feels as the difficulty along the level).
 pub fn passed_by_piece(stats: &SolverStats) -> Vec<f64> {

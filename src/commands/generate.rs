@@ -310,7 +310,7 @@ fn kept_prefix(keep: &KeepArg, game: Game) -> Result<KeptPrefix> {
         .map(|b| format!("{b:02x}"))
         .collect();
     Ok(KeptPrefix {
-        level,
+        level: Arc::new(level),
         pieces: keep.pieces,
         from: PolicyRef {
             path: keep.level.display().to_string(),

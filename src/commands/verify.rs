@@ -19,6 +19,21 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
     if args.replay {
         return replay(args);
     }
+    if args.chart.is_some() && args.levels.len() != 1 {
+        return Err(crate::shell::UsageError(
+            "--chart draws one level: give one level file".into(),
+        )
+        .into());
+    }
+    if let Some(chart) = &args.chart
+        && chart.extension().is_none_or(|e| e != "png")
+    {
+        return Err(crate::shell::UsageError(format!(
+            "--chart {}: the file name must end in .png",
+            chart.display()
+        ))
+        .into());
+    }
     let mut solvers = Solvers::default();
     let mut failed = 0;
     let mut all = Vec::new();
@@ -44,6 +59,12 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
                     println!("{}", describe(path, &level, &stats));
                 }
                 halfway.add(&level, &stats);
+                if let Some(chart) = &args.chart {
+                    let name = path.file_stem().unwrap_or_default().to_string_lossy();
+                    let png = crate::verify::pacing_chart(&name, &level, &stats).to_png();
+                    crate::fsio::write_atomic(chart, &png, crate::fsio::Overwrite::Never)?;
+                    eprintln!("wrote {}", chart.display());
+                }
                 all.push(stats);
             }
             Err(err) => {

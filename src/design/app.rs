@@ -19,6 +19,7 @@ use crate::verify::Recording;
 use super::layout::Areas;
 
 mod input;
+pub mod pacing;
 
 /// Steps of the λ slider (keys), and its range.
 pub const AUX_STEP: f64 = 0.1;
@@ -86,6 +87,7 @@ pub enum PromptKind {
     Trials,
     Policies,
     Target,
+    Curve,
 }
 
 impl PromptKind {
@@ -95,6 +97,7 @@ impl PromptKind {
             PromptKind::Trials => "Solver trials per level",
             PromptKind::Target => "target success rate, 0.05-0.95 (empty: back to the λ slider)",
             PromptKind::Policies => "policies folder, or a Generator/Solver .safetensors file",
+            PromptKind::Curve => "aux curve, fraction:λ, ... (e.g. 0:1, 0.5:1, 0.6:-1, 1:-1)",
         }
     }
 }
@@ -280,6 +283,10 @@ pub enum Effect {
         seed: u64,
         aux: f64,
         goal: Option<[f64; 3]>,
+        /// λ along the level instead of `aux`.
+        curve: Option<crate::level::pacing::AuxCurve>,
+        /// Pieces kept from an earlier level.
+        keep: Option<crate::generation::KeptPrefix>,
     },
     Trials {
         id: u64,
@@ -331,6 +338,10 @@ pub struct App {
     pub aux: f64,
     /// Target-success mode: the success rate asked for (λ follows the level found).
     pub target: Option<f64>,
+    /// λ along the level (instead of the slider's one λ).
+    pub pacing: Option<pacing::PacingChoice>,
+    /// The prefix every regeneration keeps.
+    pub kept: Option<crate::generation::KeptPrefix>,
     pub seed: u64,
     pub goal: GoalSetting,
     pub trials_wanted: u32,
@@ -369,6 +380,8 @@ impl App {
             other_policies: LoadedInfo::default(),
             aux: 1.0,
             target: None,
+            pacing: None,
+            kept: None,
             seed,
             goal: GoalSetting::FromSeed,
             trials_wanted: DEFAULT_TRIALS,
@@ -430,6 +443,8 @@ impl App {
             seed: self.seed,
             aux: self.aux,
             goal: self.goal.position(),
+            curve: self.pacing.as_ref().map(|p| p.curve.clone()),
+            keep: self.kept.clone(),
         }]
     }
 
@@ -442,6 +457,10 @@ impl App {
         };
         std::mem::swap(&mut self.policies, &mut self.other_policies);
         self.goal = GoalSetting::FromSeed;
+        self.kept = None;
+        if self.policies.generator.is_none() {
+            self.pacing = None;
+        }
         self.level = None;
         self.trials = None;
         self.sweep = None;
@@ -455,8 +474,11 @@ impl App {
         if aux == self.aux && self.target.is_none() {
             return Vec::new();
         }
-        // Moving the slider leaves target-success mode.
+        // Moving the slider leaves target-success mode and pacing.
         self.target = None;
+        if self.pacing.take().is_some() {
+            self.say("one λ again (P: pacing presets)");
+        }
         self.aux = aux;
         self.generate()
     }
@@ -470,6 +492,11 @@ impl App {
             return Vec::new();
         }
         self.target = target;
+        if target.is_some() {
+            // The search steers one λ over the whole level.
+            self.pacing = None;
+            self.kept = None;
+        }
         if let Some(p) = target {
             self.say(format!(
                 "searching λ for success {p:.2} ± 0.1 ({} runs a candidate)",
@@ -487,9 +514,21 @@ impl App {
         self.status = Some((text.into(), true));
     }
 
-    /// The file stem exports use: game, seed and λ.
+    /// The file stem exports use: game, seed and λ (or the pacing preset), and the pieces kept.
     pub fn export_stem(&self) -> String {
-        crate::level_files::file_stem(self.game, self.seed, Some(self.aux))
+        let mut stem = match &self.pacing {
+            Some(choice) => format!(
+                "{}_seed{}_pacing-{}",
+                self.game,
+                self.seed,
+                choice.name.replace(' ', "-")
+            ),
+            None => crate::level_files::file_stem(self.game, self.seed, Some(self.aux)),
+        };
+        if let Some(kept) = &self.kept {
+            stem += &format!("_keep{}", kept.pieces);
+        }
+        stem
     }
 
     fn export(&mut self, overwrite: bool) -> Vec<Effect> {

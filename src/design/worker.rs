@@ -57,18 +57,10 @@ impl Policies {
         }
     }
 
-    /// A level of `game` at `aux` for `seed` toward `goal`: the Generator's, or the rules'
-    /// without one; racing scenes hold the obstacles evaluation scenes hold.
-    pub fn level(
-        &self,
-        game: Game,
-        seed: u64,
-        aux: f64,
-        goal: Option<[f64; 3]>,
-    ) -> Result<Level, String> {
-        let request = LevelRequest::new(seed, Some(aux))
-            .goal(goal)
-            .obstacles(crate::game::facts::facts(game).scene_obstacles);
+    /// The level of `game` that `request` asks for: the Generator's, or the rules' without
+    /// one; racing scenes hold the obstacles evaluation scenes hold.
+    pub fn level(&self, game: Game, request: LevelRequest) -> Result<Level, String> {
+        let request = request.obstacles(crate::game::facts::facts(game).scene_obstacles);
         match &self.generator {
             Some(generator) => {
                 generation::generator_level(generator, &request).map_err(|e| e.to_string())
@@ -245,10 +237,21 @@ pub fn perform(
             seed,
             aux,
             goal,
-        } => send(Response::Level {
-            id,
-            result: shelf.of(game).level(game, seed, aux, goal).map(Arc::new),
-        }),
+            curve,
+            keep,
+        } => {
+            let mut request = LevelRequest::new(seed, Some(aux)).goal(goal);
+            if let Some(curve) = curve {
+                request = request.lambda(crate::generation::Lambda::Curve(curve));
+            }
+            if let Some(keep) = keep {
+                request = request.keep(keep);
+            }
+            send(Response::Level {
+                id,
+                result: shelf.of(game).level(game, request).map(Arc::new),
+            })
+        }
         Effect::Trials {
             id,
             level,
@@ -297,7 +300,8 @@ pub fn perform(
                 if stop() {
                     return;
                 }
-                let point = match current.level(game, seed, aux, goal) {
+                let point = match current.level(game, LevelRequest::new(seed, Some(aux)).goal(goal))
+                {
                     Ok(level) => {
                         let watch = Watch {
                             on_trial: &|_| {},

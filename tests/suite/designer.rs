@@ -442,6 +442,8 @@ fn newer_requests_supersede_older_ones() {
         seed: id,
         aux: 0.0,
         goal: None,
+        curve: None,
+        keep: None,
     };
     workers.submit(generate(101));
     loop {
@@ -593,4 +595,78 @@ fn the_readme_key_table_is_the_key_map() {
         table, expected,
         "README.md's key table differs from view::KEYS"
     );
+}
+
+/// Pacing keys on the shipped policies: `P` steps through the presets (the level follows the
+/// curve, each piece coloured by its λ), `C` takes a typed curve and names a bad one, `k` keeps
+/// the pieces up to the selected one through regenerations, `K` lets go; the slider goes back
+/// to one λ.
+#[test]
+fn pacing_keys_set_a_curve_and_keep_a_prefix() {
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    let (policies, info) = worker::load(&shipped, Game::Platform).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::new(policies, info, dir.path());
+    h.settle();
+    h.key(KeyCode::Char('P'));
+    assert!(
+        matches!(&h.pending[..], [Effect::Generate { curve: Some(c), .. }] if c.to_string() == "0:1, 1:-1"),
+        "{:?}",
+        h.pending
+    );
+    h.settle();
+    let level = h.app.level.clone().unwrap();
+    let pacing = level.pacing.as_ref().expect("a paced level on screen");
+    assert_eq!(
+        pacing.piece_aux.first(),
+        Some(&Some(1.0)),
+        "easy at the start"
+    );
+    insta::assert_snapshot!("pacing_ramp_up_120x36", h.screen(120, 36));
+    // The next preset, then a typed curve, then a bad one.
+    h.key(KeyCode::Char('P'));
+    assert_eq!(h.app.pacing.as_ref().unwrap().name, "ramp down");
+    h.key(KeyCode::Char('C'));
+    for _ in 0..20 {
+        h.key(KeyCode::Backspace);
+    }
+    h.keys("0:-1, 0.5:-1, 0.6:1, 1:1");
+    h.key(KeyCode::Enter);
+    assert_eq!(h.app.pacing.as_ref().unwrap().name, "custom");
+    h.key(KeyCode::Char('C'));
+    h.keys(", 0.2:1");
+    h.key(KeyCode::Enter);
+    let (status, problem) = h.app.status.clone().unwrap();
+    assert!(problem && status.contains("must increase"), "{status}");
+    h.settle();
+    // Keep the first two blocks; regenerations with new seeds keep them.
+    let before = h.app.level.clone().unwrap();
+    h.key(KeyCode::Down);
+    h.key(KeyCode::Down);
+    h.key(KeyCode::Char('k'));
+    h.settle();
+    assert_eq!(h.app.kept.as_ref().unwrap().pieces, 2);
+    h.key(KeyCode::Char('n'));
+    h.settle();
+    let after = h.app.level.clone().unwrap();
+    assert_eq!(
+        after.platform().unwrap().block_params()[..2],
+        before.platform().unwrap().block_params()[..2]
+    );
+    assert!(matches!(
+        after.source,
+        arlpcg::level::Source::Kept { pieces: 2, .. }
+    ));
+    assert!(
+        h.app.export_stem().ends_with("_pacing-custom_keep2"),
+        "{}",
+        h.app.export_stem()
+    );
+    h.key(KeyCode::Char('K'));
+    assert!(h.app.kept.is_none());
+    // The slider: one λ again.
+    h.key(KeyCode::Left);
+    assert!(h.app.pacing.is_none());
+    h.settle();
+    assert!(h.app.level.as_ref().unwrap().pacing.is_none());
 }

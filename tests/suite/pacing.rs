@@ -302,3 +302,29 @@ fn a_prefix_that_cannot_be_kept_is_refused_with_the_reason() {
     }
     assert!(!Path::new(out).exists(), "nothing written");
 }
+
+#[test]
+fn verify_draws_the_difficulty_along_one_level() {
+    let dir = tempfile::tempdir().unwrap();
+    let level = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("levels/pacing/platform_seed102_curve-8c91a45e.yaml");
+    let level = level.to_str().unwrap();
+    let chart = dir.path().join("pacing.png");
+    let chart_s = chart.to_str().unwrap();
+    let policy = shipped(Game::Platform).join("solver.safetensors");
+    let policy = policy.to_str().unwrap();
+    let output = arlpcg(&[
+        "verify", level, "--trials", "20", "--policy", policy, "--chart", chart_s,
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert!(std::fs::read(&chart).unwrap().starts_with(b"\x89PNG"));
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.contains("runs past each block: "), "{stdout}");
+    // Not over a file that is there; one level only.
+    let again = arlpcg(&[
+        "verify", level, "--trials", "5", "--policy", policy, "--chart", chart_s,
+    ]);
+    assert_eq!(again.status.code(), Some(1), "{}", stderr(&again));
+    let two = arlpcg(&["verify", level, level, "--chart", chart_s]);
+    assert_eq!(two.status.code(), Some(2), "{}", stderr(&two));
+}

@@ -86,6 +86,10 @@ impl App {
                 Vec::new()
             }
             KeyCode::Char('x') => self.export(false),
+            KeyCode::Char('P') => self.next_pacing(),
+            KeyCode::Char('C') => self.open_prompt(PromptKind::Curve),
+            KeyCode::Char('k') => self.keep_prefix(),
+            KeyCode::Char('K') => self.release_prefix(),
             _ => Vec::new(),
         }
     }
@@ -96,6 +100,10 @@ impl App {
             PromptKind::Trials => self.trials_wanted.to_string(),
             PromptKind::Target => self.target.map_or(String::new(), |t| format!("{t}")),
             PromptKind::Policies => String::new(),
+            PromptKind::Curve => self
+                .pacing
+                .as_ref()
+                .map_or(String::new(), |p| p.curve.to_string()),
         };
         self.overlay = Overlay::Prompt { kind, text };
         Vec::new()
@@ -155,6 +163,8 @@ impl App {
                     Vec::new()
                 }
             },
+            PromptKind::Curve if text.is_empty() => Vec::new(),
+            PromptKind::Curve => self.submit_curve(text),
             PromptKind::Policies if text.is_empty() => Vec::new(),
             PromptKind::Policies => {
                 self.say(format!("loading {text}"));

@@ -20,15 +20,14 @@ use crate::level::{Game, Level, Track};
 use crate::rl::checkpoint::Role;
 
 /// The key map, as the help overlay and the README show it.
-pub const KEYS: [(&str, &str); 21] = [
+pub const KEYS: [(&str, &str); 22] = [
     (
         "← →  (mouse: click/drag)",
         "λ down/up by 0.1 (-1 hard ... +1 easy)",
     ),
     ("Home End", "λ = -1 / λ = +1"),
     ("Enter, Space", "generate again (same settings: same level)"),
-    ("n", "draw a new seed"),
-    ("s", "type a seed"),
+    ("n s", "draw a new seed / type a seed"),
     ("g", "goal: from the seed / set by hand"),
     ("d D", "goal distance -5 / +5 m, racing 20 (goal by hand)"),
     ("h H", "goal height -1 / +1 m"),
@@ -39,6 +38,8 @@ pub const KEYS: [(&str, &str); 21] = [
     ("r", "replay one Solver run on the map"),
     ("w", "λ sweep: success against λ for this seed and goal"),
     ("v", "bottom-right panel: failures per piece / λ sweep"),
+    ("P C", "pacing: next preset / type a curve fraction:λ, ..."),
+    ("k K", "keep pieces up to the selected one / let go"),
     ("x", "export YAML (with the Solver statistics) + .glb"),
     ("p", "load policies (a folder or one .safetensors file)"),
     ("c", "show the loaded policies' cards"),
@@ -174,20 +175,50 @@ fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
         areas.controls,
     );
     let width = areas.slider.width as usize;
-    let knob = (((app.aux + 1.0) / 2.0) * (width.saturating_sub(1)) as f64).round() as usize;
-    let track: String = (0..width)
-        .map(|i| match i.cmp(&knob) {
-            std::cmp::Ordering::Less => '━',
-            std::cmp::Ordering::Equal => '●',
-            std::cmp::Ordering::Greater => '─',
-        })
-        .collect();
-    let mut slider = Line::from(vec![
-        Span::raw(SLIDER_LEFT).red(),
-        Span::styled(track, Style::new().fg(Color::Cyan)),
-        Span::raw(SLIDER_RIGHT).green(),
-        Span::styled(format!("  λ {:+.2}", app.aux), Style::new().bold()),
-    ]);
+    let mut slider = match &app.pacing {
+        // The curve from start to goal, taller where it is harder.
+        Some(choice) => {
+            let profile: String = (0..width)
+                .map(|i| {
+                    let aux = choice
+                        .curve
+                        .at(i as f64 / width.saturating_sub(1).max(1) as f64);
+                    let level = ((1.0 - aux) / 2.0 * 7.0).round() as usize;
+                    ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'][level.min(7)]
+                })
+                .collect();
+            // Labels as wide as the slider's; the preset and its curve on the settings line.
+            Line::from(vec![
+                Span::raw(format!("{:<w$}", "start", w = SLIDER_LEFT.chars().count())),
+                Span::styled(profile, Style::new().fg(Color::Magenta)),
+                Span::raw(format!("{:>w$}", "goal", w = SLIDER_RIGHT.chars().count())),
+                Span::styled("  pacing", Style::new().bold()),
+            ])
+        }
+        None => {
+            let knob =
+                (((app.aux + 1.0) / 2.0) * (width.saturating_sub(1)) as f64).round() as usize;
+            let track: String = (0..width)
+                .map(|i| match i.cmp(&knob) {
+                    std::cmp::Ordering::Less => '━',
+                    std::cmp::Ordering::Equal => '●',
+                    std::cmp::Ordering::Greater => '─',
+                })
+                .collect();
+            Line::from(vec![
+                Span::raw(SLIDER_LEFT).red(),
+                Span::styled(track, Style::new().fg(Color::Cyan)),
+                Span::raw(SLIDER_RIGHT).green(),
+                Span::styled(format!("  λ {:+.2}", app.aux), Style::new().bold()),
+            ])
+        }
+    };
+    if let Some(kept) = &app.kept {
+        slider.push_span(Span::styled(
+            format!("  keeping {}", kept.pieces),
+            Style::new().fg(Color::Blue),
+        ));
+    }
     if let Some(target) = app.target {
         slider.push_span(Span::styled(
             format!(" for success {target:.2}"),
@@ -208,12 +239,18 @@ fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
         GoalSetting::FromSeed => "from seed",
         GoalSetting::Custom { .. } => "by hand",
     };
-    let settings = Line::from(vec![
+    let mut settings = Line::from(vec![
         Span::raw("seed "),
         Span::styled(app.seed.to_string(), Style::new().bold()),
         Span::raw(format!("   goal ({origin}) {goal}")),
         Span::raw(format!("   trials {}", app.trials_wanted)).dim(),
     ]);
+    if let Some(choice) = &app.pacing {
+        settings.push_span(Span::styled(
+            format!("   {}: {}", choice.name, choice.curve),
+            Style::new().fg(Color::Magenta),
+        ));
+    }
     frame.render_widget(Paragraph::new(settings), areas.settings);
 }
 
@@ -365,9 +402,27 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
     );
 }
 
-/// The colour of each of `pieces` pieces (blocks, segments): the selected one cyan, the others by
-/// their share of the failures so far.
+/// The colour of λ: green at +1 (easy), yellow at 0, red at -1 (hard).
+fn aux_colour(aux: f64) -> Color {
+    let hard = ((1.0 - aux) / 2.0).clamp(0.0, 1.0);
+    let red = (255.0 * (2.0 * hard).min(1.0)) as u8;
+    let green = (255.0 * (2.0 * (1.0 - hard)).min(1.0)) as u8;
+    Color::Rgb(red, green, 40)
+}
+
+/// The colour of each of `pieces` pieces (blocks, segments): the selected one cyan; on a paced
+/// level each by the λ it was built at (kept pieces without one blue), else by its share of
+/// the failures so far.
 fn piece_colours(app: &App, pieces: usize) -> Vec<Color> {
+    if let Some(pacing) = app.level.as_ref().and_then(|l| l.pacing.as_ref()) {
+        return (0..pieces)
+            .map(|i| match pacing.piece_aux.get(i) {
+                _ if app.selected == Some(i) => Color::Cyan,
+                Some(Some(aux)) => aux_colour(*aux),
+                _ => Color::Blue,
+            })
+            .collect();
+    }
     let failures = app
         .trials
         .as_ref()
@@ -423,14 +478,16 @@ fn failures(app: &App, frame: &mut Frame, area: Rect) {
         frame.render_widget(Paragraph::new(text).block(block), area);
         return;
     }
+    let piece_aux = |i: usize| level.pacing.as_ref()?.piece_aux.get(i).copied().flatten();
     let bars: Vec<Bar> = counts
         .iter()
         .enumerate()
         .map(|(i, &c)| {
-            let style = if app.selected == Some(i) {
-                Style::new().cyan()
-            } else {
-                Style::new().red()
+            let style = match piece_aux(i) {
+                _ if app.selected == Some(i) => Style::new().cyan(),
+                // Beside the map's colours: where the curve asked for it to be hard.
+                Some(aux) => Style::new().fg(aux_colour(aux)),
+                None => Style::new().red(),
             };
             Bar::default()
                 .value(c as u64)

@@ -1,7 +1,8 @@
 //! The designer's latencies, through its real path (pure update, worker threads, drawing on an
 //! 80×24 TestBackend), on the shipped policies of each game (rules and the scripted player where
 //! a game ships none): from the key that asks for a new level to the level drawn, to the first
-//! Solver statistics, and to 100 trials done.
+//! Solver statistics, and to 100 trials done. Twice per game: a new seed (`n`) each round, and
+//! a pacing edit (`P`: the next preset, or back to one λ) each round.
 //!
 //! Run with `cargo bench --bench designer`. Targets (issues 5 and 16): level on screen < 100 ms,
 //! first statistics < 300 ms, 100 trials < 2 s on 2 cores.
@@ -28,17 +29,19 @@ fn main() {
     // SAFETY: first thing in main, before any other thread exists.
     unsafe { arlpcg::rl::threads::fix_thread_count() };
     for game in [Game::Platform, Game::Racing] {
-        measure(game);
+        for (key, what) in [('n', "new seed"), ('P', "pacing edit")] {
+            measure(game, key, what);
+        }
     }
 }
 
-fn measure(game: Game) {
+fn measure(game: Game, pressed_key: char, what: &str) {
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("policies")
         .join(game.name());
     let (policies, info) = worker::load(&shipped, game).unwrap_or_default();
     println!(
-        "{game}: Generator {}, Solver {}",
+        "{game}, {what} (`{pressed_key}`): Generator {}, Solver {}",
         info.generator
             .as_ref()
             .map_or("none (rules)", |p| p.card.training.mode.as_str()),
@@ -57,7 +60,7 @@ fn measure(game: Game) {
     let mut no_level = 0;
     for round in 0..=LEVELS {
         let pressed = Instant::now();
-        let key = KeyEvent::new(KeyCode::Char('n'), KeyModifiers::NONE);
+        let key = KeyEvent::new(KeyCode::Char(pressed_key), KeyModifiers::NONE);
         for effect in app::update(&mut app, Message::Key(key)) {
             workers.submit(effect);
         }

@@ -134,7 +134,32 @@ fn check_header(text: &str) -> Result<(), Problem> {
         Some(other) => return Err(Problem::UnsupportedVersion(describe_value(other))),
         None => return Err(Problem::NotALevel("missing field `version`".into())),
     }
+    check_counts(&fields, text)?;
     check_source_fields(fields.get("source"), text)
+}
+
+/// Lists longer than a level may hold are refused before they are parsed into pieces (a huge
+/// list would otherwise be read, and for a road, laid out, first).
+fn check_counts(fields: &serde_yaml::Mapping, text: &str) -> Result<(), Problem> {
+    for (key, max) in [
+        ("blocks", platform::MAX_BLOCKS),
+        ("segments", super::racing::MAX_SEGMENTS),
+        ("obstacles", super::racing::MAX_OBSTACLES),
+    ] {
+        if let Some(serde_yaml::Value::Sequence(items)) = fields.get(key)
+            && items.len() > max
+        {
+            return Err(Problem::Invalid {
+                field: key.into(),
+                line: line_of_key(text, key),
+                message: format!(
+                    "the level has {} {key}: at most {max} are allowed",
+                    items.len()
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The fields each `source.kind` needs, named with their path and line (serde's message for a

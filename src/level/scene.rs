@@ -74,6 +74,7 @@ pub struct SceneNode {
     pub material: Material,
     /// Metadata carried into the file (the block's generator parameters).
     pub extras: Option<Value>,
+    pub physics: Physics,
 }
 
 /// A node of its own geometry (a piece of road, a cylinder), in world coordinates.
@@ -84,6 +85,29 @@ pub struct SceneMesh {
     pub primitives: Vec<(TriangleMesh, Material)>,
     /// Metadata carried into the file (the segment's generator parameters).
     pub extras: Option<Value>,
+    pub physics: Physics,
+}
+
+/// What a node is to an engine's physics (written as the `OMI_physics_body` and
+/// `OMI_physics_shape` glTF extensions).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Physics {
+    /// Solid and static: the node's own box (its extents), or its own mesh as a triangle mesh.
+    SolidBox,
+    SolidMesh,
+    /// Solid and static: an upright cylinder standing on `base`.
+    SolidCylinder {
+        base: [f64; 3],
+        radius: f64,
+        height: f64,
+    },
+    /// Not solid: a zone an engine reports entering (the finish: within reach of the goal).
+    TriggerCylinder {
+        radius: f64,
+        height: f64,
+    },
+    /// Only to look at (markers).
+    None,
 }
 
 /// A place without geometry (where to spawn, where the finish is), in world coordinates.
@@ -95,6 +119,7 @@ pub struct ScenePoint {
     /// forward) points along it.
     pub heading: f64,
     pub extras: Value,
+    pub physics: Physics,
 }
 
 /// A level ready to export.
@@ -170,6 +195,7 @@ fn spawn_and_finish(level: &Level) -> Vec<ScenePoint> {
             position: start,
             heading: start_heading,
             extras: json!({"kind": "spawn", "heading_degrees": start_heading, "forward": "+Z"}),
+            physics: Physics::None,
         },
         ScenePoint {
             name: "finish".into(),
@@ -182,6 +208,18 @@ fn spawn_and_finish(level: &Level) -> Vec<ScenePoint> {
                 "reach_horizontal_m": horizontal,
                 "reach_vertical_m": vertical,
             }),
+            physics: Physics::None,
+        },
+        // What counts as arriving, as an engine's trigger: within reach of the goal point.
+        ScenePoint {
+            name: "finish_zone".into(),
+            position: level.goal,
+            heading: 0.0,
+            extras: json!({"kind": "finish_zone"}),
+            physics: Physics::TriggerCylinder {
+                radius: horizontal,
+                height: 2.0 * vertical,
+            },
         },
     ]
 }
@@ -195,6 +233,7 @@ fn marker(name: &str, base: [f64; 3], height: f64, material: Material) -> SceneN
         material,
         // A post to see, not to collide with (it may stand in the road).
         extras: Some(json!({"collides": false})),
+        physics: Physics::None,
     }
 }
 
@@ -211,6 +250,7 @@ fn platform_scene(level: &Level, track: &PlatformTrack) -> Scene {
         extents: [p.size, BLOCK_THICKNESS, p.size],
         material,
         extras,
+        physics: Physics::SolidBox,
     };
     let mut nodes = vec![block_node(
         "start_block".into(),
@@ -285,6 +325,7 @@ fn racing_scene(level: &Level, track: &RacingTrack) -> Scene {
                     "curve": params.curve,
                     "height": params.height,
                 })),
+                physics: Physics::SolidMesh,
             }
         })
         .collect();
@@ -302,6 +343,7 @@ fn racing_scene(level: &Level, track: &RacingTrack) -> Scene {
                 extents: size,
                 material: Material::Obstacle,
                 extras: Some(json!({"kind": "box"})),
+                physics: Physics::SolidBox,
             }),
             Obstacle::Cylinder {
                 position,
@@ -311,6 +353,11 @@ fn racing_scene(level: &Level, track: &RacingTrack) -> Scene {
                 name,
                 primitives: vec![(cylinder(position, radius, height), Material::Obstacle)],
                 extras: Some(json!({"kind": "cylinder", "radius": radius, "height": height})),
+                physics: Physics::SolidCylinder {
+                    base: position,
+                    radius,
+                    height,
+                },
             }),
         }
     }

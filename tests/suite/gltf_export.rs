@@ -59,14 +59,17 @@ fn glb_reads_back_with_one_node_per_block_and_matching_bounds() {
         std::fs::write(exports.join(format!("rules_seed{seed}.glb")), &glb).unwrap();
         let (document, buffers, _) = gltf::import_slice(&glb).expect("the .glb imports");
         let nodes: Vec<gltf::Node> = document.nodes().collect();
-        // start block, every block, start and goal markers, spawn and finish
-        assert_eq!(nodes.len(), track.block_count() + 5);
+        // start block, every block, start and goal markers, spawn, finish and its zone, then a
+        // collider beside the start block and every block
+        assert_eq!(nodes.len(), 2 * (track.block_count() + 1) + 5);
         assert_eq!(nodes[0].name(), Some("start_block"));
         assert_eq!(nodes[1].name(), Some("block_000"));
         let last_name = format!("block_{:03}", track.block_count() - 1);
         assert_eq!(nodes[track.block_count()].name(), Some(last_name.as_str()));
-        assert_eq!(nodes[nodes.len() - 3].name(), Some("goal"));
-        assert_eq!(nodes[nodes.len() - 1].name(), Some("finish"));
+        let goal = track.block_count() + 2;
+        assert_eq!(nodes[goal].name(), Some("goal"));
+        assert_eq!(nodes[goal + 2].name(), Some("finish"));
+        assert_eq!(nodes[goal + 4].name(), Some("start_block_collider"));
         // Block nodes sit where the level says: top face at the block's height, centred on it.
         for (node, platform) in nodes.iter().zip(track.platforms()) {
             let (lo, hi) = node_bounds(node);
@@ -115,7 +118,7 @@ fn export_is_deterministic_and_gltf_matches_glb() {
     assert_eq!(root["buffers"][0]["uri"], "level.bin");
     assert_eq!(
         root["nodes"].as_array().unwrap().len(),
-        level.piece_count() + 5
+        2 * (level.piece_count() + 1) + 5
     );
     assert_eq!(root["scenes"][0]["extras"]["aux"], -1.0);
     assert_eq!(
@@ -305,5 +308,91 @@ fn spawn_and_finish_nodes_carry_start_heading_and_goal_reach() {
             "{extras}"
         );
         assert_eq!(extras["goal"], serde_json::json!(level.goal));
+    }
+}
+
+/// Colliders an engine imports (`OMI_physics_body` / `OMI_physics_shape`): an unscaled box beside
+/// every block and box obstacle with the block's size, a cylinder beside every cylinder, each
+/// road segment's own mesh as a triangle mesh, and a trigger at the finish; markers collide with
+/// nothing.
+#[test]
+fn every_solid_piece_has_a_collider_and_the_finish_a_trigger() {
+    let platform = level(5);
+    let racing = arlpcg::game::racing::rules::racing_level(
+        9,
+        None,
+        None,
+        &arlpcg::level::racing::RacingRulesConfig {
+            obstacles: 6,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for level in [platform, racing] {
+        let game = level.game();
+        let out = export::to_gltf(&Scene::of_level(&level), "level.bin");
+        let root: serde_json::Value = serde_json::from_slice(&out.main).unwrap();
+        assert_eq!(
+            root["extensionsUsed"],
+            serde_json::json!(["OMI_physics_body", "OMI_physics_shape"])
+        );
+        assert!(
+            root.get("extensionsRequired").is_none(),
+            "used, not required"
+        );
+        let shapes = root["extensions"]["OMI_physics_shape"]["shapes"]
+            .as_array()
+            .unwrap();
+        let nodes = root["nodes"].as_array().unwrap();
+        let named = |name: &str| nodes.iter().find(|n| n["name"] == name);
+        let shape_of = |node: &serde_json::Value, role: &str| {
+            let index = node["extensions"]["OMI_physics_body"][role]["shape"].as_u64()?;
+            shapes.get(index as usize)
+        };
+        let mut solid = 0;
+        for node in nodes {
+            let name = node["name"].as_str().unwrap();
+            let is_box = name.starts_with("block_")
+                || name == "start_block"
+                || (name.starts_with("obstacle_") && node.get("scale").is_some());
+            if is_box && !name.ends_with("_collider") {
+                let collider = named(&format!("{name}_collider"))
+                    .unwrap_or_else(|| panic!("{game}: {name} has no collider"));
+                assert!(collider.get("scale").is_none(), "{game}: {name}: unscaled");
+                assert_eq!(collider["translation"], node["translation"]);
+                let shape = shape_of(collider, "collider").unwrap();
+                assert_eq!(shape["type"], "box");
+                assert_eq!(shape["box"]["size"], node["scale"], "{game}: {name}");
+                solid += 1;
+            }
+            if name.starts_with("segment_") {
+                let shape = shape_of(node, "collider").unwrap();
+                assert_eq!(shape["type"], "trimesh");
+                assert_eq!(shape["trimesh"]["mesh"], node["mesh"], "{game}: {name}");
+                solid += 1;
+            }
+            if name.starts_with("obstacle_")
+                && node.get("mesh").is_some()
+                && node.get("scale").is_none()
+            {
+                let collider = named(&format!("{name}_collider")).unwrap();
+                assert_eq!(shape_of(collider, "collider").unwrap()["type"], "cylinder");
+                solid += 1;
+            }
+            if name == "start" || name == "goal" {
+                assert!(
+                    node.get("extensions").is_none(),
+                    "{game}: markers do not collide"
+                );
+            }
+        }
+        assert!(solid > level.piece_count(), "{game}: {solid} solid nodes");
+        let trigger = named("finish_zone").expect("a finish zone");
+        let shape = shape_of(trigger, "trigger").unwrap();
+        assert_eq!(shape["type"], "cylinder");
+        assert!(
+            shape["cylinder"]["radius"].as_f64().unwrap() >= 3.0,
+            "{shape}"
+        );
     }
 }

@@ -17,69 +17,18 @@ use crate::policies::{load_generator, load_solver, policy_paths};
 use crate::verify::{self, Solver, SolverPolicy, verify};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
-    if args.target_success.is_some() && args.policies.is_none() {
-        return Err(crate::shell::UsageError(
-            "--target-success needs --policies: a Generator that λ steers".into(),
-        )
-        .into());
-    }
-    if args.obstacles > 0 && args.game != Game::Racing {
-        return Err(crate::shell::UsageError(
-            "--obstacles is for racing tracks (--game racing)".into(),
-        )
-        .into());
-    }
-    if args.aux_curve.is_some() && args.policies.is_none() {
-        return Err(crate::shell::UsageError(
-            "--aux-curve needs --policies: the rules know no λ, a Generator follows it".into(),
-        )
-        .into());
-    }
-    if args.keep.is_some() && args.obstacles > 0 {
-        return Err(crate::shell::UsageError(
-            "--obstacles with --keep: the kept level's scene (start, goal, obstacles) stays".into(),
-        )
-        .into());
-    }
+    let seeds = check_arguments(args)?;
     let keep = args
         .keep
         .as_ref()
         .map(|keep| kept_prefix(keep, args.game))
         .transpose()?;
-    if args.out.exists() && !args.out.is_dir() {
-        anyhow::bail!("--out {} is not a folder", args.out.display());
-    }
-    let seeds: Vec<u64> = (0..args.count as u64)
-        .filter(|&i| args.shard.is_none_or(|shard| shard.owns(i)))
-        .map(|i| args.seed.checked_add(i))
-        .collect::<Option<_>>()
-        .ok_or_else(|| {
-            crate::shell::UsageError(format!(
-                "--seed {} plus --count {} overflows a 64-bit seed",
-                args.seed, args.count
-            ))
-        })?;
+    let verify_trials = args.verify.or(args.target_success.map(|_| TARGET_TRIALS));
     let generator = match &args.policies {
-        Some(dir) => {
-            if args.aux.is_none() && args.aux_curve.is_none() && args.target_success.is_none() {
-                return Err(crate::shell::UsageError(
-                    "--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard), --aux-curve CURVE or --target-success P"
-                        .into(),
-                )
-                .into());
-            }
-            Some(load_generator(&policy_paths(dir).0, args.game)?.0)
-        }
+        Some(dir) => Some(load_generator(&policy_paths(dir).0, args.game)?.0),
         None => None,
     };
-    let verify_trials = args.verify.or(args.target_success.map(|_| TARGET_TRIALS));
     let shipped = default_solver(args.game);
-    if args.solver_policy.is_some() && verify_trials.is_none() {
-        return Err(crate::shell::UsageError(
-            "--solver-policy plays --verify N or --target-success P; give one of them".into(),
-        )
-        .into());
-    }
     let solver: Option<SolverPolicy> = match (verify_trials, &args.solver_policy, &args.policies) {
         (None, _, _) => None,
         (Some(_), Some(path), _) => Some(load_solver(path, args.game)?.0),
@@ -108,26 +57,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     // levels are in flight at once; each depends only on its seed, so the files do not depend
     // on the number of threads.
     let who = solver.as_ref().map_or(Solver::Scripted, Solver::Policy);
-    let curve = match (args.target_success, &generator, &solver, &args.policies) {
-        (Some(_), Some(generator), Some(solver), Some(dir)) => Some(
-            crate::policies::difficulty_curve(dir, generator, solver, || {
-                eprintln!(
-                    "measuring the policies' λ→success curve ({} λ values × {} levels × {} runs), once",
-                    difficulty::CURVE_AUX.len(),
-                    difficulty::CURVE_LEVELS,
-                    difficulty::CURVE_TRIALS
-                )
-            }, &|| stop.load(Ordering::SeqCst))
-            .map_err(|e| match e.downcast_ref::<difficulty::TargetError>() {
-                Some(difficulty::TargetError::Stopped) => crate::shell::Interrupted(
-                    "interrupted (Ctrl-C) while the λ→success curve was measured; nothing was written".into(),
-                )
-                .into(),
-                _ => e,
-            })?,
-        ),
-        _ => None,
-    };
+    let curve = target_curve(args, generator.as_ref(), solver.as_ref(), &stop)?;
     let bar = crate::shell::progress_bar(plans.len() as u64, "generating");
     let built: Vec<Option<Result<Level>>> = plans
         .par_iter()
@@ -194,6 +124,12 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         plans.len(),
         args.out.display()
     );
+    report_verification(&levels);
+    Ok(())
+}
+
+/// What verification did across the batch: redrawn, unsolved and uncertified levels.
+fn report_verification(levels: &[Level]) {
     let stats: Vec<_> = levels.iter().filter_map(|l| l.stats.as_ref()).collect();
     let redrawn: Vec<u32> = stats.iter().map(|s| s.redraws).filter(|&r| r > 0).collect();
     if !redrawn.is_empty() {
@@ -216,7 +152,87 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
             "{uncertified} levels have no certificate: no single run succeeded within the search (their success ratio is tiny)"
         );
     }
-    Ok(())
+}
+
+/// With `--target-success`: the policies' λ→success curve, read from beside them or measured
+/// once (Ctrl-C in `stop` ends the measurement: exit 130, nothing written).
+fn target_curve(
+    args: &GenerateArgs,
+    generator: Option<&GeneratorPolicy>,
+    solver: Option<&SolverPolicy>,
+    stop: &AtomicBool,
+) -> Result<Option<difficulty::Curve>> {
+    let (Some(_), Some(generator), Some(solver), Some(dir)) =
+        (args.target_success, generator, solver, &args.policies)
+    else {
+        return Ok(None);
+    };
+    let announce = || {
+        eprintln!(
+            "measuring the policies' λ→success curve ({} λ values × {} levels × {} runs), once",
+            difficulty::CURVE_AUX.len(),
+            difficulty::CURVE_LEVELS,
+            difficulty::CURVE_TRIALS
+        )
+    };
+    crate::policies::difficulty_curve(dir, generator, solver, announce, &|| {
+        stop.load(Ordering::SeqCst)
+    })
+    .map(Some)
+    .map_err(|e| match e.downcast_ref::<difficulty::TargetError>() {
+        Some(difficulty::TargetError::Stopped) => crate::shell::Interrupted(
+            "interrupted (Ctrl-C) while the λ→success curve was measured; nothing was written"
+                .into(),
+        )
+        .into(),
+        _ => e,
+    })
+}
+
+/// The checks on the arguments alone, before any file is read (exit 2 on a misfit); returns
+/// the seeds of the levels to make (this shard's).
+fn check_arguments(args: &GenerateArgs) -> Result<Vec<u64>> {
+    let usage = |message: &str| Err(crate::shell::UsageError(message.into()).into());
+    if args.target_success.is_some() && args.policies.is_none() {
+        return usage("--target-success needs --policies: a Generator that λ steers");
+    }
+    if args.obstacles > 0 && args.game != Game::Racing {
+        return usage("--obstacles is for racing tracks (--game racing)");
+    }
+    if args.aux_curve.is_some() && args.policies.is_none() {
+        return usage("--aux-curve needs --policies: the rules know no λ, a Generator follows it");
+    }
+    if args.keep.is_some() && args.obstacles > 0 {
+        return usage(
+            "--obstacles with --keep: the kept level's scene (start, goal, obstacles) stays",
+        );
+    }
+    if args.policies.is_some()
+        && args.aux.is_none()
+        && args.aux_curve.is_none()
+        && args.target_success.is_none()
+    {
+        return usage(
+            "--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard), --aux-curve CURVE or --target-success P",
+        );
+    }
+    if args.solver_policy.is_some() && args.verify.is_none() && args.target_success.is_none() {
+        return usage("--solver-policy plays --verify N or --target-success P; give one of them");
+    }
+    if args.out.exists() && !args.out.is_dir() {
+        anyhow::bail!("--out {} is not a folder", args.out.display());
+    }
+    (0..args.count as u64)
+        .filter(|&i| args.shard.is_none_or(|shard| shard.owns(i)))
+        .map(|i| args.seed.checked_add(i))
+        .collect::<Option<_>>()
+        .ok_or_else(|| {
+            crate::shell::UsageError(format!(
+                "--seed {} plus --count {} overflows a 64-bit seed",
+                args.seed, args.count
+            ))
+            .into()
+        })
 }
 
 /// Writes the files of `levels`, all or none: each level is rendered and staged beside its

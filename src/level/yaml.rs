@@ -402,170 +402,10 @@ impl LevelFile {
     }
 
     fn into_level(self, text: &str) -> Result<Level, Problem> {
-        let invalid = |field: String, line: Option<usize>, message: String| Problem::Invalid {
-            field,
-            line,
-            message,
-        };
         let pacing = self.pacing(text)?;
         let (track, default_goal) = match self.game {
-            Game::Platform => {
-                if self.segments.is_some() {
-                    return Err(invalid(
-                        "segments".into(),
-                        line_of_key(text, "segments"),
-                        "a platform level has `blocks`, not `segments`".into(),
-                    ));
-                }
-                if !self.obstacles.is_empty() {
-                    return Err(invalid(
-                        "obstacles".into(),
-                        line_of_key(text, "obstacles"),
-                        "a platform level has no obstacles".into(),
-                    ));
-                }
-                let blocks = self.blocks.ok_or_else(|| {
-                    invalid(
-                        "blocks".into(),
-                        None,
-                        "missing: a platform level needs its blocks".into(),
-                    )
-                })?;
-                let start = Start {
-                    position: point(&self.start.position),
-                    heading: self.start.heading.0,
-                    size: self.start.size.map_or(Start::default().size, |s| s.0),
-                };
-                let mut track = PlatformTrack::new(start);
-                for (i, block) in blocks.iter().enumerate() {
-                    let field = format!("blocks[{i}]");
-                    let line = || line_of_item(text, "blocks", i);
-                    let params = BlockParams {
-                        distance: block.distance.0,
-                        angle: block.angle.0,
-                        size: block.size.0,
-                        height: block.height.0,
-                    };
-                    track
-                        .push(params)
-                        .map_err(|e| invalid(field.clone(), line(), e.to_string()))?;
-                    let placed = track.last();
-                    if let Some(position) = &block.position {
-                        let written = point(position);
-                        let off = (0..3)
-                            .any(|k| (written[k] - placed.position[k]).abs() > TRANSFORM_TOLERANCE);
-                        if off {
-                            return Err(invalid(
-                                format!("{field}.position"),
-                                line(),
-                                format!(
-                                    "{written:?} is not where the block's parameters put it ({:?}); delete `position` and `heading` to recompute them",
-                                    placed.position.map(|c| (c * 1000.0).round() / 1000.0)
-                                ),
-                            ));
-                        }
-                    }
-                    if let Some(heading) = block.heading {
-                        let off = platform::wrap_degrees(heading.0 - placed.heading).abs();
-                        if off > TRANSFORM_TOLERANCE {
-                            return Err(invalid(
-                                format!("{field}.heading"),
-                                line(),
-                                format!(
-                                    "{} is not the heading the block's parameters give ({:.3}); delete `position` and `heading` to recompute them",
-                                    heading.0, placed.heading
-                                ),
-                            ));
-                        }
-                    }
-                }
-                let last = track.last().position;
-                (Track::Platform(track), last)
-            }
-            Game::Racing => {
-                if self.blocks.is_some() {
-                    return Err(invalid(
-                        "blocks".into(),
-                        line_of_key(text, "blocks"),
-                        "a racing level has `segments`, not `blocks`".into(),
-                    ));
-                }
-                if self.start.size.is_some() {
-                    return Err(invalid(
-                        "start.size".into(),
-                        None,
-                        "a racing level's start has no size".into(),
-                    ));
-                }
-                let segments = self.segments.ok_or_else(|| {
-                    invalid(
-                        "segments".into(),
-                        None,
-                        "missing: a racing level needs its segments".into(),
-                    )
-                })?;
-                let segments: Vec<SegmentParams> = segments
-                    .iter()
-                    .map(|s| SegmentParams {
-                        length: s.length.0,
-                        curve: s.curve.0,
-                        height: s.height.0,
-                    })
-                    .collect();
-                // Counts and each obstacle first: the geometry below is costly on a huge list,
-                // and meaningless around a NaN obstacle.
-                for (key, count, max) in [
-                    ("segments", segments.len(), super::racing::MAX_SEGMENTS),
-                    (
-                        "obstacles",
-                        self.obstacles.len(),
-                        super::racing::MAX_OBSTACLES,
-                    ),
-                ] {
-                    if count > max {
-                        return Err(invalid(
-                            key.into(),
-                            line_of_key(text, key),
-                            format!("the level has {count} {key}: at most {max} are allowed"),
-                        ));
-                    }
-                }
-                for (index, obstacle) in self.obstacles.iter().enumerate() {
-                    obstacle.check().map_err(|problem| {
-                        let (field, message) = problem.split_once(": ").unwrap_or(("", &problem));
-                        invalid(
-                            format!("obstacles[{index}].{field}"),
-                            line_of_item(text, "obstacles", index),
-                            message.to_string(),
-                        )
-                    })?;
-                }
-                let track = RacingTrack {
-                    position: point(&self.start.position),
-                    heading: self.start.heading.0,
-                    segments,
-                    obstacles: self.obstacles,
-                };
-                // Checked here (not only in `validate`) to name the segment's line.
-                if track.segments.len() <= super::racing::MAX_SEGMENTS {
-                    let geometry = track.check_geometry().map_err(|e| {
-                        let (field, index) = match e {
-                            super::racing::TrackError::Crosses { later, .. } => ("segments", later),
-                            super::racing::TrackError::HitsObstacle { segment, .. } => {
-                                ("segments", segment)
-                            }
-                        };
-                        invalid(
-                            format!("{field}[{index}]"),
-                            line_of_item(text, field, index),
-                            e.to_string(),
-                        )
-                    });
-                    geometry?;
-                }
-                let (end, _) = track.road().end();
-                (Track::Racing(track), end)
-            }
+            Game::Platform => self.platform_track(text)?,
+            Game::Racing => self.racing_track(text)?,
         };
         let level = Level {
             seed: self.seed,
@@ -602,6 +442,169 @@ impl LevelFile {
             invalid(field, line, e.to_string())
         })?;
         Ok(level)
+    }
+
+    /// The platform track the file describes, and where its last block ends (the goal when the
+    /// file gives none); each block checked with its line.
+    fn platform_track(&self, text: &str) -> Result<(Track, [f64; 3]), Problem> {
+        if self.segments.is_some() {
+            return Err(invalid(
+                "segments".into(),
+                line_of_key(text, "segments"),
+                "a platform level has `blocks`, not `segments`".into(),
+            ));
+        }
+        if !self.obstacles.is_empty() {
+            return Err(invalid(
+                "obstacles".into(),
+                line_of_key(text, "obstacles"),
+                "a platform level has no obstacles".into(),
+            ));
+        }
+        let blocks = self.blocks.as_ref().ok_or_else(|| {
+            invalid(
+                "blocks".into(),
+                None,
+                "missing: a platform level needs its blocks".into(),
+            )
+        })?;
+        let start = Start {
+            position: point(&self.start.position),
+            heading: self.start.heading.0,
+            size: self.start.size.map_or(Start::default().size, |s| s.0),
+        };
+        let mut track = PlatformTrack::new(start);
+        for (i, block) in blocks.iter().enumerate() {
+            let field = format!("blocks[{i}]");
+            let line = || line_of_item(text, "blocks", i);
+            let params = BlockParams {
+                distance: block.distance.0,
+                angle: block.angle.0,
+                size: block.size.0,
+                height: block.height.0,
+            };
+            track
+                .push(params)
+                .map_err(|e| invalid(field.clone(), line(), e.to_string()))?;
+            let placed = track.last();
+            if let Some(position) = &block.position {
+                let written = point(position);
+                let off =
+                    (0..3).any(|k| (written[k] - placed.position[k]).abs() > TRANSFORM_TOLERANCE);
+                if off {
+                    return Err(invalid(
+                        format!("{field}.position"),
+                        line(),
+                        format!(
+                            "{written:?} is not where the block's parameters put it ({:?}); delete `position` and `heading` to recompute them",
+                            placed.position.map(|c| (c * 1000.0).round() / 1000.0)
+                        ),
+                    ));
+                }
+            }
+            if let Some(heading) = block.heading {
+                let off = platform::wrap_degrees(heading.0 - placed.heading).abs();
+                if off > TRANSFORM_TOLERANCE {
+                    return Err(invalid(
+                        format!("{field}.heading"),
+                        line(),
+                        format!(
+                            "{} is not the heading the block's parameters give ({:.3}); delete `position` and `heading` to recompute them",
+                            heading.0, placed.heading
+                        ),
+                    ));
+                }
+            }
+        }
+        let last = track.last().position;
+        Ok((Track::Platform(track), last))
+    }
+
+    /// The racing track the file describes, and where its road ends (the goal when the file
+    /// gives none); counts and obstacles checked before any road geometry.
+    fn racing_track(&self, text: &str) -> Result<(Track, [f64; 3]), Problem> {
+        if self.blocks.is_some() {
+            return Err(invalid(
+                "blocks".into(),
+                line_of_key(text, "blocks"),
+                "a racing level has `segments`, not `blocks`".into(),
+            ));
+        }
+        if self.start.size.is_some() {
+            return Err(invalid(
+                "start.size".into(),
+                None,
+                "a racing level's start has no size".into(),
+            ));
+        }
+        let segments = self.segments.as_ref().ok_or_else(|| {
+            invalid(
+                "segments".into(),
+                None,
+                "missing: a racing level needs its segments".into(),
+            )
+        })?;
+        let segments: Vec<SegmentParams> = segments
+            .iter()
+            .map(|s| SegmentParams {
+                length: s.length.0,
+                curve: s.curve.0,
+                height: s.height.0,
+            })
+            .collect();
+        // Counts and each obstacle first: the geometry below is costly on a huge list,
+        // and meaningless around a NaN obstacle.
+        for (key, count, max) in [
+            ("segments", segments.len(), super::racing::MAX_SEGMENTS),
+            (
+                "obstacles",
+                self.obstacles.len(),
+                super::racing::MAX_OBSTACLES,
+            ),
+        ] {
+            if count > max {
+                return Err(invalid(
+                    key.into(),
+                    line_of_key(text, key),
+                    format!("the level has {count} {key}: at most {max} are allowed"),
+                ));
+            }
+        }
+        for (index, obstacle) in self.obstacles.iter().enumerate() {
+            obstacle.check().map_err(|problem| {
+                let (field, message) = problem.split_once(": ").unwrap_or(("", &problem));
+                invalid(
+                    format!("obstacles[{index}].{field}"),
+                    line_of_item(text, "obstacles", index),
+                    message.to_string(),
+                )
+            })?;
+        }
+        let track = RacingTrack {
+            position: point(&self.start.position),
+            heading: self.start.heading.0,
+            segments,
+            obstacles: self.obstacles.clone(),
+        };
+        // Checked here (not only in `validate`) to name the segment's line.
+        if track.segments.len() <= super::racing::MAX_SEGMENTS {
+            let geometry = track.check_geometry().map_err(|e| {
+                let (field, index) = match e {
+                    super::racing::TrackError::Crosses { later, .. } => ("segments", later),
+                    super::racing::TrackError::HitsObstacle { segment, .. } => {
+                        ("segments", segment)
+                    }
+                };
+                invalid(
+                    format!("{field}[{index}]"),
+                    line_of_item(text, field, index),
+                    e.to_string(),
+                )
+            });
+            geometry?;
+        }
+        let (end, _) = track.road().end();
+        Ok((Track::Racing(track), end))
     }
 }
 
@@ -653,6 +656,15 @@ impl LevelFile {
             curve: curve.clone(),
             piece_aux,
         }))
+    }
+}
+
+/// A rule of the level broken at `field` (and `line`, where known).
+fn invalid(field: String, line: Option<usize>, message: String) -> Problem {
+    Problem::Invalid {
+        field,
+        line,
+        message,
     }
 }
 

@@ -102,12 +102,7 @@ impl Batch {
     /// is not a regular file (a folder or FIFO is never replaced).
     pub fn stage(&mut self, path: &Path, bytes: &[u8], overwrite: Overwrite) -> Result<()> {
         check_writable(path, overwrite)?;
-        if std::fs::symlink_metadata(path).is_ok_and(|m| !m.is_file()) {
-            bail!(
-                "{} is in the way: it is not a regular file (a folder, link, FIFO or device), and is never replaced",
-                path.display()
-            );
-        }
+        check_not_in_the_way(path)?;
         let temp = synced_temp(path, bytes)?;
         self.staged.push((temp, path.to_path_buf(), overwrite));
         Ok(())
@@ -171,6 +166,18 @@ impl Batch {
         }
         Err(failure.context("nothing was written (the files written before it were taken back)"))
     }
+}
+
+/// Fails if something other than a regular file (a folder, link, FIFO or device) stands at
+/// `path`: such a thing is never read as a level's file nor replaced.
+pub fn check_not_in_the_way(path: &Path) -> Result<()> {
+    if std::fs::symlink_metadata(path).is_ok_and(|m| !m.is_file()) {
+        bail!(
+            "{} is in the way: it is not a regular file (a folder, link, FIFO or device), and is never replaced",
+            path.display()
+        );
+    }
+    Ok(())
 }
 
 /// Moves the file at `path` to a fresh temporary name beside it (removed when dropped).

@@ -4,7 +4,6 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use sha2::{Digest, Sha256};
 
 use crate::game::generator::{BuildLimits, GeneratorGame, observation_size};
 use crate::game::racing::generator::DEFAULT_CURVE_OFFSET;
@@ -27,15 +26,10 @@ fn load_pinned(
     let bytes = crate::fsio::read_limited(path, MAX_POLICY_BYTES, &format!("{role} policy"))?;
     let loaded = load_policy(&bytes, game, role, observation)
         .with_context(|| format!("{}", path.display()))?;
-    let sha256 = Sha256::digest(&bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    let reference = PolicyRef {
-        path: path.display().to_string(),
-        sha256,
-    };
-    Ok((loaded, reference))
+    Ok((
+        loaded,
+        PolicyRef::pinned(path.display().to_string(), &bytes),
+    ))
 }
 
 /// Loads a Solver policy of `game`.

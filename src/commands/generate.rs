@@ -11,7 +11,7 @@ use crate::cli::{GenerateArgs, KeepArg, default_solver};
 use crate::difficulty;
 use crate::fsio::{self, Overwrite};
 use crate::generation::{self, GeneratorPolicy, KeptPrefix, Lambda, LevelRequest};
-use crate::level::{Game, Level, PolicyRef};
+use crate::level::{Game, Level};
 use crate::level_files::{Format, LevelFiles, file_stem, render};
 use crate::policies::{load_generator, load_solver, policy_paths};
 use crate::verify::{self, Solver, SolverPolicy, verify};
@@ -251,12 +251,7 @@ fn write_batch(
     for (level, (_, files)) in levels.iter().zip(plans) {
         // A .gltf after the .bin it names.
         for (path, bytes) in render(level, files).into_iter().rev() {
-            if std::fs::symlink_metadata(&path).is_ok_and(|m| !m.is_file()) {
-                bail!(
-                    "{} is in the way: it is not a regular file (a folder, link, FIFO or device), and is never replaced; {nothing}",
-                    path.display()
-                );
-            }
+            fsio::check_not_in_the_way(&path).with_context(|| nothing.to_string())?;
             let overwrite = match std::fs::read(&path) {
                 Ok(existing) if existing == bytes => {
                     kept += 1;
@@ -301,8 +296,7 @@ fn certified(mut level: Level, solver: &Solver, seed: u64) -> Result<Level> {
 
 /// The level `--keep` names, read and checked, and the pieces to keep of it.
 fn kept_prefix(keep: &KeepArg, game: Game) -> Result<KeptPrefix> {
-    use sha2::Digest;
-    let level = crate::level::yaml::load(&keep.level)?;
+    let (level, from) = crate::level::yaml::load_pinned(&keep.level)?;
     if level.game() != game {
         anyhow::bail!(
             "{}: a {} level, but this run generates {game} levels (--game {})",
@@ -319,19 +313,10 @@ fn kept_prefix(keep: &KeepArg, game: Game) -> Result<KeptPrefix> {
             level.piece_count()
         );
     }
-    let bytes = std::fs::read(&keep.level)
-        .with_context(|| format!("cannot read {}", keep.level.display()))?;
-    let sha256 = sha2::Sha256::digest(&bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
     Ok(KeptPrefix {
         level: Arc::new(level),
         pieces: keep.pieces,
-        from: PolicyRef {
-            path: keep.level.display().to_string(),
-            sha256,
-        },
+        from,
     })
 }
 
@@ -349,10 +334,8 @@ fn stem_of_lambda(args: &GenerateArgs, seed: u64) -> String {
     match (args.target_success, &args.aux_curve) {
         (Some(target), _) => format!("{}_seed{seed}_success{target:.2}", args.game),
         (None, Some(curve)) => {
-            use sha2::Digest;
-            let hash = sha2::Sha256::digest(curve.to_string().as_bytes());
-            let short: String = hash[..4].iter().map(|b| format!("{b:02x}")).collect();
-            format!("{}_seed{seed}_curve-{short}", args.game)
+            let hash = crate::level::sha256_hex(curve.to_string().as_bytes());
+            format!("{}_seed{seed}_curve-{}", args.game, &hash[..8])
         }
         (None, None) => file_stem(args.game, seed, args.aux),
     }

@@ -292,13 +292,11 @@ fn document(
         .nodes
         .iter()
         .map(|node| {
-            let half = (node.heading.to_radians() / 2.0) as f32;
             root.push(json::Node {
                 name: Some(node.name.clone()),
                 mesh: Some(meshes[&node.material]),
                 translation: Some(node.centre.map(|c| c as f32)),
-                rotation: (node.heading != 0.0)
-                    .then(|| json::scene::UnitQuaternion([0.0, half.sin(), 0.0, half.cos()])),
+                rotation: box_rotation(node.heading),
                 scale: Some(node.extents.map(|e| e as f32)),
                 extras: node.extras.as_ref().map(raw),
                 ..Default::default()
@@ -400,17 +398,11 @@ fn document(
     }
     let mut point_nodes = Vec::with_capacity(scene.points.len());
     for point in &scene.points {
-        // Turned so that local +Z (glTF's forward) points along the heading.
-        let half = ((point.heading + 90.0).to_radians() / 2.0) as f32;
         let node = root.push(json::Node {
             name: Some(point.name.clone()),
             translation: Some(point.position.map(|c| c as f32)),
-            rotation: Some(json::scene::UnitQuaternion([
-                0.0,
-                half.sin(),
-                0.0,
-                half.cos(),
-            ])),
+            // Turned so that local +Z (glTF's forward) points along the heading.
+            rotation: Some(about_y(point.heading + 90.0)),
             extras: Some(raw(&point.extras)),
             ..Default::default()
         });
@@ -453,10 +445,6 @@ fn physics(
         );
         Some(extensions)
     };
-    let y_rotation = |degrees: f64| {
-        let half = (degrees.to_radians() / 2.0) as f32;
-        (degrees != 0.0).then(|| json::scene::UnitQuaternion([0.0, half.sin(), 0.0, half.cos()]))
-    };
     let mut extra_nodes = Vec::new();
     for node in &scene.nodes {
         if node.physics == Physics::SolidBox {
@@ -464,7 +452,7 @@ fn physics(
             extra_nodes.push(json::Node {
                 name: Some(format!("{}_collider", node.name)),
                 translation: Some(node.centre.map(|c| c as f32)),
-                rotation: y_rotation(node.heading),
+                rotation: box_rotation(node.heading),
                 extensions: body("collider", index),
                 ..Default::default()
             });
@@ -519,6 +507,17 @@ fn physics(
         .insert(OMI_SHAPE.into(), serde_json::json!({ "shapes": shapes }));
     root.extensions = Some(extensions);
     root.extensions_used = vec![OMI_BODY.into(), OMI_SHAPE.into()];
+}
+
+/// A rotation of `degrees` about +Y.
+fn about_y(degrees: f64) -> json::scene::UnitQuaternion {
+    let half = (degrees.to_radians() / 2.0) as f32;
+    json::scene::UnitQuaternion([0.0, half.sin(), 0.0, half.cos()])
+}
+
+/// A box's rotation by its heading (none when it is not turned).
+fn box_rotation(heading: f64) -> Option<json::scene::UnitQuaternion> {
+    (heading != 0.0).then(|| about_y(heading))
 }
 
 /// The glTF physics extensions written (Godot 4 reads them; other tools keep or ignore them).

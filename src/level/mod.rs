@@ -76,6 +76,25 @@ pub struct PolicyRef {
     pub sha256: String,
 }
 
+impl PolicyRef {
+    /// The file at `path` whose contents are `bytes`.
+    pub fn pinned(path: String, bytes: &[u8]) -> Self {
+        Self {
+            path,
+            sha256: sha256_hex(bytes),
+        }
+    }
+}
+
+/// The SHA-256 of `bytes`, as lowercase hex.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    sha2::Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
 /// The settings of the rule-based generator (the paper's Rule-PCG baseline).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -14,7 +14,7 @@ use super::pacing::{AuxCurve, Pacing};
 use super::params::{self, ParamRange};
 use super::platform::{self, BlockParams, PlatformTrack, Start};
 use super::racing::{Obstacle, RacingTrack, SegmentParams};
-use super::{Game, Level, SolverStats, Source, Track};
+use super::{Game, Level, PolicyRef, SolverStats, Source, Track};
 
 /// The `format` every level file declares.
 pub const FORMAT_NAME: &str = "arlpcg-level";
@@ -64,6 +64,11 @@ pub enum Problem {
 
 /// Reads and validates a level file.
 pub fn load(path: &Path) -> Result<Level, LoadError> {
+    load_pinned(path).map(|(level, _)| level)
+}
+
+/// [`load`], and the file pinned by the hash of the bytes read (what a kept prefix records).
+pub fn load_pinned(path: &Path) -> Result<(Level, PolicyRef), LoadError> {
     let fail = |problem| LoadError {
         path: path.to_path_buf(),
         problem,
@@ -80,9 +85,10 @@ pub fn load(path: &Path) -> Result<Level, LoadError> {
     if bytes.len() as u64 > MAX_FILE_BYTES {
         return Err(fail(Problem::TooLarge));
     }
+    let reference = PolicyRef::pinned(path.display().to_string(), &bytes);
     let text = String::from_utf8(bytes)
         .map_err(|e| fail(Problem::NotText(e.utf8_error().valid_up_to())))?;
-    parse(&text).map_err(fail)
+    Ok((parse(&text).map_err(fail)?, reference))
 }
 
 /// Parses and validates the text of a level file.
@@ -552,24 +558,8 @@ impl LevelFile {
                 height: s.height.0,
             })
             .collect();
-        // Counts and each obstacle first: the geometry below is costly on a huge list,
-        // and meaningless around a NaN obstacle.
-        for (key, count, max) in [
-            ("segments", segments.len(), super::racing::MAX_SEGMENTS),
-            (
-                "obstacles",
-                self.obstacles.len(),
-                super::racing::MAX_OBSTACLES,
-            ),
-        ] {
-            if count > max {
-                return Err(invalid(
-                    key.into(),
-                    line_of_key(text, key),
-                    format!("the level has {count} {key}: at most {max} are allowed"),
-                ));
-            }
-        }
+        // Each obstacle before the geometry, which is meaningless around a NaN one (the counts
+        // were refused from the first parse, in `check_counts`).
         for (index, obstacle) in self.obstacles.iter().enumerate() {
             obstacle.check().map_err(|problem| {
                 let (field, message) = problem.split_once(": ").unwrap_or(("", &problem));
@@ -587,22 +577,17 @@ impl LevelFile {
             obstacles: self.obstacles.clone(),
         };
         // Checked here (not only in `validate`) to name the segment's line.
-        if track.segments.len() <= super::racing::MAX_SEGMENTS {
-            let geometry = track.check_geometry().map_err(|e| {
-                let (field, index) = match e {
-                    super::racing::TrackError::Crosses { later, .. } => ("segments", later),
-                    super::racing::TrackError::HitsObstacle { segment, .. } => {
-                        ("segments", segment)
-                    }
-                };
-                invalid(
-                    format!("{field}[{index}]"),
-                    line_of_item(text, field, index),
-                    e.to_string(),
-                )
-            });
-            geometry?;
-        }
+        track.check_geometry().map_err(|e| {
+            let index = match e {
+                super::racing::TrackError::Crosses { later, .. } => later,
+                super::racing::TrackError::HitsObstacle { segment, .. } => segment,
+            };
+            invalid(
+                format!("segments[{index}]"),
+                line_of_item(text, "segments", index),
+                e.to_string(),
+            )
+        })?;
         let (end, _) = track.road().end();
         Ok((Track::Racing(track), end))
     }

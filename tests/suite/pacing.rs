@@ -138,6 +138,16 @@ fn a_piece_aux_without_a_curve_names_the_field() {
     assert!(err.starts_with("blocks[1].aux: missing"), "{err}");
 }
 
+/// The one file `generate` wrote into `dir`.
+fn only_file(dir: &Path) -> std::path::PathBuf {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path()
+}
+
 /// The text of each item of the top-level list `key` of a level file, as written.
 fn items(text: &str, key: &str) -> Vec<String> {
     let body = text.split(&format!("\n{key}:\n")).nth(1).unwrap();
@@ -182,12 +192,7 @@ fn a_kept_prefix_is_written_byte_for_byte_and_the_generator_builds_the_rest() {
             first.to_str().unwrap(),
         ]);
         assert!(output.status.success(), "{}", stderr(&output));
-        let first_file = std::fs::read_dir(&first)
-            .unwrap()
-            .next()
-            .unwrap()
-            .unwrap()
-            .path();
+        let first_file = only_file(&first);
         let first_text = std::fs::read_to_string(&first_file).unwrap();
         let first_items = items(&first_text, key);
         let keep = first_items.len() / 2;
@@ -212,12 +217,7 @@ fn a_kept_prefix_is_written_byte_for_byte_and_the_generator_builds_the_rest() {
             second.to_str().unwrap(),
         ]);
         assert!(output.status.success(), "{game}: {}", stderr(&output));
-        let second_file = std::fs::read_dir(&second)
-            .unwrap()
-            .next()
-            .unwrap()
-            .unwrap()
-            .path();
+        let second_file = only_file(&second);
         assert!(
             second_file
                 .to_str()

@@ -85,21 +85,11 @@ impl App {
             return Vec::new();
         }
         let text = crate::level::yaml::to_string(level);
-        let sha256 = {
-            use sha2::Digest;
-            sha2::Sha256::digest(text.as_bytes())
-                .iter()
-                .map(|b| format!("{b:02x}"))
-                .collect()
-        };
         let pieces = selected + 1;
         self.kept = Some(KeptPrefix {
             level: level.clone(),
             pieces,
-            from: PolicyRef {
-                path: format!("designer: {}", self.export_stem()),
-                sha256,
-            },
+            from: PolicyRef::pinned(format!("designer: {}", self.export_stem()), text.as_bytes()),
         });
         self.say(format!(
             "keeping the first {pieces} {}: K lets go",

@@ -5,9 +5,11 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+use crate::game::Skill;
 use crate::level::Game;
 use crate::level::pacing::AuxCurve;
 use crate::level::params;
+use crate::panel::Judge;
 use crate::train::TrainMode;
 
 #[derive(Debug, Parser)]
@@ -318,11 +320,30 @@ impl From<TrainModeArg> for TrainMode {
 pub enum SolverChoice {
     /// A trained Solver policy (--policy, default policies/<game>/solver.safetensors).
     Policy,
-    /// The scripted player (no learning). Platform: faces the next block, runs, jumps at the
-    /// edge. Racing: pure pursuit of the centre line at the speed the road ahead allows.
-    Scripted,
+    /// The scripted player (no learning) at its best. Platform: faces the next block, runs,
+    /// jumps at the edge. Racing: pure pursuit of the centre line at the speed the road ahead
+    /// allows.
+    #[value(name = "scripted-expert", alias = "scripted")]
+    ScriptedExpert,
+    /// The scripted player with an average player's mistakes (take-off timing and run-up speed;
+    /// grip misjudged, steering wobble).
+    ScriptedMedian,
+    /// The scripted player with a beginner's mistakes.
+    ScriptedNovice,
     /// Uniformly random actions (a baseline).
     Random,
+}
+
+impl SolverChoice {
+    /// The scripted player's skill, for the scripted choices.
+    pub fn skill(self) -> Option<Skill> {
+        match self {
+            SolverChoice::ScriptedExpert => Some(Skill::Expert),
+            SolverChoice::ScriptedMedian => Some(Skill::Median),
+            SolverChoice::ScriptedNovice => Some(Skill::Novice),
+            SolverChoice::Policy | SolverChoice::Random => None,
+        }
+    }
 }
 
 /// Where the shipped Solver of `game` lives.
@@ -360,6 +381,28 @@ pub struct VerifyArgs {
     /// statistics record) with the Solver that recorded it, and check that it succeeds again.
     #[arg(long, conflicts_with_all = ["solver", "policy", "trials", "json"])]
     pub replay: bool,
+    /// Play each level with a panel of judges (comma-separated; alone: every Solver in
+    /// --policies and the scripted player at three skills) and rate its difficulty b over
+    /// judges × levels: P(judge succeeds) = σ(θ_judge − b). Judges: arlpcg, rule-pcg,
+    /// fixed-track, fixed-aux, scripted-novice, scripted-median, scripted-expert.
+    #[arg(long, value_name = "JUDGES", num_args = 0..=1, default_missing_value = "",
+          value_parser = parse_judges, conflicts_with_all = ["solver", "policy", "replay", "chart"])]
+    pub panel: Option<Judges>,
+    /// The policies folder the panel's Solvers come from (default: policies/<game>).
+    #[arg(long, requires = "panel")]
+    pub policies: Option<PathBuf>,
+}
+
+/// The judges a panel is asked for (empty: the default panel).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Judges(pub Vec<Judge>);
+
+fn parse_judges(s: &str) -> Result<Judges, String> {
+    s.split(',')
+        .filter(|name| !name.trim().is_empty())
+        .map(Judge::parse)
+        .collect::<Result<Vec<_>, _>>()
+        .map(Judges)
 }
 
 #[derive(Debug, Args)]

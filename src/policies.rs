@@ -10,6 +10,7 @@ use crate::game::racing::generator::DEFAULT_CURVE_OFFSET;
 use crate::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
 use crate::generation::GeneratorPolicy;
 use crate::level::{Game, PolicyRef};
+use crate::panel::{Judge, Panel};
 use crate::rl::checkpoint::{LoadedPolicy, MAX_POLICY_BYTES, PolicyCard, Role, load_policy};
 use crate::verify::SolverPolicy;
 
@@ -172,6 +173,41 @@ pub fn difficulty_curve(
         crate::fsio::Overwrite::Allowed,
     );
     Ok(curve)
+}
+
+/// The panel of judges `chosen` from the policies folder `dir` (by default every Solver judge
+/// whose file is there, and the scripted player at its three skills). A chosen Solver judge
+/// whose file is missing is an error naming it.
+pub fn load_panel(dir: &Path, game: Game, chosen: Option<&[Judge]>) -> Result<Panel> {
+    let judges: Vec<Judge> = match chosen {
+        Some(chosen) => chosen.to_vec(),
+        None => Judge::ALL
+            .into_iter()
+            .filter(|j| j.policy_file(dir).is_none_or(|p| p.exists()))
+            .collect(),
+    };
+    let mut panel = Panel { judges: Vec::new() };
+    for judge in judges {
+        let policy = match judge.policy_file(dir) {
+            Some(path) => {
+                let (policy, card) =
+                    load_solver(&path, game).with_context(|| format!("judge {}", judge.name()))?;
+                if card.training.mode != judge.name() {
+                    anyhow::bail!(
+                        "judge {}: {} was trained in mode {}, not {}",
+                        judge.name(),
+                        path.display(),
+                        card.training.mode,
+                        judge.name()
+                    );
+                }
+                Some(policy)
+            }
+            None => None,
+        };
+        panel.judges.push((judge, policy));
+    }
+    Ok(panel)
 }
 
 /// The paths of the Generator and the Solver in a policies folder.

@@ -13,7 +13,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::game::{GameSpec, PlatformGame, RacingGame, Scripted, SolverEnv};
+use crate::game::{GameSpec, PlatformGame, RacingGame, Scripted, Skill, SolverEnv};
 use crate::level::stats::{SolverRef, SolverStats, TrialResult};
 use crate::level::{Game, Level, PolicyRef};
 use crate::rl::normalizer::RunningNorm;
@@ -36,8 +36,8 @@ pub struct SolverPolicy {
 
 /// Who plays the trials.
 pub enum Solver<'a> {
-    /// The scripted (non-learning) player of the level's game.
-    Scripted,
+    /// The scripted (non-learning) player of the level's game, at a skill.
+    Scripted(Skill),
     /// Uniformly random actions (a baseline).
     Random,
     /// A trained Solver policy.
@@ -47,7 +47,7 @@ pub enum Solver<'a> {
 impl Solver<'_> {
     fn reference(&self) -> SolverRef {
         match self {
-            Solver::Scripted => SolverRef::Scripted,
+            Solver::Scripted(skill) => SolverRef::Scripted { skill: *skill },
             Solver::Random => SolverRef::Random,
             Solver::Policy(p) => SolverRef::Policy {
                 policy: p.reference.clone(),
@@ -151,10 +151,11 @@ fn play_all<G: GameSpec>(
         result
     };
     match solver {
-        Solver::Scripted => range
+        Solver::Scripted(skill) => range
             .into_par_iter()
             .map_init(new_env, |env, i| {
-                (!(watch.stop)()).then(|| reported(play_scripted(env, seed.wrapping_add(i))))
+                (!(watch.stop)())
+                    .then(|| reported(play_scripted(env, seed.wrapping_add(i), *skill)))
             })
             .collect(),
         Solver::Random => range
@@ -196,12 +197,15 @@ pub fn record(level: &Level, solver: &Solver, seed: u64) -> Result<Recording, Wr
 fn record_env<E: SolverEnv>(mut env: E, solver: &Solver, seed: u64) -> Recording {
     env.reset(seed);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut scripted = E::scripted(seed);
+    let mut scripted = match solver {
+        Solver::Scripted(skill) => Some(E::scripted(seed, *skill)),
+        _ => None,
+    };
     let mut observation = vec![0.0; E::OBSERVATION_SIZE];
     let mut path = vec![env.marker()];
     loop {
         let action = match solver {
-            Solver::Scripted => scripted.act(&env),
+            Solver::Scripted(_) => scripted.as_mut().expect("made above").act(&env),
             Solver::Random => E::random_action(&mut rng),
             Solver::Policy(policy) => {
                 env.observe(&mut observation);
@@ -239,10 +243,10 @@ pub fn certify(
     Ok(None)
 }
 
-/// Plays one run with the game's scripted player, seeded by `seed`.
-pub fn play_scripted<E: SolverEnv>(env: &mut E, seed: u64) -> TrialResult {
+/// Plays one run with the game's scripted player of `skill`, seeded by `seed`.
+pub fn play_scripted<E: SolverEnv>(env: &mut E, seed: u64, skill: Skill) -> TrialResult {
     env.reset(seed);
-    let mut player = E::scripted(seed);
+    let mut player = E::scripted(seed, skill);
     loop {
         if let Some(outcome) = env.step(player.act(env)).outcome {
             return env.trial_result(outcome);

@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use crate::cli::{GenerateArgs, KeepArg, default_solver};
 use crate::difficulty;
 use crate::fsio::{self, Overwrite};
+use crate::game::Skill;
 use crate::generation::{self, GeneratorPolicy, KeptPrefix, Lambda, LevelRequest};
 use crate::level::{Game, Level};
 use crate::level_files::{Format, LevelFiles, file_stem, render};
@@ -56,7 +57,9 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     // cannot be built leaves the folder as it was, and --force replaces nothing. Several
     // levels are in flight at once; each depends only on its seed, so the files do not depend
     // on the number of threads.
-    let who = solver.as_ref().map_or(Solver::Scripted, Solver::Policy);
+    let who = solver
+        .as_ref()
+        .map_or(Solver::Scripted(Skill::Expert), Solver::Policy);
     let curve = target_curve(args, generator.as_ref(), solver.as_ref(), &stop)?;
     let bar = crate::shell::progress_bar(plans.len() as u64, "generating");
     let built: Vec<Option<Result<Level>>> = plans

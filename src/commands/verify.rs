@@ -2,22 +2,27 @@
 //! summary over all the levels.
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use serde_json::json;
 
-use crate::cli::{SolverChoice, VerifyArgs, default_solver};
+use crate::cli::{Judges, SolverChoice, VerifyArgs, default_solver};
+use crate::game::Skill;
 use crate::game::facts::facts;
-use crate::level::stats::{Outcome, SolverRef, SolverStats};
+use crate::level::stats::{Outcome, PanelStats, SolverRef, SolverStats};
 use crate::level::yaml;
 use crate::level::{Game, Level};
-use crate::policies::load_solver;
+use crate::panel::{Panel, panel_stats, rate};
+use crate::policies::{load_panel, load_solver};
 use crate::verify::{HalfwaySplit, Solver, SolverPolicy, Summary, passed_by_piece, verify};
 
 pub fn run(args: &VerifyArgs) -> Result<()> {
     if args.replay {
         return replay(args);
+    }
+    if let Some(judges) = &args.panel {
+        return panel(args, judges);
     }
     if args.chart.is_some() && args.levels.len() != 1 {
         return Err(crate::shell::UsageError(
@@ -141,7 +146,7 @@ fn replay_one(level: &crate::level::Level) -> Result<String> {
         .context("its statistics record no certificate (no successful run was found)")?;
     let loaded;
     let solver = match &stats.solver {
-        SolverRef::Scripted => Solver::Scripted,
+        SolverRef::Scripted { skill } => Solver::Scripted(*skill),
         SolverRef::Random => Solver::Random,
         SolverRef::Policy { policy } => {
             loaded = load_solver(Path::new(&policy.path), level.game())?.0;
@@ -169,6 +174,116 @@ fn replay_one(level: &crate::level::Level) -> Result<String> {
     ))
 }
 
+/// `verify --panel`: every level played by every judge, then rated over judges × levels (the
+/// levels of each game together).
+fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
+    let mut panels: HashMap<Game, Panel> = HashMap::new();
+    let mut rated: Vec<(&Path, Game, PanelStats)> = Vec::new();
+    let mut failed = 0;
+    for path in &args.levels {
+        let outcome = yaml::load(path)
+            .map_err(anyhow::Error::from)
+            .and_then(|level| {
+                let game = level.game();
+                if !panels.contains_key(&game) {
+                    let dir = args
+                        .policies
+                        .clone()
+                        .unwrap_or_else(|| PathBuf::from(format!("policies/{game}")));
+                    let chosen = (!chosen.0.is_empty()).then_some(chosen.0.as_slice());
+                    let panel = load_panel(&dir, game, chosen)?;
+                    if !args.json {
+                        eprintln!("{game} panel: {}", panel.names().join(", "));
+                    }
+                    panels.insert(game, panel);
+                }
+                let panel = &panels[&game];
+                let runs = args.trials as u64 * panel.judges.len() as u64;
+                let bar = crate::shell::progress_bar(runs, &path.display().to_string());
+                let played = (0..panel.judges.len())
+                    .map(|k| {
+                        verify(&level, &panel.solver(k), args.trials, args.seed, &|| {
+                            bar.inc(1)
+                        })
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                bar.finish_and_clear();
+                Ok((game, panel_stats(panel, args.seed, args.trials, &played)))
+            });
+        match outcome {
+            Ok((game, stats)) => rated.push((path, game, stats)),
+            Err(err) => {
+                failed += 1;
+                eprintln!(
+                    "error: {}: {}",
+                    path.display(),
+                    one_line(&format!("{err:#}"))
+                );
+            }
+        }
+    }
+    for game in [Game::Platform, Game::Racing] {
+        let mut of_game: Vec<&mut PanelStats> = rated
+            .iter_mut()
+            .filter(|(_, g, _)| *g == game)
+            .map(|(_, _, s)| s)
+            .collect();
+        if of_game.is_empty() {
+            continue;
+        }
+        let abilities = rate(&mut of_game);
+        if !args.json {
+            let shown: Vec<String> = abilities
+                .iter()
+                .map(|(name, theta)| format!("{name} {theta:+.2}"))
+                .collect();
+            println!("{game} judges' ability θ (logits): {}", shown.join(", "));
+        }
+    }
+    for (path, _, stats) in &rated {
+        let rating = stats.rating.expect("rated above");
+        if args.json {
+            let ratios: serde_json::Map<String, serde_json::Value> = stats
+                .judges
+                .iter()
+                .map(|j| (j.judge.clone(), json!(j.success_ratio)))
+                .collect();
+            println!(
+                "{}",
+                json!({
+                    "level": path.display().to_string(),
+                    "seed": stats.seed,
+                    "trials": stats.trials,
+                    "panel": ratios,
+                    "panel_ci95": stats.judges.iter().map(|j| (j.judge.clone(), json!(j.ci95))).collect::<serde_json::Map<_, _>>(),
+                    "rating": {"b": rating.b, "ci95": rating.ci95, "levels": rating.levels},
+                })
+            );
+        } else {
+            let judges: Vec<String> = stats
+                .judges
+                .iter()
+                .map(|j| format!("{} {:.2}", j.judge, j.success_ratio))
+                .collect();
+            println!(
+                "{}: difficulty b {:+.2} (95% CI {:+.2} to {:+.2}); {}",
+                path.display(),
+                rating.b,
+                rating.ci95[0],
+                rating.ci95[1],
+                judges.join(", ")
+            );
+        }
+    }
+    if failed > 0 {
+        anyhow::bail!(
+            "{failed} of {} level files could not be verified",
+            args.levels.len()
+        );
+    }
+    Ok(())
+}
+
 /// The Solver of each game met so far, resolved from the arguments once per game.
 #[derive(Default)]
 struct Solvers {
@@ -177,7 +292,7 @@ struct Solvers {
 
 enum Resolved {
     Policy(Box<SolverPolicy>),
-    Scripted,
+    Scripted(Skill),
     Random,
 }
 
@@ -194,21 +309,21 @@ impl Solvers {
             .unwrap_or(if args.policy.is_some() || shipped.exists() {
                 SolverChoice::Policy
             } else {
-                SolverChoice::Scripted
+                SolverChoice::ScriptedExpert
             });
         let resolved = match choice {
             SolverChoice::Policy => Resolved::Policy(Box::new(load_solver(&policy, game)?.0)),
-            SolverChoice::Scripted => Resolved::Scripted,
             SolverChoice::Random => Resolved::Random,
+            scripted => Resolved::Scripted(scripted.skill().expect("the other choices")),
         };
         if !args.json {
             let who = match &resolved {
                 Resolved::Policy(p) => format!("policy {}", p.reference.path),
-                Resolved::Scripted if args.solver.is_none() => format!(
+                Resolved::Scripted(_) if args.solver.is_none() => format!(
                     "scripted player (no trained Solver at {})",
                     shipped.display()
                 ),
-                Resolved::Scripted => "scripted player".into(),
+                Resolved::Scripted(skill) => format!("scripted player ({skill})"),
                 Resolved::Random => "random actions".into(),
             };
             eprintln!("{game} solver: {who}");
@@ -220,7 +335,7 @@ impl Solvers {
     fn get(&self, game: Game) -> Solver<'_> {
         match &self.resolved[&game] {
             Resolved::Policy(p) => Solver::Policy(p),
-            Resolved::Scripted => Solver::Scripted,
+            Resolved::Scripted(skill) => Solver::Scripted(*skill),
             Resolved::Random => Solver::Random,
         }
     }

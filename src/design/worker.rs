@@ -12,6 +12,7 @@ use anyhow::Result;
 
 use super::app::{Effect, ExportOutcome, LoadedInfo, PolicyInfo, Response, SweepPoint};
 use crate::fsio::Overwrite;
+use crate::game::Skill;
 use crate::generation::{self, GeneratorPolicy, LevelRequest};
 use crate::level::{Game, Level};
 use crate::level_files::{Format, LevelFiles, write_level_files};
@@ -53,7 +54,7 @@ impl Policies {
     fn solver(&self) -> Solver<'_> {
         match &self.solver {
             Some(policy) => Solver::Policy(policy.as_ref()),
-            None => Solver::Scripted,
+            None => Solver::Scripted(Skill::Expert),
         }
     }
 

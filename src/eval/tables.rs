@@ -199,7 +199,14 @@ pub(super) mod tests {
                 })
             })
             .collect();
-        SolverStats::from_trials(SolverRef::Scripted, 0, 2, &runs)
+        SolverStats::from_trials(
+            SolverRef::Scripted {
+                skill: crate::game::Skill::Expert,
+            },
+            0,
+            2,
+            &runs,
+        )
     }
 
     /// Two Solvers (the ARLPCG one second), 1, 2, 0, 1, 1 levels at the five λ, a validation

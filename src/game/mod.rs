@@ -54,12 +54,57 @@ pub trait SolverEnv: Send + Sync + Sized {
     fn action_from_policy_row(row: &[f32]) -> Self::Action;
     /// A uniformly random action (the random baseline).
     fn random_action(rng: &mut rand_chacha::ChaCha8Rng) -> Self::Action;
-    /// The scripted player of run `seed`, as verification uses it.
-    fn scripted(seed: u64) -> Self::Scripted;
+    /// The scripted player of run `seed` at `skill`, as verification uses it.
+    fn scripted(seed: u64, skill: Skill) -> Self::Scripted;
     /// The finished run as verification records it.
     fn trial_result(&self, outcome: Outcome) -> crate::level::stats::TrialResult;
     /// Where the player is (a recorded run's path).
     fn marker(&self) -> [f32; 3];
+}
+
+/// How well a scripted player plays: a Solver-independent yardstick of difficulty, physically
+/// grounded and without a network. Each game turns a skill into its own imperfections (take-off
+/// timing and run-up speed on the platform game, grip misjudged and steering wobble in racing:
+/// docs/platform-physics.md and docs/racing-physics.md); `Expert` is the scripted player that
+/// verification used before skills existed.
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Skill {
+    Novice,
+    Median,
+    #[default]
+    Expert,
+}
+
+impl Skill {
+    /// Every skill, weakest first.
+    pub const ALL: [Skill; 3] = [Skill::Novice, Skill::Median, Skill::Expert];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Skill::Novice => "novice",
+            Skill::Median => "median",
+            Skill::Expert => "expert",
+        }
+    }
+}
+
+impl std::fmt::Display for Skill {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// A scripted player of environment `E`.

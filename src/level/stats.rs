@@ -10,8 +10,12 @@ use super::params::show_number;
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
 pub enum SolverRef {
-    /// The scripted (non-learning) controller: walk to the edge, jump.
-    Scripted,
+    /// The game's scripted (non-learning) player, at a skill (files written before skills
+    /// existed name none: the expert).
+    Scripted {
+        #[serde(default)]
+        skill: crate::game::Skill,
+    },
     /// Uniformly random actions (a baseline).
     Random,
     /// A trained Solver policy.
@@ -21,7 +25,7 @@ pub enum SolverRef {
 impl SolverRef {
     pub fn describe(&self) -> String {
         match self {
-            SolverRef::Scripted => "scripted controller".to_string(),
+            SolverRef::Scripted { skill } => format!("scripted player ({skill})"),
             SolverRef::Random => "random actions".to_string(),
             SolverRef::Policy { policy } => format!("policy {}", policy.path),
         }
@@ -107,6 +111,51 @@ pub struct SolverStats {
     /// Earlier draws of this seed that no run completed, replaced by this one.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub redraws: u32,
+    /// The level played by a panel of judges, and its difficulty rating (`generate --panel`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub panel: Option<PanelStats>,
+}
+
+/// A level played by a panel of judges (src/panel.rs): each judge's success, and the level's
+/// difficulty b fitted over judges × levels.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PanelStats {
+    /// Seed of each judge's first trial; trial `i` uses `seed + i`.
+    pub seed: u64,
+    /// Runs per judge.
+    pub trials: u32,
+    pub judges: Vec<JudgeStats>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rating: Option<Rating>,
+}
+
+/// One judge's runs on a level.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JudgeStats {
+    /// `arlpcg`, `rule-pcg`, `fixed-track`, `fixed-aux`, `scripted-novice`, `scripted-median`
+    /// or `scripted-expert`.
+    pub judge: String,
+    /// The Solver policy this judge was (none for the scripted player).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub policy: Option<PolicyRef>,
+    pub successes: u32,
+    pub success_ratio: f64,
+    /// 95% Wilson score interval of the success ratio.
+    pub ci95: [f64; 2],
+}
+
+/// A level's difficulty on the Rasch scale (src/rating.rs): P(judge completes it) =
+/// σ(θ_judge − b), in logits; one more means half the odds for every judge.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Rating {
+    pub b: f64,
+    /// 95% interval of b.
+    pub ci95: [f64; 2],
+    /// Levels fitted together (the judges' abilities come from all of them).
+    pub levels: u32,
 }
 
 fn is_zero(count: &u32) -> bool {
@@ -159,6 +208,7 @@ impl SolverStats {
                 .map(|sum| round4(sum / n as f64)),
             certificate: None,
             redraws: 0,
+            panel: None,
         }
     }
 
@@ -305,7 +355,14 @@ mod tests {
             t(Outcome::Fell, 0.2, 0),
             t(Outcome::TimedOut, 0.5, 1),
         ];
-        let stats = SolverStats::from_trials(SolverRef::Scripted, 7, 3, &trials);
+        let stats = SolverStats::from_trials(
+            SolverRef::Scripted {
+                skill: crate::game::Skill::Expert,
+            },
+            7,
+            3,
+            &trials,
+        );
         assert_eq!(
             (stats.trials, stats.successes, stats.fell, stats.timed_out),
             (4, 1, 2, 1)

@@ -113,7 +113,14 @@ fn rule_tracks_are_cleared_by_the_scripted_driver() {
     let stats: Vec<_> = (0..8)
         .map(|seed| {
             let level = rule_level(seed, (seed % 3) as u32);
-            verify(&level, &Solver::Scripted, 10, 0, &|| {}).unwrap()
+            verify(
+                &level,
+                &Solver::Scripted(arlpcg::game::Skill::Expert),
+                10,
+                0,
+                &|| {},
+            )
+            .unwrap()
         })
         .collect();
     let summary = Summary::of(&stats);

@@ -354,8 +354,8 @@ impl crate::game::SolverEnv for PlatformEnv {
         }
     }
 
-    fn scripted(seed: u64) -> super::ScriptedController {
-        super::ScriptedController::new(seed, super::scripted::VERIFY_JITTER)
+    fn scripted(seed: u64, skill: crate::game::Skill) -> super::ScriptedController {
+        super::ScriptedController::with_skill(seed, super::scripted::ControllerSkill::of(skill))
     }
 
     fn trial_result(&self, outcome: Outcome) -> crate::level::stats::TrialResult {

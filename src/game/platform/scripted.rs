@@ -1,7 +1,9 @@
 //! A scripted, non-learning platform controller: face the next block, run at the speed whose
 //! jump lands just inside it, jump at the edge. It reads the world directly (it is a test
 //! instrument and a stand-in Solver, not a learner), and is seeded: each run takes off a little
-//! earlier or later, as a player would.
+//! earlier or later, as a player would. Its [`Skill`] sets how much: the expert takes off up to
+//! 0.3 m early and runs at the speed it wants; weaker players take off earlier still and misjudge
+//! the run-up speed of each jump (docs/platform-physics.md, "The scripted controller's skills").
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -12,9 +14,33 @@ use super::character::{
 };
 use super::env::PlatformEnv;
 use super::world::PlatformBox;
+use crate::game::Skill;
 
-/// Take-off jitter of the scripted controller when it verifies levels, m.
+/// Take-off jitter of the expert scripted controller, m.
 pub const VERIFY_JITTER: f32 = 0.3;
+
+/// What a skill means to the platform controller.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControllerSkill {
+    /// Take-off up to this many metres before the planned point, drawn per jump.
+    pub takeoff_jitter: f32,
+    /// The run-up speed of each jump is off by up to this share, either way, drawn per jump.
+    pub speed_error: f32,
+}
+
+impl ControllerSkill {
+    pub fn of(skill: Skill) -> Self {
+        let (takeoff_jitter, speed_error) = match skill {
+            Skill::Novice => (1.5, 0.3),
+            Skill::Median => (1.1, 0.2),
+            Skill::Expert => (VERIFY_JITTER, 0.0),
+        };
+        Self {
+            takeoff_jitter,
+            speed_error,
+        }
+    }
+}
 /// Metres inside the next block's near edge the controller aims to land.
 const LANDING_DEPTH: f32 = 1.5;
 /// Largest heading error, degrees, at which it still runs and jumps.
@@ -23,24 +49,51 @@ const ALIGNED_DEG: f32 = 12.0;
 /// The scripted controller.
 pub struct ScriptedController {
     rng: ChaCha8Rng,
-    /// Up to this many metres of take-off timing noise (0 for a perfect player).
-    takeoff_jitter: f32,
+    skill: ControllerSkill,
     /// Commanded speed fraction, kept through the air.
     forward: f32,
     /// Take-off distance before the edge drawn for the current jump.
     takeoff_margin: f32,
+    /// Factor on the run-up speed drawn for the current jump.
+    speed_factor: f32,
 }
 
 impl ScriptedController {
     /// A controller whose take-off point varies by up to `takeoff_jitter` metres, seeded.
     pub fn new(seed: u64, takeoff_jitter: f32) -> Self {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let takeoff_margin = rng.random_range(0.0..=takeoff_jitter.max(0.0));
-        Self {
-            rng,
-            takeoff_jitter: takeoff_jitter.max(0.0),
+        Self::with_skill(
+            seed,
+            ControllerSkill {
+                takeoff_jitter,
+                speed_error: 0.0,
+            },
+        )
+    }
+
+    /// A controller of `skill`, seeded.
+    pub fn with_skill(seed: u64, skill: ControllerSkill) -> Self {
+        let skill = ControllerSkill {
+            takeoff_jitter: skill.takeoff_jitter.max(0.0),
+            speed_error: skill.speed_error.clamp(0.0, 0.9),
+        };
+        let mut this = Self {
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            skill,
             forward: 0.0,
-            takeoff_margin,
+            takeoff_margin: 0.0,
+            speed_factor: 1.0,
+        };
+        this.draw_next_jump();
+        this
+    }
+
+    /// Draws the timing of the next jump (the speed only when this player misjudges it, so the
+    /// expert's runs are those of the controller before skills).
+    fn draw_next_jump(&mut self) {
+        self.takeoff_margin = self.rng.random_range(0.0..=self.skill.takeoff_jitter);
+        if self.skill.speed_error > 0.0 {
+            let e = self.skill.speed_error;
+            self.speed_factor = 1.0 + self.rng.random_range(-e..=e);
         }
     }
 
@@ -77,10 +130,10 @@ impl ScriptedController {
         let aim = enter + LANDING_DEPTH.min(0.5 * (leave - enter));
         let flight = flight_time(next.top.y - c.feet.y);
         let speed = ((aim - takeoff) / flight).clamp(1.0, RUN_SPEED);
-        self.forward = speed / RUN_SPEED;
+        self.forward = (self.speed_factor * speed / RUN_SPEED).min(1.0);
         let jump = takeoff < speed * DECISION_DT + self.takeoff_margin;
         if jump {
-            self.takeoff_margin = self.rng.random_range(0.0..=self.takeoff_jitter);
+            self.draw_next_jump();
         }
         PlatformAction {
             forward: self.forward,

@@ -453,8 +453,8 @@ impl crate::game::SolverEnv for RacingEnv {
         }
     }
 
-    fn scripted(seed: u64) -> super::ScriptedDriver {
-        super::ScriptedDriver::new(seed, super::scripted::VERIFY_JITTER)
+    fn scripted(seed: u64, skill: crate::game::Skill) -> super::ScriptedDriver {
+        super::ScriptedDriver::with_skill(seed, super::scripted::DriverSkill::of(skill))
     }
 
     fn trial_result(&self, outcome: Outcome) -> crate::level::stats::TrialResult {

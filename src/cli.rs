@@ -191,6 +191,16 @@ pub struct GenerateArgs {
     /// one beside the Generator or the shipped one.
     #[arg(long, value_name = "FILE")]
     pub solver_policy: Option<PathBuf>,
+    /// Play --verify and --target-success with this judge instead: a Solver of --policies (or
+    /// policies/<game>) named by its training mode (arlpcg, rule-pcg, fixed-track, fixed-aux),
+    /// or the scripted player (scripted-novice, scripted-median, scripted-expert).
+    #[arg(long, value_name = "NAME", value_parser = Judge::parse, conflicts_with = "solver_policy")]
+    pub judge: Option<Judge>,
+    /// With --verify, also play each level with the panel of judges (every Solver of --policies
+    /// or policies/<game>, and the scripted player at three skills), and record each judge's
+    /// success and the level's difficulty b, rated over the levels of this batch.
+    #[arg(long, requires = "verify")]
+    pub panel: bool,
     /// Replace files that already exist (by default nothing is overwritten; files identical to
     /// what this run makes are left as they are, so a re-run finishes an interrupted batch).
     #[arg(long)]

@@ -36,7 +36,8 @@ pub const CURVE_TRIALS: u32 = 20;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Curve {
-    /// SHA-256 of the Generator and of the Solver it was measured with.
+    /// SHA-256 of the Generator and of the Solver it was measured with (for the scripted
+    /// player, its judge name: `scripted-median`).
     pub generator_sha256: String,
     pub solver_sha256: String,
     /// (λ, mean success ratio), easy to hard.

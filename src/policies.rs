@@ -133,18 +133,25 @@ pub fn curve_path(dir: &Path, solver_path: &Path, solver_sha256: &str) -> PathBu
 pub fn difficulty_curve(
     dir: &Path,
     generator: &GeneratorPolicy,
-    solver: &SolverPolicy,
+    solver: &crate::verify::Solver,
     on_measure: impl FnOnce(),
     stopped: &dyn Fn() -> bool,
 ) -> Result<crate::difficulty::Curve> {
-    let path = curve_path(
-        dir,
-        Path::new(&solver.reference.path),
-        &solver.reference.sha256,
-    );
+    use crate::verify::Solver;
+    // A Solver is known by its SHA-256; the scripted player (no file) by its judge name.
+    let (path, identity) = match solver {
+        Solver::Policy(p) => (
+            curve_path(dir, Path::new(&p.reference.path), &p.reference.sha256),
+            p.reference.sha256.clone(),
+        ),
+        Solver::Scripted(skill) => {
+            let name = Judge::Scripted(*skill).name();
+            (dir.join(format!("difficulty-curve-{name}.yaml")), name)
+        }
+        Solver::Random => anyhow::bail!("random actions have no difficulty curve to aim with"),
+    };
     let current = |c: &crate::difficulty::Curve| {
-        c.generator_sha256 == generator.reference.sha256
-            && c.solver_sha256 == solver.reference.sha256
+        c.generator_sha256 == generator.reference.sha256 && c.solver_sha256 == identity
     };
     if let Ok(bytes) = crate::fsio::read_limited(&path, 1 << 20, "difficulty curve")
         && let Ok(curve) = serde_yaml::from_slice::<crate::difficulty::Curve>(&bytes)
@@ -160,12 +167,7 @@ pub fn difficulty_curve(
         return Ok(curve);
     }
     on_measure();
-    let curve = crate::difficulty::measure(
-        generator,
-        &crate::verify::Solver::Policy(solver),
-        &solver.reference.sha256,
-        stopped,
-    )?;
+    let curve = crate::difficulty::measure(generator, solver, &identity, stopped)?;
     // A folder that cannot be written only costs a new measurement next time.
     let _ = crate::fsio::write_atomic(
         &path,

@@ -55,6 +55,14 @@ impl Solver<'_> {
         }
     }
 
+    /// The policy file, for a trained Solver.
+    pub fn policy_reference(&self) -> Option<PolicyRef> {
+        match self {
+            Solver::Policy(p) => Some(p.reference.clone()),
+            Solver::Scripted(_) | Solver::Random => None,
+        }
+    }
+
     /// Checks that a policy plays the level's game.
     fn check_game(&self, level: Game) -> Result<(), WrongGame> {
         match self {

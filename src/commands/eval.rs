@@ -8,9 +8,11 @@ use anyhow::{Context, Result, bail};
 use crate::cli::EvalArgs;
 use crate::eval::{self, Budget, NamedSolver, PART_FILE, Part};
 use crate::fsio::{self, Overwrite};
+use crate::game::Skill;
 use crate::generation::GeneratorPolicy;
+use crate::panel::Judge;
 use crate::policies::{GENERATOR_FILE, load_generator, load_solver};
-use crate::verify::SolverPolicy;
+use crate::verify::{Solver, SolverPolicy};
 
 pub fn run(args: &EvalArgs) -> Result<()> {
     if !args.merge.is_empty() {
@@ -44,12 +46,17 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         Overwrite::Never
     };
     let pool = crate::shell::thread_pool(args.threads)?;
+    // The trained Solvers, then the scripted player at each skill: every judge of the panel.
     let named: Vec<NamedSolver> = solvers
         .iter()
         .map(|(mode, policy)| NamedSolver {
             mode: mode.clone(),
-            policy,
+            solver: Solver::Policy(policy),
         })
+        .chain(Skill::ALL.into_iter().map(|skill| NamedSolver {
+            mode: Judge::Scripted(skill).name(),
+            solver: Solver::Scripted(skill),
+        }))
         .collect();
     if let Some(shard) = args.shard {
         return write_shard(args, shard, &pool, &generator, &named, budget, overwrite);
@@ -199,7 +206,7 @@ fn write_shard(
             generator.reference.clone(),
             named
                 .iter()
-                .map(|s| (s.mode.clone(), s.policy.reference.clone()))
+                .map(|s| (s.mode.clone(), s.solver.policy_reference()))
                 .collect(),
             levels.layout,
             indices.into_iter().zip(stats).collect(),

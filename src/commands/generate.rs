@@ -1,6 +1,7 @@
 //! `arlpcg generate`: levels from a trained Generator or from the rules, optionally verified by
 //! the Solver, written as files named after game, seed and aux.
 
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -12,9 +13,11 @@ use crate::difficulty;
 use crate::fsio::{self, Overwrite};
 use crate::game::Skill;
 use crate::generation::{self, GeneratorPolicy, KeptPrefix, Lambda, LevelRequest};
+use crate::level::stats::PanelStats;
 use crate::level::{Game, Level};
 use crate::level_files::{Format, LevelFiles, file_stem, render};
-use crate::policies::{load_generator, load_solver, policy_paths};
+use crate::panel::{Judge, Panel, panel_stats, rate};
+use crate::policies::{load_generator, load_panel, load_solver, policy_paths};
 use crate::verify::{self, Solver, SolverPolicy, verify};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
@@ -30,12 +33,23 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         None => None,
     };
     let shipped = default_solver(args.game);
+    let judge_file = args.judge.and_then(|j| j.policy_file(&policies_dir(args)));
     let solver: Option<SolverPolicy> = match (verify_trials, &args.solver_policy, &args.policies) {
         (None, _, _) => None,
+        (Some(_), _, _) if matches!(args.judge, Some(Judge::Scripted(_))) => None,
         (Some(_), Some(path), _) => Some(load_solver(path, args.game)?.0),
+        (Some(_), None, _) if judge_file.is_some() => Some(
+            load_solver(judge_file.as_ref().expect("checked"), args.game)
+                .with_context(|| format!("--judge {}", args.judge.expect("given").name()))?
+                .0,
+        ),
         (Some(_), None, Some(dir)) => Some(load_solver(&policy_paths(dir).1, args.game)?.0),
         (Some(_), None, None) if shipped.exists() => Some(load_solver(&shipped, args.game)?.0),
         (Some(_), None, None) => None,
+    };
+    let panel = match args.panel {
+        true => Some(load_panel(&policies_dir(args), args.game, None)?),
+        false => None,
     };
     let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
     let plans: Vec<(u64, LevelFiles)> = seeds
@@ -57,10 +71,14 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     // cannot be built leaves the folder as it was, and --force replaces nothing. Several
     // levels are in flight at once; each depends only on its seed, so the files do not depend
     // on the number of threads.
+    let skill = match args.judge {
+        Some(Judge::Scripted(skill)) => skill,
+        _ => Skill::Expert,
+    };
     let who = solver
         .as_ref()
-        .map_or(Solver::Scripted(Skill::Expert), Solver::Policy);
-    let curve = target_curve(args, generator.as_ref(), solver.as_ref(), &stop)?;
+        .map_or(Solver::Scripted(skill), Solver::Policy);
+    let curve = target_curve(args, generator.as_ref(), &who, &stop)?;
     let bar = crate::shell::progress_bar(plans.len() as u64, "generating");
     let built: Vec<Option<Result<Level>>> = plans
         .par_iter()
@@ -94,6 +112,14 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
             Some(level) => levels.push(level?),
             None => break,
         }
+    }
+    if let Some(panel) = &panel {
+        play_panel(
+            panel,
+            &mut levels,
+            verify_trials.unwrap_or(TARGET_TRIALS),
+            &stop,
+        );
     }
     // The folder is made only now, and removed again if the batch fails.
     let made_folder = !args.out.exists();
@@ -159,14 +185,54 @@ fn report_verification(levels: &[Level]) {
 
 /// With `--target-success`: the policies' λ→success curve, read from beside them or measured
 /// once (Ctrl-C in `stop` ends the measurement: exit 130, nothing written).
+/// The folder the judges come from: --policies, else the shipped policies of the game.
+fn policies_dir(args: &GenerateArgs) -> PathBuf {
+    args.policies
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("policies/{}", args.game)))
+}
+
+/// Plays every level with every judge of `panel` (seeds as --verify's) and rates them together.
+/// Levels a Ctrl-C left unplayed are dropped from the end, as unbuilt ones are.
+fn play_panel(panel: &Panel, levels: &mut Vec<Level>, trials: u32, stop: &AtomicBool) {
+    let runs = (levels.len() * panel.judges.len()) as u64 * trials as u64;
+    let bar = crate::shell::progress_bar(runs, "panel runs");
+    let played: Vec<Option<PanelStats>> = levels
+        .par_iter()
+        .map(|level| {
+            let seed = level.stats.as_ref().map_or(0, |s| s.seed);
+            let mut stats = Vec::with_capacity(panel.judges.len());
+            for k in 0..panel.judges.len() {
+                if stop.load(Ordering::SeqCst) {
+                    return None;
+                }
+                let solver = panel.solver(k);
+                let s = verify(level, &solver, trials, seed, &|| bar.inc(1))
+                    .expect("judges are loaded for the batch's game");
+                stats.push(s);
+            }
+            Some(panel_stats(panel, seed, trials, &stats))
+        })
+        .collect();
+    bar.finish_and_clear();
+    let done = played.iter().take_while(|p| p.is_some()).count();
+    levels.truncate(done);
+    let mut panels: Vec<PanelStats> = played.into_iter().flatten().take(done).collect();
+    rate(&mut panels.iter_mut().collect::<Vec<_>>());
+    for (level, panel) in levels.iter_mut().zip(panels) {
+        if let Some(stats) = level.stats.as_mut() {
+            stats.panel = Some(panel);
+        }
+    }
+}
+
 fn target_curve(
     args: &GenerateArgs,
     generator: Option<&GeneratorPolicy>,
-    solver: Option<&SolverPolicy>,
+    solver: &Solver,
     stop: &AtomicBool,
 ) -> Result<Option<difficulty::Curve>> {
-    let (Some(_), Some(generator), Some(solver), Some(dir)) =
-        (args.target_success, generator, solver, &args.policies)
+    let (Some(_), Some(generator), Some(dir)) = (args.target_success, generator, &args.policies)
     else {
         return Ok(None);
     };

@@ -379,8 +379,14 @@ fn target_level(
     let folder = Path::new(&generator.reference.path)
         .parent()
         .unwrap_or(Path::new("."));
-    let curve = crate::policies::difficulty_curve(folder, generator, solver, || {}, &|| false)
-        .map_err(|e| format!("{e:#}"))?;
+    let curve = crate::policies::difficulty_curve(
+        folder,
+        generator,
+        &Solver::Policy(solver),
+        || {},
+        &|| false,
+    )
+    .map_err(|e| format!("{e:#}"))?;
     crate::difficulty::level_for(
         generator,
         &Solver::Policy(solver),

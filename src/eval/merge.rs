@@ -36,8 +36,8 @@ pub struct Part {
     pub shard: [u64; 2],
     pub budget: Budget,
     pub generator: PolicyRef,
-    /// Each Solver's mode and file, in table order.
-    pub solvers: Vec<(String, PolicyRef)>,
+    /// Each judge's name and Solver file (none for the scripted player), in table order.
+    pub solvers: Vec<(String, Option<PolicyRef>)>,
     pub layout: Layout,
     /// (play index, its statistics) for this shard's plays.
     pub plays: Vec<(usize, SolverStats)>,
@@ -49,7 +49,7 @@ impl Part {
         shard: [u64; 2],
         budget: Budget,
         generator: PolicyRef,
-        solvers: Vec<(String, PolicyRef)>,
+        solvers: Vec<(String, Option<PolicyRef>)>,
         layout: Layout,
         plays: Vec<(usize, SolverStats)>,
     ) -> Self {
@@ -238,10 +238,9 @@ fn difference(a: &Part, b: &Part) -> Option<&'static str> {
     } else if a.generator.sha256 != b.generator.sha256 {
         Some("Generator")
     } else if a.solvers.len() != b.solvers.len()
-        || a.solvers
-            .iter()
-            .zip(&b.solvers)
-            .any(|(x, y)| x.0 != y.0 || x.1.sha256 != y.1.sha256)
+        || a.solvers.iter().zip(&b.solvers).any(|(x, y)| {
+            x.0 != y.0 || x.1.as_ref().map(|r| &r.sha256) != y.1.as_ref().map(|r| &r.sha256)
+        })
     {
         Some("Solvers")
     } else if a.layout != b.layout {
@@ -282,8 +281,8 @@ mod tests {
                     Budget::QUICK,
                     reference("gen"),
                     vec![
-                        ("rule-pcg".into(), reference("a")),
-                        ("arlpcg".into(), reference("b")),
+                        ("rule-pcg".into(), Some(reference("a"))),
+                        ("arlpcg".into(), Some(reference("b"))),
                     ],
                     layout.clone(),
                     plays,

@@ -31,7 +31,7 @@ pub use tables::{ControllabilityRow, CrossRow, GeneralizationRow, Results, assem
 use serde::Serialize;
 
 use crate::generation::GeneratorPolicy;
-use crate::verify::SolverPolicy;
+use crate::verify::Solver;
 
 /// The λ values of the tables, easy to hard.
 pub const AUX_VALUES: [f64; 5] = [1.0, 0.5, 0.0, -0.5, -1.0];
@@ -68,8 +68,9 @@ impl Budget {
 
 /// A Solver under evaluation, named by its training mode.
 pub struct NamedSolver<'a> {
+    /// The judge's name: a trained Solver's mode, or `scripted-<skill>`.
     pub mode: String,
-    pub policy: &'a SolverPolicy,
+    pub solver: Solver<'a>,
 }
 
 /// Runs the whole evaluation. `solvers` must include the `arlpcg` one (it plays the

@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use crate::level::Game;
 use crate::level::stats::SolverStats;
-use crate::verify::{Solver, verify};
+use crate::verify::verify;
 
 use super::{Budget, Levels, NamedSolver};
 
@@ -104,7 +104,7 @@ pub fn play(
             };
             let stats = verify(
                 level,
-                &Solver::Policy(solvers[solver].policy),
+                &solvers[solver].solver,
                 trials,
                 level.seed.unwrap_or(0),
                 &|| {},

@@ -55,7 +55,7 @@ pub fn markdown(results: &Results) -> String {
             num(row.avg_steps, 0)
         );
     }
-    md += "\n## Each Solver on Generator levels at each λ\n\n| mode |";
+    md += "\n## Each judge (trained Solvers, the scripted player's skills) on Generator levels at each λ\n\n| judge |";
     for aux in AUX_VALUES {
         md += &format!(" λ = {aux:+.1} |");
     }

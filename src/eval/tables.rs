@@ -48,6 +48,15 @@ pub struct CrossRow {
     pub success_ratio: Vec<f64>,
 }
 
+/// One judge at one λ: its success on the controllability levels (the cross table's plays).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JudgeRow {
+    pub judge: String,
+    pub aux: f64,
+    pub success_ratio: f64,
+    pub completed_by_any: f64,
+}
+
 /// Everything `eval` measures.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Results {
@@ -59,6 +68,8 @@ pub struct Results {
     pub controllability: Vec<ControllabilityRow>,
     pub generalization: Vec<GeneralizationRow>,
     pub cross: Vec<CrossRow>,
+    /// Every judge (trained Solvers and the scripted player's skills) at every λ.
+    pub controllability_by_judge: Vec<JudgeRow>,
 }
 
 /// The tables from the layout and the statistics of every play (`stats[i]` of play `i`).
@@ -125,6 +136,7 @@ pub fn assemble(
         .collect();
     let mut generalization = Vec::new();
     let mut cross = Vec::new();
+    let mut controllability_by_judge = Vec::new();
     for (k, mode) in layout.solvers.iter().enumerate() {
         let s = summary(&|p| matches!(p, Play::Generalization { solver, .. } if *solver == k));
         let rules = layout.validation_rule_levels;
@@ -148,14 +160,22 @@ pub fn assemble(
             },
             tracks: layout.validation_levels,
         });
-        let success_ratio = (0..AUX_VALUES.len())
+        let by_aux: Vec<Summary> = (0..AUX_VALUES.len())
             .map(|a| {
                 summary(
                     &|p| matches!(p, Play::Cross { solver, aux, .. } if *solver == k && *aux == a),
                 )
-                .mean_success
             })
             .collect();
+        for (s, &aux) in by_aux.iter().zip(&AUX_VALUES) {
+            controllability_by_judge.push(JudgeRow {
+                judge: mode.clone(),
+                aux,
+                success_ratio: s.mean_success,
+                completed_by_any: s.completed_by_any,
+            });
+        }
+        let success_ratio = by_aux.iter().map(|s| s.mean_success).collect();
         cross.push(CrossRow {
             mode: mode.clone(),
             success_ratio,
@@ -168,6 +188,7 @@ pub fn assemble(
         controllability,
         generalization,
         cross,
+        controllability_by_judge,
     }
 }
 

@@ -11,6 +11,7 @@ mod gltf_export;
 mod hostile_input;
 mod level_format;
 mod pacing;
+mod panel;
 mod platform_game;
 mod ppo_learns;
 mod racing_game;

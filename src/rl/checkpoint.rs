@@ -80,6 +80,10 @@ pub struct TrainingRecord {
     /// The commit that trained it, `-dirty` when the tree held uncommitted changes.
     pub commit: String,
     pub command: String,
+    /// A Generator trained against a population: the Solver steps at which each earlier
+    /// Solver it played was taken, oldest first (the current Solver played too).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub population: Vec<u64>,
 }
 
 /// Everything needed to continue a training run where it stopped.
@@ -128,14 +132,21 @@ pub fn policy_bytes(policy: &ActorCritic, card: &PolicyCard) -> Vec<u8> {
     safetensors::serialize(tensors, Some(metadata)).expect("policy tensors serialize")
 }
 
-/// Serializes a training checkpoint: policy, optimizer moments, card and training state.
-pub fn checkpoint_bytes(ppo: &Ppo, card: &PolicyCard, state: &TrainingState) -> Vec<u8> {
+/// Serializes a training checkpoint: policy, optimizer moments, card and training state, and
+/// `extra` tensors the run keeps beside them (named apart from the policy's).
+pub fn checkpoint_bytes(
+    ppo: &Ppo,
+    card: &PolicyCard,
+    state: &TrainingState,
+    extra: Vec<(String, Tensor)>,
+) -> Vec<u8> {
     let vars = ppo.policy.named_vars();
     let mut tensors: Vec<(String, Tensor)> = vars
         .iter()
         .map(|(n, v)| (n.clone(), v.as_tensor().clone()))
         .collect();
     tensors.extend(ppo.adam.named_state(&vars));
+    tensors.extend(extra);
     let metadata = HashMap::from([
         (
             CARD_KEY.to_string(),

@@ -52,6 +52,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 rng,
                 Self::rules(mode, config),
                 AdversarialState::default(),
+                Vec::new(),
             )?)
         };
         let solver = Run::start(out, mode, config, build)?;
@@ -79,6 +80,11 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         }
         let (loaded, generator_state) = read_checkpoint(&path, G::GAME, Role::Generator, mode)?;
         let generator_iteration = generator_state.iteration;
+        let record: PopulationRecord = match &generator_state.source {
+            serde_json::Value::Null => PopulationRecord::default(),
+            source => serde_json::from_value(source.clone())
+                .with_context(|| format!("{}: population", path.display()))?,
+        };
         let build = move |config: &TrainConfig, source: Option<serde_json::Value>| {
             if let Some(trained) = loaded.card.curve_offset
                 && trained != config.generator.curve_offset
@@ -93,6 +99,12 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             }
             let state: AdversarialState =
                 serde_json::from_value(source.unwrap_or_default()).context("match source")?;
+            let mut population =
+                population_from(&record, &loaded.tensors, &solver_shape(config, G::GAME))
+                    .map_err(|e| anyhow::anyhow!("{}: population: {e}", path.display()))?;
+            // A configuration that keeps fewer snapshots drops the oldest.
+            let surplus = population.len().saturating_sub(config.generator.population);
+            population.drain(..surplus);
             let vars = loaded.policy.named_vars();
             let mut ppo = Ppo::new(config.generator.ppo.clone(), loaded.policy)?;
             ppo.adam
@@ -109,6 +121,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 generator_state.rng,
                 Self::rules(mode, config),
                 state,
+                population,
             )?)
         };
         let solver = Run::resume(out, mode, replacement, build)?;
@@ -130,7 +143,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
 
     pub(super) fn generator_card(&self, wall_time_s: f64) -> PolicyCard {
         let envs = &self.solver.trainer.env;
-        card(
+        let mut card = card(
             G::GAME,
             Role::Generator,
             self.solver.mode,
@@ -138,7 +151,28 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             &envs.generator.norm,
             envs.state.generator_steps,
             wall_time_s,
-        )
+        );
+        card.training.population = envs.population.iter().map(|s| s.solver_steps).collect();
+        card
+    }
+
+    /// Takes a snapshot of the Solver for the population when the last is
+    /// `population_every_steps` old (or there is none).
+    fn snapshot_if_due(&mut self) -> Result<()> {
+        let generator = &self.solver.config.generator;
+        let (keep, every) = (generator.population, generator.population_every_steps);
+        let trainer = &mut self.solver.trainer;
+        let now = trainer.global_step;
+        let due = trainer
+            .env
+            .population
+            .last()
+            .is_none_or(|last| now.saturating_sub(last.solver_steps) >= every);
+        if keep > 0 && due {
+            let snapshot = Snapshot::of(&trainer.ppo.policy, &trainer.norm, now)?;
+            trainer.env.add_snapshot(snapshot, keep);
+        }
+        Ok(())
     }
 
     /// Plays until a batch of Generator decisions is complete, and learns from it.
@@ -211,9 +245,9 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                 let envs = self.envs();
                 envs.state.phase_steps += rollout.steps;
                 let warm = self.solver.trainer.global_step >= phases.solver_warmup_steps;
-                let envs = self.envs();
-                if warm && envs.state.phase_steps >= phases.solver_phase_steps {
-                    envs.set_phase(Phase::Generator);
+                if warm && self.envs().state.phase_steps >= phases.solver_phase_steps {
+                    self.snapshot_if_due()?;
+                    self.envs().set_phase(Phase::Generator);
                 }
                 Ok(format!(
                     "solver: return {:.2}, success {:.2}",
@@ -237,17 +271,18 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
 
     fn save_checkpoint(&self, wall: f64) -> Result<()> {
         let envs = &self.solver.trainer.env;
+        let (population, tensors) = population_record(&envs.population);
         let state = TrainingState {
             global_step: envs.state.generator_steps,
             iteration: self.generator_iteration,
             adam_step: envs.generator.ppo.adam.step,
             wall_time_s: wall,
             rng: envs.rng.clone(),
-            source: serde_json::Value::Null,
+            source: serde_json::to_value(population)?,
             config: serde_json::to_value(&self.solver.config)?,
         };
-        let bytes =
-            checkpoint::checkpoint_bytes(&envs.generator.ppo, &self.generator_card(wall), &state);
+        let card = self.generator_card(wall);
+        let bytes = checkpoint::checkpoint_bytes(&envs.generator.ppo, &card, &state, tensors);
         let out = &self.solver.out;
         fsio::write_atomic(&out.join(GENERATOR_CHECKPOINT), &bytes, Overwrite::Allowed)?;
         self.solver.save_solver_checkpoint(wall)

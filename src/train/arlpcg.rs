@@ -8,6 +8,11 @@
 //! decisions are recorded per match, to be learned from with PPO once enough have completed.
 //! Each match draws its goal, start (and racing obstacles) and λ from its own seed (episode
 //! counter from [`TRAINING_SEED_BASE`]), so runs are reproducible and resumable.
+//!
+//! With a population, each match also draws who plays it while the Generator learns: the
+//! current Solver or one of its earlier [`Snapshot`]s, so that the Generator's failure reward
+//! comes from several networks and no single one's blind spot pays. While the Solver learns it
+//! plays every match itself.
 
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
@@ -20,7 +25,7 @@ use crate::game::generator::{
 };
 use crate::level::stats::Outcome;
 use crate::rl::normalizer::RunningNorm;
-use crate::rl::policy::ActMode;
+use crate::rl::policy::{ActMode, ActorCritic};
 use crate::rl::ppo::{Batch, Ppo, gae};
 use crate::rl::vec_env::{Transition, VecEnv};
 use crate::seeds::TRAINING_SEED_BASE;
@@ -65,6 +70,110 @@ pub struct MatchRules {
     /// Obstacles drawn into each racing match's scene.
     pub obstacles: u32,
     pub rewards: GeneratorRewards,
+}
+
+/// An earlier Solver that the Generator plays against.
+pub struct Snapshot {
+    pub policy: ActorCritic,
+    pub norm: RunningNorm,
+    /// The Solver's steps when it was taken.
+    pub solver_steps: u64,
+}
+
+impl Snapshot {
+    /// A copy of `policy` (new variables, the same values) with its normalizer.
+    pub fn of(
+        policy: &ActorCritic,
+        norm: &RunningNorm,
+        solver_steps: u64,
+    ) -> candle_core::Result<Self> {
+        let copy = ActorCritic::new(policy.shape().clone(), 0)?;
+        for ((_, to), (_, from)) in copy.named_vars().iter().zip(policy.named_vars()) {
+            to.set(&from.as_tensor().copy()?)?;
+        }
+        Ok(Self {
+            policy: copy,
+            norm: norm.clone(),
+            solver_steps,
+        })
+    }
+}
+
+/// How a Generator checkpoint records its population: the snapshots' tensors are named
+/// `population.K.<variable>`, and this (its training state's `source`) holds the rest.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct PopulationRecord {
+    pub snapshots: Vec<SnapshotRecord>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct SnapshotRecord {
+    pub solver_steps: u64,
+    pub norm: RunningNorm,
+}
+
+/// The population as a checkpoint stores it: its record and its tensors.
+pub fn population_record(
+    population: &[Snapshot],
+) -> (PopulationRecord, Vec<(String, candle_core::Tensor)>) {
+    let mut tensors = Vec::new();
+    let mut record = PopulationRecord::default();
+    for (k, snapshot) in population.iter().enumerate() {
+        for (name, var) in snapshot.policy.named_vars() {
+            tensors.push((format!("population.{k}.{name}"), var.as_tensor().clone()));
+        }
+        record.snapshots.push(SnapshotRecord {
+            solver_steps: snapshot.solver_steps,
+            norm: snapshot.norm.clone(),
+        });
+    }
+    (record, tensors)
+}
+
+/// The population a checkpoint stored: Solvers of `shape`, each tensor checked for its shape
+/// and for finite values. `Err` names the tensor.
+pub fn population_from(
+    record: &PopulationRecord,
+    tensors: &std::collections::HashMap<String, candle_core::Tensor>,
+    shape: &crate::rl::policy::PolicyShape,
+) -> Result<Vec<Snapshot>, String> {
+    let mut population = Vec::with_capacity(record.snapshots.len());
+    for (k, entry) in record.snapshots.iter().enumerate() {
+        let policy = ActorCritic::new(shape.clone(), 0).map_err(|e| e.to_string())?;
+        for (name, var) in policy.named_vars() {
+            let key = format!("population.{k}.{name}");
+            let saved = tensors.get(&key).ok_or(format!("tensor {key}: missing"))?;
+            if saved.dims() != var.as_tensor().dims() {
+                return Err(format!(
+                    "tensor {key}: shape {:?}, the Solver's network needs {:?}",
+                    saved.dims(),
+                    var.as_tensor().dims()
+                ));
+            }
+            let finite = saved
+                .flatten_all()
+                .and_then(|t| t.to_vec1::<f32>())
+                .map_err(|e| format!("tensor {key}: {e}"))?
+                .iter()
+                .all(|v| v.is_finite());
+            if !finite {
+                return Err(format!("tensor {key}: holds NaN or infinite values"));
+            }
+            var.set(saved).map_err(|e| format!("tensor {key}: {e}"))?;
+        }
+        let d = shape.observation;
+        if entry.norm.mean.len() != d || entry.norm.var.len() != d {
+            return Err(format!(
+                "snapshot {k}: its normalizer does not observe {d} values"
+            ));
+        }
+        population.push(Snapshot {
+            policy,
+            norm: entry.norm.clone(),
+            solver_steps: entry.solver_steps,
+        });
+    }
+    Ok(population)
 }
 
 /// The Generator with its optimizer and normalizer.
@@ -114,6 +223,11 @@ pub struct AdversarialEnvs<G: GeneratorGame> {
     recorded: Vec<Vec<Decision>>,
     generator_returns: Vec<f32>,
     pub stats: MatchStats,
+    /// Earlier Solvers, oldest first.
+    pub population: Vec<Snapshot>,
+    /// Per match, the snapshot that plays it while the Generator learns (`None`: the current
+    /// Solver).
+    opponents: Vec<Option<usize>>,
 }
 
 impl<G: GeneratorGame> AdversarialEnvs<G> {
@@ -124,6 +238,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         rng: ChaCha8Rng,
         rules: MatchRules,
         state: AdversarialState,
+        population: Vec<Snapshot>,
     ) -> candle_core::Result<Self> {
         let mut this = Self {
             matches: Vec::with_capacity(num_matches),
@@ -134,10 +249,13 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             recorded: vec![Vec::new(); num_matches],
             generator_returns: vec![0.0; num_matches],
             stats: MatchStats::default(),
+            population,
+            opponents: Vec::with_capacity(num_matches),
         };
         for _ in 0..num_matches {
-            let fresh = this.next_match();
+            let (fresh, opponent) = this.next_match();
             this.matches.push(fresh);
+            this.opponents.push(opponent);
         }
         this.first_pieces((0..num_matches).collect())?;
         Ok(this)
@@ -183,13 +301,63 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         }
     }
 
-    fn next_match(&mut self) -> Match<G> {
+    /// The next match, and the snapshot that plays it while the Generator learns.
+    fn next_match(&mut self) -> (Match<G>, Option<usize>) {
         let seed = TRAINING_SEED_BASE + self.state.episodes_started;
         self.state.episodes_started += 1;
         let (build, mut rng) = G::new_build(seed, None, self.rules.limits, self.rules.obstacles);
         let values = &self.rules.aux_values;
         let aux = values[rng.random_range(0..values.len())];
-        Match::new(build, vec![aux], seed)
+        let snapshots = self.population.len();
+        let opponent = match snapshots {
+            0 => None,
+            n => Some(rng.random_range(0..=n)).filter(|&k| k < n),
+        };
+        (Match::new(build, vec![aux], seed), opponent)
+    }
+
+    /// Adds a snapshot of the Solver, the oldest leaving beyond `keep`; the matches it played
+    /// go to the current Solver.
+    pub fn add_snapshot(&mut self, snapshot: Snapshot, keep: usize) {
+        self.population.push(snapshot);
+        while self.population.len() > keep {
+            self.population.remove(0);
+            for opponent in &mut self.opponents {
+                *opponent = opponent.and_then(|k| k.checked_sub(1));
+            }
+        }
+    }
+
+    /// The actions with those of the matches that snapshots play replaced by the snapshots'
+    /// (one batched forward pass per snapshot), while the Generator learns.
+    fn with_opponents(&mut self, actions: &[f32]) -> candle_core::Result<Option<Vec<f32>>> {
+        if !self.learning() || self.opponents.iter().all(Option::is_none) {
+            return Ok(None);
+        }
+        let width = actions.len() / self.matches.len();
+        let d = G::Env::OBSERVATION_SIZE;
+        let mut replaced = actions.to_vec();
+        for (k, snapshot) in self.population.iter().enumerate() {
+            let played: Vec<usize> = (0..self.matches.len())
+                .filter(|&i| self.opponents[i] == Some(k))
+                .collect();
+            if played.is_empty() {
+                continue;
+            }
+            let mut observations = vec![0.0; played.len() * d];
+            for (&i, row) in played.iter().zip(observations.chunks_mut(d)) {
+                self.matches[i].env().observe(row);
+            }
+            snapshot.norm.normalize(&mut observations);
+            let acted = snapshot
+                .policy
+                .act(&observations, ActMode::Sample, &mut self.rng)?;
+            for (n, &i) in played.iter().enumerate() {
+                replaced[i * width..(i + 1) * width]
+                    .copy_from_slice(&acted.actions[n * width..(n + 1) * width]);
+            }
+        }
+        Ok(Some(replaced))
     }
 
     /// Lets the Generator place a piece in each of the matches `indices`; returns the matches
@@ -265,7 +433,9 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         if let Some(last) = self.recorded[i].last_mut() {
             last.ended = true;
         }
-        self.matches[i] = self.next_match();
+        let (fresh, opponent) = self.next_match();
+        self.matches[i] = fresh;
+        self.opponents[i] = opponent;
     }
 
     /// Recorded Generator decisions that are complete (their reward is final).
@@ -344,6 +514,10 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
     }
 
     fn step(&mut self, actions: &[f32], out: &mut [Transition]) {
+        let replaced = self
+            .with_opponents(actions)
+            .expect("the snapshots' forward pass runs on the CPU");
+        let actions = replaced.as_deref().unwrap_or(actions);
         let width = actions.len() / self.matches.len();
         let rewards = &self.rules.rewards;
         let steps: Vec<(crate::game::Step, f32)> = self

@@ -138,6 +138,7 @@ pub(super) fn card(
                 .chain(std::env::args().skip(1))
                 .collect::<Vec<_>>()
                 .join(" "),
+            population: Vec::new(),
         },
         results: Default::default(),
         max_pieces: (role == Role::Generator).then_some(config.generator.max_pieces),

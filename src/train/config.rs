@@ -104,6 +104,14 @@ pub struct GeneratorConfig {
     /// ...and Generator decisions in each Generator phase. The Solver acts about 25 times per
     /// block, so its phase switches about a tenth as often as the Generator's in its own steps.
     pub generator_phase_steps: u64,
+    /// While the Generator learns, each match is played by the current Solver or by one of up
+    /// to this many earlier snapshots of it, drawn uniformly per match, so that no single
+    /// network's blind spot pays (0: the current Solver alone, as in the paper). The snapshots
+    /// are part of the Generator's checkpoint.
+    pub population: usize,
+    /// Solver steps between snapshots (one is taken when a Solver phase ends this long after
+    /// the last; the oldest leaves when there are more than `population`).
+    pub population_every_steps: u64,
 }
 
 impl Default for TrainConfig {
@@ -145,6 +153,8 @@ impl Default for GeneratorConfig {
             solver_warmup_steps: 500_000,
             solver_phase_steps: 100_000,
             generator_phase_steps: 10_000,
+            population: 4,
+            population_every_steps: 500_000,
         }
     }
 }
@@ -154,6 +164,8 @@ const MAX_CONFIG_BYTES: u64 = 1 << 20;
 /// Limits on the networks' size (a 4096-unit layer is already 64 MB of weights and moments).
 const MAX_HIDDEN_LAYERS: usize = 8;
 const MAX_HIDDEN_UNITS: usize = 4096;
+/// Snapshots of the Solver a Generator may play against (each is a network's weights).
+const MAX_POPULATION: usize = 16;
 /// Limit on each phase length and the warm-up (10^12 steps: years of training).
 const MAX_PHASE_STEPS: u64 = 1_000_000_000_000;
 
@@ -330,6 +342,16 @@ pub(super) fn check_config(config: &TrainConfig, game: Game) -> Result<(), Strin
     .all(f32::is_finite)
     {
         return Err("generator.rewards: every weight must be a finite number".into());
+    }
+    if g.population > MAX_POPULATION {
+        return Err(format!(
+            "generator.population must be within [0, {MAX_POPULATION}]"
+        ));
+    }
+    if !(1..=MAX_PHASE_STEPS).contains(&g.population_every_steps) {
+        return Err(format!(
+            "generator.population_every_steps must be within [1, {MAX_PHASE_STEPS}]"
+        ));
     }
     let max_pieces = match game {
         Game::Platform => PlatformGame::MAX_PIECES,

@@ -36,7 +36,10 @@ use crate::rl::policy::{ActorCritic, PolicyShape};
 use crate::rl::ppo::{Ppo, UpdateStats};
 use crate::rl::vec_env::{RolloutStats, Trainer, VecEnv};
 use adversarial_run::AdversarialRun;
-use arlpcg::{AdversarialEnvs, AdversarialState, Generator, MatchRules, MatchStats, Phase};
+use arlpcg::{
+    AdversarialEnvs, AdversarialState, Generator, MatchRules, MatchStats, Phase, PopulationRecord,
+    Snapshot, population_from, population_record,
+};
 use cards::*;
 use config::{check_config, check_resumable_change, load_config};
 pub use metrics::write_learning_curve;

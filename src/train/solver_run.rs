@@ -148,7 +148,7 @@ impl<E: Resumable> Run<E> {
             config: serde_json::to_value(&self.config)?,
         };
         let card = self.solver_card(wall_time_s);
-        let bytes = checkpoint::checkpoint_bytes(&self.trainer.ppo, &card, &state);
+        let bytes = checkpoint::checkpoint_bytes(&self.trainer.ppo, &card, &state, Vec::new());
         fsio::write_atomic(&self.out.join(CHECKPOINT), &bytes, Overwrite::Allowed)
     }
 

@@ -44,7 +44,10 @@ fn scripted_skills_are_clearly_apart_on_rule_levels() {
             novice + 0.15 < median && median < expert,
             "{game}: novice {novice:.2}, median {median:.2}, expert {expert:.2}"
         );
-        assert!(novice < 0.8, "{game}: a novice below the trained Solvers, {novice:.2}");
+        assert!(
+            novice < 0.8,
+            "{game}: a novice below the trained Solvers, {novice:.2}"
+        );
     }
 }
 
@@ -66,15 +69,25 @@ fn verify_panel_reports_every_judge_and_rates_the_levels_together() {
     assert_eq!(rows.len(), 2);
     for row in &rows {
         let panel = row["panel"].as_object().unwrap();
-        assert_eq!(panel.len(), 7, "every shipped Solver and three skills: {panel:?}");
+        assert_eq!(
+            panel.len(),
+            7,
+            "every shipped Solver and three skills: {panel:?}"
+        );
         assert!(panel.contains_key("rule-pcg") && panel.contains_key("scripted-novice"));
         assert_eq!(row["rating"]["levels"], 2);
         let ci = row["rating"]["ci95"].as_array().unwrap();
         let b = row["rating"]["b"].as_f64().unwrap();
-        assert!(ci[0].as_f64().unwrap() < b && b < ci[1].as_f64().unwrap(), "{row}");
+        assert!(
+            ci[0].as_f64().unwrap() < b && b < ci[1].as_f64().unwrap(),
+            "{row}"
+        );
     }
     let b = |k: usize| rows[k]["rating"]["b"].as_f64().unwrap();
-    assert!(b(0) < b(1), "the λ = 1 level rates easier than the λ = -1 one");
+    assert!(
+        b(0) < b(1),
+        "the λ = 1 level rates easier than the λ = -1 one"
+    );
 
     let some = arlpcg(&[
         "verify",

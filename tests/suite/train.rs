@@ -335,7 +335,21 @@ generator:
   solver_warmup_steps: 128
   solver_phase_steps: 128
   generator_phase_steps: 16
+  population: 2
+  population_every_steps: 256
 ";
+
+/// The Solver steps of the snapshots a run's Generator card says it played against.
+fn population(dir: &Path) -> Vec<u64> {
+    let loaded = load_policy(
+        &std::fs::read(dir.join("generator.safetensors")).unwrap(),
+        Game::Platform,
+        Role::Generator,
+        GENERATOR_OBSERVATION_SIZE,
+    )
+    .unwrap();
+    loaded.card.training.population
+}
 
 /// Generator iterations logged so far (rows of generator-metrics.csv).
 fn generator_rows(dir: &Path) -> usize {
@@ -369,6 +383,12 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
         generator_before >= 3,
         "{generator_before} Generator iterations"
     );
+    // Snapshots when a Solver phase ends at least 256 steps after the last one.
+    let first_population = population(&out);
+    assert!(
+        !first_population.is_empty() && first_population.len() <= 2,
+        "{first_population:?}"
+    );
     let resumed = arlpcg(&[
         "train", "--mode", "arlpcg", "--steps", "1024", "--out", out_s, "--resume",
     ]);
@@ -382,6 +402,11 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
         generator_rows(&out) > generator_before,
         "the Generator went on learning"
     );
+    // The population came back from the checkpoint and grew, keeping the newest two.
+    let resumed_population = population(&out);
+    assert_eq!(resumed_population.len(), 2, "{resumed_population:?}");
+    assert!(resumed_population.last() > first_population.last());
+    assert!(resumed_population.windows(2).all(|w| w[1] - w[0] >= 256));
     for (file, role, size) in [
         ("solver.safetensors", Role::Solver, OBSERVATION_SIZE),
         (
@@ -489,6 +514,29 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
         "avg_block_size",
     ] {
         assert!(rows[0].get(key).is_some(), "controllability.{key}");
+    }
+    let by_judge = json["controllability_by_judge"].as_array().unwrap();
+    let judges: std::collections::BTreeSet<&str> = by_judge
+        .iter()
+        .map(|row| row["judge"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        judges,
+        [
+            "arlpcg",
+            "scripted-expert",
+            "scripted-median",
+            "scripted-novice"
+        ]
+        .into(),
+        "the run's Solver and the scripted player's skills"
+    );
+    assert_eq!(by_judge.len(), 4 * 5, "every judge at every λ");
+    for key in ["aux", "success_ratio", "completed_by_any"] {
+        assert!(
+            by_judge[0].get(key).is_some(),
+            "controllability_by_judge.{key}"
+        );
     }
     let generalization = json["generalization"].as_array().unwrap();
     assert_eq!(generalization[0]["mode"], "arlpcg");

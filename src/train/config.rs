@@ -136,12 +136,16 @@ impl Default for TrainConfig {
 impl Default for GeneratorConfig {
     fn default() -> Self {
         Self {
+            // What trained the shipped Generators: a constant 3e-4 and a little entropy. The
+            // paper's 2e-4, annealed, without an entropy bonus, gave Generators that λ did not
+            // steer (docs/training.md).
             ppo: PpoConfig {
-                learning_rate: 2e-4,
+                learning_rate: 3e-4,
+                anneal_lr: false,
                 gamma: 0.99,
                 num_envs: 64,
                 num_steps: 16,
-                ent_coef: 0.0,
+                ent_coef: 0.001,
                 ..PpoConfig::default()
             },
             rewards: GeneratorRewards::default(),

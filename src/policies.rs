@@ -190,26 +190,34 @@ pub fn load_panel(dir: &Path, game: Game, chosen: Option<&[Judge]>) -> Result<Pa
     };
     let mut panel = Panel { judges: Vec::new() };
     for judge in judges {
-        let policy = match judge.policy_file(dir) {
-            Some(path) => {
-                let (policy, card) =
-                    load_solver(&path, game).with_context(|| format!("judge {}", judge.name()))?;
-                if card.training.mode != judge.name() {
-                    anyhow::bail!(
-                        "judge {}: {} was trained in mode {}, not {}",
-                        judge.name(),
-                        path.display(),
-                        card.training.mode,
-                        judge.name()
-                    );
-                }
-                Some(policy)
-            }
-            None => None,
-        };
+        let policy = load_judge(dir, game, judge)?.map(|(policy, _)| policy);
         panel.judges.push((judge, policy));
     }
     Ok(panel)
+}
+
+/// The Solver of `judge` in the policies folder `dir`, checked to be trained in the judge's
+/// mode; `None` for the scripted player.
+pub fn load_judge(
+    dir: &Path,
+    game: Game,
+    judge: Judge,
+) -> Result<Option<(SolverPolicy, PolicyCard)>> {
+    let Some(path) = judge.policy_file(dir) else {
+        return Ok(None);
+    };
+    let (policy, card) =
+        load_solver(&path, game).with_context(|| format!("judge {}", judge.name()))?;
+    if card.training.mode != judge.name() {
+        anyhow::bail!(
+            "judge {}: {} was trained in mode {}, not {}",
+            judge.name(),
+            path.display(),
+            card.training.mode,
+            judge.name()
+        );
+    }
+    Ok(Some((policy, card)))
 }
 
 /// The paths of the Generator and the Solver in a policies folder.

@@ -2,6 +2,7 @@
 //! summary over all the levels.
 
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
@@ -185,19 +186,21 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
             .map_err(anyhow::Error::from)
             .and_then(|level| {
                 let game = level.game();
-                if !panels.contains_key(&game) {
-                    let dir = args
-                        .policies
-                        .clone()
-                        .unwrap_or_else(|| PathBuf::from(format!("policies/{game}")));
-                    let chosen = (!chosen.0.is_empty()).then_some(chosen.0.as_slice());
-                    let panel = load_panel(&dir, game, chosen)?;
-                    if !args.json {
-                        eprintln!("{game} panel: {}", panel.names().join(", "));
+                let panel = match panels.entry(game) {
+                    Entry::Occupied(known) => known.into_mut(),
+                    Entry::Vacant(new) => {
+                        let dir = args
+                            .policies
+                            .clone()
+                            .unwrap_or_else(|| PathBuf::from(format!("policies/{game}")));
+                        let chosen = (!chosen.0.is_empty()).then_some(chosen.0.as_slice());
+                        let panel = load_panel(&dir, game, chosen)?;
+                        if !args.json {
+                            eprintln!("{game} panel: {}", panel.names().join(", "));
+                        }
+                        new.insert(panel)
                     }
-                    panels.insert(game, panel);
-                }
-                let panel = &panels[&game];
+                };
                 let runs = args.trials as u64 * panel.judges.len() as u64;
                 let bar = crate::shell::progress_bar(runs, &path.display().to_string());
                 let played = (0..panel.judges.len())

@@ -3,16 +3,18 @@
 //! [`Effect`]s, which the shell hands to the worker threads. Nothing here touches the terminal,
 //! the file system or a clock, so key scripts drive it in tests.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use ratatui::crossterm::event::{KeyEvent, MouseEvent};
 use ratatui::layout::Rect;
 
+use crate::game::Skill;
 use crate::level::params::quantize;
 use crate::level::platform::heading_direction;
 use crate::level::stats::{Outcome, SolverStats, TrialResult, wilson_interval};
 use crate::level::{Game, Level};
+use crate::panel::Judge;
 use crate::rl::checkpoint::PolicyCard;
 use crate::verify::Recording;
 
@@ -78,6 +80,38 @@ pub struct PolicyInfo {
 pub struct LoadedInfo {
     pub generator: Option<PolicyInfo>,
     pub solver: Option<PolicyInfo>,
+    /// The scripted player's skill, when it plays (no Solver).
+    pub skill: Skill,
+}
+
+impl LoadedInfo {
+    /// Who plays the trials: the Solver, by its training mode, or the scripted player.
+    pub fn judge(&self) -> Judge {
+        let mode = self.solver.as_ref().map(|s| s.card.training.mode.as_str());
+        match mode.map(Judge::parse) {
+            Some(Ok(judge)) => judge,
+            // A Solver of a mode no judge has (none today) plays as the ARLPCG one.
+            Some(Err(_)) => Judge::Solver(crate::train::TrainMode::Arlpcg),
+            None => Judge::Scripted(self.skill),
+        }
+    }
+
+    /// The folder the judges come from: the Solver's, else the Generator's, else the shipped
+    /// policies of `game`.
+    pub fn folder(&self, game: Game) -> PathBuf {
+        [&self.solver, &self.generator]
+            .into_iter()
+            .flatten()
+            .find_map(|p| p.path.parent().map(Path::to_path_buf))
+            .unwrap_or_else(|| PathBuf::from(format!("policies/{game}")))
+    }
+}
+
+/// The judge now playing the trials, after `j`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JudgeSwitch {
+    pub solver: Option<PolicyInfo>,
+    pub skill: Skill,
 }
 
 /// A prompt being typed.
@@ -265,6 +299,7 @@ pub enum Response {
     /// Export done (the paths written), refused because files exist, or failed.
     Exported(ExportOutcome),
     Loaded(Result<Box<LoadedInfo>, String>),
+    Judged(Result<Box<JudgeSwitch>, String>),
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -315,6 +350,12 @@ pub enum Effect {
     },
     /// Policies of `game` from a folder or one file.
     Load { path: PathBuf, game: Game },
+    /// The next judge after `after` whose Solver is in `folder` (or a scripted skill) plays.
+    NextJudge {
+        game: Game,
+        after: Judge,
+        folder: PathBuf,
+    },
     /// A level of `game` whose success, measured with `trials` runs, is within ±0.1 of `target`
     /// (the search of `generate --target-success`).
     Target {
@@ -766,6 +807,21 @@ impl App {
                 }
                 Vec::new()
             }
+            Response::Judged(result) => match result {
+                Ok(switch) => {
+                    self.policies.solver = switch.solver;
+                    self.policies.skill = switch.skill;
+                    self.say(format!(
+                        "judge: {} plays the trials",
+                        self.policies.judge().name()
+                    ));
+                    self.generate()
+                }
+                Err(problem) => {
+                    self.complain(problem);
+                    Vec::new()
+                }
+            },
             Response::Loaded(result) => match result {
                 Ok(info) => {
                     self.say(format!(

@@ -10,12 +10,15 @@ use std::sync::{Arc, Mutex};
 
 use anyhow::Result;
 
-use super::app::{Effect, ExportOutcome, LoadedInfo, PolicyInfo, Response, SweepPoint};
+use super::app::{
+    Effect, ExportOutcome, JudgeSwitch, LoadedInfo, PolicyInfo, Response, SweepPoint,
+};
 use crate::fsio::Overwrite;
 use crate::game::Skill;
 use crate::generation::{self, GeneratorPolicy, LevelRequest};
 use crate::level::{Game, Level};
 use crate::level_files::{Format, LevelFiles, write_level_files};
+use crate::panel::Judge;
 use crate::policies::{load_generator, load_solver, policy_paths};
 use crate::rl::checkpoint::PolicyError;
 use crate::verify::{self, Solver, SolverPolicy, Watch};
@@ -25,6 +28,8 @@ use crate::verify::{self, Solver, SolverPolicy, Watch};
 pub struct Policies {
     pub generator: Option<Arc<GeneratorPolicy>>,
     pub solver: Option<Arc<SolverPolicy>>,
+    /// The scripted player's skill, when it plays (no Solver).
+    pub skill: Skill,
 }
 
 /// The policies of each game.
@@ -54,7 +59,7 @@ impl Policies {
     fn solver(&self) -> Solver<'_> {
         match &self.solver {
             Some(policy) => Solver::Policy(policy.as_ref()),
-            None => Solver::Scripted(Skill::Expert),
+            None => Solver::Scripted(self.skill),
         }
     }
 
@@ -139,7 +144,7 @@ fn slot(effect: &Effect) -> (Slot, u64) {
         }
         Effect::Record { id, .. } => (Slot::Record, *id),
         Effect::Sweep { id, .. } => (Slot::Sweep, *id),
-        Effect::Export { .. } | Effect::Load { .. } => (Slot::Always, 0),
+        Effect::Export { .. } | Effect::Load { .. } | Effect::NextJudge { .. } => (Slot::Always, 0),
     }
 }
 
@@ -342,6 +347,13 @@ pub fn perform(
             id,
             result: target_level(shelf.of(game), seed, goal, target, trials).map(Arc::new),
         }),
+        Effect::NextJudge {
+            game,
+            after,
+            folder,
+        } => send(Response::Judged(
+            next_judge(policies, game, after, &folder).map(Box::new),
+        )),
         Effect::Load { path, game } => send(Response::Loaded(match load(&path, game) {
             Ok((loaded, info)) => {
                 // A single file replaces only its own role.
@@ -350,6 +362,7 @@ pub fn perform(
                     *old = Policies {
                         generator: loaded.generator.or(old.generator.clone()),
                         solver: loaded.solver.or(old.solver.clone()),
+                        skill: old.skill,
                     };
                 }
                 Ok(Box::new(info))
@@ -357,6 +370,49 @@ pub fn perform(
             Err(e) => Err(format!("{e:#}")),
         })),
     }
+}
+
+/// The judge after `after` in [`Judge::ALL`] (cyclically) that can play: a scripted skill, or a
+/// Solver whose file is in `folder` (others are passed over); it becomes the game's player.
+fn next_judge(
+    policies: &Mutex<GamePolicies>,
+    game: Game,
+    after: Judge,
+    folder: &Path,
+) -> Result<JudgeSwitch, String> {
+    let start = Judge::ALL.iter().position(|j| *j == after).unwrap_or(0);
+    for k in 1..=Judge::ALL.len() {
+        let judge = Judge::ALL[(start + k) % Judge::ALL.len()];
+        let (solver, info, skill) = match judge {
+            Judge::Scripted(skill) => (None, None, skill),
+            Judge::Solver(_) => {
+                let path = judge
+                    .policy_file(folder)
+                    .expect("a Solver judge has a file");
+                if !path.exists() {
+                    continue;
+                }
+                let (policy, card) = crate::policies::load_judge(folder, game, judge)
+                    .map_err(|e| format!("{e:#}"))?
+                    .expect("a Solver judge is loaded with its policy");
+                (
+                    Some(Arc::new(policy)),
+                    Some(PolicyInfo { path, card }),
+                    Skill::Expert,
+                )
+            }
+        };
+        if let Ok(mut shared) = policies.lock() {
+            let current = shared.of_mut(game);
+            current.solver = solver;
+            current.skill = skill;
+        }
+        return Ok(JudgeSwitch {
+            solver: info,
+            skill,
+        });
+    }
+    Err("no judge can play".into())
 }
 
 /// The target-success search of `generate --target-success` with the designer's policies: the

@@ -12,8 +12,6 @@ pub struct GameFacts {
     /// A piece, and several (`block`/`blocks`, `segment`/`segments`).
     pub piece: &'static str,
     pub pieces: &'static str,
-    /// The game's scripted (non-learning) player, as screens name it.
-    pub scripted_player: &'static str,
     /// Where a failed run is counted: "on the way to" a block, "on" a segment.
     pub failed_at: &'static str,
     /// Obstacles in each evaluation and designer scene (the racing Generator trained with 3).
@@ -51,7 +49,6 @@ pub const PLATFORM: GameFacts = GameFacts {
     game: Game::Platform,
     piece: "block",
     pieces: "blocks",
-    scripted_player: "scripted controller",
     failed_at: "on the way to",
     scene_obstacles: 0,
     piece_columns: &[("avg_block_distance", " m"), ("avg_block_size", " m")],
@@ -77,7 +74,6 @@ pub const RACING: GameFacts = GameFacts {
     game: Game::Racing,
     piece: "segment",
     pieces: "segments",
-    scripted_player: "scripted driver",
     failed_at: "on",
     scene_obstacles: super::racing::generator::MATCH_OBSTACLES,
     piece_columns: &[

@@ -321,6 +321,7 @@ mod tests {
                 seed: 0,
                 commit: "none".into(),
                 command: String::new(),
+                population: Vec::new(),
             },
             results: HashMap::new(),
             max_pieces: None,

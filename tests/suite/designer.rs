@@ -371,7 +371,7 @@ fn racing_tracks_are_designed_like_platform_levels() {
         "off road ",
         "flipped ",
         "air time ",
-        "Solver: scripted driver",
+        "Solver: scripted-expert",
         "failures per segment",
     ] {
         assert!(screen.contains(part), "{part} missing from\n{screen}");
@@ -563,6 +563,7 @@ fn trials_that_fail_say_why() {
     let wrong = Policies {
         generator: None,
         solver: racing.solver.clone(),
+        ..Policies::default()
     };
     let mut h = Harness::new(wrong, LoadedInfo::default(), dir.path());
     h.settle();
@@ -669,4 +670,53 @@ fn pacing_keys_set_a_curve_and_keep_a_prefix() {
     assert!(h.app.pacing.is_none());
     h.settle();
     assert!(h.app.level.as_ref().unwrap().pacing.is_none());
+}
+
+/// `j` hands the trials to the next judge: the folder's other Solvers in turn, then the scripted
+/// player at each skill, then back; the header and the statistics say who plays.
+#[test]
+fn the_judge_key_cycles_through_the_panel() {
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    let (policies, info) = worker::load(&shipped, Game::Platform).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::new(policies, info, dir.path());
+    h.settle();
+    let mut seen = Vec::new();
+    for _ in 0..7 {
+        h.key(KeyCode::Char('j'));
+        h.settle();
+        let judge = h.app.policies.judge().name();
+        let trials = h
+            .app
+            .trials
+            .as_ref()
+            .and_then(|t| t.stats.as_ref())
+            .unwrap();
+        match &trials.solver {
+            arlpcg::level::SolverRef::Scripted { skill } => {
+                assert_eq!(judge, format!("scripted-{skill}"));
+                assert!(
+                    h.screen(80, 24)
+                        .contains(&format!("Solver: scripted-{skill}"))
+                );
+            }
+            arlpcg::level::SolverRef::Policy { policy } => {
+                assert!(policy.path.contains("solver"), "{}", policy.path);
+            }
+            other => panic!("{other:?}"),
+        }
+        seen.push(judge);
+    }
+    assert_eq!(
+        seen,
+        [
+            "rule-pcg",
+            "fixed-track",
+            "fixed-aux",
+            "scripted-novice",
+            "scripted-median",
+            "scripted-expert",
+            "arlpcg"
+        ]
+    );
 }

@@ -47,6 +47,14 @@ impl App {
                 self.overlay = Overlay::Cards;
                 Vec::new()
             }
+            KeyCode::Char('j') => {
+                self.say("switching judge".to_string());
+                vec![Effect::NextJudge {
+                    game: self.game,
+                    after: self.policies.judge(),
+                    folder: self.policies.folder(self.game),
+                }]
+            }
             KeyCode::Tab => self.switch_game(),
             KeyCode::Left => self.set_aux(self.aux - AUX_STEP),
             KeyCode::Right => self.set_aux(self.aux + AUX_STEP),

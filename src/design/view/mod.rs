@@ -17,6 +17,7 @@ use super::app::{App, GoalSetting, Overlay, Panel, PolicyInfo, SweepPoint};
 use super::layout::{Areas, SLIDER_LEFT, SLIDER_RIGHT, fits};
 use crate::level::stats::Outcome;
 use crate::level::{Game, Level, Track};
+use crate::panel::Judge;
 use crate::rl::checkpoint::Role;
 
 /// The key map, as the help overlay and the README show it.
@@ -42,7 +43,7 @@ pub const KEYS: [(&str, &str); 22] = [
     ("k K", "keep pieces up to the selected one / let go"),
     ("x", "export YAML (with the Solver statistics) + .glb"),
     ("p", "load policies (a folder or one .safetensors file)"),
-    ("c", "show the loaded policies' cards"),
+    ("c j", "the policies' cards / next judge: who plays trials"),
     ("Tab", "game: platform / racing"),
     ("?", "this help (any key closes it)"),
     ("q, Esc", "quit"),
@@ -157,7 +158,8 @@ fn header(app: &App, frame: &mut Frame, area: Rect) {
         None => (none.to_string(), String::new()),
     };
     let (generator, generator_budget) = mode(&app.policies.generator, "rules");
-    let (solver, solver_budget) = mode(&app.policies.solver, "scripted");
+    let scripted = Judge::Scripted(app.policies.skill).name();
+    let (solver, solver_budget) = mode(&app.policies.solver, &scripted);
     let long =
         format!("  Generator: {generator}{generator_budget}  Solver: {solver}{solver_budget}");
     let policies = if line.width() + long.chars().count() <= area.width as usize {
@@ -307,8 +309,8 @@ fn draw_replay(app: &App, ctx: &mut Context, project: impl Fn(&[f32; 3]) -> [f64
 }
 
 fn stats(app: &App, frame: &mut Frame, area: Rect) {
-    let scripted = crate::game::facts::facts(app.game).scripted_player;
-    let solver = policy_label(&app.policies.solver, scripted);
+    let scripted = Judge::Scripted(app.policies.skill).name();
+    let solver = policy_label(&app.policies.solver, &scripted);
     let mut lines = Vec::new();
     match &app.trials {
         Some(t) => {

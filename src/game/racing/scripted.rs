@@ -159,7 +159,7 @@ impl ScriptedDriver {
         let distance = ahead.hypot(left).max(1.0);
         let mut steer = (2.0 * WHEELBASE * alpha.sin() / distance).atan() / MAX_STEER;
         if self.skill.steer_wobble > 0.0 {
-            if self.wobble_age % WOBBLE_DECISIONS == 0 {
+            if self.wobble_age.is_multiple_of(WOBBLE_DECISIONS) {
                 let w = self.skill.steer_wobble;
                 self.wobble = self.rng.random_range(-w..=w);
             }

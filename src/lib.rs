@@ -12,6 +12,7 @@
 //! Nothing below the shells prints, reads the clock or uses a global RNG: the same inputs give
 //! the same bytes.
 
+pub mod bootstrap;
 pub mod chart;
 pub mod cli;
 pub mod commands;

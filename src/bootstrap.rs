@@ -84,7 +84,7 @@ pub fn probability_of_improvement(x: &[Vec<f64>], y: &[Vec<f64>], seed: u64) -> 
     assert_eq!(x.len(), y.len(), "the same tasks");
     let value = improvement(x, y);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut resample = |tasks: &[Vec<f64>], rng: &mut ChaCha8Rng| -> Vec<Vec<f64>> {
+    let resample = |tasks: &[Vec<f64>], rng: &mut ChaCha8Rng| -> Vec<Vec<f64>> {
         tasks
             .iter()
             .map(|t| {

@@ -90,8 +90,16 @@ pub struct EvalArgs {
     /// Folders of trained policies: the Generator (generator.safetensors, from the first folder
     /// that has one) and every Solver (solver*.safetensors; each named by its card's training
     /// mode). One Solver must be the arlpcg one.
-    #[arg(long, num_args = 1.., required_unless_present = "merge", value_name = "DIR")]
+    #[arg(long, num_args = 1.., required_unless_present_any = ["merge", "runs"], value_name = "DIR")]
     pub policies: Vec<PathBuf>,
+    /// Score training runs over their seeds instead: each folder is one run (its
+    /// solver.safetensors, and generator.safetensors for adversarial runs; mode and seed from
+    /// the card). Writes seeds.md and seeds.json to --out: per mode the IQM and mean validation
+    /// success over seeds with 95% stratified-bootstrap intervals, each adversarial run's own
+    /// controllability, and P(arlpcg > baseline). The validation set's Generator levels come
+    /// from the first --policies folder (default policies/<game>).
+    #[arg(long, num_args = 1.., value_name = "RUN", conflicts_with_all = ["merge", "shard"])]
+    pub runs: Vec<PathBuf>,
     /// Play only shard I of K of the evaluation (0 <= I < K) and write its raw per-level
     /// statistics to --out as eval-part.json, for `--merge`.
     #[arg(long, value_name = "I/K", value_parser = parse_shard, conflicts_with = "merge")]

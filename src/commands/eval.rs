@@ -18,6 +18,9 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     if !args.merge.is_empty() {
         return merge(args);
     }
+    if !args.runs.is_empty() {
+        return seeds(args);
+    }
     if let Some(missing) = args.policies.iter().find(|dir| !dir.is_dir()) {
         bail!("--policies {}: no such folder", missing.display());
     }
@@ -29,17 +32,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         .with_context(|| format!("no {GENERATOR_FILE} in any --policies folder"))?;
     let (generator, _) = load_generator(&generator_path, args.game)?;
     let solvers = load_solvers(args)?;
-    let base = if args.full {
-        Budget::FULL
-    } else {
-        Budget::QUICK
-    };
-    let budget = Budget {
-        tracks: args.tracks.unwrap_or(base.tracks),
-        trials: args.trials.unwrap_or(base.trials),
-        validation_tracks: args.validation_tracks.unwrap_or(base.validation_tracks),
-        validation_trials: args.trials.unwrap_or(base.validation_trials),
-    };
+    let budget = budget(args);
     let overwrite = if args.force {
         Overwrite::Allowed
     } else {
@@ -96,6 +89,92 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     let results = pool.install(|| eval::evaluate(&generator, &named, budget, &|| bar.inc(1)))?;
     bar.finish_and_clear();
     write_results(&results, &args.out, overwrite)
+}
+
+/// The budget the arguments ask for.
+fn budget(args: &EvalArgs) -> Budget {
+    let base = if args.full {
+        Budget::FULL
+    } else {
+        Budget::QUICK
+    };
+    Budget {
+        tracks: args.tracks.unwrap_or(base.tracks),
+        trials: args.trials.unwrap_or(base.trials),
+        validation_tracks: args.validation_tracks.unwrap_or(base.validation_tracks),
+        validation_trials: args.trials.unwrap_or(base.validation_trials),
+    }
+}
+
+/// `eval --runs`: every run's Solver on one validation set, each adversarial run's own pair on
+/// its controllability levels, summarized over seeds (seeds.md, seeds.json).
+fn seeds(args: &EvalArgs) -> Result<()> {
+    let overwrite = if args.force {
+        Overwrite::Allowed
+    } else {
+        Overwrite::Never
+    };
+    let targets = [args.out.join("seeds.md"), args.out.join("seeds.json")];
+    for target in &targets {
+        fsio::check_writable(target, overwrite)?;
+    }
+    let shipped = PathBuf::from(format!("policies/{}", args.game));
+    let folder = args.policies.first().unwrap_or(&shipped);
+    let (validation_generator, _) = load_generator(&folder.join(GENERATOR_FILE), args.game)?;
+    let mut loaded = Vec::new();
+    for dir in &args.runs {
+        let (solver, card) = load_solver(&dir.join(crate::policies::SOLVER_FILE), args.game)?;
+        let generator_file = dir.join(GENERATOR_FILE);
+        let generator = match generator_file.exists() {
+            true => Some(load_generator(&generator_file, args.game)?.0),
+            false => None,
+        };
+        loaded.push((dir, solver, card, generator));
+    }
+    let runs: Vec<eval::seeds::Run> = loaded
+        .iter()
+        .map(|(dir, solver, card, generator)| eval::seeds::Run {
+            folder: dir.display().to_string(),
+            mode: card.training.mode.clone(),
+            seed: card.training.seed,
+            solver,
+            generator: generator.as_ref(),
+        })
+        .collect();
+    let budget = budget(args);
+    let pool = crate::shell::thread_pool(args.threads)?;
+    let validation =
+        pool.install(|| eval::validation_levels(&validation_generator, budget.validation_tracks))?;
+    let rule_levels = validation.iter().filter(|l| eval::is_rule_level(l)).count();
+    let per_run = |r: &eval::seeds::Run| {
+        validation.len() as u64
+            + r.generator
+                .map_or(0, |_| eval::AUX_VALUES.len() as u64 * budget.tracks as u64)
+    };
+    let bar = crate::shell::progress_bar(runs.iter().map(per_run).sum(), "levels played");
+    let scores = pool.install(|| {
+        eval::seeds::score_runs(&runs, &validation, rule_levels, budget, &|| bar.inc(1))
+    })?;
+    bar.finish_and_clear();
+    let results = eval::seeds::summarize(budget, &validation_generator.reference.path, scores);
+    let markdown = eval::seeds::markdown(&results);
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let mut batch = fsio::Batch::new();
+    batch.stage(&targets[0], markdown.as_bytes(), overwrite)?;
+    batch.stage(
+        &targets[1],
+        &serde_json::to_vec_pretty(&results)?,
+        overwrite,
+    )?;
+    batch.commit()?;
+    println!("{markdown}");
+    println!(
+        "wrote {} and {}",
+        targets[0].display(),
+        targets[1].display()
+    );
+    Ok(())
 }
 
 /// Writes results.md, results.json, results.png and the CSV tables into `out`.

@@ -64,6 +64,14 @@ pub fn validation_levels(
     Ok(levels)
 }
 
+/// Whether a level comes from the rules (the validation set's first half).
+pub fn is_rule_level(level: &Level) -> bool {
+    matches!(
+        level.source,
+        crate::level::Source::Rules { .. } | crate::level::Source::RacingRules { .. }
+    )
+}
+
 /// The levels of an evaluation and its layout.
 pub struct Levels {
     pub by_aux: Vec<Vec<Level>>,
@@ -100,15 +108,7 @@ pub fn levels(
         levels_per_aux: by_aux.iter().map(Vec::len).collect(),
         piece_means,
         validation_levels: validation.len(),
-        validation_rule_levels: validation
-            .iter()
-            .filter(|l| {
-                matches!(
-                    l.source,
-                    crate::level::Source::Rules { .. } | crate::level::Source::RacingRules { .. }
-                )
-            })
-            .count(),
+        validation_rule_levels: validation.iter().filter(|l| is_rule_level(l)).count(),
         solvers: solvers.iter().map(|s| s.mode.clone()).collect(),
     };
     Ok(Levels {

@@ -20,9 +20,10 @@ mod levels;
 mod merge;
 mod plays;
 mod report;
+pub mod seeds;
 pub(crate) mod tables;
 
-pub use levels::{Levels, generator_levels, levels, validation_levels};
+pub use levels::{Levels, generator_levels, is_rule_level, levels, validation_levels};
 pub use merge::{PART_FILE, Part, merge};
 pub use plays::{Layout, Play, play};
 pub use report::{chart, csv_tables, markdown};

@@ -551,6 +551,41 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     ] {
         assert!(results.join(name).exists(), "{name}");
     }
+    // The run scored as one seed of its mode (`eval --runs`): its own pair's controllability and
+    // its Solver on the validation set, with (here degenerate) intervals.
+    let seeds = dir.path().join("seeds");
+    let scored = arlpcg(&[
+        "eval",
+        "--runs",
+        out_s,
+        "--policies",
+        out_s,
+        "--tracks",
+        "2",
+        "--trials",
+        "2",
+        "--validation-tracks",
+        "4",
+        "--out",
+        seeds.to_str().unwrap(),
+    ]);
+    assert!(
+        scored.status.success(),
+        "{}",
+        String::from_utf8_lossy(&scored.stderr)
+    );
+    let seeds_json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(seeds.join("seeds.json")).unwrap()).unwrap();
+    assert_eq!(seeds_json["modes"][0]["mode"], "arlpcg");
+    assert_eq!(seeds_json["modes"][0]["seeds"], serde_json::json!([5]));
+    assert_eq!(
+        seeds_json["runs"][0]["controllability"]
+            .as_array()
+            .unwrap()
+            .len(),
+        5
+    );
+    assert!(seeds.join("seeds.md").exists());
     let again = arlpcg(&[
         "eval",
         "--policies",

@@ -1,0 +1,315 @@
+//! Results over training seeds (`eval --runs`): each run folder's Solver on one shared
+//! validation set, each adversarial run's own pair on its controllability levels, then per
+//! mode the IQM and mean over seeds with stratified-bootstrap intervals, and the probability
+//! that the ARLPCG Solver beats each baseline on validation ([`crate::bootstrap`]).
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::bootstrap::{Aggregate, Estimate, estimate, probability_of_improvement};
+use crate::generation::GeneratorPolicy;
+use crate::level::Level;
+use crate::seeds::EVAL_SEED_BASE;
+use crate::verify::{Solver, SolverPolicy, verify};
+
+use super::{AUX_VALUES, Budget, generator_levels};
+
+/// What one training run scored.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunScores {
+    /// The run's folder.
+    pub run: String,
+    pub mode: String,
+    pub seed: u64,
+    /// Mean success on the validation set's rule levels and on its Generator levels...
+    pub validation_rule_levels: f64,
+    pub validation_generator_levels: f64,
+    /// ...and on all of it.
+    pub validation: f64,
+    /// An adversarial run's own pair: its Solver on its Generator's levels at each λ of
+    /// [`AUX_VALUES`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub controllability: Option<Vec<f64>>,
+}
+
+/// One mode over its seeds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModeSummary {
+    pub mode: String,
+    pub seeds: Vec<u64>,
+    /// Validation success: IQM and mean over (half, seed), stratified by half.
+    pub validation_iqm: Estimate,
+    pub validation_mean: Estimate,
+    /// Mean controllability success at each λ (adversarial modes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub controllability: Option<Vec<Estimate>>,
+}
+
+/// P(arlpcg's validation success > the baseline's), over seeds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Improvement {
+    pub baseline: String,
+    pub probability: Estimate,
+}
+
+/// Everything `eval --runs` reports (`seeds.json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SeedResults {
+    pub budget: Budget,
+    /// The Generator whose levels make the validation set's other half.
+    pub validation_generator: String,
+    pub aux: Vec<f64>,
+    pub runs: Vec<RunScores>,
+    pub modes: Vec<ModeSummary>,
+    pub arlpcg_beats: Vec<Improvement>,
+}
+
+/// One run to score: its Solver, mode and seed, and its Generator when it has one.
+pub struct Run<'a> {
+    pub folder: String,
+    pub mode: String,
+    pub seed: u64,
+    pub solver: &'a SolverPolicy,
+    pub generator: Option<&'a GeneratorPolicy>,
+}
+
+/// Plays the validation set (rule levels first, `rule_levels` of them) with every run's Solver,
+/// and each adversarial run's own pair on its controllability levels; `on_level` after each
+/// level played.
+pub fn score_runs(
+    runs: &[Run],
+    validation: &[Level],
+    rule_levels: usize,
+    budget: Budget,
+    on_level: &(dyn Fn() + Sync),
+) -> Result<Vec<RunScores>, candle_core::Error> {
+    let play = |solver: &SolverPolicy, levels: &[Level], trials: u32| -> Vec<f64> {
+        levels
+            .par_iter()
+            .map(|level| {
+                let stats = verify(
+                    level,
+                    &Solver::Policy(solver),
+                    trials,
+                    level.seed.unwrap_or(0),
+                    &|| {},
+                )
+                .expect("runs are loaded for the evaluation's game");
+                on_level();
+                stats.success_ratio
+            })
+            .collect()
+    };
+    let mean = |xs: &[f64]| xs.iter().sum::<f64>() / xs.len().max(1) as f64;
+    runs.iter()
+        .map(|run| {
+            let success = play(run.solver, validation, budget.validation_trials);
+            let (rules, generated) = success.split_at(rule_levels.min(success.len()));
+            let controllability = match run.generator {
+                Some(generator) => Some(
+                    AUX_VALUES
+                        .iter()
+                        .map(|&aux| {
+                            let levels =
+                                generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks)?;
+                            Ok(mean(&play(run.solver, &levels, budget.trials)))
+                        })
+                        .collect::<Result<Vec<f64>, candle_core::Error>>()?,
+                ),
+                None => None,
+            };
+            Ok(RunScores {
+                run: run.folder.clone(),
+                mode: run.mode.clone(),
+                seed: run.seed,
+                validation_rule_levels: mean(rules),
+                validation_generator_levels: mean(generated),
+                validation: mean(&success),
+                controllability,
+            })
+        })
+        .collect()
+}
+
+/// The summaries over seeds (pure: the same scores give the same bytes).
+pub fn summarize(budget: Budget, validation_generator: &str, runs: Vec<RunScores>) -> SeedResults {
+    let mut modes: Vec<String> = Vec::new();
+    for run in &runs {
+        if !modes.contains(&run.mode) {
+            modes.push(run.mode.clone());
+        }
+    }
+    fn of<'a>(runs: &'a [RunScores], mode: &'a str) -> impl Iterator<Item = &'a RunScores> {
+        runs.iter().filter(move |r| r.mode == mode)
+    }
+    let halves = |mode: &str| -> Vec<Vec<f64>> {
+        vec![
+            of(&runs, mode).map(|r| r.validation_rule_levels).collect(),
+            of(&runs, mode)
+                .map(|r| r.validation_generator_levels)
+                .collect(),
+        ]
+    };
+    let summaries = modes
+        .iter()
+        .map(|mode| {
+            let controllability = of(&runs, mode)
+                .all(|r| r.controllability.is_some())
+                .then(|| {
+                    (0..AUX_VALUES.len())
+                        .map(|a| {
+                            let at: Vec<f64> = of(&runs, mode)
+                                .map(|r| r.controllability.as_ref().expect("checked")[a])
+                                .collect();
+                            estimate(&[at], Aggregate::Mean, a as u64)
+                        })
+                        .collect()
+                });
+            ModeSummary {
+                mode: mode.clone(),
+                seeds: of(&runs, mode).map(|r| r.seed).collect(),
+                validation_iqm: estimate(&halves(mode), Aggregate::Iqm, 0),
+                validation_mean: estimate(&halves(mode), Aggregate::Mean, 0),
+                controllability,
+            }
+        })
+        .collect();
+    let arlpcg_beats = match modes.iter().any(|m| m == "arlpcg") {
+        true => modes
+            .iter()
+            .filter(|m| *m != "arlpcg")
+            .map(|baseline| Improvement {
+                baseline: baseline.clone(),
+                probability: probability_of_improvement(&halves("arlpcg"), &halves(baseline), 0),
+            })
+            .collect(),
+        false => Vec::new(),
+    };
+    SeedResults {
+        budget,
+        validation_generator: validation_generator.to_string(),
+        aux: AUX_VALUES.to_vec(),
+        runs,
+        modes: summaries,
+        arlpcg_beats,
+    }
+}
+
+/// The report as markdown.
+pub fn markdown(results: &SeedResults) -> String {
+    let e = |x: &Estimate| format!("{:.3} [{:.3}, {:.3}]", x.value, x.ci95[0], x.ci95[1]);
+    let mut md = String::from(
+        "## Validation success over training seeds\n\n| mode | seeds | IQM [95% CI] | mean [95% CI] |\n|---|---|---|---|\n",
+    );
+    for m in &results.modes {
+        let seeds: Vec<String> = m.seeds.iter().map(u64::to_string).collect();
+        md += &format!(
+            "| {} | {} | {} | {} |\n",
+            m.mode,
+            seeds.join(", "),
+            e(&m.validation_iqm),
+            e(&m.validation_mean)
+        );
+    }
+    if !results.arlpcg_beats.is_empty() {
+        md += "\n| P(arlpcg > baseline) on validation | [95% CI] |\n|---|---|\n";
+        for b in &results.arlpcg_beats {
+            md += &format!("| {} | {} |\n", b.baseline, e(&b.probability));
+        }
+    }
+    md += "\n## Controllability over seeds (each run's own Generator and Solver)\n\n| mode |";
+    for aux in &results.aux {
+        md += &format!(" λ = {aux:+.1} |");
+    }
+    md += "\n|---|";
+    md += &"---|".repeat(results.aux.len());
+    md += "\n";
+    for m in &results.modes {
+        if let Some(by_aux) = &m.controllability {
+            md += &format!("| {} |", m.mode);
+            for x in by_aux {
+                md += &format!(" {} |", e(x));
+            }
+            md += "\n";
+        }
+    }
+    md += "\n## Each run\n\n| run | mode | seed | validation (rule / Generator levels) | controllability λ = +1 … -1 |\n|---|---|---|---|---|\n";
+    for r in &results.runs {
+        let control = r.controllability.as_ref().map_or(String::from("—"), |c| {
+            c.iter()
+                .map(|x| format!("{x:.2}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        });
+        md += &format!(
+            "| {} | {} | {} | {:.3} ({:.3} / {:.3}) | {control} |\n",
+            r.run,
+            r.mode,
+            r.seed,
+            r.validation,
+            r.validation_rule_levels,
+            r.validation_generator_levels
+        );
+    }
+    md += &format!(
+        "\nBudget: {} validation levels × {} runs (half rule levels, half from {}); {} levels × {} runs per λ. Intervals: stratified bootstrap over seeds, {} resamples.\n",
+        results.budget.validation_tracks,
+        results.budget.validation_trials,
+        results.validation_generator,
+        results.budget.tracks,
+        results.budget.trials,
+        crate::bootstrap::RESAMPLES
+    );
+    md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(mode: &str, seed: u64, rules: f64, generated: f64) -> RunScores {
+        RunScores {
+            run: format!("runs/{mode}-{seed}"),
+            mode: mode.into(),
+            seed,
+            validation_rule_levels: rules,
+            validation_generator_levels: generated,
+            validation: 0.5 * (rules + generated),
+            controllability: (mode == "arlpcg").then(|| vec![1.0, 0.9, 0.8, 0.6, 0.5]),
+        }
+    }
+
+    #[test]
+    fn modes_are_summarized_over_their_seeds() {
+        let runs = vec![
+            run("arlpcg", 0, 0.9, 0.8),
+            run("rule-pcg", 0, 0.8, 0.6),
+            run("arlpcg", 1, 0.92, 0.82),
+            run("rule-pcg", 1, 0.9, 0.7),
+            run("arlpcg", 2, 0.88, 0.78),
+        ];
+        let results = summarize(Budget::QUICK, "g", runs);
+        let names: Vec<&str> = results.modes.iter().map(|m| m.mode.as_str()).collect();
+        assert_eq!(names, ["arlpcg", "rule-pcg"]);
+        assert_eq!(results.modes[0].seeds, [0, 1, 2]);
+        let mean = results.modes[0].validation_mean;
+        assert!((mean.value - 0.85).abs() < 1e-12, "{mean:?}");
+        assert!(mean.ci95[0] <= mean.value && mean.value <= mean.ci95[1]);
+        let control = results.modes[0].controllability.as_ref().unwrap();
+        assert_eq!(control[4].value, 0.5);
+        assert!(results.modes[1].controllability.is_none());
+        // On the rule half arlpcg's seeds (0.9, 0.92, 0.88) against rule-pcg's (0.8, 0.9) win
+        // 4 pairs, tie 1 and lose 1 (0.75); on the Generator half they win all 6.
+        let p = &results.arlpcg_beats[0];
+        assert_eq!(p.baseline, "rule-pcg");
+        assert!(
+            (p.probability.value - (0.75 + 1.0) / 2.0).abs() < 1e-12,
+            "{p:?}"
+        );
+        let md = markdown(&results);
+        assert!(
+            md.contains("| arlpcg | 0, 1, 2 |") && md.contains("| rule-pcg |"),
+            "{md}"
+        );
+    }
+}

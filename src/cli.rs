@@ -428,6 +428,7 @@ fn parse_judges(s: &str) -> Result<Judges, String> {
     arlpcg train --game platform --mode rule-pcg --minutes 60 --out runs/solver\n  \
     arlpcg train --game platform --mode rule-pcg --minutes 60 --out runs/solver --resume\n  \
     arlpcg train --game platform --mode arlpcg --steps 4000000 --out runs/arlpcg\n  \
+    arlpcg train --game platform --mode arlpcg --seed 1 --out runs/platform-arlpcg-s1\n  \
     arlpcg train --mode arlpcg --steps 4000000 --out runs/arlpcg --resume --config new.yaml\n  \
     arlpcg train --print-config > train.yaml")]
 pub struct TrainArgs {
@@ -458,6 +459,10 @@ pub struct TrainArgs {
     /// Continue the run in --out from its checkpoint.
     #[arg(long)]
     pub resume: bool,
+    /// The run's seed (network initialization, action sampling, minibatches), in place of the
+    /// configuration's `seed` (default 0); the card records it. A resumed run keeps its own.
+    #[arg(long, conflicts_with = "resume")]
+    pub seed: Option<u64>,
     /// Print the default configuration as YAML and exit.
     #[arg(long)]
     pub print_config: bool,

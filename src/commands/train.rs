@@ -44,6 +44,7 @@ pub fn run(args: &TrainArgs) -> Result<()> {
             args.mode.into(),
             out,
             args.config.as_deref(),
+            args.seed,
             args.resume,
         )?;
         train_loop(run.as_mut(), args.steps, args.minutes)

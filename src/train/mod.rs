@@ -53,14 +53,16 @@ pub(super) const METRICS: &str = "metrics.csv";
 pub(super) const GENERATOR_METRICS: &str = "generator-metrics.csv";
 pub(super) const METRICS_HEADER: &str = "iteration,global_step,wall_time_s,steps_per_s,rollout_s,update_s,learning_rate,episodes,mean_return,success_ratio,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance";
 
-/// The run in `out`: started afresh with `config` (the game's defaults when `None`), or with
-/// `resume` continued from its checkpoints (`config`, if given, replaces its hyper-parameters
-/// from here on). The caller installs the thread pool the run's environments and updates use.
+/// The run in `out`: started afresh with `config` (the game's defaults when `None`; `seed`, if
+/// given, replaces its seed), or with `resume` continued from its checkpoints (`config`, if
+/// given, replaces its hyper-parameters from here on). The caller installs the thread pool the
+/// run's environments and updates use.
 pub fn open(
     game: Game,
     mode: TrainMode,
     out: &Path,
     config: Option<&Path>,
+    seed: Option<u64>,
     resume: bool,
 ) -> Result<Box<dyn Training>> {
     // A new run's configuration, or a resumed run's replacement (None: keep its own).
@@ -82,10 +84,14 @@ pub fn open(
                 out.display()
             );
         }
-        Some(match config {
+        let mut config = match config {
             Some(path) => load_config(path, game)?,
             None => TrainConfig::for_game(game),
-        })
+        };
+        if let Some(seed) = seed {
+            config.seed = seed;
+        }
+        Some(config)
     };
     match (mode.solver_only(), game) {
         (Some(source), Game::Platform) => {

@@ -86,8 +86,8 @@ pub struct GeneratorConfig {
     pub obstacles: u32,
     /// Racing: how far, in degrees, the Generator's curve action may ask to turn from the goal's
     /// bearing, in [0, 180] (the segment's curve stays within ±30°). 30 keeps the road within
-    /// about 30° of the bearing; 90 lets it bend away from the goal and back. The platform game
-    /// has no curve: there it stays 30.
+    /// about 30° of the bearing; 90 (the racing default) lets it bend away from the goal and
+    /// back. The platform game has no curve: there it stays 30.
     pub curve_offset: f64,
     /// Log standard deviation of the new Generator's actions (in [-1, 1] units). At 0 (std 1)
     /// its turns span ±180° and almost no track reaches its goal; -1.6 (std 0.2) starts it at
@@ -200,6 +200,9 @@ impl TrainConfig {
             config.generator.rewards = RacingGame::default_rewards();
             config.generator.max_pieces = RacingGame::DEFAULT_MAX_PIECES;
             config.generator.obstacles = crate::game::racing::generator::MATCH_OBSTACLES;
+            // What trained the shipped racing Generator: with 30° the road stays near the
+            // goal's bearing and cannot make the sustained bends that are hard to drive.
+            config.generator.curve_offset = 90.0;
         }
         config
     }
@@ -419,9 +422,10 @@ mod tests {
             TrainConfig::parse_for("", Game::Racing).unwrap(),
             TrainConfig::for_game(Game::Racing)
         );
-        let wide =
-            TrainConfig::parse_for("generator:\n  curve_offset: 90\n", Game::Racing).unwrap();
-        assert_eq!(wide.generator.curve_offset, 90.0);
+        assert_eq!(TrainConfig::for_game(Game::Racing).generator.curve_offset, 90.0);
+        let narrow =
+            TrainConfig::parse_for("generator:\n  curve_offset: 30\n", Game::Racing).unwrap();
+        assert_eq!(narrow.generator.curve_offset, 30.0);
         for (text, game, says) in [
             (
                 "generator:\n  curve_offset: 200\n",

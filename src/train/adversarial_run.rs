@@ -239,13 +239,17 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
 
     fn iterate(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String> {
         let phases = self.solver.config.generator.clone();
+        // The stage in force where this iteration starts (a stage begins at a phase's end).
+        let schedule = phases.schedule_at(self.solver.trainer.global_step);
         match self.envs().state.phase {
             Phase::Solver => {
-                let rollout = self.solver.solver_iteration(lr_scale, wall)?;
+                let rollout =
+                    self.solver
+                        .solver_iteration(lr_scale, schedule.solver_learning_rate, wall)?;
                 let envs = self.envs();
                 envs.state.phase_steps += rollout.steps;
                 let warm = self.solver.trainer.global_step >= phases.solver_warmup_steps;
-                if warm && self.envs().state.phase_steps >= phases.solver_phase_steps {
+                if warm && self.envs().state.phase_steps >= schedule.solver_phase_steps {
                     self.snapshot_if_due()?;
                     self.envs().set_phase(Phase::Generator);
                 }
@@ -257,7 +261,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
             Phase::Generator => {
                 let message = self.generator_iteration(lr_scale, wall)?;
                 let envs = self.envs();
-                if envs.state.phase_steps >= phases.generator_phase_steps {
+                if envs.state.phase_steps >= schedule.generator_phase_steps {
                     envs.set_phase(Phase::Solver);
                 }
                 Ok(message)

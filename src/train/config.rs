@@ -112,6 +112,23 @@ pub struct GeneratorConfig {
     /// Solver steps between snapshots (one is taken when a Solver phase ends this long after
     /// the last; the oldest leaves when there are more than `population`).
     pub population_every_steps: u64,
+    /// Later stretches of the run with their own schedule, each from a number of Solver steps
+    /// on (the last one reached applies): e.g. a last stage where the Solver is frozen and the
+    /// Generator goes on against it and the population.
+    pub stages: Vec<Stage>,
+}
+
+/// A stretch of an adversarial run with its own schedule.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stage {
+    /// It applies from this many Solver steps on.
+    pub from_steps: u64,
+    /// The Solver's learning rate in it, in place of `solver.learning_rate` and its annealing
+    /// (0: frozen; its phases only play, and its observation normalizer still follows them).
+    pub solver_learning_rate: f64,
+    pub solver_phase_steps: u64,
+    pub generator_phase_steps: u64,
 }
 
 impl Default for TrainConfig {
@@ -131,6 +148,38 @@ impl Default for TrainConfig {
             generator: GeneratorConfig::default(),
         }
     }
+}
+
+impl GeneratorConfig {
+    /// The schedule at `solver_steps`: the last stage reached, else the run's own phases.
+    pub fn schedule_at(&self, solver_steps: u64) -> Schedule {
+        match self
+            .stages
+            .iter()
+            .rev()
+            .find(|s| solver_steps >= s.from_steps)
+        {
+            Some(stage) => Schedule {
+                solver_learning_rate: Some(stage.solver_learning_rate),
+                solver_phase_steps: stage.solver_phase_steps,
+                generator_phase_steps: stage.generator_phase_steps,
+            },
+            None => Schedule {
+                solver_learning_rate: None,
+                solver_phase_steps: self.solver_phase_steps,
+                generator_phase_steps: self.generator_phase_steps,
+            },
+        }
+    }
+}
+
+/// The phases in force at a point of a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Schedule {
+    /// The stage's Solver learning rate (`None`: the configured one, annealed or not).
+    pub solver_learning_rate: Option<f64>,
+    pub solver_phase_steps: u64,
+    pub generator_phase_steps: u64,
 }
 
 impl Default for GeneratorConfig {
@@ -159,6 +208,7 @@ impl Default for GeneratorConfig {
             generator_phase_steps: 10_000,
             population: 4,
             population_every_steps: 500_000,
+            stages: Vec::new(),
         }
     }
 }
@@ -168,6 +218,8 @@ const MAX_CONFIG_BYTES: u64 = 1 << 20;
 /// Limits on the networks' size (a 4096-unit layer is already 64 MB of weights and moments).
 const MAX_HIDDEN_LAYERS: usize = 8;
 const MAX_HIDDEN_UNITS: usize = 4096;
+/// Stages of one run.
+const MAX_STAGES: usize = 16;
 /// Snapshots of the Solver a Generator may play against (each is a network's weights).
 const MAX_POPULATION: usize = 16;
 /// Limit on each phase length and the warm-up (10^12 steps: years of training).
@@ -350,6 +402,29 @@ pub(super) fn check_config(config: &TrainConfig, game: Game) -> Result<(), Strin
     {
         return Err("generator.rewards: every weight must be a finite number".into());
     }
+    if g.stages.len() > MAX_STAGES {
+        return Err(format!("generator.stages: at most {MAX_STAGES}"));
+    }
+    for (k, stage) in g.stages.iter().enumerate() {
+        let rate = stage.solver_learning_rate;
+        if !(rate.is_finite() && (0.0..=1.0).contains(&rate)) {
+            return Err(format!(
+                "generator.stages[{k}].solver_learning_rate must be a number in [0, 1]"
+            ));
+        }
+        if !(1..=MAX_PHASE_STEPS).contains(&stage.solver_phase_steps)
+            || !(1..=MAX_PHASE_STEPS).contains(&stage.generator_phase_steps)
+        {
+            return Err(format!(
+                "generator.stages[{k}]: solver_phase_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
+            ));
+        }
+        if k > 0 && stage.from_steps <= g.stages[k - 1].from_steps {
+            return Err(format!(
+                "generator.stages[{k}].from_steps must be after the stage before it"
+            ));
+        }
+    }
     if g.population > MAX_POPULATION {
         return Err(format!(
             "generator.population must be within [0, {MAX_POPULATION}]"
@@ -422,7 +497,24 @@ mod tests {
             TrainConfig::parse_for("", Game::Racing).unwrap(),
             TrainConfig::for_game(Game::Racing)
         );
-        assert_eq!(TrainConfig::for_game(Game::Racing).generator.curve_offset, 90.0);
+        assert_eq!(
+            TrainConfig::for_game(Game::Racing).generator.curve_offset,
+            90.0
+        );
+        let staged = "generator:\n  stages:\n  - {from_steps: 100, solver_learning_rate: 0, solver_phase_steps: 8, generator_phase_steps: 9}\n";
+        let staged = TrainConfig::parse_for(staged, Game::Platform)
+            .unwrap()
+            .generator;
+        assert_eq!(staged.schedule_at(99).generator_phase_steps, 10_000);
+        let last = staged.schedule_at(100);
+        assert_eq!(
+            (
+                last.solver_learning_rate,
+                last.solver_phase_steps,
+                last.generator_phase_steps
+            ),
+            (Some(0.0), 8, 9)
+        );
         let narrow =
             TrainConfig::parse_for("generator:\n  curve_offset: 30\n", Game::Racing).unwrap();
         assert_eq!(narrow.generator.curve_offset, 30.0);
@@ -441,6 +533,21 @@ mod tests {
                 "generator:\n  curve_offset: 90\n",
                 Game::Platform,
                 "platform game has no curve",
+            ),
+            (
+                "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n  - {from_steps: 5, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n",
+                Game::Platform,
+                "stages[1].from_steps must be after",
+            ),
+            (
+                "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: .nan, solver_phase_steps: 1, generator_phase_steps: 1}\n",
+                Game::Platform,
+                "stages[0].solver_learning_rate",
+            ),
+            (
+                "generator:\n  population: 99\n",
+                Game::Platform,
+                "generator.population must be within [0, 16]",
             ),
         ] {
             let err = TrainConfig::parse_for(text, game).unwrap_err();

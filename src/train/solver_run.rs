@@ -168,12 +168,13 @@ impl<E: Resumable> Run<E> {
     pub(super) fn solver_iteration(
         &mut self,
         lr_scale: f64,
+        stage_rate: Option<f64>,
         wall: &dyn Fn() -> f64,
     ) -> Result<RolloutStats> {
-        let learning_rate = if self.config.solver.anneal_lr {
-            self.config.solver.learning_rate * lr_scale
-        } else {
-            self.config.solver.learning_rate
+        let learning_rate = match stage_rate {
+            Some(rate) => rate,
+            None if self.config.solver.anneal_lr => self.config.solver.learning_rate * lr_scale,
+            None => self.config.solver.learning_rate,
         };
         let t0 = wall();
         let (batch, rollout) = self.trainer.collect()?;
@@ -212,7 +213,7 @@ impl<G: GameSpec> Training for Run<SolverEnvs<G>> {
 
     fn iterate(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String> {
         let t0 = wall();
-        let rollout = self.solver_iteration(lr_scale, wall)?;
+        let rollout = self.solver_iteration(lr_scale, None, wall)?;
         Ok(format!(
             "return {:.2}, success {:.2}, {:.0} steps/s",
             rollout.mean_return,

@@ -337,6 +337,11 @@ generator:
   generator_phase_steps: 16
   population: 2
   population_every_steps: 256
+  stages:
+  - from_steps: 768
+    solver_learning_rate: 0.0
+    solver_phase_steps: 128
+    generator_phase_steps: 8
 ";
 
 /// The Solver steps of the snapshots a run's Generator card says it played against.
@@ -402,6 +407,23 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
         generator_rows(&out) > generator_before,
         "the Generator went on learning"
     );
+    // From 768 Solver steps on, the last stage: the Solver is frozen (learning rate 0).
+    let metrics = std::fs::read_to_string(out.join("metrics.csv")).unwrap();
+    let rates: Vec<(u64, f64)> = metrics
+        .lines()
+        .skip(1)
+        .map(|row| {
+            let cells: Vec<&str> = row.split(',').collect();
+            (cells[1].parse().unwrap(), cells[6].parse().unwrap())
+        })
+        .collect();
+    for (step, rate) in &rates {
+        assert_eq!(
+            *step > 768,
+            *rate == 0.0,
+            "step {step}: learning rate {rate}"
+        );
+    }
     // The population came back from the checkpoint and grew, keeping the newest two.
     let resumed_population = population(&out);
     assert_eq!(resumed_population.len(), 2, "{resumed_population:?}");

@@ -815,10 +815,10 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
     assert_eq!(curve(&out).last().unwrap().1, 1024);
     assert!(generator_rows(&out) > generator_before);
     // The curve offset belongs to the Generator's weights: a resumed run cannot change it.
-    let wider = dir.path().join("wider.yaml");
+    let narrower = dir.path().join("narrower.yaml");
     std::fs::write(
-        &wider,
-        TINY_ADVERSARIAL.replace("generator:\n", "generator:\n  curve_offset: 90\n"),
+        &narrower,
+        TINY_ADVERSARIAL.replace("generator:\n", "generator:\n  curve_offset: 30\n"),
     )
     .unwrap();
     let refused = arlpcg(&[
@@ -833,14 +833,14 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
         out_s,
         "--resume",
         "--config",
-        wider.to_str().unwrap(),
+        narrower.to_str().unwrap(),
     ]);
     assert_eq!(refused.status.code(), Some(1));
     let message = String::from_utf8_lossy(&refused.stderr);
     assert!(
         message.contains("generator-checkpoint.safetensors")
             && message
-                .contains("trained with generator.curve_offset 30, the configuration says 90"),
+                .contains("trained with generator.curve_offset 90, the configuration says 30"),
         "{message}"
     );
     assert_eq!(

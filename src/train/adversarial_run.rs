@@ -31,6 +31,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             },
             obstacles: config.generator.obstacles,
             rewards: config.generator.rewards.clone(),
+            snapshot_share: config.generator.snapshot_share,
         }
     }
 

@@ -70,6 +70,9 @@ pub struct MatchRules {
     /// Obstacles drawn into each racing match's scene.
     pub obstacles: u32,
     pub rewards: GeneratorRewards,
+    /// The share of matches a snapshot plays (`None`: uniform over the current Solver and the
+    /// snapshots).
+    pub snapshot_share: Option<f64>,
 }
 
 /// An earlier Solver that the Generator plays against.
@@ -309,9 +312,10 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         let values = &self.rules.aux_values;
         let aux = values[rng.random_range(0..values.len())];
         let snapshots = self.population.len();
-        let opponent = match snapshots {
-            0 => None,
-            n => Some(rng.random_range(0..=n)).filter(|&k| k < n),
+        let opponent = match (snapshots, self.rules.snapshot_share) {
+            (0, _) => None,
+            (n, None) => Some(rng.random_range(0..=n)).filter(|&k| k < n),
+            (n, Some(share)) => rng.random_bool(share).then(|| rng.random_range(0..n)),
         };
         (Match::new(build, vec![aux], seed), opponent)
     }

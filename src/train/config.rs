@@ -112,6 +112,9 @@ pub struct GeneratorConfig {
     /// Solver steps between snapshots (one is taken when a Solver phase ends this long after
     /// the last; the oldest leaves when there are more than `population`).
     pub population_every_steps: u64,
+    /// The share of a Generator phase's matches that a snapshot plays (the rest: the current
+    /// Solver); none: the current Solver and each snapshot equally often.
+    pub snapshot_share: Option<f64>,
     /// Later stretches of the run with their own schedule, each from a number of Solver steps
     /// on (the last one reached applies): e.g. a last stage where the Solver is frozen and the
     /// Generator goes on against it and the population.
@@ -208,6 +211,7 @@ impl Default for GeneratorConfig {
             generator_phase_steps: 10_000,
             population: 4,
             population_every_steps: 500_000,
+            snapshot_share: None,
             stages: Vec::new(),
         }
     }
@@ -402,6 +406,9 @@ pub(super) fn check_config(config: &TrainConfig, game: Game) -> Result<(), Strin
     {
         return Err("generator.rewards: every weight must be a finite number".into());
     }
+    if g.snapshot_share.is_some_and(|p| !(0.0..=1.0).contains(&p)) {
+        return Err("generator.snapshot_share must be a number in [0, 1]".into());
+    }
     if g.stages.len() > MAX_STAGES {
         return Err(format!("generator.stages: at most {MAX_STAGES}"));
     }
@@ -543,6 +550,11 @@ mod tests {
                 "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: .nan, solver_phase_steps: 1, generator_phase_steps: 1}\n",
                 Game::Platform,
                 "stages[0].solver_learning_rate",
+            ),
+            (
+                "generator:\n  snapshot_share: 1.5\n",
+                Game::Platform,
+                "generator.snapshot_share must be a number in [0, 1]",
             ),
             (
                 "generator:\n  population: 99\n",

@@ -366,7 +366,7 @@ impl SolverChoice {
 
 /// Where the shipped Solver of `game` lives.
 pub fn default_solver(game: Game) -> PathBuf {
-    PathBuf::from(format!("policies/{game}/solver.safetensors"))
+    crate::policies::shipped_dir(game).join(crate::policies::SOLVER_FILE)
 }
 
 #[derive(Debug, Args)]

@@ -177,6 +177,11 @@ pub fn difficulty_curve(
     Ok(curve)
 }
 
+/// The folder of the policies shipped for `game`: `policies/<game>`.
+pub fn shipped_dir(game: Game) -> PathBuf {
+    PathBuf::from("policies").join(game.name())
+}
+
 /// The panel of judges `chosen` from the policies folder `dir` (by default every Solver judge
 /// whose file is there, and the scripted player at its three skills). A chosen Solver judge
 /// whose file is missing is an error naming it.

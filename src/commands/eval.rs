@@ -118,7 +118,7 @@ fn seeds(args: &EvalArgs) -> Result<()> {
     for target in &targets {
         fsio::check_writable(target, overwrite)?;
     }
-    let shipped = PathBuf::from(format!("policies/{}", args.game));
+    let shipped = crate::policies::shipped_dir(args.game);
     let folder = args.policies.first().unwrap_or(&shipped);
     let (validation_generator, _) = load_generator(&folder.join(GENERATOR_FILE), args.game)?;
     let mut loaded = Vec::new();

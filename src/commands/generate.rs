@@ -17,7 +17,7 @@ use crate::level::stats::PanelStats;
 use crate::level::{Game, Level};
 use crate::level_files::{Format, LevelFiles, file_stem, render};
 use crate::panel::{Judge, Panel, panel_stats, rate};
-use crate::policies::{load_generator, load_panel, load_solver, policy_paths};
+use crate::policies::{load_generator, load_judge, load_panel, load_solver, policy_paths};
 use crate::verify::{self, Solver, SolverPolicy, verify};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
@@ -33,19 +33,18 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         None => None,
     };
     let shipped = default_solver(args.game);
-    let judge_file = args.judge.and_then(|j| j.policy_file(&policies_dir(args)));
-    let solver: Option<SolverPolicy> = match (verify_trials, &args.solver_policy, &args.policies) {
+    let solver: Option<SolverPolicy> = match (verify_trials, args.judge, &args.solver_policy) {
         (None, _, _) => None,
-        (Some(_), _, _) if matches!(args.judge, Some(Judge::Scripted(_))) => None,
-        (Some(_), Some(path), _) => Some(load_solver(path, args.game)?.0),
-        (Some(_), None, _) if judge_file.is_some() => Some(
-            load_solver(judge_file.as_ref().expect("checked"), args.game)
-                .with_context(|| format!("--judge {}", args.judge.expect("given").name()))?
-                .0,
-        ),
-        (Some(_), None, Some(dir)) => Some(load_solver(&policy_paths(dir).1, args.game)?.0),
-        (Some(_), None, None) if shipped.exists() => Some(load_solver(&shipped, args.game)?.0),
-        (Some(_), None, None) => None,
+        // A Solver judge's policy; none for the scripted player.
+        (Some(_), Some(judge), _) => {
+            load_judge(&policies_dir(args), args.game, judge)?.map(|(policy, _)| policy)
+        }
+        (Some(_), None, Some(path)) => Some(load_solver(path, args.game)?.0),
+        (Some(_), None, None) => match &args.policies {
+            Some(dir) => Some(load_solver(&policy_paths(dir).1, args.game)?.0),
+            None if shipped.exists() => Some(load_solver(&shipped, args.game)?.0),
+            None => None,
+        },
     };
     let panel = match args.panel {
         true => Some(load_panel(&policies_dir(args), args.game, None)?),
@@ -189,7 +188,7 @@ fn report_verification(levels: &[Level]) {
 fn policies_dir(args: &GenerateArgs) -> PathBuf {
     args.policies
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("policies/{}", args.game)))
+        .unwrap_or_else(|| crate::policies::shipped_dir(args.game))
 }
 
 /// Plays every level with every judge of `panel` (seeds as --verify's) and rates them together.

@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 use std::collections::hash_map::Entry;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::{Context, Result};
 use serde_json::json;
@@ -120,11 +120,7 @@ fn replay(args: &VerifyArgs) -> Result<()> {
             Ok(said) => println!("{}: {said}", path.display()),
             Err(err) => {
                 failed += 1;
-                eprintln!(
-                    "error: {}: {}",
-                    path.display(),
-                    one_line(&format!("{err:#}"))
-                );
+                report_error(path, &err);
             }
         }
     }
@@ -192,7 +188,7 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
                         let dir = args
                             .policies
                             .clone()
-                            .unwrap_or_else(|| PathBuf::from(format!("policies/{game}")));
+                            .unwrap_or_else(|| crate::policies::shipped_dir(game));
                         let chosen = (!chosen.0.is_empty()).then_some(chosen.0.as_slice());
                         let panel = load_panel(&dir, game, chosen)?;
                         if !args.json {
@@ -217,11 +213,7 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
             Ok((game, stats)) => rated.push((path, game, stats)),
             Err(err) => {
                 failed += 1;
-                eprintln!(
-                    "error: {}: {}",
-                    path.display(),
-                    one_line(&format!("{err:#}"))
-                );
+                report_error(path, &err);
             }
         }
     }
@@ -438,6 +430,15 @@ fn describe(path: &Path, level: &Level, s: &SolverStats) -> String {
         );
     }
     text
+}
+
+/// Prints a level file's error on one line.
+fn report_error(path: &Path, err: &anyhow::Error) {
+    eprintln!(
+        "error: {}: {}",
+        path.display(),
+        one_line(&format!("{err:#}"))
+    );
 }
 
 /// Folds a multi-line error message onto one line.

@@ -3,25 +3,26 @@
 //! [`Effect`]s, which the shell hands to the worker threads. Nothing here touches the terminal,
 //! the file system or a clock, so key scripts drive it in tests.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use ratatui::crossterm::event::{KeyEvent, MouseEvent};
 use ratatui::layout::Rect;
 
-use crate::game::Skill;
 use crate::level::params::quantize;
 use crate::level::platform::heading_direction;
 use crate::level::stats::{Outcome, SolverStats, TrialResult, wilson_interval};
 use crate::level::{Game, Level};
 use crate::panel::Judge;
-use crate::rl::checkpoint::PolicyCard;
 use crate::verify::Recording;
 
 use super::layout::Areas;
 
 mod input;
 pub mod pacing;
+mod policies;
+
+pub use policies::{JudgeSwitch, LoadedInfo, PolicyInfo};
 
 /// Steps of the λ slider (keys), and its range.
 pub const AUX_STEP: f64 = 0.1;
@@ -65,53 +66,6 @@ impl GoalSetting {
             }
         }
     }
-}
-
-/// What is known about a loaded policy, for display.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PolicyInfo {
-    pub path: PathBuf,
-    pub card: PolicyCard,
-}
-
-/// The policies the worker holds: a Generator and a Solver, each optional (without a Generator
-/// the designer draws rule levels; without a Solver the scripted controller plays).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct LoadedInfo {
-    pub generator: Option<PolicyInfo>,
-    pub solver: Option<PolicyInfo>,
-    /// The scripted player's skill, when it plays (no Solver).
-    pub skill: Skill,
-}
-
-impl LoadedInfo {
-    /// Who plays the trials: the Solver, by its training mode, or the scripted player.
-    pub fn judge(&self) -> Judge {
-        let mode = self.solver.as_ref().map(|s| s.card.training.mode.as_str());
-        match mode.map(Judge::parse) {
-            Some(Ok(judge)) => judge,
-            // A Solver of a mode no judge has (none today) plays as the ARLPCG one.
-            Some(Err(_)) => Judge::Solver(crate::train::TrainMode::Arlpcg),
-            None => Judge::Scripted(self.skill),
-        }
-    }
-
-    /// The folder the judges come from: the Solver's, else the Generator's, else the shipped
-    /// policies of `game`.
-    pub fn folder(&self, game: Game) -> PathBuf {
-        [&self.solver, &self.generator]
-            .into_iter()
-            .flatten()
-            .find_map(|p| p.path.parent().map(Path::to_path_buf))
-            .unwrap_or_else(|| PathBuf::from(format!("policies/{game}")))
-    }
-}
-
-/// The judge now playing the trials, after `j`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct JudgeSwitch {
-    pub solver: Option<PolicyInfo>,
-    pub skill: Skill,
 }
 
 /// A prompt being typed.

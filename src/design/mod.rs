@@ -50,7 +50,7 @@ fn starting_policies(
             Ok((policies, info, None))
         }
         None => {
-            let shipped = PathBuf::from("policies").join(game.name());
+            let shipped = crate::policies::shipped_dir(game);
             match worker::load(&shipped, game) {
                 Ok((policies, info)) => Ok((policies, info, None)),
                 Err(e) => Ok((

@@ -190,6 +190,35 @@ fn check_normalizer(norm: &RunningNorm) -> Result<(), PolicyError> {
     Err(PolicyError::Card(problem.into()))
 }
 
+/// Sets `var` to the tensor `name` of `tensors`, checked for the variable's shape and for finite
+/// values.
+pub fn restore_var(
+    tensors: &HashMap<String, Tensor>,
+    name: &str,
+    var: &candle_core::Var,
+) -> Result<(), PolicyError> {
+    let problem = |problem: String| PolicyError::Tensor {
+        name: name.to_string(),
+        problem,
+    };
+    let saved = tensors.get(name).ok_or_else(|| problem("missing".into()))?;
+    if saved.dims() != var.as_tensor().dims() {
+        return Err(problem(format!(
+            "shape {:?}, the network needs {:?}",
+            saved.dims(),
+            var.as_tensor().dims()
+        )));
+    }
+    let values = saved
+        .flatten_all()
+        .and_then(|t| t.to_vec1::<f32>())
+        .map_err(|e| problem(e.to_string()))?;
+    if values.iter().any(|v| !v.is_finite()) {
+        return Err(problem("holds NaN or infinite values".into()));
+    }
+    var.set(saved).map_err(|e| problem(e.to_string()))
+}
+
 /// Reads a policy or checkpoint, requiring `game` and `role` and the observation size the game
 /// produces now.
 pub fn load_policy(
@@ -259,37 +288,7 @@ pub fn load_policy(
     let policy =
         ActorCritic::new(card.network.clone(), 0).map_err(|e| PolicyError::Card(e.to_string()))?;
     for (name, var) in policy.named_vars() {
-        let saved = tensors.get(&name).ok_or_else(|| PolicyError::Tensor {
-            name: name.clone(),
-            problem: "missing".into(),
-        })?;
-        if saved.dims() != var.as_tensor().dims() {
-            return Err(PolicyError::Tensor {
-                name,
-                problem: format!(
-                    "shape {:?}, the card's network needs {:?}",
-                    saved.dims(),
-                    var.as_tensor().dims()
-                ),
-            });
-        }
-        let values = saved
-            .flatten_all()
-            .and_then(|t| t.to_vec1::<f32>())
-            .map_err(|e| PolicyError::Tensor {
-                name: name.clone(),
-                problem: e.to_string(),
-            })?;
-        if values.iter().any(|v| !v.is_finite()) {
-            return Err(PolicyError::Tensor {
-                name,
-                problem: "holds NaN or infinite values".into(),
-            });
-        }
-        var.set(saved).map_err(|e| PolicyError::Tensor {
-            name: name.clone(),
-            problem: e.to_string(),
-        })?;
+        restore_var(&tensors, &name, &var)?;
     }
     Ok(LoadedPolicy {
         policy,

@@ -145,24 +145,7 @@ pub fn population_from(
         let policy = ActorCritic::new(shape.clone(), 0).map_err(|e| e.to_string())?;
         for (name, var) in policy.named_vars() {
             let key = format!("population.{k}.{name}");
-            let saved = tensors.get(&key).ok_or(format!("tensor {key}: missing"))?;
-            if saved.dims() != var.as_tensor().dims() {
-                return Err(format!(
-                    "tensor {key}: shape {:?}, the Solver's network needs {:?}",
-                    saved.dims(),
-                    var.as_tensor().dims()
-                ));
-            }
-            let finite = saved
-                .flatten_all()
-                .and_then(|t| t.to_vec1::<f32>())
-                .map_err(|e| format!("tensor {key}: {e}"))?
-                .iter()
-                .all(|v| v.is_finite());
-            if !finite {
-                return Err(format!("tensor {key}: holds NaN or infinite values"));
-            }
-            var.set(saved).map_err(|e| format!("tensor {key}: {e}"))?;
+            crate::rl::checkpoint::restore_var(tensors, &key, &var).map_err(|e| e.to_string())?;
         }
         let d = shape.observation;
         if entry.norm.mean.len() != d || entry.norm.var.len() != d {

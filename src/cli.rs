@@ -46,6 +46,8 @@ pub enum Command {
     Generate(GenerateArgs),
     /// Convert a level file to glTF (.glb, or .gltf with a .bin beside it).
     Export(ExportArgs),
+    /// Write a trained policy's actor as ONNX (with a JSON sidecar), to run it in an engine.
+    ExportPolicy(ExportPolicyArgs),
     /// Play levels many times and report how often the Solver gets through.
     Verify(VerifyArgs),
     /// Reproduce the paper's tables (controllability, generalization, each Solver at each λ)
@@ -297,6 +299,38 @@ pub struct ExportArgs {
     /// Replace files that already exist.
     #[arg(long)]
     pub force: bool,
+}
+
+#[derive(Debug, Args)]
+#[command(
+    after_help = "The graph takes raw observations (the normalizer is inside) and gives \
+    the deterministic actions this tool plays with. The sidecar (OUT.json) lists the observation \
+    layout, each output's meaning and example rows with their expected outputs.\n\n\
+    Examples:\n  \
+    arlpcg export-policy policies/racing/solver.safetensors --out racing-solver.onnx\n  \
+    arlpcg export-policy policies/platform/solver.safetensors --profile mlagents --out Platform.onnx"
+)]
+pub struct ExportPolicyArgs {
+    /// The policy file (.safetensors): a Solver or a Generator of either game.
+    pub policy: PathBuf,
+    /// Output file (.onnx); the sidecar goes beside it as OUT.json.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Whose names the graph uses: `plain` (this tool's) or `mlagents` (ML-Agents' model
+    /// contract, for Unity's Inference Engine).
+    #[arg(long, default_value = "plain", value_parser = parse_profile)]
+    pub profile: crate::onnx::Profile,
+    /// Replace files that already exist.
+    #[arg(long)]
+    pub force: bool,
+}
+
+fn parse_profile(s: &str) -> Result<crate::onnx::Profile, String> {
+    match s {
+        "plain" => Ok(crate::onnx::Profile::Plain),
+        "mlagents" => Ok(crate::onnx::Profile::Mlagents),
+        _ => Err(format!("unknown profile {s}: plain or mlagents")),
+    }
 }
 
 impl From<FormatArg> for crate::level_files::Format {

@@ -24,6 +24,7 @@ pub mod game;
 pub mod generation;
 pub mod level;
 pub mod level_files;
+pub mod onnx;
 pub mod panel;
 pub mod policies;
 pub mod rating;

@@ -4,6 +4,7 @@
 
 mod eval;
 mod export;
+mod export_policy;
 mod generate;
 mod train;
 mod verify;
@@ -20,6 +21,7 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Generate(args)) => generate::run(&args),
         Some(Command::Export(args)) => export::run(&args),
+        Some(Command::ExportPolicy(args)) => export_policy::run(&args),
         Some(Command::Verify(args)) => verify::run(&args),
         Some(Command::Eval(args)) => eval::run(&args),
         Some(Command::Train(args)) => train::run(&args),

@@ -219,14 +219,12 @@ pub fn restore_var(
     var.set(saved).map_err(|e| problem(e.to_string()))
 }
 
-/// Reads a policy or checkpoint, requiring `game` and `role` and the observation size the game
-/// produces now.
-pub fn load_policy(
-    bytes: &[u8],
-    game: Game,
-    role: Role,
-    observation_size: usize,
-) -> Result<LoadedPolicy, PolicyError> {
+/// The card of a policy or checkpoint, whatever its game and role (nothing else is checked).
+pub fn read_card(bytes: &[u8]) -> Result<PolicyCard, PolicyError> {
+    Ok(read_header(bytes)?.1)
+}
+
+fn read_header(bytes: &[u8]) -> Result<(safetensors::tensor::Metadata, PolicyCard), PolicyError> {
     let (_, header) = safetensors::SafeTensors::read_metadata(bytes)
         .map_err(|e| PolicyError::NotSafetensors(e.to_string()))?;
     let metadata = header.metadata().clone().unwrap_or_default();
@@ -239,6 +237,19 @@ pub fn load_policy(
             card.format, card.version
         )));
     }
+    Ok((header, card))
+}
+
+/// Reads a policy or checkpoint, requiring `game` and `role` and the observation size the game
+/// produces now.
+pub fn load_policy(
+    bytes: &[u8],
+    game: Game,
+    role: Role,
+    observation_size: usize,
+) -> Result<LoadedPolicy, PolicyError> {
+    let (header, card) = read_header(bytes)?;
+    let metadata = header.metadata().clone().unwrap_or_default();
     if card.game != game || card.role != role {
         return Err(PolicyError::WrongKind {
             found: format!("{} {}", card.game, card.role),

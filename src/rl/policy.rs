@@ -240,6 +240,16 @@ impl ActorCritic {
         Ok(self.sample(&obs, mode, Draws::PerRow(rngs))?.0)
     }
 
+    /// The actor's raw output for a batch of (normalized) observations: rows of the continuous
+    /// actions' means, then the binary actions' logits (what [`crate::onnx`] exports).
+    pub fn actor_head(&self, observations: &[f32]) -> candle_core::Result<Vec<f32>> {
+        let obs = self.observation_tensor(observations)?;
+        self.actor
+            .forward(&obs, false)?
+            .flatten_all()?
+            .to_vec1::<f32>()
+    }
+
     fn observation_tensor(&self, observations: &[f32]) -> candle_core::Result<Tensor> {
         let n = observations.len() / self.shape.observation;
         Tensor::from_slice(observations, (n, self.shape.observation), &Device::Cpu)

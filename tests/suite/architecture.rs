@@ -16,6 +16,10 @@ const CORE: &[&str] = &[
     "generation.rs",
     "difficulty.rs",
     "seeds.rs",
+    "onnx",
+    "panel.rs",
+    "rating.rs",
+    "bootstrap.rs",
 ];
 
 /// What the core may not name, and why.

@@ -10,6 +10,7 @@ mod faults;
 mod gltf_export;
 mod hostile_input;
 mod level_format;
+mod onnx_export;
 mod pacing;
 mod panel;
 mod platform_game;

@@ -1,0 +1,220 @@
+//! Policies out as ONNX: every shipped policy, in both profiles, run by a runtime that is not
+//! ours (tract) on observations it was not exported with, gives the actions this tool plays.
+
+use std::path::{Path, PathBuf};
+
+use arlpcg::level::{Game, PolicyRef};
+use arlpcg::onnx::{self, Exported, Profile, example_observations, reference_outputs};
+use arlpcg::rl::checkpoint::{PolicyCard, Role, read_card};
+use arlpcg::rl::policy::ActorCritic;
+use tract_onnx::prelude::*;
+
+use crate::common::{arlpcg, stderr};
+
+const ROWS: usize = 64;
+
+fn shipped_policies() -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    for game in [Game::Platform, Game::Racing] {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("policies")
+            .join(game.name());
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "safetensors") {
+                found.push(path);
+            }
+        }
+    }
+    found.sort();
+    found
+}
+
+fn load(path: &Path) -> (ActorCritic, PolicyCard, PolicyRef) {
+    let card = read_card(&std::fs::read(path).unwrap()).unwrap();
+    match card.role {
+        Role::Solver => {
+            let (p, card) = arlpcg::policies::load_solver(path, card.game).unwrap();
+            (p.policy, card, p.reference)
+        }
+        Role::Generator => {
+            let (p, card) = arlpcg::policies::load_generator(path, card.game).unwrap();
+            (p.policy, card, p.reference)
+        }
+    }
+}
+
+/// Runs the graph with tract: the observation rows, and `masks` for `action_masks` if the graph
+/// takes it; every output, by name.
+fn run_tract(
+    exported: &Exported,
+    observations: &[f32],
+    masks: Option<&[f32]>,
+) -> Vec<(String, Vec<f32>)> {
+    let sidecar = &exported.sidecar;
+    let width = exported.sidecar.inputs[0].shape[1].as_u64().unwrap() as usize;
+    let rows = observations.len() / width;
+    let mut model = tract_onnx::onnx()
+        .model_for_read(&mut std::io::Cursor::new(&exported.onnx))
+        .expect("tract reads the graph");
+    let mut inputs: TVec<TValue> = tvec![
+        tract_ndarray::Array2::from_shape_vec((rows, width), observations.to_vec())
+            .unwrap()
+            .into_tensor()
+            .into()
+    ];
+    model = model
+        .with_input_fact(0, f32::fact([rows, width]).into())
+        .unwrap();
+    if let Some(port) = sidecar.inputs.get(1) {
+        let columns = port.shape[1].as_u64().unwrap() as usize;
+        let masks = masks
+            .map(<[f32]>::to_vec)
+            .unwrap_or(vec![1.0; rows * columns]);
+        model = model
+            .with_input_fact(1, f32::fact([rows, columns]).into())
+            .unwrap();
+        inputs.push(
+            tract_ndarray::Array2::from_shape_vec((rows, columns), masks)
+                .unwrap()
+                .into_tensor()
+                .into(),
+        );
+    }
+    let plan = model.into_optimized().unwrap().into_runnable().unwrap();
+    let outputs = plan.run(inputs).expect("tract runs the graph");
+    sidecar
+        .outputs
+        .iter()
+        .zip(outputs.iter())
+        .map(|(port, value)| {
+            let values = value.to_plain_array_view::<f32>().unwrap();
+            (port.name.clone(), values.iter().copied().collect())
+        })
+        .collect()
+}
+
+#[test]
+fn every_shipped_policy_runs_in_tract_as_it_plays_here() {
+    let policies = shipped_policies();
+    assert!(
+        policies.len() >= 10,
+        "expected the shipped policies: {policies:?}"
+    );
+    for path in &policies {
+        let (policy, card, reference) = load(path);
+        // Observations the export did not see (its examples use seed 0).
+        let observations = example_observations(&card.normalizer, ROWS, 1);
+        for profile in [Profile::Plain, Profile::Mlagents] {
+            let exported = onnx::export(&policy, &card, reference.clone(), profile).unwrap();
+            let expected = reference_outputs(&policy, &card, profile, &observations).unwrap();
+            let got = run_tract(&exported, &observations, None);
+            for (name, want) in &expected {
+                let (_, values) = got.iter().find(|(n, _)| n == name).unwrap_or_else(|| {
+                    panic!("{}: no output {name}", path.display());
+                });
+                let want: Vec<f32> = want.iter().flatten().copied().collect();
+                assert_eq!(values.len(), want.len(), "{} {name}", path.display());
+                let error = values
+                    .iter()
+                    .zip(&want)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0f32, f32::max);
+                assert!(
+                    error < 1e-4,
+                    "{} ({}) {name}: max abs error {error}",
+                    path.display(),
+                    profile.name()
+                );
+            }
+            if profile == Profile::Mlagents {
+                let constant = |name: &str| got.iter().find(|(n, _)| n == name).unwrap().1.clone();
+                assert_eq!(constant("version_number"), vec![3.0]);
+                assert_eq!(constant("memory_size"), vec![0.0]);
+                if card.network.continuous > 0 {
+                    assert_eq!(
+                        constant("continuous_action_output_shape"),
+                        vec![card.network.continuous as f32]
+                    );
+                }
+            }
+            // The example rows in the sidecar are this tool's own answers too.
+            let examples = &exported.sidecar.examples;
+            let rows: Vec<f32> = examples.observations.iter().flatten().copied().collect();
+            assert_eq!(
+                examples.outputs,
+                reference_outputs(&policy, &card, profile, &rows).unwrap()
+            );
+        }
+    }
+}
+
+#[test]
+fn mlagents_action_masks_decide_a_masked_branch() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform/solver.safetensors");
+    let (policy, card, reference) = load(&path);
+    assert_eq!(card.network.binary, 1, "the platform Solver jumps");
+    let exported = onnx::export(&policy, &card, reference, Profile::Mlagents).unwrap();
+    let observations = example_observations(&card.normalizer, ROWS, 2);
+    let jump = |masks: &[f32]| {
+        let masks: Vec<f32> = masks.iter().copied().cycle().take(2 * ROWS).collect();
+        run_tract(&exported, &observations, Some(&masks))
+            .into_iter()
+            .find(|(n, _)| n == "discrete_actions")
+            .unwrap()
+            .1
+    };
+    let free = jump(&[1.0, 1.0]);
+    assert!(
+        free.contains(&0.0) && free.contains(&1.0),
+        "unmasked, the rows should differ: {free:?}"
+    );
+    assert!(jump(&[1.0, 0.0]).iter().all(|&a| a == 0.0), "jump masked");
+    assert!(
+        jump(&[0.0, 1.0]).iter().all(|&a| a == 1.0),
+        "staying masked"
+    );
+}
+
+#[test]
+fn export_policy_writes_the_graph_and_its_sidecar_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("racing.onnx");
+    let out_arg = out.to_str().unwrap();
+    let policy = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/policies/racing/solver.safetensors"
+    );
+    let first = arlpcg(&["export-policy", policy, "--out", out_arg]);
+    assert!(first.status.success(), "{}", stderr(&first));
+    let bytes = std::fs::read(&out).unwrap();
+    let sidecar: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("racing.onnx.json")).unwrap())
+            .unwrap();
+    assert_eq!(sidecar["game"], "racing");
+    assert_eq!(sidecar["inputs"][0]["name"], "observation");
+    assert_eq!(sidecar["outputs"][0]["columns"][1]["name"], "steer");
+
+    // Existing files stay unless --force; the same policy gives the same bytes.
+    let again = arlpcg(&["export-policy", policy, "--out", out_arg]);
+    assert!(!again.status.success());
+    assert!(stderr(&again).contains("racing.onnx"), "{}", stderr(&again));
+    let forced = arlpcg(&["export-policy", policy, "--out", out_arg, "--force"]);
+    assert!(forced.status.success(), "{}", stderr(&forced));
+    assert_eq!(std::fs::read(&out).unwrap(), bytes);
+
+    // Not a policy, or not an .onnx name: a clear error, nothing written.
+    let level = concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.toml");
+    let other = dir.path().join("other.onnx");
+    let bad = arlpcg(&["export-policy", level, "--out", other.to_str().unwrap()]);
+    assert!(!bad.status.success());
+    assert!(stderr(&bad).contains("Cargo.toml"), "{}", stderr(&bad));
+    let wrong_name = arlpcg(&["export-policy", policy, "--out", "model.pt"]);
+    assert!(!wrong_name.status.success());
+    assert!(
+        stderr(&wrong_name).contains(".onnx"),
+        "{}",
+        stderr(&wrong_name)
+    );
+    assert!(!other.exists() && !Path::new("model.pt").exists());
+}

@@ -193,6 +193,11 @@ pub struct GenerateArgs {
     /// File formats to write, comma-separated.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "yaml,glb")]
     pub format: Vec<FormatArg>,
+    /// Name every solid node of the glTF with Godot's `-col` import hint, so that Godot 3 (which
+    /// ignores the physics extension) makes a static body for each. Not for Godot 4.3 and later,
+    /// which read the extension and would make two.
+    #[arg(long)]
+    pub collision_names: bool,
     /// Play each level this many times with the Solver (with --policies the one beside the
     /// Generator, with --rules the shipped one) and store the statistics in the YAML.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
@@ -296,6 +301,11 @@ pub struct ExportArgs {
     /// Output file: .glb for binary glTF, .gltf for JSON glTF plus a .bin beside it.
     #[arg(long)]
     pub out: PathBuf,
+    /// Name every solid node of the glTF with Godot's `-col` import hint, so that Godot 3 (which
+    /// ignores the physics extension) makes a static body for each. Not for Godot 4.3 and later,
+    /// which read the extension and would make two.
+    #[arg(long)]
+    pub collision_names: bool,
     /// Replace files that already exist.
     #[arg(long)]
     pub force: bool,

@@ -27,6 +27,8 @@ pub struct LevelFiles {
     dir: PathBuf,
     stem: String,
     formats: Vec<Format>,
+    /// glTF files name their solid nodes for Godot's import hints ([`Scene::with_collision_names`]).
+    collision_names: bool,
 }
 
 impl LevelFiles {
@@ -42,7 +44,14 @@ impl LevelFiles {
             dir: dir.to_path_buf(),
             stem: stem.to_string(),
             formats: unique,
+            collision_names: false,
         }
+    }
+
+    /// The same files, their glTF naming solid nodes for Godot's import hints or not.
+    pub fn with_collision_names(mut self, on: bool) -> Self {
+        self.collision_names = on;
+        self
     }
 
     fn path(&self, extension: &str) -> PathBuf {
@@ -72,7 +81,10 @@ impl LevelFiles {
 /// The bytes of each file of `files` for `level`, in [`LevelFiles::paths`] order (the same
 /// level always gives the same bytes).
 pub fn render(level: &Level, files: &LevelFiles) -> Vec<(PathBuf, Vec<u8>)> {
-    let scene = || Scene::of_level(level);
+    let scene = || match files.collision_names {
+        true => Scene::of_level(level).with_collision_names(),
+        false => Scene::of_level(level),
+    };
     let mut out = Vec::new();
     for format in &files.formats {
         match format {

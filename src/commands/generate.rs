@@ -56,7 +56,8 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         .map(|&seed| {
             (
                 seed,
-                LevelFiles::new(&args.out, &stem(args, seed), &formats),
+                LevelFiles::new(&args.out, &stem(args, seed), &formats)
+                    .with_collision_names(args.collision_names),
             )
         })
         .collect();

@@ -136,7 +136,31 @@ pub struct Scene {
     pub extras: Value,
 }
 
+/// The suffix Godot's import hints read as "this mesh also collides" (a static body with the
+/// mesh's triangles as its shape, the mesh kept), in Godot 3 and 4 alike.
+pub const COLLISION_SUFFIX: &str = "-col";
+
 impl Scene {
+    /// The scene with every solid node and mesh named for Godot's import hints
+    /// ([`COLLISION_SUFFIX`]): colliders for tools that read names and not the physics
+    /// extension (Godot 3). Godot 4.3 and later read the extension too, and would make both.
+    pub fn with_collision_names(mut self) -> Scene {
+        for node in &mut self.nodes {
+            if node.physics == Physics::SolidBox {
+                node.name.push_str(COLLISION_SUFFIX);
+            }
+        }
+        for mesh in &mut self.meshes {
+            if matches!(
+                mesh.physics,
+                Physics::SolidMesh | Physics::SolidCylinder { .. }
+            ) {
+                mesh.name.push_str(COLLISION_SUFFIX);
+            }
+        }
+        self
+    }
+
     /// The scene of a level: every block or piece of road, obstacles, start and goal markers.
     pub fn of_level(level: &Level) -> Scene {
         let mut scene = match &level.track {

@@ -396,3 +396,63 @@ fn every_solid_piece_has_a_collider_and_the_finish_a_trigger() {
         );
     }
 }
+
+/// `--collision-names`: every solid node with a mesh (and only those) is named with Godot's
+/// `-col` import hint, one for each collider of the physics extension; markers keep their names.
+#[test]
+fn collision_names_mark_exactly_the_solid_meshes() {
+    use arlpcg::level::scene::COLLISION_SUFFIX;
+    let racing = arlpcg::game::racing::rules::racing_level(
+        9,
+        None,
+        None,
+        &arlpcg::level::racing::RacingRulesConfig {
+            obstacles: 6,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for level in [level(5), racing] {
+        let game = level.game();
+        let nodes_of = |scene: Scene| {
+            let out = export::to_gltf(&scene, "level.bin");
+            let root: serde_json::Value = serde_json::from_slice(&out.main).unwrap();
+            root["nodes"].as_array().unwrap().clone()
+        };
+        let plain = nodes_of(Scene::of_level(&level));
+        assert!(
+            plain
+                .iter()
+                .all(|n| !n["name"].as_str().unwrap().ends_with(COLLISION_SUFFIX)),
+            "{game}: no hints unless asked"
+        );
+        let named = nodes_of(Scene::of_level(&level).with_collision_names());
+        let name = |n: &serde_json::Value| n["name"].as_str().unwrap().to_string();
+        let hinted: Vec<String> = named
+            .iter()
+            .map(name)
+            .filter(|n| n.ends_with(COLLISION_SUFFIX))
+            .collect();
+        let mut colliders = 0;
+        for node in &named {
+            if node["extensions"]["OMI_physics_body"]["collider"].is_null() {
+                continue;
+            }
+            colliders += 1;
+            let visual = name(node).trim_end_matches("_collider").to_string();
+            assert!(
+                hinted.contains(&visual),
+                "{game}: the collider {} belongs to no -col mesh",
+                name(node)
+            );
+        }
+        assert_eq!(hinted.len(), colliders, "{game}: {hinted:?}");
+        assert!(colliders > level.piece_count(), "{game}");
+        for marker in ["start", "goal"] {
+            assert!(
+                named.iter().any(|n| n["name"] == marker),
+                "{game}: {marker}"
+            );
+        }
+    }
+}

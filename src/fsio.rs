@@ -254,8 +254,9 @@ pub fn remove_stale_temps(dir: &Path, now: std::time::SystemTime) -> Result<usiz
     Ok(removed)
 }
 
-/// The first entry of `dir` besides this tool's temporary files, if it exists and has one.
-pub fn first_entry(dir: &Path) -> Result<Option<String>> {
+/// The first entry of `dir` besides this tool's temporary files and the names in `besides`, if
+/// it exists and has one.
+pub fn first_entry(dir: &Path, besides: &[&str]) -> Result<Option<String>> {
     let entries = match std::fs::read_dir(dir) {
         Ok(entries) => entries,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
@@ -266,7 +267,7 @@ pub fn first_entry(dir: &Path) -> Result<Option<String>> {
     for entry in entries {
         let entry = entry.with_context(|| format!("cannot read the folder {}", dir.display()))?;
         let name = entry.file_name().to_string_lossy().into_owned();
-        if !is_our_temp(&name) {
+        if !is_our_temp(&name) && !besides.contains(&name.as_str()) {
             return Ok(Some(name));
         }
     }
@@ -333,11 +334,11 @@ mod tests {
             .collect();
         names.sort();
         assert_eq!(names, [".arlpcg-new.tmp", "level.yaml", "old.tmp"]);
-        assert!(first_entry(dir.path()).unwrap().is_some());
+        assert!(first_entry(dir.path(), &[]).unwrap().is_some());
         std::fs::remove_file(dir.path().join("level.yaml")).unwrap();
         std::fs::remove_file(dir.path().join("old.tmp")).unwrap();
         assert_eq!(
-            first_entry(dir.path()).unwrap(),
+            first_entry(dir.path(), &[]).unwrap(),
             None,
             "our temporaries do not count"
         );

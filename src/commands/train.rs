@@ -29,6 +29,9 @@ pub fn run(args: &TrainArgs) -> Result<()> {
             "give a budget: --steps N (total Solver environment steps) or --minutes M (this session)",
         ));
     }
+    // One session per run folder: a second (a resume started twice) would interleave
+    // checkpoints. Taken before anything in the folder is touched.
+    let _lock = RunLock::take(out)?;
     // Temporary files a killed session left (a checkpoint half written) go first.
     let stale = crate::fsio::remove_stale_temps(out, std::time::SystemTime::now())?;
     if stale > 0 {
@@ -124,4 +127,64 @@ fn train_loop(run: &mut dyn Training, steps: Option<u64>, minutes: Option<f64>) 
     }
     println!("finished {summary}");
     Ok(())
+}
+
+/// The run folder's lock: [`train::LOCK_FILE`] holding this process's id, removed when the
+/// session ends. A lock whose process is gone (a killed session) is taken over; the check reads
+/// `/proc`, so where there is none every lock counts as gone.
+struct RunLock {
+    path: std::path::PathBuf,
+}
+
+impl RunLock {
+    fn take(out: &std::path::Path) -> Result<Self> {
+        if !out.exists() {
+            std::fs::create_dir_all(out)
+                .with_context(|| format!("cannot create the run folder {}", out.display()))?;
+        }
+        let path = out.join(train::LOCK_FILE);
+        let ours = std::process::id();
+        loop {
+            match std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&path)
+            {
+                Ok(mut file) => {
+                    use std::io::Write;
+                    writeln!(file, "{ours}")
+                        .with_context(|| format!("cannot write {}", path.display()))?;
+                    return Ok(Self { path });
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let holder = std::fs::read_to_string(&path)
+                        .ok()
+                        .and_then(|text| text.trim().parse::<u32>().ok());
+                    if let Some(pid) = holder
+                        && pid != ours
+                        && std::path::Path::new(&format!("/proc/{pid}")).exists()
+                    {
+                        anyhow::bail!(
+                            "{} is in use by another training session (process {pid}); wait for \
+                             it to finish or stop it (Ctrl-C saves its checkpoint) before resuming",
+                            out.display()
+                        );
+                    }
+                    // Its session is gone: the lock is stale.
+                    std::fs::remove_file(&path).with_context(|| {
+                        format!("cannot remove the stale lock {}", path.display())
+                    })?;
+                }
+                Err(e) => {
+                    return Err(e).with_context(|| format!("cannot create {}", path.display()));
+                }
+            }
+        }
+    }
+}
+
+impl Drop for RunLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
 }

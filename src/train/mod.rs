@@ -48,6 +48,9 @@ use solver_envs::{SolverEnvs, SourceState};
 use solver_run::*;
 
 pub(super) const CHECKPOINT: &str = "checkpoint.safetensors";
+/// The file a training session holds in its run folder while it runs (the shell's: see
+/// `commands/train.rs`); it does not make a folder a run.
+pub const LOCK_FILE: &str = "train.lock";
 pub(super) const GENERATOR_CHECKPOINT: &str = "generator-checkpoint.safetensors";
 pub(super) const METRICS: &str = "metrics.csv";
 pub(super) const GENERATOR_METRICS: &str = "generator-metrics.csv";
@@ -78,7 +81,7 @@ pub fn open(
         if out.exists() && !out.is_dir() {
             bail!("--out {} is not a folder", out.display());
         }
-        if let Some(name) = fsio::first_entry(out)? {
+        if let Some(name) = fsio::first_entry(out, &[LOCK_FILE])? {
             bail!(
                 "{} is not empty (it holds {name}): a new run starts in a new or empty folder, so that no policy or card is replaced; choose another --out",
                 out.display()

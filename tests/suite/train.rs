@@ -80,9 +80,37 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
         );
         std::thread::sleep(Duration::from_millis(50));
     }
+    let killed = child.id();
     child.kill().unwrap();
     child.wait().unwrap();
     let before = curve(&out);
+    // The killed session leaves its lock, naming a process that is gone.
+    let lock = out.join("train.lock");
+    assert_eq!(
+        std::fs::read_to_string(&lock).unwrap().trim(),
+        killed.to_string()
+    );
+    // A lock held by a live process (this test's) refuses a second session and changes nothing.
+    std::fs::write(&lock, format!("{}\n", std::process::id())).unwrap();
+    let busy = arlpcg(&[
+        "train",
+        "--mode",
+        "fixed-track",
+        "--steps",
+        "100000",
+        "--out",
+        out_s,
+        "--resume",
+    ]);
+    assert_eq!(busy.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&busy.stderr).contains("in use by another training session"),
+        "{}",
+        String::from_utf8_lossy(&busy.stderr)
+    );
+    assert_eq!(curve(&out), before);
+    // The stale lock does not hold (the sessions below take it over).
+    std::fs::write(&lock, format!("{killed}\n")).unwrap();
     let checkpoint = std::fs::read(out.join("checkpoint.safetensors")).unwrap();
     let saved = load_policy(&checkpoint, Game::Platform, Role::Solver, OBSERVATION_SIZE).unwrap();
     let state = saved.training_state().unwrap();
@@ -130,6 +158,7 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
         "{}",
         String::from_utf8_lossy(&resumed.stderr)
     );
+    assert!(!lock.exists(), "a finished session removes its lock");
     let after = curve(&out);
     // The rows up to the checkpoint are kept, later ones (written after it) dropped and redone.
     assert_eq!(

@@ -162,139 +162,14 @@ fn document(
         extensions: None,
         extras: None,
     });
-    let vertex_bytes = CUBE_VERTICES * VEC3_BYTES;
-    let mut view = |offset: usize, length: usize, target, name: &str| {
-        root.push(json::buffer::View {
-            buffer,
-            byte_length: USize64::from(length),
-            byte_offset: Some(USize64::from(offset)),
-            byte_stride: None,
-            name: Some(name.into()),
-            target: Some(Valid(target)),
-            extensions: None,
-            extras: None,
-        })
-    };
-    let positions_view = view(
-        0,
-        vertex_bytes,
-        json::buffer::Target::ArrayBuffer,
-        "positions",
-    );
-    let normals_view = view(
-        vertex_bytes,
-        vertex_bytes,
-        json::buffer::Target::ArrayBuffer,
-        "normals",
-    );
-    let indices_view = view(
-        2 * vertex_bytes,
-        2 * CUBE_INDICES,
-        json::buffer::Target::ElementArrayBuffer,
-        "indices",
-    );
-    let accessor =
-        |view, count: usize, component, type_, bounds: Option<(f32, f32)>, name: &str| {
-            json::Accessor {
-                buffer_view: Some(view),
-                byte_offset: None,
-                count: USize64::from(count),
-                component_type: Valid(json::accessor::GenericComponentType(component)),
-                extensions: None,
-                extras: None,
-                type_: Valid(type_),
-                min: bounds.map(|(lo, _)| json::Value::from(vec![lo; 3])),
-                max: bounds.map(|(_, hi)| json::Value::from(vec![hi; 3])),
-                name: Some(name.into()),
-                normalized: false,
-                sparse: None,
-            }
-        };
-    use json::accessor::{ComponentType, Type};
-    let positions = root.push(accessor(
-        positions_view,
-        CUBE_VERTICES,
-        ComponentType::F32,
-        Type::Vec3,
-        Some((-0.5, 0.5)),
-        "positions",
-    ));
-    let normals = root.push(accessor(
-        normals_view,
-        CUBE_VERTICES,
-        ComponentType::F32,
-        Type::Vec3,
-        None,
-        "normals",
-    ));
-    let indices = root.push(accessor(
-        indices_view,
-        CUBE_INDICES,
-        ComponentType::U16,
-        Type::Scalar,
-        None,
-        "indices",
-    ));
-
-    let new_material = |root: &mut json::Root, material: Material| {
-        root.push(json::Material {
-            name: Some(material.name().into()),
-            pbr_metallic_roughness: json::material::PbrMetallicRoughness {
-                base_color_factor: json::material::PbrBaseColorFactor(material.colour()),
-                metallic_factor: json::material::StrengthFactor(0.0),
-                roughness_factor: json::material::StrengthFactor(0.8),
-                ..Default::default()
-            },
-            ..Default::default()
-        })
-    };
-    let mut materials = BTreeMap::new();
-    let mut meshes = BTreeMap::new();
-    for material in Material::ALL {
-        if !scene.nodes.iter().any(|n| n.material == material) {
-            continue;
-        }
-        let material_index = new_material(&mut root, material);
-        materials.insert(material, material_index);
-        let mesh = root.push(json::Mesh {
-            name: Some(material.name().into()),
-            primitives: vec![json::mesh::Primitive {
-                attributes: BTreeMap::from([
-                    (Valid(json::mesh::Semantic::Positions), positions),
-                    (Valid(json::mesh::Semantic::Normals), normals),
-                ]),
-                extensions: None,
-                extras: None,
-                indices: Some(indices),
-                material: Some(material_index),
-                mode: Valid(json::mesh::Mode::Triangles),
-                targets: None,
-            }],
-            weights: None,
-            extensions: None,
-            extras: None,
-        });
-        meshes.insert(material, mesh);
-    }
-
-    for material in Material::ALL {
-        let used = scene
-            .meshes
-            .iter()
-            .any(|m| m.primitives.iter().any(|(_, pm)| *pm == material));
-        if used && !materials.contains_key(&material) {
-            let index = new_material(&mut root, material);
-            materials.insert(material, index);
-        }
-    }
-
+    let (materials, cube_meshes) = materials_and_cube_meshes(scene, &mut root, buffer);
     let mut nodes: Vec<json::Index<json::Node>> = scene
         .nodes
         .iter()
         .map(|node| {
             root.push(json::Node {
                 name: Some(node.name.clone()),
-                mesh: Some(meshes[&node.material]),
+                mesh: Some(cube_meshes[&node.material]),
                 translation: Some(node.centre.map(|c| c as f32)),
                 rotation: box_rotation(node.heading),
                 scale: Some(node.extents.map(|e| e as f32)),
@@ -310,74 +185,7 @@ fn document(
             .iter()
             .zip(parts)
             .map(|((_, material), part)| {
-                let view =
-                    |root: &mut json::Root, offset: usize, length: usize, target, name: &str| {
-                        root.push(json::buffer::View {
-                            buffer,
-                            byte_length: USize64::from(length),
-                            byte_offset: Some(USize64::from(offset)),
-                            byte_stride: None,
-                            name: Some(format!("{}_{name}", mesh.name)),
-                            target: Some(Valid(target)),
-                            extensions: None,
-                            extras: None,
-                        })
-                    };
-                let vertex_target = json::buffer::Target::ArrayBuffer;
-                let n = part.vertices;
-                let positions_view = view(
-                    &mut root,
-                    part.positions,
-                    n * 12,
-                    vertex_target,
-                    "positions",
-                );
-                let normals_view = view(&mut root, part.normals, n * 12, vertex_target, "normals");
-                let uvs_view = view(&mut root, part.uvs, n * 8, vertex_target, "uvs");
-                let indices_view = view(
-                    &mut root,
-                    part.indices,
-                    part.triangles * 12,
-                    json::buffer::Target::ElementArrayBuffer,
-                    "indices",
-                );
-                let mut attribute = |view, count, component, type_, name: &str| {
-                    let mut a = accessor(view, count, component, type_, None, name);
-                    if name == "positions" {
-                        a.min = Some(json::Value::from(part.min.to_vec()));
-                        a.max = Some(json::Value::from(part.max.to_vec()));
-                    }
-                    root.push(a)
-                };
-                let positions = attribute(
-                    positions_view,
-                    n,
-                    ComponentType::F32,
-                    Type::Vec3,
-                    "positions",
-                );
-                let normals = attribute(normals_view, n, ComponentType::F32, Type::Vec3, "normals");
-                let uvs = attribute(uvs_view, n, ComponentType::F32, Type::Vec2, "uvs");
-                let indices = attribute(
-                    indices_view,
-                    3 * part.triangles,
-                    ComponentType::U32,
-                    Type::Scalar,
-                    "indices",
-                );
-                json::mesh::Primitive {
-                    attributes: BTreeMap::from([
-                        (Valid(json::mesh::Semantic::Positions), positions),
-                        (Valid(json::mesh::Semantic::Normals), normals),
-                        (Valid(json::mesh::Semantic::TexCoords(0)), uvs),
-                    ]),
-                    extensions: None,
-                    extras: None,
-                    indices: Some(indices),
-                    material: Some(materials[material]),
-                    mode: Valid(json::mesh::Mode::Triangles),
-                    targets: None,
-                }
+                mesh_primitive(&mut root, buffer, &mesh.name, part, materials[material])
             })
             .collect();
         let mesh_index = root.push(json::Mesh {
@@ -418,6 +226,260 @@ fn document(
     });
     root.scene = Some(scene_index);
     root
+}
+
+type MaterialIndices = BTreeMap<Material, json::Index<json::Material>>;
+type MeshIndices = BTreeMap<Material, json::Index<json::Mesh>>;
+
+/// The unit cube's views and accessors; a material and a cube mesh for each material the boxes
+/// use, then a material for each further one the meshes use.
+fn materials_and_cube_meshes(
+    scene: &Scene,
+    root: &mut json::Root,
+    buffer: json::Index<json::Buffer>,
+) -> (MaterialIndices, MeshIndices) {
+    use json::accessor::{ComponentType, Type};
+    use json::buffer::Target;
+    let vertex_bytes = CUBE_VERTICES * VEC3_BYTES;
+    let positions_view = push_view(
+        root,
+        buffer,
+        0,
+        vertex_bytes,
+        Target::ArrayBuffer,
+        "positions",
+    );
+    let normals_view = push_view(
+        root,
+        buffer,
+        vertex_bytes,
+        vertex_bytes,
+        Target::ArrayBuffer,
+        "normals",
+    );
+    let indices_view = push_view(
+        root,
+        buffer,
+        2 * vertex_bytes,
+        2 * CUBE_INDICES,
+        Target::ElementArrayBuffer,
+        "indices",
+    );
+    let positions = root.push(accessor(
+        positions_view,
+        CUBE_VERTICES,
+        ComponentType::F32,
+        Type::Vec3,
+        Some((vec![-0.5; 3], vec![0.5; 3])),
+        "positions",
+    ));
+    let normals = root.push(accessor(
+        normals_view,
+        CUBE_VERTICES,
+        ComponentType::F32,
+        Type::Vec3,
+        None,
+        "normals",
+    ));
+    let indices = root.push(accessor(
+        indices_view,
+        CUBE_INDICES,
+        ComponentType::U16,
+        Type::Scalar,
+        None,
+        "indices",
+    ));
+    let mut materials = BTreeMap::new();
+    let mut meshes = BTreeMap::new();
+    for material in Material::ALL {
+        if !scene.nodes.iter().any(|n| n.material == material) {
+            continue;
+        }
+        let material_index = push_material(root, material);
+        materials.insert(material, material_index);
+        let mesh = root.push(json::Mesh {
+            name: Some(material.name().into()),
+            primitives: vec![json::mesh::Primitive {
+                attributes: BTreeMap::from([
+                    (Valid(json::mesh::Semantic::Positions), positions),
+                    (Valid(json::mesh::Semantic::Normals), normals),
+                ]),
+                extensions: None,
+                extras: None,
+                indices: Some(indices),
+                material: Some(material_index),
+                mode: Valid(json::mesh::Mode::Triangles),
+                targets: None,
+            }],
+            weights: None,
+            extensions: None,
+            extras: None,
+        });
+        meshes.insert(material, mesh);
+    }
+    for material in Material::ALL {
+        let used = scene
+            .meshes
+            .iter()
+            .any(|m| m.primitives.iter().any(|(_, pm)| *pm == material));
+        if used && !materials.contains_key(&material) {
+            let index = push_material(root, material);
+            materials.insert(material, index);
+        }
+    }
+    (materials, meshes)
+}
+
+fn push_material(root: &mut json::Root, material: Material) -> json::Index<json::Material> {
+    root.push(json::Material {
+        name: Some(material.name().into()),
+        pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+            base_color_factor: json::material::PbrBaseColorFactor(material.colour()),
+            metallic_factor: json::material::StrengthFactor(0.0),
+            roughness_factor: json::material::StrengthFactor(0.8),
+            ..Default::default()
+        },
+        ..Default::default()
+    })
+}
+
+/// One primitive of a mesh of the scene: its four views and accessors into the buffer.
+fn mesh_primitive(
+    root: &mut json::Root,
+    buffer: json::Index<json::Buffer>,
+    mesh_name: &str,
+    part: &PrimitiveLayout,
+    material: json::Index<json::Material>,
+) -> json::mesh::Primitive {
+    use json::accessor::{ComponentType, Type};
+    use json::buffer::Target;
+    let n = part.vertices;
+    let name = |what: &str| format!("{mesh_name}_{what}");
+    let positions_view = push_view(
+        root,
+        buffer,
+        part.positions,
+        n * 12,
+        Target::ArrayBuffer,
+        &name("positions"),
+    );
+    let normals_view = push_view(
+        root,
+        buffer,
+        part.normals,
+        n * 12,
+        Target::ArrayBuffer,
+        &name("normals"),
+    );
+    let uvs_view = push_view(
+        root,
+        buffer,
+        part.uvs,
+        n * 8,
+        Target::ArrayBuffer,
+        &name("uvs"),
+    );
+    let indices_view = push_view(
+        root,
+        buffer,
+        part.indices,
+        part.triangles * 12,
+        Target::ElementArrayBuffer,
+        &name("indices"),
+    );
+    let positions = root.push(accessor(
+        positions_view,
+        n,
+        ComponentType::F32,
+        Type::Vec3,
+        Some((part.min.to_vec(), part.max.to_vec())),
+        "positions",
+    ));
+    let normals = root.push(accessor(
+        normals_view,
+        n,
+        ComponentType::F32,
+        Type::Vec3,
+        None,
+        "normals",
+    ));
+    let uvs = root.push(accessor(
+        uvs_view,
+        n,
+        ComponentType::F32,
+        Type::Vec2,
+        None,
+        "uvs",
+    ));
+    let indices = root.push(accessor(
+        indices_view,
+        3 * part.triangles,
+        ComponentType::U32,
+        Type::Scalar,
+        None,
+        "indices",
+    ));
+    json::mesh::Primitive {
+        attributes: BTreeMap::from([
+            (Valid(json::mesh::Semantic::Positions), positions),
+            (Valid(json::mesh::Semantic::Normals), normals),
+            (Valid(json::mesh::Semantic::TexCoords(0)), uvs),
+        ]),
+        extensions: None,
+        extras: None,
+        indices: Some(indices),
+        material: Some(material),
+        mode: Valid(json::mesh::Mode::Triangles),
+        targets: None,
+    }
+}
+
+fn push_view(
+    root: &mut json::Root,
+    buffer: json::Index<json::Buffer>,
+    offset: usize,
+    length: usize,
+    target: json::buffer::Target,
+    name: &str,
+) -> json::Index<json::buffer::View> {
+    root.push(json::buffer::View {
+        buffer,
+        byte_length: USize64::from(length),
+        byte_offset: Some(USize64::from(offset)),
+        byte_stride: None,
+        name: Some(name.into()),
+        target: Some(Valid(target)),
+        extensions: None,
+        extras: None,
+    })
+}
+
+/// An accessor of `count` elements in `view`; `bounds` its min and max, where given.
+fn accessor(
+    view: json::Index<json::buffer::View>,
+    count: usize,
+    component: json::accessor::ComponentType,
+    type_: json::accessor::Type,
+    bounds: Option<(Vec<f32>, Vec<f32>)>,
+    name: &str,
+) -> json::Accessor {
+    let (min, max) = bounds
+        .map(|(lo, hi)| (json::Value::from(lo), json::Value::from(hi)))
+        .unzip();
+    json::Accessor {
+        buffer_view: Some(view),
+        byte_offset: None,
+        count: USize64::from(count),
+        component_type: Valid(json::accessor::GenericComponentType(component)),
+        extensions: None,
+        extras: None,
+        type_: Valid(type_),
+        min,
+        max,
+        name: Some(name.into()),
+        normalized: false,
+        sparse: None,
+    }
 }
 
 /// Colliders and the finish trigger as the `OMI_physics_shape` / `OMI_physics_body` extensions

@@ -32,20 +32,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         Some(dir) => Some(load_generator(&policy_paths(dir).0, args.game)?.0),
         None => None,
     };
-    let shipped = default_solver(args.game);
-    let solver: Option<SolverPolicy> = match (verify_trials, args.judge, &args.solver_policy) {
-        (None, _, _) => None,
-        // A Solver judge's policy; none for the scripted player.
-        (Some(_), Some(judge), _) => {
-            load_judge(&policies_dir(args), args.game, judge)?.map(|(policy, _)| policy)
-        }
-        (Some(_), None, Some(path)) => Some(load_solver(path, args.game)?.0),
-        (Some(_), None, None) => match &args.policies {
-            Some(dir) => Some(load_solver(&policy_paths(dir).1, args.game)?.0),
-            None if shipped.exists() => Some(load_solver(&shipped, args.game)?.0),
-            None => None,
-        },
-    };
+    let solver = chosen_solver(args, verify_trials)?;
     let panel = match args.panel {
         true => Some(load_panel(&policies_dir(args), args.game, None)?),
         false => None,
@@ -79,40 +66,16 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         .as_ref()
         .map_or(Solver::Scripted(skill), Solver::Policy);
     let curve = target_curve(args, generator.as_ref(), &who, &stop)?;
-    let bar = crate::shell::progress_bar(plans.len() as u64, "generating");
-    let built: Vec<Option<Result<Level>>> = plans
-        .par_iter()
-        .map(|(seed, _)| {
-            if stop.load(Ordering::SeqCst) {
-                return None;
-            }
-            let level = match (args.target_success, &curve, &generator) {
-                (Some(target), Some(curve), Some(generator)) => difficulty::level_for(
-                    generator,
-                    &who,
-                    curve,
-                    *seed,
-                    args.goal,
-                    target,
-                    verify_trials.unwrap_or(TARGET_TRIALS),
-                )
-                .map_err(anyhow::Error::from)
-                .and_then(|level| certified(level, &who, *seed)),
-                _ => build_verified(args, keep.as_ref(), generator.as_ref(), &who, *seed),
-            };
-            bar.inc(1);
-            Some(level.with_context(|| format!("seed {seed} (nothing was written)")))
-        })
-        .collect();
-    bar.finish_and_clear();
-    // The levels finished before a Ctrl-C: a prefix of the batch, so that a re-run resumes it.
-    let mut levels = Vec::with_capacity(plans.len());
-    for level in built {
-        match level {
-            Some(level) => levels.push(level?),
-            None => break,
-        }
-    }
+    let mut levels = build_levels(
+        args,
+        &plans,
+        keep.as_ref(),
+        generator.as_ref(),
+        &who,
+        curve.as_ref(),
+        verify_trials,
+        &stop,
+    )?;
     if let Some(panel) = &panel {
         play_panel(
             panel,
@@ -463,4 +426,74 @@ fn build_verified(
     bail!(
         "none of the {MAX_DRAWS} levels drawn for this seed was completed by any of {trials} runs (--allow-unsolved keeps the first anyway)"
     )
+}
+
+/// The Solver that plays `--verify` and `--target-success`: the judge asked for, the file asked
+/// for, the one beside the Generator, or the shipped one; none for the scripted player or when
+/// nothing is verified.
+fn chosen_solver(args: &GenerateArgs, verify_trials: Option<u32>) -> Result<Option<SolverPolicy>> {
+    let shipped = default_solver(args.game);
+    Ok(match (verify_trials, args.judge, &args.solver_policy) {
+        (None, _, _) => None,
+        // A Solver judge's policy; none for the scripted player.
+        (Some(_), Some(judge), _) => {
+            load_judge(&policies_dir(args), args.game, judge)?.map(|(policy, _)| policy)
+        }
+        (Some(_), None, Some(path)) => Some(load_solver(path, args.game)?.0),
+        (Some(_), None, None) => match &args.policies {
+            Some(dir) => Some(load_solver(&policy_paths(dir).1, args.game)?.0),
+            None if shipped.exists() => Some(load_solver(&shipped, args.game)?.0),
+            None => None,
+        },
+    })
+}
+
+/// Builds (and verifies) the level of every plan, several at once; after a Ctrl-C, the levels
+/// finished before it, a prefix of the batch, so that a re-run resumes it.
+#[allow(clippy::too_many_arguments)]
+fn build_levels(
+    args: &GenerateArgs,
+    plans: &[(u64, LevelFiles)],
+    keep: Option<&KeptPrefix>,
+    generator: Option<&GeneratorPolicy>,
+    who: &Solver,
+    curve: Option<&difficulty::Curve>,
+    verify_trials: Option<u32>,
+    stop: &AtomicBool,
+) -> Result<Vec<Level>> {
+    let bar = crate::shell::progress_bar(plans.len() as u64, "generating");
+    let built: Vec<Option<Result<Level>>> = plans
+        .par_iter()
+        .map(|(seed, _)| {
+            if stop.load(Ordering::SeqCst) {
+                return None;
+            }
+            let level = match (args.target_success, curve, generator) {
+                (Some(target), Some(curve), Some(generator)) => difficulty::level_for(
+                    generator,
+                    who,
+                    curve,
+                    *seed,
+                    args.goal,
+                    target,
+                    verify_trials.unwrap_or(TARGET_TRIALS),
+                )
+                .map_err(anyhow::Error::from)
+                .and_then(|level| certified(level, who, *seed)),
+                _ => build_verified(args, keep, generator, who, *seed),
+            };
+            bar.inc(1);
+            Some(level.with_context(|| format!("seed {seed} (nothing was written)")))
+        })
+        .collect();
+    bar.finish_and_clear();
+    // The levels finished before a Ctrl-C: a prefix of the batch, so that a re-run resumes it.
+    let mut levels = Vec::with_capacity(plans.len());
+    for level in built {
+        match level {
+            Some(level) => levels.push(level?),
+            None => break,
+        }
+    }
+    Ok(levels)
 }

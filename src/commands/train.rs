@@ -30,8 +30,12 @@ pub fn run(args: &TrainArgs) -> Result<()> {
         ));
     }
     // One session per run folder: a second (a resume started twice) would interleave
-    // checkpoints. Taken before anything in the folder is touched.
-    let _lock = RunLock::take(out)?;
+    // checkpoints. Taken before anything in the folder is touched; a folder that does not
+    // exist yet is locked as soon as the run has made it (a refused run makes none).
+    let lock = match out.is_dir() {
+        true => Some(RunLock::take(out)?),
+        false => None,
+    };
     // Temporary files a killed session left (a checkpoint half written) go first.
     let stale = crate::fsio::remove_stale_temps(out, std::time::SystemTime::now())?;
     if stale > 0 {
@@ -50,6 +54,10 @@ pub fn run(args: &TrainArgs) -> Result<()> {
             args.seed,
             args.resume,
         )?;
+        let _lock = match lock {
+            Some(lock) => lock,
+            None => RunLock::take(out)?,
+        };
         train_loop(run.as_mut(), args.steps, args.minutes)
     })
 }
@@ -138,10 +146,6 @@ struct RunLock {
 
 impl RunLock {
     fn take(out: &std::path::Path) -> Result<Self> {
-        if !out.exists() {
-            std::fs::create_dir_all(out)
-                .with_context(|| format!("cannot create the run folder {}", out.display()))?;
-        }
         let path = out.join(train::LOCK_FILE);
         let ours = std::process::id();
         loop {

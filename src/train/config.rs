@@ -378,16 +378,20 @@ pub(super) fn check_config(config: &TrainConfig, game: Game) -> Result<(), Strin
     ] {
         p.check().map_err(|problem| format!("{name}.{problem}"))?;
     }
-    let g = &config.generator;
+    check_generator(&config.generator, game).map_err(|problem| format!("generator.{problem}"))
+}
+
+/// The Generator's part of [`check_config`]; problems name the field below `generator.`.
+fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
     if g.aux_values.is_empty()
         || g.aux_values.len() > 1000
         || g.aux_values.iter().any(|l| !(-1.0..=1.0).contains(l))
     {
-        return Err("generator.aux_values: give 1 to 1000 values, each within [-1, 1]".into());
+        return Err("aux_values: give 1 to 1000 values, each within [-1, 1]".into());
     }
     if g.rewards.aux.len() != 1 {
         return Err(format!(
-            "generator.rewards.aux: the {game} game has 1 aux input, so give 1 weight pair, not {}",
+            "rewards.aux: the {game} game has 1 aux input, so give 1 weight pair, not {}",
             g.rewards.aux.len()
         ));
     }
@@ -404,42 +408,40 @@ pub(super) fn check_config(config: &TrainConfig, game: Game) -> Result<(), Strin
     .chain(weights)
     .all(f32::is_finite)
     {
-        return Err("generator.rewards: every weight must be a finite number".into());
+        return Err("rewards: every weight must be a finite number".into());
     }
     if g.snapshot_share.is_some_and(|p| !(0.0..=1.0).contains(&p)) {
-        return Err("generator.snapshot_share must be a number in [0, 1]".into());
+        return Err("snapshot_share must be a number in [0, 1]".into());
     }
     if g.stages.len() > MAX_STAGES {
-        return Err(format!("generator.stages: at most {MAX_STAGES}"));
+        return Err(format!("stages: at most {MAX_STAGES}"));
     }
     for (k, stage) in g.stages.iter().enumerate() {
         let rate = stage.solver_learning_rate;
         if !(rate.is_finite() && (0.0..=1.0).contains(&rate)) {
             return Err(format!(
-                "generator.stages[{k}].solver_learning_rate must be a number in [0, 1]"
+                "stages[{k}].solver_learning_rate must be a number in [0, 1]"
             ));
         }
         if !(1..=MAX_PHASE_STEPS).contains(&stage.solver_phase_steps)
             || !(1..=MAX_PHASE_STEPS).contains(&stage.generator_phase_steps)
         {
             return Err(format!(
-                "generator.stages[{k}]: solver_phase_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
+                "stages[{k}]: solver_phase_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
             ));
         }
         if k > 0 && stage.from_steps <= g.stages[k - 1].from_steps {
             return Err(format!(
-                "generator.stages[{k}].from_steps must be after the stage before it"
+                "stages[{k}].from_steps must be after the stage before it"
             ));
         }
     }
     if g.population > MAX_POPULATION {
-        return Err(format!(
-            "generator.population must be within [0, {MAX_POPULATION}]"
-        ));
+        return Err(format!("population must be within [0, {MAX_POPULATION}]"));
     }
     if !(1..=MAX_PHASE_STEPS).contains(&g.population_every_steps) {
         return Err(format!(
-            "generator.population_every_steps must be within [1, {MAX_PHASE_STEPS}]"
+            "population_every_steps must be within [1, {MAX_PHASE_STEPS}]"
         ));
     }
     let max_pieces = match game {
@@ -447,34 +449,32 @@ pub(super) fn check_config(config: &TrainConfig, game: Game) -> Result<(), Strin
         Game::Racing => RacingGame::MAX_PIECES,
     };
     if !(1..=max_pieces).contains(&g.max_pieces) {
-        return Err(format!(
-            "generator.max_pieces must be within [1, {max_pieces}]"
-        ));
+        return Err(format!("max_pieces must be within [1, {max_pieces}]"));
     }
     let default_offset = crate::game::racing::generator::DEFAULT_CURVE_OFFSET;
     if !(0.0..=180.0).contains(&g.curve_offset) {
-        return Err("generator.curve_offset must be a number of degrees in [0, 180]".into());
+        return Err("curve_offset must be a number of degrees in [0, 180]".into());
     }
     if game == Game::Platform && g.curve_offset != default_offset {
         return Err(format!(
-            "generator.curve_offset is the racing Generator's: the platform game has no curve (leave it at {default_offset})"
+            "curve_offset is the racing Generator's: the platform game has no curve (leave it at {default_offset})"
         ));
     }
     if g.obstacles > crate::level::racing::MAX_OBSTACLES as u32 {
         return Err(format!(
-            "generator.obstacles must be at most {}",
+            "obstacles must be at most {}",
             crate::level::racing::MAX_OBSTACLES
         ));
     }
     if !(-10.0..=2.0).contains(&g.initial_log_std) {
-        return Err("generator.initial_log_std must be within [-10, 2]".into());
+        return Err("initial_log_std must be within [-10, 2]".into());
     }
     if g.solver_warmup_steps > MAX_PHASE_STEPS
         || !(1..=MAX_PHASE_STEPS).contains(&g.solver_phase_steps)
         || !(1..=MAX_PHASE_STEPS).contains(&g.generator_phase_steps)
     {
         return Err(format!(
-            "generator: solver_phase_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}], solver_warmup_steps at most that"
+            "solver_phase_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}], solver_warmup_steps at most that"
         ));
     }
     Ok(())

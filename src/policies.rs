@@ -11,7 +11,10 @@ use crate::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
 use crate::generation::GeneratorPolicy;
 use crate::level::{Game, PolicyRef};
 use crate::panel::{Judge, Panel};
-use crate::rl::checkpoint::{LoadedPolicy, MAX_POLICY_BYTES, PolicyCard, Role, load_policy};
+use crate::rl::checkpoint::{
+    LoadedPolicy, MAX_POLICY_BYTES, PolicyCard, Role, load_policy, read_card,
+};
+use crate::rl::policy::ActorCritic;
 use crate::verify::SolverPolicy;
 
 /// File names inside a policies folder.
@@ -124,6 +127,23 @@ pub fn curve_path(dir: &Path, solver_path: &Path, solver_sha256: &str) -> PathBu
         .unwrap_or("solver");
     let short = solver_sha256.get(..12).unwrap_or(solver_sha256);
     dir.join(format!("difficulty-curve-{stem}-{short}.yaml"))
+}
+
+/// The policy in `path`, whichever game and role its card names, loaded and checked as that
+/// game's Solver or Generator: its network, card and pinned reference.
+pub fn load_any(path: &Path) -> Result<(ActorCritic, PolicyCard, PolicyRef)> {
+    let bytes = crate::fsio::read_limited(path, MAX_POLICY_BYTES, "policy")?;
+    let card = read_card(&bytes).with_context(|| format!("{}", path.display()))?;
+    Ok(match card.role {
+        Role::Solver => {
+            let (solver, card) = load_solver(path, card.game)?;
+            (solver.policy, card, solver.reference)
+        }
+        Role::Generator => {
+            let (generator, card) = load_generator(path, card.game)?;
+            (generator.policy, card, generator.reference)
+        }
+    })
 }
 
 /// The λ→success curve of `generator` with `solver`, kept in `dir` (see [`curve_path`]): read

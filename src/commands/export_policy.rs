@@ -4,7 +4,6 @@ use anyhow::{Context, Result};
 
 use crate::cli::ExportPolicyArgs;
 use crate::fsio::{Batch, Overwrite};
-use crate::rl::checkpoint::{MAX_POLICY_BYTES, Role, read_card};
 
 pub fn run(args: &ExportPolicyArgs) -> Result<()> {
     if args.out.extension().and_then(|e| e.to_str()) != Some("onnx") {
@@ -23,19 +22,8 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
     for path in [&args.out, &sidecar_path] {
         crate::fsio::check_writable(path, overwrite)?;
     }
-    let bytes = crate::fsio::read_limited(&args.policy, MAX_POLICY_BYTES, "policy")?;
-    let card = read_card(&bytes).with_context(|| format!("{}", args.policy.display()))?;
     // Loaded through the game's own loader: game, role, shape and normalizer all checked.
-    let (policy, card, reference) = match card.role {
-        Role::Solver => {
-            let (solver, card) = crate::policies::load_solver(&args.policy, card.game)?;
-            (solver.policy, card, solver.reference)
-        }
-        Role::Generator => {
-            let (generator, card) = crate::policies::load_generator(&args.policy, card.game)?;
-            (generator.policy, card, generator.reference)
-        }
-    };
+    let (policy, card, reference) = crate::policies::load_any(&args.policy)?;
     let exported = crate::onnx::export(&policy, &card, reference, args.profile)
         .with_context(|| format!("{}: exporting the actor", args.policy.display()))?;
     let sidecar = serde_json::to_string_pretty(&exported.sidecar)? + "\n";

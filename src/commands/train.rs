@@ -32,10 +32,7 @@ pub fn run(args: &TrainArgs) -> Result<()> {
     // One session per run folder: a second (a resume started twice) would interleave
     // checkpoints. Taken before anything in the folder is touched; a folder that does not
     // exist yet is locked as soon as the run has made it (a refused run makes none).
-    let lock = match out.is_dir() {
-        true => Some(RunLock::take(out)?),
-        false => None,
-    };
+    let lock = out.is_dir().then(|| RunLock::take(out)).transpose()?;
     // Temporary files a killed session left (a checkpoint half written) go first.
     let stale = crate::fsio::remove_stale_temps(out, std::time::SystemTime::now())?;
     if stale > 0 {

@@ -311,14 +311,9 @@ fn spawn_and_finish_nodes_carry_start_heading_and_goal_reach() {
     }
 }
 
-/// Colliders an engine imports (`OMI_physics_body` / `OMI_physics_shape`): an unscaled box beside
-/// every block and box obstacle with the block's size, a cylinder beside every cylinder, each
-/// road segment's own mesh as a triangle mesh, and a trigger at the finish; markers collide with
-/// nothing.
-#[test]
-fn every_solid_piece_has_a_collider_and_the_finish_a_trigger() {
-    let platform = level(5);
-    let racing = arlpcg::game::racing::rules::racing_level(
+/// Racing rule track 9 with 6 obstacles (boxes and cylinders).
+fn racing_with_obstacles() -> Level {
+    arlpcg::game::racing::rules::racing_level(
         9,
         None,
         None,
@@ -327,8 +322,16 @@ fn every_solid_piece_has_a_collider_and_the_finish_a_trigger() {
             ..Default::default()
         },
     )
-    .unwrap();
-    for level in [platform, racing] {
+    .unwrap()
+}
+
+/// Colliders an engine imports (`OMI_physics_body` / `OMI_physics_shape`): an unscaled box beside
+/// every block and box obstacle with the block's size, a cylinder beside every cylinder, each
+/// road segment's own mesh as a triangle mesh, and a trigger at the finish; markers collide with
+/// nothing.
+#[test]
+fn every_solid_piece_has_a_collider_and_the_finish_a_trigger() {
+    for level in [level(5), racing_with_obstacles()] {
         let game = level.game();
         let out = export::to_gltf(&Scene::of_level(&level), "level.bin");
         let root: serde_json::Value = serde_json::from_slice(&out.main).unwrap();
@@ -402,17 +405,7 @@ fn every_solid_piece_has_a_collider_and_the_finish_a_trigger() {
 #[test]
 fn collision_names_mark_exactly_the_solid_meshes() {
     use arlpcg::level::scene::COLLISION_SUFFIX;
-    let racing = arlpcg::game::racing::rules::racing_level(
-        9,
-        None,
-        None,
-        &arlpcg::level::racing::RacingRulesConfig {
-            obstacles: 6,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    for level in [level(5), racing] {
+    for level in [level(5), racing_with_obstacles()] {
         let game = level.game();
         let nodes_of = |scene: Scene| {
             let out = export::to_gltf(&scene, "level.bin");

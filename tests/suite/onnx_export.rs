@@ -3,10 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use arlpcg::level::{Game, PolicyRef};
+use arlpcg::level::Game;
 use arlpcg::onnx::{self, Exported, Profile, example_observations, reference_outputs};
-use arlpcg::rl::checkpoint::{PolicyCard, Role, read_card};
-use arlpcg::rl::policy::ActorCritic;
 use tract_onnx::prelude::*;
 
 use crate::common::{arlpcg, stderr};
@@ -28,20 +26,6 @@ fn shipped_policies() -> Vec<PathBuf> {
     }
     found.sort();
     found
-}
-
-fn load(path: &Path) -> (ActorCritic, PolicyCard, PolicyRef) {
-    let card = read_card(&std::fs::read(path).unwrap()).unwrap();
-    match card.role {
-        Role::Solver => {
-            let (p, card) = arlpcg::policies::load_solver(path, card.game).unwrap();
-            (p.policy, card, p.reference)
-        }
-        Role::Generator => {
-            let (p, card) = arlpcg::policies::load_generator(path, card.game).unwrap();
-            (p.policy, card, p.reference)
-        }
-    }
 }
 
 /// Runs the graph with tract: the observation rows, and `masks` for `action_masks` if the graph
@@ -102,7 +86,7 @@ fn every_shipped_policy_runs_in_tract_as_it_plays_here() {
         "expected the shipped policies: {policies:?}"
     );
     for path in &policies {
-        let (policy, card, reference) = load(path);
+        let (policy, card, reference) = arlpcg::policies::load_any(path).unwrap();
         // Observations the export did not see (its examples use seed 0).
         let observations = example_observations(&card.normalizer, ROWS, 1);
         for profile in [Profile::Plain, Profile::Mlagents] {
@@ -152,7 +136,7 @@ fn every_shipped_policy_runs_in_tract_as_it_plays_here() {
 #[test]
 fn mlagents_action_masks_decide_a_masked_branch() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform/solver.safetensors");
-    let (policy, card, reference) = load(&path);
+    let (policy, card, reference) = arlpcg::policies::load_any(&path).unwrap();
     assert_eq!(card.network.binary, 1, "the platform Solver jumps");
     let exported = onnx::export(&policy, &card, reference, Profile::Mlagents).unwrap();
     let observations = example_observations(&card.normalizer, ROWS, 2);

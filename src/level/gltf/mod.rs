@@ -7,7 +7,11 @@ use std::collections::BTreeMap;
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
-use super::scene::{Material, Physics, Scene};
+mod physics;
+
+use super::scene::{Material, Scene};
+use physics::physics;
+pub use physics::{OMI_BODY, OMI_SHAPE};
 
 /// A `.gltf` document and the `.bin` buffer it refers to.
 #[derive(Debug, Clone, PartialEq)]
@@ -482,95 +486,6 @@ fn accessor(
     }
 }
 
-/// Colliders and the finish trigger as the `OMI_physics_shape` / `OMI_physics_body` extensions
-/// (used, not required; Godot 4 imports them as static bodies and areas): a box collider node
-/// beside each block and box obstacle (unscaled, as physics engines want), a cylinder beside each
-/// cylinder obstacle, the road segments' own meshes as triangle meshes, a cylinder trigger on the
-/// finish zone. Collider nodes are pushed after `nodes`' existing ones.
-fn physics(
-    scene: &Scene,
-    root: &mut json::Root,
-    nodes: &mut Vec<json::Index<json::Node>>,
-    mesh_nodes: &[(json::Index<json::Node>, json::Index<json::Mesh>)],
-    point_nodes: &[json::Index<json::Node>],
-) {
-    let mut shapes: Vec<serde_json::Value> = Vec::new();
-    let mut shape = |value: serde_json::Value| {
-        shapes.push(value);
-        shapes.len() - 1
-    };
-    let body = |role: &str, shape: usize| {
-        let mut extensions = json::extensions::scene::Node::default();
-        extensions.others.insert(
-            OMI_BODY.into(),
-            serde_json::json!({ role: { "shape": shape } }),
-        );
-        Some(extensions)
-    };
-    let mut extra_nodes = Vec::new();
-    for node in &scene.nodes {
-        if node.physics == Physics::SolidBox {
-            let index = shape(serde_json::json!({"type": "box", "box": {"size": node.extents}}));
-            extra_nodes.push(json::Node {
-                name: Some(format!("{}_collider", node.name)),
-                translation: Some(node.centre.map(|c| c as f32)),
-                rotation: box_rotation(node.heading),
-                extensions: body("collider", index),
-                ..Default::default()
-            });
-        }
-    }
-    for (mesh, &(node, mesh_index)) in scene.meshes.iter().zip(mesh_nodes) {
-        match mesh.physics {
-            Physics::SolidMesh => {
-                let index = shape(serde_json::json!({
-                    "type": "trimesh",
-                    "trimesh": {"mesh": mesh_index.value()},
-                }));
-                root.nodes[node.value()].extensions = body("collider", index);
-            }
-            Physics::SolidCylinder {
-                base,
-                radius,
-                height,
-            } => {
-                let index = shape(serde_json::json!({
-                    "type": "cylinder",
-                    "cylinder": {"radius": radius, "height": height},
-                }));
-                extra_nodes.push(json::Node {
-                    name: Some(format!("{}_collider", mesh.name)),
-                    translation: Some([base[0], base[1] + 0.5 * height, base[2]].map(|c| c as f32)),
-                    extensions: body("collider", index),
-                    ..Default::default()
-                });
-            }
-            _ => {}
-        }
-    }
-    for (point, &node) in scene.points.iter().zip(point_nodes) {
-        if let Physics::TriggerCylinder { radius, height } = point.physics {
-            let index = shape(serde_json::json!({
-                "type": "cylinder",
-                "cylinder": {"radius": radius, "height": height},
-            }));
-            root.nodes[node.value()].extensions = body("trigger", index);
-        }
-    }
-    if shapes.is_empty() {
-        return;
-    }
-    for node in extra_nodes {
-        nodes.push(root.push(node));
-    }
-    let mut extensions = json::extensions::root::Root::default();
-    extensions
-        .others
-        .insert(OMI_SHAPE.into(), serde_json::json!({ "shapes": shapes }));
-    root.extensions = Some(extensions);
-    root.extensions_used = vec![OMI_BODY.into(), OMI_SHAPE.into()];
-}
-
 /// A rotation of `degrees` about +Y.
 fn about_y(degrees: f64) -> json::scene::UnitQuaternion {
     let half = (degrees.to_radians() / 2.0) as f32;
@@ -581,10 +496,6 @@ fn about_y(degrees: f64) -> json::scene::UnitQuaternion {
 fn box_rotation(heading: f64) -> Option<json::scene::UnitQuaternion> {
     (heading != 0.0).then(|| about_y(heading))
 }
-
-/// The glTF physics extensions written (Godot 4 reads them; other tools keep or ignore them).
-pub const OMI_BODY: &str = "OMI_physics_body";
-pub const OMI_SHAPE: &str = "OMI_physics_shape";
 
 fn raw(value: &serde_json::Value) -> Box<serde_json::value::RawValue> {
     serde_json::value::to_raw_value(value).expect("JSON values always serialize")

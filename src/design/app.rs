@@ -21,6 +21,7 @@ use super::layout::Areas;
 mod input;
 pub mod pacing;
 mod policies;
+mod responses;
 
 pub use policies::{JudgeSwitch, LoadedInfo, PolicyInfo};
 
@@ -666,141 +667,6 @@ impl App {
             level,
             trials: self.trials_wanted,
         }]
-    }
-
-    fn response(&mut self, response: Response) -> Vec<Effect> {
-        match response {
-            Response::Level { id, result } => {
-                if id != self.requested {
-                    return Vec::new();
-                }
-                self.shown = id;
-                match result {
-                    Ok(level) => {
-                        self.generation_error = None;
-                        self.selected = self.selected.filter(|&i| i < level.piece_count());
-                        // In target-success mode the slider shows the λ the search found.
-                        if let (Some(_), Some(aux)) = (self.target, level.aux) {
-                            self.aux = aux;
-                        }
-                        self.level = Some(level);
-                        self.start_trials()
-                    }
-                    Err(problem) => {
-                        self.generation_error = Some(problem.clone());
-                        self.level = None;
-                        self.trials = None;
-                        self.complain(problem);
-                        Vec::new()
-                    }
-                }
-            }
-            Response::Trial { id, result } => {
-                if let Some(trials) = self.trials.as_mut().filter(|t| t.id == id) {
-                    trials.results.push(result);
-                }
-                Vec::new()
-            }
-            Response::TrialsDone { id, stats } => {
-                if let Some(trials) = self.trials.as_mut().filter(|t| t.id == id) {
-                    trials.stats = Some(*stats);
-                }
-                Vec::new()
-            }
-            Response::TrialsFailed { id, problem } => {
-                if let Some(trials) = self.trials.as_mut().filter(|t| t.id == id) {
-                    trials.error = Some(problem.clone());
-                    self.complain(format!("the trials stopped: {problem}"));
-                }
-                Vec::new()
-            }
-            Response::Recorded { id, result } => {
-                let Some((_, seed)) = self.recording.filter(|&(wanted, _)| wanted == id) else {
-                    return Vec::new();
-                };
-                self.recording = None;
-                match result {
-                    Ok(recording) => {
-                        self.say(format!(
-                            "replay: {} after {} steps",
-                            recording.result.outcome.describe(),
-                            recording.result.steps
-                        ));
-                        self.replay = Some(Replay {
-                            seed,
-                            recording: *recording,
-                            frame: 0,
-                        });
-                    }
-                    Err(problem) => self.complain(problem),
-                }
-                Vec::new()
-            }
-            Response::SweepPoint { id, index, point } => {
-                if let Some(sweep) = self.sweep.as_mut().filter(|s| s.id == id)
-                    && let Some(slot) = sweep.points.get_mut(index)
-                {
-                    slot.1 = point;
-                }
-                Vec::new()
-            }
-            Response::Exported(outcome) => {
-                match outcome {
-                    ExportOutcome::Written(paths) => self.say(format!(
-                        "exported {}",
-                        paths
-                            .iter()
-                            .map(|p| p.display().to_string())
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    )),
-                    ExportOutcome::WouldOverwrite(paths) => {
-                        self.overlay = Overlay::ConfirmOverwrite { paths };
-                    }
-                    ExportOutcome::Failed(problem) => self.complain(problem),
-                }
-                Vec::new()
-            }
-            Response::Judged(result) => match result {
-                Ok(switch) => {
-                    self.policies.solver = switch.solver;
-                    self.policies.skill = switch.skill;
-                    self.say(format!(
-                        "judge: {} plays the trials",
-                        self.policies.judge().name()
-                    ));
-                    self.generate()
-                }
-                Err(problem) => {
-                    self.complain(problem);
-                    Vec::new()
-                }
-            },
-            Response::Loaded(result) => match result {
-                Ok(info) => {
-                    self.say(format!(
-                        "loaded {}",
-                        [&info.generator, &info.solver]
-                            .into_iter()
-                            .flatten()
-                            .map(|p| p.path.display().to_string())
-                            .collect::<Vec<_>>()
-                            .join(" and ")
-                    ));
-                    if info.generator.is_some() {
-                        self.policies.generator = info.generator;
-                    }
-                    if info.solver.is_some() {
-                        self.policies.solver = info.solver;
-                    }
-                    self.generate()
-                }
-                Err(problem) => {
-                    self.complain(problem);
-                    Vec::new()
-                }
-            },
-        }
     }
 
     fn tick(&mut self) {

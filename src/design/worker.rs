@@ -263,30 +263,7 @@ pub fn perform(
             level,
             trials,
             seed,
-        } => {
-            let on_trial = |result: &_| {
-                send(Response::Trial {
-                    id,
-                    result: *result,
-                })
-            };
-            let watch = Watch {
-                on_trial: &on_trial,
-                stop,
-            };
-            let current = shelf.of(level.game());
-            match verify::verify_watched(&level, &current.solver(), trials, seed, &watch) {
-                Ok(Some(stats)) => send(Response::TrialsDone {
-                    id,
-                    stats: Box::new(stats),
-                }),
-                Ok(None) => {}
-                Err(e) => send(Response::TrialsFailed {
-                    id,
-                    problem: e.to_string(),
-                }),
-            }
-        }
+        } => play_trials(shelf.of(level.game()), id, &level, trials, seed, stop, send),
         Effect::Record { id, level, seed } => send(Response::Recorded {
             id,
             result: verify::record(&level, &shelf.of(level.game()).solver(), seed)
@@ -306,26 +283,9 @@ pub fn perform(
                 if stop() {
                     return;
                 }
-                let point = match current.level(game, LevelRequest::new(seed, Some(aux)).goal(goal))
-                {
-                    Ok(level) => {
-                        let watch = Watch {
-                            on_trial: &|_| {},
-                            stop,
-                        };
-                        match verify::verify_watched(
-                            &level,
-                            &current.solver(),
-                            trials,
-                            seed,
-                            &watch,
-                        ) {
-                            Ok(Some(stats)) => SweepPoint::Success(stats.success_ratio),
-                            Ok(None) => return,
-                            Err(e) => SweepPoint::NoLevel(e.to_string()),
-                        }
-                    }
-                    Err(problem) => SweepPoint::NoLevel(problem),
+                let request = LevelRequest::new(seed, Some(aux)).goal(goal);
+                let Some(point) = sweep_point(current, game, request, trials, stop) else {
+                    return;
                 };
                 send(Response::SweepPoint { id, index, point });
             }
@@ -354,22 +314,86 @@ pub fn perform(
         } => send(Response::Judged(
             next_judge(policies, game, after, &folder).map(Box::new),
         )),
-        Effect::Load { path, game } => send(Response::Loaded(match load(&path, game) {
-            Ok((loaded, info)) => {
-                // A single file replaces only its own role.
-                if let Ok(mut shared) = policies.lock() {
-                    let old = shared.of_mut(game);
-                    *old = Policies {
-                        generator: loaded.generator.or(old.generator.clone()),
-                        solver: loaded.solver.or(old.solver.clone()),
-                        skill: old.skill,
-                    };
-                }
-                Ok(Box::new(info))
-            }
-            Err(e) => Err(format!("{e:#}")),
-        })),
+        Effect::Load { path, game } => send(Response::Loaded(load_into(policies, &path, game))),
     }
+}
+
+/// Plays `trials` runs of `level` with the game's current player, answering each trial as it
+/// ends and then the statistics (nothing when `stop` cut the trials short).
+fn play_trials(
+    current: &Policies,
+    id: u64,
+    level: &Level,
+    trials: u32,
+    seed: u64,
+    stop: &(dyn Fn() -> bool + Sync),
+    send: &(dyn Fn(Response) + Sync),
+) {
+    let on_trial = |result: &_| {
+        send(Response::Trial {
+            id,
+            result: *result,
+        })
+    };
+    let watch = Watch {
+        on_trial: &on_trial,
+        stop,
+    };
+    match verify::verify_watched(level, &current.solver(), trials, seed, &watch) {
+        Ok(Some(stats)) => send(Response::TrialsDone {
+            id,
+            stats: Box::new(stats),
+        }),
+        Ok(None) => {}
+        Err(e) => send(Response::TrialsFailed {
+            id,
+            problem: e.to_string(),
+        }),
+    }
+}
+
+/// One point of the λ sweep: the success of the current player on the level `request` asks
+/// for, or why there is none; `None` when `stop` cut the trials short.
+fn sweep_point(
+    current: &Policies,
+    game: Game,
+    request: LevelRequest,
+    trials: u32,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Option<SweepPoint> {
+    let seed = request.seed;
+    let level = match current.level(game, request) {
+        Ok(level) => level,
+        Err(problem) => return Some(SweepPoint::NoLevel(problem)),
+    };
+    let watch = Watch {
+        on_trial: &|_| {},
+        stop,
+    };
+    match verify::verify_watched(&level, &current.solver(), trials, seed, &watch) {
+        Ok(Some(stats)) => Some(SweepPoint::Success(stats.success_ratio)),
+        Ok(None) => None,
+        Err(e) => Some(SweepPoint::NoLevel(e.to_string())),
+    }
+}
+
+/// Loads the policies at `path` for `game` into the shared shelf: a single file replaces only
+/// its own role.
+fn load_into(
+    policies: &Mutex<GamePolicies>,
+    path: &Path,
+    game: Game,
+) -> Result<Box<LoadedInfo>, String> {
+    let (loaded, info) = load(path, game).map_err(|e| format!("{e:#}"))?;
+    if let Ok(mut shared) = policies.lock() {
+        let old = shared.of_mut(game);
+        *old = Policies {
+            generator: loaded.generator.or(old.generator.clone()),
+            solver: loaded.solver.or(old.solver.clone()),
+            skill: old.skill,
+        };
+    }
+    Ok(Box::new(info))
 }
 
 /// The judge after `after` in [`Judge::ALL`] (cyclically) that can play: a scripted skill, or a

@@ -469,11 +469,11 @@ fn parse_judges(s: &str) -> Result<Judges, String> {
 
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
-    arlpcg train --game platform --mode rule-pcg --minutes 60 --out runs/solver\n  \
-    arlpcg train --game platform --mode rule-pcg --minutes 60 --out runs/solver --resume\n  \
-    arlpcg train --game platform --mode arlpcg --steps 4000000 --out runs/arlpcg\n  \
     arlpcg train --game platform --mode arlpcg --seed 1 --out runs/platform-arlpcg-s1\n  \
-    arlpcg train --mode arlpcg --steps 4000000 --out runs/arlpcg --resume --config new.yaml\n  \
+    arlpcg train --game platform --mode arlpcg --seed 1 --out runs/platform-arlpcg-s1 --resume\n  \
+    arlpcg train --game racing --mode rule-pcg --minutes 60 --out runs/racing-solver\n  \
+    arlpcg train --game platform --mode arlpcg --steps 200000 --out runs/try\n  \
+    arlpcg train --mode arlpcg --out runs/arlpcg --resume --config new.yaml\n  \
     arlpcg train --print-config > train.yaml")]
 pub struct TrainArgs {
     /// Which game.
@@ -484,11 +484,12 @@ pub struct TrainArgs {
     /// the Generator too.
     #[arg(long, value_enum, default_value = "rule-pcg")]
     pub mode: TrainModeArg,
-    /// Stop when the Solver has learned from this many environment steps in all (over every
-    /// resume).
+    /// The run's budget: stop when the Solver has learned from this many environment steps in
+    /// all, over every resume (default: the configuration's `steps`, the game's recipe: platform
+    /// 8M, racing 10M). Given with --resume it becomes the run's new budget.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub steps: Option<u64>,
-    /// Stop after this many minutes of this session.
+    /// Stop this session after this many minutes (its checkpoint is saved; --resume goes on).
     #[arg(long, value_parser = parse_minutes)]
     pub minutes: Option<f64>,
     /// Training configuration (YAML; see --print-config for every field and its default). With

@@ -24,11 +24,6 @@ pub fn run(args: &TrainArgs) -> Result<()> {
     let out = args.out.as_ref().ok_or_else(|| {
         usage("--out DIR is required: where the run's checkpoint, metrics and policy go")
     })?;
-    if args.steps.is_none() && args.minutes.is_none() {
-        return Err(usage(
-            "give a budget: --steps N (total Solver environment steps) or --minutes M (this session)",
-        ));
-    }
     // One session per run folder: a second (a resume started twice) would interleave
     // checkpoints. Taken before anything in the folder is touched; a folder that does not
     // exist yet is locked as soon as the run has made it (a refused run makes none).
@@ -49,19 +44,20 @@ pub fn run(args: &TrainArgs) -> Result<()> {
             out,
             args.config.as_deref(),
             args.seed,
+            args.steps,
             args.resume,
         )?;
         let _lock = match lock {
             Some(lock) => lock,
             None => RunLock::take(out)?,
         };
-        train_loop(run.as_mut(), args.steps, args.minutes)
+        train_loop(run.as_mut(), args.minutes)
     })
 }
 
-/// Iterates `run` until `steps` Solver steps in all or `minutes` of this session, or a signal;
+/// Iterates `run` until its budget of Solver steps or `minutes` of this session, or a signal;
 /// checkpoints on the run's interval and at the end, then writes the final policies.
-fn train_loop(run: &mut dyn Training, steps: Option<u64>, minutes: Option<f64>) -> Result<()> {
+fn train_loop(run: &mut dyn Training, minutes: Option<f64>) -> Result<()> {
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = stop.clone();
@@ -72,26 +68,16 @@ fn train_loop(run: &mut dyn Training, steps: Option<u64>, minutes: Option<f64>) 
     let wall_before = run.wall_before();
     let wall = || wall_before + session.elapsed().as_secs_f64();
     let mut last_checkpoint = Instant::now();
-    let bar = match steps {
-        Some(total) => crate::shell::progress_bar(total, "training"),
-        None => {
-            crate::shell::progress_bar(minutes.map_or(0, |m| (m * 60.0) as u64), "training (s)")
-        }
-    };
-    bar.set_position(match steps {
-        Some(_) => run.solver_steps(),
-        None => 0,
-    });
+    let total = run.budget();
+    let bar = crate::shell::progress_bar(total, "training");
+    bar.set_position(run.solver_steps());
     loop {
-        let done_by_steps = steps.is_some_and(|t| run.solver_steps() >= t);
+        let done_by_steps = run.solver_steps() >= total;
         let done_by_time = minutes.is_some_and(|m| session.elapsed().as_secs_f64() >= m * 60.0);
         if done_by_steps || done_by_time || stop.load(Ordering::SeqCst) {
             break;
         }
-        let lr_scale = match steps {
-            Some(total) => (1.0 - run.solver_steps() as f64 / total as f64).max(0.0),
-            None => 1.0,
-        };
+        let lr_scale = (1.0 - run.solver_steps() as f64 / total as f64).max(0.0);
         let message = run.iterate(lr_scale, &wall).with_context(|| {
             format!(
                 "training stopped at {} Solver steps; the last checkpoint in {} is kept \
@@ -101,10 +87,7 @@ fn train_loop(run: &mut dyn Training, steps: Option<u64>, minutes: Option<f64>) 
             )
         })?;
         bar.set_message(message);
-        match steps {
-            Some(_) => bar.set_position(run.solver_steps()),
-            None => bar.set_position(session.elapsed().as_secs()),
-        }
+        bar.set_position(run.solver_steps());
         if last_checkpoint.elapsed().as_secs_f64() >= run.checkpoint_minutes() * 60.0 {
             run.save_checkpoint(wall())?;
             train::write_learning_curve(run.out())?;

@@ -69,11 +69,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         })
     }
 
-    pub(super) fn resume(
-        out: &Path,
-        mode: TrainMode,
-        replacement: Option<TrainConfig>,
-    ) -> Result<Self> {
+    pub(super) fn resume(out: &Path, mode: TrainMode, change: ConfigChange) -> Result<Self> {
         let path = out.join(GENERATOR_CHECKPOINT);
         if !path.exists() && out.join(CHECKPOINT).exists() {
             // A Solver-only run: its checkpoint says which mode it was trained in.
@@ -125,7 +121,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 population,
             )?)
         };
-        let solver = Run::resume(out, mode, replacement, build)?;
+        let solver = Run::resume(out, mode, change, build)?;
         truncate_metrics(
             &out.join(GENERATOR_METRICS),
             &generator_metrics_header::<G>(),
@@ -232,6 +228,10 @@ impl<G: GeneratorGame> AdversarialRun<G> {
 impl<G: GeneratorGame> Training for AdversarialRun<G> {
     fn solver_steps(&self) -> u64 {
         self.solver.trainer.global_step
+    }
+
+    fn budget(&self) -> u64 {
+        self.solver.config.steps
     }
 
     fn wall_before(&self) -> f64 {

@@ -54,6 +54,10 @@ impl TrainMode {
 pub struct TrainConfig {
     /// Seeds network initialization and action sampling.
     pub seed: u64,
+    /// The run's budget: Solver environment steps in all, over every `--resume` (`--steps`
+    /// sets it). Annealed learning rates fall to 0 over it. The default is the recipe's
+    /// (platform 8M, racing 10M): every mode of a game learns for the same budget.
+    pub steps: u64,
     /// Hidden layer sizes of the actors and critics of both agents (the paper: 2 × 512).
     pub hidden: Vec<usize>,
     /// Minutes between checkpoints.
@@ -138,6 +142,7 @@ impl Default for TrainConfig {
     fn default() -> Self {
         Self {
             seed: 0,
+            steps: PLATFORM_STEPS,
             hidden: vec![512, 512],
             checkpoint_minutes: 5.0,
             solver: PpoConfig {
@@ -242,16 +247,21 @@ pub(super) fn load_config(path: &Path, game: Game) -> Result<TrainConfig> {
         .map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))
 }
 
+/// The recipe's budget of each game in Solver steps ([`TrainConfig::steps`]).
+pub const PLATFORM_STEPS: u64 = 8_000_000;
+pub const RACING_STEPS: u64 = 10_000_000;
+
 /// The racing Solver's discount (docs/spec.md §3: γ 0.998; its runs are hundreds of steps
 /// longer than a platform run).
 pub const RACING_SOLVER_GAMMA: f32 = 0.998;
 
 impl TrainConfig {
     /// The defaults for training `game`: the paper's values; the racing game differs in the
-    /// Solver's γ, the Generator's rewards and the obstacles of its scenes.
+    /// budget, the Solver's γ, the Generator's rewards and the obstacles of its scenes.
     pub fn for_game(game: Game) -> TrainConfig {
         let mut config = TrainConfig::default();
         if game == Game::Racing {
+            config.steps = RACING_STEPS;
             config.solver.gamma = RACING_SOLVER_GAMMA;
             config.generator.rewards = RacingGame::default_rewards();
             config.generator.max_pieces = RacingGame::DEFAULT_MAX_PIECES;
@@ -365,6 +375,9 @@ pub(super) fn check_config(config: &TrainConfig, game: Game) -> Result<(), Strin
         return Err(format!(
             "hidden: give 1 to {MAX_HIDDEN_LAYERS} layers, each of 1 to {MAX_HIDDEN_UNITS} units"
         ));
+    }
+    if !(1..=MAX_PHASE_STEPS).contains(&config.steps) {
+        return Err(format!("steps must be in [1, {MAX_PHASE_STEPS}]"));
     }
     let minutes = config.checkpoint_minutes;
     if !(minutes.is_finite() && (0.0..=24.0 * 60.0).contains(&minutes)) {
@@ -497,6 +510,10 @@ mod tests {
         let platform = TrainConfig::parse_for(text, Game::Platform).unwrap();
         assert_eq!(platform.generator.rewards.air_step, 0.0);
         assert_eq!(platform.solver.gamma, 0.99);
+        assert_eq!(
+            (platform.steps, racing.steps),
+            (PLATFORM_STEPS, RACING_STEPS)
+        );
         let old = "ppo:\n  gamma: 0.95\ngenerator:\n  max_blocks: 12\n";
         let read = TrainConfig::parse_for(old, Game::Racing).unwrap();
         assert_eq!((read.solver.gamma, read.generator.max_pieces), (0.95, 12));

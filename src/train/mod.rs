@@ -56,21 +56,24 @@ pub(super) const METRICS: &str = "metrics.csv";
 pub(super) const GENERATOR_METRICS: &str = "generator-metrics.csv";
 pub(super) const METRICS_HEADER: &str = "iteration,global_step,wall_time_s,steps_per_s,rollout_s,update_s,learning_rate,episodes,mean_return,success_ratio,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance";
 
-/// The run in `out`: started afresh with `config` (the game's defaults when `None`; `seed`, if
-/// given, replaces its seed), or with `resume` continued from its checkpoints (`config`, if
-/// given, replaces its hyper-parameters from here on). The caller installs the thread pool the
-/// run's environments and updates use.
+/// The run in `out`: started afresh with `config` (the game's defaults when `None`; `seed` and
+/// `steps`, if given, replace its seed and budget), or with `resume` continued from its
+/// checkpoints (`config` and `steps`, if given, replace its hyper-parameters and budget from
+/// here on). The caller installs the thread pool the run's environments and updates use.
 pub fn open(
     game: Game,
     mode: TrainMode,
     out: &Path,
     config: Option<&Path>,
     seed: Option<u64>,
+    steps: Option<u64>,
     resume: bool,
 ) -> Result<Box<dyn Training>> {
-    // A new run's configuration, or a resumed run's replacement (None: keep its own).
     let config = if resume {
-        config.map(|path| load_config(path, game)).transpose()?
+        Start::Resume(ConfigChange {
+            config: config.map(|path| load_config(path, game)).transpose()?,
+            steps,
+        })
     } else {
         if out.join(CHECKPOINT).exists() {
             bail!(
@@ -94,15 +97,42 @@ pub fn open(
         if let Some(seed) = seed {
             config.seed = seed;
         }
-        Some(config)
+        if let Some(steps) = steps {
+            config.steps = steps;
+        }
+        Start::New(config)
     };
     match (mode.solver_only(), game) {
-        (Some(source), Game::Platform) => {
-            solver_run::<PlatformGame>(out, mode, source, config, resume)
+        (Some(source), Game::Platform) => solver_run::<PlatformGame>(out, mode, source, config),
+        (Some(source), Game::Racing) => solver_run::<RacingGame>(out, mode, source, config),
+        (None, Game::Platform) => adversarial_run::<PlatformGame>(out, mode, config),
+        (None, Game::Racing) => adversarial_run::<RacingGame>(out, mode, config),
+    }
+}
+
+/// How a session opens its run: a new one with its configuration, or a resumed one with what
+/// changes in its stored configuration.
+enum Start {
+    New(TrainConfig),
+    Resume(ConfigChange),
+}
+
+/// What a resumed run changes in its configuration: `--config` replaces all of it, `--steps`
+/// the budget.
+#[derive(Debug, Default)]
+pub(super) struct ConfigChange {
+    pub config: Option<TrainConfig>,
+    pub steps: Option<u64>,
+}
+
+impl ConfigChange {
+    /// The resumed run's configuration, from the one it stored.
+    pub(super) fn apply(self, stored: &TrainConfig) -> TrainConfig {
+        let mut new = self.config.unwrap_or_else(|| stored.clone());
+        if let Some(steps) = self.steps {
+            new.steps = steps;
         }
-        (Some(source), Game::Racing) => solver_run::<RacingGame>(out, mode, source, config, resume),
-        (None, Game::Platform) => adversarial_run::<PlatformGame>(out, mode, config, resume),
-        (None, Game::Racing) => adversarial_run::<RacingGame>(out, mode, config, resume),
+        new
     }
 }
 
@@ -111,16 +141,12 @@ pub fn open(
 fn adversarial_run<G: GeneratorGame>(
     out: &Path,
     mode: TrainMode,
-    config: Option<TrainConfig>,
-    resume: bool,
+    start: Start,
 ) -> Result<Box<dyn Training>> {
-    let run = if resume {
-        AdversarialRun::<G>::resume(out, mode, config)?
-    } else {
-        let config = config.unwrap_or_else(|| TrainConfig::for_game(G::GAME));
-        AdversarialRun::<G>::start(out, mode, config)?
-    };
-    Ok(Box::new(run))
+    Ok(Box::new(match start {
+        Start::New(config) => AdversarialRun::<G>::start(out, mode, config)?,
+        Start::Resume(change) => AdversarialRun::<G>::resume(out, mode, change)?,
+    }))
 }
 
 /// Trains a Solver of game `G` alone (the Solver-only modes), starting or resuming.
@@ -128,8 +154,7 @@ fn solver_run<G: GameSpec>(
     out: &Path,
     mode: TrainMode,
     source: solver_envs::SolverMode,
-    config: Option<TrainConfig>,
-    resume: bool,
+    start: Start,
 ) -> Result<Box<dyn Training>> {
     let build = |config: &TrainConfig, state: Option<serde_json::Value>| {
         let state: SourceState = match state {
@@ -138,19 +163,18 @@ fn solver_run<G: GameSpec>(
         };
         Ok(SolverEnvs::<G>::new(source, config.solver.num_envs, state))
     };
-    let run = if resume {
-        Run::resume(out, mode, config, build)?
-    } else {
-        let config = config.unwrap_or_else(|| TrainConfig::for_game(G::GAME));
-        Run::start(out, mode, config, build)?
-    };
-    Ok(Box::new(run))
+    Ok(Box::new(match start {
+        Start::New(config) => Run::start(out, mode, config, build)?,
+        Start::Resume(change) => Run::resume(out, mode, change, build)?,
+    }))
 }
 
 /// What the training loop drives: one iteration at a time, checkpoints, the final policies.
 pub trait Training {
-    /// Solver environment steps learned from so far (the budget `--steps` counts).
+    /// Solver environment steps learned from so far...
     fn solver_steps(&self) -> u64;
+    /// ...and the run's budget of them ([`TrainConfig::steps`]).
+    fn budget(&self) -> u64;
     /// Wall-clock seconds of earlier sessions.
     fn wall_before(&self) -> f64;
     /// One PPO iteration (of whichever agent learns now) at `lr_scale` times the configured

@@ -74,12 +74,12 @@ impl<E: Resumable> Run<E> {
         })
     }
 
-    /// Resumes the run in `out`; `replacement` (from `--config`) replaces its configuration from
-    /// here on, the old one kept as `config-until-step-N.yaml`.
+    /// Resumes the run in `out`; `change` (from `--config`, `--steps`) replaces its
+    /// configuration from here on, the old one kept as `config-until-step-N.yaml`.
     pub(super) fn resume(
         out: &Path,
         mode: TrainMode,
-        replacement: Option<TrainConfig>,
+        change: ConfigChange,
         build: impl FnOnce(&TrainConfig, Option<serde_json::Value>) -> Result<E>,
     ) -> Result<Self> {
         let path = out.join(CHECKPOINT);
@@ -90,30 +90,25 @@ impl<E: Resumable> Run<E> {
         check_config(&stored, E::GAME).map_err(|problem| {
             anyhow::anyhow!("{}: stored configuration: {problem}", path.display())
         })?;
-        let config = match replacement {
-            None => stored,
-            Some(new) => {
-                check_resumable_change(&stored, &new).map_err(|problem| {
-                    anyhow::anyhow!(
-                        "--config with --resume: {problem} (the run in {})",
-                        out.display()
-                    )
-                })?;
-                if new != stored {
-                    fsio::write_atomic(
-                        &out.join(format!("config-until-step-{}.yaml", state.global_step)),
-                        serde_yaml::to_string(&stored)?.as_bytes(),
-                        Overwrite::Never,
-                    )?;
-                    fsio::write_atomic(
-                        &out.join("config.yaml"),
-                        serde_yaml::to_string(&new)?.as_bytes(),
-                        Overwrite::Allowed,
-                    )?;
-                }
-                new
-            }
-        };
+        let config = change.apply(&stored);
+        check_resumable_change(&stored, &config).map_err(|problem| {
+            anyhow::anyhow!(
+                "--config with --resume: {problem} (the run in {})",
+                out.display()
+            )
+        })?;
+        if config != stored {
+            fsio::write_atomic(
+                &out.join(format!("config-until-step-{}.yaml", state.global_step)),
+                serde_yaml::to_string(&stored)?.as_bytes(),
+                Overwrite::Never,
+            )?;
+            fsio::write_atomic(
+                &out.join("config.yaml"),
+                serde_yaml::to_string(&config)?.as_bytes(),
+                Overwrite::Allowed,
+            )?;
+        }
         let vars = loaded.policy.named_vars();
         let mut ppo = Ppo::new(config.solver.clone(), loaded.policy)?;
         ppo.adam
@@ -205,6 +200,10 @@ impl<E: Resumable> Run<E> {
 impl<G: GameSpec> Training for Run<SolverEnvs<G>> {
     fn solver_steps(&self) -> u64 {
         self.trainer.global_step
+    }
+
+    fn budget(&self) -> u64 {
+        self.config.steps
     }
 
     fn wall_before(&self) -> f64 {

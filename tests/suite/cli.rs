@@ -510,7 +510,6 @@ fn arguments_that_do_not_fit_together_exit_2() {
             vec!["generate", "--policies", "policies/platform", "--out", "x"],
             "--policies needs --aux",
         ),
-        (vec!["train", "--out", "x"], "give a budget"),
         (vec!["train", "--steps", "10"], "--out <OUT>"),
         (
             vec![

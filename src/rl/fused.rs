@@ -534,6 +534,34 @@ mod tests {
 
     /// The fused gradients against candle's autograd of the same loss, on random inputs, for
     /// shapes with and without each kind of action.
+    /// The PPO loss of `policy` on `(observations, actions)` as candle computes it, for its
+    /// autograd to differentiate.
+    fn autograd_loss(
+        policy: &ActorCritic,
+        (observations, actions): (&Tensor, &Tensor),
+        old_log_probs: &Tensor,
+        advantages: &Tensor,
+        returns: &Tensor,
+        weights: LossWeights,
+    ) -> Tensor {
+        let (new_log_prob, entropy, values) = policy.evaluate(observations, actions).unwrap();
+        let policy_loss =
+            clipped_policy_loss(&new_log_prob, old_log_probs, advantages, weights.clip_coef)
+                .unwrap();
+        let value_loss = ((values - returns)
+            .unwrap()
+            .sqr()
+            .unwrap()
+            .mean_all()
+            .unwrap()
+            * 0.5)
+            .unwrap();
+        let entropy = entropy.mean_all().unwrap();
+        ((&policy_loss - (&entropy * weights.ent_coef as f64).unwrap()).unwrap()
+            + (&value_loss * weights.vf_coef as f64).unwrap())
+        .unwrap()
+    }
+
     #[test]
     fn gradients_match_candle_autograd() {
         for (continuous, binary, rows) in [(2, 1, 150), (3, 0, 64), (0, 2, 70)] {
@@ -599,26 +627,14 @@ mod tests {
             );
 
             let column = |v: &[f32]| Tensor::from_slice(v, rows, &Device::Cpu).unwrap();
-            let (new_log_prob, entropy, values) = policy.evaluate(&obs_t, &act_t).unwrap();
-            let policy_loss = clipped_policy_loss(
-                &new_log_prob,
+            let loss = autograd_loss(
+                &policy,
+                (&obs_t, &act_t),
                 &column(&old_log_probs),
                 &column(&advantages),
-                weights.clip_coef,
-            )
-            .unwrap();
-            let value_loss = ((values - column(&returns))
-                .unwrap()
-                .sqr()
-                .unwrap()
-                .mean_all()
-                .unwrap()
-                * 0.5)
-                .unwrap();
-            let entropy = entropy.mean_all().unwrap();
-            let loss = ((&policy_loss - (&entropy * weights.ent_coef as f64).unwrap()).unwrap()
-                + (&value_loss * weights.vf_coef as f64).unwrap())
-            .unwrap();
+                &column(&returns),
+                weights,
+            );
             let reference_loss = loss.to_scalar::<f32>().unwrap();
             assert!(
                 (terms.total(weights) - reference_loss).abs()

@@ -1,7 +1,7 @@
 //! The layering docs/architecture.md describes, checked on the source: the core (levels, games,
 //! learning, training, evaluation, verification, generation) reads no clock, prints nothing,
 //! uses no global random generator and knows nothing of the shells above it, so the same inputs
-//! give the same bytes.
+//! give the same bytes; and no function grows past 120 lines.
 
 use std::path::{Path, PathBuf};
 
@@ -90,4 +90,76 @@ fn the_core_reads_no_clock_prints_nothing_and_knows_no_shell() {
         "the core must stay pure:\n{}",
         problems.join("\n")
     );
+}
+
+/// The longest a function may be, in lines (signature to closing brace).
+const MAX_FUNCTION_LINES: usize = 120;
+
+/// Lines from each `fn` to its closing brace; braces inside strings count too, which in this
+/// code always pair up.
+fn function_lengths(text: &str) -> Vec<(usize, usize)> {
+    let lines: Vec<&str> = text.lines().collect();
+    let is_fn = |line: &str| {
+        let mut rest = line.trim_start();
+        for prefix in [
+            "pub(crate) ",
+            "pub(super) ",
+            "pub ",
+            "const ",
+            "async ",
+            "unsafe ",
+        ] {
+            rest = rest.strip_prefix(prefix).unwrap_or(rest);
+        }
+        rest.starts_with("fn ")
+    };
+    let mut found = Vec::new();
+    for start in (0..lines.len()).filter(|&i| is_fn(lines[i])) {
+        let (mut depth, mut opened) = (0i64, false);
+        for (k, line) in lines[start..].iter().enumerate() {
+            opened |= line.contains('{');
+            depth += line.matches('{').count() as i64 - line.matches('}').count() as i64;
+            if opened && depth <= 0 {
+                found.push((start + 1, k + 1));
+                break;
+            }
+            if !opened && line.trim_end().ends_with(';') {
+                break; // a declaration without a body
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn no_function_is_longer_than_120_lines() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    for part in ["src", "tests", "benches"] {
+        rust_files(&root.join(part), &mut files);
+    }
+    let long: Vec<String> = files
+        .iter()
+        .flat_map(|file| {
+            let text = std::fs::read_to_string(file).unwrap();
+            function_lengths(&text)
+                .into_iter()
+                .filter(|&(_, lines)| lines > MAX_FUNCTION_LINES)
+                .map(|(line, lines)| {
+                    format!(
+                        "{}:{line}: {lines} lines",
+                        file.strip_prefix(root).unwrap().display()
+                    )
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    assert!(
+        long.is_empty(),
+        "functions longer than {MAX_FUNCTION_LINES} lines (split them):\n{}",
+        long.join("\n")
+    );
+    // The count is real: this file's own longest function is found with its length.
+    let own = function_lengths(include_str!("architecture.rs"));
+    assert!(own.iter().any(|&(_, lines)| lines > 20), "{own:?}");
 }

@@ -11,7 +11,7 @@ use arlpcg::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
 use arlpcg::level::Game;
 use arlpcg::rl::checkpoint::{Role, load_policy};
 
-use crate::common::arlpcg;
+use crate::common::{arlpcg, arlpcg_ok};
 
 const TINY: &str = "\
 seed: 3
@@ -90,25 +90,7 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
         std::fs::read_to_string(&lock).unwrap().trim(),
         killed.to_string()
     );
-    // A lock held by a live process (this test's) refuses a second session and changes nothing.
-    std::fs::write(&lock, format!("{}\n", std::process::id())).unwrap();
-    let busy = arlpcg(&[
-        "train",
-        "--mode",
-        "fixed-track",
-        "--steps",
-        "100000",
-        "--out",
-        out_s,
-        "--resume",
-    ]);
-    assert_eq!(busy.status.code(), Some(1));
-    assert!(
-        String::from_utf8_lossy(&busy.stderr).contains("in use by another training session"),
-        "{}",
-        String::from_utf8_lossy(&busy.stderr)
-    );
-    assert_eq!(curve(&out), before);
+    a_live_lock_refuses_a_second_session(&out);
     // The stale lock does not hold (the sessions below take it over).
     std::fs::write(&lock, format!("{killed}\n")).unwrap();
     let checkpoint = std::fs::read(out.join("checkpoint.safetensors")).unwrap();
@@ -120,25 +102,7 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
         (state.iteration, state.global_step)
     );
 
-    // Resuming without --resume is refused and changes nothing.
-    let refused = arlpcg(&[
-        "train",
-        "--mode",
-        "fixed-track",
-        "--steps",
-        "100",
-        "--out",
-        out_s,
-    ]);
-    assert_eq!(refused.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&refused.stderr).contains("add --resume"));
-    // A resume with another mode is refused.
-    let refused = arlpcg(&[
-        "train", "--mode", "rule-pcg", "--steps", "100", "--out", out_s, "--resume",
-    ]);
-    assert!(
-        String::from_utf8_lossy(&refused.stderr).contains("was trained with --mode fixed-track")
-    );
+    wrong_resumes_are_refused(out_s);
 
     let target = state.global_step + 3 * 128;
     let resumed = arlpcg(&[
@@ -190,6 +154,53 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
     let card: serde_yaml::Value =
         serde_yaml::from_str(&std::fs::read_to_string(out.join("solver.yaml")).unwrap()).unwrap();
     assert_eq!(card["role"], "solver");
+}
+
+/// A lock held by a live process (this test's) refuses a second session and changes nothing.
+fn a_live_lock_refuses_a_second_session(out: &Path) {
+    let lock = out.join("train.lock");
+    let before = curve(out);
+    let out_s = out.to_str().unwrap();
+    std::fs::write(&lock, format!("{}\n", std::process::id())).unwrap();
+    let busy = arlpcg(&[
+        "train",
+        "--mode",
+        "fixed-track",
+        "--steps",
+        "100000",
+        "--out",
+        out_s,
+        "--resume",
+    ]);
+    assert_eq!(busy.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&busy.stderr).contains("in use by another training session"),
+        "{}",
+        String::from_utf8_lossy(&busy.stderr)
+    );
+    assert_eq!(curve(out), before);
+}
+
+/// Resuming without --resume, or with another mode, is refused.
+fn wrong_resumes_are_refused(out_s: &str) {
+    let refused = arlpcg(&[
+        "train",
+        "--mode",
+        "fixed-track",
+        "--steps",
+        "100",
+        "--out",
+        out_s,
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("add --resume"));
+    // A resume with another mode is refused.
+    let refused = arlpcg(&[
+        "train", "--mode", "rule-pcg", "--steps", "100", "--out", out_s, "--resume",
+    ]);
+    assert!(
+        String::from_utf8_lossy(&refused.stderr).contains("was trained with --mode fixed-track")
+    );
 }
 
 #[test]
@@ -409,14 +420,9 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     let out = dir.path().join("run");
     let out_s = out.to_str().unwrap();
     let config_s = config.to_str().unwrap();
-    let first = arlpcg(&[
+    arlpcg_ok(&[
         "train", "--mode", "arlpcg", "--steps", "512", "--config", config_s, "--out", out_s,
     ]);
-    assert!(
-        first.status.success(),
-        "{}",
-        String::from_utf8_lossy(&first.stderr)
-    );
     // 512 Solver steps in phases of 128: both agents learned, in turn.
     assert_eq!(curve(&out).last().unwrap().1, 512);
     let generator_before = generator_rows(&out);
@@ -430,35 +436,17 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
         !first_population.is_empty() && first_population.len() <= 2,
         "{first_population:?}"
     );
-    let resumed = arlpcg(&[
+    arlpcg_ok(&[
         "train", "--mode", "arlpcg", "--steps", "1024", "--out", out_s, "--resume",
     ]);
-    assert!(
-        resumed.status.success(),
-        "{}",
-        String::from_utf8_lossy(&resumed.stderr)
-    );
     assert_eq!(curve(&out).last().unwrap().1, 1024);
     assert!(
         generator_rows(&out) > generator_before,
         "the Generator went on learning"
     );
     // From 768 Solver steps on, the last stage: the Solver is frozen (learning rate 0).
-    let metrics = std::fs::read_to_string(out.join("metrics.csv")).unwrap();
-    let rates: Vec<(u64, f64)> = metrics
-        .lines()
-        .skip(1)
-        .map(|row| {
-            let cells: Vec<&str> = row.split(',').collect();
-            (cells[1].parse().unwrap(), cells[6].parse().unwrap())
-        })
-        .collect();
-    for (step, rate) in &rates {
-        assert_eq!(
-            *step > 768,
-            *rate == 0.0,
-            "step {step}: learning rate {rate}"
-        );
+    for (step, rate) in learning_rates(&out) {
+        assert_eq!(step > 768, rate == 0.0, "step {step}: learning rate {rate}");
     }
     // The population came back from the checkpoint and grew, keeping the newest two.
     let resumed_population = population(&out);
@@ -482,51 +470,58 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
         .unwrap();
         assert_eq!(loaded.card.training.mode, "arlpcg");
     }
+    // The run's folder is a policies folder for every command that takes one.
+    generate_and_verify_with_a_run(dir.path(), out_s);
+    evaluate_a_run(dir.path(), out_s);
+    score_a_run_as_one_seed(dir.path(), out_s);
+}
 
-    // The run's folder is a policies folder: generate with its Generator, verify with its Solver.
-    let levels = dir.path().join("levels");
-    let generated = arlpcg(&[
-        "generate",
-        "--policies",
-        out_s,
-        "--aux",
-        "-0.5",
-        "--seed",
-        "3",
-        "--verify",
-        "4",
-        "--goal",
-        "0,0,0",
-        "--format",
-        "yaml",
-        "--out",
-        levels.to_str().unwrap(),
-    ]);
+/// (global_step, learning_rate) of every metrics row.
+fn learning_rates(run: &Path) -> Vec<(u64, f64)> {
+    let metrics = std::fs::read_to_string(run.join("metrics.csv")).unwrap();
+    metrics
+        .lines()
+        .skip(1)
+        .map(|row| {
+            let cells: Vec<&str> = row.split(',').collect();
+            (cells[1].parse().unwrap(), cells[6].parse().unwrap())
+        })
+        .collect()
+}
+
+/// `generate` with the run's Generator, verified with its Solver; a goal it cannot reach and
+/// a folder without a Generator are named.
+fn generate_and_verify_with_a_run(dir: &Path, run: &str) {
+    let levels = dir.join("levels");
+    let levels_s = levels.to_str().unwrap();
+    let generate = |goal: &str| {
+        arlpcg(&[
+            "generate",
+            "--policies",
+            run,
+            "--aux",
+            "-0.5",
+            "--seed",
+            "3",
+            "--verify",
+            "4",
+            "--goal",
+            goal,
+            "--format",
+            "yaml",
+            "--out",
+            levels_s,
+        ])
+    };
     // An untrained Generator may find no way to an arbitrary goal; a goal on the start block's
     // own spot is never reached either (blocks are at least 5 m apart), so expect the clear error.
+    let generated = generate("0,0,0");
     assert!(!generated.status.success());
     let stderr = String::from_utf8_lossy(&generated.stderr);
     assert!(stderr.contains("no valid level"), "{stderr}");
     let (_, start, _) = arlpcg::game::rules::goal_and_start(3, None);
     let [x, z] = arlpcg::level::platform::heading_direction(start.heading);
-    let goal = format!("{},0,{}", 7.5 * x, 7.5 * z);
-    let generated = arlpcg(&[
-        "generate",
-        "--policies",
-        out_s,
-        "--aux",
-        "-0.5",
-        "--seed",
-        "3",
-        "--verify",
-        "4",
-        "--goal",
-        &goal,
-        "--format",
-        "yaml",
-        "--out",
-        levels.to_str().unwrap(),
-    ]);
+    let generated = generate(&format!("{},0,{}", 7.5 * x, 7.5 * z));
     assert!(
         generated.status.success(),
         "{}",
@@ -541,12 +536,29 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     assert_eq!(stats.trials, 4);
     assert!(stats.solver.describe().contains("solver.safetensors"));
 
-    // `eval` over the run: every table, in every format, with the keys results.json promises.
-    let results = dir.path().join("results");
-    let evaluated = arlpcg(&[
+    let missing_aux = arlpcg(&["generate", "--policies", run, "--out", levels_s]);
+    assert!(String::from_utf8_lossy(&missing_aux.stderr).contains("--aux"));
+    let wrong = arlpcg(&[
+        "generate",
+        "--policies",
+        dir.to_str().unwrap(),
+        "--aux",
+        "1",
+        "--out",
+        levels_s,
+    ]);
+    assert!(String::from_utf8_lossy(&wrong.stderr).contains("generator.safetensors"));
+}
+
+/// `eval` over the run: every table, in every format, with the keys results.json promises; a
+/// second eval into the same folder is refused.
+fn evaluate_a_run(dir: &Path, run: &str) {
+    let results = dir.join("results");
+    let results_s = results.to_str().unwrap();
+    arlpcg_ok(&[
         "eval",
         "--policies",
-        out_s,
+        run,
         "--tracks",
         "2",
         "--trials",
@@ -554,13 +566,8 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
         "--validation-tracks",
         "4",
         "--out",
-        results.to_str().unwrap(),
+        results_s,
     ]);
-    assert!(
-        evaluated.status.success(),
-        "{}",
-        String::from_utf8_lossy(&evaluated.stderr)
-    );
     let json: serde_json::Value = crate::common::results_json(&results);
     let rows = json["controllability"].as_array().unwrap();
     assert_eq!(rows.len(), 5);
@@ -609,15 +616,23 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     ] {
         assert!(results.join(name).exists(), "{name}");
     }
-    // The run scored as one seed of its mode (`eval --runs`): its own pair's controllability and
-    // its Solver on the validation set, with (here degenerate) intervals.
-    let seeds = dir.path().join("seeds");
-    let scored = arlpcg(&[
+    let again = arlpcg(&["eval", "--policies", run, "--out", results_s]);
+    assert!(
+        String::from_utf8_lossy(&again.stderr).contains("--force"),
+        "results are not clobbered"
+    );
+}
+
+/// The run scored as one seed of its mode (`eval --runs`): its own pair's controllability and
+/// its Solver on the validation set, with (here degenerate) intervals.
+fn score_a_run_as_one_seed(dir: &Path, run: &str) {
+    let seeds = dir.join("seeds");
+    arlpcg_ok(&[
         "eval",
         "--runs",
-        out_s,
+        run,
         "--policies",
-        out_s,
+        run,
         "--tracks",
         "2",
         "--trials",
@@ -627,11 +642,6 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
         "--out",
         seeds.to_str().unwrap(),
     ]);
-    assert!(
-        scored.status.success(),
-        "{}",
-        String::from_utf8_lossy(&scored.stderr)
-    );
     let seeds_json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(seeds.join("seeds.json")).unwrap()).unwrap();
     assert_eq!(seeds_json["modes"][0]["mode"], "arlpcg");
@@ -644,36 +654,6 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
         5
     );
     assert!(seeds.join("seeds.md").exists());
-    let again = arlpcg(&[
-        "eval",
-        "--policies",
-        out_s,
-        "--out",
-        results.to_str().unwrap(),
-    ]);
-    assert!(
-        String::from_utf8_lossy(&again.stderr).contains("--force"),
-        "results are not clobbered"
-    );
-
-    let missing_aux = arlpcg(&[
-        "generate",
-        "--policies",
-        out_s,
-        "--out",
-        levels.to_str().unwrap(),
-    ]);
-    assert!(String::from_utf8_lossy(&missing_aux.stderr).contains("--aux"));
-    let wrong = arlpcg(&[
-        "generate",
-        "--policies",
-        dir.path().to_str().unwrap(),
-        "--aux",
-        "1",
-        "--out",
-        levels.to_str().unwrap(),
-    ]);
-    assert!(String::from_utf8_lossy(&wrong.stderr).contains("generator.safetensors"));
 }
 
 /// `--resume --config` replaces the hyper-parameters (the old file is kept) but refuses the
@@ -915,9 +895,14 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
     );
     assert_eq!(loaded.card.max_pieces, Some(30));
 
-    // Tracks from the run's Generator, verified by its Solver; a goal one segment ahead is
-    // within reach of even an untrained Generator.
-    let tracks = dir.path().join("tracks");
+    generate_racing_tracks_with_a_run(dir.path(), out_s);
+    evaluate_a_racing_run(dir.path(), out_s);
+}
+
+/// Tracks from the run's Generator, verified by its Solver; a goal one segment ahead is
+/// within reach of even an untrained Generator.
+fn generate_racing_tracks_with_a_run(dir: &Path, run: &str) {
+    let tracks = dir.join("tracks");
     let (_, heading, _, _) = arlpcg::game::racing::rules::goal_and_start(2, None, 0);
     let [x, z] = arlpcg::level::platform::heading_direction(heading);
     let goal = format!("{},0,{}", 50.0 * x, 50.0 * z);
@@ -926,7 +911,7 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
         "--game",
         "racing",
         "--policies",
-        out_s,
+        run,
         "--aux",
         "-1",
         "--seed",
@@ -950,14 +935,17 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
     assert!(matches!(level.source, arlpcg::level::Source::Policy { .. }));
     assert!(level.racing().is_some_and(|t| !t.segments.is_empty()));
     assert_eq!(level.stats.unwrap().trials, 2);
+}
 
-    let results = dir.path().join("results");
+/// `eval` of a racing run: the racing columns and the paper's racing figures.
+fn evaluate_a_racing_run(dir: &Path, run: &str) {
+    let results = dir.join("results");
     let evaluated = arlpcg(&[
         "eval",
         "--game",
         "racing",
         "--policies",
-        out_s,
+        run,
         "--tracks",
         "1",
         "--trials",

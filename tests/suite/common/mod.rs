@@ -16,6 +16,18 @@ pub fn stderr(output: &Output) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()
 }
 
+/// `arlpcg args`, which must succeed (the failure shows its stderr).
+pub fn arlpcg_ok(args: &[&str]) -> Output {
+    let output = arlpcg(args);
+    assert!(
+        output.status.success(),
+        "arlpcg {}: {}",
+        args.join(" "),
+        stderr(&output)
+    );
+    output
+}
+
 /// The `results.json` an `eval` wrote into `dir`.
 pub fn results_json(dir: &Path) -> serde_json::Value {
     let path = dir.join("results.json");

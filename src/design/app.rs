@@ -19,6 +19,7 @@ use crate::verify::Recording;
 use super::layout::Areas;
 
 mod input;
+pub mod judging;
 pub mod pacing;
 mod policies;
 mod responses;
@@ -113,6 +114,8 @@ pub enum Overlay {
 pub enum Panel {
     Failures,
     Sweep,
+    /// The whole panel of judges on the level on screen.
+    Judges,
 }
 
 /// The Solver's trials on the level on screen, as they come in.
@@ -255,6 +258,10 @@ pub enum Response {
     Exported(ExportOutcome),
     Loaded(Result<Box<LoadedInfo>, String>),
     Judged(Result<Box<JudgeSwitch>, String>),
+    Panel {
+        id: u64,
+        update: judging::PanelUpdate,
+    },
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -311,6 +318,13 @@ pub enum Effect {
         after: Judge,
         folder: PathBuf,
     },
+    /// Every judge whose Solver is in `folder`, and the scripted skills, play `level`.
+    Panel {
+        id: u64,
+        level: Arc<Level>,
+        folder: PathBuf,
+        trials: u32,
+    },
     /// A level of `game` whose success, measured with `trials` runs, is within ±0.1 of `target`
     /// (the search of `generate --target-success`).
     Target {
@@ -354,6 +368,7 @@ pub struct App {
     recording: Option<(u64, u64)>,
     replays: u64,
     pub sweep: Option<Sweep>,
+    pub judging: Option<judging::Judging>,
     pub panel: Panel,
     /// Selected block (index into the level's blocks).
     pub selected: Option<usize>,
@@ -391,6 +406,7 @@ impl App {
             recording: None,
             replays: 0,
             sweep: None,
+            judging: None,
             panel: Panel::Failures,
             selected: None,
             overlay: Overlay::None,
@@ -534,8 +550,9 @@ impl App {
         };
         let mut level = Level::clone(level);
         level.stats = self.trials.as_ref().and_then(|t| t.stats.clone());
-        if level.stats.is_none() {
-            self.say("exporting without Solver statistics (trials still running)");
+        match &mut level.stats {
+            Some(stats) => stats.panel = self.panel_on_screen(),
+            None => self.say("exporting without Solver statistics (trials still running)"),
         }
         vec![Effect::Export {
             level: Box::new(level),

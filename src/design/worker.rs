@@ -10,6 +10,7 @@ use std::sync::{Arc, Mutex};
 
 use anyhow::Result;
 
+use super::app::judging::{PANEL_SEED, PanelUpdate};
 use super::app::{
     Effect, ExportOutcome, JudgeSwitch, LoadedInfo, PolicyInfo, Response, SweepPoint,
 };
@@ -18,7 +19,7 @@ use crate::game::Skill;
 use crate::generation::{self, GeneratorPolicy, LevelRequest};
 use crate::level::{Game, Level};
 use crate::level_files::{Format, LevelFiles, write_level_files};
-use crate::panel::Judge;
+use crate::panel::{Judge, panel_stats, rate};
 use crate::policies::{load_generator, load_solver, policy_paths};
 use crate::rl::checkpoint::PolicyError;
 use crate::verify::{self, Solver, SolverPolicy, Watch};
@@ -133,8 +134,9 @@ enum Slot {
     Level = 0,
     Record = 1,
     Sweep = 2,
+    Panel = 3,
     /// Exports and loads: never superseded.
-    Always = 3,
+    Always = 4,
 }
 
 fn slot(effect: &Effect) -> (Slot, u64) {
@@ -144,13 +146,14 @@ fn slot(effect: &Effect) -> (Slot, u64) {
         }
         Effect::Record { id, .. } => (Slot::Record, *id),
         Effect::Sweep { id, .. } => (Slot::Sweep, *id),
+        Effect::Panel { id, .. } => (Slot::Panel, *id),
         Effect::Export { .. } | Effect::Load { .. } | Effect::NextJudge { .. } => (Slot::Always, 0),
     }
 }
 
 /// The newest request id of each slot, shared by the UI (which raises them) and the workers.
 #[derive(Default)]
-struct Latest([AtomicU64; 4]);
+struct Latest([AtomicU64; 5]);
 
 impl Latest {
     fn superseded(&self, slot: Slot, id: u64) -> bool {
@@ -158,12 +161,13 @@ impl Latest {
     }
 }
 
-/// The worker threads: one for levels, trials, replays, exports and loads; one for sweeps (so a
-/// sweep never holds up the level on screen).
+/// The worker threads: one for levels, trials, replays, exports and loads; one for sweeps and
+/// one for the panel (so neither holds up the level on screen).
 pub struct Workers {
     latest: Arc<Latest>,
     main: Sender<Effect>,
     sweeps: Sender<Effect>,
+    panel: Sender<Effect>,
 }
 
 impl Workers {
@@ -183,6 +187,7 @@ impl Workers {
         Self {
             main: spawn("designer-worker"),
             sweeps: spawn("designer-sweeps"),
+            panel: spawn("designer-panel"),
             latest,
         }
     }
@@ -195,6 +200,7 @@ impl Workers {
         }
         let to = match slot {
             Slot::Sweep => &self.sweeps,
+            Slot::Panel => &self.panel,
             _ => &self.main,
         };
         // A worker only stops when the designer drops its sender, so sending cannot fail.
@@ -315,7 +321,53 @@ pub fn perform(
             next_judge(policies, game, after, &folder).map(Box::new),
         )),
         Effect::Load { path, game } => send(Response::Loaded(load_into(policies, &path, game))),
+        Effect::Panel {
+            id,
+            level,
+            folder,
+            trials,
+        } => play_panel(&level, &folder, trials, stop, &|update| {
+            send(Response::Panel { id, update })
+        }),
     }
+}
+
+/// Every judge of the panel in `folder` plays `level` `trials` times, each reported as it
+/// ends; then the level is rated. Nothing more once `stop` says so.
+fn play_panel(
+    level: &Level,
+    folder: &Path,
+    trials: u32,
+    stop: &(dyn Fn() -> bool + Sync),
+    send: &dyn Fn(PanelUpdate),
+) {
+    let panel = match crate::policies::load_panel(folder, level.game(), None) {
+        Ok(panel) => panel,
+        Err(e) => return send(PanelUpdate::Failed(format!("{e:#}"))),
+    };
+    send(PanelUpdate::Judges(panel.names()));
+    let watch = Watch {
+        on_trial: &|_| {},
+        stop,
+    };
+    let mut played = Vec::with_capacity(panel.judges.len());
+    for index in 0..panel.judges.len() {
+        match verify::verify_watched(level, &panel.solver(index), trials, PANEL_SEED, &watch) {
+            Ok(Some(stats)) => {
+                send(PanelUpdate::Played {
+                    index,
+                    success_ratio: stats.success_ratio,
+                    ci95: stats.ci95,
+                });
+                played.push(stats);
+            }
+            Ok(None) => return,
+            Err(e) => return send(PanelUpdate::Failed(e.to_string())),
+        }
+    }
+    let mut stats = panel_stats(&panel, PANEL_SEED, trials, &played);
+    rate(&mut [&mut stats]);
+    send(PanelUpdate::Rated(Box::new(stats)));
 }
 
 /// Plays `trials` runs of `level` with the game's current player, answering each trial as it

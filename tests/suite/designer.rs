@@ -720,3 +720,78 @@ fn the_judge_key_cycles_through_the_panel() {
         ]
     );
 }
+
+/// `J`: every judge of the folder plays the level on screen and the level is rated; the panel
+/// follows a new level while it is shown, an export records it, and `verify --panel` on the
+/// exported file gives the same figures.
+#[test]
+fn the_whole_panel_plays_the_level_on_screen_and_the_export_records_it() {
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    let (policies, info) = worker::load(&shipped, Game::Platform).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::new(policies, info, dir.path());
+    h.settle();
+    h.key(KeyCode::Char('J'));
+    assert_eq!(h.app.panel, app::Panel::Judges);
+    h.settle();
+    let judging = h.app.judging.clone().expect("the panel played");
+    let names: Vec<&str> = judging.judges.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "arlpcg",
+            "rule-pcg",
+            "fixed-track",
+            "fixed-aux",
+            "scripted-novice",
+            "scripted-median",
+            "scripted-expert"
+        ]
+    );
+    let stats = judging.stats.clone().expect("rated once all played");
+    assert!(stats.rating.is_some());
+    insta::assert_snapshot!("judges_panel_120x36", h.screen(120, 36));
+    // A new level is measured afresh while the panel is shown.
+    h.key(KeyCode::Left);
+    h.settle();
+    let again = h.app.judging.clone().unwrap();
+    assert_eq!(Some(&again.level), h.app.level.as_ref());
+    assert_ne!(again.level, judging.level);
+    assert!(again.stats.is_some());
+
+    h.key(KeyCode::Char('x'));
+    h.settle();
+    let stem = h.app.export_stem();
+    let file = dir.path().join("platform").join(format!("{stem}.yaml"));
+    let exported = yaml::load(&file).unwrap();
+    let recorded = exported
+        .stats
+        .unwrap()
+        .panel
+        .expect("the export records the panel");
+    assert_eq!(Some(&recorded), again.stats.as_ref());
+    let verified = crate::common::arlpcg_ok(&[
+        "verify",
+        file.to_str().unwrap(),
+        "--panel",
+        "--trials",
+        "40",
+        "--json",
+        "--policies",
+        shipped.to_str().unwrap(),
+    ]);
+    let row: serde_json::Value = serde_json::from_slice(&verified.stdout).unwrap();
+    for judge in &recorded.judges {
+        assert_eq!(
+            row["panel"][&judge.judge].as_f64(),
+            Some(judge.success_ratio),
+            "{}",
+            judge.judge
+        );
+    }
+    assert_eq!(
+        row["rating"]["b"].as_f64(),
+        recorded.rating.map(|r| r.b),
+        "the same rating"
+    );
+}

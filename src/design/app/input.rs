@@ -89,10 +89,12 @@ impl App {
             KeyCode::Char('v') => {
                 self.panel = match self.panel {
                     Panel::Failures => Panel::Sweep,
-                    Panel::Sweep => Panel::Failures,
+                    Panel::Sweep => Panel::Judges,
+                    Panel::Judges => Panel::Failures,
                 };
-                Vec::new()
+                self.judge_if_shown()
             }
+            KeyCode::Char('J') => self.judge_level(),
             KeyCode::Char('x') => self.export(false),
             KeyCode::Char('P') => self.next_pacing(),
             KeyCode::Char('C') => self.open_prompt(PromptKind::Curve),

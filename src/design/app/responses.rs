@@ -57,6 +57,10 @@ impl App {
                     Vec::new()
                 }
             },
+            Response::Panel { id, update } => {
+                self.panel_update(id, update);
+                Vec::new()
+            }
             Response::Loaded(result) => match result {
                 Ok(info) => self.loaded(*info),
                 Err(problem) => {
@@ -82,7 +86,9 @@ impl App {
                     self.aux = aux;
                 }
                 self.level = Some(level);
-                self.start_trials()
+                let mut effects = self.start_trials();
+                effects.extend(self.judge_if_shown());
+                effects
             }
             Err(problem) => {
                 self.generation_error = Some(problem.clone());

@@ -10,6 +10,7 @@ use ratatui::widgets::{
     Axis, Bar, BarChart, BarGroup, Block, Chart, Clear, Dataset, GraphType, Paragraph, Wrap,
 };
 
+mod judges;
 mod platform;
 mod racing;
 
@@ -38,12 +39,12 @@ pub const KEYS: [(&str, &str); 22] = [
     ("T", "target success rate: λ is searched for it"),
     ("r", "replay one Solver run on the map"),
     ("w", "λ sweep: success against λ for this seed and goal"),
-    ("v", "bottom-right panel: failures per piece / λ sweep"),
+    ("v", "bottom-right panel: failures / λ sweep / judges"),
     ("P C", "pacing: next preset / type a curve fraction:λ, ..."),
     ("k K", "keep pieces up to the selected one / let go"),
     ("x", "export YAML (with the Solver statistics) + .glb"),
     ("p", "load policies (a folder or one .safetensors file)"),
-    ("c j", "the policies' cards / next judge: who plays trials"),
+    ("c j J", "cards / next judge plays trials / all judges play"),
     ("Tab", "game: platform / racing"),
     ("?", "this help (any key closes it)"),
     ("q, Esc", "quit"),
@@ -93,6 +94,7 @@ pub fn render(app: &App, frame: &mut Frame) {
     match app.panel {
         Panel::Failures => failures(app, frame, areas.panel),
         Panel::Sweep => sweep(app, frame, areas.panel),
+        Panel::Judges => judges::judges(app, frame, areas.panel),
     }
     footer(app, frame, areas.footer);
     overlay(app, frame, screen);
@@ -513,7 +515,7 @@ fn sweep(app: &App, frame: &mut Frame, area: Rect) {
         frame.render_widget(
             Paragraph::new("press w to sweep λ for this seed and goal")
                 .wrap(Wrap { trim: true })
-                .block(Block::bordered().title(" λ sweep (v: failures) ")),
+                .block(Block::bordered().title(" λ sweep (v: panel) ")),
             area,
         );
         return;

@@ -98,8 +98,10 @@ pub struct EvalArgs {
     /// solver.safetensors, and generator.safetensors for adversarial runs; mode and seed from
     /// the card). Writes seeds.md and seeds.json to --out: per mode the IQM and mean validation
     /// success over seeds with 95% stratified-bootstrap intervals, each adversarial run's own
-    /// controllability, and P(arlpcg > baseline). The validation set's Generator levels come
-    /// from the first --policies folder (default policies/<game>).
+    /// controllability and that of the judges it never trained against (the rule-pcg Solver of
+    /// the first --policies folder, the scripted median and expert), and P(arlpcg > baseline).
+    /// The validation set's Generator levels come from the first --policies folder (default
+    /// policies/<game>).
     #[arg(long, num_args = 1.., value_name = "RUN", conflicts_with_all = ["merge", "shard"])]
     pub runs: Vec<PathBuf>,
     /// Play only shard I of K of the evaluation (0 <= I < K) and write its raw per-level

@@ -12,6 +12,7 @@ use crate::game::Skill;
 use crate::generation::GeneratorPolicy;
 use crate::panel::Judge;
 use crate::policies::{GENERATOR_FILE, load_generator, load_solver};
+use crate::train::TrainMode;
 use crate::verify::{Solver, SolverPolicy};
 
 pub fn run(args: &EvalArgs) -> Result<()> {
@@ -141,6 +142,17 @@ fn seeds(args: &EvalArgs) -> Result<()> {
             generator: generator.as_ref(),
         })
         .collect();
+    // The judges the runs never trained against, from the same folder.
+    let judges = [
+        Judge::Solver(TrainMode::RulePcg),
+        Judge::Scripted(Skill::Median),
+        Judge::Scripted(Skill::Expert),
+    ];
+    let available: Vec<Judge> = judges
+        .into_iter()
+        .filter(|j| j.policy_file(folder).is_none_or(|p| p.exists()))
+        .collect();
+    let judges = crate::policies::load_panel(folder, args.game, Some(&available))?;
     let budget = budget(args);
     let pool = crate::shell::thread_pool(args.threads)?;
     let validation =
@@ -148,12 +160,17 @@ fn seeds(args: &EvalArgs) -> Result<()> {
     let rule_levels = validation.iter().filter(|l| eval::is_rule_level(l)).count();
     let per_run = |r: &eval::seeds::Run| {
         validation.len() as u64
-            + r.generator
-                .map_or(0, |_| eval::AUX_VALUES.len() as u64 * budget.tracks as u64)
+            + r.generator.map_or(0, |_| {
+                (1 + judges.judges.len() as u64)
+                    * eval::AUX_VALUES.len() as u64
+                    * budget.tracks as u64
+            })
     };
     let bar = crate::shell::progress_bar(runs.iter().map(per_run).sum(), "levels played");
     let scores = pool.install(|| {
-        eval::seeds::score_runs(&runs, &validation, rule_levels, budget, &|| bar.inc(1))
+        eval::seeds::score_runs(&runs, &judges, &validation, rule_levels, budget, &|| {
+            bar.inc(1)
+        })
     })?;
     bar.finish_and_clear();
     let results = eval::seeds::summarize(budget, &validation_generator.reference.path, scores);

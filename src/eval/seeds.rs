@@ -3,16 +3,23 @@
 //! mode the IQM and mean over seeds with stratified-bootstrap intervals, and the probability
 //! that the ARLPCG Solver beats each baseline on validation ([`crate::bootstrap`]).
 
+use std::collections::BTreeMap;
+
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::bootstrap::{Aggregate, Estimate, estimate, probability_of_improvement};
 use crate::generation::GeneratorPolicy;
 use crate::level::Level;
+use crate::panel::Panel;
 use crate::seeds::EVAL_SEED_BASE;
 use crate::verify::{Solver, SolverPolicy, verify};
 
 use super::{AUX_VALUES, Budget, generator_levels};
+
+/// How much a judge's success may rise from one λ to the next harder one and still count as
+/// falling monotonically (the noise of the default budget).
+pub const DROP_TOLERANCE: f64 = 0.05;
 
 /// What one training run scored.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -30,6 +37,44 @@ pub struct RunScores {
     /// [`AUX_VALUES`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub controllability: Option<Vec<f64>>,
+    /// The same levels played by the judges the run never trained against (the rule-pcg
+    /// Solver of the evaluation's policies, the scripted player at median and expert skill).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub controllability_by_judge: Vec<JudgeCurve>,
+}
+
+/// One judge's success at each λ of [`AUX_VALUES`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JudgeCurve {
+    pub judge: String,
+    pub success_ratio: Vec<f64>,
+}
+
+impl RunScores {
+    /// The median over the judges of their drop in success from λ = +1 to λ = -1, and whether
+    /// every judge's success falls monotonically (within `tolerance`); `None` without judges.
+    pub fn judges_drop(&self, tolerance: f64) -> Option<(f64, bool)> {
+        let mut drops: Vec<f64> = self
+            .controllability_by_judge
+            .iter()
+            .map(|c| c.success_ratio[0] - c.success_ratio[c.success_ratio.len() - 1])
+            .collect();
+        if drops.is_empty() {
+            return None;
+        }
+        drops.sort_by(f64::total_cmp);
+        let n = drops.len();
+        let median = if n % 2 == 1 {
+            drops[n / 2]
+        } else {
+            0.5 * (drops[n / 2 - 1] + drops[n / 2])
+        };
+        let monotone = self
+            .controllability_by_judge
+            .iter()
+            .all(|c| c.success_ratio.windows(2).all(|w| w[1] <= w[0] + tolerance));
+        Some((median, monotone))
+    }
 }
 
 /// One mode over its seeds.
@@ -43,6 +88,16 @@ pub struct ModeSummary {
     /// Mean controllability success at each λ (adversarial modes).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub controllability: Option<Vec<Estimate>>,
+    /// The same for each judge the runs never trained against.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub controllability_by_judge: Vec<JudgeSummary>,
+}
+
+/// One judge's mean success at each λ over a mode's seeds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JudgeSummary {
+    pub judge: String,
+    pub success_ratio: Vec<Estimate>,
 }
 
 /// P(arlpcg's validation success > the baseline's), over seeds.
@@ -59,7 +114,8 @@ pub struct SeedResults {
     /// The Generator whose levels make the validation set's other half.
     pub validation_generator: String,
     pub aux: Vec<f64>,
-    pub runs: Vec<RunScores>,
+    /// Each mode's runs, one entry per seed.
+    pub seeds: BTreeMap<String, Vec<RunScores>>,
     pub modes: Vec<ModeSummary>,
     pub arlpcg_beats: Vec<Improvement>,
 }
@@ -74,50 +130,61 @@ pub struct Run<'a> {
 }
 
 /// Plays the validation set (rule levels first, `rule_levels` of them) with every run's Solver,
-/// and each adversarial run's own pair on its controllability levels; `on_level` after each
-/// level played.
+/// and each adversarial run's own pair and the `judges` on its controllability levels;
+/// `on_level` after each level played.
 pub fn score_runs(
     runs: &[Run],
+    judges: &Panel,
     validation: &[Level],
     rule_levels: usize,
     budget: Budget,
     on_level: &(dyn Fn() + Sync),
 ) -> Result<Vec<RunScores>, candle_core::Error> {
-    let play = |solver: &SolverPolicy, levels: &[Level], trials: u32| -> Vec<f64> {
-        levels
+    let play = |solver: &Solver, levels: &[Level], trials: u32| -> f64 {
+        let success: Vec<f64> = levels
             .par_iter()
             .map(|level| {
-                let stats = verify(
-                    level,
-                    &Solver::Policy(solver),
-                    trials,
-                    level.seed.unwrap_or(0),
-                    &|| {},
-                )
-                .expect("runs are loaded for the evaluation's game");
+                let stats = verify(level, solver, trials, level.seed.unwrap_or(0), &|| {})
+                    .expect("runs are loaded for the evaluation's game");
                 on_level();
                 stats.success_ratio
             })
-            .collect()
+            .collect();
+        success.iter().sum::<f64>() / success.len().max(1) as f64
     };
-    let mean = |xs: &[f64]| xs.iter().sum::<f64>() / xs.len().max(1) as f64;
     runs.iter()
         .map(|run| {
-            let success = play(run.solver, validation, budget.validation_trials);
+            let own = Solver::Policy(run.solver);
+            let success: Vec<f64> = validation
+                .par_iter()
+                .map(|level| play(&own, std::slice::from_ref(level), budget.validation_trials))
+                .collect();
             let (rules, generated) = success.split_at(rule_levels.min(success.len()));
-            let controllability = match run.generator {
-                Some(generator) => Some(
-                    AUX_VALUES
-                        .iter()
-                        .map(|&aux| {
-                            let levels =
-                                generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks)?;
-                            Ok(mean(&play(run.solver, &levels, budget.trials)))
-                        })
-                        .collect::<Result<Vec<f64>, candle_core::Error>>()?,
-                ),
-                None => None,
-            };
+            let mean = |xs: &[f64]| xs.iter().sum::<f64>() / xs.len().max(1) as f64;
+            let mut controllability = None;
+            let mut controllability_by_judge: Vec<JudgeCurve> = judges
+                .names()
+                .into_iter()
+                .map(|judge| JudgeCurve {
+                    judge,
+                    success_ratio: Vec::new(),
+                })
+                .collect();
+            if let Some(generator) = run.generator {
+                let mut own_curve = Vec::with_capacity(AUX_VALUES.len());
+                for &aux in &AUX_VALUES {
+                    let levels = generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks)?;
+                    own_curve.push(play(&own, &levels, budget.trials));
+                    for (k, curve) in controllability_by_judge.iter_mut().enumerate() {
+                        curve
+                            .success_ratio
+                            .push(play(&judges.solver(k), &levels, budget.trials));
+                    }
+                }
+                controllability = Some(own_curve);
+            } else {
+                controllability_by_judge.clear();
+            }
             Ok(RunScores {
                 run: run.folder.clone(),
                 mode: run.mode.clone(),
@@ -126,6 +193,7 @@ pub fn score_runs(
                 validation_generator_levels: mean(generated),
                 validation: mean(&success),
                 controllability,
+                controllability_by_judge,
             })
         })
         .collect()
@@ -171,6 +239,7 @@ pub fn summarize(budget: Budget, validation_generator: &str, runs: Vec<RunScores
                 validation_iqm: estimate(&halves(mode), Aggregate::Iqm, 0),
                 validation_mean: estimate(&halves(mode), Aggregate::Mean, 0),
                 controllability,
+                controllability_by_judge: judge_summaries(of(&runs, mode).collect()),
             }
         })
         .collect();
@@ -185,14 +254,49 @@ pub fn summarize(budget: Budget, validation_generator: &str, runs: Vec<RunScores
             .collect(),
         false => Vec::new(),
     };
+    let mut seeds: BTreeMap<String, Vec<RunScores>> = BTreeMap::new();
+    for run in runs {
+        seeds.entry(run.mode.clone()).or_default().push(run);
+    }
     SeedResults {
         budget,
         validation_generator: validation_generator.to_string(),
         aux: AUX_VALUES.to_vec(),
-        runs,
+        seeds,
         modes: summaries,
         arlpcg_beats,
     }
+}
+
+/// Each judge's mean success at each λ over `runs` (the judges every run was played by).
+fn judge_summaries(runs: Vec<&RunScores>) -> Vec<JudgeSummary> {
+    let Some(first) = runs.first() else {
+        return Vec::new();
+    };
+    first
+        .controllability_by_judge
+        .iter()
+        .filter_map(|curve| {
+            let of_judge: Vec<&JudgeCurve> = runs
+                .iter()
+                .map(|r| {
+                    r.controllability_by_judge
+                        .iter()
+                        .find(|c| c.judge == curve.judge)
+                })
+                .collect::<Option<_>>()?;
+            let success_ratio = (0..curve.success_ratio.len())
+                .map(|a| {
+                    let at: Vec<f64> = of_judge.iter().map(|c| c.success_ratio[a]).collect();
+                    estimate(&[at], Aggregate::Mean, a as u64)
+                })
+                .collect();
+            Some(JudgeSummary {
+                judge: curve.judge.clone(),
+                success_ratio,
+            })
+        })
+        .collect()
 }
 
 /// The report as markdown.
@@ -233,16 +337,47 @@ pub fn markdown(results: &SeedResults) -> String {
             md += "\n";
         }
     }
-    md += "\n## Each run\n\n| run | mode | seed | validation (rule / Generator levels) | controllability λ = +1 … -1 |\n|---|---|---|---|---|\n";
-    for r in &results.runs {
-        let control = r.controllability.as_ref().map_or(String::from("—"), |c| {
-            c.iter()
-                .map(|x| format!("{x:.2}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        });
+    let judged: Vec<&ModeSummary> = results
+        .modes
+        .iter()
+        .filter(|m| !m.controllability_by_judge.is_empty())
+        .collect();
+    if !judged.is_empty() {
+        md += "\n## Controllability over seeds for the judges the runs never trained against\n\n| mode | judge |";
+        for aux in &results.aux {
+            md += &format!(" λ = {aux:+.1} |");
+        }
+        md += "\n|---|---|";
+        md += &"---|".repeat(results.aux.len());
+        md += "\n";
+        for m in judged {
+            for j in &m.controllability_by_judge {
+                md += &format!("| {} | {} |", m.mode, j.judge);
+                for x in &j.success_ratio {
+                    md += &format!(" {} |", e(x));
+                }
+                md += "\n";
+            }
+        }
+    }
+    let list = |xs: &[f64]| {
+        xs.iter()
+            .map(|x| format!("{x:.2}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    md += &format!(
+        "\n## Each run\n\n| run | mode | seed | validation (rule / Generator levels) | controllability λ = +1 … -1 | judges' median drop, all monotone (±{DROP_TOLERANCE}) |\n|---|---|---|---|---|---|\n"
+    );
+    for r in results.seeds.values().flatten() {
+        let control = r.controllability.as_deref().map_or(String::from("—"), list);
+        let drop = r
+            .judges_drop(DROP_TOLERANCE)
+            .map_or(String::from("—"), |(median, monotone)| {
+                format!("{median:.2}, {}", if monotone { "yes" } else { "no" })
+            });
         md += &format!(
-            "| {} | {} | {} | {:.3} ({:.3} / {:.3}) | {control} |\n",
+            "| {} | {} | {} | {:.3} ({:.3} / {:.3}) | {control} | {drop} |\n",
             r.run,
             r.mode,
             r.seed,
@@ -276,6 +411,19 @@ mod tests {
             validation_generator_levels: generated,
             validation: 0.5 * (rules + generated),
             controllability: (mode == "arlpcg").then(|| vec![1.0, 0.9, 0.8, 0.6, 0.5]),
+            controllability_by_judge: match mode {
+                "arlpcg" => vec![
+                    JudgeCurve {
+                        judge: "scripted-median".into(),
+                        success_ratio: vec![1.0, 0.95, 0.9, 0.8, 0.7],
+                    },
+                    JudgeCurve {
+                        judge: "scripted-expert".into(),
+                        success_ratio: vec![1.0, 1.0, 1.0, 0.98, 0.9 - 0.1 * seed as f64],
+                    },
+                ],
+                _ => Vec::new(),
+            },
         }
     }
 
@@ -306,10 +454,23 @@ mod tests {
             (p.probability.value - (0.75 + 1.0) / 2.0).abs() < 1e-12,
             "{p:?}"
         );
+        // Each judge over the seeds, and each run's median drop over its judges.
+        let judges = &results.modes[0].controllability_by_judge;
+        assert_eq!(judges[0].judge, "scripted-median");
+        assert!((judges[0].success_ratio[4].value - 0.7).abs() < 1e-12);
+        assert!((judges[1].success_ratio[4].value - 0.8).abs() < 1e-12);
+        assert!(results.modes[1].controllability_by_judge.is_empty());
+        assert_eq!(results.seeds["arlpcg"].len(), 3);
+        assert_eq!(results.seeds["rule-pcg"][1].seed, 1);
+        let (median, monotone) = results.seeds["arlpcg"][0].judges_drop(0.05).unwrap();
+        assert!((median - 0.2).abs() < 1e-12 && monotone, "{median}");
+        assert_eq!(results.seeds["rule-pcg"][0].judges_drop(0.05), None);
         let md = markdown(&results);
         assert!(
             md.contains("| arlpcg | 0, 1, 2 |") && md.contains("| rule-pcg |"),
             "{md}"
         );
+        assert!(md.contains("| arlpcg | scripted-expert |"), "{md}");
+        assert!(md.contains("| 0.20, yes |"), "{md}");
     }
 }

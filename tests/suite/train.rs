@@ -646,12 +646,20 @@ fn score_a_run_as_one_seed(dir: &Path, run: &str) {
         serde_json::from_slice(&std::fs::read(seeds.join("seeds.json")).unwrap()).unwrap();
     assert_eq!(seeds_json["modes"][0]["mode"], "arlpcg");
     assert_eq!(seeds_json["modes"][0]["seeds"], serde_json::json!([5]));
-    assert_eq!(
-        seeds_json["runs"][0]["controllability"]
-            .as_array()
-            .unwrap()
-            .len(),
-        5
+    let run = &seeds_json["seeds"]["arlpcg"][0];
+    assert_eq!(run["controllability"].as_array().unwrap().len(), 5);
+    // The judges it never trained against: the folder has no rule-pcg Solver, so the scripted
+    // player's two skills, on the same levels.
+    let judges = run["controllability_by_judge"].as_array().unwrap();
+    let names: Vec<&str> = judges
+        .iter()
+        .map(|j| j["judge"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["scripted-median", "scripted-expert"]);
+    assert!(
+        judges
+            .iter()
+            .all(|j| j["success_ratio"].as_array().unwrap().len() == 5)
     );
     assert!(seeds.join("seeds.md").exists());
 }

@@ -5,8 +5,6 @@
 //! and the level's difficulty b from the Rasch fit over judges × levels ([`crate::rating`]), go
 //! into the level's statistics as [`PanelStats`].
 
-use std::path::{Path, PathBuf};
-
 use crate::game::Skill;
 use crate::level::stats::{JudgeStats, PanelStats, Rating, SolverStats};
 use crate::rating::{Outcomes, fit};
@@ -53,16 +51,6 @@ impl Judge {
                     names.join(", ")
                 )
             })
-    }
-
-    /// The Solver file of this judge in a policies folder (`solver.safetensors` is the ARLPCG
-    /// Solver, `solver-<mode>.safetensors` the others); `None` for the scripted player.
-    pub fn policy_file(self, dir: &Path) -> Option<PathBuf> {
-        match self {
-            Judge::Solver(TrainMode::Arlpcg) => Some(dir.join(crate::policies::SOLVER_FILE)),
-            Judge::Solver(mode) => Some(dir.join(format!("solver-{}.safetensors", mode.name()))),
-            Judge::Scripted(_) => None,
-        }
     }
 }
 

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
+use crate::game::generator::DEFAULT_CURVE_OFFSET;
 use crate::game::generator::{BuildLimits, GeneratorGame, observation_size};
-use crate::game::racing::generator::DEFAULT_CURVE_OFFSET;
 use crate::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
 use crate::generation::GeneratorPolicy;
 use crate::level::{Game, PolicyRef};
@@ -15,6 +15,7 @@ use crate::rl::checkpoint::{
     LoadedPolicy, MAX_POLICY_BYTES, PolicyCard, Role, load_policy, read_card,
 };
 use crate::rl::policy::ActorCritic;
+use crate::train::TrainMode;
 use crate::verify::SolverPolicy;
 
 /// File names inside a policies folder.
@@ -202,6 +203,16 @@ pub fn shipped_dir(game: Game) -> PathBuf {
     PathBuf::from("policies").join(game.name())
 }
 
+/// The Solver file of `judge` in a policies folder (`solver.safetensors` is the ARLPCG
+/// Solver, `solver-<mode>.safetensors` the others); `None` for the scripted player.
+pub fn judge_file(dir: &Path, judge: Judge) -> Option<PathBuf> {
+    match judge {
+        Judge::Solver(TrainMode::Arlpcg) => Some(dir.join(SOLVER_FILE)),
+        Judge::Solver(mode) => Some(dir.join(format!("solver-{}.safetensors", mode.name()))),
+        Judge::Scripted(_) => None,
+    }
+}
+
 /// The panel of judges `chosen` from the policies folder `dir` (by default every Solver judge
 /// whose file is there, and the scripted player at its three skills). A chosen Solver judge
 /// whose file is missing is an error naming it.
@@ -210,7 +221,7 @@ pub fn load_panel(dir: &Path, game: Game, chosen: Option<&[Judge]>) -> Result<Pa
         Some(chosen) => chosen.to_vec(),
         None => Judge::ALL
             .into_iter()
-            .filter(|j| j.policy_file(dir).is_none_or(|p| p.exists()))
+            .filter(|&j| judge_file(dir, j).is_none_or(|p| p.exists()))
             .collect(),
     };
     let mut panel = Panel { judges: Vec::new() };
@@ -228,7 +239,7 @@ pub fn load_judge(
     game: Game,
     judge: Judge,
 ) -> Result<Option<(SolverPolicy, PolicyCard)>> {
-    let Some(path) = judge.policy_file(dir) else {
+    let Some(path) = judge_file(dir, judge) else {
         return Ok(None);
     };
     let (policy, card) =

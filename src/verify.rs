@@ -163,7 +163,7 @@ fn play_all<G: GameSpec>(
             .into_par_iter()
             .map_init(new_env, |env, i| {
                 (!(watch.stop)())
-                    .then(|| reported(play_scripted(env, seed.wrapping_add(i), *skill)))
+                    .then(|| reported(play_scripted::<G>(env, seed.wrapping_add(i), *skill)))
             })
             .collect(),
         Solver::Random => range
@@ -189,12 +189,12 @@ pub fn record(level: &Level, solver: &Solver, seed: u64) -> Result<Recording, Wr
     solver.check_game(level.game())?;
     let unexpected = "a level's environment is of its own game";
     Ok(match level.game() {
-        Game::Platform => record_env(
+        Game::Platform => record_env::<PlatformGame>(
             PlatformGame::solver_env(level).expect(unexpected),
             solver,
             seed,
         ),
-        Game::Racing => record_env(
+        Game::Racing => record_env::<RacingGame>(
             RacingGame::solver_env(level).expect(unexpected),
             solver,
             seed,
@@ -202,19 +202,19 @@ pub fn record(level: &Level, solver: &Solver, seed: u64) -> Result<Recording, Wr
     })
 }
 
-fn record_env<E: SolverEnv>(mut env: E, solver: &Solver, seed: u64) -> Recording {
+fn record_env<G: GameSpec>(mut env: G::Env, solver: &Solver, seed: u64) -> Recording {
     env.reset(seed);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut scripted = match solver {
-        Solver::Scripted(skill) => Some(E::scripted(seed, *skill)),
+        Solver::Scripted(skill) => Some(G::scripted(seed, *skill)),
         _ => None,
     };
-    let mut observation = vec![0.0; E::OBSERVATION_SIZE];
+    let mut observation = vec![0.0; <G::Env as SolverEnv>::OBSERVATION_SIZE];
     let mut path = vec![env.marker()];
     loop {
         let action = match solver {
             Solver::Scripted(_) => scripted.as_mut().expect("made above").act(&env),
-            Solver::Random => E::random_action(&mut rng),
+            Solver::Random => G::Env::random_action(&mut rng),
             Solver::Policy(policy) => {
                 env.observe(&mut observation);
                 policy.normalizer.normalize(&mut observation);
@@ -222,7 +222,7 @@ fn record_env<E: SolverEnv>(mut env: E, solver: &Solver, seed: u64) -> Recording
                     .policy
                     .choose(&observation, ActMode::Sample, &mut rng)
                     .expect("a policy checked for the level's game acts on its observations");
-                E::action_from_policy_row(&action)
+                G::Env::action_from_policy_row(&action)
             }
         };
         let outcome = env.step(action).outcome;
@@ -252,9 +252,9 @@ pub fn certify(
 }
 
 /// Plays one run with the game's scripted player of `skill`, seeded by `seed`.
-pub fn play_scripted<E: SolverEnv>(env: &mut E, seed: u64, skill: Skill) -> TrialResult {
+pub fn play_scripted<G: GameSpec>(env: &mut G::Env, seed: u64, skill: Skill) -> TrialResult {
     env.reset(seed);
-    let mut player = E::scripted(seed, skill);
+    let mut player = G::scripted(seed, skill);
     loop {
         if let Some(outcome) = env.step(player.act(env)).outcome {
             return env.trial_result(outcome);

@@ -150,7 +150,7 @@ fn seeds(args: &EvalArgs) -> Result<()> {
     ];
     let available: Vec<Judge> = judges
         .into_iter()
-        .filter(|j| j.policy_file(folder).is_none_or(|p| p.exists()))
+        .filter(|&j| crate::policies::judge_file(folder, j).is_none_or(|p| p.exists()))
         .collect();
     let judges = crate::policies::load_panel(folder, args.game, Some(&available))?;
     let budget = budget(args);

@@ -462,9 +462,8 @@ fn next_judge(
         let (solver, info, skill) = match judge {
             Judge::Scripted(skill) => (None, None, skill),
             Judge::Solver(_) => {
-                let path = judge
-                    .policy_file(folder)
-                    .expect("a Solver judge has a file");
+                let path =
+                    crate::policies::judge_file(folder, judge).expect("a Solver judge has a file");
                 if !path.exists() {
                     continue;
                 }

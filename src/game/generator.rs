@@ -177,6 +177,12 @@ pub trait GeneratorGame: GameSpec {
     fn air_steps(env: &Self::Env) -> u32;
 }
 
+/// How far, in degrees, the racing Generator's curve action may ask to turn from the goal's
+/// bearing by default: with 30 (the segment's own ±30° limit) the road keeps within about 30°
+/// of the bearing and cannot bend away from the goal and back. A Generator's card records its
+/// own.
+pub const DEFAULT_CURVE_OFFSET: f64 = 30.0;
+
 /// What bounds a Generator's track besides its actions (a Generator's card records both).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BuildLimits {
@@ -192,7 +198,7 @@ impl BuildLimits {
     pub fn default_for<G: GeneratorGame>() -> Self {
         Self {
             max_pieces: G::DEFAULT_MAX_PIECES,
-            curve_offset: crate::game::racing::generator::DEFAULT_CURVE_OFFSET,
+            curve_offset: DEFAULT_CURVE_OFFSET,
         }
     }
 }

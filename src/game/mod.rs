@@ -8,6 +8,7 @@ pub mod racing;
 pub mod rules;
 
 use crate::level::stats::Outcome;
+pub use crate::level::stats::Skill;
 
 /// What one decision led to.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,8 +40,6 @@ impl Step {
 pub trait SolverEnv: Send + Sync + Sized {
     /// One decision.
     type Action: Copy + Send + Sync;
-    /// The game's scripted (non-learning) player.
-    type Scripted: Scripted<Self>;
     /// Length of the observation vector.
     const OBSERVATION_SIZE: usize;
 
@@ -54,57 +53,10 @@ pub trait SolverEnv: Send + Sync + Sized {
     fn action_from_policy_row(row: &[f32]) -> Self::Action;
     /// A uniformly random action (the random baseline).
     fn random_action(rng: &mut rand_chacha::ChaCha8Rng) -> Self::Action;
-    /// The scripted player of run `seed` at `skill`, as verification uses it.
-    fn scripted(seed: u64, skill: Skill) -> Self::Scripted;
     /// The finished run as verification records it.
     fn trial_result(&self, outcome: Outcome) -> crate::level::stats::TrialResult;
     /// Where the player is (a recorded run's path).
     fn marker(&self) -> [f32; 3];
-}
-
-/// How well a scripted player plays: a Solver-independent yardstick of difficulty, physically
-/// grounded and without a network. Each game turns a skill into its own imperfections (take-off
-/// timing and run-up speed on the platform game, grip misjudged and steering wobble in racing:
-/// docs/platform-physics.md and docs/racing-physics.md); `Expert` is the scripted player that
-/// verification used before skills existed.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Hash,
-    PartialOrd,
-    Ord,
-    Default,
-    serde::Serialize,
-    serde::Deserialize,
-)]
-#[serde(rename_all = "lowercase")]
-pub enum Skill {
-    Novice,
-    Median,
-    #[default]
-    Expert,
-}
-
-impl Skill {
-    /// Every skill, weakest first.
-    pub const ALL: [Skill; 3] = [Skill::Novice, Skill::Median, Skill::Expert];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Skill::Novice => "novice",
-            Skill::Median => "median",
-            Skill::Expert => "expert",
-        }
-    }
-}
-
-impl std::fmt::Display for Skill {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
 }
 
 /// A scripted player of environment `E`.
@@ -119,6 +71,8 @@ pub trait Scripted<E: SolverEnv> {
 pub trait GameSpec: Send + Sync + 'static {
     const GAME: crate::level::Game;
     type Env: SolverEnv;
+    /// The game's scripted (non-learning) player.
+    type Scripted: Scripted<Self::Env>;
     /// The Solver's observation, named parts in order.
     const OBSERVATION_LAYOUT: &'static [(&'static str, usize)];
     /// The Solver's continuous actions, in the policy's order...
@@ -130,6 +84,8 @@ pub trait GameSpec: Send + Sync + 'static {
     fn solver_env(level: &crate::level::Level) -> Option<Self::Env>;
     /// The rule-based level of `seed` (its goal drawn from the seed), if the rules find one.
     fn rule_level(seed: u64) -> Option<crate::level::Level>;
+    /// The scripted player of run `seed` at `skill`, as verification uses it.
+    fn scripted(seed: u64, skill: Skill) -> Self::Scripted;
 }
 
 /// The platform game: blocks to jump across.
@@ -141,6 +97,7 @@ pub struct RacingGame;
 impl GameSpec for PlatformGame {
     const GAME: crate::level::Game = crate::level::Game::Platform;
     type Env = platform::PlatformEnv;
+    type Scripted = platform::ScriptedController;
     const OBSERVATION_LAYOUT: &'static [(&'static str, usize)] = &platform::env::OBSERVATION_LAYOUT;
     const CONTINUOUS_ACTIONS: &'static [&'static str] = &["forward", "turn"];
     const BINARY_ACTIONS: &'static [&'static str] = &["jump"];
@@ -157,11 +114,17 @@ impl GameSpec for PlatformGame {
     fn rule_level(seed: u64) -> Option<crate::level::Level> {
         rules::platform_level(seed, None, None, &crate::level::RulesConfig::default()).ok()
     }
+
+    fn scripted(seed: u64, skill: Skill) -> platform::ScriptedController {
+        let skill = platform::scripted::ControllerSkill::of(skill);
+        platform::ScriptedController::with_skill(seed, skill)
+    }
 }
 
 impl GameSpec for RacingGame {
     const GAME: crate::level::Game = crate::level::Game::Racing;
     type Env = racing::RacingEnv;
+    type Scripted = racing::ScriptedDriver;
     const OBSERVATION_LAYOUT: &'static [(&'static str, usize)] = &racing::env::OBSERVATION_LAYOUT;
     const CONTINUOUS_ACTIONS: &'static [&'static str] = &["throttle", "steer"];
     const BINARY_ACTIONS: &'static [&'static str] = &[];
@@ -179,5 +142,9 @@ impl GameSpec for RacingGame {
 
     fn rule_level(seed: u64) -> Option<crate::level::Level> {
         racing::rules::racing_level(seed, None, None, &Default::default()).ok()
+    }
+
+    fn scripted(seed: u64, skill: Skill) -> racing::ScriptedDriver {
+        racing::ScriptedDriver::with_skill(seed, racing::scripted::DriverSkill::of(skill))
     }
 }

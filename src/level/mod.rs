@@ -220,7 +220,7 @@ pub enum InvalidLevel {
     )]
     RoadShort { at: [f64; 3], goal: [f64; 3] },
     #[error("{0}")]
-    Road(#[from] racing::TrackError),
+    Road(#[from] road::TrackError),
     #[error("the level has {count} {what}: at most {max} are allowed")]
     TooMany {
         what: &'static str,

@@ -1,12 +1,11 @@
 //! Racing levels as data: where the road starts, its segments (each relative to the end of the
-//! previous one) and the obstacles the road must avoid. The road's shape is resolved by
-//! [`super::road`]; the rules a track must keep (no crossing, no obstacle hit, the goal reached)
-//! are checked here, with that geometry.
+//! previous one) and the obstacles the road must avoid, with the checks that need no geometry
+//! (ranges, the goal reached). The road's shape, and the rules it must keep (no crossing, no
+//! obstacle hit), are resolved and checked by [`super::road`].
 
 use serde::{Deserialize, Serialize};
 
 use super::params::{self, RangeError};
-use super::road::{self, Road};
 
 /// The most segments a track may have (a 10 km road).
 pub const MAX_SEGMENTS: usize = 400;
@@ -200,29 +199,6 @@ pub struct RacingTrack {
     pub obstacles: Vec<Obstacle>,
 }
 
-/// A rule of the road broken by a track.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum TrackError {
-    #[error(
-        "segment {later} crosses segment {earlier}: the road's centre lines come {distance:.1} m apart, less than {min} m",
-        min = road::MIN_SELF_DISTANCE
-    )]
-    Crosses {
-        earlier: usize,
-        later: usize,
-        distance: f64,
-    },
-    #[error(
-        "segment {segment} runs into obstacle {obstacle}: its centre line passes {distance:.1} m from it, less than {min} m",
-        min = road::MIN_OBSTACLE_DISTANCE
-    )]
-    HitsObstacle {
-        segment: usize,
-        obstacle: usize,
-        distance: f64,
-    },
-}
-
 impl RacingTrack {
     /// An empty track starting at `position`, heading `heading` degrees.
     pub fn new(position: [f64; 3], heading: f64) -> Self {
@@ -232,21 +208,6 @@ impl RacingTrack {
             segments: Vec::new(),
             obstacles: Vec::new(),
         }
-    }
-
-    /// The resolved road: centre line, banking and edges.
-    pub fn road(&self) -> Road {
-        Road::new(self)
-    }
-
-    /// Checks that the road never crosses itself or an obstacle.
-    pub fn check_geometry(&self) -> Result<(), TrackError> {
-        let road = self.road();
-        if let Some(e) = road.first_crossing(0) {
-            return Err(e);
-        }
-        road.first_obstacle_hit(&self.obstacles, 0)
-            .map_or(Ok(()), Err)
     }
 }
 

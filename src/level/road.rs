@@ -1,5 +1,6 @@
 //! The racing road resolved from its segments, pure math (no physics): the centre line, its
-//! height profile, its banking, and the triangle meshes that physics and glTF share.
+//! height profile, its banking, and the triangle meshes that physics and glTF share; and the
+//! rules of the road a track must keep ([`TrackError`]: no crossing, no obstacle hit).
 //!
 //! - **Plan**: each segment is an arc of constant curvature (`curve / length`), so heading is
 //!   continuous at every join (C1 in plan).
@@ -13,7 +14,7 @@
 //!
 //! Heading `h` (degrees about +Y) points along `(cos h, 0, −sin h)`; positive curve turns left.
 
-use super::racing::{Obstacle, RacingTrack, SegmentParams, TrackError};
+use super::racing::{Obstacle, RacingTrack, SegmentParams};
 
 /// Width of the road surface, m.
 pub const ROAD_WIDTH: f64 = 9.0;
@@ -86,6 +87,46 @@ pub struct Road {
     banks: Vec<f64>,
     /// Pose at the end of the road: position, heading (radians).
     end: ([f64; 3], f64),
+}
+
+/// A rule of the road broken by a track.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TrackError {
+    #[error(
+        "segment {later} crosses segment {earlier}: the road's centre lines come {distance:.1} m apart, less than {min} m",
+        min = MIN_SELF_DISTANCE
+    )]
+    Crosses {
+        earlier: usize,
+        later: usize,
+        distance: f64,
+    },
+    #[error(
+        "segment {segment} runs into obstacle {obstacle}: its centre line passes {distance:.1} m from it, less than {min} m",
+        min = MIN_OBSTACLE_DISTANCE
+    )]
+    HitsObstacle {
+        segment: usize,
+        obstacle: usize,
+        distance: f64,
+    },
+}
+
+impl RacingTrack {
+    /// The resolved road: centre line, banking and edges.
+    pub fn road(&self) -> Road {
+        Road::new(self)
+    }
+
+    /// Checks that the road never crosses itself or an obstacle.
+    pub fn check_geometry(&self) -> Result<(), TrackError> {
+        let road = self.road();
+        if let Some(e) = road.first_crossing(0) {
+            return Err(e);
+        }
+        road.first_obstacle_hit(&self.obstacles, 0)
+            .map_or(Ok(()), Err)
+    }
 }
 
 impl Road {

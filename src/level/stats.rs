@@ -14,7 +14,7 @@ pub enum SolverRef {
     /// existed name none: the expert).
     Scripted {
         #[serde(default)]
-        skill: crate::game::Skill,
+        skill: Skill,
     },
     /// Uniformly random actions (a baseline).
     Random,
@@ -322,6 +322,51 @@ pub fn wilson_interval(successes: u32, trials: u32) -> [f64; 2] {
     [low, high]
 }
 
+/// How well a scripted player plays: a Solver-independent yardstick of difficulty, physically
+/// grounded and without a network. Each game turns a skill into its own imperfections (take-off
+/// timing and run-up speed on the platform game, grip misjudged and steering wobble in racing:
+/// docs/platform-physics.md and docs/racing-physics.md); `Expert` is the scripted player that
+/// verification used before skills existed.
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Skill {
+    Novice,
+    Median,
+    #[default]
+    Expert,
+}
+
+impl Skill {
+    /// Every skill, weakest first.
+    pub const ALL: [Skill; 3] = [Skill::Novice, Skill::Median, Skill::Expert];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Skill::Novice => "novice",
+            Skill::Median => "median",
+            Skill::Expert => "expert",
+        }
+    }
+}
+
+impl std::fmt::Display for Skill {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -357,7 +402,7 @@ mod tests {
         ];
         let stats = SolverStats::from_trials(
             SolverRef::Scripted {
-                skill: crate::game::Skill::Expert,
+                skill: Skill::Expert,
             },
             7,
             3,

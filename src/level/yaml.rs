@@ -579,8 +579,8 @@ impl LevelFile {
         // Checked here (not only in `validate`) to name the segment's line.
         track.check_geometry().map_err(|e| {
             let index = match e {
-                super::racing::TrackError::Crosses { later, .. } => later,
-                super::racing::TrackError::HitsObstacle { segment, .. } => segment,
+                super::road::TrackError::Crosses { later, .. } => later,
+                super::road::TrackError::HitsObstacle { segment, .. } => segment,
             };
             invalid(
                 format!("segments[{index}]"),

@@ -209,7 +209,7 @@ impl Default for GeneratorConfig {
             aux_values: vec![-1.0, -1.0, -0.5, 0.5, 1.0, 1.0],
             max_pieces: PlatformGame::DEFAULT_MAX_PIECES,
             obstacles: 0,
-            curve_offset: crate::game::racing::generator::DEFAULT_CURVE_OFFSET,
+            curve_offset: crate::game::generator::DEFAULT_CURVE_OFFSET,
             initial_log_std: -1.6,
             solver_warmup_steps: 500_000,
             solver_phase_steps: 100_000,
@@ -464,7 +464,7 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
     if !(1..=max_pieces).contains(&g.max_pieces) {
         return Err(format!("max_pieces must be within [1, {max_pieces}]"));
     }
-    let default_offset = crate::game::racing::generator::DEFAULT_CURVE_OFFSET;
+    let default_offset = crate::game::generator::DEFAULT_CURVE_OFFSET;
     if !(0.0..=180.0).contains(&g.curve_offset) {
         return Err("curve_offset must be a number of degrees in [0, 180]".into());
     }

@@ -163,3 +163,69 @@ fn no_function_is_longer_than_120_lines() {
     let own = function_lengths(include_str!("architecture.rs"));
     assert!(own.iter().any(|&(_, lines)| lines > 20), "{own:?}");
 }
+
+/// The module path of a file under `src/` (`level/racing.rs` → `level::racing`; a `mod.rs` is
+/// its folder).
+fn module_of(src: &Path, file: &Path) -> String {
+    let relative = file.strip_prefix(src).unwrap().with_extension("");
+    let parts: Vec<String> = relative
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .filter(|p| p != "mod")
+        .collect();
+    parts.join("::")
+}
+
+/// Whether the code of `text` (tests and comments aside), in module `from`, names module `to`:
+/// by its `crate::` path, or as a sibling through `super::`.
+fn names_module(text: &str, from: &str, to: &str) -> bool {
+    let code = text.split("#[cfg(test)]").next().unwrap();
+    let (from_parent, to_parent) = (
+        from.rsplit_once("::").map_or("", |(p, _)| p),
+        to.rsplit_once("::").map_or("", |(p, _)| p),
+    );
+    let to_name = to.rsplit("::").next().unwrap();
+    let mut paths = vec![format!("crate::{to}::"), format!("crate::{to}}}")];
+    if from_parent == to_parent {
+        paths.extend([
+            format!("super::{to_name}::"),
+            format!("super::{to_name}}}"),
+            format!("super::{to_name};"),
+        ]);
+    }
+    code.lines()
+        .filter(|line| !line.trim_start().starts_with("//"))
+        .any(|line| paths.iter().any(|p| line.contains(p.as_str())))
+}
+
+#[test]
+fn no_two_modules_import_each_other() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let modules: Vec<(String, String)> = files
+        .iter()
+        .map(|f| (module_of(&src, f), std::fs::read_to_string(f).unwrap()))
+        .collect();
+    let mut loops = Vec::new();
+    for (i, (a, a_text)) in modules.iter().enumerate() {
+        for (b, b_text) in &modules[i + 1..] {
+            // A folder's mod.rs and the files in it belong together.
+            let nested = |outer: &str, inner: &str| inner.starts_with(&format!("{outer}::"));
+            if nested(a, b) || nested(b, a) {
+                continue;
+            }
+            if names_module(a_text, a, b) && names_module(b_text, b, a) {
+                loops.push(format!("{a} <-> {b}"));
+            }
+        }
+    }
+    assert!(
+        loops.is_empty(),
+        "modules that import each other (one should own what both need):\n{}",
+        loops.join("\n")
+    );
+    // The check sees imports: level::road names level::racing.
+    let road = modules.iter().find(|(m, _)| m == "level::road").unwrap();
+    assert!(names_module(&road.1, "level::road", "level::racing"));
+}

@@ -327,7 +327,6 @@ impl PlatformEnv {
 
 impl crate::game::SolverEnv for PlatformEnv {
     type Action = PlatformAction;
-    type Scripted = super::ScriptedController;
     const OBSERVATION_SIZE: usize = OBSERVATION_SIZE;
 
     fn reset(&mut self, seed: u64) {
@@ -352,10 +351,6 @@ impl crate::game::SolverEnv for PlatformEnv {
             turn: rng.random_range(-1.0..=1.0),
             jump: rng.random_bool(0.5),
         }
-    }
-
-    fn scripted(seed: u64, skill: crate::game::Skill) -> super::ScriptedController {
-        super::ScriptedController::with_skill(seed, super::scripted::ControllerSkill::of(skill))
     }
 
     fn trial_result(&self, outcome: Outcome) -> crate::level::stats::TrialResult {

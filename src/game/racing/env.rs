@@ -427,7 +427,6 @@ impl Clone for RacingEnv {
 
 impl crate::game::SolverEnv for RacingEnv {
     type Action = CarAction;
-    type Scripted = super::ScriptedDriver;
     const OBSERVATION_SIZE: usize = OBSERVATION_SIZE;
 
     fn reset(&mut self, seed: u64) {
@@ -451,10 +450,6 @@ impl crate::game::SolverEnv for RacingEnv {
             throttle: rng.random_range(-1.0..=1.0),
             steer: rng.random_range(-1.0..=1.0),
         }
-    }
-
-    fn scripted(seed: u64, skill: crate::game::Skill) -> super::ScriptedDriver {
-        super::ScriptedDriver::with_skill(seed, super::scripted::DriverSkill::of(skill))
     }
 
     fn trial_result(&self, outcome: Outcome) -> crate::level::stats::TrialResult {

@@ -9,7 +9,9 @@ use rand_chacha::ChaCha8Rng;
 
 use super::env::{RacingEnv, SIGHT, SolverRewards};
 use crate::game::RacingGame;
-use crate::game::generator::{BuildLimits, GeneratorGame, GeneratorRewards, Placement, TrackBuild};
+use crate::game::generator::{
+    BuildLimits, DEFAULT_CURVE_OFFSET, GeneratorGame, GeneratorRewards, Placement, TrackBuild,
+};
 use crate::level::Track;
 use crate::level::params::{SEGMENT_CURVE, SEGMENT_HEIGHT, SEGMENT_LENGTH, quantize};
 use crate::level::platform::{direction_heading, heading_direction, wrap_degrees};
@@ -32,10 +34,6 @@ const RAY_STEP: f64 = 4.0;
 /// The segment budget of a Generator's track by default (goals are at most 360 m away,
 /// segments 20-30 m long).
 pub const DEFAULT_MAX_SEGMENTS: usize = 30;
-/// How far, in degrees, the Generator's curve action may ask to turn from the goal's bearing by
-/// default: with 30 (the segment's own ±30° limit) the road keeps within about 30° of the
-/// bearing and cannot bend away from the goal and back. A Generator's card records its own.
-pub const DEFAULT_CURVE_OFFSET: f64 = 30.0;
 /// Obstacles drawn into each training match's scene (some draws fall too near the start or the
 /// goal and are dropped).
 pub const MATCH_OBSTACLES: u32 = 3;

@@ -6,10 +6,11 @@
 //! into the level's statistics as [`PanelStats`].
 
 use crate::game::Skill;
+use crate::level::Level;
 use crate::level::stats::{JudgeStats, PanelStats, Rating, SolverStats};
 use crate::rating::{Outcomes, fit};
 use crate::train::TrainMode;
-use crate::verify::{Solver, SolverPolicy};
+use crate::verify::{Solver, SolverPolicy, Watch, WrongGame, verify_watched};
 
 /// One judge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -93,6 +94,28 @@ pub fn panel_stats(panel: &Panel, seed: u64, trials: u32, played: &[SolverStats]
             .collect(),
         rating: None,
     }
+}
+
+/// Every judge of `panel` plays `level` `trials` times from `seed` (each judge's runs are
+/// verification's), `on_judge` after each judge; not yet rated. `Ok(None)` when `watch.stop`
+/// cut the play short.
+pub fn play(
+    panel: &Panel,
+    level: &Level,
+    trials: u32,
+    seed: u64,
+    watch: &Watch,
+    on_judge: &dyn Fn(usize, &SolverStats),
+) -> Result<Option<PanelStats>, WrongGame> {
+    let mut played = Vec::with_capacity(panel.judges.len());
+    for k in 0..panel.judges.len() {
+        let Some(stats) = verify_watched(level, &panel.solver(k), trials, seed, watch)? else {
+            return Ok(None);
+        };
+        on_judge(k, &stats);
+        played.push(stats);
+    }
+    Ok(Some(panel_stats(panel, seed, trials, &played)))
 }
 
 /// Rates every level of `panels` together: fits the Rasch model over their judges × levels (a

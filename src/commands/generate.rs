@@ -16,7 +16,7 @@ use crate::generation::{self, GeneratorPolicy, KeptPrefix, Lambda, LevelRequest}
 use crate::level::stats::PanelStats;
 use crate::level::{Game, Level};
 use crate::level_files::{Format, LevelFiles, file_stem, render};
-use crate::panel::{Judge, Panel, panel_stats, rate};
+use crate::panel::{Judge, Panel, rate};
 use crate::policies::{load_generator, load_judge, load_panel, load_solver, policy_paths};
 use crate::verify::{self, Solver, SolverPolicy, verify};
 
@@ -164,17 +164,12 @@ fn play_panel(panel: &Panel, levels: &mut Vec<Level>, trials: u32, stop: &Atomic
         .par_iter()
         .map(|level| {
             let seed = level.stats.as_ref().map_or(0, |s| s.seed);
-            let mut stats = Vec::with_capacity(panel.judges.len());
-            for k in 0..panel.judges.len() {
-                if stop.load(Ordering::SeqCst) {
-                    return None;
-                }
-                let solver = panel.solver(k);
-                let s = verify(level, &solver, trials, seed, &|| bar.inc(1))
-                    .expect("judges are loaded for the batch's game");
-                stats.push(s);
-            }
-            Some(panel_stats(panel, seed, trials, &stats))
+            let watch = verify::Watch {
+                on_trial: &|_| bar.inc(1),
+                stop: &|| stop.load(Ordering::SeqCst),
+            };
+            crate::panel::play(panel, level, trials, seed, &watch, &|_, _| {})
+                .expect("judges are loaded for the batch's game")
         })
         .collect();
     bar.finish_and_clear();

@@ -14,9 +14,9 @@ use crate::game::facts::facts;
 use crate::level::stats::{Outcome, PanelStats, SolverRef, SolverStats};
 use crate::level::yaml;
 use crate::level::{Game, Level};
-use crate::panel::{Panel, panel_stats, rate};
+use crate::panel::{Panel, rate};
 use crate::policies::{load_panel, load_solver};
-use crate::verify::{HalfwaySplit, Solver, SolverPolicy, Summary, passed_by_piece, verify};
+use crate::verify::{HalfwaySplit, Solver, SolverPolicy, Summary, Watch, passed_by_piece, verify};
 
 pub fn run(args: &VerifyArgs) -> Result<()> {
     if args.replay {
@@ -199,15 +199,15 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
                 };
                 let runs = args.trials as u64 * panel.judges.len() as u64;
                 let bar = crate::shell::progress_bar(runs, &path.display().to_string());
-                let played = (0..panel.judges.len())
-                    .map(|k| {
-                        verify(&level, &panel.solver(k), args.trials, args.seed, &|| {
-                            bar.inc(1)
-                        })
-                    })
-                    .collect::<Result<Vec<_>, _>>()?;
+                let watch = Watch {
+                    on_trial: &|_| bar.inc(1),
+                    stop: &|| false,
+                };
+                let played =
+                    crate::panel::play(panel, &level, args.trials, args.seed, &watch, &|_, _| {})?
+                        .expect("a panel without a stop condition plays to the end");
                 bar.finish_and_clear();
-                Ok((game, panel_stats(panel, args.seed, args.trials, &played)))
+                Ok((game, played))
             });
         match outcome {
             Ok((game, stats)) => rated.push((path, game, stats)),

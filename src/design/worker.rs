@@ -19,7 +19,7 @@ use crate::game::Skill;
 use crate::generation::{self, GeneratorPolicy, LevelRequest};
 use crate::level::{Game, Level};
 use crate::level_files::{Format, LevelFiles, write_level_files};
-use crate::panel::{Judge, panel_stats, rate};
+use crate::panel::{Judge, rate};
 use crate::policies::{load_generator, load_solver, policy_paths};
 use crate::rl::checkpoint::PolicyError;
 use crate::verify::{self, Solver, SolverPolicy, Watch};
@@ -350,24 +350,21 @@ fn play_panel(
         on_trial: &|_| {},
         stop,
     };
-    let mut played = Vec::with_capacity(panel.judges.len());
-    for index in 0..panel.judges.len() {
-        match verify::verify_watched(level, &panel.solver(index), trials, PANEL_SEED, &watch) {
-            Ok(Some(stats)) => {
-                send(PanelUpdate::Played {
-                    index,
-                    success_ratio: stats.success_ratio,
-                    ci95: stats.ci95,
-                });
-                played.push(stats);
-            }
-            Ok(None) => return,
-            Err(e) => return send(PanelUpdate::Failed(e.to_string())),
+    let on_judge = |index: usize, stats: &crate::level::stats::SolverStats| {
+        send(PanelUpdate::Played {
+            index,
+            success_ratio: stats.success_ratio,
+            ci95: stats.ci95,
+        })
+    };
+    match crate::panel::play(&panel, level, trials, PANEL_SEED, &watch, &on_judge) {
+        Ok(Some(mut stats)) => {
+            rate(&mut [&mut stats]);
+            send(PanelUpdate::Rated(Box::new(stats)));
         }
+        Ok(None) => {}
+        Err(e) => send(PanelUpdate::Failed(e.to_string())),
     }
-    let mut stats = panel_stats(&panel, PANEL_SEED, trials, &played);
-    rate(&mut [&mut stats]);
-    send(PanelUpdate::Rated(Box::new(stats)));
 }
 
 /// Plays `trials` runs of `level` with the game's current player, answering each trial as it

@@ -140,8 +140,9 @@ pub fn score_runs(
     budget: Budget,
     on_level: &(dyn Fn() + Sync),
 ) -> Result<Vec<RunScores>, candle_core::Error> {
-    let play = |solver: &Solver, levels: &[Level], trials: u32| -> f64 {
-        let success: Vec<f64> = levels
+    // Each level's success ratio with `solver`.
+    let play = |solver: &Solver, levels: &[Level], trials: u32| -> Vec<f64> {
+        levels
             .par_iter()
             .map(|level| {
                 let stats = verify(level, solver, trials, level.seed.unwrap_or(0), &|| {})
@@ -149,42 +150,38 @@ pub fn score_runs(
                 on_level();
                 stats.success_ratio
             })
-            .collect();
-        success.iter().sum::<f64>() / success.len().max(1) as f64
+            .collect()
     };
+    let mean = |xs: &[f64]| xs.iter().sum::<f64>() / xs.len().max(1) as f64;
     runs.iter()
         .map(|run| {
             let own = Solver::Policy(run.solver);
-            let success: Vec<f64> = validation
-                .par_iter()
-                .map(|level| play(&own, std::slice::from_ref(level), budget.validation_trials))
-                .collect();
+            let success = play(&own, validation, budget.validation_trials);
             let (rules, generated) = success.split_at(rule_levels.min(success.len()));
-            let mean = |xs: &[f64]| xs.iter().sum::<f64>() / xs.len().max(1) as f64;
-            let mut controllability = None;
-            let mut controllability_by_judge: Vec<JudgeCurve> = judges
-                .names()
-                .into_iter()
-                .map(|judge| JudgeCurve {
-                    judge,
-                    success_ratio: Vec::new(),
-                })
-                .collect();
-            if let Some(generator) = run.generator {
-                let mut own_curve = Vec::with_capacity(AUX_VALUES.len());
-                for &aux in &AUX_VALUES {
-                    let levels = generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks)?;
-                    own_curve.push(play(&own, &levels, budget.trials));
-                    for (k, curve) in controllability_by_judge.iter_mut().enumerate() {
-                        curve
-                            .success_ratio
-                            .push(play(&judges.solver(k), &levels, budget.trials));
+            let (controllability, controllability_by_judge) = match run.generator {
+                Some(generator) => {
+                    let mut own_curve = Vec::with_capacity(AUX_VALUES.len());
+                    let mut curves: Vec<JudgeCurve> = judges
+                        .names()
+                        .into_iter()
+                        .map(|judge| JudgeCurve {
+                            judge,
+                            success_ratio: Vec::with_capacity(AUX_VALUES.len()),
+                        })
+                        .collect();
+                    for &aux in &AUX_VALUES {
+                        let levels =
+                            generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks)?;
+                        own_curve.push(mean(&play(&own, &levels, budget.trials)));
+                        for (k, curve) in curves.iter_mut().enumerate() {
+                            let success = play(&judges.solver(k), &levels, budget.trials);
+                            curve.success_ratio.push(mean(&success));
+                        }
                     }
+                    (Some(own_curve), curves)
                 }
-                controllability = Some(own_curve);
-            } else {
-                controllability_by_judge.clear();
-            }
+                None => (None, Vec::new()),
+            };
             Ok(RunScores {
                 run: run.folder.clone(),
                 mode: run.mode.clone(),

@@ -19,6 +19,11 @@ use ratatui::crossterm::event::{
 };
 
 /// A designer whose effects run inline, on `policies`.
+/// The shipped platform policies' folder.
+fn shipped_platform() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform")
+}
+
 struct Harness {
     app: App,
     policies: Mutex<GamePolicies>,
@@ -43,6 +48,12 @@ impl Harness {
     /// Rules and the scripted controller: no trained policy, fully deterministic.
     fn rules(out: &Path) -> Self {
         Self::new(Policies::default(), LoadedInfo::default(), out)
+    }
+
+    /// A designer on the shipped platform policies.
+    fn shipped(out: &Path) -> Self {
+        let (policies, info) = worker::load(&shipped_platform(), Game::Platform).unwrap();
+        Self::new(policies, info, out)
     }
 
     fn send(&mut self, message: Message) {
@@ -470,7 +481,7 @@ fn newer_requests_supersede_older_ones() {
 /// the files load and the .glb validates.
 #[test]
 fn scripted_session_on_the_shipped_policies() {
-    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    let shipped = shipped_platform();
     let (policies, info) =
         worker::load(&shipped, Game::Platform).expect("the shipped policies load");
     assert!(info.solver.is_some(), "a Solver is shipped");
@@ -528,9 +539,7 @@ fn target_success_mode_finds_a_level_in_band() {
     let (text, is_error) = rules.app.status.clone().unwrap();
     assert!(is_error && text.contains("needs a Generator"), "{text}");
 
-    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
-    let (policies, info) = worker::load(&shipped, Game::Platform).unwrap();
-    let mut h = Harness::new(policies, info, dir.path());
+    let mut h = Harness::shipped(dir.path());
     h.settle();
     h.key(KeyCode::Char('T'));
     h.keys("0.6");
@@ -604,10 +613,8 @@ fn the_readme_key_table_is_the_key_map() {
 /// to one λ.
 #[test]
 fn pacing_keys_set_a_curve_and_keep_a_prefix() {
-    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
-    let (policies, info) = worker::load(&shipped, Game::Platform).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let mut h = Harness::new(policies, info, dir.path());
+    let mut h = Harness::shipped(dir.path());
     h.settle();
     h.key(KeyCode::Char('P'));
     assert!(
@@ -676,10 +683,8 @@ fn pacing_keys_set_a_curve_and_keep_a_prefix() {
 /// player at each skill, then back; the header and the statistics say who plays.
 #[test]
 fn the_judge_key_cycles_through_the_panel() {
-    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
-    let (policies, info) = worker::load(&shipped, Game::Platform).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let mut h = Harness::new(policies, info, dir.path());
+    let mut h = Harness::shipped(dir.path());
     h.settle();
     let mut seen = Vec::new();
     for _ in 0..7 {
@@ -726,10 +731,8 @@ fn the_judge_key_cycles_through_the_panel() {
 /// exported file gives the same figures.
 #[test]
 fn the_whole_panel_plays_the_level_on_screen_and_the_export_records_it() {
-    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
-    let (policies, info) = worker::load(&shipped, Game::Platform).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let mut h = Harness::new(policies, info, dir.path());
+    let mut h = Harness::shipped(dir.path());
     h.settle();
     h.key(KeyCode::Char('J'));
     assert_eq!(h.app.panel, app::Panel::Judges);
@@ -778,7 +781,7 @@ fn the_whole_panel_plays_the_level_on_screen_and_the_export_records_it() {
         "40",
         "--json",
         "--policies",
-        shipped.to_str().unwrap(),
+        shipped_platform().to_str().unwrap(),
     ]);
     let row: serde_json::Value = serde_json::from_slice(&verified.stdout).unwrap();
     for judge in &recorded.judges {

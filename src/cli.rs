@@ -507,8 +507,9 @@ pub struct TrainArgs {
     #[arg(long)]
     pub resume: bool,
     /// The run's seed (network initialization, action sampling, minibatches), in place of the
-    /// configuration's `seed` (default 0); the card records it. A resumed run keeps its own.
-    #[arg(long, conflicts_with = "resume")]
+    /// configuration's `seed` (default 0); the card records it. A resumed run keeps its own:
+    /// given with --resume, it must be that seed.
+    #[arg(long)]
     pub seed: Option<u64>,
     /// Print the default configuration as YAML and exit.
     #[arg(long)]

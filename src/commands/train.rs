@@ -51,6 +51,12 @@ pub fn run(args: &TrainArgs) -> Result<()> {
             Some(lock) => lock,
             None => RunLock::take(out)?,
         };
+        run.add_session(
+            std::iter::once("arlpcg".to_string())
+                .chain(std::env::args().skip(1))
+                .collect::<Vec<_>>()
+                .join(" "),
+        );
         train_loop(run.as_mut(), args.minutes)
     })
 }

@@ -79,7 +79,12 @@ pub struct TrainingRecord {
     pub seed: u64,
     /// The commit that trained it, `-dirty` when the tree held uncommitted changes.
     pub commit: String,
+    /// The command that started the run.
     pub command: String,
+    /// The commands of the sessions that resumed it, in order (a run from one command has
+    /// only that command plus `--resume` here).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub resumed_with: Vec<String>,
     /// A Generator trained against a population: the Solver steps at which each earlier
     /// Solver it played was taken, oldest first (the current Solver played too).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -331,6 +336,7 @@ mod tests {
                 seed: 0,
                 commit: "none".into(),
                 command: String::new(),
+                resumed_with: Vec::new(),
                 population: Vec::new(),
             },
             results: HashMap::new(),

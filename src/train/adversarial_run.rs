@@ -150,6 +150,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             wall_time_s,
         );
         card.training.population = envs.population.iter().map(|s| s.solver_steps).collect();
+        record_commands(&mut card, &self.solver.commands);
         card
     }
 
@@ -236,6 +237,10 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
 
     fn wall_before(&self) -> f64 {
         self.solver.wall_before
+    }
+
+    fn add_session(&mut self, command: String) {
+        self.solver.commands.push(command);
     }
 
     fn iterate(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String> {

@@ -82,7 +82,25 @@ pub(super) fn generator_shape(config: &TrainConfig, game: Game) -> PolicyShape {
     }
 }
 
-/// A policy card for a policy trained by this run.
+/// Records the run's sessions in `card`: `commands[0]` started it, the others resumed it.
+pub(super) fn record_commands(card: &mut PolicyCard, commands: &[String]) {
+    if let Some((first, later)) = commands.split_first() {
+        card.training.command = first.clone();
+        card.training.resumed_with = later.to_vec();
+    }
+}
+
+/// The sessions a loaded card records, oldest first (a card from before `resumed_with` holds
+/// only its last session's command).
+pub(super) fn recorded_commands(card: &PolicyCard) -> Vec<String> {
+    std::iter::once(card.training.command.clone())
+        .filter(|command| !command.is_empty())
+        .chain(card.training.resumed_with.iter().cloned())
+        .collect()
+}
+
+/// A policy card for a policy trained by this run (its commands are set by
+/// [`record_commands`]).
 pub(super) fn card(
     game: Game,
     role: Role,
@@ -134,10 +152,8 @@ pub(super) fn card(
             wall_time_s: (wall_time_s * 10.0).round() / 10.0,
             seed: config.seed,
             commit: git_commit(),
-            command: std::iter::once("arlpcg".to_string())
-                .chain(std::env::args().skip(1))
-                .collect::<Vec<_>>()
-                .join(" "),
+            command: String::new(),
+            resumed_with: Vec::new(),
             population: Vec::new(),
         },
         results: Default::default(),

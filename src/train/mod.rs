@@ -72,6 +72,7 @@ pub fn open(
     let config = if resume {
         Start::Resume(ConfigChange {
             config: config.map(|path| load_config(path, game)).transpose()?,
+            seed,
             steps,
         })
     } else {
@@ -118,10 +119,12 @@ enum Start {
 }
 
 /// What a resumed run changes in its configuration: `--config` replaces all of it, `--steps`
-/// the budget.
+/// the budget. `--seed` may be given again (the run's first command plus `--resume`), but it
+/// cannot change.
 #[derive(Debug, Default)]
 pub(super) struct ConfigChange {
     pub config: Option<TrainConfig>,
+    pub seed: Option<u64>,
     pub steps: Option<u64>,
 }
 
@@ -129,6 +132,9 @@ impl ConfigChange {
     /// The resumed run's configuration, from the one it stored.
     pub(super) fn apply(self, stored: &TrainConfig) -> TrainConfig {
         let mut new = self.config.unwrap_or_else(|| stored.clone());
+        if let Some(seed) = self.seed {
+            new.seed = seed;
+        }
         if let Some(steps) = self.steps {
             new.steps = steps;
         }
@@ -177,6 +183,9 @@ pub trait Training {
     fn budget(&self) -> u64;
     /// Wall-clock seconds of earlier sessions.
     fn wall_before(&self) -> f64;
+    /// Records this session's command line in the run's cards (the shell names it: the core
+    /// reads no process arguments).
+    fn add_session(&mut self, command: String);
     /// One PPO iteration (of whichever agent learns now) at `lr_scale` times the configured
     /// learning rates; returns the progress bar's message. `wall` is the clock the shell lends:
     /// the run's wall-clock seconds over every session, for the metrics' time columns.

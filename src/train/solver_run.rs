@@ -39,6 +39,8 @@ pub(super) struct Run<E: Resumable> {
     pub(super) iteration: u64,
     pub(super) wall_before: f64,
     pub(super) metrics: std::fs::File,
+    /// Each session's command line, the first one's first (the shell names them).
+    pub(super) commands: Vec<String>,
 }
 
 impl<E: Resumable> Run<E> {
@@ -71,6 +73,7 @@ impl<E: Resumable> Run<E> {
             trainer,
             iteration: 0,
             wall_before: 0.0,
+            commands: Vec::new(),
         })
     }
 
@@ -93,7 +96,7 @@ impl<E: Resumable> Run<E> {
         let config = change.apply(&stored);
         check_resumable_change(&stored, &config).map_err(|problem| {
             anyhow::anyhow!(
-                "--config with --resume: {problem} (the run in {})",
+                "--resume with --config or --seed: {problem} (the run in {})",
                 out.display()
             )
         })?;
@@ -129,6 +132,7 @@ impl<E: Resumable> Run<E> {
             trainer,
             iteration: state.iteration,
             wall_before: state.wall_time_s,
+            commands: recorded_commands(&loaded.card),
         })
     }
 
@@ -148,7 +152,7 @@ impl<E: Resumable> Run<E> {
     }
 
     pub(super) fn solver_card(&self, wall_time_s: f64) -> PolicyCard {
-        card(
+        let mut card = card(
             E::GAME,
             Role::Solver,
             self.mode,
@@ -156,7 +160,9 @@ impl<E: Resumable> Run<E> {
             &self.trainer.norm,
             self.trainer.global_step,
             wall_time_s,
-        )
+        );
+        record_commands(&mut card, &self.commands);
+        card
     }
 
     /// Collects a rollout, updates the Solver, logs a metrics row.
@@ -208,6 +214,10 @@ impl<G: GameSpec> Training for Run<SolverEnvs<G>> {
 
     fn wall_before(&self) -> f64 {
         self.wall_before
+    }
+
+    fn add_session(&mut self, command: String) {
+        self.commands.push(command);
     }
 
     fn iterate(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String> {

@@ -1,6 +1,7 @@
 //! glTF export read back with the `gltf` crate: one node per block plus start block and
 //! markers, names, extras, and world bounds that match the level.
 
+use crate::common::import_glb;
 use arlpcg::game::rules;
 use arlpcg::level::platform::BLOCK_THICKNESS;
 use arlpcg::level::scene::Scene;
@@ -57,7 +58,7 @@ fn glb_reads_back_with_one_node_per_block_and_matching_bounds() {
         let exports = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("gltf-exports");
         std::fs::create_dir_all(&exports).unwrap();
         std::fs::write(exports.join(format!("rules_seed{seed}.glb")), &glb).unwrap();
-        let (document, buffers, _) = gltf::import_slice(&glb).expect("the .glb imports");
+        let (document, buffers) = import_glb(&glb);
         let nodes: Vec<gltf::Node> = document.nodes().collect();
         // start block, every block, start and goal markers, spawn, finish and its zone, then a
         // collider beside the start block and every block
@@ -128,10 +129,7 @@ fn export_is_deterministic_and_gltf_matches_glb() {
 }
 
 /// Each triangle of `primitive`: its three positions and three normals.
-fn triangles(
-    primitive: &gltf::Primitive,
-    buffers: &[gltf::buffer::Data],
-) -> Vec<[([f32; 3], [f32; 3]); 3]> {
+fn triangles(primitive: &gltf::Primitive, buffers: &[Vec<u8>]) -> Vec<[([f32; 3], [f32; 3]); 3]> {
     let reader = primitive.reader(|b| Some(&buffers[b.index()]));
     let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
     let normals: Vec<[f32; 3]> = reader.read_normals().unwrap().collect();
@@ -190,7 +188,7 @@ fn every_mesh_faces_outward_and_its_winding_agrees_with_its_normals() {
     );
     for level in [platform, racing] {
         let glb = export::to_glb(&Scene::of_level(&level));
-        let (document, buffers, _) = gltf::import_slice(&glb).unwrap();
+        let (document, buffers) = import_glb(&glb);
         let mut closed_meshes = 0;
         for mesh in document.meshes() {
             let name = mesh.name().unwrap_or("?").to_string();
@@ -239,7 +237,7 @@ fn spawn_and_finish_nodes_carry_start_heading_and_goal_reach() {
         arlpcg::game::racing::rules::racing_level(6, None, None, &Default::default()).unwrap();
     for level in [platform, racing] {
         let glb = export::to_glb(&Scene::of_level(&level));
-        let (document, _, _) = gltf::import_slice(&glb).unwrap();
+        let (document, _) = import_glb(&glb);
         let node = |name: &str| {
             document
                 .nodes()

@@ -137,19 +137,49 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
         );
     }
     assert_eq!(after.last().unwrap().1, target);
-    // The budget is stored with the run: a resume without --steps stops at it at once.
-    let again = arlpcg(&["train", "--mode", "fixed-track", "--out", out_s, "--resume"]);
+    // The budget is stored with the run: the first command plus --resume (no --steps) stops
+    // at it at once.
+    let again = arlpcg(&[
+        "train",
+        "--mode",
+        "fixed-track",
+        "--seed",
+        "3",
+        "--out",
+        out_s,
+        "--resume",
+    ]);
     assert!(
         again.status.success(),
         "{}",
         String::from_utf8_lossy(&again.stderr)
     );
     assert_eq!(curve(&out), after);
-    // The finished policy loads with its card, which records the whole run.
+    the_card_records_the_whole_run(&out, target);
+}
+
+/// The finished policy loads with its card, which records the whole run: its budget, mode,
+/// network, and the command of every session.
+fn the_card_records_the_whole_run(out: &Path, target: u64) {
+    let out_s = out.to_str().unwrap();
     let policy = std::fs::read(out.join("solver.safetensors")).unwrap();
     let loaded = load_policy(&policy, Game::Platform, Role::Solver, OBSERVATION_SIZE).unwrap();
     assert_eq!(loaded.card.training.steps, target);
     assert_eq!(loaded.card.training.mode, "fixed-track");
+    // The card names the command that started the run and each session that resumed it.
+    assert!(
+        loaded
+            .card
+            .training
+            .command
+            .starts_with("arlpcg train --mode fixed-track --steps 100000000"),
+        "{}",
+        loaded.card.training.command
+    );
+    let resumes = &loaded.card.training.resumed_with;
+    assert_eq!(resumes.len(), 2, "{resumes:?}");
+    assert!(resumes.iter().all(|command| command.contains("--resume")));
+    assert!(resumes[1].ends_with(&format!("--seed 3 --out {out_s} --resume")));
     assert_eq!(loaded.card.network.hidden, vec![16, 16]);
     let card: serde_yaml::Value =
         serde_yaml::from_str(&std::fs::read_to_string(out.join("solver.yaml")).unwrap()).unwrap();
@@ -200,6 +230,23 @@ fn wrong_resumes_are_refused(out_s: &str) {
     ]);
     assert!(
         String::from_utf8_lossy(&refused.stderr).contains("was trained with --mode fixed-track")
+    );
+    // A resume with another seed is refused by name; the run's own seed may be given again.
+    let refused = arlpcg(&[
+        "train",
+        "--mode",
+        "fixed-track",
+        "--seed",
+        "5",
+        "--out",
+        out_s,
+        "--resume",
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&refused.stderr).contains("seed cannot change"),
+        "{}",
+        String::from_utf8_lossy(&refused.stderr)
     );
 }
 

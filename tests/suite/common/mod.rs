@@ -34,3 +34,32 @@ pub fn results_json(dir: &Path) -> serde_json::Value {
     let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     serde_json::from_slice(&bytes).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
+
+/// A `.glb` read back as an engine's importer reads it: the document parsed and validated, and
+/// each buffer's bytes (every buffer must be the file's binary chunk, long enough for it).
+/// Our files hold no images, so the `gltf` crate's `import` feature (an image decoder) is not
+/// needed.
+pub fn import_glb(glb: &[u8]) -> (gltf::Document, Vec<Vec<u8>>) {
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice(glb).expect("the .glb parses and validates");
+    let blob = blob.expect("the .glb has a binary chunk");
+    let buffers = document
+        .buffers()
+        .map(|buffer| {
+            assert!(
+                matches!(buffer.source(), gltf::buffer::Source::Bin),
+                "buffer {} is not the .glb's binary chunk",
+                buffer.index()
+            );
+            assert!(
+                blob.len() >= buffer.length(),
+                "buffer {} needs {} bytes, the binary chunk has {}",
+                buffer.index(),
+                buffer.length(),
+                blob.len()
+            );
+            blob.clone()
+        })
+        .collect();
+    (document, buffers)
+}

@@ -27,7 +27,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn main() {
     // SAFETY: first thing in main, before any other thread exists.
-    unsafe { arlpcg::rl::threads::fix_thread_count() };
+    unsafe { arlpcg::shell::fix_thread_count() };
     for game in [Game::Platform, Game::Racing] {
         for (key, what) in [('n', "new seed"), ('P', "pacing edit")] {
             measure(game, key, what);

@@ -32,7 +32,7 @@ fn matmul_gflops(n: usize) -> f64 {
 
 fn main() {
     // SAFETY: first thing in main, before any other thread exists.
-    unsafe { arlpcg::rl::threads::fix_thread_count() };
+    unsafe { arlpcg::shell::fix_thread_count() };
     let shape = PolicyShape {
         observation: 40,
         hidden: vec![512, 512],

@@ -102,7 +102,7 @@ fn measure(label: &str, budget: Duration, mut round: impl FnMut() -> u64) -> f64
 
 fn main() {
     // SAFETY: first thing in main, before any other thread exists.
-    unsafe { arlpcg::rl::threads::fix_thread_count() };
+    unsafe { arlpcg::shell::fix_thread_count() };
     let budget = Duration::from_secs(3);
     let single = |driver, observe, label: &str| {
         let mut worker = Worker::new(1, driver, observe);

@@ -18,7 +18,7 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() {
     // SAFETY: first thing in main, before any other thread exists.
-    unsafe { arlpcg::rl::threads::fix_thread_count() };
+    unsafe { arlpcg::shell::fix_thread_count() };
     let config = TrainConfig::default();
     let shape = PolicyShape {
         observation: arlpcg::game::platform::OBSERVATION_SIZE,

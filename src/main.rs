@@ -8,7 +8,7 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() -> ExitCode {
     // SAFETY: first thing in main, before any other thread exists.
-    unsafe { arlpcg::rl::threads::fix_thread_count() };
+    unsafe { arlpcg::shell::fix_thread_count() };
     let cli = arlpcg::cli::Cli::parse();
     match arlpcg::commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,

@@ -10,5 +10,4 @@ pub mod fused;
 pub mod normalizer;
 pub mod policy;
 pub mod ppo;
-pub mod threads;
 pub mod vec_env;

@@ -33,6 +33,8 @@ const FORBIDDEN: &[(&str, &str)] = &[
     ("stderr()", "prints"),
     ("thread_rng", "uses a global RNG"),
     ("rand::rng()", "uses a global RNG"),
+    ("std::env::args", "reads the command line (the shell's job)"),
+    ("std::env::var", "reads the environment (the shell's job)"),
     ("ctrlc", "handles signals (the shell's job)"),
     ("indicatif", "draws progress (the shell's job)"),
     ("crate::shell", "reaches up into the shells"),

@@ -6,6 +6,7 @@ mod common;
 mod architecture;
 mod cli;
 mod designer;
+mod determinism;
 mod faults;
 mod gltf_export;
 mod hostile_input;

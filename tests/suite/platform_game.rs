@@ -1,4 +1,4 @@
-//! The platform world: determinism, the calibrated reach, observations and rewards as the
+//! The platform world (its determinism is in determinism.rs): the calibrated reach, observations and rewards as the
 //! Solver sees them, and how runs end.
 
 use arlpcg::game::platform::reach::{self, REACH_HEIGHTS, REACH_TABLE, play_scripted, single_jump};
@@ -8,50 +8,6 @@ use arlpcg::level::stats::Outcome;
 
 fn env_of(track: &PlatformTrack) -> PlatformEnv {
     PlatformEnv::new(track, track.last().position, SolverRewards::default())
-}
-
-/// A fixed, varied action sequence: run, turn, jump now and then.
-fn scripted_actions(n: usize) -> Vec<PlatformAction> {
-    (0..n)
-        .map(|i| PlatformAction {
-            forward: ((i as f32) * 0.37).sin(),
-            turn: ((i as f32) * 0.11).cos(),
-            jump: i % 17 == 0,
-        })
-        .collect()
-}
-
-fn trajectory(track: &PlatformTrack, seed: u64, actions: &[PlatformAction]) -> Vec<u32> {
-    let mut env = env_of(track);
-    env.reset(seed);
-    let mut bits = Vec::new();
-    for &action in actions {
-        let step = env.step(action);
-        bits.extend(env.observation().iter().map(|x| x.to_bits()));
-        bits.push(step.reward.to_bits());
-        if step.outcome.is_some() {
-            break;
-        }
-    }
-    bits
-}
-
-#[test]
-fn same_level_seed_and_actions_give_a_bitwise_identical_trajectory() {
-    let level = arlpcg::game::rules::platform_level(11, None, None, &Default::default()).unwrap();
-    let track = level.platform().unwrap();
-    let actions = scripted_actions(400);
-    let a = trajectory(track, 5, &actions);
-    assert!(
-        a.len() > 10 * OBSERVATION_SIZE,
-        "the run should last a while"
-    );
-    assert_eq!(a, trajectory(track, 5, &actions));
-    assert_ne!(
-        a,
-        trajectory(track, 6, &actions),
-        "the seed should place the character differently"
-    );
 }
 
 #[test]

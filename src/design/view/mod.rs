@@ -618,7 +618,11 @@ fn overlay(app: &App, frame: &mut Frame, screen: Rect) {
                         for (k, v) in results {
                             lines.push(Line::from(format!("  {k}: {v:.3}")));
                         }
-                        lines.push(Line::from(format!("  command: {}", t.command)).dim());
+                        let resumed = match t.resumed_with.len() {
+                            0 => String::new(),
+                            n => format!(" (resumed {n}×)"),
+                        };
+                        lines.push(Line::from(format!("  command: {}{resumed}", t.command)).dim());
                     }
                     None => lines.push(Line::from(format!(
                         "{role}: none loaded ({})",

@@ -17,8 +17,8 @@ fn run_bits<G: GameSpec>(seed: u64) -> Vec<u32> {
     let mut random = ChaCha8Rng::seed_from_u64(7);
     let mut observation = vec![0.0; G::Env::OBSERVATION_SIZE];
     let mut bits = Vec::new();
-    for step in 0..2000 {
-        let action = match step % 10 {
+    for tick in 0..2000 {
+        let action = match tick % 10 {
             0 => G::Env::random_action(&mut random),
             _ => player.act(&env),
         };

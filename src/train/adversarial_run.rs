@@ -247,6 +247,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         let phases = self.solver.config.generator.clone();
         // The stage in force where this iteration starts (a stage begins at a phase's end).
         let schedule = phases.schedule_at(self.solver.trainer.global_step);
+        self.envs().rules.snapshot_share = schedule.snapshot_share;
         match self.envs().state.phase {
             Phase::Solver => {
                 let rollout =

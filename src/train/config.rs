@@ -136,6 +136,10 @@ pub struct Stage {
     pub solver_learning_rate: f64,
     pub solver_phase_steps: u64,
     pub generator_phase_steps: u64,
+    /// The share of the stage's matches that a snapshot plays (0: the current Solver alone);
+    /// none: the run's `snapshot_share`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub snapshot_share: Option<f64>,
 }
 
 impl Default for TrainConfig {
@@ -171,11 +175,13 @@ impl GeneratorConfig {
                 solver_learning_rate: Some(stage.solver_learning_rate),
                 solver_phase_steps: stage.solver_phase_steps,
                 generator_phase_steps: stage.generator_phase_steps,
+                snapshot_share: stage.snapshot_share.or(self.snapshot_share),
             },
             None => Schedule {
                 solver_learning_rate: None,
                 solver_phase_steps: self.solver_phase_steps,
                 generator_phase_steps: self.generator_phase_steps,
+                snapshot_share: self.snapshot_share,
             },
         }
     }
@@ -188,6 +194,8 @@ pub struct Schedule {
     pub solver_learning_rate: Option<f64>,
     pub solver_phase_steps: u64,
     pub generator_phase_steps: u64,
+    /// The share of matches a snapshot plays (`GeneratorConfig::snapshot_share`).
+    pub snapshot_share: Option<f64>,
 }
 
 impl Default for GeneratorConfig {
@@ -443,6 +451,14 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
                 "stages[{k}]: solver_phase_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
             ));
         }
+        if stage
+            .snapshot_share
+            .is_some_and(|p| !(0.0..=1.0).contains(&p))
+        {
+            return Err(format!(
+                "stages[{k}].snapshot_share must be a number in [0, 1]"
+            ));
+        }
         if k > 0 && stage.from_steps <= g.stages[k - 1].from_steps {
             return Err(format!(
                 "stages[{k}].from_steps must be after the stage before it"
@@ -525,7 +541,7 @@ mod tests {
             TrainConfig::for_game(Game::Racing).generator.curve_offset,
             90.0
         );
-        let staged = "generator:\n  stages:\n  - {from_steps: 100, solver_learning_rate: 0, solver_phase_steps: 8, generator_phase_steps: 9}\n";
+        let staged = "generator:\n  snapshot_share: 0.5\n  stages:\n  - {from_steps: 100, solver_learning_rate: 0, solver_phase_steps: 8, generator_phase_steps: 9}\n  - {from_steps: 200, solver_learning_rate: 0, solver_phase_steps: 8, generator_phase_steps: 9, snapshot_share: 0}\n";
         let staged = TrainConfig::parse_for(staged, Game::Platform)
             .unwrap()
             .generator;
@@ -538,6 +554,10 @@ mod tests {
                 last.generator_phase_steps
             ),
             (Some(0.0), 8, 9)
+        );
+        assert_eq!(
+            [99, 100, 200].map(|steps| staged.schedule_at(steps).snapshot_share),
+            [Some(0.5), Some(0.5), Some(0.0)]
         );
         let narrow =
             TrainConfig::parse_for("generator:\n  curve_offset: 30\n", Game::Racing).unwrap();
@@ -567,6 +587,11 @@ mod tests {
                 "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: .nan, solver_phase_steps: 1, generator_phase_steps: 1}\n",
                 Game::Platform,
                 "stages[0].solver_learning_rate",
+            ),
+            (
+                "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1, snapshot_share: -1}\n",
+                Game::Platform,
+                "stages[0].snapshot_share",
             ),
             (
                 "generator:\n  snapshot_share: 1.5\n",

@@ -670,7 +670,7 @@ fn ctrl_c_in_a_batch_keeps_finished_levels_and_no_temporaries() {
         .unwrap();
     assert!(sent.success());
     let output = child.wait_with_output().unwrap();
-    let err = String::from_utf8_lossy(&output.stderr);
+    let err = stderr(&output);
     assert_eq!(output.status.code(), Some(130), "{err}");
     let files = files_of(dir.path());
     assert!(

@@ -2,6 +2,7 @@
 //! level, a policy, a configuration or an output file should be is refused at once (opening it
 //! would block forever), and nothing is overwritten without `--force`.
 
+use crate::common::stderr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -69,7 +70,7 @@ fn a_fifo_is_refused_wherever_a_file_is_read_or_written() {
     ];
     for (what, args) in cases {
         let output = arlpcg_within(&args, Duration::from_secs(20));
-        let err = String::from_utf8_lossy(&output.stderr);
+        let err = stderr(&output);
         assert!(
             matches!(output.status.code(), Some(1 | 2)),
             "{what}: {:?} {err}",
@@ -90,7 +91,7 @@ fn generate_leaves_a_fifo_where_its_file_should_go_alone() {
         "generate", "--rules", "--game", "platform", "--seed", "3", "--out", out,
     ];
     let output = arlpcg_within(&args, Duration::from_secs(20));
-    let err = String::from_utf8_lossy(&output.stderr);
+    let err = stderr(&output);
     assert_eq!(output.status.code(), Some(1), "{err}");
     assert!(err.contains("not a regular file"), "{err}");
     let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
@@ -105,7 +106,7 @@ fn a_new_training_run_never_starts_in_a_folder_holding_files() {
     std::fs::write(out.join("solver.safetensors"), b"a designer's policy").unwrap();
     let args = ["train", "--steps", "100", "--out", out.to_str().unwrap()];
     let output = arlpcg_within(&args, Duration::from_secs(20));
-    let err = String::from_utf8_lossy(&output.stderr);
+    let err = stderr(&output);
     assert_eq!(output.status.code(), Some(1), "{err}");
     assert!(
         err.contains("is not empty (it holds solver.safetensors)"),
@@ -190,7 +191,7 @@ fn messages_name_the_field_and_exit_codes_tell_arguments_from_input() {
     ];
     for (args, code, expected) in cases {
         let output = arlpcg_within(&args, Duration::from_secs(20));
-        let err = String::from_utf8_lossy(&output.stderr);
+        let err = stderr(&output);
         assert_eq!(output.status.code(), Some(code), "{args:?}: {err}");
         assert!(err.contains(expected), "{args:?}: {err}");
     }
@@ -215,7 +216,7 @@ fn arlpcg_with_file_limit(kib: u32, args: &[&str]) -> Option<Output> {
         quoted.join(" ")
     );
     let output = Command::new("bash").args(["-c", &script]).output().ok()?;
-    if String::from_utf8_lossy(&output.stderr).contains("ulimit") {
+    if stderr(&output).contains("ulimit") {
         eprintln!("skipped: cannot limit file sizes here");
         return None;
     }
@@ -269,7 +270,7 @@ fn a_batch_that_cannot_be_written_whole_leaves_the_folder_as_it_was() {
     let Some(output) = arlpcg_with_file_limit(4, &args) else {
         return;
     };
-    let err = String::from_utf8_lossy(&output.stderr);
+    let err = stderr(&output);
     assert_eq!(output.status.code(), Some(1), "{err}");
     assert!(
         err.contains("nothing was written") && err.contains("File too large"),
@@ -287,12 +288,7 @@ fn a_batch_that_cannot_be_written_whole_leaves_the_folder_as_it_was() {
     let args = batch(&old, "-1", &["--force"]);
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let output = arlpcg_with_file_limit(4, &args).unwrap();
-    assert_eq!(
-        output.status.code(),
-        Some(1),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
     assert_eq!(
         folder(&old),
         before,

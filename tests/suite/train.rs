@@ -117,11 +117,7 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
         "--threads",
         "2",
     ]);
-    assert!(
-        resumed.status.success(),
-        "{}",
-        String::from_utf8_lossy(&resumed.stderr)
-    );
+    assert!(resumed.status.success(), "{}", stderr(&resumed));
     assert!(!lock.exists(), "a finished session removes its lock");
     let after = curve(&out);
     // The rows up to the checkpoint are kept, later ones (written after it) dropped and redone.
@@ -199,9 +195,9 @@ fn a_live_lock_refuses_a_second_session(out: &Path) {
     ]);
     assert_eq!(busy.status.code(), Some(1));
     assert!(
-        String::from_utf8_lossy(&busy.stderr).contains("in use by another training session"),
+        stderr(&busy).contains("in use by another training session"),
         "{}",
-        String::from_utf8_lossy(&busy.stderr)
+        stderr(&busy)
     );
     assert_eq!(curve(out), before);
 }
@@ -218,14 +214,12 @@ fn wrong_resumes_are_refused(out_s: &str) {
         out_s,
     ]);
     assert_eq!(refused.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&refused.stderr).contains("add --resume"));
+    assert!(stderr(&refused).contains("add --resume"));
     // A resume with another mode is refused.
     let refused = arlpcg(&[
         "train", "--mode", "rule-pcg", "--steps", "100", "--out", out_s, "--resume",
     ]);
-    assert!(
-        String::from_utf8_lossy(&refused.stderr).contains("was trained with --mode fixed-track")
-    );
+    assert!(stderr(&refused).contains("was trained with --mode fixed-track"));
     // A resume with another seed is refused by name; the run's own seed may be given again.
     let refused = arlpcg(&[
         "train",
@@ -259,7 +253,7 @@ fn bad_training_configs_are_named() {
         "--out",
         dir.path().join("r").to_str().unwrap(),
     ]);
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1));
     assert!(
         err.contains("bad.yaml") && err.contains("unknown field `learning_rat`"),
@@ -324,7 +318,7 @@ fn out_of_range_training_configs_are_refused_before_anything_is_written() {
             "--out",
             run.to_str().unwrap(),
         ]);
-        let err = String::from_utf8_lossy(&out.stderr);
+        let err = stderr(&out);
         assert_eq!(out.status.code(), Some(1), "{text}: {err}");
         assert!(
             err.contains(&format!("bad-{k}.yaml")) && err.contains(field),
@@ -559,16 +553,12 @@ fn generate_and_verify_with_a_run(dir: &Path, run: &str) {
     // own spot is never reached either (blocks are at least 5 m apart), so expect the clear error.
     let generated = generate("0,0,0");
     assert!(!generated.status.success());
-    let stderr = String::from_utf8_lossy(&generated.stderr);
-    assert!(stderr.contains("no valid level"), "{stderr}");
+    let said = stderr(&generated);
+    assert!(said.contains("no valid level"), "{said}");
     let (_, start, _) = arlpcg::game::rules::goal_and_start(3, None);
     let [x, z] = arlpcg::level::platform::heading_direction(start.heading);
     let generated = generate(&format!("{},0,{}", 7.5 * x, 7.5 * z));
-    assert!(
-        generated.status.success(),
-        "{}",
-        String::from_utf8_lossy(&generated.stderr)
-    );
+    assert!(generated.status.success(), "{}", stderr(&generated));
     let level = arlpcg::level::yaml::load(&levels.join("platform_seed3_aux-0.50.yaml")).unwrap();
     assert_eq!(level.aux, Some(-0.5));
     assert!(matches!(level.source, arlpcg::level::Source::Policy { .. }));
@@ -579,7 +569,7 @@ fn generate_and_verify_with_a_run(dir: &Path, run: &str) {
     assert!(stats.solver.describe().contains("solver.safetensors"));
 
     let missing_aux = arlpcg(&["generate", "--policies", run, "--out", levels_s]);
-    assert!(String::from_utf8_lossy(&missing_aux.stderr).contains("--aux"));
+    assert!(stderr(&missing_aux).contains("--aux"));
     let wrong = arlpcg(&[
         "generate",
         "--policies",
@@ -589,7 +579,7 @@ fn generate_and_verify_with_a_run(dir: &Path, run: &str) {
         "--out",
         levels_s,
     ]);
-    assert!(String::from_utf8_lossy(&wrong.stderr).contains("generator.safetensors"));
+    assert!(stderr(&wrong).contains("generator.safetensors"));
 }
 
 /// `eval` over the run: every table, in every format, with the keys results.json promises; a
@@ -660,7 +650,7 @@ fn evaluate_a_run(dir: &Path, run: &str) {
     }
     let again = arlpcg(&["eval", "--policies", run, "--out", results_s]);
     assert!(
-        String::from_utf8_lossy(&again.stderr).contains("--force"),
+        stderr(&again).contains("--force"),
         "results are not clobbered"
     );
 }
@@ -724,11 +714,7 @@ fn a_resumed_run_takes_new_hyper_parameters_but_not_a_new_shape() {
     let first = arlpcg(&[
         "train", "--mode", "rule-pcg", "--steps", "128", "--config", config_s, "--out", out_s,
     ]);
-    assert!(
-        first.status.success(),
-        "{}",
-        String::from_utf8_lossy(&first.stderr)
-    );
+    assert!(first.status.success(), "{}", stderr(&first));
 
     let reshaped = dir.path().join("reshaped.yaml");
     std::fs::write(
@@ -738,17 +724,13 @@ fn a_resumed_run_takes_new_hyper_parameters_but_not_a_new_shape() {
     .unwrap();
     let refused = train("256", reshaped.to_str().unwrap());
     assert_eq!(refused.status.code(), Some(1));
-    let message = String::from_utf8_lossy(&refused.stderr);
+    let message = stderr(&refused);
     assert!(message.contains("hidden cannot change"), "{message}");
 
     let faster = dir.path().join("faster.yaml");
     std::fs::write(&faster, format!("{TINY}  learning_rate: 0.001\n")).unwrap();
     let resumed = train("256", faster.to_str().unwrap());
-    assert!(
-        resumed.status.success(),
-        "{}",
-        String::from_utf8_lossy(&resumed.stderr)
-    );
+    assert!(resumed.status.success(), "{}", stderr(&resumed));
     let kept = std::fs::read_to_string(out.join("config-until-step-128.yaml")).unwrap();
     assert!(kept.contains("learning_rate: 0.0003"), "{kept}");
     let now = std::fs::read_to_string(out.join("config.yaml")).unwrap();
@@ -783,11 +765,7 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
             args.push("--resume");
         }
         let run = arlpcg(&args);
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
+        assert!(run.status.success(), "{}", stderr(&run));
     };
     train("256", false);
     train("512", true);
@@ -826,11 +804,7 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
         "4",
         "--json",
     ]);
-    assert!(
-        played.status.success(),
-        "{}",
-        String::from_utf8_lossy(&played.stderr)
-    );
+    assert!(played.status.success(), "{}", stderr(&played));
     let report: serde_json::Value = serde_json::from_slice(&played.stdout).unwrap();
     assert_eq!(report["trials"], 4);
     let refused = arlpcg(&[
@@ -840,8 +814,8 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
         policy.to_str().unwrap(),
     ]);
     assert_eq!(refused.status.code(), Some(1));
-    let stderr = String::from_utf8_lossy(&refused.stderr);
-    assert!(stderr.contains("racing solver policy"), "{stderr}");
+    let said = stderr(&refused);
+    assert!(said.contains("racing solver policy"), "{said}");
 }
 
 /// The racing Generator trains through the adversarial loop written for both games: it
@@ -865,11 +839,7 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
             args.extend(["--config", config.to_str().unwrap()]);
         }
         let run = arlpcg(&args);
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
+        assert!(run.status.success(), "{}", stderr(&run));
     };
     train("512", false);
     let generator_before = generator_rows(&out);
@@ -902,7 +872,7 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
         narrower.to_str().unwrap(),
     ]);
     assert_eq!(refused.status.code(), Some(1));
-    let message = String::from_utf8_lossy(&refused.stderr);
+    let message = stderr(&refused);
     assert!(
         message.contains("generator-checkpoint.safetensors")
             && message
@@ -976,11 +946,7 @@ fn generate_racing_tracks_with_a_run(dir: &Path, run: &str) {
         "--out",
         tracks.to_str().unwrap(),
     ]);
-    assert!(
-        generated.status.success(),
-        "{}",
-        String::from_utf8_lossy(&generated.stderr)
-    );
+    assert!(generated.status.success(), "{}", stderr(&generated));
     let level = arlpcg::level::yaml::load(&tracks.join("racing_seed2_aux-1.00.yaml")).unwrap();
     assert!(matches!(level.source, arlpcg::level::Source::Policy { .. }));
     assert!(level.racing().is_some_and(|t| !t.segments.is_empty()));
@@ -1005,11 +971,7 @@ fn evaluate_a_racing_run(dir: &Path, run: &str) {
         "--out",
         results.to_str().unwrap(),
     ]);
-    assert!(
-        evaluated.status.success(),
-        "{}",
-        String::from_utf8_lossy(&evaluated.stderr)
-    );
+    assert!(evaluated.status.success(), "{}", stderr(&evaluated));
     let json: serde_json::Value = crate::common::results_json(&results);
     let rows = json["controllability"].as_array().unwrap();
     assert_eq!(rows.len(), 5);
@@ -1071,11 +1033,7 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
         "--out",
         out_s,
     ]);
-    assert!(
-        trained.status.success(),
-        "{}",
-        String::from_utf8_lossy(&trained.stderr)
-    );
+    assert!(trained.status.success(), "{}", stderr(&trained));
     let checkpoint = out.join("checkpoint.safetensors");
     let cases: [(&str, serde_json::Value, &str); 2] = [
         ("num_envs", serde_json::json!(100_000_000), "num_envs"),
@@ -1098,7 +1056,7 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
             out_s,
             "--resume",
         ]);
-        let err = String::from_utf8_lossy(&resumed.stderr);
+        let err = stderr(&resumed);
         assert_eq!(resumed.status.code(), Some(1), "{field}: {err}");
         assert!(
             err.contains("stored configuration") && err.contains(expected),

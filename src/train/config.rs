@@ -225,7 +225,7 @@ impl Default for GeneratorConfig {
             population: 4,
             population_every_steps: 500_000,
             snapshot_share: None,
-            stages: Vec::new(),
+            stages: vec![platform_finish()],
         }
     }
 }
@@ -255,13 +255,36 @@ pub(super) fn load_config(path: &Path, game: Game) -> Result<TrainConfig> {
         .map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))
 }
 
-/// The recipe's budget of each game in Solver steps ([`TrainConfig::steps`]).
-pub const PLATFORM_STEPS: u64 = 8_000_000;
-pub const RACING_STEPS: u64 = 10_000_000;
+/// The recipe's budget of each game in Solver steps ([`TrainConfig::steps`]). On the platform
+/// the Solver learns for 8M of them; in the adversarial modes the last 40k are the finishing
+/// stage ([`platform_finish`]), in which it only plays.
+pub const PLATFORM_STEPS: u64 = 8_040_000;
+/// The racing Solver passes 0.99 success within 1M steps of rule tracks; 5M leaves the
+/// adversarial loop room and keeps the run within 45 minutes on 2 threads.
+pub const RACING_STEPS: u64 = 5_000_000;
+/// Racing Generator phases are short: each segment costs the Solver (and its snapshots) about
+/// 40 steps of driving without learning, and these phases were 73% of a 10M run's time at 10k.
+pub const RACING_GENERATOR_PHASE_STEPS: u64 = 4_096;
 
 /// The racing Solver's discount (docs/spec.md §3: γ 0.998; its runs are hundreds of steps
 /// longer than a platform run).
 pub const RACING_SOLVER_GAMMA: f32 = 0.998;
+
+/// The platform recipe's last stage: from 8M Solver steps the Solver is frozen and the
+/// Generator trains on against it alone (no snapshots), in 100k-block phases between
+/// one-iteration Solver phases: about 400k blocks over the last 40k Solver steps. Against the
+/// population alone the Generator finds nothing its own Solver cannot do (λ = -1 levels
+/// succeed 0.93-0.97 of the time); this stage brings that to about 0.67 while the players it
+/// never met keep most of their drop (docs/training.md, "The recipe").
+pub fn platform_finish() -> Stage {
+    Stage {
+        from_steps: 8_000_000,
+        solver_learning_rate: 0.0,
+        solver_phase_steps: 8_192,
+        generator_phase_steps: 100_000,
+        snapshot_share: Some(0.0),
+    }
+}
 
 impl TrainConfig {
     /// The defaults for training `game`: the paper's values; the racing game differs in the
@@ -277,6 +300,10 @@ impl TrainConfig {
             // What trained the shipped racing Generator: with 30° the road stays near the
             // goal's bearing and cannot make the sustained bends that are hard to drive.
             config.generator.curve_offset = 90.0;
+            config.generator.generator_phase_steps = RACING_GENERATOR_PHASE_STEPS;
+            // A finishing stage against the frozen Solver found nothing it could not drive in
+            // 172k segments (docs/training.md, "The recipe"), so racing has none.
+            config.generator.stages = Vec::new();
         }
         config
     }
@@ -540,6 +567,16 @@ mod tests {
         assert_eq!(
             TrainConfig::for_game(Game::Racing).generator.curve_offset,
             90.0
+        );
+        // The recipes: the platform's finishing stage starts where its Solver's 8M end; racing
+        // has short Generator phases and no finishing stage.
+        let platform = TrainConfig::for_game(Game::Platform);
+        assert_eq!(platform.generator.stages, vec![platform_finish()]);
+        assert!(platform_finish().from_steps < platform.steps);
+        let racing = TrainConfig::for_game(Game::Racing).generator;
+        assert_eq!(
+            (racing.generator_phase_steps, racing.stages.len()),
+            (4_096, 0)
         );
         let staged = "generator:\n  snapshot_share: 0.5\n  stages:\n  - {from_steps: 100, solver_learning_rate: 0, solver_phase_steps: 8, generator_phase_steps: 9}\n  - {from_steps: 200, solver_learning_rate: 0, solver_phase_steps: 8, generator_phase_steps: 9, snapshot_share: 0}\n";
         let staged = TrainConfig::parse_for(staged, Game::Platform)

@@ -488,7 +488,8 @@ pub struct TrainArgs {
     pub mode: TrainModeArg,
     /// The run's budget: stop when the Solver has learned from this many environment steps in
     /// all, over every resume (default: the configuration's `steps`, the game's recipe: platform
-    /// 8M, racing 10M). Given with --resume it becomes the run's new budget.
+    /// 8M, racing 5M); an adversarial run then plays its `generator.finish`. Given with
+    /// --resume it becomes the run's new budget.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub steps: Option<u64>,
     /// Stop this session after this many minutes (its checkpoint is saved; --resume goes on).

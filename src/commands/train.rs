@@ -83,8 +83,7 @@ fn train_loop(run: &mut dyn Training, minutes: Option<f64>) -> Result<()> {
         if done_by_steps || done_by_time || stop.load(Ordering::SeqCst) {
             break;
         }
-        let lr_scale = (1.0 - run.solver_steps() as f64 / total as f64).max(0.0);
-        let message = run.iterate(lr_scale, &wall).with_context(|| {
+        let message = run.iterate(&wall).with_context(|| {
             format!(
                 "training stopped at {} Solver steps; the last checkpoint in {} is kept \
                  (--resume, with --config for a smaller learning rate, continues from it)",

@@ -232,7 +232,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
     }
 
     fn budget(&self) -> u64 {
-        self.solver.config.steps
+        self.solver.config.adversarial_budget()
     }
 
     fn wall_before(&self) -> f64 {
@@ -243,10 +243,13 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         self.solver.commands.push(command);
     }
 
-    fn iterate(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String> {
-        let phases = self.solver.config.generator.clone();
+    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
+        let config = &self.solver.config;
+        let steps = self.solver.trainer.global_step;
         // The stage in force where this iteration starts (a stage begins at a phase's end).
-        let schedule = phases.schedule_at(self.solver.trainer.global_step);
+        let schedule = config.schedule_at(steps);
+        let lr_scale = config.lr_scale(steps);
+        let warmup_steps = config.generator.solver_warmup_steps;
         self.envs().rules.snapshot_share = schedule.snapshot_share;
         match self.envs().state.phase {
             Phase::Solver => {
@@ -255,7 +258,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                         .solver_iteration(lr_scale, schedule.solver_learning_rate, wall)?;
                 let envs = self.envs();
                 envs.state.phase_steps += rollout.steps;
-                let warm = self.solver.trainer.global_step >= phases.solver_warmup_steps;
+                let warm = self.solver.trainer.global_step >= warmup_steps;
                 if warm && self.envs().state.phase_steps >= schedule.solver_phase_steps {
                     self.snapshot_if_due()?;
                     self.envs().set_phase(Phase::Generator);

@@ -123,6 +123,34 @@ pub struct GeneratorConfig {
     /// on (the last one reached applies): e.g. a last stage where the Solver is frozen and the
     /// Generator goes on against it and the population.
     pub stages: Vec<Stage>,
+    /// After the Solver's budget, the Generator's finish against the Solver frozen and alone.
+    #[serde(default = "Finish::none")]
+    pub finish: Finish,
+}
+
+/// The last stretch of an adversarial run, after the Solver's `steps`: the Solver is frozen
+/// (its one-iteration phases only play; its observation normalizer follows them) and the
+/// Generator learns against it alone, in phases of `generator_phase_steps`, until the Solver
+/// has played `solver_steps` more steps. The run's budget is then `steps + solver_steps`;
+/// learning rates that anneal reach 0 at `steps`, so an annealed Generator learning rate is
+/// refused with a finish.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Finish {
+    /// Solver steps played in the finish (0: no finish).
+    pub solver_steps: u64,
+    pub generator_phase_steps: u64,
+}
+
+impl Finish {
+    pub const NONE: Finish = Finish {
+        solver_steps: 0,
+        generator_phase_steps: 100_000,
+    };
+
+    fn none() -> Finish {
+        Finish::NONE
+    }
 }
 
 /// A stretch of an adversarial run with its own schedule.
@@ -225,7 +253,8 @@ impl Default for GeneratorConfig {
             population: 4,
             population_every_steps: 500_000,
             snapshot_share: None,
-            stages: vec![platform_finish()],
+            stages: Vec::new(),
+            finish: PLATFORM_FINISH,
         }
     }
 }
@@ -255,12 +284,8 @@ pub(super) fn load_config(path: &Path, game: Game) -> Result<TrainConfig> {
         .map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))
 }
 
-/// The recipe's budget of each game in Solver steps ([`TrainConfig::steps`]). On the platform
-/// the Solver learns for 8M of them; in the adversarial modes the last 40k are the finishing
-/// stage ([`platform_finish`]), in which it only plays.
-pub const PLATFORM_STEPS: u64 = 8_040_000;
-/// The racing Solver passes 0.99 success within 1M steps of rule tracks; 5M leaves the
-/// adversarial loop room and keeps the run within 45 minutes on 2 threads.
+/// The recipe's budget of each game in Solver steps learned from ([`TrainConfig::steps`]).
+pub const PLATFORM_STEPS: u64 = 8_000_000;
 pub const RACING_STEPS: u64 = 5_000_000;
 /// Racing Generator phases are short: each segment costs the Solver (and its snapshots) about
 /// 40 steps of driving without learning, and these phases were 73% of a 10M run's time at 10k.
@@ -270,23 +295,45 @@ pub const RACING_GENERATOR_PHASE_STEPS: u64 = 4_096;
 /// longer than a platform run).
 pub const RACING_SOLVER_GAMMA: f32 = 0.998;
 
-/// The platform recipe's last stage: from 8M Solver steps the Solver is frozen and the
-/// Generator trains on against it alone (no snapshots), in 100k-block phases between
-/// one-iteration Solver phases: about 400k blocks over the last 40k Solver steps. Against the
-/// population alone the Generator finds nothing its own Solver cannot do (λ = -1 levels
-/// succeed 0.93-0.97 of the time); this stage brings that to about 0.67 while the players it
-/// never met keep most of their drop (docs/training.md, "The recipe").
-pub fn platform_finish() -> Stage {
-    Stage {
-        from_steps: 8_000_000,
-        solver_learning_rate: 0.0,
-        solver_phase_steps: 8_192,
-        generator_phase_steps: 100_000,
-        snapshot_share: Some(0.0),
-    }
-}
+/// The platform recipe's finish: after its 8M steps the Solver is frozen and the Generator
+/// trains on against it alone (no snapshots) in 100k-block phases, four of them between
+/// one-iteration Solver phases over 32,768 more Solver steps. Against the population alone
+/// the Generator finds nothing its own Solver cannot do (λ = -1 levels succeed 0.93-0.97 of
+/// the time); this brings that to about 0.67 while the players it never met keep part of their
+/// drop (docs/training.md, "The recipe").
+pub const PLATFORM_FINISH: Finish = Finish {
+    solver_steps: 32_768,
+    generator_phase_steps: 100_000,
+};
 
 impl TrainConfig {
+    /// An adversarial run's budget in Solver steps: `steps`, then the finish's.
+    pub fn adversarial_budget(&self) -> u64 {
+        self.steps
+            .saturating_add(self.generator.finish.solver_steps)
+    }
+
+    /// An adversarial run's schedule at `solver_steps`: the finish past `steps`, else the last
+    /// stage reached, else the run's own phases.
+    pub fn schedule_at(&self, solver_steps: u64) -> Schedule {
+        let finish = self.generator.finish;
+        if finish.solver_steps > 0 && solver_steps >= self.steps {
+            return Schedule {
+                solver_learning_rate: Some(0.0),
+                solver_phase_steps: 1,
+                generator_phase_steps: finish.generator_phase_steps,
+                snapshot_share: Some(0.0),
+            };
+        }
+        self.generator.schedule_at(solver_steps)
+    }
+
+    /// What annealing leaves of the configured learning rates at `solver_steps`: 1 at the
+    /// start, 0 from `steps` on.
+    pub fn lr_scale(&self, solver_steps: u64) -> f64 {
+        (1.0 - solver_steps as f64 / self.steps as f64).max(0.0)
+    }
+
     /// The defaults for training `game`: the paper's values; the racing game differs in the
     /// budget, the Solver's γ, the Generator's rewards and the obstacles of its scenes.
     pub fn for_game(game: Game) -> TrainConfig {
@@ -301,9 +348,9 @@ impl TrainConfig {
             // goal's bearing and cannot make the sustained bends that are hard to drive.
             config.generator.curve_offset = 90.0;
             config.generator.generator_phase_steps = RACING_GENERATOR_PHASE_STEPS;
-            // A finishing stage against the frozen Solver found nothing it could not drive in
-            // 172k segments (docs/training.md, "The recipe"), so racing has none.
-            config.generator.stages = Vec::new();
+            // A finish against the frozen Solver found nothing it could not drive in 172k
+            // segments (docs/training.md, "The recipe"), so racing has none.
+            config.generator.finish = Finish::NONE;
         }
         config
     }
@@ -492,6 +539,22 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
             ));
         }
     }
+    if g.finish.solver_steps > 0 {
+        if !(1..=MAX_PHASE_STEPS).contains(&g.finish.generator_phase_steps)
+            || g.finish.solver_steps > MAX_PHASE_STEPS
+        {
+            return Err(format!(
+                "finish: solver_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
+            ));
+        }
+        if g.ppo.anneal_lr {
+            return Err(
+                "finish: the Generator's learning rate is annealed to 0 by the finish \
+                 (generator.ppo.anneal_lr); turn annealing off or set finish.solver_steps to 0"
+                    .into(),
+            );
+        }
+    }
     if g.population > MAX_POPULATION {
         return Err(format!("population must be within [0, {MAX_POPULATION}]"));
     }
@@ -568,16 +631,21 @@ mod tests {
             TrainConfig::for_game(Game::Racing).generator.curve_offset,
             90.0
         );
-        // The recipes: the platform's finishing stage starts where its Solver's 8M end; racing
-        // has short Generator phases and no finishing stage.
+        // The recipes: the platform's finish starts where its Solver's 8M end; racing
+        // has short Generator phases and no finish.
         let platform = TrainConfig::for_game(Game::Platform);
-        assert_eq!(platform.generator.stages, vec![platform_finish()]);
-        assert!(platform_finish().from_steps < platform.steps);
-        let racing = TrainConfig::for_game(Game::Racing).generator;
+        assert_eq!(platform.generator.finish, PLATFORM_FINISH);
+        assert_eq!(platform.adversarial_budget(), 8_032_768);
+        let finish = platform.schedule_at(8_000_000);
         assert_eq!(
-            (racing.generator_phase_steps, racing.stages.len()),
-            (4_096, 0)
+            (finish.solver_learning_rate, finish.snapshot_share),
+            (Some(0.0), Some(0.0))
         );
+        assert_eq!(platform.schedule_at(7_999_999).solver_learning_rate, None);
+        assert_eq!(platform.lr_scale(8_010_000), 0.0);
+        let racing = TrainConfig::for_game(Game::Racing);
+        assert_eq!(racing.generator.generator_phase_steps, 4_096);
+        assert_eq!(racing.adversarial_budget(), racing.steps);
         let staged = "generator:\n  snapshot_share: 0.5\n  stages:\n  - {from_steps: 100, solver_learning_rate: 0, solver_phase_steps: 8, generator_phase_steps: 9}\n  - {from_steps: 200, solver_learning_rate: 0, solver_phase_steps: 8, generator_phase_steps: 9, snapshot_share: 0}\n";
         let staged = TrainConfig::parse_for(staged, Game::Platform)
             .unwrap()

@@ -177,19 +177,20 @@ fn solver_run<G: GameSpec>(
 
 /// What the training loop drives: one iteration at a time, checkpoints, the final policies.
 pub trait Training {
-    /// Solver environment steps learned from so far...
+    /// Solver environment steps taken so far...
     fn solver_steps(&self) -> u64;
-    /// ...and the run's budget of them ([`TrainConfig::steps`]).
+    /// ...and the run's budget of them ([`TrainConfig::steps`], plus an adversarial run's
+    /// finish).
     fn budget(&self) -> u64;
     /// Wall-clock seconds of earlier sessions.
     fn wall_before(&self) -> f64;
     /// Records this session's command line in the run's cards (the shell names it: the core
     /// reads no process arguments).
     fn add_session(&mut self, command: String);
-    /// One PPO iteration (of whichever agent learns now) at `lr_scale` times the configured
-    /// learning rates; returns the progress bar's message. `wall` is the clock the shell lends:
-    /// the run's wall-clock seconds over every session, for the metrics' time columns.
-    fn iterate(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String>;
+    /// One PPO iteration (of whichever agent learns now); returns the progress bar's message.
+    /// `wall` is the clock the shell lends: the run's wall-clock seconds over every session,
+    /// for the metrics' time columns.
+    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String>;
     fn checkpoint_minutes(&self) -> f64;
     fn save_checkpoint(&self, wall: f64) -> Result<()>;
     fn save_policies(&self, wall: f64) -> Result<()>;

@@ -220,8 +220,9 @@ impl<G: GameSpec> Training for Run<SolverEnvs<G>> {
         self.commands.push(command);
     }
 
-    fn iterate(&mut self, lr_scale: f64, wall: &dyn Fn() -> f64) -> Result<String> {
+    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
         let t0 = wall();
+        let lr_scale = self.config.lr_scale(self.trainer.global_step);
         let rollout = self.solver_iteration(lr_scale, None, wall)?;
         Ok(format!(
             "return {:.2}, success {:.2}, {:.0} steps/s",

@@ -425,6 +425,9 @@ generator:
     solver_learning_rate: 0.0
     solver_phase_steps: 128
     generator_phase_steps: 8
+  finish:
+    solver_steps: 128
+    generator_phase_steps: 8
 ";
 
 /// The Solver steps of the snapshots a run's Generator card says it played against.
@@ -459,8 +462,8 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     arlpcg_ok(&[
         "train", "--mode", "arlpcg", "--steps", "512", "--config", config_s, "--out", out_s,
     ]);
-    // 512 Solver steps in phases of 128: both agents learned, in turn.
-    assert_eq!(curve(&out).last().unwrap().1, 512);
+    // 512 Solver steps in phases of 128: both agents learned, in turn; then the finish's 128.
+    assert_eq!(curve(&out).last().unwrap().1, 512 + 128);
     let generator_before = generator_rows(&out);
     assert!(
         generator_before >= 3,
@@ -475,14 +478,16 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     arlpcg_ok(&[
         "train", "--mode", "arlpcg", "--steps", "1024", "--out", out_s, "--resume",
     ]);
-    assert_eq!(curve(&out).last().unwrap().1, 1024);
+    assert_eq!(curve(&out).last().unwrap().1, 1024 + 128);
     assert!(
         generator_rows(&out) > generator_before,
         "the Generator went on learning"
     );
-    // From 768 Solver steps on, the last stage: the Solver is frozen (learning rate 0).
+    // The Solver is frozen (learning rate 0) in the first session's finish (past 512), and
+    // from 768 Solver steps on: the last stage, then the finish past the new budget.
     for (step, rate) in learning_rates(&out) {
-        assert_eq!(step > 768, rate == 0.0, "step {step}: learning rate {rate}");
+        let frozen = (512 < step && step <= 640) || step > 768;
+        assert_eq!(frozen, rate == 0.0, "step {step}: learning rate {rate}");
     }
     // The population came back from the checkpoint and grew, keeping the newest two.
     let resumed_population = population(&out);

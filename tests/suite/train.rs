@@ -517,6 +517,90 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     score_a_run_as_one_seed(dir.path(), out_s);
 }
 
+/// A staged run with a finish, resumed with a larger budget (through its last stage and a
+/// second finish), gives the same bytes every time, on one thread or two: the weights of both
+/// networks and every metrics column but the clock's.
+#[test]
+fn a_staged_run_with_a_finish_resumes_to_the_same_bytes_on_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.yaml");
+    std::fs::write(&config, TINY_ADVERSARIAL).unwrap();
+    let config_s = config.to_str().unwrap();
+    let train = |threads: &str| {
+        let out = dir.path().join(format!("run-{threads}"));
+        let out_s = out.to_str().unwrap();
+        let first = [
+            "train", "--mode", "arlpcg", "--config", config_s, "--out", out_s,
+        ];
+        // 640 Solver steps and the finish's 128 (the stage begins at 768)...
+        arlpcg_ok(&[&first[..], &["--steps", "640", "--threads", threads]].concat());
+        // ...then resumed to a budget of 1024, inside the stage, and the finish after it.
+        arlpcg_ok(&[
+            "train",
+            "--mode",
+            "arlpcg",
+            "--steps",
+            "1024",
+            "--out",
+            out_s,
+            "--resume",
+            "--threads",
+            threads,
+        ]);
+        out
+    };
+    let (one, two) = (train("1"), train("2"));
+    for file in ["solver.safetensors", "generator.safetensors"] {
+        let weights = |run: &Path| {
+            let role = if file.starts_with("solver") {
+                Role::Solver
+            } else {
+                Role::Generator
+            };
+            let size = match role {
+                Role::Solver => OBSERVATION_SIZE,
+                Role::Generator => GENERATOR_OBSERVATION_SIZE,
+            };
+            let loaded = load_policy(
+                &std::fs::read(run.join(file)).unwrap(),
+                Game::Platform,
+                role,
+                size,
+            )
+            .unwrap();
+            let mut tensors: Vec<(String, Vec<f32>)> = loaded
+                .tensors
+                .iter()
+                .map(|(name, t)| (name.clone(), t.flatten_all().unwrap().to_vec1().unwrap()))
+                .collect();
+            tensors.sort_by(|a, b| a.0.cmp(&b.0));
+            tensors
+        };
+        assert_eq!(weights(&one), weights(&two), "{file}");
+    }
+    // Metrics without the clock's columns (wall time, steps/s, rollout and update seconds).
+    for (file, clock) in [("metrics.csv", 2..6), ("generator-metrics.csv", 3..6)] {
+        let rows = |run: &Path| -> Vec<String> {
+            std::fs::read_to_string(run.join(file))
+                .unwrap()
+                .lines()
+                .map(|row| {
+                    let cells: Vec<&str> = row.split(',').collect();
+                    let kept: Vec<&str> = cells
+                        .iter()
+                        .enumerate()
+                        .filter(|(k, _)| !clock.contains(k))
+                        .map(|(_, c)| *c)
+                        .collect();
+                    kept.join(",")
+                })
+                .collect()
+        };
+        assert_eq!(rows(&one), rows(&two), "{file}");
+    }
+    assert_eq!(curve(&one).last().unwrap().1, 1024 + 128);
+}
+
 /// (global_step, learning_rate) of every metrics row.
 fn learning_rates(run: &Path) -> Vec<(u64, f64)> {
     let metrics = std::fs::read_to_string(run.join("metrics.csv")).unwrap();

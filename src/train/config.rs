@@ -445,6 +445,58 @@ pub(super) fn check_resumable_change(old: &TrainConfig, new: &TrainConfig) -> Re
     }
 }
 
+/// The stages' and the finish's fields.
+fn check_schedule(g: &GeneratorConfig) -> Result<(), String> {
+    if g.stages.len() > MAX_STAGES {
+        return Err(format!("stages: at most {MAX_STAGES}"));
+    }
+    for (k, stage) in g.stages.iter().enumerate() {
+        let rate = stage.solver_learning_rate;
+        if !(rate.is_finite() && (0.0..=1.0).contains(&rate)) {
+            return Err(format!(
+                "stages[{k}].solver_learning_rate must be a number in [0, 1]"
+            ));
+        }
+        if !(1..=MAX_PHASE_STEPS).contains(&stage.solver_phase_steps)
+            || !(1..=MAX_PHASE_STEPS).contains(&stage.generator_phase_steps)
+        {
+            return Err(format!(
+                "stages[{k}]: solver_phase_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
+            ));
+        }
+        if stage
+            .snapshot_share
+            .is_some_and(|p| !(0.0..=1.0).contains(&p))
+        {
+            return Err(format!(
+                "stages[{k}].snapshot_share must be a number in [0, 1]"
+            ));
+        }
+        if k > 0 && stage.from_steps <= g.stages[k - 1].from_steps {
+            return Err(format!(
+                "stages[{k}].from_steps must be after the stage before it"
+            ));
+        }
+    }
+    if g.finish.solver_steps > 0 {
+        if !(1..=MAX_PHASE_STEPS).contains(&g.finish.generator_phase_steps)
+            || g.finish.solver_steps > MAX_PHASE_STEPS
+        {
+            return Err(format!(
+                "finish: solver_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
+            ));
+        }
+        if g.ppo.anneal_lr {
+            return Err(
+                "finish: the Generator's learning rate is annealed to 0 by the finish \
+                 (generator.ppo.anneal_lr); turn annealing off or set finish.solver_steps to 0"
+                    .into(),
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Checks the values serde cannot: sizes, ranges, finite numbers.
 pub(super) fn check_config(config: &TrainConfig, game: Game) -> Result<(), String> {
     if config.hidden.is_empty()
@@ -508,53 +560,7 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
     if g.snapshot_share.is_some_and(|p| !(0.0..=1.0).contains(&p)) {
         return Err("snapshot_share must be a number in [0, 1]".into());
     }
-    if g.stages.len() > MAX_STAGES {
-        return Err(format!("stages: at most {MAX_STAGES}"));
-    }
-    for (k, stage) in g.stages.iter().enumerate() {
-        let rate = stage.solver_learning_rate;
-        if !(rate.is_finite() && (0.0..=1.0).contains(&rate)) {
-            return Err(format!(
-                "stages[{k}].solver_learning_rate must be a number in [0, 1]"
-            ));
-        }
-        if !(1..=MAX_PHASE_STEPS).contains(&stage.solver_phase_steps)
-            || !(1..=MAX_PHASE_STEPS).contains(&stage.generator_phase_steps)
-        {
-            return Err(format!(
-                "stages[{k}]: solver_phase_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
-            ));
-        }
-        if stage
-            .snapshot_share
-            .is_some_and(|p| !(0.0..=1.0).contains(&p))
-        {
-            return Err(format!(
-                "stages[{k}].snapshot_share must be a number in [0, 1]"
-            ));
-        }
-        if k > 0 && stage.from_steps <= g.stages[k - 1].from_steps {
-            return Err(format!(
-                "stages[{k}].from_steps must be after the stage before it"
-            ));
-        }
-    }
-    if g.finish.solver_steps > 0 {
-        if !(1..=MAX_PHASE_STEPS).contains(&g.finish.generator_phase_steps)
-            || g.finish.solver_steps > MAX_PHASE_STEPS
-        {
-            return Err(format!(
-                "finish: solver_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
-            ));
-        }
-        if g.ppo.anneal_lr {
-            return Err(
-                "finish: the Generator's learning rate is annealed to 0 by the finish \
-                 (generator.ppo.anneal_lr); turn annealing off or set finish.solver_steps to 0"
-                    .into(),
-            );
-        }
-    }
+    check_schedule(g)?;
     if g.population > MAX_POPULATION {
         return Err(format!("population must be within [0, {MAX_POPULATION}]"));
     }

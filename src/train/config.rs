@@ -124,7 +124,7 @@ pub struct GeneratorConfig {
     /// Generator goes on against it and the population.
     pub stages: Vec<Stage>,
     /// After the Solver's budget, the Generator's finish against the Solver frozen and alone.
-    #[serde(default = "Finish::none")]
+    #[serde(default)]
     pub finish: Finish,
 }
 
@@ -142,15 +142,17 @@ pub struct Finish {
     pub generator_phase_steps: u64,
 }
 
+impl Default for Finish {
+    fn default() -> Self {
+        Finish::NONE
+    }
+}
+
 impl Finish {
     pub const NONE: Finish = Finish {
         solver_steps: 0,
         generator_phase_steps: 100_000,
     };
-
-    fn none() -> Finish {
-        Finish::NONE
-    }
 }
 
 /// A stretch of an adversarial run with its own schedule.

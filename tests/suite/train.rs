@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use arlpcg::game::platform::OBSERVATION_SIZE;
 use arlpcg::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
 use arlpcg::level::Game;
-use arlpcg::rl::checkpoint::{Role, load_policy};
+use arlpcg::rl::checkpoint::{LoadedPolicy, Role, load_policy};
 
 use crate::common::{arlpcg, arlpcg_ok, stderr};
 
@@ -432,14 +432,26 @@ generator:
 
 /// The Solver steps of the snapshots a run's Generator card says it played against.
 fn population(dir: &Path) -> Vec<u64> {
-    let loaded = load_policy(
-        &std::fs::read(dir.join("generator.safetensors")).unwrap(),
+    load_network(dir, GENERATOR).card.training.population
+}
+
+/// A platform run's two networks: file, role and observation size.
+const SOLVER: (&str, Role, usize) = ("solver.safetensors", Role::Solver, OBSERVATION_SIZE);
+const GENERATOR: (&str, Role, usize) = (
+    "generator.safetensors",
+    Role::Generator,
+    GENERATOR_OBSERVATION_SIZE,
+);
+
+/// One of a platform run's networks, loaded as the commands load it.
+fn load_network(run: &Path, (file, role, size): (&str, Role, usize)) -> LoadedPolicy {
+    load_policy(
+        &std::fs::read(run.join(file)).unwrap(),
         Game::Platform,
-        Role::Generator,
-        GENERATOR_OBSERVATION_SIZE,
+        role,
+        size,
     )
-    .unwrap();
-    loaded.card.training.population
+    .unwrap()
 }
 
 /// Generator iterations logged so far (rows of generator-metrics.csv).
@@ -494,22 +506,8 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     assert_eq!(resumed_population.len(), 2, "{resumed_population:?}");
     assert!(resumed_population.last() > first_population.last());
     assert!(resumed_population.windows(2).all(|w| w[1] - w[0] >= 256));
-    for (file, role, size) in [
-        ("solver.safetensors", Role::Solver, OBSERVATION_SIZE),
-        (
-            "generator.safetensors",
-            Role::Generator,
-            GENERATOR_OBSERVATION_SIZE,
-        ),
-    ] {
-        let loaded = load_policy(
-            &std::fs::read(out.join(file)).unwrap(),
-            Game::Platform,
-            role,
-            size,
-        )
-        .unwrap();
-        assert_eq!(loaded.card.training.mode, "arlpcg");
+    for network in [SOLVER, GENERATOR] {
+        assert_eq!(load_network(&out, network).card.training.mode, "arlpcg");
     }
     // The run's folder is a policies folder for every command that takes one.
     generate_and_verify_with_a_run(dir.path(), out_s);
@@ -550,24 +548,9 @@ fn a_staged_run_with_a_finish_resumes_to_the_same_bytes_on_any_thread_count() {
         out
     };
     let (one, two) = (train("1"), train("2"));
-    for file in ["solver.safetensors", "generator.safetensors"] {
+    for network in [SOLVER, GENERATOR] {
         let weights = |run: &Path| {
-            let role = if file.starts_with("solver") {
-                Role::Solver
-            } else {
-                Role::Generator
-            };
-            let size = match role {
-                Role::Solver => OBSERVATION_SIZE,
-                Role::Generator => GENERATOR_OBSERVATION_SIZE,
-            };
-            let loaded = load_policy(
-                &std::fs::read(run.join(file)).unwrap(),
-                Game::Platform,
-                role,
-                size,
-            )
-            .unwrap();
+            let loaded = load_network(run, network);
             let mut tensors: Vec<(String, Vec<f32>)> = loaded
                 .tensors
                 .iter()
@@ -576,7 +559,7 @@ fn a_staged_run_with_a_finish_resumes_to_the_same_bytes_on_any_thread_count() {
             tensors.sort_by(|a, b| a.0.cmp(&b.0));
             tensors
         };
-        assert_eq!(weights(&one), weights(&two), "{file}");
+        assert_eq!(weights(&one), weights(&two), "{}", network.0);
     }
     // Metrics without the clock's columns (wall time, steps/s, rollout and update seconds).
     for (file, clock) in [("metrics.csv", 2..6), ("generator-metrics.csv", 3..6)] {

@@ -128,18 +128,29 @@ pub struct GeneratorConfig {
     pub finish: Finish,
 }
 
-/// The last stretch of an adversarial run, after the Solver's `steps`: the Solver is frozen
-/// (its one-iteration phases only play; its observation normalizer follows them) and the
-/// Generator learns against it alone, in phases of `generator_phase_steps`, until the Solver
-/// has played `solver_steps` more steps. The run's budget is then `steps + solver_steps`;
-/// learning rates that anneal reach 0 at `steps`, so an annealed Generator learning rate is
-/// refused with a finish.
+/// The last stretch of an adversarial run, after the Solver's `steps`: the Generator learns
+/// against the final Solver alone (no snapshots), in phases of `generator_phase_steps`, until
+/// the Solver has played `solver_steps` more steps. By default the Solver is frozen (its
+/// one-iteration phases only play; its observation normalizer follows them); a
+/// `solver_learning_rate` above 0 lets it keep up a little, in phases of `solver_phase_steps`.
+/// The run's budget is then `steps + solver_steps`; learning rates that anneal reach 0 at
+/// `steps`, so an annealed Generator learning rate is refused with a finish.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Finish {
     /// Solver steps played in the finish (0: no finish).
     pub solver_steps: u64,
     pub generator_phase_steps: u64,
+    /// The Solver's constant learning rate in the finish (0: frozen).
+    #[serde(default)]
+    pub solver_learning_rate: f64,
+    /// Solver steps in each of its finish phases (1: one iteration).
+    #[serde(default = "one_iteration")]
+    pub solver_phase_steps: u64,
+}
+
+fn one_iteration() -> u64 {
+    1
 }
 
 impl Default for Finish {
@@ -152,6 +163,8 @@ impl Finish {
     pub const NONE: Finish = Finish {
         solver_steps: 0,
         generator_phase_steps: 100_000,
+        solver_learning_rate: 0.0,
+        solver_phase_steps: 1,
     };
 }
 
@@ -306,6 +319,8 @@ pub const RACING_SOLVER_GAMMA: f32 = 0.998;
 pub const PLATFORM_FINISH: Finish = Finish {
     solver_steps: 32_768,
     generator_phase_steps: 100_000,
+    solver_learning_rate: 0.0,
+    solver_phase_steps: 1,
 };
 
 impl TrainConfig {
@@ -321,8 +336,8 @@ impl TrainConfig {
         let finish = self.generator.finish;
         if finish.solver_steps > 0 && solver_steps >= self.steps {
             return Schedule {
-                solver_learning_rate: Some(0.0),
-                solver_phase_steps: 1,
+                solver_learning_rate: Some(finish.solver_learning_rate),
+                solver_phase_steps: finish.solver_phase_steps,
                 generator_phase_steps: finish.generator_phase_steps,
                 snapshot_share: Some(0.0),
             };
@@ -482,11 +497,16 @@ fn check_schedule(g: &GeneratorConfig) -> Result<(), String> {
     }
     if g.finish.solver_steps > 0 {
         if !(1..=MAX_PHASE_STEPS).contains(&g.finish.generator_phase_steps)
+            || !(1..=MAX_PHASE_STEPS).contains(&g.finish.solver_phase_steps)
             || g.finish.solver_steps > MAX_PHASE_STEPS
         {
             return Err(format!(
-                "finish: solver_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
+                "finish: solver_steps, solver_phase_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
             ));
+        }
+        let rate = g.finish.solver_learning_rate;
+        if !(rate.is_finite() && (0.0..=1.0).contains(&rate)) {
+            return Err("finish.solver_learning_rate must be a number in [0, 1]".into());
         }
         if g.ppo.anneal_lr {
             return Err(
@@ -651,6 +671,18 @@ mod tests {
         );
         assert_eq!(platform.schedule_at(7_999_999).solver_learning_rate, None);
         assert_eq!(platform.lr_scale(8_010_000), 0.0);
+        // A finish in which the Solver keeps learning, with its own phases.
+        let learning = "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, solver_learning_rate: 1.0e-4, solver_phase_steps: 16}\n";
+        let learning = TrainConfig::parse_for(learning, Game::Platform).unwrap();
+        let finish = learning.schedule_at(learning.steps);
+        assert_eq!(
+            (
+                finish.solver_learning_rate,
+                finish.solver_phase_steps,
+                finish.generator_phase_steps
+            ),
+            (Some(1.0e-4), 16, 9)
+        );
         let racing = TrainConfig::for_game(Game::Racing);
         assert_eq!(racing.generator.generator_phase_steps, 4_096);
         assert_eq!(racing.adversarial_budget(), racing.steps);
@@ -705,6 +737,11 @@ mod tests {
                 "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1, snapshot_share: -1}\n",
                 Game::Platform,
                 "stages[0].snapshot_share",
+            ),
+            (
+                "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, solver_learning_rate: -1}\n",
+                Game::Platform,
+                "finish.solver_learning_rate",
             ),
             (
                 "generator:\n  snapshot_share: 1.5\n",

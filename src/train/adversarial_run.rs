@@ -250,6 +250,11 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         let schedule = config.schedule_at(steps);
         let lr_scale = config.lr_scale(steps);
         let warmup_steps = config.generator.solver_warmup_steps;
+        // Where the finish begins (none: never).
+        let finish_from = match config.generator.finish.solver_steps {
+            0 => u64::MAX,
+            _ => config.steps,
+        };
         self.envs().rules.snapshot_share = schedule.snapshot_share;
         match self.envs().state.phase {
             Phase::Solver => {
@@ -257,9 +262,14 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                     self.solver
                         .solver_iteration(lr_scale, schedule.solver_learning_rate, wall)?;
                 let envs = self.envs();
+                // A Solver phase under way when the finish begins ends with the finish's first
+                // iteration, so that the finish opens with the Generator's phase.
+                let opens_finish =
+                    steps >= finish_from && steps - envs.state.phase_steps.min(steps) < finish_from;
                 envs.state.phase_steps += rollout.steps;
+                let ends = opens_finish || envs.state.phase_steps >= schedule.solver_phase_steps;
                 let warm = self.solver.trainer.global_step >= warmup_steps;
-                if warm && self.envs().state.phase_steps >= schedule.solver_phase_steps {
+                if warm && ends {
                     self.snapshot_if_due()?;
                     self.envs().set_phase(Phase::Generator);
                 }

@@ -584,6 +584,52 @@ fn a_staged_run_with_a_finish_resumes_to_the_same_bytes_on_any_thread_count() {
     assert_eq!(curve(&one).last().unwrap().1, 1024 + 128);
 }
 
+/// A finish in which the Solver learns: it opens with the Generator's phase even when the
+/// budget ends inside a Solver phase, and its Solver phase (here longer than what is left)
+/// learns at the finish's constant rate to the end, against the Generator frozen.
+#[test]
+fn a_learning_finish_opens_with_the_generator_and_ends_with_the_solver_catching_up() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("catch-up.yaml");
+    let catch_up = TINY_ADVERSARIAL
+        .replace("  solver_phase_steps: 128\n  generator_phase_steps: 16", "  solver_phase_steps: 384\n  generator_phase_steps: 16")
+        .replace(
+            "    solver_steps: 128\n    generator_phase_steps: 8\n",
+            "    solver_steps: 192\n    generator_phase_steps: 8\n    solver_learning_rate: 1.0e-4\n    solver_phase_steps: 1000000\n",
+        );
+    assert_ne!(catch_up, TINY_ADVERSARIAL);
+    std::fs::write(&config, catch_up).unwrap();
+    let out = dir.path().join("run");
+    arlpcg_ok(&[
+        "train",
+        "--mode",
+        "arlpcg",
+        "--steps",
+        "640",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    // Solver phases of 384 steps (three iterations of 128): the one from 384 is under way at
+    // 640, where the finish begins; its first iteration (to 768) ends it...
+    let generator_steps: Vec<u64> = std::fs::read_to_string(out.join("generator-metrics.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|row| row.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    let in_finish: Vec<u64> = generator_steps.into_iter().filter(|&s| s > 640).collect();
+    assert!(!in_finish.is_empty(), "the finish has a Generator phase");
+    assert!(in_finish.iter().all(|&s| s == 768), "{in_finish:?}");
+    // ...and the Solver learns at 1e-4 from 640 to the budget, 640 + 192.
+    let finish_rates: Vec<(u64, f64)> = learning_rates(&out)
+        .into_iter()
+        .filter(|&(step, _)| step > 640)
+        .collect();
+    assert_eq!(finish_rates, vec![(768, 1e-4), (896, 1e-4)]);
+}
+
 /// (global_step, learning_rate) of every metrics row.
 fn learning_rates(run: &Path) -> Vec<(u64, f64)> {
     let metrics = std::fs::read_to_string(run.join("metrics.csv")).unwrap();

@@ -323,6 +323,19 @@ pub const PLATFORM_FINISH: Finish = Finish {
     solver_phase_steps: 1,
 };
 
+/// The racing recipe's finish, in two parts: one 140k-segment Generator phase against the
+/// final Solver (which only plays in it), then the Solver catches up at a constant 1e-4
+/// against that Generator, frozen, to 409,600 Solver steps past the budget (its phase is longer
+/// than what is left). Without the catch-up the Generator's λ = -1 tracks were completed by
+/// under half of its Solver's runs; with 1M steps of it the Solver drove them all and λ
+/// steered nothing; 400k left 0.64 at λ = -1 (docs/results.md, "A finish with a catch-up").
+pub const RACING_FINISH: Finish = Finish {
+    solver_steps: 409_600,
+    generator_phase_steps: 140_000,
+    solver_learning_rate: 1e-4,
+    solver_phase_steps: 1_000_000_000,
+};
+
 impl TrainConfig {
     /// An adversarial run's budget in Solver steps: `steps`, then the finish's.
     pub fn adversarial_budget(&self) -> u64 {
@@ -365,9 +378,7 @@ impl TrainConfig {
             // goal's bearing and cannot make the sustained bends that are hard to drive.
             config.generator.curve_offset = 90.0;
             config.generator.generator_phase_steps = RACING_GENERATOR_PHASE_STEPS;
-            // A finish against the frozen Solver found nothing it could not drive in 172k
-            // segments (docs/training.md, "The recipe"), so racing has none.
-            config.generator.finish = Finish::NONE;
+            config.generator.finish = RACING_FINISH;
         }
         config
     }
@@ -660,7 +671,7 @@ mod tests {
             90.0
         );
         // The recipes: the platform's finish starts where its Solver's 8M end; racing
-        // has short Generator phases and no finish.
+        // has short Generator phases and a finish that ends with the Solver catching up.
         let platform = TrainConfig::for_game(Game::Platform);
         assert_eq!(platform.generator.finish, PLATFORM_FINISH);
         assert_eq!(platform.adversarial_budget(), 8_032_768);
@@ -685,7 +696,12 @@ mod tests {
         );
         let racing = TrainConfig::for_game(Game::Racing);
         assert_eq!(racing.generator.generator_phase_steps, 4_096);
-        assert_eq!(racing.adversarial_budget(), racing.steps);
+        assert_eq!(racing.generator.finish, RACING_FINISH);
+        assert_eq!(racing.adversarial_budget(), 5_409_600);
+        assert_eq!(
+            racing.schedule_at(5_000_000).solver_learning_rate,
+            Some(1.0e-4)
+        );
         let staged = "generator:\n  snapshot_share: 0.5\n  stages:\n  - {from_steps: 100, solver_learning_rate: 0, solver_phase_steps: 8, generator_phase_steps: 9}\n  - {from_steps: 200, solver_learning_rate: 0, solver_phase_steps: 8, generator_phase_steps: 9, snapshot_share: 0}\n";
         let staged = TrainConfig::parse_for(staged, Game::Platform)
             .unwrap()

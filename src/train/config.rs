@@ -670,6 +670,10 @@ mod tests {
             TrainConfig::for_game(Game::Racing).generator.curve_offset,
             90.0
         );
+    }
+
+    #[test]
+    fn the_recipes_finish_after_the_budget_and_stages_apply_from_their_step() {
         // The recipes: the platform's finish starts where its Solver's 8M end; racing
         // has short Generator phases and a finish that ends with the Solver catching up.
         let platform = TrainConfig::for_game(Game::Platform);

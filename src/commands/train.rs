@@ -78,7 +78,8 @@ fn train_loop(run: &mut dyn Training, minutes: Option<f64>) -> Result<()> {
     let bar = crate::shell::progress_bar(total, "training");
     bar.set_position(run.solver_steps());
     loop {
-        let done_by_steps = run.solver_steps() >= total;
+        // The budget may end early (a finish whose catch-up reached its success).
+        let done_by_steps = run.solver_steps() >= run.budget();
         let done_by_time = minutes.is_some_and(|m| session.elapsed().as_secs_f64() >= m * 60.0);
         if done_by_steps || done_by_time || stop.load(Ordering::SeqCst) {
             break;

@@ -232,7 +232,14 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
     }
 
     fn budget(&self) -> u64 {
-        self.solver.config.adversarial_budget()
+        let config = &self.solver.config;
+        let budget = config.adversarial_budget();
+        match self.solver.trainer.env.state.finish_ended_at {
+            // A finish ended early by its catch-up's success, unless the budget has grown
+            // past where it ended (a resume with more steps trains on).
+            Some(at) if at > config.steps => at.min(budget),
+            _ => budget,
+        }
     }
 
     fn wall_before(&self) -> f64 {
@@ -255,6 +262,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
             0 => u64::MAX,
             _ => config.steps,
         };
+        let until_hard_success = config.generator.finish.until_hard_success;
         self.envs().rules.snapshot_share = schedule.snapshot_share;
         match self.envs().state.phase {
             Phase::Solver => {
@@ -268,6 +276,13 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                     steps >= finish_from && steps - envs.state.phase_steps.min(steps) < finish_from;
                 envs.state.phase_steps += rollout.steps;
                 let ends = opens_finish || envs.state.phase_steps >= schedule.solver_phase_steps;
+                if let Some(target) = until_hard_success
+                    && steps >= finish_from
+                    && !opens_finish
+                {
+                    let now = self.solver.trainer.global_step;
+                    self.envs().count_catch_up(target, now);
+                }
                 let warm = self.solver.trainer.global_step >= warmup_steps;
                 if warm && ends {
                     self.snapshot_if_due()?;

@@ -29,6 +29,7 @@ use crate::rl::policy::{ActMode, ActorCritic};
 use crate::rl::ppo::{Batch, Ppo, gae};
 use crate::rl::vec_env::{Transition, VecEnv};
 use crate::seeds::TRAINING_SEED_BASE;
+use crate::train::config::CATCH_UP_WINDOW;
 
 /// Which agent is learning.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -48,6 +49,13 @@ pub struct AdversarialState {
     pub phase_steps: u64,
     /// Generator decisions learned from, over the run.
     pub generator_steps: u64,
+    /// The finish's catch-up: the Solver's successes and finished hard matches (λ < 0) in the
+    /// block being counted (`Finish::until_hard_success`)...
+    #[serde(default)]
+    pub catch_up_block: [u32; 2],
+    /// ...and the Solver steps where it ended the finish (none: it has not).
+    #[serde(default)]
+    pub finish_ended_at: Option<u64>,
 }
 
 impl Default for AdversarialState {
@@ -57,6 +65,8 @@ impl Default for AdversarialState {
             phase: Phase::Solver,
             phase_steps: 0,
             generator_steps: 0,
+            catch_up_block: [0, 0],
+            finish_ended_at: None,
         }
     }
 }
@@ -481,6 +491,22 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
     /// The match statistics gathered since the last call.
     pub fn take_stats(&mut self) -> MatchStats {
         std::mem::take(&mut self.stats)
+    }
+
+    /// Counts the hard matches finished since the last count into the catch-up's block; a full
+    /// block ([`CATCH_UP_WINDOW`] matches) whose success reaches `target` ends the finish at
+    /// `solver_steps`, and a new block begins either way.
+    pub fn count_catch_up(&mut self, target: f64, solver_steps: u64) {
+        let stats = self.take_stats();
+        let block = &mut self.state.catch_up_block;
+        block[0] += stats.successes[1];
+        block[1] += stats.judged[1];
+        if block[1] >= CATCH_UP_WINDOW {
+            if f64::from(block[0]) >= target * f64::from(block[1]) {
+                self.state.finish_ended_at = Some(solver_steps);
+            }
+            *block = [0, 0];
+        }
     }
 }
 

@@ -147,7 +147,16 @@ pub struct Finish {
     /// Solver steps in each of its finish phases (1: one iteration).
     #[serde(default = "one_iteration")]
     pub solver_phase_steps: u64,
+    /// With a learning Solver: the finish ends once a Solver phase after its Generator phase
+    /// (the catch-up) has brought the Solver's success on hard matches (λ < 0) to this ratio,
+    /// counted over blocks of [`CATCH_UP_WINDOW`] of them; `solver_steps` stays the limit.
+    /// None: the finish ends at `solver_steps`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub until_hard_success: Option<f64>,
 }
+
+/// Hard matches (λ < 0) over which a catch-up's success is counted, block after block.
+pub const CATCH_UP_WINDOW: u32 = 32;
 
 fn one_iteration() -> u64 {
     1
@@ -165,6 +174,7 @@ impl Finish {
         generator_phase_steps: 100_000,
         solver_learning_rate: 0.0,
         solver_phase_steps: 1,
+        until_hard_success: None,
     };
 }
 
@@ -321,6 +331,7 @@ pub const PLATFORM_FINISH: Finish = Finish {
     generator_phase_steps: 100_000,
     solver_learning_rate: 0.0,
     solver_phase_steps: 1,
+    until_hard_success: None,
 };
 
 /// The racing recipe's finish, in two parts: one 140k-segment Generator phase against the
@@ -334,6 +345,7 @@ pub const RACING_FINISH: Finish = Finish {
     generator_phase_steps: 140_000,
     solver_learning_rate: 1e-4,
     solver_phase_steps: 1_000_000_000,
+    until_hard_success: None,
 };
 
 impl TrainConfig {
@@ -514,6 +526,12 @@ fn check_schedule(g: &GeneratorConfig) -> Result<(), String> {
             return Err(format!(
                 "finish: solver_steps, solver_phase_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
             ));
+        }
+        if g.finish
+            .until_hard_success
+            .is_some_and(|r| !(0.0..=1.0).contains(&r))
+        {
+            return Err("finish.until_hard_success must be a ratio in [0, 1]".into());
         }
         let rate = g.finish.solver_learning_rate;
         if !(rate.is_finite() && (0.0..=1.0).contains(&rate)) {
@@ -762,6 +780,11 @@ mod tests {
                 "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, solver_learning_rate: -1}\n",
                 Game::Platform,
                 "finish.solver_learning_rate",
+            ),
+            (
+                "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, until_hard_success: .nan}\n",
+                Game::Platform,
+                "finish.until_hard_success",
             ),
             (
                 "generator:\n  snapshot_share: 1.5\n",

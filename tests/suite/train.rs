@@ -630,6 +630,36 @@ fn a_learning_finish_opens_with_the_generator_and_ends_with_the_solver_catching_
     assert_eq!(finish_rates, vec![(768, 1e-4), (896, 1e-4)]);
 }
 
+/// A catch-up that ends at a success: with `until_hard_success: 0` the first block of hard
+/// matches the Solver finishes in it ends the run, long before the finish's limit.
+#[test]
+fn a_catch_up_until_a_success_ends_the_run_early() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("until.yaml");
+    let until = TINY_ADVERSARIAL.replace(
+        "    solver_steps: 128\n    generator_phase_steps: 8\n",
+        "    solver_steps: 64000\n    generator_phase_steps: 8\n    solver_learning_rate: 1.0e-4\n    solver_phase_steps: 1000000\n    until_hard_success: 0.0\n",
+    );
+    assert_ne!(until, TINY_ADVERSARIAL);
+    std::fs::write(&config, until).unwrap();
+    let out = dir.path().join("run");
+    arlpcg_ok(&[
+        "train",
+        "--mode",
+        "arlpcg",
+        "--steps",
+        "640",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let last = curve(&out).last().unwrap().1;
+    // The catch-up begins at 768 (after the finish's Generator phase) and ends with the
+    // iteration that completes a block of 32 hard matches, before the limit of 640 + 64,000.
+    assert!((896..640 + 64_000).contains(&last), "ended at {last}");
+}
+
 /// (global_step, learning_rate) of every metrics row.
 fn learning_rates(run: &Path) -> Vec<(u64, f64)> {
     let metrics = std::fs::read_to_string(run.join("metrics.csv")).unwrap();

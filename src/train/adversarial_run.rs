@@ -257,11 +257,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         let schedule = config.schedule_at(steps);
         let lr_scale = config.lr_scale(steps);
         let warmup_steps = config.generator.solver_warmup_steps;
-        // Where the finish begins (none: never).
-        let finish_from = match config.generator.finish.solver_steps {
-            0 => u64::MAX,
-            _ => config.steps,
-        };
+        let in_finish = config.in_finish(steps);
         let until_hard_success = config.generator.finish.until_hard_success;
         self.envs().rules.snapshot_share = schedule.snapshot_share;
         match self.envs().state.phase {
@@ -269,16 +265,16 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                 let rollout =
                     self.solver
                         .solver_iteration(lr_scale, schedule.solver_learning_rate, wall)?;
-                let envs = self.envs();
+                let phase_began = steps.saturating_sub(self.envs().state.phase_steps);
+                let catching_up = self.solver.config.in_finish(phase_began);
                 // A Solver phase under way when the finish begins ends with the finish's first
                 // iteration, so that the finish opens with the Generator's phase.
-                let opens_finish =
-                    steps >= finish_from && steps - envs.state.phase_steps.min(steps) < finish_from;
+                let opens_finish = in_finish && !catching_up;
+                let envs = self.envs();
                 envs.state.phase_steps += rollout.steps;
                 let ends = opens_finish || envs.state.phase_steps >= schedule.solver_phase_steps;
                 if let Some(target) = until_hard_success
-                    && steps >= finish_from
-                    && !opens_finish
+                    && catching_up
                 {
                     let now = self.solver.trainer.global_step;
                     self.envs().count_catch_up(target, now);

@@ -356,11 +356,16 @@ impl TrainConfig {
             .saturating_add(self.generator.finish.solver_steps)
     }
 
+    /// Whether `solver_steps` fall in an adversarial run's finish (past `steps`, if it has one).
+    pub fn in_finish(&self, solver_steps: u64) -> bool {
+        self.generator.finish.solver_steps > 0 && solver_steps >= self.steps
+    }
+
     /// An adversarial run's schedule at `solver_steps`: the finish past `steps`, else the last
     /// stage reached, else the run's own phases.
     pub fn schedule_at(&self, solver_steps: u64) -> Schedule {
         let finish = self.generator.finish;
-        if finish.solver_steps > 0 && solver_steps >= self.steps {
+        if self.in_finish(solver_steps) {
             return Schedule {
                 solver_learning_rate: Some(finish.solver_learning_rate),
                 solver_phase_steps: finish.solver_phase_steps,

@@ -584,22 +584,16 @@ fn a_staged_run_with_a_finish_resumes_to_the_same_bytes_on_any_thread_count() {
     assert_eq!(curve(&one).last().unwrap().1, 1024 + 128);
 }
 
-/// A finish in which the Solver learns: it opens with the Generator's phase even when the
-/// budget ends inside a Solver phase, and its Solver phase (here longer than what is left)
-/// learns at the finish's constant rate to the end, against the Generator frozen.
-#[test]
-fn a_learning_finish_opens_with_the_generator_and_ends_with_the_solver_catching_up() {
-    let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("catch-up.yaml");
-    let catch_up = TINY_ADVERSARIAL
-        .replace("  solver_phase_steps: 128\n  generator_phase_steps: 16", "  solver_phase_steps: 384\n  generator_phase_steps: 16")
-        .replace(
-            "    solver_steps: 128\n    generator_phase_steps: 8\n",
-            "    solver_steps: 192\n    generator_phase_steps: 8\n    solver_learning_rate: 1.0e-4\n    solver_phase_steps: 1000000\n",
-        );
-    assert_ne!(catch_up, TINY_ADVERSARIAL);
-    std::fs::write(&config, catch_up).unwrap();
-    let out = dir.path().join("run");
+/// An arlpcg run of `config` (a variant of [`TINY_ADVERSARIAL`], which it must differ from) to a
+/// budget of 640 Solver steps and its finish, in `dir/run`.
+fn train_tiny_to_640(dir: &Path, config: &str) -> std::path::PathBuf {
+    assert_ne!(
+        config, TINY_ADVERSARIAL,
+        "the variant changes the tiny configuration"
+    );
+    let path = dir.join("variant.yaml");
+    std::fs::write(&path, config).unwrap();
+    let out = dir.join("run");
     arlpcg_ok(&[
         "train",
         "--mode",
@@ -607,10 +601,26 @@ fn a_learning_finish_opens_with_the_generator_and_ends_with_the_solver_catching_
         "--steps",
         "640",
         "--config",
-        config.to_str().unwrap(),
+        path.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
     ]);
+    out
+}
+
+/// A finish in which the Solver learns: it opens with the Generator's phase even when the
+/// budget ends inside a Solver phase, and its Solver phase (here longer than what is left)
+/// learns at the finish's constant rate to the end, against the Generator frozen.
+#[test]
+fn a_learning_finish_opens_with_the_generator_and_ends_with_the_solver_catching_up() {
+    let dir = tempfile::tempdir().unwrap();
+    let catch_up = TINY_ADVERSARIAL
+        .replace("  solver_phase_steps: 128\n  generator_phase_steps: 16", "  solver_phase_steps: 384\n  generator_phase_steps: 16")
+        .replace(
+            "    solver_steps: 128\n    generator_phase_steps: 8\n",
+            "    solver_steps: 192\n    generator_phase_steps: 8\n    solver_learning_rate: 1.0e-4\n    solver_phase_steps: 1000000\n",
+        );
+    let out = train_tiny_to_640(dir.path(), &catch_up);
     // Solver phases of 384 steps (three iterations of 128): the one from 384 is under way at
     // 640, where the finish begins; its first iteration (to 768) ends it...
     let generator_steps: Vec<u64> = std::fs::read_to_string(out.join("generator-metrics.csv"))
@@ -635,25 +645,11 @@ fn a_learning_finish_opens_with_the_generator_and_ends_with_the_solver_catching_
 #[test]
 fn a_catch_up_until_a_success_ends_the_run_early() {
     let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("until.yaml");
     let until = TINY_ADVERSARIAL.replace(
         "    solver_steps: 128\n    generator_phase_steps: 8\n",
         "    solver_steps: 64000\n    generator_phase_steps: 8\n    solver_learning_rate: 1.0e-4\n    solver_phase_steps: 1000000\n    until_hard_success: 0.0\n",
     );
-    assert_ne!(until, TINY_ADVERSARIAL);
-    std::fs::write(&config, until).unwrap();
-    let out = dir.path().join("run");
-    arlpcg_ok(&[
-        "train",
-        "--mode",
-        "arlpcg",
-        "--steps",
-        "640",
-        "--config",
-        config.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let out = train_tiny_to_640(dir.path(), &until);
     let last = curve(&out).last().unwrap().1;
     // The catch-up begins at 768 (after the finish's Generator phase) and ends with the
     // iteration that completes a block of 32 hard matches, before the limit of 640 + 64,000.

@@ -173,12 +173,13 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         Ok(())
     }
 
-    /// Plays until a batch of Generator decisions is complete, and learns from it.
+    /// Plays until a batch of Generator decisions is complete, and learns from it; returns
+    /// its progress line and the statistics of the matches that ended meanwhile.
     pub(super) fn generator_iteration(
         &mut self,
         lr_scale: f64,
         wall: &dyn Fn() -> f64,
-    ) -> Result<String> {
+    ) -> Result<(String, MatchStats)> {
         let config = self.solver.config.generator.ppo.clone();
         let learning_rate = if config.anneal_lr {
             config.learning_rate * lr_scale
@@ -217,12 +218,13 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             update_columns(&update)
         )?;
         let ratio = |a: u32, b: u32| a as f64 / b.max(1) as f64;
-        Ok(format!(
+        let message = format!(
             "generator: success easy {:.2} / hard {:.2}, invalid {:.2}",
             ratio(stats.successes[0], stats.judged[0]),
             ratio(stats.successes[1], stats.judged[1]),
             ratio(stats.invalid, stats.episodes)
-        ))
+        );
+        Ok((message, stats))
     }
 }
 
@@ -258,7 +260,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         let lr_scale = config.lr_scale(steps);
         let warmup_steps = config.generator.solver_warmup_steps;
         let in_finish = config.in_finish(steps);
-        let until_hard_success = config.generator.finish.until_hard_success;
+        let finish = config.generator.finish;
         self.envs().rules.snapshot_share = schedule.snapshot_share;
         match self.envs().state.phase {
             Phase::Solver => {
@@ -273,11 +275,15 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                 let envs = self.envs();
                 envs.state.phase_steps += rollout.steps;
                 let ends = opens_finish || envs.state.phase_steps >= schedule.solver_phase_steps;
-                if let Some(target) = until_hard_success
+                if let Some(target) = finish.until_hard_success
                     && catching_up
                 {
                     let now = self.solver.trainer.global_step;
-                    self.envs().count_catch_up(target, now);
+                    let envs = self.envs();
+                    let stats = envs.take_stats();
+                    if envs.count_hard_block(&stats).is_some_and(|s| s >= target) {
+                        envs.state.finish_ended_at = Some(now);
+                    }
                 }
                 let warm = self.solver.trainer.global_step >= warmup_steps;
                 if warm && ends {
@@ -290,9 +296,16 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                 ))
             }
             Phase::Generator => {
-                let message = self.generator_iteration(lr_scale, wall)?;
+                let (message, stats) = self.generator_iteration(lr_scale, wall)?;
                 let envs = self.envs();
-                if envs.state.phase_steps >= schedule.generator_phase_steps {
+                // In the finish, the phase may end early once the Solver fails enough.
+                let hard_enough = match finish.generator_until_hard_success {
+                    Some(target) if in_finish => {
+                        envs.count_hard_block(&stats).is_some_and(|s| s <= target)
+                    }
+                    _ => false,
+                };
+                if hard_enough || envs.state.phase_steps >= schedule.generator_phase_steps {
                     envs.set_phase(Phase::Solver);
                 }
                 Ok(message)

@@ -29,7 +29,7 @@ use crate::rl::policy::{ActMode, ActorCritic};
 use crate::rl::ppo::{Batch, Ppo, gae};
 use crate::rl::vec_env::{Transition, VecEnv};
 use crate::seeds::TRAINING_SEED_BASE;
-use crate::train::config::CATCH_UP_WINDOW;
+use crate::train::config::HARD_MATCH_BLOCK;
 
 /// Which agent is learning.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -49,11 +49,11 @@ pub struct AdversarialState {
     pub phase_steps: u64,
     /// Generator decisions learned from, over the run.
     pub generator_steps: u64,
-    /// The finish's catch-up: the Solver's successes and finished hard matches (λ < 0) in the
-    /// block being counted (`Finish::until_hard_success`)...
-    #[serde(default)]
-    pub catch_up_block: [u32; 2],
-    /// ...and the Solver steps where it ended the finish (none: it has not).
+    /// The finish: the Solver's successes and finished hard matches (λ < 0) in the block being
+    /// counted (`Finish::generator_until_hard_success`, `Finish::until_hard_success`)...
+    #[serde(default, alias = "catch_up_block")]
+    pub hard_block: [u32; 2],
+    /// ...and the Solver steps where the catch-up ended the finish (none: it has not).
     #[serde(default)]
     pub finish_ended_at: Option<u64>,
 }
@@ -65,7 +65,7 @@ impl Default for AdversarialState {
             phase: Phase::Solver,
             phase_steps: 0,
             generator_steps: 0,
-            catch_up_block: [0, 0],
+            hard_block: [0, 0],
             finish_ended_at: None,
         }
     }
@@ -292,6 +292,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
     pub fn set_phase(&mut self, phase: Phase) {
         self.state.phase = phase;
         self.state.phase_steps = 0;
+        self.state.hard_block = [0, 0];
         for recorded in &mut self.recorded {
             recorded.clear();
         }
@@ -493,20 +494,19 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         std::mem::take(&mut self.stats)
     }
 
-    /// Counts the hard matches finished since the last count into the catch-up's block; a full
-    /// block ([`CATCH_UP_WINDOW`] matches) whose success reaches `target` ends the finish at
-    /// `solver_steps`, and a new block begins either way.
-    pub fn count_catch_up(&mut self, target: f64, solver_steps: u64) {
-        let stats = self.take_stats();
-        let block = &mut self.state.catch_up_block;
+    /// Adds the hard matches (λ < 0) of `stats` to the block being counted; once the block
+    /// holds [`HARD_MATCH_BLOCK`] of them, returns the Solver's success ratio over it and
+    /// begins a new one.
+    pub fn count_hard_block(&mut self, stats: &MatchStats) -> Option<f64> {
+        let block = &mut self.state.hard_block;
         block[0] += stats.successes[1];
         block[1] += stats.judged[1];
-        if block[1] >= CATCH_UP_WINDOW {
-            if f64::from(block[0]) >= target * f64::from(block[1]) {
-                self.state.finish_ended_at = Some(solver_steps);
-            }
-            *block = [0, 0];
+        if block[1] < HARD_MATCH_BLOCK {
+            return None;
         }
+        let ratio = f64::from(block[0]) / f64::from(block[1]);
+        *block = [0, 0];
+        Some(ratio)
     }
 }
 

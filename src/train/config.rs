@@ -147,16 +147,22 @@ pub struct Finish {
     /// Solver steps in each of its finish phases (1: one iteration).
     #[serde(default = "one_iteration")]
     pub solver_phase_steps: u64,
+    /// The finish's Generator phases end once the Solver's success on hard matches (λ < 0)
+    /// has fallen to this ratio, counted over blocks of [`HARD_MATCH_BLOCK`] of them;
+    /// `generator_phase_steps` stays the limit. None: they end at `generator_phase_steps`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub generator_until_hard_success: Option<f64>,
     /// With a learning Solver: the finish ends once a Solver phase after its Generator phase
-    /// (the catch-up) has brought the Solver's success on hard matches (λ < 0) to this ratio,
-    /// counted over blocks of [`CATCH_UP_WINDOW`] of them; `solver_steps` stays the limit.
-    /// None: the finish ends at `solver_steps`.
+    /// (the catch-up) has brought the Solver's success on hard matches back up to this ratio,
+    /// counted the same way; `solver_steps` stays the limit. None: the finish ends at
+    /// `solver_steps`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub until_hard_success: Option<f64>,
 }
 
-/// Hard matches (λ < 0) over which a catch-up's success is counted, block after block.
-pub const CATCH_UP_WINDOW: u32 = 32;
+/// Hard matches (λ < 0) over which the Solver's success is counted in the finish, block after
+/// block, for `Finish::generator_until_hard_success` and `Finish::until_hard_success`.
+pub const HARD_MATCH_BLOCK: u32 = 32;
 
 fn one_iteration() -> u64 {
     1
@@ -174,6 +180,7 @@ impl Finish {
         generator_phase_steps: 100_000,
         solver_learning_rate: 0.0,
         solver_phase_steps: 1,
+        generator_until_hard_success: None,
         until_hard_success: None,
     };
 }
@@ -331,21 +338,25 @@ pub const PLATFORM_FINISH: Finish = Finish {
     generator_phase_steps: 100_000,
     solver_learning_rate: 0.0,
     solver_phase_steps: 1,
+    generator_until_hard_success: None,
     until_hard_success: None,
 };
 
-/// The racing recipe's finish, in two parts: one 140k-segment Generator phase against the
-/// final Solver (which only plays in it), then the Solver catches up at a constant 1e-4
-/// against that Generator, frozen, until it succeeds on 70% of its hard matches (at most 1M
-/// Solver steps past the budget; its phase is longer than that). Without the catch-up the
-/// Generator's λ = -1 tracks were completed by under half of its Solver's runs; with 1M steps
-/// of it the Solver drove them all and λ steered nothing; a fixed 400k left 0.64 at λ = -1 in
-/// one run and 0.94 in another (docs/results.md, "A finish with a catch-up").
+/// The racing recipe's finish, in two parts, each ended by the Solver's success on hard
+/// matches: a Generator phase against the final Solver (which only plays in it) until that
+/// success has fallen to 30% (at most 400k track segments), then the Solver catches up at a
+/// constant 1e-4 against that Generator, frozen, until it succeeds on 70% of its hard matches
+/// again (at most 1M Solver steps past the budget; its phase is longer than that). Without the
+/// catch-up the Generator's λ = -1 tracks were completed by under half of its Solver's runs;
+/// with 1M steps of it the Solver drove them all and λ steered nothing; a fixed 140k-segment
+/// Generator phase left the Solver at 30% in one run and 60% in another (docs/results.md,
+/// "A finish with a catch-up").
 pub const RACING_FINISH: Finish = Finish {
     solver_steps: 1_000_000,
-    generator_phase_steps: 140_000,
+    generator_phase_steps: 400_000,
     solver_learning_rate: 1e-4,
     solver_phase_steps: 1_000_000_000,
+    generator_until_hard_success: Some(0.3),
     until_hard_success: Some(0.7),
 };
 
@@ -533,11 +544,16 @@ fn check_schedule(g: &GeneratorConfig) -> Result<(), String> {
                 "finish: solver_steps, solver_phase_steps and generator_phase_steps must be within [1, {MAX_PHASE_STEPS}]"
             ));
         }
-        if g.finish
-            .until_hard_success
-            .is_some_and(|r| !(0.0..=1.0).contains(&r))
-        {
-            return Err("finish.until_hard_success must be a ratio in [0, 1]".into());
+        for (name, ratio) in [
+            (
+                "generator_until_hard_success",
+                g.finish.generator_until_hard_success,
+            ),
+            ("until_hard_success", g.finish.until_hard_success),
+        ] {
+            if ratio.is_some_and(|r| !(0.0..=1.0).contains(&r)) {
+                return Err(format!("finish.{name} must be a ratio in [0, 1]"));
+            }
         }
         let rate = g.finish.solver_learning_rate;
         if !(rate.is_finite() && (0.0..=1.0).contains(&rate)) {

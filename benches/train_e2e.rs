@@ -11,7 +11,7 @@ use arlpcg::rl::policy::{ActorCritic, PolicyShape};
 use arlpcg::rl::ppo::Ppo;
 use arlpcg::rl::vec_env::Trainer;
 use arlpcg::train::TrainConfig;
-use arlpcg::train::solver_envs::{SolverEnvs, SolverMode, SourceState};
+use arlpcg::train::solver_envs::{SolverEnvs, SolverMode, SourceRecord};
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
@@ -26,15 +26,15 @@ fn main() {
         continuous: 2,
         binary: 1,
     };
+    let action_size = shape.action_size();
     let ppo = Ppo::new(config.solver.clone(), ActorCritic::new(shape, 0).unwrap()).unwrap();
     let envs = SolverEnvs::<PlatformGame>::new(
         SolverMode::RulePcg,
         config.solver.num_envs,
-        SourceState {
-            levels_drawn: 0,
-            episodes_started: 0,
-        },
-    );
+        SourceRecord::default(),
+        action_size,
+    )
+    .unwrap();
     let mut trainer = Trainer::new(ppo, envs, 0);
     let (mut rollout_s, mut update_s) = (0.0, 0.0);
     let iterations = 6;

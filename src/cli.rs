@@ -495,6 +495,11 @@ pub struct TrainArgs {
     /// Stop this session after this many minutes (its checkpoint is saved; --resume goes on).
     #[arg(long, value_parser = parse_minutes)]
     pub minutes: Option<f64>,
+    /// Stop this session once the Solver has learned from this many steps in all (its
+    /// checkpoint is saved; --resume goes on with the episodes and matches under way, to the
+    /// same bytes as a run never stopped).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub pause_at: Option<u64>,
     /// Training configuration (YAML; see --print-config for every field and its default). With
     /// --resume it replaces the run's hyper-parameters from the checkpoint on (not `seed`,
     /// `hidden`, `solver.num_envs`, `generator.max_pieces` or `generator.curve_offset`); the old

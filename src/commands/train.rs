@@ -57,13 +57,14 @@ pub fn run(args: &TrainArgs) -> Result<()> {
                 .collect::<Vec<_>>()
                 .join(" "),
         );
-        train_loop(run.as_mut(), args.minutes)
+        train_loop(run.as_mut(), args.minutes, args.pause_at)
     })
 }
 
-/// Iterates `run` until its budget of Solver steps or `minutes` of this session, or a signal;
-/// checkpoints on the run's interval and at the end, then writes the final policies.
-fn train_loop(run: &mut dyn Training, minutes: Option<f64>) -> Result<()> {
+/// Iterates `run` until its budget of Solver steps, `minutes` of this session, `pause_at` Solver
+/// steps, or a signal; checkpoints on the run's interval and at the end, then writes the
+/// policies.
+fn train_loop(run: &mut dyn Training, minutes: Option<f64>, pause_at: Option<u64>) -> Result<()> {
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = stop.clone();
@@ -81,7 +82,8 @@ fn train_loop(run: &mut dyn Training, minutes: Option<f64>) -> Result<()> {
         // The budget may end early (a finish whose catch-up reached its success).
         let done_by_steps = run.solver_steps() >= run.budget();
         let done_by_time = minutes.is_some_and(|m| session.elapsed().as_secs_f64() >= m * 60.0);
-        if done_by_steps || done_by_time || stop.load(Ordering::SeqCst) {
+        let paused = pause_at.is_some_and(|at| run.solver_steps() >= at);
+        if done_by_steps || done_by_time || paused || stop.load(Ordering::SeqCst) {
             break;
         }
         let message = run.iterate(&wall).with_context(|| {
@@ -119,7 +121,11 @@ fn train_loop(run: &mut dyn Training, minutes: Option<f64>) -> Result<()> {
         ))
         .into());
     }
-    println!("finished {summary}");
+    if run.solver_steps() < run.budget() {
+        println!("paused {summary} (--resume goes on)");
+    } else {
+        println!("finished {summary}");
+    }
     Ok(())
 }
 

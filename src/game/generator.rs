@@ -260,11 +260,21 @@ impl<G: GeneratorGame> Match<G> {
         &self.build
     }
 
+    /// The seed the match was made from (its Solver's run is reset with it).
+    pub fn seed(&self) -> u64 {
+        self.solver_seed
+    }
+
     /// The Solver's run (once the first piece is placed).
     pub fn env(&self) -> &G::Env {
         self.env
             .as_ref()
             .expect("the Solver plays once the first piece is placed")
+    }
+
+    /// Whether the Solver's run has begun (the first piece is placed).
+    pub fn started(&self) -> bool {
+        self.env.is_some()
     }
 
     /// Whether it is the Generator's turn: at the start, and whenever the Solver has come close

@@ -104,6 +104,9 @@ pub struct TrainingState {
     pub rng: rand_chacha::ChaCha8Rng,
     /// Game-specific progress (e.g. the next level seed), opaque here.
     pub source: serde_json::Value,
+    /// Each environment's return so far in its episode under way (none: start afresh).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub episode_returns: Vec<f32>,
 }
 
 /// Why a policy or checkpoint could not be read.

@@ -47,7 +47,8 @@ pub struct Trainer<E: VecEnv> {
     pub rng: ChaCha8Rng,
     pub global_step: u64,
     observations: Vec<f32>,
-    episode_returns: Vec<f32>,
+    /// Each environment's return so far in its episode under way (a checkpoint keeps them).
+    pub episode_returns: Vec<f32>,
 }
 
 impl<E: VecEnv> Trainer<E> {

@@ -47,14 +47,15 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 norm: RunningNorm::new(observation_size::<G>()),
             };
             let rng = ChaCha8Rng::seed_from_u64(config.seed.wrapping_add(1));
-            Ok(AdversarialEnvs::new(
+            AdversarialEnvs::new(
                 config.solver.num_envs,
                 generator,
                 rng,
                 Self::rules(mode, config),
-                AdversarialState::default(),
+                AdversarialRecord::default(),
                 Vec::new(),
-            )?)
+                solver_shape(config, G::GAME).action_size(),
+            )
         };
         let solver = Run::start(out, mode, config, build)?;
         fsio::write_atomic(
@@ -94,7 +95,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                     config.generator.curve_offset
                 );
             }
-            let state: AdversarialState =
+            let matches: AdversarialRecord =
                 serde_json::from_value(source.unwrap_or_default()).context("match source")?;
             let mut population =
                 population_from(&record, &loaded.tensors, &solver_shape(config, G::GAME))
@@ -111,15 +112,16 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 ppo,
                 norm: loaded.card.normalizer.clone(),
             };
-            // Unfinished matches are gone: the run goes on with fresh ones, in the same phase.
-            Ok(AdversarialEnvs::new(
+            // The matches under way are replayed (none if the rules changed: fresh ones start).
+            AdversarialEnvs::new(
                 config.solver.num_envs,
                 generator,
                 generator_state.rng,
                 Self::rules(mode, config),
-                state,
+                matches,
                 population,
-            )?)
+                solver_shape(config, G::GAME).action_size(),
+            )
         };
         let solver = Run::resume(out, mode, change, build)?;
         truncate_metrics(
@@ -328,12 +330,17 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
             rng: envs.rng.clone(),
             source: serde_json::to_value(population)?,
             config: serde_json::to_value(&self.solver.config)?,
+            episode_returns: Vec::new(),
         };
         let card = self.generator_card(wall);
         let bytes = checkpoint::checkpoint_bytes(&envs.generator.ppo, &card, &state, tensors);
         let out = &self.solver.out;
-        fsio::write_atomic(&out.join(GENERATOR_CHECKPOINT), &bytes, Overwrite::Allowed)?;
-        self.solver.save_solver_checkpoint(wall)
+        // Both or neither: a resume needs the two networks of one iteration.
+        let mut batch = fsio::Batch::new();
+        batch.stage(&out.join(GENERATOR_CHECKPOINT), &bytes, Overwrite::Allowed)?;
+        let solver = self.solver.solver_checkpoint_bytes(wall)?;
+        batch.stage(&out.join(CHECKPOINT), &solver, Overwrite::Allowed)?;
+        batch.commit()
     }
 
     fn save_policies(&self, wall: f64) -> Result<()> {

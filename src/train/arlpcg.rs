@@ -13,6 +13,11 @@
 //! current Solver or one of its earlier [`Snapshot`]s, so that the Generator's failure reward
 //! comes from several networks and no single one's blind spot pays. While the Solver learns it
 //! plays every match itself.
+//!
+//! Each match keeps the log of what it has been through (its seed, then every piece placed and
+//! every Solver step, as action rows); a checkpoint stores the logs with the Generator's
+//! pending decisions ([`MatchesUnderWay`]) and a resume replays them, so a resumed run goes on
+//! with the very matches it stopped in.
 
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
@@ -179,7 +184,7 @@ pub struct Generator {
 }
 
 /// One recorded Generator decision.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 struct Decision {
     observation: Vec<f32>,
     action: Vec<f32>,
@@ -192,7 +197,7 @@ struct Decision {
 }
 
 /// Episode statistics since they were last taken, split by the sign of λ.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct MatchStats {
     pub episodes: u32,
     pub invalid: u32,
@@ -207,9 +212,50 @@ pub struct MatchStats {
     pub air_steps: [u64; 2],
 }
 
+/// What a match has been through since it began: enough to play it again to where it is.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MatchLog {
+    pub seed: u64,
+    pub events: Vec<MatchEvent>,
+}
+
+/// One thing that happened in a match, as the action row that made it happen.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MatchEvent {
+    /// The Generator placed a piece.
+    Place(Vec<f32>),
+    /// The Solver (or the snapshot playing the match) took a step.
+    Step(Vec<f32>),
+}
+
+/// The matches under way as a checkpoint stores them: per match its log, who plays it, the
+/// Generator's return so far and its decisions still to learn from; and the statistics not
+/// yet taken.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MatchesUnderWay {
+    logs: Vec<MatchLog>,
+    opponents: Vec<Option<usize>>,
+    generator_returns: Vec<f32>,
+    recorded: Vec<Vec<Decision>>,
+    stats: MatchStats,
+}
+
+/// What a checkpoint stores of the matches: the source's progress and, since checkpoints
+/// have held them, the matches under way (none: fresh matches start).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct AdversarialRecord {
+    #[serde(flatten)]
+    pub state: AdversarialState,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub under_way: Option<MatchesUnderWay>,
+}
+
 /// Many matches of the Generator against the Solver, as the Solver's environments.
 pub struct AdversarialEnvs<G: GeneratorGame> {
     matches: Vec<Match<G>>,
+    /// Per match, what it has been through.
+    logs: Vec<MatchLog>,
     pub generator: Generator,
     /// Samples the Generator's actions and shuffles its minibatches.
     pub rng: ChaCha8Rng,
@@ -227,34 +273,155 @@ pub struct AdversarialEnvs<G: GeneratorGame> {
 }
 
 impl<G: GeneratorGame> AdversarialEnvs<G> {
-    /// `num_matches` matches, continuing from `state`; every match gets its first block.
+    /// `num_matches` matches, continuing from `record`: its matches under way are replayed
+    /// (Solver action rows of `solver_action_size`); without them, fresh matches start and
+    /// each gets its first piece. `Err` says why a record's matches cannot be replayed.
     pub fn new(
         num_matches: usize,
         generator: Generator,
         rng: ChaCha8Rng,
         rules: MatchRules,
-        state: AdversarialState,
+        record: AdversarialRecord,
         population: Vec<Snapshot>,
-    ) -> candle_core::Result<Self> {
+        solver_action_size: usize,
+    ) -> anyhow::Result<Self> {
         let mut this = Self {
             matches: Vec::with_capacity(num_matches),
+            logs: Vec::with_capacity(num_matches),
             generator,
             rng,
             rules,
-            state,
+            state: record.state,
             recorded: vec![Vec::new(); num_matches],
             generator_returns: vec![0.0; num_matches],
             stats: MatchStats::default(),
             population,
             opponents: Vec::with_capacity(num_matches),
         };
+        if let Some(under_way) = record.under_way {
+            this.replay(num_matches, under_way, solver_action_size)
+                .map_err(|problem| anyhow::anyhow!("matches under way: {problem}"))?;
+            return Ok(this);
+        }
         for _ in 0..num_matches {
             let (fresh, opponent) = this.next_match();
+            this.logs.push(MatchLog {
+                seed: fresh.seed(),
+                events: Vec::new(),
+            });
             this.matches.push(fresh);
             this.opponents.push(opponent);
         }
         this.first_pieces((0..num_matches).collect())?;
         Ok(this)
+    }
+
+    /// The source's progress and the matches under way, as a checkpoint stores them.
+    pub fn record(&self) -> AdversarialRecord {
+        AdversarialRecord {
+            state: self.state,
+            under_way: Some(MatchesUnderWay {
+                logs: self.logs.clone(),
+                opponents: self.opponents.clone(),
+                generator_returns: self.generator_returns.clone(),
+                recorded: self.recorded.clone(),
+                stats: self.stats.clone(),
+            }),
+        }
+    }
+
+    /// Plays the matches of `under_way` again to where they were, checking what a tampered
+    /// checkpoint could get wrong.
+    fn replay(
+        &mut self,
+        num_matches: usize,
+        under_way: MatchesUnderWay,
+        solver_action_size: usize,
+    ) -> Result<(), String> {
+        let n = num_matches;
+        if [
+            under_way.logs.len(),
+            under_way.opponents.len(),
+            under_way.generator_returns.len(),
+            under_way.recorded.len(),
+        ] != [n; 4]
+        {
+            return Err(format!("they are not {n}, one per match"));
+        }
+        let snapshots = self.population.len();
+        if under_way
+            .opponents
+            .iter()
+            .flatten()
+            .any(|&k| k >= snapshots)
+        {
+            return Err(format!(
+                "a match is played by a snapshot beyond the {snapshots} kept"
+            ));
+        }
+        let shape = self.generator.ppo.policy.shape();
+        let (d, width) = (shape.observation, shape.action_size());
+        let decision_fits = |decision: &Decision| {
+            decision.observation.len() == d
+                && decision.action.len() == width
+                && decision
+                    .observation
+                    .iter()
+                    .chain(&decision.action)
+                    .all(|v| v.is_finite())
+        };
+        if !under_way.recorded.iter().flatten().all(decision_fits) {
+            return Err(format!(
+                "a recorded Generator decision is not {d} observed and {width} acted finite numbers"
+            ));
+        }
+        let rewards = &self.rules.rewards;
+        self.matches = under_way
+            .logs
+            .par_iter()
+            .map(|log| self.replayed(log, width, solver_action_size, rewards))
+            .collect::<Result<_, String>>()?;
+        self.logs = under_way.logs;
+        self.opponents = under_way.opponents;
+        self.generator_returns = under_way.generator_returns;
+        self.recorded = under_way.recorded;
+        self.stats = under_way.stats;
+        Ok(())
+    }
+
+    /// The match of `log` played again: built from its seed, then every event of it.
+    fn replayed(
+        &self,
+        log: &MatchLog,
+        generator_width: usize,
+        solver_width: usize,
+        rewards: &GeneratorRewards,
+    ) -> Result<Match<G>, String> {
+        let (mut game, _) = self.match_of(log.seed);
+        let fits =
+            |row: &[f32], width: usize| row.len() == width && row.iter().all(|v| v.is_finite());
+        for event in &log.events {
+            match event {
+                MatchEvent::Place(row) if fits(row, generator_width) => {
+                    if game.place(row).is_invalid() {
+                        return Err(format!("match {}: a placement is invalid", log.seed));
+                    }
+                }
+                MatchEvent::Step(row) if fits(row, solver_width) && game.started() => {
+                    let action = G::Env::action_from_policy_row(row);
+                    if game.step_solver(action, rewards).0.outcome.is_some() {
+                        return Err(format!("match {}: it ends before its last step", log.seed));
+                    }
+                }
+                _ => {
+                    return Err(format!(
+                        "match {}: an action row of the wrong size, not finite, or a step before the first piece",
+                        log.seed
+                    ));
+                }
+            }
+        }
+        Ok(game)
     }
 
     /// Lets the Generator place the first piece of the fresh matches `indices`; a match whose
@@ -302,16 +469,23 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
     fn next_match(&mut self) -> (Match<G>, Option<usize>) {
         let seed = TRAINING_SEED_BASE + self.state.episodes_started;
         self.state.episodes_started += 1;
-        let (build, mut rng) = G::new_build(seed, None, self.rules.limits, self.rules.obstacles);
-        let values = &self.rules.aux_values;
-        let aux = values[rng.random_range(0..values.len())];
+        let (fresh, mut rng) = self.match_of(seed);
         let snapshots = self.population.len();
         let opponent = match (snapshots, self.rules.snapshot_share) {
             (0, _) => None,
             (n, None) => Some(rng.random_range(0..=n)).filter(|&k| k < n),
             (n, Some(share)) => rng.random_bool(share).then(|| rng.random_range(0..n)),
         };
-        (Match::new(build, vec![aux], seed), opponent)
+        (fresh, opponent)
+    }
+
+    /// The match of `seed` before its first piece (its build and λ drawn from the seed), and
+    /// the seed's generator, to draw on from.
+    fn match_of(&self, seed: u64) -> (Match<G>, ChaCha8Rng) {
+        let (build, mut rng) = G::new_build(seed, None, self.rules.limits, self.rules.obstacles);
+        let values = &self.rules.aux_values;
+        let aux = values[rng.random_range(0..values.len())];
+        (Match::new(build, vec![aux], seed), rng)
     }
 
     /// Adds a snapshot of the Solver, the oldest leaving beyond `keep`; the matches it played
@@ -385,6 +559,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             let action = &acted.actions[k * width..(k + 1) * width];
             let game = &mut self.matches[i];
             let invalid = game.place(action).is_invalid();
+            self.logs[i].events.push(MatchEvent::Place(action.to_vec()));
             let mut reward = self.rules.rewards.per_piece(&game.aux);
             if invalid {
                 reward += self.rules.rewards.invalid;
@@ -432,6 +607,10 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             last.ended = true;
         }
         let (fresh, opponent) = self.next_match();
+        self.logs[i] = MatchLog {
+            seed: fresh.seed(),
+            events: Vec::new(),
+        };
         self.matches[i] = fresh;
         self.opponents[i] = opponent;
     }
@@ -536,8 +715,12 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
         let steps: Vec<(crate::game::Step, f32)> = self
             .matches
             .par_iter_mut()
+            .zip(self.logs.par_iter_mut())
             .zip(actions.par_chunks(width))
-            .map(|(game, row)| game.step_solver(G::Env::action_from_policy_row(row), rewards))
+            .map(|((game, log), row)| {
+                log.events.push(MatchEvent::Step(row.to_vec()));
+                game.step_solver(G::Env::action_from_policy_row(row), rewards)
+            })
             .collect();
         let mut finished = Vec::new();
         let mut turns = Vec::new();

@@ -809,6 +809,11 @@ mod tests {
                 "finish.until_hard_success",
             ),
             (
+                "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, generator_until_hard_success: 2}\n",
+                Game::Platform,
+                "finish.generator_until_hard_success",
+            ),
+            (
                 "generator:\n  snapshot_share: 1.5\n",
                 Game::Platform,
                 "generator.snapshot_share must be a number in [0, 1]",

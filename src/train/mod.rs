@@ -37,14 +37,14 @@ use crate::rl::ppo::{Ppo, UpdateStats};
 use crate::rl::vec_env::{RolloutStats, Trainer, VecEnv};
 use adversarial_run::AdversarialRun;
 use arlpcg::{
-    AdversarialEnvs, AdversarialState, Generator, MatchRules, MatchStats, Phase, PopulationRecord,
+    AdversarialEnvs, AdversarialRecord, Generator, MatchRules, MatchStats, Phase, PopulationRecord,
     Snapshot, population_from, population_record,
 };
 use cards::*;
 use config::{check_config, check_resumable_change, load_config};
 pub use metrics::write_learning_curve;
 use metrics::*;
-use solver_envs::{SolverEnvs, SourceState};
+use solver_envs::{SolverEnvs, SourceRecord};
 use solver_run::*;
 
 pub(super) const CHECKPOINT: &str = "checkpoint.safetensors";
@@ -53,6 +53,9 @@ pub(super) const CHECKPOINT: &str = "checkpoint.safetensors";
 pub const LOCK_FILE: &str = "train.lock";
 pub(super) const GENERATOR_CHECKPOINT: &str = "generator-checkpoint.safetensors";
 pub(super) const METRICS: &str = "metrics.csv";
+/// The key under which a checkpoint's `source` holds the episodes or matches under way
+/// ([`SourceRecord`], [`AdversarialRecord`]).
+pub(super) const UNDER_WAY: &str = "under_way";
 pub(super) const GENERATOR_METRICS: &str = "generator-metrics.csv";
 pub(super) const METRICS_HEADER: &str = "iteration,global_step,wall_time_s,steps_per_s,rollout_s,update_s,learning_rate,episodes,mean_return,success_ratio,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance";
 
@@ -163,11 +166,13 @@ fn solver_run<G: GameSpec>(
     start: Start,
 ) -> Result<Box<dyn Training>> {
     let build = |config: &TrainConfig, state: Option<serde_json::Value>| {
-        let state: SourceState = match state {
+        let record: SourceRecord = match state {
             Some(json) => serde_json::from_value(json).context("level source")?,
-            None => SourceState::default(),
+            None => SourceRecord::default(),
         };
-        Ok(SolverEnvs::<G>::new(source, config.solver.num_envs, state))
+        let action_size = solver_shape(config, G::GAME).action_size();
+        SolverEnvs::<G>::new(source, config.solver.num_envs, record, action_size)
+            .map_err(|problem| anyhow::anyhow!("level source: {problem}"))
     };
     Ok(Box::new(match start {
         Start::New(config) => Run::start(out, mode, config, build)?,

@@ -18,14 +18,14 @@ pub(super) trait Resumable: VecEnv {
 impl<G: GameSpec> Resumable for SolverEnvs<G> {
     const GAME: Game = G::GAME;
     fn source_state(&self) -> serde_json::Value {
-        serde_json::to_value(self.state()).expect("source states serialize")
+        serde_json::to_value(self.record()).expect("source states serialize")
     }
 }
 
 impl<G: GeneratorGame> Resumable for AdversarialEnvs<G> {
     const GAME: Game = G::GAME;
     fn source_state(&self) -> serde_json::Value {
-        serde_json::to_value(self.state).expect("source states serialize")
+        serde_json::to_value(self.record()).expect("source states serialize")
     }
 }
 
@@ -117,12 +117,33 @@ impl<E: Resumable> Run<E> {
         ppo.adam
             .restore(&vars, &loaded.tensors, state.adam_step)
             .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        let envs = build(&config, Some(state.source.clone()))
-            .with_context(|| format!("{}", path.display()))?;
+        // The episodes under way go on where they were, unless the configuration changes
+        // (other rules, other rewards): then fresh ones start.
+        let mut source = state.source.clone();
+        let same_rules = TrainConfig {
+            steps: stored.steps,
+            ..config.clone()
+        } == stored;
+        if !same_rules && let Some(fields) = source.as_object_mut() {
+            fields.remove(UNDER_WAY);
+        }
+        let replayed = source.get(UNDER_WAY).is_some();
+        let envs = build(&config, Some(source)).with_context(|| format!("{}", path.display()))?;
         let mut trainer = Trainer::new(ppo, envs, config.seed);
         trainer.norm = loaded.card.normalizer.clone();
         trainer.rng = state.rng;
         trainer.global_step = state.global_step;
+        if replayed {
+            if state.episode_returns.len() != trainer.episode_returns.len() {
+                bail!(
+                    "{}: {} episode returns for {} episodes under way",
+                    path.display(),
+                    state.episode_returns.len(),
+                    trainer.episode_returns.len()
+                );
+            }
+            trainer.episode_returns = state.episode_returns.clone();
+        }
         truncate_metrics(&out.join(METRICS), METRICS_HEADER, state.iteration)?;
         Ok(Self {
             metrics: open_append(&out.join(METRICS))?,
@@ -137,6 +158,11 @@ impl<E: Resumable> Run<E> {
     }
 
     pub(super) fn save_solver_checkpoint(&self, wall_time_s: f64) -> Result<()> {
+        let bytes = self.solver_checkpoint_bytes(wall_time_s)?;
+        fsio::write_atomic(&self.out.join(CHECKPOINT), &bytes, Overwrite::Allowed)
+    }
+
+    pub(super) fn solver_checkpoint_bytes(&self, wall_time_s: f64) -> Result<Vec<u8>> {
         let state = TrainingState {
             global_step: self.trainer.global_step,
             iteration: self.iteration,
@@ -145,10 +171,15 @@ impl<E: Resumable> Run<E> {
             rng: self.trainer.rng.clone(),
             source: self.trainer.env.source_state(),
             config: serde_json::to_value(&self.config)?,
+            episode_returns: self.trainer.episode_returns.clone(),
         };
         let card = self.solver_card(wall_time_s);
-        let bytes = checkpoint::checkpoint_bytes(&self.trainer.ppo, &card, &state, Vec::new());
-        fsio::write_atomic(&self.out.join(CHECKPOINT), &bytes, Overwrite::Allowed)
+        Ok(checkpoint::checkpoint_bytes(
+            &self.trainer.ppo,
+            &card,
+            &state,
+            Vec::new(),
+        ))
     }
 
     pub(super) fn solver_card(&self, wall_time_s: f64) -> PolicyCard {

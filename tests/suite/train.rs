@@ -548,7 +548,14 @@ fn a_staged_run_with_a_finish_resumes_to_the_same_bytes_on_any_thread_count() {
         out
     };
     let (one, two) = (train("1"), train("2"));
-    for network in [SOLVER, GENERATOR] {
+    assert_same_training(&one, &two, &[SOLVER, GENERATOR]);
+    assert_eq!(curve(&one).last().unwrap().1, 1024 + 128);
+}
+
+/// The weights of `networks` and every metrics column but the clock's are the same in the two
+/// runs.
+fn assert_same_training(one: &Path, two: &Path, networks: &[(&str, Role, usize)]) {
+    for &network in networks {
         let weights = |run: &Path| {
             let loaded = load_network(run, network);
             let mut tensors: Vec<(String, Vec<f32>)> = loaded
@@ -559,29 +566,73 @@ fn a_staged_run_with_a_finish_resumes_to_the_same_bytes_on_any_thread_count() {
             tensors.sort_by(|a, b| a.0.cmp(&b.0));
             tensors
         };
-        assert_eq!(weights(&one), weights(&two), "{}", network.0);
+        assert_eq!(weights(one), weights(two), "{}", network.0);
     }
     // Metrics without the clock's columns (wall time, steps/s, rollout and update seconds).
     for (file, clock) in [("metrics.csv", 2..6), ("generator-metrics.csv", 3..6)] {
-        let rows = |run: &Path| -> Vec<String> {
-            std::fs::read_to_string(run.join(file))
-                .unwrap()
-                .lines()
-                .map(|row| {
-                    let cells: Vec<&str> = row.split(',').collect();
-                    let kept: Vec<&str> = cells
-                        .iter()
-                        .enumerate()
-                        .filter(|(k, _)| !clock.contains(k))
-                        .map(|(_, c)| *c)
-                        .collect();
-                    kept.join(",")
-                })
-                .collect()
+        let rows = |run: &Path| -> Option<Vec<String>> {
+            let text = std::fs::read_to_string(run.join(file)).ok()?;
+            let rows = text.lines().map(|row| {
+                let cells: Vec<&str> = row.split(',').collect();
+                let kept: Vec<&str> = cells
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, _)| !clock.contains(k))
+                    .map(|(_, c)| *c)
+                    .collect();
+                kept.join(",")
+            });
+            Some(rows.collect())
         };
-        assert_eq!(rows(&one), rows(&two), "{file}");
+        assert_eq!(rows(one), rows(two), "{file}");
     }
-    assert_eq!(curve(&one).last().unwrap().1, 1024 + 128);
+}
+
+/// A run paused (`--pause-at`) and resumed gives the bytes of the run never paused: the
+/// episodes and matches under way go on where they were. An adversarial run with a stage and
+/// a finish, paused inside its stage, and a Solver-only run.
+#[test]
+fn a_run_paused_mid_stage_resumes_to_the_bytes_of_one_never_paused() {
+    let dir = tempfile::tempdir().unwrap();
+    let train = |mode: &str, config: &str, steps: &str, pause_at: Option<&str>| {
+        let name = format!("{mode}-{}", pause_at.unwrap_or("whole"));
+        let path = dir.path().join(format!("{name}.yaml"));
+        std::fs::write(&path, config).unwrap();
+        let out = dir.path().join(name);
+        let out_s = out.to_str().unwrap();
+        let start = [
+            "train",
+            "--mode",
+            mode,
+            "--config",
+            path.to_str().unwrap(),
+            "--steps",
+            steps,
+            "--out",
+            out_s,
+        ];
+        match pause_at {
+            None => {
+                arlpcg_ok(&start);
+            }
+            Some(at) => {
+                arlpcg_ok(&[&start[..], &["--pause-at", at]].concat());
+                let paused = curve(&out).last().unwrap().1;
+                let (at, steps): (u64, u64) = (at.parse().unwrap(), steps.parse().unwrap());
+                assert!((at..steps).contains(&paused), "paused at {paused}");
+                arlpcg_ok(&["train", "--mode", mode, "--out", out_s, "--resume"]);
+            }
+        }
+        out
+    };
+    // The stage begins at 768: paused at 896, inside it, with matches under way.
+    let whole = train("arlpcg", TINY_ADVERSARIAL, "1024", None);
+    let paused = train("arlpcg", TINY_ADVERSARIAL, "1024", Some("800"));
+    assert_same_training(&whole, &paused, &[SOLVER, GENERATOR]);
+    assert_eq!(curve(&paused).last().unwrap().1, 1024 + 128);
+    let whole = train("rule-pcg", TINY, "640", None);
+    let paused = train("rule-pcg", TINY, "640", Some("300"));
+    assert_same_training(&whole, &paused, &[SOLVER]);
 }
 
 /// An arlpcg run of `config` (a variant of [`TINY_ADVERSARIAL`], which it must differ from) to a
@@ -654,6 +705,38 @@ fn a_catch_up_until_a_success_ends_the_run_early() {
     // The catch-up begins at 768 (after the finish's Generator phase) and ends with the
     // iteration that completes a block of 32 hard matches, before the limit of 640 + 64,000.
     assert!((896..640 + 64_000).contains(&last), "ended at {last}");
+}
+
+/// A finish's Generator phase that ends at a success: with `generator_until_hard_success: 1`
+/// the first block of 32 hard matches ends it, long before its limit of 4,000 decisions, and
+/// the catch-up that follows runs to the budget.
+#[test]
+fn a_finish_generator_phase_until_a_success_ends_early() {
+    let dir = tempfile::tempdir().unwrap();
+    let until = TINY_ADVERSARIAL.replace(
+        "    solver_steps: 128\n    generator_phase_steps: 8\n",
+        "    solver_steps: 256\n    generator_phase_steps: 4000\n    solver_learning_rate: 1.0e-4\n    solver_phase_steps: 1000000\n    generator_until_hard_success: 1.0\n",
+    );
+    let out = train_tiny_to_640(dir.path(), &until);
+    // Generator rows of the finish (its phase opens at the budget, 640), each with the
+    // Generator's decisions so far; the batch is 16 decisions.
+    let rows: Vec<(u64, u64)> = std::fs::read_to_string(out.join("generator-metrics.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|row| {
+            let cells: Vec<&str> = row.split(',').collect();
+            (cells[1].parse().unwrap(), cells[2].parse().unwrap())
+        })
+        .filter(|&(solver_steps, _)| solver_steps >= 640)
+        .collect();
+    assert!(!rows.is_empty(), "the finish has a Generator phase");
+    let decisions = rows.last().unwrap().1 - rows[0].1 + 16;
+    // 32 hard matches take a few dozen batches of these short levels, not the phase's 4,000
+    // decisions.
+    assert!((32..2_000).contains(&decisions), "{decisions} decisions");
+    // Then the Solver catches up to the budget, 640 + 256.
+    assert_eq!(curve(&out).last().unwrap().1, 896);
 }
 
 /// (global_step, learning_rate) of every metrics row.

@@ -635,6 +635,50 @@ fn a_run_paused_mid_stage_resumes_to_the_bytes_of_one_never_paused() {
     assert_same_training(&whole, &paused, &[SOLVER]);
 }
 
+/// A run killed while its Generator learns (phases of six iterations here) resumes from its
+/// last checkpoint to the bytes of one never stopped: the Generator's decisions not yet
+/// learned from are in the checkpoint with the matches under way.
+#[test]
+fn a_run_killed_while_its_generator_learns_resumes_to_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.yaml");
+    let long_phases = TINY_ADVERSARIAL.replace(
+        "  solver_phase_steps: 128\n  generator_phase_steps: 16",
+        "  solver_phase_steps: 128\n  generator_phase_steps: 96",
+    );
+    std::fs::write(&config, &long_phases).unwrap();
+    let args = |out: &Path| -> Vec<String> {
+        let config = config.to_str().unwrap();
+        let out = out.to_str().unwrap();
+        [
+            "train", "--mode", "arlpcg", "--config", config, "--steps", "768", "--out", out,
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let whole = dir.path().join("whole");
+    arlpcg_ok(&args(&whole).iter().map(String::as_str).collect::<Vec<_>>());
+    let killed = dir.path().join("killed");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+        .args(args(&killed))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // The first Generator phase runs iterations 1 to 6: kill it after its third.
+    let metrics = killed.join("generator-metrics.csv");
+    let start = Instant::now();
+    while std::fs::read_to_string(&metrics).map_or(0, |text| text.lines().count()) < 4 {
+        assert!(start.elapsed() < Duration::from_secs(120), "no progress");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let killed_s = killed.to_str().unwrap();
+    arlpcg_ok(&["train", "--mode", "arlpcg", "--out", killed_s, "--resume"]);
+    assert_same_training(&whole, &killed, &[SOLVER, GENERATOR]);
+}
+
 /// An arlpcg run of `config` (a variant of [`TINY_ADVERSARIAL`], which it must differ from) to a
 /// budget of 640 Solver steps and its finish, in `dir/run`.
 fn train_tiny_to_640(dir: &Path, config: &str) -> std::path::PathBuf {

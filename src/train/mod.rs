@@ -17,6 +17,7 @@ pub mod arlpcg;
 mod cards;
 mod config;
 mod metrics;
+mod recipe;
 pub mod solver_envs;
 mod solver_run;
 

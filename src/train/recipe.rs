@@ -1,15 +1,16 @@
-//! The recipe: what `train` does by default for each game (the budget, the racing Solver's
-//! discount and phases, each game's finish), so that `arlpcg train --game G --mode M --seed S
-//! --out D` alone makes what ships. docs/training.md ("The recipe") says how each value was
-//! found.
+//! The recipe: what `train` does by default for each game, so that `arlpcg train --game G
+//! --mode M --seed S --out D` alone makes what ships. The platform's is the configuration's
+//! default (config.rs: its budget and finish); racing's differs in its budget, the Solver's
+//! discount, the Generator's phases, rewards and curve offset, and its finish.
+//! docs/training.md ("The recipe") says how each value was found.
 
 use super::config::{Finish, TrainConfig};
 use crate::game::RacingGame;
 use crate::game::generator::GeneratorGame;
 use crate::level::Game;
 
-/// The recipe's budget of each game in Solver steps learned from ([`TrainConfig::steps`]).
-pub const PLATFORM_STEPS: u64 = 8_000_000;
+/// The racing recipe's budget in Solver steps learned from ([`TrainConfig::steps`]; the
+/// platform's is the configuration's default, `config::PLATFORM_STEPS`).
 pub const RACING_STEPS: u64 = 5_000_000;
 /// Racing Generator phases are short: each segment costs the Solver (and its snapshots) about
 /// 40 steps of driving without learning, and these phases were 73% of a 10M run's time at 10k.
@@ -18,21 +19,6 @@ pub const RACING_GENERATOR_PHASE_STEPS: u64 = 4_096;
 /// The racing Solver's discount (docs/spec.md §3: γ 0.998; its runs are hundreds of steps
 /// longer than a platform run).
 pub const RACING_SOLVER_GAMMA: f32 = 0.998;
-
-/// The platform recipe's finish: after its 8M steps the Solver is frozen and the Generator
-/// trains on against it alone (no snapshots) in 100k-block phases, four of them between
-/// one-iteration Solver phases over 32,768 more Solver steps. Against the population alone
-/// the Generator finds nothing its own Solver cannot do (λ = -1 levels succeed 0.93-0.97 of
-/// the time); this brings that to about 0.67 while the players it never met keep part of their
-/// drop (docs/training.md, "The recipe").
-pub const PLATFORM_FINISH: Finish = Finish {
-    solver_steps: 32_768,
-    generator_phase_steps: 100_000,
-    solver_learning_rate: 0.0,
-    solver_phase_steps: 1,
-    generator_until_hard_success: None,
-    until_hard_success: None,
-};
 
 /// The racing recipe's finish, in two parts, each ended by the Solver's success on hard
 /// matches: a Generator phase against the final Solver (which only plays in it) until that
@@ -70,5 +56,28 @@ impl TrainConfig {
             config.generator.finish = RACING_FINISH;
         }
         config
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_racing_recipe_has_short_generator_phases_and_a_finish_that_catches_up() {
+        let racing = TrainConfig::for_game(Game::Racing);
+        assert_eq!(racing.steps, RACING_STEPS);
+        assert_eq!(racing.solver.gamma, RACING_SOLVER_GAMMA);
+        assert_eq!(racing.generator.curve_offset, 90.0);
+        assert_eq!(racing.generator.generator_phase_steps, 4_096);
+        assert_eq!(racing.generator.finish, RACING_FINISH);
+        assert_eq!(racing.adversarial_budget(), 6_000_000);
+        // The finish's phases: the Generator's first, then the Solver's at its constant rate.
+        let finish = racing.schedule_at(5_000_000);
+        assert_eq!(
+            (finish.solver_learning_rate, finish.generator_phase_steps),
+            (Some(1.0e-4), 400_000)
+        );
+        assert_eq!(racing.schedule_at(4_999_999).solver_learning_rate, None);
     }
 }

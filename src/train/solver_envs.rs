@@ -114,7 +114,7 @@ impl<G: GameSpec> SolverEnvs<G> {
         this.envs = this
             .logs
             .par_iter()
-            .map(|log| replay::<G>(log, action_size))
+            .map(|log| this.replayed(log, action_size))
             .collect::<Result<_, String>>()?;
         Ok(this)
     }
@@ -145,25 +145,31 @@ impl<G: GameSpec> SolverEnvs<G> {
         }
     }
 
-    /// The environment of a fresh episode.
+    /// The environment of a fresh episode: a fixed level when it is one of them, else the
+    /// rule level of its seed.
     fn start(&self, log: &EpisodeLog) -> G::Env {
-        let level = match self.mode {
-            SolverMode::FixedTrack => &self.fixed[(log.level_seed - TRAINING_SEED_BASE) as usize],
-            SolverMode::RulePcg => &rule_level::<G>(log.level_seed),
+        let fixed = match self.mode {
+            SolverMode::FixedTrack => log
+                .level_seed
+                .checked_sub(TRAINING_SEED_BASE)
+                .and_then(|k| self.fixed.get(usize::try_from(k).ok()?)),
+            SolverMode::RulePcg => None,
+        };
+        let level = match fixed {
+            Some(level) => level,
+            None => &rule_level::<G>(log.level_seed),
         };
         let mut env = G::solver_env(level).expect("training levels are of the run's game");
         env.reset(log.reset_seed);
         env
     }
-}
 
-/// The episode of `log` played again to where it was: its level, reset, and every row stepped.
-fn replay<G: GameSpec>(log: &EpisodeLog, action_size: usize) -> Result<G::Env, String> {
-    let level = rule_level::<G>(log.level_seed);
-    let mut env = G::solver_env(&level).ok_or("a training level of another game")?;
-    env.reset(log.reset_seed);
-    play_rows::<G::Env>(&mut env, &log.rows, action_size)?;
-    Ok(env)
+    /// The episode of `log` played again to where it was: started, and every row stepped.
+    fn replayed(&self, log: &EpisodeLog, action_size: usize) -> Result<G::Env, String> {
+        let mut env = self.start(log);
+        play_rows::<G::Env>(&mut env, &log.rows, action_size)?;
+        Ok(env)
+    }
 }
 
 /// Steps `env` with `rows` (each of `action_size` finite values), which must leave its

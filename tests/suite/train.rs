@@ -679,6 +679,15 @@ fn a_run_killed_while_its_generator_learns_resumes_to_the_same_bytes() {
     assert_same_training(&whole, &killed, &[SOLVER, GENERATOR]);
 }
 
+/// [`TINY_ADVERSARIAL`] with its finish replaced by `fields` (one `key: value` per line).
+fn tiny_with_finish(fields: &str) -> String {
+    let finish: String = fields.lines().map(|line| format!("    {line}\n")).collect();
+    TINY_ADVERSARIAL.replace(
+        "    solver_steps: 128\n    generator_phase_steps: 8\n",
+        &finish,
+    )
+}
+
 /// An arlpcg run of `config` (a variant of [`TINY_ADVERSARIAL`], which it must differ from) to a
 /// budget of 640 Solver steps and its finish, in `dir/run`.
 fn train_tiny_to_640(dir: &Path, config: &str) -> std::path::PathBuf {
@@ -740,9 +749,8 @@ fn a_learning_finish_opens_with_the_generator_and_ends_with_the_solver_catching_
 #[test]
 fn a_catch_up_until_a_success_ends_the_run_early() {
     let dir = tempfile::tempdir().unwrap();
-    let until = TINY_ADVERSARIAL.replace(
-        "    solver_steps: 128\n    generator_phase_steps: 8\n",
-        "    solver_steps: 64000\n    generator_phase_steps: 8\n    solver_learning_rate: 1.0e-4\n    solver_phase_steps: 1000000\n    until_hard_success: 0.0\n",
+    let until = tiny_with_finish(
+        "solver_steps: 64000\ngenerator_phase_steps: 8\nsolver_learning_rate: 1.0e-4\nsolver_phase_steps: 1000000\nuntil_hard_success: 0.0",
     );
     let out = train_tiny_to_640(dir.path(), &until);
     let last = curve(&out).last().unwrap().1;
@@ -757,9 +765,8 @@ fn a_catch_up_until_a_success_ends_the_run_early() {
 #[test]
 fn a_finish_generator_phase_until_a_success_ends_early() {
     let dir = tempfile::tempdir().unwrap();
-    let until = TINY_ADVERSARIAL.replace(
-        "    solver_steps: 128\n    generator_phase_steps: 8\n",
-        "    solver_steps: 256\n    generator_phase_steps: 4000\n    solver_learning_rate: 1.0e-4\n    solver_phase_steps: 1000000\n    generator_until_hard_success: 1.0\n",
+    let until = tiny_with_finish(
+        "solver_steps: 256\ngenerator_phase_steps: 4000\nsolver_learning_rate: 1.0e-4\nsolver_phase_steps: 1000000\ngenerator_until_hard_success: 1.0",
     );
     let out = train_tiny_to_640(dir.path(), &until);
     // Generator rows of the finish (its phase opens at the budget, 640), each with the

@@ -196,7 +196,13 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         let batch = self.envs().take_generator_batch();
         let stats = self.envs().take_stats();
         let t1 = wall();
+        let run = &self.solver.config;
+        let entropy = match run.generator.finish.generator_entropy {
+            Some(entropy) if run.in_finish(self.solver.trainer.global_step) => entropy,
+            _ => config.ent_coef,
+        };
         let envs = self.envs();
+        envs.generator.ppo.config.ent_coef = entropy;
         let update = envs
             .generator
             .ppo

@@ -30,11 +30,15 @@ use crate::game::generator::{
 };
 use crate::level::stats::Outcome;
 use crate::rl::normalizer::RunningNorm;
-use crate::rl::policy::{ActMode, ActorCritic};
+use crate::rl::policy::ActMode;
 use crate::rl::ppo::{Batch, Ppo, gae};
 use crate::rl::vec_env::{Transition, VecEnv};
 use crate::seeds::TRAINING_SEED_BASE;
 use crate::train::config::HARD_MATCH_BLOCK;
+use crate::train::population::Snapshot;
+
+mod replay;
+pub use replay::{AdversarialRecord, MatchEvent, MatchLog, MatchesUnderWay};
 
 /// Which agent is learning.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -90,93 +94,6 @@ pub struct MatchRules {
     pub snapshot_share: Option<f64>,
 }
 
-/// An earlier Solver that the Generator plays against.
-pub struct Snapshot {
-    pub policy: ActorCritic,
-    pub norm: RunningNorm,
-    /// The Solver's steps when it was taken.
-    pub solver_steps: u64,
-}
-
-impl Snapshot {
-    /// A copy of `policy` (new variables, the same values) with its normalizer.
-    pub fn of(
-        policy: &ActorCritic,
-        norm: &RunningNorm,
-        solver_steps: u64,
-    ) -> candle_core::Result<Self> {
-        let copy = ActorCritic::new(policy.shape().clone(), 0)?;
-        for ((_, to), (_, from)) in copy.named_vars().iter().zip(policy.named_vars()) {
-            to.set(&from.as_tensor().copy()?)?;
-        }
-        Ok(Self {
-            policy: copy,
-            norm: norm.clone(),
-            solver_steps,
-        })
-    }
-}
-
-/// How a Generator checkpoint records its population: the snapshots' tensors are named
-/// `population.K.<variable>`, and this (its training state's `source`) holds the rest.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
-pub struct PopulationRecord {
-    pub snapshots: Vec<SnapshotRecord>,
-}
-
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct SnapshotRecord {
-    pub solver_steps: u64,
-    pub norm: RunningNorm,
-}
-
-/// The population as a checkpoint stores it: its record and its tensors.
-pub fn population_record(
-    population: &[Snapshot],
-) -> (PopulationRecord, Vec<(String, candle_core::Tensor)>) {
-    let mut tensors = Vec::new();
-    let mut record = PopulationRecord::default();
-    for (k, snapshot) in population.iter().enumerate() {
-        for (name, var) in snapshot.policy.named_vars() {
-            tensors.push((format!("population.{k}.{name}"), var.as_tensor().clone()));
-        }
-        record.snapshots.push(SnapshotRecord {
-            solver_steps: snapshot.solver_steps,
-            norm: snapshot.norm.clone(),
-        });
-    }
-    (record, tensors)
-}
-
-/// The population a checkpoint stored: Solvers of `shape`, each tensor checked for its shape
-/// and for finite values. `Err` names the tensor.
-pub fn population_from(
-    record: &PopulationRecord,
-    tensors: &std::collections::HashMap<String, candle_core::Tensor>,
-    shape: &crate::rl::policy::PolicyShape,
-) -> Result<Vec<Snapshot>, String> {
-    let mut population = Vec::with_capacity(record.snapshots.len());
-    for (k, entry) in record.snapshots.iter().enumerate() {
-        let policy = ActorCritic::new(shape.clone(), 0).map_err(|e| e.to_string())?;
-        for (name, var) in policy.named_vars() {
-            let key = format!("population.{k}.{name}");
-            crate::rl::checkpoint::restore_var(tensors, &key, &var).map_err(|e| e.to_string())?;
-        }
-        let d = shape.observation;
-        if entry.norm.mean.len() != d || entry.norm.var.len() != d {
-            return Err(format!(
-                "snapshot {k}: its normalizer does not observe {d} values"
-            ));
-        }
-        population.push(Snapshot {
-            policy,
-            norm: entry.norm.clone(),
-            solver_steps: entry.solver_steps,
-        });
-    }
-    Ok(population)
-}
-
 /// The Generator with its optimizer and normalizer.
 pub struct Generator {
     pub ppo: Ppo,
@@ -210,45 +127,6 @@ pub struct MatchStats {
     pub pieces: [u32; 2],
     pub feature_sums: [[f64; 2]; 2],
     pub air_steps: [u64; 2],
-}
-
-/// What a match has been through since it began: enough to play it again to where it is.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MatchLog {
-    pub seed: u64,
-    pub events: Vec<MatchEvent>,
-}
-
-/// One thing that happened in a match, as the action row that made it happen.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum MatchEvent {
-    /// The Generator placed a piece.
-    Place(Vec<f32>),
-    /// The Solver (or the snapshot playing the match) took a step.
-    Step(Vec<f32>),
-}
-
-/// The matches under way as a checkpoint stores them: per match its log, who plays it, the
-/// Generator's return so far and its decisions still to learn from; and the statistics not
-/// yet taken.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MatchesUnderWay {
-    logs: Vec<MatchLog>,
-    opponents: Vec<Option<usize>>,
-    generator_returns: Vec<f32>,
-    recorded: Vec<Vec<Decision>>,
-    stats: MatchStats,
-}
-
-/// What a checkpoint stores of the matches: the source's progress and, since checkpoints
-/// have held them, the matches under way (none: fresh matches start).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct AdversarialRecord {
-    #[serde(flatten)]
-    pub state: AdversarialState,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub under_way: Option<MatchesUnderWay>,
 }
 
 /// Many matches of the Generator against the Solver, as the Solver's environments.
@@ -314,114 +192,6 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         }
         this.first_pieces((0..num_matches).collect())?;
         Ok(this)
-    }
-
-    /// The source's progress and the matches under way, as a checkpoint stores them.
-    pub fn record(&self) -> AdversarialRecord {
-        AdversarialRecord {
-            state: self.state,
-            under_way: Some(MatchesUnderWay {
-                logs: self.logs.clone(),
-                opponents: self.opponents.clone(),
-                generator_returns: self.generator_returns.clone(),
-                recorded: self.recorded.clone(),
-                stats: self.stats.clone(),
-            }),
-        }
-    }
-
-    /// Plays the matches of `under_way` again to where they were, checking what a tampered
-    /// checkpoint could get wrong.
-    fn replay(
-        &mut self,
-        num_matches: usize,
-        under_way: MatchesUnderWay,
-        solver_action_size: usize,
-    ) -> Result<(), String> {
-        let n = num_matches;
-        if [
-            under_way.logs.len(),
-            under_way.opponents.len(),
-            under_way.generator_returns.len(),
-            under_way.recorded.len(),
-        ] != [n; 4]
-        {
-            return Err(format!("they are not {n}, one per match"));
-        }
-        let snapshots = self.population.len();
-        if under_way
-            .opponents
-            .iter()
-            .flatten()
-            .any(|&k| k >= snapshots)
-        {
-            return Err(format!(
-                "a match is played by a snapshot beyond the {snapshots} kept"
-            ));
-        }
-        let shape = self.generator.ppo.policy.shape();
-        let (d, width) = (shape.observation, shape.action_size());
-        let decision_fits = |decision: &Decision| {
-            decision.observation.len() == d
-                && decision.action.len() == width
-                && decision
-                    .observation
-                    .iter()
-                    .chain(&decision.action)
-                    .all(|v| v.is_finite())
-        };
-        if !under_way.recorded.iter().flatten().all(decision_fits) {
-            return Err(format!(
-                "a recorded Generator decision is not {d} observed and {width} acted finite numbers"
-            ));
-        }
-        let rewards = &self.rules.rewards;
-        self.matches = under_way
-            .logs
-            .par_iter()
-            .map(|log| self.replayed(log, width, solver_action_size, rewards))
-            .collect::<Result<_, String>>()?;
-        self.logs = under_way.logs;
-        self.opponents = under_way.opponents;
-        self.generator_returns = under_way.generator_returns;
-        self.recorded = under_way.recorded;
-        self.stats = under_way.stats;
-        Ok(())
-    }
-
-    /// The match of `log` played again: built from its seed, then every event of it.
-    fn replayed(
-        &self,
-        log: &MatchLog,
-        generator_width: usize,
-        solver_width: usize,
-        rewards: &GeneratorRewards,
-    ) -> Result<Match<G>, String> {
-        let (mut game, _) = self.match_of(log.seed);
-        let fits =
-            |row: &[f32], width: usize| row.len() == width && row.iter().all(|v| v.is_finite());
-        for event in &log.events {
-            match event {
-                MatchEvent::Place(row) if fits(row, generator_width) => {
-                    if game.place(row).is_invalid() {
-                        return Err(format!("match {}: a placement is invalid", log.seed));
-                    }
-                }
-                MatchEvent::Step(row) if fits(row, solver_width) && game.started() => {
-                    let action = G::Env::action_from_policy_row(row);
-                    if game.step_solver(action, rewards).0.outcome.is_some() {
-                        return Err(format!("match {}: it ends before its last step", log.seed));
-                    }
-                }
-                _ => {
-                    return Err(format!(
-                        "match {}: an action row of the wrong size, not finite, or a step before the first piece",
-                        log.seed
-                    ));
-                }
-            }
-        }
-        Ok(game)
     }
 
     /// Lets the Generator place the first piece of the fresh matches `indices`; a match whose

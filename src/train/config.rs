@@ -158,6 +158,11 @@ pub struct Finish {
     /// `solver_steps`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub until_hard_success: Option<f64>,
+    /// The Generator's entropy bonus in the finish's Generator phases, in place of
+    /// `generator.ppo.ent_coef` (none: that one): a larger one keeps it trying new tracks
+    /// against the final Solver instead of refining those it already makes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub generator_entropy: Option<f32>,
 }
 
 /// Hard matches (λ < 0) over which the Solver's success is counted in the finish, block after
@@ -182,6 +187,7 @@ impl Finish {
         solver_phase_steps: 1,
         generator_until_hard_success: None,
         until_hard_success: None,
+        generator_entropy: None,
     };
 }
 
@@ -319,6 +325,7 @@ pub const PLATFORM_FINISH: Finish = Finish {
     solver_phase_steps: 1,
     generator_until_hard_success: None,
     until_hard_success: None,
+    generator_entropy: None,
 };
 
 pub(super) fn load_config(path: &Path, game: Game) -> Result<TrainConfig> {
@@ -513,6 +520,12 @@ fn check_schedule(g: &GeneratorConfig) -> Result<(), String> {
         let rate = g.finish.solver_learning_rate;
         if !(rate.is_finite() && (0.0..=1.0).contains(&rate)) {
             return Err("finish.solver_learning_rate must be a number in [0, 1]".into());
+        }
+        if g.finish
+            .generator_entropy
+            .is_some_and(|e| !(0.0..=1.0).contains(&e))
+        {
+            return Err("finish.generator_entropy must be a number in [0, 1]".into());
         }
         if g.ppo.anneal_lr {
             return Err(
@@ -754,6 +767,11 @@ mod tests {
                 "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, generator_until_hard_success: 2}\n",
                 Game::Platform,
                 "finish.generator_until_hard_success",
+            ),
+            (
+                "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, generator_entropy: -0.1}\n",
+                Game::Platform,
+                "finish.generator_entropy",
             ),
             (
                 "generator:\n  snapshot_share: 1.5\n",

@@ -17,6 +17,7 @@ pub mod arlpcg;
 mod cards;
 mod config;
 mod metrics;
+pub mod population;
 mod recipe;
 pub mod solver_envs;
 mod solver_run;
@@ -37,14 +38,12 @@ use crate::rl::policy::{ActorCritic, PolicyShape};
 use crate::rl::ppo::{Ppo, UpdateStats};
 use crate::rl::vec_env::{RolloutStats, Trainer, VecEnv};
 use adversarial_run::AdversarialRun;
-use arlpcg::{
-    AdversarialEnvs, AdversarialRecord, Generator, MatchRules, MatchStats, Phase, PopulationRecord,
-    Snapshot, population_from, population_record,
-};
+use arlpcg::{AdversarialEnvs, AdversarialRecord, Generator, MatchRules, MatchStats, Phase};
 use cards::*;
 use config::{check_config, check_resumable_change, load_config};
 pub use metrics::write_learning_curve;
 use metrics::*;
+use population::{PopulationRecord, Snapshot, population_from, population_record};
 use solver_envs::{SolverEnvs, SourceRecord};
 use solver_run::*;
 

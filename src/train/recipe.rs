@@ -36,6 +36,7 @@ pub const RACING_FINISH: Finish = Finish {
     solver_phase_steps: 1_000_000_000,
     generator_until_hard_success: Some(0.3),
     until_hard_success: Some(0.7),
+    generator_entropy: None,
 };
 
 impl TrainConfig {

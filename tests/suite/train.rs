@@ -790,6 +790,52 @@ fn a_finish_generator_phase_until_a_success_ends_early() {
     assert_eq!(curve(&out).last().unwrap().1, 896);
 }
 
+/// `finish.generator_entropy` is the Generator's entropy bonus in the finish alone: with a large
+/// one its policy spreads out there, and every row before the finish is the run without it.
+#[test]
+fn a_finish_generator_entropy_spreads_the_generator_in_the_finish_only() {
+    let run = |entropy: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let config = tiny_with_finish(&format!(
+            "solver_steps: 128\ngenerator_phase_steps: 400{entropy}"
+        ))
+        .replace("  ppo:\n", "  ppo:\n    learning_rate: 0.01\n");
+        let out = train_tiny_to_640(dir.path(), &config);
+        // (solver_step, the columns that do not tell time, entropy) of each Generator row.
+        std::fs::read_to_string(out.join("generator-metrics.csv"))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|row| {
+                let cells: Vec<&str> = row.split(',').collect();
+                let steps: u64 = cells[1].parse().unwrap();
+                let kept = [&cells[..3], &cells[6..]].concat().join(",");
+                (steps, kept, cells[20].parse::<f64>().unwrap())
+            })
+            .collect::<Vec<_>>()
+    };
+    let (plain, spread) = (run(""), run("\ngenerator_entropy: 1.0"));
+    let before = |rows: &[(u64, String, f64)]| -> Vec<String> {
+        rows.iter()
+            .filter(|r| r.0 < 640)
+            .map(|r| r.1.clone())
+            .collect()
+    };
+    assert!(!before(&plain).is_empty());
+    assert_eq!(
+        before(&plain),
+        before(&spread),
+        "the bonus waits for the finish"
+    );
+    let last = |rows: &[(u64, String, f64)]| rows.last().unwrap().2;
+    assert!(
+        last(&spread) > last(&plain) + 0.5,
+        "entropy at the finish's end: {} with the bonus, {} without",
+        last(&spread),
+        last(&plain)
+    );
+}
+
 /// (global_step, learning_rate) of every metrics row.
 fn learning_rates(run: &Path) -> Vec<(u64, f64)> {
     let metrics = std::fs::read_to_string(run.join("metrics.csv")).unwrap();

@@ -28,7 +28,8 @@ pub const RACING_SOLVER_GAMMA: f32 = 0.998;
 /// catch-up the Generator's λ = -1 tracks were completed by under half of its Solver's runs;
 /// with 1M steps of it the Solver drove them all and λ steered nothing; a fixed 140k-segment
 /// Generator phase left the Solver at 30% in one run and 60% in another (docs/results.md,
-/// "A finish with a catch-up").
+/// "A finish with a catch-up"). In its Generator phase the Generator's entropy bonus is 0.01
+/// (the run's is 0.001), so that it keeps trying new tracks against the final Solver.
 pub const RACING_FINISH: Finish = Finish {
     solver_steps: 1_000_000,
     generator_phase_steps: 400_000,
@@ -36,7 +37,7 @@ pub const RACING_FINISH: Finish = Finish {
     solver_phase_steps: 1_000_000_000,
     generator_until_hard_success: Some(0.3),
     until_hard_success: Some(0.7),
-    generator_entropy: None,
+    generator_entropy: Some(0.01),
 };
 
 impl TrainConfig {

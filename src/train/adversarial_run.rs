@@ -175,11 +175,13 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         Ok(())
     }
 
-    /// Plays until a batch of Generator decisions is complete, and learns from it; returns
-    /// its progress line and the statistics of the matches that ended meanwhile.
+    /// Plays until a batch of Generator decisions is complete, and learns from it (with the
+    /// schedule's entropy bonus, if it sets one); returns its progress line and the statistics
+    /// of the matches that ended meanwhile.
     pub(super) fn generator_iteration(
         &mut self,
         lr_scale: f64,
+        entropy: Option<f32>,
         wall: &dyn Fn() -> f64,
     ) -> Result<(String, MatchStats)> {
         let config = self.solver.config.generator.ppo.clone();
@@ -196,13 +198,8 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         let batch = self.envs().take_generator_batch();
         let stats = self.envs().take_stats();
         let t1 = wall();
-        let run = &self.solver.config;
-        let entropy = match run.generator.finish.generator_entropy {
-            Some(entropy) if run.in_finish(self.solver.trainer.global_step) => entropy,
-            _ => config.ent_coef,
-        };
         let envs = self.envs();
-        envs.generator.ppo.config.ent_coef = entropy;
+        envs.generator.ppo.config.ent_coef = entropy.unwrap_or(config.ent_coef);
         let update = envs
             .generator
             .ppo
@@ -304,7 +301,8 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                 ))
             }
             Phase::Generator => {
-                let (message, stats) = self.generator_iteration(lr_scale, wall)?;
+                let (message, stats) =
+                    self.generator_iteration(lr_scale, schedule.generator_entropy, wall)?;
                 let envs = self.envs();
                 // In the finish, the phase may end early once the Solver fails enough.
                 let hard_enough = match finish.generator_until_hard_success {

@@ -242,12 +242,14 @@ impl GeneratorConfig {
                 solver_phase_steps: stage.solver_phase_steps,
                 generator_phase_steps: stage.generator_phase_steps,
                 snapshot_share: stage.snapshot_share.or(self.snapshot_share),
+                generator_entropy: None,
             },
             None => Schedule {
                 solver_learning_rate: None,
                 solver_phase_steps: self.solver_phase_steps,
                 generator_phase_steps: self.generator_phase_steps,
                 snapshot_share: self.snapshot_share,
+                generator_entropy: None,
             },
         }
     }
@@ -262,6 +264,8 @@ pub struct Schedule {
     pub generator_phase_steps: u64,
     /// The share of matches a snapshot plays (`GeneratorConfig::snapshot_share`).
     pub snapshot_share: Option<f64>,
+    /// The Generator's entropy bonus (`None`: `generator.ppo.ent_coef`).
+    pub generator_entropy: Option<f32>,
 }
 
 impl Default for GeneratorConfig {
@@ -363,6 +367,7 @@ impl TrainConfig {
                 solver_phase_steps: finish.solver_phase_steps,
                 generator_phase_steps: finish.generator_phase_steps,
                 snapshot_share: Some(0.0),
+                generator_entropy: finish.generator_entropy,
             };
         }
         self.generator.schedule_at(solver_steps)

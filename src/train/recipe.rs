@@ -20,25 +20,22 @@ pub const RACING_GENERATOR_PHASE_STEPS: u64 = 4_096;
 /// longer than a platform run).
 pub const RACING_SOLVER_GAMMA: f32 = 0.998;
 
-/// The racing recipe's finish, in two parts, each ended by the Solver's success on hard
-/// matches (counted over blocks of 32): a Generator phase against the final Solver (which only
-/// plays in it) until that success has fallen to 40% (at most 800k track segments), then the
-/// Solver catches up at a constant 1e-4 against that Generator, frozen, until it succeeds on 55%
-/// of its hard matches again (at most 1M Solver steps past the budget; its phase is longer than
-/// that). Without the catch-up the Generator's λ = -1 tracks were completed by under half of its
-/// Solver's runs; with 1M steps of it the Solver drove them all and λ steered nothing. With
-/// the earlier 30% and 70% (at most 400k segments), seed 0's Generator phase ran to its cap at
-/// about 70% and its Solver then drove 84% of the evaluation's λ = -1 tracks (target at most
-/// 70%), hence the longer phase and the lower thresholds (docs/results.md, "A finish with a
-/// catch-up" and after). In its Generator phase the Generator's entropy bonus is 0.01
-/// (the run's is 0.001), so that it keeps trying new tracks against the final Solver.
+/// The racing recipe's finish: one Generator phase against the final Solver, frozen and alone,
+/// until the Solver succeeds on only half of its hard matches (counted over blocks of 32; at
+/// most 800k track segments), then one frozen Solver iteration and the run ends. In that phase
+/// the Generator's entropy bonus is 0.01 (the run's is 0.001), so that it keeps trying new
+/// tracks against the final Solver. Earlier finishes let the Solver catch up at 1e-4 after the
+/// Generator's phase, until it succeeded on 70% (then 55%) of its hard matches again; each
+/// time it then drove 84% (then 89%) of the evaluation's λ = -1 tracks (target at most 70%;
+/// docs/results.md, "A finish with a catch-up" and after).
 pub const RACING_FINISH: Finish = Finish {
-    solver_steps: 1_000_000,
+    // The iteration under way at the budget, then the one after the Generator's phase.
+    solver_steps: 16_384,
     generator_phase_steps: 800_000,
-    solver_learning_rate: 1e-4,
-    solver_phase_steps: 1_000_000_000,
-    generator_until_hard_success: Some(0.4),
-    until_hard_success: Some(0.55),
+    solver_learning_rate: 0.0,
+    solver_phase_steps: 1,
+    generator_until_hard_success: Some(0.5),
+    until_hard_success: None,
     generator_entropy: Some(0.01),
 };
 
@@ -68,19 +65,19 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_racing_recipe_has_short_generator_phases_and_a_finish_that_catches_up() {
+    fn the_racing_recipe_has_short_generator_phases_and_a_frozen_finish() {
         let racing = TrainConfig::for_game(Game::Racing);
         assert_eq!(racing.steps, RACING_STEPS);
         assert_eq!(racing.solver.gamma, RACING_SOLVER_GAMMA);
         assert_eq!(racing.generator.curve_offset, 90.0);
         assert_eq!(racing.generator.generator_phase_steps, 4_096);
         assert_eq!(racing.generator.finish, RACING_FINISH);
-        assert_eq!(racing.adversarial_budget(), 6_000_000);
-        // The finish's phases: the Generator's first, then the Solver's at its constant rate.
+        assert_eq!(racing.adversarial_budget(), 5_016_384);
+        // The finish: the Generator's phase against the Solver frozen.
         let finish = racing.schedule_at(5_000_000);
         assert_eq!(
             (finish.solver_learning_rate, finish.generator_phase_steps),
-            (Some(1.0e-4), 800_000)
+            (Some(0.0), 800_000)
         );
         assert_eq!(racing.schedule_at(4_999_999).solver_learning_rate, None);
     }

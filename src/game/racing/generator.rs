@@ -442,7 +442,8 @@ mod tests {
         let mut driver = ScriptedDriver::new(3, 0.0);
         let (mut placements, mut generator_return) = (0, 0.0);
         let mut outcome = None;
-        let mut first_view = None;
+        let mut views = Vec::new();
+        let mut actions = Vec::new();
         for _ in 0..20_000 {
             while game.needs_piece() {
                 let placed = game.place(&[0.0; 3]);
@@ -455,12 +456,11 @@ mod tests {
                     || racing::reaches(game.build().road.end().0, game.build().goal),
                 "the road is built beyond the Solver's sight"
             );
-            if first_view.is_none() {
-                let mut view = vec![0.0; OBSERVATION_SIZE];
-                game.env().observe(&mut view);
-                first_view = Some(view);
-            }
+            let mut view = vec![0.0; OBSERVATION_SIZE];
+            game.env().observe(&mut view);
+            views.push(view);
             let action = driver.act(game.env());
+            actions.push(action);
             let (step, reward) = game.step_solver(action, &rewards);
             generator_return += reward;
             if step.outcome.is_some() {
@@ -493,15 +493,20 @@ mod tests {
         let mut env = RacingEnv::new(&track, game.build().goal, SolverRewards::default());
         env.reset(3);
         assert_eq!(env.road().length(), game.env().road().length());
-        // The Solver saw the start of the match as it sees the start of the finished track.
+        // The same actions on the finished track make the same run: the Solver sees at every
+        // step what it saw in the match, and the run ends the same way on the same step.
         let mut view = vec![0.0; OBSERVATION_SIZE];
-        env.observe(&mut view);
-        let first_view = first_view.unwrap();
-        for (k, (a, b)) in first_view.iter().zip(&view).enumerate() {
-            assert!(
-                (a - b).abs() < 1e-4,
-                "value {k}: {a} in the match, {b} on the track"
-            );
+        for (step, (seen, action)) in views.iter().zip(&actions).enumerate() {
+            env.observe(&mut view);
+            for (k, (a, b)) in seen.iter().zip(&view).enumerate() {
+                assert!(
+                    (a - b).abs() < 1e-4,
+                    "step {step}, value {k}: {a} in the match, {b} on the track"
+                );
+            }
+            let ended = env.step(*action).outcome;
+            let last = step + 1 == actions.len();
+            assert_eq!(ended, if last { outcome } else { None }, "step {step}");
         }
     }
 

@@ -29,7 +29,8 @@ pub const RACING_SOLVER_GAMMA: f32 = 0.998;
 /// time it then drove 84% (then 89%) of the evaluation's λ = -1 tracks (target at most 70%;
 /// docs/results.md, "A finish with a catch-up" and after).
 pub const RACING_FINISH: Finish = Finish {
-    // The iteration under way at the budget, then the one after the Generator's phase.
+    // Two frozen Solver iterations: the one that opens the finish, then one after the
+    // Generator's phase.
     solver_steps: 16_384,
     generator_phase_steps: 800_000,
     solver_learning_rate: 0.0,

@@ -472,20 +472,20 @@ fn parse_judges(s: &str) -> Result<Judges, String> {
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     arlpcg train --game platform --mode arlpcg --seed 1 --out runs/platform-arlpcg-s1\n  \
-    arlpcg train --game platform --mode arlpcg --seed 1 --out runs/platform-arlpcg-s1 --resume\n  \
+    arlpcg train --out runs/platform-arlpcg-s1 --resume\n  \
     arlpcg train --game racing --mode rule-pcg --minutes 60 --out runs/racing-solver\n  \
     arlpcg train --game platform --mode arlpcg --steps 200000 --out runs/try\n  \
-    arlpcg train --mode arlpcg --out runs/arlpcg --resume --config new.yaml\n  \
+    arlpcg train --out runs/arlpcg --resume --config new.yaml\n  \
     arlpcg train --print-config > train.yaml")]
 pub struct TrainArgs {
-    /// Which game.
-    #[arg(long, default_value = "platform", value_parser = parse_game)]
-    pub game: Game,
+    /// Which game (default: platform; a resumed run's own).
+    #[arg(long, value_parser = parse_game)]
+    pub game: Option<Game>,
     /// How the Solver is trained: on rule levels, on a fixed set, or against a Generator
     /// (`arlpcg`: λ drawn per match; `fixed-aux`: λ = 1). The adversarial modes train and save
-    /// the Generator too.
-    #[arg(long, value_enum, default_value = "rule-pcg")]
-    pub mode: TrainModeArg,
+    /// the Generator too. Default: rule-pcg; a resumed run's own.
+    #[arg(long, value_enum)]
+    pub mode: Option<TrainModeArg>,
     /// The run's budget: stop when the Solver has learned from this many environment steps in
     /// all, over every resume (default: the configuration's `steps`, the game's recipe: platform
     /// 8M, racing 5M); an adversarial run then plays its `generator.finish`. Given with

@@ -16,7 +16,9 @@ pub fn run(args: &TrainArgs) -> Result<()> {
     if args.print_config {
         print!(
             "{}",
-            serde_yaml::to_string(&TrainConfig::for_game(args.game))?
+            serde_yaml::to_string(&TrainConfig::for_game(
+                args.game.unwrap_or(crate::level::Game::Platform)
+            ))?
         );
         return Ok(());
     }
@@ -40,7 +42,7 @@ pub fn run(args: &TrainArgs) -> Result<()> {
     pool.install(|| {
         let mut run = train::open(
             args.game,
-            args.mode.into(),
+            args.mode.map(Into::into),
             out,
             args.config.as_deref(),
             args.seed,

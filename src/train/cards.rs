@@ -182,6 +182,22 @@ pub(super) fn save_policy_files(
     )
 }
 
+/// The game and mode of the run whose checkpoint is `path`: what `--resume` continues when
+/// `--game` or `--mode` is not given.
+pub(super) fn checkpoint_identity(path: &Path) -> Result<(Game, TrainMode)> {
+    let bytes = crate::fsio::read_limited(path, checkpoint::MAX_POLICY_BYTES, "checkpoint")
+        .context("cannot resume")?;
+    let card = checkpoint::read_card(&bytes).with_context(|| format!("{}", path.display()))?;
+    let mode = TrainMode::from_name(&card.training.mode).with_context(|| {
+        format!(
+            "{}: training.mode `{}` is not one of rule-pcg, fixed-track, fixed-aux, arlpcg",
+            path.display(),
+            card.training.mode
+        )
+    })?;
+    Ok((card.game, mode))
+}
+
 /// Reads a checkpoint of `role`, checking that it was trained in `mode`.
 pub(super) fn read_checkpoint(
     path: &Path,

@@ -28,6 +28,18 @@ pub enum TrainMode {
 }
 
 impl TrainMode {
+    pub const ALL: [TrainMode; 4] = [
+        TrainMode::RulePcg,
+        TrainMode::FixedTrack,
+        TrainMode::FixedAux,
+        TrainMode::Arlpcg,
+    ];
+
+    /// The mode whose [`name`](Self::name) is `name` (as a card records it).
+    pub fn from_name(name: &str) -> Option<TrainMode> {
+        Self::ALL.into_iter().find(|mode| mode.name() == name)
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             TrainMode::RulePcg => "rule-pcg",

@@ -64,14 +64,22 @@ pub(super) const METRICS_HEADER: &str = "iteration,global_step,wall_time_s,steps
 /// checkpoints (`config` and `steps`, if given, replace its hyper-parameters and budget from
 /// here on). The caller installs the thread pool the run's environments and updates use.
 pub fn open(
-    game: Game,
-    mode: TrainMode,
+    game: Option<Game>,
+    mode: Option<TrainMode>,
     out: &Path,
     config: Option<&Path>,
     seed: Option<u64>,
     steps: Option<u64>,
     resume: bool,
 ) -> Result<Box<dyn Training>> {
+    let (game, mode) = if resume {
+        resumed_identity(out, game, mode)?
+    } else {
+        (
+            game.unwrap_or(Game::Platform),
+            mode.unwrap_or(TrainMode::RulePcg),
+        )
+    };
     let config = if resume {
         Start::Resume(ConfigChange {
             config: config.map(|path| load_config(path, game)).transpose()?,
@@ -112,6 +120,32 @@ pub fn open(
         (None, Game::Platform) => adversarial_run::<PlatformGame>(out, mode, config),
         (None, Game::Racing) => adversarial_run::<RacingGame>(out, mode, config),
     }
+}
+
+/// The game and mode a resumed run goes on with: its checkpoint's, which `--game` and `--mode`,
+/// when given, must name.
+fn resumed_identity(
+    out: &Path,
+    game: Option<Game>,
+    mode: Option<TrainMode>,
+) -> Result<(Game, TrainMode)> {
+    let path = out.join(CHECKPOINT);
+    if !path.exists() {
+        bail!(
+            "{} holds no checkpoint to resume: start the run without --resume",
+            out.display()
+        );
+    }
+    let (run_game, run_mode) = checkpoint_identity(&path)?;
+    if game.is_some_and(|game| game != run_game) || mode.is_some_and(|mode| mode != run_mode) {
+        bail!(
+            "{} is a {run_game} {} run: resume it with --game {run_game} --mode {}, or leave both out",
+            out.display(),
+            run_mode.name(),
+            run_mode.name()
+        );
+    }
+    Ok((run_game, run_mode))
 }
 
 /// How a session opens its run: a new one with its configuration, or a resumed one with what

@@ -215,11 +215,18 @@ fn wrong_resumes_are_refused(out_s: &str) {
     ]);
     assert_eq!(refused.status.code(), Some(1));
     assert!(stderr(&refused).contains("add --resume"));
-    // A resume with another mode is refused.
-    let refused = arlpcg(&[
-        "train", "--mode", "rule-pcg", "--steps", "100", "--out", out_s, "--resume",
-    ]);
-    assert!(stderr(&refused).contains("was trained with --mode fixed-track"));
+    // A resume with another mode or game is refused, naming the run's own.
+    for other in [["--mode", "rule-pcg"], ["--game", "racing"]] {
+        let refused = arlpcg(&[
+            "train", other[0], other[1], "--steps", "100", "--out", out_s, "--resume",
+        ]);
+        assert_eq!(refused.status.code(), Some(1));
+        assert!(
+            stderr(&refused).contains("is a platform fixed-track run"),
+            "{}",
+            stderr(&refused)
+        );
+    }
     // A resume with another seed is refused by name; the run's own seed may be given again.
     let refused = arlpcg(&[
         "train",
@@ -1071,28 +1078,23 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
     std::fs::write(&config, TINY).unwrap();
     let out = dir.path().join("run");
     let out_s = out.to_str().unwrap();
-    let train = |steps: &str, resume: bool| {
-        let mut args = vec![
-            "train",
-            "--game",
-            "racing",
-            "--mode",
-            "rule-pcg",
-            "--steps",
-            steps,
-            "--config",
-            config.to_str().unwrap(),
-            "--out",
-            out_s,
-        ];
-        if resume {
-            args.push("--resume");
-        }
-        let run = arlpcg(&args);
-        assert!(run.status.success(), "{}", stderr(&run));
-    };
-    train("256", false);
-    train("512", true);
+    let trained = arlpcg(&[
+        "train",
+        "--game",
+        "racing",
+        "--mode",
+        "rule-pcg",
+        "--steps",
+        "256",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out_s,
+    ]);
+    assert!(trained.status.success(), "{}", stderr(&trained));
+    // A resume takes the game and mode from the run.
+    let resumed = arlpcg(&["train", "--steps", "512", "--out", out_s, "--resume"]);
+    assert!(resumed.status.success(), "{}", stderr(&resumed));
     assert_eq!(curve(&out).last().map(|r| r.1), Some(512));
     let stored = std::fs::read_to_string(out.join("config.yaml")).unwrap();
     assert!(stored.contains("gamma: 0.998"), "{stored}");

@@ -17,6 +17,10 @@
 //!   λ < 0);
 //! - an invalid placement (overlap, crossing, obstacle) or a track that runs out of pieces before
 //!   the goal: `invalid`, and the match ends.
+//!
+//! A paced match ([`MatchPacing`]) changes λ along the track: each piece is built, and each of
+//! the terms above paid, at the λ of the piece it belongs to (the failure and air terms at the
+//! piece the Solver is on), so failing the Solver pays only where λ asks for it.
 
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -228,9 +232,23 @@ pub fn observation_size<G: GeneratorGame>() -> usize {
     G::GENERATOR_OBSERVATION_LAYOUT.iter().map(|(_, k)| k).sum()
 }
 
+/// λ that changes once along a match's track: `before` up to the fraction `switch` of the
+/// start-to-goal distance, `after` from there (a piece takes the value where it begins, as
+/// `generate --aux-curve` builds a level).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MatchPacing {
+    pub before: f32,
+    pub after: f32,
+    pub switch: f64,
+}
+
 /// One Generator building a level while one Solver plays it.
 pub struct Match<G: GeneratorGame> {
+    /// λ of the match (a paced match: where it begins).
     pub aux: Vec<f32>,
+    pacing: Option<MatchPacing>,
+    /// λ of each piece placed (all `aux` unless paced).
+    piece_aux: Vec<f32>,
     build: G::Build,
     /// The Solver's run, from the first piece on.
     env: Option<G::Env>,
@@ -247,6 +265,8 @@ impl<G: GeneratorGame> Match<G> {
     pub fn new(build: G::Build, aux: Vec<f32>, solver_seed: u64) -> Self {
         Self {
             aux,
+            pacing: None,
+            piece_aux: Vec::new(),
             build,
             env: None,
             solver_seed,
@@ -256,8 +276,53 @@ impl<G: GeneratorGame> Match<G> {
         }
     }
 
+    /// The same match with λ changing along the track (one aux input).
+    pub fn paced(mut self, pacing: MatchPacing) -> Self {
+        self.aux = vec![pacing.before];
+        self.pacing = Some(pacing);
+        self
+    }
+
+    pub fn pacing(&self) -> Option<MatchPacing> {
+        self.pacing
+    }
+
     pub fn build(&self) -> &G::Build {
         &self.build
+    }
+
+    /// λ for the next piece: the match's, or a paced match's at the fraction of the way the
+    /// track has covered.
+    fn next_piece_aux(&self) -> Vec<f32> {
+        match self.pacing {
+            None => self.aux.clone(),
+            Some(pacing) => {
+                let whole = self.build.distance_to_goal(0);
+                let left = self.build.distance_to_goal(self.build.piece_count());
+                let covered = crate::level::pacing::covered(whole, left);
+                vec![if covered < pacing.switch {
+                    pacing.before
+                } else {
+                    pacing.after
+                }]
+            }
+        }
+    }
+
+    /// λ of piece `k` (0: the first placed; beyond the last: the last's).
+    pub fn piece_aux(&self, k: usize) -> &[f32] {
+        match self.pacing {
+            None => &self.aux,
+            Some(_) => self
+                .piece_aux
+                .get(k.min(self.piece_aux.len().saturating_sub(1)))
+                .map_or(&self.aux[..], std::slice::from_ref),
+        }
+    }
+
+    /// λ of the piece placed last (valid or not).
+    pub fn placed_aux(&self) -> &[f32] {
+        self.piece_aux(usize::MAX)
     }
 
     /// The seed the match was made from (its Solver's run is reset with it).
@@ -285,12 +350,16 @@ impl<G: GeneratorGame> Match<G> {
 
     /// The Generator's observation, into `out`.
     pub fn observe_generator(&self, out: &mut [f32]) {
-        self.build.observe(&self.aux, out);
+        self.build.observe(&self.next_piece_aux(), out);
     }
 
     /// Places the Generator's piece (one action row).
     pub fn place(&mut self, row: &[f32]) -> Placement {
+        let aux = self.next_piece_aux();
         let placement = self.build.place(row);
+        if self.pacing.is_some() {
+            self.piece_aux.push(aux[0]);
+        }
         if placement.is_invalid() {
             return placement;
         }
@@ -327,13 +396,15 @@ impl<G: GeneratorGame> Match<G> {
             self.paid_up_to = furthest;
         }
         let air = G::air_steps(env);
+        // λ of the piece the Solver is on: the one after those it has left behind.
+        let aux = self.piece_aux(furthest);
         if air > self.air_paid {
-            generator += rewards.per_air_step(&self.aux) * (air - self.air_paid) as f32;
-            self.air_paid = air;
+            generator += rewards.per_air_step(aux) * (air - self.air_paid) as f32;
         }
         if step.outcome.is_some_and(|o| o != Outcome::Success) {
-            generator += rewards.on_failure(&self.aux);
+            generator += rewards.on_failure(aux);
         }
+        self.air_paid = self.air_paid.max(air);
         (step, generator)
     }
 }

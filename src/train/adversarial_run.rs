@@ -32,6 +32,10 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             obstacles: config.generator.obstacles,
             rewards: config.generator.rewards.clone(),
             snapshot_share: config.generator.snapshot_share,
+            paced_share: match mode {
+                TrainMode::FixedAux => 0.0,
+                _ => config.generator.paced_share,
+            },
         }
     }
 

@@ -26,7 +26,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::game::SolverEnv;
 use crate::game::generator::{
-    BuildLimits, GeneratorGame, GeneratorRewards, Match, TrackBuild, observation_size,
+    BuildLimits, GeneratorGame, GeneratorRewards, Match, MatchPacing, TrackBuild, observation_size,
 };
 use crate::level::stats::Outcome;
 use crate::rl::normalizer::RunningNorm;
@@ -92,6 +92,9 @@ pub struct MatchRules {
     /// The share of matches a snapshot plays (`None`: uniform over the current Solver and the
     /// snapshots).
     pub snapshot_share: Option<f64>,
+    /// The share of matches whose λ changes along the track
+    /// ([`GeneratorConfig::paced_share`](super::GeneratorConfig::paced_share)).
+    pub paced_share: f64,
 }
 
 /// The Generator with its optimizer and normalizer.
@@ -255,7 +258,17 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         let (build, mut rng) = G::new_build(seed, None, self.rules.limits, self.rules.obstacles);
         let values = &self.rules.aux_values;
         let aux = values[rng.random_range(0..values.len())];
-        (Match::new(build, vec![aux], seed), rng)
+        let fresh = Match::new(build, vec![aux], seed);
+        // Drawn only when pacing is on, so that runs without it keep their bytes.
+        if self.rules.paced_share > 0.0 && rng.random_bool(self.rules.paced_share) {
+            let pacing = MatchPacing {
+                before: aux,
+                after: values[rng.random_range(0..values.len())],
+                switch: rng.random_range(0.25..=0.75),
+            };
+            return (fresh.paced(pacing), rng);
+        }
+        (fresh, rng)
     }
 
     /// Adds a snapshot of the Solver, the oldest leaving beyond `keep`; the matches it played
@@ -330,7 +343,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             let game = &mut self.matches[i];
             let invalid = game.place(action).is_invalid();
             self.logs[i].events.push(MatchEvent::Place(action.to_vec()));
-            let mut reward = self.rules.rewards.per_piece(&game.aux);
+            let mut reward = self.rules.rewards.per_piece(game.placed_aux());
             if invalid {
                 reward += self.rules.rewards.invalid;
                 ended.push(i);
@@ -360,7 +373,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         self.generator_returns[i] = 0.0;
         match solver_outcome {
             None => stats.invalid += 1,
-            Some(outcome) if aux != 0.0 => {
+            Some(outcome) if aux != 0.0 && game.pacing().is_none() => {
                 let side = usize::from(aux < 0.0);
                 stats.judged[side] += 1;
                 stats.successes[side] += u32::from(outcome == Outcome::Success);

@@ -131,6 +131,12 @@ pub struct GeneratorConfig {
     /// The share of a Generator phase's matches that a snapshot plays (the rest: the current
     /// Solver); none: the current Solver and each snapshot equally often.
     pub snapshot_share: Option<f64>,
+    /// The share of matches whose λ changes once along the track (λ before and after drawn
+    /// from `aux_values` apart, switching at a fraction of the way to the goal drawn within
+    /// [0.25, 0.75]), so that the Generator learns to put difficulty where λ asks for it, as
+    /// `generate --aux-curve` uses it (0: one λ per match, as in the paper). Paced matches
+    /// are left out of the hard-match success counts.
+    pub paced_share: f64,
     /// Later stretches of the run with their own schedule, each from a number of Solver steps
     /// on (the last one reached applies): e.g. a last stage where the Solver is frozen and the
     /// Generator goes on against it and the population.
@@ -307,6 +313,7 @@ impl Default for GeneratorConfig {
             population: 4,
             population_every_steps: 500_000,
             snapshot_share: None,
+            paced_share: 0.0,
             stages: Vec::new(),
             finish: PLATFORM_FINISH,
         }
@@ -594,6 +601,9 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
     {
         return Err("aux_values: give 1 to 1000 values, each within [-1, 1]".into());
     }
+    if !(0.0..=1.0).contains(&g.paced_share) {
+        return Err("paced_share must be a number in [0, 1]".into());
+    }
     if g.rewards.aux.len() != 1 {
         return Err(format!(
             "rewards.aux: the {game} game has 1 aux input, so give 1 weight pair, not {}",
@@ -794,6 +804,11 @@ mod tests {
                 "generator:\n  snapshot_share: 1.5\n",
                 Game::Platform,
                 "generator.snapshot_share must be a number in [0, 1]",
+            ),
+            (
+                "generator:\n  paced_share: .nan\n",
+                Game::Racing,
+                "generator.paced_share must be a number in [0, 1]",
             ),
             (
                 "generator:\n  population: 99\n",

@@ -644,15 +644,17 @@ fn a_run_paused_mid_stage_resumes_to_the_bytes_of_one_never_paused() {
 
 /// A run killed while its Generator learns (phases of six iterations here) resumes from its
 /// last checkpoint to the bytes of one never stopped: the Generator's decisions not yet
-/// learned from are in the checkpoint with the matches under way.
+/// learned from are in the checkpoint with the matches under way, half of them paced (λ
+/// changing along the track).
 #[test]
 fn a_run_killed_while_its_generator_learns_resumes_to_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("tiny.yaml");
     let long_phases = TINY_ADVERSARIAL.replace(
         "  solver_phase_steps: 128\n  generator_phase_steps: 16",
-        "  solver_phase_steps: 128\n  generator_phase_steps: 96",
+        "  solver_phase_steps: 128\n  generator_phase_steps: 96\n  paced_share: 0.5",
     );
+    assert_ne!(long_phases, TINY_ADVERSARIAL);
     std::fs::write(&config, &long_phases).unwrap();
     let args = |out: &Path| -> Vec<String> {
         let config = config.to_str().unwrap();

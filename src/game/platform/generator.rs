@@ -368,6 +368,70 @@ mod tests {
         );
     }
 
+    /// A paced match (λ +1 then -1, or -1 then +1, switching halfway) played by the scripted
+    /// controller until `stop_after` blocks are behind it, then standing still until its time
+    /// runs out: the λ each block was built at, and the Generator's reward at the failure.
+    fn paced_match(before: f32, after: f32, stop_after: usize) -> (Vec<f32>, Vec<f32>, f32) {
+        use crate::game::generator::MatchPacing;
+        let goal = [40.0, 0.0, 0.0];
+        let build = PlatformBuild {
+            track: PlatformTrack::new(Start::default()),
+            goal,
+            max_blocks: 30,
+        };
+        let pacing = MatchPacing {
+            before,
+            after,
+            switch: 0.5,
+        };
+        let mut game = Match::<PlatformGame>::new(build, vec![before], 7).paced(pacing);
+        let rewards = GeneratorRewards::default();
+        let mut controller = crate::game::platform::ScriptedController::new(7, 0.0);
+        let (mut observed, mut placed) = (Vec::new(), Vec::new());
+        for _ in 0..20_000 {
+            if game.needs_piece() {
+                let mut observation = [0.0; GENERATOR_OBSERVATION_SIZE];
+                game.observe_generator(&mut observation);
+                observed.push(observation[GENERATOR_OBSERVATION_SIZE - 1]);
+                let row = aimed(&game.build().track, goal);
+                assert!(!game.place(&row).is_invalid());
+                placed.push(game.placed_aux()[0]);
+            }
+            let action = if PlatformGame::furthest_piece(game.env()) >= stop_after {
+                crate::game::platform::PlatformAction::default()
+            } else {
+                controller.act(game.env())
+            };
+            let (step, reward) = game.step_solver(action, &rewards);
+            if let Some(outcome) = step.outcome {
+                assert_ne!(outcome, Outcome::Success, "it stood still");
+                return (observed, placed, reward);
+            }
+        }
+        panic!("the run did not end");
+    }
+
+    #[test]
+    fn a_paced_match_builds_and_pays_each_block_at_its_own_λ() {
+        let (_, _, early) = paced_match(1.0, -1.0, 1);
+        let (observed, placed, late) = paced_match(1.0, -1.0, 6);
+        assert_eq!(
+            observed, placed,
+            "each block is built at the λ it was observed with"
+        );
+        // 40 m in blocks of at most 7.5 m: halfway comes after the first two or three.
+        assert_eq!(&placed[..2], &[1.0, 1.0], "{placed:?}");
+        assert_eq!(placed.last(), Some(&-1.0), "{placed:?}");
+        assert!(placed.len() >= 6, "{placed:?}");
+        // Standing still costs nothing but the failure: paid at the λ of the block the Solver
+        // stands before (-10·λ).
+        assert_eq!(early, -10.0, "failing at λ = +1 costs");
+        assert_eq!(late, 10.0, "failing at λ = -1 pays");
+        let (_, reversed, early) = paced_match(-1.0, 1.0, 1);
+        assert_eq!(reversed[0], -1.0);
+        assert_eq!(early, 10.0, "failing in the hard first half pays");
+    }
+
     #[test]
     fn a_zero_action_heads_straight_for_the_goal_in_three_dimensions() {
         let track = PlatformTrack::new(Start {

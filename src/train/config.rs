@@ -749,6 +749,10 @@ mod tests {
         let narrow =
             TrainConfig::parse_for("generator:\n  curve_offset: 30\n", Game::Racing).unwrap();
         assert_eq!(narrow.generator.curve_offset, 30.0);
+    }
+
+    #[test]
+    fn out_of_range_generator_fields_are_named() {
         for (text, game, says) in [
             (
                 "generator:\n  curve_offset: 200\n",

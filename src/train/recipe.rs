@@ -1,7 +1,7 @@
 //! The recipe: what `train` does by default for each game, so that `arlpcg train --game G
 //! --mode M --seed S --out D` alone makes what ships. The platform's is the configuration's
 //! default (config.rs: its budget and finish); racing's differs in its budget, the Solver's
-//! discount, the Generator's phases, rewards and curve offset, and its finish.
+//! discount, the Generator's phases, rewards and curve offset, its paced matches and its finish.
 //! docs/training.md ("The recipe") says how each value was found.
 
 use super::config::{Finish, TrainConfig};
@@ -15,6 +15,13 @@ pub const RACING_STEPS: u64 = 5_000_000;
 /// Racing Generator phases are short: each segment costs the Solver (and its snapshots) about
 /// 40 steps of driving without learning, and these phases were 73% of a 10M run's time at 10k.
 pub const RACING_GENERATOR_PHASE_STEPS: u64 = 4_096;
+
+/// The share of racing matches whose λ changes along the track
+/// ([`GeneratorConfig::paced_share`](super::GeneratorConfig::paced_share)). Without them the
+/// recipe's Generator put its difficulty late in the track whatever λ asked there (a λ of -1 on
+/// the first half and +1 on the second: every failure past halfway; docs/results.md, "A finish
+/// without a catch-up"), so `generate --aux-curve` could not pace it.
+pub const RACING_PACED_SHARE: f64 = 0.5;
 
 /// The racing Solver's discount (docs/spec.md §3: γ 0.998; its runs are hundreds of steps
 /// longer than a platform run).
@@ -56,6 +63,7 @@ impl TrainConfig {
             config.generator.curve_offset = 90.0;
             config.generator.generator_phase_steps = RACING_GENERATOR_PHASE_STEPS;
             config.generator.finish = RACING_FINISH;
+            config.generator.paced_share = RACING_PACED_SHARE;
         }
         config
     }
@@ -73,6 +81,11 @@ mod tests {
         assert_eq!(racing.generator.curve_offset, 90.0);
         assert_eq!(racing.generator.generator_phase_steps, 4_096);
         assert_eq!(racing.generator.finish, RACING_FINISH);
+        assert_eq!(racing.generator.paced_share, 0.5);
+        assert_eq!(
+            TrainConfig::for_game(Game::Platform).generator.paced_share,
+            0.0
+        );
         assert_eq!(racing.adversarial_budget(), 5_016_384);
         // The finish: the Generator's phase against the Solver frozen.
         let finish = racing.schedule_at(5_000_000);

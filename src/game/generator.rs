@@ -291,22 +291,18 @@ impl<G: GeneratorGame> Match<G> {
         &self.build
     }
 
-    /// λ for the next piece: the match's, or a paced match's at the fraction of the way the
-    /// track has covered.
-    fn next_piece_aux(&self) -> Vec<f32> {
-        match self.pacing {
-            None => self.aux.clone(),
-            Some(pacing) => {
-                let whole = self.build.distance_to_goal(0);
-                let left = self.build.distance_to_goal(self.build.piece_count());
-                let covered = crate::level::pacing::covered(whole, left);
-                vec![if covered < pacing.switch {
-                    pacing.before
-                } else {
-                    pacing.after
-                }]
-            }
-        }
+    /// A paced match's λ for the next piece, at the fraction of the way the track has covered
+    /// (none: the match has one λ, `aux`).
+    fn next_paced_aux(&self) -> Option<f32> {
+        let pacing = self.pacing?;
+        let whole = self.build.distance_to_goal(0);
+        let left = self.build.distance_to_goal(self.build.piece_count());
+        let covered = crate::level::pacing::covered(whole, left);
+        Some(if covered < pacing.switch {
+            pacing.before
+        } else {
+            pacing.after
+        })
     }
 
     /// λ of piece `k` (0: the first placed; beyond the last: the last's).
@@ -350,16 +346,17 @@ impl<G: GeneratorGame> Match<G> {
 
     /// The Generator's observation, into `out`.
     pub fn observe_generator(&self, out: &mut [f32]) {
-        self.build.observe(&self.next_piece_aux(), out);
+        match self.next_paced_aux() {
+            Some(aux) => self.build.observe(&[aux], out),
+            None => self.build.observe(&self.aux, out),
+        }
     }
 
     /// Places the Generator's piece (one action row).
     pub fn place(&mut self, row: &[f32]) -> Placement {
-        let aux = self.next_piece_aux();
+        let paced = self.next_paced_aux();
         let placement = self.build.place(row);
-        if self.pacing.is_some() {
-            self.piece_aux.push(aux[0]);
-        }
+        self.piece_aux.extend(paced);
         if placement.is_invalid() {
             return placement;
         }

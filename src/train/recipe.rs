@@ -1,6 +1,6 @@
 //! The recipe: what `train` does by default for each game, so that `arlpcg train --game G
 //! --mode M --seed S --out D` alone makes what ships. The platform's is the configuration's
-//! default (config.rs: its budget and finish); racing's differs in its budget, the Solver's
+//! default (config/mod.rs: its budget and finish); racing's differs in its budget, the Solver's
 //! discount, the Generator's phases, rewards and curve offset, its paced matches and its finish.
 //! docs/training.md ("The recipe") says how each value was found.
 

@@ -1,0 +1,153 @@
+use super::*;
+
+#[test]
+fn a_partial_file_takes_its_games_defaults_and_old_names_still_read() {
+    let text = "generator:\n  ppo:\n    ent_coef: 0.001\n  generator_phase_steps: 20000\n";
+    let racing = TrainConfig::parse_for(text, Game::Racing).unwrap();
+    let mut expected = TrainConfig::for_game(Game::Racing);
+    expected.generator.ppo.ent_coef = 0.001;
+    expected.generator.generator_phase_steps = 20_000;
+    assert_eq!(racing, expected);
+    assert_eq!(racing.generator.rewards.air_step, 0.05);
+    let platform = TrainConfig::parse_for(text, Game::Platform).unwrap();
+    assert_eq!(platform.generator.rewards.air_step, 0.0);
+    assert_eq!(platform.solver.gamma, 0.99);
+    assert_eq!((platform.steps, racing.steps), (PLATFORM_STEPS, 5_000_000));
+    let old = "ppo:\n  gamma: 0.95\ngenerator:\n  max_blocks: 12\n";
+    let read = TrainConfig::parse_for(old, Game::Racing).unwrap();
+    assert_eq!((read.solver.gamma, read.generator.max_pieces), (0.95, 12));
+    assert_eq!(
+        TrainConfig::parse_for("", Game::Racing).unwrap(),
+        TrainConfig::for_game(Game::Racing)
+    );
+    assert_eq!(
+        TrainConfig::for_game(Game::Racing).generator.curve_offset,
+        90.0
+    );
+}
+
+#[test]
+fn the_platform_finish_follows_the_budget_and_stages_apply_from_their_step() {
+    // The platform recipe's finish starts where its Solver's 8M end (racing's: recipe.rs).
+    let platform = TrainConfig::for_game(Game::Platform);
+    assert_eq!(platform.generator.finish, PLATFORM_FINISH);
+    assert_eq!(platform.adversarial_budget(), 8_032_768);
+    let finish = platform.schedule_at(8_000_000);
+    assert_eq!(
+        (finish.solver_learning_rate, finish.snapshot_share),
+        (Some(0.0), Some(0.0))
+    );
+    assert_eq!(platform.schedule_at(7_999_999).solver_learning_rate, None);
+    assert_eq!(platform.lr_scale(8_010_000), 0.0);
+    // A finish in which the Solver keeps learning, with its own phases.
+    let learning = "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, solver_learning_rate: 1.0e-4, solver_phase_steps: 16}\n";
+    let learning = TrainConfig::parse_for(learning, Game::Platform).unwrap();
+    let finish = learning.schedule_at(learning.steps);
+    assert_eq!(
+        (
+            finish.solver_learning_rate,
+            finish.solver_phase_steps,
+            finish.generator_phase_steps
+        ),
+        (Some(1.0e-4), 16, 9)
+    );
+    let staged = "generator:\n  snapshot_share: 0.5\n  stages:\n  - {from_steps: 100, solver_learning_rate: 0, solver_phase_steps: 8, generator_phase_steps: 9}\n  - {from_steps: 200, solver_learning_rate: 0, solver_phase_steps: 8, generator_phase_steps: 9, snapshot_share: 0}\n";
+    let staged = TrainConfig::parse_for(staged, Game::Platform)
+        .unwrap()
+        .generator;
+    assert_eq!(staged.schedule_at(99).generator_phase_steps, 10_000);
+    let last = staged.schedule_at(100);
+    assert_eq!(
+        (
+            last.solver_learning_rate,
+            last.solver_phase_steps,
+            last.generator_phase_steps
+        ),
+        (Some(0.0), 8, 9)
+    );
+    assert_eq!(
+        [99, 100, 200].map(|steps| staged.schedule_at(steps).snapshot_share),
+        [Some(0.5), Some(0.5), Some(0.0)]
+    );
+    let narrow = TrainConfig::parse_for("generator:\n  curve_offset: 30\n", Game::Racing).unwrap();
+    assert_eq!(narrow.generator.curve_offset, 30.0);
+}
+
+#[test]
+fn out_of_range_generator_fields_are_named() {
+    for (text, game, says) in [
+        (
+            "generator:\n  curve_offset: 200\n",
+            Game::Racing,
+            "in [0, 180]",
+        ),
+        (
+            "generator:\n  curve_offset: .nan\n",
+            Game::Racing,
+            "in [0, 180]",
+        ),
+        (
+            "generator:\n  curve_offset: 90\n",
+            Game::Platform,
+            "platform game has no curve",
+        ),
+        (
+            "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n  - {from_steps: 5, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n",
+            Game::Platform,
+            "stages[1].from_steps must be after",
+        ),
+        (
+            "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: .nan, solver_phase_steps: 1, generator_phase_steps: 1}\n",
+            Game::Platform,
+            "stages[0].solver_learning_rate",
+        ),
+        (
+            "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1, snapshot_share: -1}\n",
+            Game::Platform,
+            "stages[0].snapshot_share",
+        ),
+        (
+            "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, solver_learning_rate: -1}\n",
+            Game::Platform,
+            "finish.solver_learning_rate",
+        ),
+        (
+            "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, until_hard_success: .nan}\n",
+            Game::Platform,
+            "finish.until_hard_success",
+        ),
+        (
+            "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, generator_until_hard_success: 2}\n",
+            Game::Platform,
+            "finish.generator_until_hard_success",
+        ),
+        (
+            "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, generator_entropy: -0.1}\n",
+            Game::Platform,
+            "finish.generator_entropy",
+        ),
+        (
+            "generator:\n  snapshot_share: 1.5\n",
+            Game::Platform,
+            "generator.snapshot_share must be a number in [0, 1]",
+        ),
+        (
+            "generator:\n  paced_share: .nan\n",
+            Game::Racing,
+            "generator.paced_share must be a number in [0, 1]",
+        ),
+        (
+            "generator:\n  population: 99\n",
+            Game::Platform,
+            "generator.population must be within [0, 16]",
+        ),
+    ] {
+        let err = TrainConfig::parse_for(text, game).unwrap_err();
+        assert!(err.to_string().contains(says), "{text}: {err}");
+    }
+    let err = TrainConfig::parse_for("generator:\n  max_pieces: 500\n", Game::Racing).unwrap_err();
+    assert!(
+        err.contains("generator.max_pieces must be within [1, 400]"),
+        "{err}"
+    );
+}

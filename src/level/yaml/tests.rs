@@ -1,0 +1,105 @@
+use super::*;
+use crate::level::{Source, params};
+
+const HAND_MADE: &str = "\
+format: arlpcg-level
+version: 1
+game: platform
+start: {position: [0, 0, 0], heading: 0}
+blocks:
+- {distance: 7, angle: 0, size: 5, height: 1}
+- {distance: 6, angle: 30, size: 4, height: -1}
+";
+
+#[test]
+fn a_hand_made_level_needs_only_relative_parameters() {
+    let level = parse(HAND_MADE).unwrap();
+    let track = level.platform().unwrap();
+    assert_eq!(track.block_count(), 2);
+    assert_eq!(
+        level.goal,
+        track.last().position.map(params::quantize),
+        "the goal defaults to the last block"
+    );
+    assert_eq!(level.source, Source::Hand);
+    // Written back, it reads back to the same level, byte for byte on a second round.
+    let text = to_string(&level);
+    let again = parse(&text).unwrap();
+    assert_eq!(again, level);
+    assert_eq!(to_string(&again), text);
+}
+
+fn problem(text: &str) -> String {
+    parse(text).unwrap_err().to_string()
+}
+
+#[test]
+fn out_of_range_values_name_field_and_line() {
+    let msg = problem(&HAND_MADE.replace("size: 4,", "size: 12,"));
+    assert!(
+        msg.contains("blocks[1]") && msg.contains("size 12 is out of range [4, 6] m"),
+        "{msg}"
+    );
+    assert!(msg.contains("line 7"), "{msg}");
+    let msg = problem(&HAND_MADE.replace("height: 1}", "height: .nan}"));
+    assert!(
+        msg.contains("blocks[0]: height must be a number, not NaN"),
+        "{msg}"
+    );
+    // In block style too, the item and its line are named.
+    let block_style = to_string(&parse(HAND_MADE).unwrap()).replacen("size: 5.0", "size: 5.5e3", 1);
+    let msg = problem(&block_style);
+    assert!(
+        msg.contains("blocks[0]: size 5500 is out of range") && msg.contains("line 16"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn header_problems_come_first() {
+    assert!(problem("").contains("empty"));
+    assert!(
+        problem(&HAND_MADE.replace("version: 1", "version: 2"))
+            .contains("format version 2 is not supported")
+    );
+    assert!(problem(&HAND_MADE.replace("arlpcg-level", "gltf")).contains("format is gltf"));
+    assert!(problem("just some words").contains("not an arlpcg level"));
+    assert!(problem("- a\n- list").contains("not an arlpcg level"));
+}
+
+#[test]
+fn unknown_missing_and_misplaced_fields_are_named() {
+    let msg = problem(&HAND_MADE.replace("game: platform", "game: platform\ncolour: red"));
+    assert!(msg.contains("unknown field `colour`"), "{msg}");
+    let msg = problem(&HAND_MADE.replace("game: platform", "game: chess"));
+    assert!(msg.contains("unknown variant `chess`"), "{msg}");
+    let msg = problem(&HAND_MADE.replace("size: 5, ", ""));
+    assert!(msg.contains("blocks[0]: missing field `size`"), "{msg}");
+    let msg = problem(&HAND_MADE.replace("blocks:", "segments:"));
+    assert!(msg.contains("segments"), "{msg}");
+}
+
+#[test]
+fn overlaps_moved_transforms_and_unreached_goals_are_caught() {
+    let overlap = HAND_MADE.replace(
+        "{distance: 6, angle: 30, size: 4, height: -1}",
+        "{distance: 7, angle: 180, size: 4, height: -1}",
+    );
+    let msg = problem(&overlap);
+    assert!(
+        msg.contains("blocks[1]: block 1 overlaps the start block (line 7)"),
+        "{msg}"
+    );
+    let moved = HAND_MADE.replace("height: 1}", "height: 1, position: [7, 1, 3]}");
+    assert!(problem(&moved).contains("blocks[0].position"));
+    let far_goal = format!("{HAND_MADE}goal: [100, 0, 0]\n");
+    assert!(problem(&far_goal).contains("does not reach the goal"));
+}
+
+#[test]
+fn line_of_item_finds_block_style_items() {
+    let text = "a: 1\nblocks:\n  - x: 1\n    y: 2\n  - x: 3\nsource:\n  kind: hand\n";
+    assert_eq!(line_of_item(text, "blocks", 0), Some(3));
+    assert_eq!(line_of_item(text, "blocks", 1), Some(5));
+    assert_eq!(line_of_item(text, "blocks", 2), None);
+}

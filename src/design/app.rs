@@ -6,23 +6,26 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use ratatui::crossterm::event::{KeyEvent, MouseEvent};
 use ratatui::layout::Rect;
 
 use crate::level::params::quantize;
 use crate::level::platform::heading_direction;
-use crate::level::stats::{Outcome, SolverStats, TrialResult, wilson_interval};
+
 use crate::level::{Game, Level};
-use crate::panel::Judge;
 use crate::verify::Recording;
 
 use super::layout::Areas;
 
 mod input;
 pub mod judging;
+mod messages;
 pub mod pacing;
 mod policies;
 mod responses;
+mod trials;
+
+pub use messages::{Effect, ExportOutcome, Message, Response};
+pub use trials::Trials;
 
 pub use policies::{JudgeSwitch, LoadedInfo, PolicyInfo};
 
@@ -118,74 +121,6 @@ pub enum Panel {
     Judges,
 }
 
-/// The Solver's trials on the level on screen, as they come in.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Trials {
-    pub id: u64,
-    pub wanted: u32,
-    pub results: Vec<TrialResult>,
-    /// The final statistics (the same as `arlpcg verify` gives), once all trials are in.
-    pub stats: Option<SolverStats>,
-    /// Why the trials stopped before they were all in, if they could not be played.
-    pub error: Option<String>,
-}
-
-impl Trials {
-    pub fn done(&self) -> u32 {
-        self.results.len() as u32
-    }
-
-    pub fn successes(&self) -> u32 {
-        self.results
-            .iter()
-            .filter(|r| r.outcome == Outcome::Success)
-            .count() as u32
-    }
-
-    /// Success ratio and its 95% interval so far (`None` before the first trial).
-    pub fn success(&self) -> Option<(f64, [f64; 2])> {
-        let n = self.done();
-        (n > 0).then(|| {
-            let s = self.successes();
-            (s as f64 / n as f64, wilson_interval(s, n))
-        })
-    }
-
-    pub fn mean_progress(&self) -> Option<f64> {
-        let n = self.results.len();
-        (n > 0).then(|| self.results.iter().map(|r| r.progress).sum::<f64>() / n as f64)
-    }
-
-    /// Racing: mean seconds per run with the car in the air so far (`None` on platform levels
-    /// and before the first trial).
-    pub fn mean_air_seconds(&self) -> Option<f64> {
-        let air: Vec<u32> = self.results.iter().filter_map(|r| r.air_steps).collect();
-        (!air.is_empty()).then(|| {
-            let dt = f64::from(crate::game::racing::car::DECISION_DT);
-            dt * air.iter().map(|&a| f64::from(a)).sum::<f64>() / air.len() as f64
-        })
-    }
-
-    pub fn count(&self, outcome: Outcome) -> u32 {
-        self.results.iter().filter(|r| r.outcome == outcome).count() as u32
-    }
-
-    /// Failed runs per block so far (`blocks` blocks), as `SolverStats::failures_by_piece`.
-    pub fn failures_by_block(&self, blocks: usize) -> Vec<u32> {
-        let mut failures = vec![0; blocks];
-        for r in self
-            .results
-            .iter()
-            .filter(|r| r.outcome != Outcome::Success)
-        {
-            if blocks > 0 {
-                failures[r.target_piece.min(blocks - 1)] += 1;
-            }
-        }
-        failures
-    }
-}
-
 /// A recorded run being played back.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Replay {
@@ -209,132 +144,6 @@ pub struct Sweep {
     pub id: u64,
     pub seed: u64,
     pub points: Vec<(f64, SweepPoint)>,
-}
-
-/// A message from the user (through the terminal) or from the worker.
-#[derive(Debug, Clone)]
-pub enum Message {
-    Key(KeyEvent),
-    Mouse(MouseEvent),
-    Resize {
-        width: u16,
-        height: u16,
-    },
-    /// Animation clock (about 30 per second).
-    Tick,
-    Worker(Response),
-}
-
-/// The worker's answers; each names the request it answers.
-#[derive(Debug, Clone)]
-pub enum Response {
-    Level {
-        id: u64,
-        result: Result<Arc<Level>, String>,
-    },
-    Trial {
-        id: u64,
-        result: TrialResult,
-    },
-    TrialsDone {
-        id: u64,
-        stats: Box<SolverStats>,
-    },
-    /// The trials could not be played (the Solver does not fit the level, say).
-    TrialsFailed {
-        id: u64,
-        problem: String,
-    },
-    Recorded {
-        id: u64,
-        result: Result<Box<Recording>, String>,
-    },
-    SweepPoint {
-        id: u64,
-        index: usize,
-        point: SweepPoint,
-    },
-    /// Export done (the paths written), refused because files exist, or failed.
-    Exported(ExportOutcome),
-    Loaded(Result<Box<LoadedInfo>, String>),
-    Judged(Result<Box<JudgeSwitch>, String>),
-    Panel {
-        id: u64,
-        update: judging::PanelUpdate,
-    },
-}
-
-#[derive(Debug, Clone, PartialEq)]
-pub enum ExportOutcome {
-    Written(Vec<PathBuf>),
-    WouldOverwrite(Vec<PathBuf>),
-    Failed(String),
-}
-
-/// Work for the worker threads.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Effect {
-    Generate {
-        id: u64,
-        game: Game,
-        seed: u64,
-        aux: f64,
-        goal: Option<[f64; 3]>,
-        /// λ along the level instead of `aux`.
-        curve: Option<crate::level::pacing::AuxCurve>,
-        /// Pieces kept from an earlier level.
-        keep: Option<crate::generation::KeptPrefix>,
-    },
-    Trials {
-        id: u64,
-        level: Arc<Level>,
-        trials: u32,
-        seed: u64,
-    },
-    Record {
-        id: u64,
-        level: Arc<Level>,
-        seed: u64,
-    },
-    Sweep {
-        id: u64,
-        game: Game,
-        seed: u64,
-        goal: Option<[f64; 3]>,
-        auxes: Vec<f64>,
-        trials: u32,
-    },
-    Export {
-        level: Box<Level>,
-        dir: PathBuf,
-        stem: String,
-        overwrite: bool,
-    },
-    /// Policies of `game` from a folder or one file.
-    Load { path: PathBuf, game: Game },
-    /// The next judge after `after` whose Solver is in `folder` (or a scripted skill) plays.
-    NextJudge {
-        game: Game,
-        after: Judge,
-        folder: PathBuf,
-    },
-    /// Every judge whose Solver is in `folder`, and the scripted skills, play `level`.
-    Panel {
-        id: u64,
-        level: Arc<Level>,
-        folder: PathBuf,
-        trials: u32,
-    },
-    /// A level of `game` whose success, measured with `trials` runs, is within ±0.1 of `target`
-    /// (the search of `generate --target-success`).
-    Target {
-        id: u64,
-        game: Game,
-        seed: u64,
-        goal: Option<[f64; 3]>,
-        target: f64,
-        trials: u32,
-    },
 }
 
 /// Everything the designer shows and remembers.

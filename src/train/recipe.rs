@@ -40,11 +40,9 @@ pub const RACING_FINISH: Finish = Finish {
     // Generator's phase.
     solver_steps: 16_384,
     generator_phase_steps: 800_000,
-    solver_learning_rate: 0.0,
-    solver_phase_steps: 1,
     generator_until_hard_success: Some(0.5),
-    until_hard_success: None,
     generator_entropy: Some(0.01),
+    ..Finish::NONE
 };
 
 impl TrainConfig {

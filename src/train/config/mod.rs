@@ -201,6 +201,9 @@ impl Default for Finish {
 }
 
 impl Finish {
+    /// No finish; its other fields are a finish's defaults (the Solver frozen in one-iteration
+    /// phases, 100k-step Generator phases, no stop on success), which the recipes' finishes
+    /// start from.
     pub const NONE: Finish = Finish {
         solver_steps: 0,
         generator_phase_steps: 100_000,
@@ -337,12 +340,7 @@ pub const PLATFORM_STEPS: u64 = 8_000_000;
 /// drop (docs/training.md, "The recipe").
 pub const PLATFORM_FINISH: Finish = Finish {
     solver_steps: 32_768,
-    generator_phase_steps: 100_000,
-    solver_learning_rate: 0.0,
-    solver_phase_steps: 1,
-    generator_until_hard_success: None,
-    until_hard_success: None,
-    generator_entropy: None,
+    ..Finish::NONE
 };
 
 pub(super) fn load_config(path: &Path, game: Game) -> Result<TrainConfig> {

@@ -1,7 +1,8 @@
 //! The recipe: what `train` does by default for each game, so that `arlpcg train --game G
 //! --mode M --seed S --out D` alone makes what ships. The platform's is the configuration's
 //! default (config/mod.rs: its budget and finish); racing's differs in its budget, the Solver's
-//! discount, the Generator's phases, rewards and curve offset, its paced matches and its finish.
+//! discount and constant learning rate, the Generator's phases, rewards and curve offset, its
+//! paced matches and its finish.
 //! docs/training.md ("The recipe") says how each value was found.
 
 use super::config::{Finish, TrainConfig};
@@ -26,6 +27,14 @@ pub const RACING_PACED_SHARE: f64 = 0.5;
 /// The racing Solver's discount (docs/spec.md §3: γ 0.998; its runs are hundreds of steps
 /// longer than a platform run).
 pub const RACING_SOLVER_GAMMA: f32 = 0.998;
+
+/// Whether the racing Solver's learning rate anneals to 0 over the budget: it does not, it stays
+/// at 3e-4 like the Generator's. Annealed (6e-5 at 4M of 5M), the Generator went on learning
+/// against a Solver that hardly did, and what it found was that one network's blind spot:
+/// its own Solver 0.29 at λ = -1, every other judge flat or rising. Constant, the Solver leads
+/// until the finish, and the finish's hard tracks are hard for the judges it never met too
+/// (docs/results.md, "Seed 0 of the paced recipe" and "A Solver that keeps learning").
+pub const RACING_SOLVER_ANNEAL_LR: bool = false;
 
 /// The racing recipe's finish: one Generator phase against the final Solver, frozen and alone,
 /// until the Solver succeeds on only half of its hard matches (counted over blocks of 32; at
@@ -53,6 +62,7 @@ impl TrainConfig {
         if game == Game::Racing {
             config.steps = RACING_STEPS;
             config.solver.gamma = RACING_SOLVER_GAMMA;
+            config.solver.anneal_lr = RACING_SOLVER_ANNEAL_LR;
             config.generator.rewards = RacingGame::default_rewards();
             config.generator.max_pieces = RacingGame::DEFAULT_MAX_PIECES;
             config.generator.obstacles = crate::game::racing::generator::MATCH_OBSTACLES;
@@ -76,6 +86,7 @@ mod tests {
         let racing = TrainConfig::for_game(Game::Racing);
         assert_eq!(racing.steps, RACING_STEPS);
         assert_eq!(racing.solver.gamma, RACING_SOLVER_GAMMA);
+        assert!(!racing.solver.anneal_lr && TrainConfig::for_game(Game::Platform).solver.anneal_lr);
         assert_eq!(racing.generator.curve_offset, 90.0);
         assert_eq!(racing.generator.generator_phase_steps, 4_096);
         assert_eq!(racing.generator.finish, RACING_FINISH);

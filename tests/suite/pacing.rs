@@ -60,8 +60,8 @@ fn each_piece_is_built_at_the_curves_value_where_it_begins_and_records_it() {
 
 /// The shipped racing Generator follows λ late in a track: the second half of an easy-then-hard
 /// track fails more often than that of a hard-then-easy one. It does not make a track's start
-/// hard (a car starts from rest; docs/results.md, "A Solver that keeps learning"), so where the
-/// failures fall is not asked of the first half.
+/// hard (likely because a car starts from rest; docs/results.md, "A Solver that keeps
+/// learning"), so where the failures fall is not asked of the first half.
 #[test]
 fn the_shipped_racing_generator_makes_a_tracks_second_half_as_hard_as_the_curve_asks() {
     let game = Game::Racing;

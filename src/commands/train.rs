@@ -16,8 +16,9 @@ pub fn run(args: &TrainArgs) -> Result<()> {
     if args.print_config {
         print!(
             "{}",
-            serde_yaml::to_string(&TrainConfig::for_game(
-                args.game.unwrap_or(crate::level::Game::Platform)
+            serde_yaml::to_string(&TrainConfig::for_run(
+                args.game.unwrap_or(crate::level::Game::Platform),
+                args.mode.map_or(train::TrainMode::RulePcg, Into::into)
             ))?
         );
         return Ok(());

@@ -5,7 +5,7 @@
 //! paced matches and its finish.
 //! docs/training.md ("The recipe") says how each value was found.
 
-use super::config::{Finish, TrainConfig};
+use super::config::{Finish, TrainConfig, TrainMode};
 use crate::game::RacingGame;
 use crate::game::generator::GeneratorGame;
 use crate::level::Game;
@@ -75,6 +75,18 @@ impl TrainConfig {
         }
         config
     }
+
+    /// The defaults for training `game` in `mode`: the game's, without the finish in
+    /// `fixed-aux`. Its matches are all at λ = 1, so its Generator has no hard tracks to make
+    /// against the frozen Solver, and the racing finish's stop (the Solver failing half its
+    /// hard matches) would never come: the phase would run to its cap.
+    pub fn for_run(game: Game, mode: TrainMode) -> TrainConfig {
+        let mut config = Self::for_game(game);
+        if mode == TrainMode::FixedAux {
+            config.generator.finish = Finish::NONE;
+        }
+        config
+    }
 }
 
 #[cfg(test)]
@@ -103,5 +115,21 @@ mod tests {
             (Some(0.0), 800_000)
         );
         assert_eq!(racing.schedule_at(4_999_999).solver_learning_rate, None);
+    }
+
+    #[test]
+    fn fixed_aux_runs_end_with_their_budget_and_other_modes_keep_the_finish() {
+        for game in [Game::Platform, Game::Racing] {
+            let fixed_aux = TrainConfig::for_run(game, TrainMode::FixedAux);
+            assert_eq!(fixed_aux.generator.finish, Finish::NONE);
+            assert_eq!(fixed_aux.adversarial_budget(), fixed_aux.steps);
+            assert!(!fixed_aux.in_finish(fixed_aux.steps));
+            for mode in [TrainMode::Arlpcg, TrainMode::RulePcg, TrainMode::FixedTrack] {
+                assert_eq!(
+                    TrainConfig::for_run(game, mode),
+                    TrainConfig::for_game(game)
+                );
+            }
+        }
     }
 }

@@ -147,12 +147,13 @@ fn the_shipped_racing_solvers_load_and_drive() {
             card.observation.iter().map(|(_, k)| k).sum::<usize>(),
             OBSERVATION_SIZE
         );
-        // The ARLPCG Solver is the recipe's: 5M steps, then 16,384 played in the finish (the
-        // last 8k-step update may pass them). The baselines learned for the 10M of then.
-        let budget = if mode == "arlpcg" {
-            5_016_384..5_030_000
-        } else {
-            10_000_000..10_100_000
+        // The recipe's budget is 5M Solver steps (the last 8k-step update may pass it); the
+        // ARLPCG Solver then plays 16,384 more in the finish. The fixed-track and fixed-aux
+        // Solvers learned for the 10M of before the recipe.
+        let budget = match mode {
+            "arlpcg" => 5_016_384..5_030_000,
+            "rule-pcg" => 5_000_000..5_010_000,
+            _ => 10_000_000..10_100_000,
         };
         assert!(
             budget.contains(&card.training.steps),
@@ -240,17 +241,19 @@ fn each_verification_trial_is_the_run_recorded_from_its_seed() {
     }
 }
 
-/// Each game's shipped ARLPCG pair is seed 0 of the recipe: the configuration its run folder
-/// records (the folder `--out` names in its card's command) is what `train --game G --mode
-/// arlpcg --seed 0` uses today.
+/// Each game's shipped ARLPCG pair and rule-pcg Solver are seed 0 of the recipe: the
+/// configuration a run folder records (the folder `--out` names in the card's command) is what
+/// `train --game G --mode M --seed 0` uses today.
 #[test]
-fn the_shipped_arlpcg_pairs_were_trained_by_the_recipe() {
+fn the_shipped_policies_were_trained_by_the_recipe() {
     use arlpcg::level::Game;
-    use arlpcg::train::TrainConfig;
+    use arlpcg::train::{TrainConfig, TrainMode};
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    // The pairs and the rule-pcg Solvers (the fixed-aux and fixed-track ones come from before
+    // the recipe).
     for game in [Game::Platform, Game::Racing] {
         let dir = root.join("policies").join(game.name());
-        for file in ["generator.yaml", "solver.yaml"] {
+        for file in ["generator.yaml", "solver.yaml", "solver-rule-pcg.yaml"] {
             let card: arlpcg::rl::checkpoint::PolicyCard =
                 serde_yaml::from_str(&std::fs::read_to_string(dir.join(file)).unwrap()).unwrap();
             let words: Vec<&str> = card.training.command.split_whitespace().collect();
@@ -260,7 +263,10 @@ fn the_shipped_arlpcg_pairs_were_trained_by_the_recipe() {
                 .map(|i| words[i + 1])
                 .expect("the card's command names its run folder");
             let text = std::fs::read_to_string(root.join(out).join("config.yaml")).unwrap();
-            let mut recipe = TrainConfig::for_game(game);
+            let mode = file
+                .strip_prefix("solver-")
+                .map_or("arlpcg", |f| f.trim_end_matches(".yaml"));
+            let mut recipe = TrainConfig::for_run(game, TrainMode::from_name(mode).unwrap());
             recipe.seed = 0;
             assert_eq!(
                 TrainConfig::parse_for(&text, game).unwrap(),
@@ -270,7 +276,9 @@ fn the_shipped_arlpcg_pairs_were_trained_by_the_recipe() {
             );
             assert_eq!(
                 (card.training.mode.as_str(), card.training.seed),
-                ("arlpcg", 0)
+                (mode, 0),
+                "{}/{file}",
+                game.name()
             );
         }
     }

@@ -340,6 +340,53 @@ fn out_of_range_training_configs_are_refused_before_anything_is_written() {
     }
 }
 
+/// A fixed-aux run plays only λ = 1 matches: a configuration whose finish waits for the Solver
+/// to fail hard matches (the racing ARLPCG recipe's) would never end its Generator phase early,
+/// so it is refused, naming the file and the field; the mode's own defaults have no finish.
+#[test]
+fn a_fixed_aux_run_refuses_a_finish_that_waits_for_hard_matches() {
+    let dir = tempfile::tempdir().unwrap();
+    let recipe = arlpcg(&[
+        "train",
+        "--game",
+        "racing",
+        "--mode",
+        "arlpcg",
+        "--print-config",
+    ]);
+    let config = dir.path().join("racing-arlpcg.yaml");
+    std::fs::write(&config, &recipe.stdout).unwrap();
+    let run = dir.path().join("run");
+    let out = arlpcg(&[
+        "train",
+        "--game",
+        "racing",
+        "--mode",
+        "fixed-aux",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("racing-arlpcg.yaml") && err.contains("generator_until_hard_success"),
+        "{err}"
+    );
+    assert!(!run.exists(), "a refused run left {}", run.display());
+    let defaults = arlpcg(&[
+        "train",
+        "--game",
+        "racing",
+        "--mode",
+        "fixed-aux",
+        "--print-config",
+    ]);
+    let defaults: arlpcg::train::TrainConfig = serde_yaml::from_slice(&defaults.stdout).unwrap();
+    assert_eq!(defaults.adversarial_budget(), defaults.steps);
+}
+
 /// Ctrl-C, and SIGTERM as Slurm and Kubernetes stop a job, save a checkpoint and the policy,
 /// then exit 130.
 #[test]

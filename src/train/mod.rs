@@ -102,26 +102,29 @@ pub fn open(
                 out.display()
             );
         }
-        let config_path = config;
         let mut config = match config {
-            Some(path) => load_config(path, game)?,
+            Some(path) => {
+                let config = load_config(path, game)?;
+                // fixed-aux plays no hard match, so a finish that waits for them never ends.
+                if mode == TrainMode::FixedAux
+                    && config
+                        .generator
+                        .finish
+                        .generator_until_hard_success
+                        .is_some()
+                {
+                    bail!(
+                        "{}: generator.finish.generator_until_hard_success: fixed-aux plays only \
+                         λ = 1 matches, so its Solver fails no hard one and the finish's \
+                         Generator phase would run to its cap; set it to null, or the finish's \
+                         solver_steps to 0",
+                        path.display()
+                    );
+                }
+                config
+            }
             None => TrainConfig::for_run(game, mode),
         };
-        if let Some(path) = config_path
-            && mode == TrainMode::FixedAux
-            && config
-                .generator
-                .finish
-                .generator_until_hard_success
-                .is_some()
-        {
-            bail!(
-                "{}: generator.finish.generator_until_hard_success: fixed-aux plays only λ = 1 \
-                 matches, so its Solver fails no hard one and the finish's Generator phase would \
-                 run to its cap; set it to null, or the finish's solver_steps to 0",
-                path.display()
-            );
-        }
         if let Some(seed) = seed {
             config.seed = seed;
         }

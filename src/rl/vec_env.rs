@@ -152,11 +152,19 @@ impl<E: VecEnv> Trainer<E> {
     }
 
     /// Plays one tick of every environment with the current policy, learning nothing (the
-    /// normalizer stays as it is too): the frozen side of an adversarial phase.
+    /// normalizer stays as it is too): the frozen side of an adversarial phase. Nothing is
+    /// learned from these steps, so the critic is not run (a third of a racing finish's
+    /// Generator phase was the Solver's two networks); the actions are those a learning tick
+    /// would choose, from the same random numbers.
     pub fn play_tick(&mut self) -> candle_core::Result<()> {
-        let (_, acted) = self.act_sampled()?;
+        let mut normalized = self.observations.clone();
+        self.norm.normalize(&mut normalized);
+        let actions = self
+            .ppo
+            .policy
+            .choose(&normalized, ActMode::Sample, &mut self.rng)?;
         let mut transitions = vec![Transition::default(); self.env.num_envs()];
-        self.env.step(&acted.actions, &mut transitions);
+        self.env.step(&actions, &mut transitions);
         for (e, t) in transitions.iter().enumerate() {
             self.episode_returns[e] = if t.ended {
                 0.0

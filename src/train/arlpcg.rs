@@ -304,12 +304,13 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
                 self.matches[i].env().observe(row);
             }
             snapshot.norm.normalize(&mut observations);
-            let acted = snapshot
+            // Playing, not learning: the actor alone, with the random numbers `act` would draw.
+            let actions = snapshot
                 .policy
-                .act(&observations, ActMode::Sample, &mut self.rng)?;
+                .choose(&observations, ActMode::Sample, &mut self.rng)?;
             for (n, &i) in played.iter().enumerate() {
                 replaced[i * width..(i + 1) * width]
-                    .copy_from_slice(&acted.actions[n * width..(n + 1) * width]);
+                    .copy_from_slice(&actions[n * width..(n + 1) * width]);
             }
         }
         Ok(Some(replaced))

@@ -290,7 +290,10 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                     let now = self.solver.trainer.global_step;
                     let envs = self.envs();
                     let stats = envs.take_stats();
-                    if envs.count_hard_block(&stats).is_some_and(|s| s >= target) {
+                    if envs
+                        .count_hard_block(&stats, finish.hard_match_block)
+                        .is_some_and(|s| s >= target)
+                    {
                         envs.state.finish_ended_at = Some(now);
                     }
                 }
@@ -310,9 +313,9 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                 let envs = self.envs();
                 // In the finish, the phase may end early once the Solver fails enough.
                 let hard_enough = match finish.generator_until_hard_success {
-                    Some(target) if in_finish => {
-                        envs.count_hard_block(&stats).is_some_and(|s| s <= target)
-                    }
+                    Some(target) if in_finish => envs
+                        .count_hard_block(&stats, finish.hard_match_block)
+                        .is_some_and(|s| s <= target),
                     _ => false,
                 };
                 if hard_enough || envs.state.phase_steps >= schedule.generator_phase_steps {

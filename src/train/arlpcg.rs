@@ -34,7 +34,6 @@ use crate::rl::policy::ActMode;
 use crate::rl::ppo::{Batch, Ppo, gae};
 use crate::rl::vec_env::{Transition, VecEnv};
 use crate::seeds::TRAINING_SEED_BASE;
-use crate::train::config::HARD_MATCH_BLOCK;
 use crate::train::population::Snapshot;
 
 mod replay;
@@ -458,13 +457,13 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
     }
 
     /// Adds the hard matches (λ < 0) of `stats` to the block being counted; once the block
-    /// holds [`HARD_MATCH_BLOCK`] of them, returns the Solver's success ratio over it and
-    /// begins a new one.
-    pub fn count_hard_block(&mut self, stats: &MatchStats) -> Option<f64> {
+    /// holds `block_size` of them, returns the Solver's success ratio over it and begins a
+    /// new one.
+    pub fn count_hard_block(&mut self, stats: &MatchStats, block_size: u32) -> Option<f64> {
         let block = &mut self.state.hard_block;
         block[0] += stats.successes[1];
         block[1] += stats.judged[1];
-        if block[1] < HARD_MATCH_BLOCK {
+        if block[1] < block_size {
             return None;
         }
         let ratio = f64::from(block[0]) / f64::from(block[1]);

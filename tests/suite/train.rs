@@ -817,33 +817,42 @@ fn a_catch_up_until_a_success_ends_the_run_early() {
 
 /// A finish's Generator phase that ends at a success: with `generator_until_hard_success: 1`
 /// the first block of 32 hard matches ends it, long before its limit of 4,000 decisions, and
-/// the catch-up that follows runs to the budget.
+/// the catch-up that follows runs to the budget. With blocks of 96 (`hard_match_block`) the
+/// same phase plays on until three times as many hard matches have ended.
 #[test]
 fn a_finish_generator_phase_until_a_success_ends_early() {
-    let dir = tempfile::tempdir().unwrap();
-    let until = tiny_with_finish(
-        "solver_steps: 256\ngenerator_phase_steps: 4000\nsolver_learning_rate: 1.0e-4\nsolver_phase_steps: 1000000\ngenerator_until_hard_success: 1.0",
-    );
-    let out = train_tiny_to_640(dir.path(), &until);
-    // Generator rows of the finish (its phase opens at the budget, 640), each with the
-    // Generator's decisions so far; the batch is 16 decisions.
-    let rows: Vec<(u64, u64)> = std::fs::read_to_string(out.join("generator-metrics.csv"))
-        .unwrap()
-        .lines()
-        .skip(1)
-        .map(|row| {
-            let cells: Vec<&str> = row.split(',').collect();
-            (cells[1].parse().unwrap(), cells[2].parse().unwrap())
-        })
-        .filter(|&(solver_steps, _)| solver_steps >= 640)
-        .collect();
-    assert!(!rows.is_empty(), "the finish has a Generator phase");
-    let decisions = rows.last().unwrap().1 - rows[0].1 + 16;
+    let finish_decisions = |block: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let until = tiny_with_finish(&format!(
+            "solver_steps: 256\ngenerator_phase_steps: 4000\nsolver_learning_rate: 1.0e-4\nsolver_phase_steps: 1000000\ngenerator_until_hard_success: 1.0{block}"
+        ));
+        let out = train_tiny_to_640(dir.path(), &until);
+        // Generator rows of the finish (its phase opens at the budget, 640), each with the
+        // Generator's decisions so far; the batch is 16 decisions.
+        let rows: Vec<(u64, u64)> = std::fs::read_to_string(out.join("generator-metrics.csv"))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|row| {
+                let cells: Vec<&str> = row.split(',').collect();
+                (cells[1].parse().unwrap(), cells[2].parse().unwrap())
+            })
+            .filter(|&(solver_steps, _)| solver_steps >= 640)
+            .collect();
+        assert!(!rows.is_empty(), "the finish has a Generator phase");
+        // Then the Solver catches up to the budget, 640 + 256.
+        assert_eq!(curve(&out).last().unwrap().1, 896);
+        rows.last().unwrap().1 - rows[0].1 + 16
+    };
+    let decisions = finish_decisions("");
     // 32 hard matches take a few dozen batches of these short levels, not the phase's 4,000
     // decisions.
     assert!((32..2_000).contains(&decisions), "{decisions} decisions");
-    // Then the Solver catches up to the budget, 640 + 256.
-    assert_eq!(curve(&out).last().unwrap().1, 896);
+    let in_blocks_of_96 = finish_decisions("\nhard_match_block: 96");
+    assert!(
+        in_blocks_of_96 > 2 * decisions && in_blocks_of_96 < 4_000,
+        "blocks of 96: {in_blocks_of_96} decisions, of 32: {decisions}"
+    );
 }
 
 /// `finish.generator_entropy` is the Generator's entropy bonus in the finish alone: with a large

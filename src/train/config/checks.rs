@@ -15,6 +15,8 @@ const MAX_STAGES: usize = 16;
 const MAX_POPULATION: usize = 16;
 /// Limit on each phase length and the warm-up (10^12 steps: years of training).
 const MAX_PHASE_STEPS: u64 = 1_000_000_000_000;
+/// Hard matches in a finish's block (a Generator phase plays a few hundred a minute).
+const MAX_HARD_MATCH_BLOCK: u32 = 100_000;
 
 /// Checks that `new` may replace `old` in a resumed run: the fields that fix the networks'
 /// shapes, the number of matches and the seed stream stay; learning rates, coefficients,
@@ -97,6 +99,11 @@ fn check_schedule(g: &GeneratorConfig) -> Result<(), String> {
             if ratio.is_some_and(|r| !(0.0..=1.0).contains(&r)) {
                 return Err(format!("finish.{name} must be a ratio in [0, 1]"));
             }
+        }
+        if !(1..=MAX_HARD_MATCH_BLOCK).contains(&g.finish.hard_match_block) {
+            return Err(format!(
+                "finish.hard_match_block must be within [1, {MAX_HARD_MATCH_BLOCK}] matches"
+            ));
         }
         let rate = g.finish.solver_learning_rate;
         if !(rate.is_finite() && (0.0..=1.0).contains(&rate)) {

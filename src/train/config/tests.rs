@@ -122,6 +122,11 @@ fn out_of_range_generator_fields_are_named() {
             "finish.generator_until_hard_success",
         ),
         (
+            "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, hard_match_block: 0}\n",
+            Game::Platform,
+            "finish.hard_match_block",
+        ),
+        (
             "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, generator_entropy: -0.1}\n",
             Game::Platform,
             "finish.generator_entropy",

@@ -106,12 +106,10 @@ pub fn open(
             Some(path) => {
                 let config = load_config(path, game)?;
                 // fixed-aux plays no hard match, so a finish that waits for them never ends.
+                let finish = config.generator.finish;
                 if mode == TrainMode::FixedAux
-                    && config
-                        .generator
-                        .finish
-                        .generator_until_hard_success
-                        .is_some()
+                    && finish.solver_steps > 0
+                    && finish.generator_until_hard_success.is_some()
                 {
                     bail!(
                         "{}: generator.finish.generator_until_hard_success: fixed-aux plays only \

@@ -148,12 +148,10 @@ fn the_shipped_racing_solvers_load_and_drive() {
             OBSERVATION_SIZE
         );
         // The recipe's budget is 5M Solver steps (the last 8k-step update may pass it); the
-        // ARLPCG Solver then plays 16,384 more in the finish. The fixed-track and fixed-aux
-        // Solvers learned for the 10M of before the recipe.
+        // ARLPCG Solver then plays 16,384 more in the finish.
         let budget = match mode {
             "arlpcg" => 5_016_384..5_030_000,
-            "rule-pcg" => 5_000_000..5_010_000,
-            _ => 10_000_000..10_100_000,
+            _ => 5_000_000..5_010_000,
         };
         assert!(
             budget.contains(&card.training.steps),
@@ -241,19 +239,23 @@ fn each_verification_trial_is_the_run_recorded_from_its_seed() {
     }
 }
 
-/// Each game's shipped ARLPCG pair and rule-pcg Solver are seed 0 of the recipe: the
-/// configuration a run folder records (the folder `--out` names in the card's command) is what
-/// `train --game G --mode M --seed 0` uses today.
+/// Every shipped policy of each game is seed 0 of the recipe: the configuration a run folder
+/// records (the folder `--out` names in the card's command) is what `train --game G --mode M
+/// --seed 0` uses today.
 #[test]
 fn the_shipped_policies_were_trained_by_the_recipe() {
     use arlpcg::level::Game;
     use arlpcg::train::{TrainConfig, TrainMode};
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    // The pairs and the rule-pcg Solvers (the fixed-aux and fixed-track ones come from before
-    // the recipe).
     for game in [Game::Platform, Game::Racing] {
         let dir = root.join("policies").join(game.name());
-        for file in ["generator.yaml", "solver.yaml", "solver-rule-pcg.yaml"] {
+        for file in [
+            "generator.yaml",
+            "solver.yaml",
+            "solver-rule-pcg.yaml",
+            "solver-fixed-track.yaml",
+            "solver-fixed-aux.yaml",
+        ] {
             let card: arlpcg::rl::checkpoint::PolicyCard =
                 serde_yaml::from_str(&std::fs::read_to_string(dir.join(file)).unwrap()).unwrap();
             let words: Vec<&str> = card.training.command.split_whitespace().collect();

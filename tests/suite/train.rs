@@ -383,7 +383,19 @@ fn a_fixed_aux_run_refuses_a_finish_that_waits_for_hard_matches() {
         "fixed-aux",
         "--print-config",
     ]);
-    let defaults: arlpcg::train::TrainConfig = serde_yaml::from_slice(&defaults.stdout).unwrap();
+    // What --print-config prints for fixed-aux reads back as fixed-aux's defaults: the
+    // racing finish's stop is not filled in from the game's defaults.
+    let text = String::from_utf8(defaults.stdout).unwrap();
+    let read_back =
+        arlpcg::train::TrainConfig::parse_for(&text, arlpcg::level::Game::Racing).unwrap();
+    assert_eq!(
+        read_back,
+        arlpcg::train::TrainConfig::for_run(
+            arlpcg::level::Game::Racing,
+            arlpcg::train::TrainMode::FixedAux
+        )
+    );
+    let defaults: arlpcg::train::TrainConfig = serde_yaml::from_str(&text).unwrap();
     assert_eq!(defaults.adversarial_budget(), defaults.steps);
 }
 

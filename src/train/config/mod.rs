@@ -156,6 +156,9 @@ pub struct GeneratorConfig {
 /// `solver_learning_rate` above 0 lets it keep up a little, in phases of `solver_phase_steps`.
 /// The run's budget is then `steps + solver_steps`; learning rates that anneal reach 0 at
 /// `steps`, so an annealed Generator learning rate is refused with a finish.
+/// Its optional fields are written out even when none (`null`): a configuration file's
+/// missing fields take the game's defaults (`TrainConfig::parse_for`), so a printed or saved
+/// configuration with a field left out would read back as that game's value.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Finish {
@@ -171,13 +174,13 @@ pub struct Finish {
     /// The finish's Generator phases end once the Solver's success on hard matches (λ < 0)
     /// has fallen to this ratio, counted over blocks of `hard_match_block` of them;
     /// `generator_phase_steps` stays the limit. None: they end at `generator_phase_steps`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub generator_until_hard_success: Option<f64>,
     /// With a learning Solver: the finish ends once a Solver phase after its Generator phase
     /// (the catch-up) has brought the Solver's success on hard matches back up to this ratio,
     /// counted the same way; `solver_steps` stays the limit. None: the finish ends at
     /// `solver_steps`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub until_hard_success: Option<f64>,
     /// Hard matches (λ < 0) in each block over which the two stops above count the Solver's
     /// success, one block after another. A larger block stops on a fall that lasts rather
@@ -188,7 +191,7 @@ pub struct Finish {
     /// The Generator's entropy bonus in the finish's Generator phases, in place of
     /// `generator.ppo.ent_coef` (none: that one): a larger one keeps it trying new tracks
     /// against the final Solver instead of refining those it already makes.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub generator_entropy: Option<f32>,
 }
 

@@ -140,10 +140,16 @@ impl<E: VecEnv> Trainer<E> {
         Ok((batch, stats))
     }
 
-    /// The current observations normalized, and the actions sampled for them.
-    fn act_sampled(&mut self) -> candle_core::Result<(Vec<f32>, Acted)> {
+    /// The current observations normalized (the normalizer itself stays as it is).
+    fn normalized(&self) -> Vec<f32> {
         let mut normalized = self.observations.clone();
         self.norm.normalize(&mut normalized);
+        normalized
+    }
+
+    /// The current observations normalized, and the actions sampled for them.
+    fn act_sampled(&mut self) -> candle_core::Result<(Vec<f32>, Acted)> {
+        let normalized = self.normalized();
         let acted = self
             .ppo
             .policy
@@ -153,16 +159,14 @@ impl<E: VecEnv> Trainer<E> {
 
     /// Plays one tick of every environment with the current policy, learning nothing (the
     /// normalizer stays as it is too): the frozen side of an adversarial phase. Nothing is
-    /// learned from these steps, so the critic is not run (a third of a racing finish's
-    /// Generator phase was the Solver's two networks); the actions are those a learning tick
-    /// would choose, from the same random numbers.
+    /// learned from these steps, so the critic is not run (in a racing finish the networks
+    /// were about a quarter of the Generator phase's time); the actions are those a learning
+    /// tick would choose, from the same random numbers.
     pub fn play_tick(&mut self) -> candle_core::Result<()> {
-        let mut normalized = self.observations.clone();
-        self.norm.normalize(&mut normalized);
         let actions = self
             .ppo
             .policy
-            .choose(&normalized, ActMode::Sample, &mut self.rng)?;
+            .choose(&self.normalized(), ActMode::Sample, &mut self.rng)?;
         let mut transitions = vec![Transition::default(); self.env.num_envs()];
         self.env.step(&actions, &mut transitions);
         for (e, t) in transitions.iter().enumerate() {

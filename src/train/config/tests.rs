@@ -31,7 +31,7 @@ fn the_platform_finish_follows_the_budget_and_stages_apply_from_their_step() {
     // The platform recipe's finish starts where its Solver's 8M end (racing's: recipe.rs).
     let platform = TrainConfig::for_game(Game::Platform);
     assert_eq!(platform.generator.finish, PLATFORM_FINISH);
-    assert_eq!(platform.adversarial_budget(), 8_032_768);
+    assert_eq!(platform.adversarial_budget(), 8_016_384);
     let finish = platform.schedule_at(8_000_000);
     assert_eq!(
         (finish.solver_learning_rate, finish.snapshot_share),

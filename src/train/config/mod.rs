@@ -351,7 +351,8 @@ pub const PLATFORM_STEPS: u64 = 8_000_000;
 /// 1M Generator steps), then one frozen Solver iteration. Against the population alone the
 /// Generator finds nothing its own Solver cannot do (λ = -1 levels succeed 0.93-0.97 of the
 /// time). Four fixed 100k phases at the run's bonus, the finish before this one, left one seed
-/// in five flat (0.98 at λ = -1) and took another past every judge's reach (0.14); the stop
+/// in five flat (0.98 at λ = -1) and took another to 0.14, hard for its own Solver alone
+/// (the other judges' median drop 0.01); the stop
 /// ends the phase where the Solver fails, however fast or slow the Generator gets there
 /// (docs/training.md, "The recipe").
 pub const PLATFORM_FINISH: Finish = Finish {

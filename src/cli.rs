@@ -101,7 +101,8 @@ pub struct EvalArgs {
     /// controllability and that of the judges it never trained against (the rule-pcg Solver of
     /// the first --policies folder, the scripted median and expert), and P(arlpcg > baseline).
     /// The validation set's Generator levels come from the first --policies folder (default
-    /// policies/<game>).
+    /// policies/<game>). With two ARLPCG runs or more, every Solver also plays the λ = -1
+    /// levels of each ARLPCG run's Generator but its own, with P(arlpcg > baseline) there.
     #[arg(long, num_args = 1.., value_name = "RUN", conflicts_with_all = ["merge", "shard"])]
     pub runs: Vec<PathBuf>,
     /// Play only shard I of K of the evaluation (0 <= I < K) and write its raw per-level

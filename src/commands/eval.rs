@@ -122,6 +122,21 @@ fn seeds(args: &EvalArgs) -> Result<()> {
     let shipped = crate::policies::shipped_dir(args.game);
     let folder = args.policies.first().unwrap_or(&shipped);
     let (validation_generator, _) = load_generator(&folder.join(GENERATOR_FILE), args.game)?;
+    // A run named twice would count as two seeds (and, being its own Generator's, as no other
+    // run's on the other Generators' levels).
+    for (k, dir) in args.runs.iter().enumerate() {
+        let same = |other: &PathBuf| match (dir.canonicalize(), other.canonicalize()) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => dir == other,
+        };
+        if let Some(first) = args.runs[..k].iter().find(|other| same(other)) {
+            bail!(
+                "--runs names the run {} twice (also as {}): each run is one seed",
+                dir.display(),
+                first.display()
+            );
+        }
+    }
     let mut loaded = Vec::new();
     for dir in &args.runs {
         let (solver, card) = load_solver(&dir.join(crate::policies::SOLVER_FILE), args.game)?;
@@ -158,8 +173,14 @@ fn seeds(args: &EvalArgs) -> Result<()> {
     let validation =
         pool.install(|| eval::validation_levels(&validation_generator, budget.validation_tracks))?;
     let rule_levels = validation.iter().filter(|l| eval::is_rule_level(l)).count();
+    let arlpcg_generators = runs
+        .iter()
+        .filter(|r| r.mode == "arlpcg" && r.generator.is_some())
+        .count();
     let per_run = |r: &eval::seeds::Run| {
+        let own = r.mode == "arlpcg" && r.generator.is_some();
         validation.len() as u64
+            + eval::seeds::other_generators_plays(arlpcg_generators, own, budget.tracks)
             + r.generator.map_or(0, |_| {
                 (1 + judges.judges.len() as u64)
                     * eval::AUX_VALUES.len() as u64

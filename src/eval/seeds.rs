@@ -1,7 +1,10 @@
 //! Results over training seeds (`eval --runs`): each run folder's Solver on one shared
 //! validation set, each adversarial run's own pair on its controllability levels, then per
 //! mode the IQM and mean over seeds with stratified-bootstrap intervals, and the probability
-//! that the ARLPCG Solver beats each baseline on validation ([`crate::bootstrap`]).
+//! that the ARLPCG Solver beats each baseline on validation ([`crate::bootstrap`]). With two
+//! ARLPCG runs or more, each Solver also plays the hardest levels (λ = -1) of the ARLPCG
+//! Generators it did not train with: a Generator's finish aims at its own Solver's failures,
+//! so its levels judge every Solver but that one as unseen levels.
 
 use std::collections::BTreeMap;
 
@@ -41,6 +44,21 @@ pub struct RunScores {
     /// Solver of the evaluation's policies, the scripted player at median and expert skill).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub controllability_by_judge: Vec<JudgeCurve>,
+    /// Mean success on the λ = -1 levels of the ARLPCG runs' Generators other than the run's
+    /// own (none when there is no other)...
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub other_generators_hard: Option<f64>,
+    /// ...and on each of them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub on_other_generators: Vec<GeneratorScore>,
+}
+
+/// A Solver's mean success on the λ = -1 levels of one run's Generator.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GeneratorScore {
+    /// The Generator's run folder.
+    pub generator: String,
+    pub success_ratio: f64,
 }
 
 /// One judge's success at each λ of [`AUX_VALUES`].
@@ -91,6 +109,9 @@ pub struct ModeSummary {
     /// The same for each judge the runs never trained against.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub controllability_by_judge: Vec<JudgeSummary>,
+    /// Mean over seeds of [`RunScores::other_generators_hard`], when every seed has it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub other_generators_hard: Option<Estimate>,
 }
 
 /// One judge's mean success at each λ over a mode's seeds.
@@ -118,6 +139,9 @@ pub struct SeedResults {
     pub seeds: BTreeMap<String, Vec<RunScores>>,
     pub modes: Vec<ModeSummary>,
     pub arlpcg_beats: Vec<Improvement>,
+    /// P(arlpcg's success > the baseline's) on the other Generators' λ = -1 levels.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub arlpcg_beats_on_other_generators: Vec<Improvement>,
 }
 
 /// One run to score: its Solver, mode and seed, and its Generator when it has one.
@@ -130,8 +154,9 @@ pub struct Run<'a> {
 }
 
 /// Plays the validation set (rule levels first, `rule_levels` of them) with every run's Solver,
-/// and each adversarial run's own pair and the `judges` on its controllability levels;
-/// `on_level` after each level played.
+/// each adversarial run's own pair and the `judges` on its controllability levels, and every
+/// Solver on the λ = -1 levels of the ARLPCG Generators other than its run's own
+/// ([`other_generators_plays`] of them); `on_level` after each level played.
 pub fn score_runs(
     runs: &[Run],
     judges: &Panel,
@@ -153,6 +178,25 @@ pub fn score_runs(
             .collect()
     };
     let mean = |xs: &[f64]| xs.iter().sum::<f64>() / xs.len().max(1) as f64;
+    let hardest = AUX_VALUES[AUX_VALUES.len() - 1];
+    let arlpcg_generators: Vec<(&str, &GeneratorPolicy)> = runs
+        .iter()
+        .filter(|run| run.mode == "arlpcg")
+        .filter_map(|run| run.generator.map(|g| (run.folder.as_str(), g)))
+        .collect();
+    // With one ARLPCG Generator there is no other to compare its own Solver on.
+    let hard_levels: Vec<(&str, Vec<Level>)> = match arlpcg_generators.len() {
+        0 | 1 => Vec::new(),
+        _ => arlpcg_generators
+            .into_iter()
+            .map(|(folder, g)| {
+                Ok((
+                    folder,
+                    generator_levels(g, hardest, EVAL_SEED_BASE, budget.tracks)?,
+                ))
+            })
+            .collect::<Result<_, candle_core::Error>>()?,
+    };
     runs.iter()
         .map(|run| {
             let own = Solver::Policy(run.solver);
@@ -182,6 +226,18 @@ pub fn score_runs(
                 }
                 None => (None, Vec::new()),
             };
+            let on_other_generators: Vec<GeneratorScore> = hard_levels
+                .iter()
+                .filter(|(folder, _)| *folder != run.folder)
+                .map(|(folder, levels)| GeneratorScore {
+                    generator: folder.to_string(),
+                    success_ratio: mean(&play(&own, levels, budget.trials)),
+                })
+                .collect();
+            let others: Vec<f64> = on_other_generators
+                .iter()
+                .map(|g| g.success_ratio)
+                .collect();
             Ok(RunScores {
                 run: run.folder.clone(),
                 mode: run.mode.clone(),
@@ -191,9 +247,21 @@ pub fn score_runs(
                 validation: mean(&success),
                 controllability,
                 controllability_by_judge,
+                other_generators_hard: (!others.is_empty()).then(|| mean(&others)),
+                on_other_generators,
             })
         })
         .collect()
+}
+
+/// The levels [`score_runs`] plays on other Generators' λ = -1 levels for a run: `tracks` per
+/// ARLPCG Generator of `runs` but its own (`own`: the run is one of those), when there are at
+/// least two.
+pub fn other_generators_plays(arlpcg_generators: usize, own: bool, tracks: u32) -> u64 {
+    if arlpcg_generators < 2 {
+        return 0;
+    }
+    (arlpcg_generators - usize::from(own)) as u64 * tracks as u64
 }
 
 /// The summaries over seeds (pure: the same scores give the same bytes).
@@ -214,6 +282,10 @@ pub fn summarize(budget: Budget, validation_generator: &str, runs: Vec<RunScores
                 .map(|r| r.validation_generator_levels)
                 .collect(),
         ]
+    };
+    // Every seed's success on the other Generators' hard levels, if every seed has one.
+    let hard = |mode: &str| -> Option<Vec<f64>> {
+        of(&runs, mode).map(|r| r.other_generators_hard).collect()
     };
     let summaries = modes
         .iter()
@@ -237,6 +309,8 @@ pub fn summarize(budget: Budget, validation_generator: &str, runs: Vec<RunScores
                 validation_mean: estimate(&halves(mode), Aggregate::Mean, 0),
                 controllability,
                 controllability_by_judge: judge_summaries(of(&runs, mode).collect()),
+                other_generators_hard: hard(mode)
+                    .map(|at| estimate(&[at], Aggregate::Mean, AUX_VALUES.len() as u64)),
             }
         })
         .collect();
@@ -251,6 +325,23 @@ pub fn summarize(budget: Budget, validation_generator: &str, runs: Vec<RunScores
             .collect(),
         false => Vec::new(),
     };
+    let arlpcg_beats_on_other_generators = match hard("arlpcg") {
+        Some(arlpcg) => modes
+            .iter()
+            .filter(|m| *m != "arlpcg")
+            .filter_map(|baseline| {
+                Some(Improvement {
+                    baseline: baseline.clone(),
+                    probability: probability_of_improvement(
+                        std::slice::from_ref(&arlpcg),
+                        &[hard(baseline)?],
+                        0,
+                    ),
+                })
+            })
+            .collect(),
+        None => Vec::new(),
+    };
     let mut seeds: BTreeMap<String, Vec<RunScores>> = BTreeMap::new();
     for run in runs {
         seeds.entry(run.mode.clone()).or_default().push(run);
@@ -262,6 +353,7 @@ pub fn summarize(budget: Budget, validation_generator: &str, runs: Vec<RunScores
         seeds,
         modes: summaries,
         arlpcg_beats,
+        arlpcg_beats_on_other_generators,
     }
 }
 
@@ -296,6 +388,52 @@ fn judge_summaries(runs: Vec<&RunScores>) -> Vec<JudgeSummary> {
         .collect()
 }
 
+/// Each ARLPCG Generator's λ = -1 levels: its own Solver's success (its controllability at
+/// λ = -1, the same levels and runs) beside the mean of the other ARLPCG Solvers and of each
+/// baseline's Solvers on them.
+fn generator_by_generator(results: &SeedResults) -> String {
+    let runs: Vec<&RunScores> = results.seeds.values().flatten().collect();
+    let baselines: Vec<&str> = results
+        .modes
+        .iter()
+        .map(|m| m.mode.as_str())
+        .filter(|m| *m != "arlpcg")
+        .collect();
+    let mut md = String::from("\n| Generator (λ = -1) | own Solver | other arlpcg Solvers |");
+    for b in &baselines {
+        md += &format!(" {b} Solvers |");
+    }
+    md += "\n|---|---|---|";
+    md += &"---|".repeat(baselines.len());
+    md += "\n";
+    let on = |generator: &str, mode: &str| -> String {
+        let scores: Vec<f64> = runs
+            .iter()
+            .filter(|r| r.mode == mode)
+            .flat_map(|r| &r.on_other_generators)
+            .filter(|g| g.generator == generator)
+            .map(|g| g.success_ratio)
+            .collect();
+        match scores.is_empty() {
+            true => String::from("—"),
+            false => format!("{:.3}", scores.iter().sum::<f64>() / scores.len() as f64),
+        }
+    };
+    for run in runs.iter().filter(|r| r.mode == "arlpcg") {
+        let own = run
+            .controllability
+            .as_ref()
+            .and_then(|c| c.last())
+            .map_or(String::from("—"), |x| format!("{x:.3}"));
+        md += &format!("| {} | {own} | {} |", run.run, on(&run.run, "arlpcg"));
+        for b in &baselines {
+            md += &format!(" {} |", on(&run.run, b));
+        }
+        md += "\n";
+    }
+    md
+}
+
 /// The report as markdown.
 pub fn markdown(results: &SeedResults) -> String {
     let e = |x: &Estimate| format!("{:.3} [{:.3}, {:.3}]", x.value, x.ci95[0], x.ci95[1]);
@@ -317,6 +455,19 @@ pub fn markdown(results: &SeedResults) -> String {
         for b in &results.arlpcg_beats {
             md += &format!("| {} | {} |\n", b.baseline, e(&b.probability));
         }
+    }
+    if !results.arlpcg_beats_on_other_generators.is_empty() {
+        md += "\n## On other runs' Generators (λ = -1 levels of every ARLPCG Generator but the run's own)\n\n| mode | success: mean [95% CI] |\n|---|---|\n";
+        for m in &results.modes {
+            if let Some(hard) = &m.other_generators_hard {
+                md += &format!("| {} | {} |\n", m.mode, e(hard));
+            }
+        }
+        md += "\n| P(arlpcg > baseline) on other runs' Generators | [95% CI] |\n|---|---|\n";
+        for b in &results.arlpcg_beats_on_other_generators {
+            md += &format!("| {} | {} |\n", b.baseline, e(&b.probability));
+        }
+        md += &generator_by_generator(results);
     }
     md += "\n## Controllability over seeds (each run's own Generator and Solver)\n\n| mode |";
     for aux in &results.aux {
@@ -364,7 +515,7 @@ pub fn markdown(results: &SeedResults) -> String {
             .join(", ")
     };
     md += &format!(
-        "\n## Each run\n\n| run | mode | seed | validation (rule / Generator levels) | controllability λ = +1 … -1 | judges' median drop, all monotone (±{DROP_TOLERANCE}) |\n|---|---|---|---|---|---|\n"
+        "\n## Each run\n\n| run | mode | seed | validation (rule / Generator levels) | controllability λ = +1 … -1 | judges' median drop, all monotone (±{DROP_TOLERANCE}) | other Generators' λ = -1 |\n|---|---|---|---|---|---|---|\n"
     );
     for r in results.seeds.values().flatten() {
         let control = r.controllability.as_deref().map_or(String::from("—"), list);
@@ -373,8 +524,11 @@ pub fn markdown(results: &SeedResults) -> String {
             .map_or(String::from("—"), |(median, monotone)| {
                 format!("{median:.2}, {}", if monotone { "yes" } else { "no" })
             });
+        let others = r
+            .other_generators_hard
+            .map_or(String::from("—"), |x| format!("{x:.3}"));
         md += &format!(
-            "| {} | {} | {} | {:.3} ({:.3} / {:.3}) | {control} | {drop} |\n",
+            "| {} | {} | {} | {:.3} ({:.3} / {:.3}) | {control} | {drop} | {others} |\n",
             r.run,
             r.mode,
             r.seed,
@@ -421,6 +575,8 @@ mod tests {
                 ],
                 _ => Vec::new(),
             },
+            other_generators_hard: None,
+            on_other_generators: Vec::new(),
         }
     }
 
@@ -468,6 +624,75 @@ mod tests {
             "{md}"
         );
         assert!(md.contains("| arlpcg | scripted-expert |"), "{md}");
-        assert!(md.contains("| 0.20, yes |"), "{md}");
+        assert!(md.contains("| 0.20, yes | — |"), "{md}");
+        assert!(results.arlpcg_beats_on_other_generators.is_empty());
+        assert!(!md.contains("other runs' Generators"), "{md}");
+    }
+
+    /// On the other Generators' hard levels: the mean over each mode's seeds, and P(arlpcg
+    /// better) from those seeds alone; a baseline some seed of which lacks the figure is left
+    /// out.
+    #[test]
+    fn other_generators_hard_levels_are_summarized_over_seeds() {
+        // Two ARLPCG runs: each plays the other's Generator; rule-pcg's play both.
+        let on = |scores: &[(u64, f64)]| -> Vec<GeneratorScore> {
+            scores
+                .iter()
+                .map(|&(g, success_ratio)| GeneratorScore {
+                    generator: format!("runs/arlpcg-{g}"),
+                    success_ratio,
+                })
+                .collect()
+        };
+        let with = |mode: &str, seed: u64, scores: &[(u64, f64)]| {
+            let on_other_generators = on(scores);
+            let n = on_other_generators.len();
+            RunScores {
+                other_generators_hard: (mode != "fixed-track").then(|| {
+                    on_other_generators
+                        .iter()
+                        .map(|g| g.success_ratio)
+                        .sum::<f64>()
+                        / n as f64
+                }),
+                on_other_generators,
+                ..run(mode, seed, 0.9, 0.8)
+            }
+        };
+        let runs = vec![
+            with("arlpcg", 0, &[(1, 0.8)]),
+            with("arlpcg", 1, &[(0, 0.7)]),
+            with("rule-pcg", 0, &[(0, 0.7), (1, 0.8)]),
+            with("rule-pcg", 1, &[(0, 0.6), (1, 0.6)]),
+            with("fixed-track", 0, &[]),
+        ];
+        let results = summarize(Budget::QUICK, "g", runs);
+        let hard = results.modes[0].other_generators_hard.unwrap();
+        assert!((hard.value - 0.75).abs() < 1e-12, "{hard:?}");
+        assert!(results.modes[2].other_generators_hard.is_none());
+        // arlpcg (0.8, 0.7) against rule-pcg (0.75, 0.6): 3 of 4 pairs won.
+        let beats = &results.arlpcg_beats_on_other_generators;
+        assert_eq!(beats.len(), 1, "{beats:?}");
+        assert_eq!(beats[0].baseline, "rule-pcg");
+        assert!(
+            (beats[0].probability.value - 0.75).abs() < 1e-12,
+            "{beats:?}"
+        );
+        let md = markdown(&results);
+        assert!(md.contains("| arlpcg | 0.750 ["), "{md}");
+        assert!(md.contains("| 0.800 |"), "{md}");
+        // Generator 0's levels: its own Solver 0.5 (controllability at λ = -1), the other
+        // ARLPCG Solver 0.7, the rule-pcg Solvers (0.7 + 0.6) / 2; fixed-track played none.
+        assert!(
+            md.contains("| runs/arlpcg-0 | 0.500 | 0.700 | 0.650 | — |"),
+            "{md}"
+        );
+        assert!(
+            md.contains("| runs/arlpcg-1 | 0.500 | 0.800 | 0.700 | — |"),
+            "{md}"
+        );
+        assert_eq!(other_generators_plays(5, true, 20), 80);
+        assert_eq!(other_generators_plays(5, false, 20), 100);
+        assert_eq!(other_generators_plays(1, false, 20), 0);
     }
 }

@@ -1061,6 +1061,7 @@ fn evaluate_a_run(dir: &Path, run: &str) {
 /// The run scored as one seed of its mode (`eval --runs`): its own pair's controllability and
 /// its Solver on the validation set, with (here degenerate) intervals.
 fn score_a_run_as_one_seed(dir: &Path, run: &str) {
+    let run_dir = run;
     let seeds = dir.join("seeds");
     arlpcg_ok(&[
         "eval",
@@ -1097,6 +1098,26 @@ fn score_a_run_as_one_seed(dir: &Path, run: &str) {
             .all(|j| j["success_ratio"].as_array().unwrap().len() == 5)
     );
     assert!(seeds.join("seeds.md").exists());
+    // One ARLPCG run has no other run's Generator to be played on.
+    assert!(run.get("other_generators_hard").is_none(), "{run}");
+    assert!(
+        seeds_json["arlpcg_beats_on_other_generators"].is_null(),
+        "{seeds_json}"
+    );
+    // A run named twice is not two seeds.
+    let twice = arlpcg(&[
+        "eval",
+        "--runs",
+        run_dir,
+        &format!("{run_dir}/."),
+        "--policies",
+        run_dir,
+        "--out",
+        dir.join("twice").to_str().unwrap(),
+    ]);
+    assert_eq!(twice.status.code(), Some(1), "{}", stderr(&twice));
+    assert!(stderr(&twice).contains("twice"), "{}", stderr(&twice));
+    assert!(!dir.join("twice").exists());
 }
 
 /// `--resume --config` replaces the hyper-parameters (the old file is kept) but refuses the

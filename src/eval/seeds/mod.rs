@@ -20,6 +20,9 @@ use crate::verify::{Solver, SolverPolicy, verify};
 
 use super::{AUX_VALUES, Budget, generator_levels};
 
+mod markdown;
+pub use markdown::markdown;
+
 /// How much a judge's success may rise from one λ to the next harder one and still count as
 /// falling monotonically (the noise of the default budget).
 pub const DROP_TOLERANCE: f64 = 0.05;
@@ -178,50 +181,57 @@ pub fn score_runs(
             .collect()
     };
     let mean = |xs: &[f64]| xs.iter().sum::<f64>() / xs.len().max(1) as f64;
-    let hardest = AUX_VALUES[AUX_VALUES.len() - 1];
-    let arlpcg_generators: Vec<(&str, &GeneratorPolicy)> = runs
+    // Each adversarial run's controllability levels, at every λ of AUX_VALUES, built once:
+    // its own pair and the judges play them, and every other run its λ = -1 ones.
+    let controllability_levels: Vec<Option<Vec<Vec<Level>>>> = runs
         .iter()
-        .filter(|run| run.mode == "arlpcg")
-        .filter_map(|run| run.generator.map(|g| (run.folder.as_str(), g)))
+        .map(|run| {
+            run.generator
+                .map(|generator| {
+                    AUX_VALUES
+                        .iter()
+                        .map(|&aux| generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks))
+                        .collect::<Result<Vec<_>, _>>()
+                })
+                .transpose()
+        })
+        .collect::<Result<_, _>>()?;
+    let mut hard_levels: Vec<(&str, &[Level])> = runs
+        .iter()
+        .zip(&controllability_levels)
+        .filter(|(run, _)| run.mode == "arlpcg")
+        .filter_map(|(run, levels)| {
+            Some((run.folder.as_str(), levels.as_ref()?.last()?.as_slice()))
+        })
         .collect();
     // With one ARLPCG Generator there is no other to compare its own Solver on.
-    let hard_levels: Vec<(&str, Vec<Level>)> = match arlpcg_generators.len() {
-        0 | 1 => Vec::new(),
-        _ => arlpcg_generators
-            .into_iter()
-            .map(|(folder, g)| {
-                Ok((
-                    folder,
-                    generator_levels(g, hardest, EVAL_SEED_BASE, budget.tracks)?,
-                ))
-            })
-            .collect::<Result<_, candle_core::Error>>()?,
-    };
+    if hard_levels.len() < 2 {
+        hard_levels.clear();
+    }
     runs.iter()
-        .map(|run| {
+        .zip(&controllability_levels)
+        .map(|(run, levels)| {
             let own = Solver::Policy(run.solver);
             let success = play(&own, validation, budget.validation_trials);
             let (rules, generated) = success.split_at(rule_levels.min(success.len()));
-            let (controllability, controllability_by_judge) = match run.generator {
-                Some(generator) => {
-                    let mut own_curve = Vec::with_capacity(AUX_VALUES.len());
-                    let mut curves: Vec<JudgeCurve> = judges
+            let (controllability, controllability_by_judge) = match levels {
+                Some(levels) => {
+                    let own_curve = levels
+                        .iter()
+                        .map(|at| mean(&play(&own, at, budget.trials)))
+                        .collect();
+                    let curves = judges
                         .names()
                         .into_iter()
-                        .map(|judge| JudgeCurve {
+                        .enumerate()
+                        .map(|(k, judge)| JudgeCurve {
                             judge,
-                            success_ratio: Vec::with_capacity(AUX_VALUES.len()),
+                            success_ratio: levels
+                                .iter()
+                                .map(|at| mean(&play(&judges.solver(k), at, budget.trials)))
+                                .collect(),
                         })
                         .collect();
-                    for &aux in &AUX_VALUES {
-                        let levels =
-                            generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks)?;
-                        own_curve.push(mean(&play(&own, &levels, budget.trials)));
-                        for (k, curve) in curves.iter_mut().enumerate() {
-                            let success = play(&judges.solver(k), &levels, budget.trials);
-                            curve.success_ratio.push(mean(&success));
-                        }
-                    }
                     (Some(own_curve), curves)
                 }
                 None => (None, Vec::new()),
@@ -234,10 +244,6 @@ pub fn score_runs(
                     success_ratio: mean(&play(&own, levels, budget.trials)),
                 })
                 .collect();
-            let others: Vec<f64> = on_other_generators
-                .iter()
-                .map(|g| g.success_ratio)
-                .collect();
             Ok(RunScores {
                 run: run.folder.clone(),
                 mode: run.mode.clone(),
@@ -247,7 +253,14 @@ pub fn score_runs(
                 validation: mean(&success),
                 controllability,
                 controllability_by_judge,
-                other_generators_hard: (!others.is_empty()).then(|| mean(&others)),
+                other_generators_hard: (!on_other_generators.is_empty()).then(|| {
+                    mean(
+                        &on_other_generators
+                            .iter()
+                            .map(|g| g.success_ratio)
+                            .collect::<Vec<_>>(),
+                    )
+                }),
                 on_other_generators,
             })
         })
@@ -386,167 +399,6 @@ fn judge_summaries(runs: Vec<&RunScores>) -> Vec<JudgeSummary> {
             })
         })
         .collect()
-}
-
-/// Each ARLPCG Generator's λ = -1 levels: its own Solver's success (its controllability at
-/// λ = -1, the same levels and runs) beside the mean of the other ARLPCG Solvers and of each
-/// baseline's Solvers on them.
-fn generator_by_generator(results: &SeedResults) -> String {
-    let runs: Vec<&RunScores> = results.seeds.values().flatten().collect();
-    let baselines: Vec<&str> = results
-        .modes
-        .iter()
-        .map(|m| m.mode.as_str())
-        .filter(|m| *m != "arlpcg")
-        .collect();
-    let mut md = String::from("\n| Generator (λ = -1) | own Solver | other arlpcg Solvers |");
-    for b in &baselines {
-        md += &format!(" {b} Solvers |");
-    }
-    md += "\n|---|---|---|";
-    md += &"---|".repeat(baselines.len());
-    md += "\n";
-    let on = |generator: &str, mode: &str| -> String {
-        let scores: Vec<f64> = runs
-            .iter()
-            .filter(|r| r.mode == mode)
-            .flat_map(|r| &r.on_other_generators)
-            .filter(|g| g.generator == generator)
-            .map(|g| g.success_ratio)
-            .collect();
-        match scores.is_empty() {
-            true => String::from("—"),
-            false => format!("{:.3}", scores.iter().sum::<f64>() / scores.len() as f64),
-        }
-    };
-    for run in runs.iter().filter(|r| r.mode == "arlpcg") {
-        let own = run
-            .controllability
-            .as_ref()
-            .and_then(|c| c.last())
-            .map_or(String::from("—"), |x| format!("{x:.3}"));
-        md += &format!("| {} | {own} | {} |", run.run, on(&run.run, "arlpcg"));
-        for b in &baselines {
-            md += &format!(" {} |", on(&run.run, b));
-        }
-        md += "\n";
-    }
-    md
-}
-
-/// The report as markdown.
-pub fn markdown(results: &SeedResults) -> String {
-    let e = |x: &Estimate| format!("{:.3} [{:.3}, {:.3}]", x.value, x.ci95[0], x.ci95[1]);
-    let mut md = String::from(
-        "## Validation success over training seeds\n\n| mode | seeds | IQM [95% CI] | mean [95% CI] |\n|---|---|---|---|\n",
-    );
-    for m in &results.modes {
-        let seeds: Vec<String> = m.seeds.iter().map(u64::to_string).collect();
-        md += &format!(
-            "| {} | {} | {} | {} |\n",
-            m.mode,
-            seeds.join(", "),
-            e(&m.validation_iqm),
-            e(&m.validation_mean)
-        );
-    }
-    if !results.arlpcg_beats.is_empty() {
-        md += "\n| P(arlpcg > baseline) on validation | [95% CI] |\n|---|---|\n";
-        for b in &results.arlpcg_beats {
-            md += &format!("| {} | {} |\n", b.baseline, e(&b.probability));
-        }
-    }
-    if !results.arlpcg_beats_on_other_generators.is_empty() {
-        md += "\n## On other runs' Generators (λ = -1 levels of every ARLPCG Generator but the run's own)\n\n| mode | success: mean [95% CI] |\n|---|---|\n";
-        for m in &results.modes {
-            if let Some(hard) = &m.other_generators_hard {
-                md += &format!("| {} | {} |\n", m.mode, e(hard));
-            }
-        }
-        md += "\n| P(arlpcg > baseline) on other runs' Generators | [95% CI] |\n|---|---|\n";
-        for b in &results.arlpcg_beats_on_other_generators {
-            md += &format!("| {} | {} |\n", b.baseline, e(&b.probability));
-        }
-        md += &generator_by_generator(results);
-    }
-    md += "\n## Controllability over seeds (each run's own Generator and Solver)\n\n| mode |";
-    for aux in &results.aux {
-        md += &format!(" λ = {aux:+.1} |");
-    }
-    md += "\n|---|";
-    md += &"---|".repeat(results.aux.len());
-    md += "\n";
-    for m in &results.modes {
-        if let Some(by_aux) = &m.controllability {
-            md += &format!("| {} |", m.mode);
-            for x in by_aux {
-                md += &format!(" {} |", e(x));
-            }
-            md += "\n";
-        }
-    }
-    let judged: Vec<&ModeSummary> = results
-        .modes
-        .iter()
-        .filter(|m| !m.controllability_by_judge.is_empty())
-        .collect();
-    if !judged.is_empty() {
-        md += "\n## Controllability over seeds for the judges the runs never trained against\n\n| mode | judge |";
-        for aux in &results.aux {
-            md += &format!(" λ = {aux:+.1} |");
-        }
-        md += "\n|---|---|";
-        md += &"---|".repeat(results.aux.len());
-        md += "\n";
-        for m in judged {
-            for j in &m.controllability_by_judge {
-                md += &format!("| {} | {} |", m.mode, j.judge);
-                for x in &j.success_ratio {
-                    md += &format!(" {} |", e(x));
-                }
-                md += "\n";
-            }
-        }
-    }
-    let list = |xs: &[f64]| {
-        xs.iter()
-            .map(|x| format!("{x:.2}"))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    md += &format!(
-        "\n## Each run\n\n| run | mode | seed | validation (rule / Generator levels) | controllability λ = +1 … -1 | judges' median drop, all monotone (±{DROP_TOLERANCE}) | other Generators' λ = -1 |\n|---|---|---|---|---|---|---|\n"
-    );
-    for r in results.seeds.values().flatten() {
-        let control = r.controllability.as_deref().map_or(String::from("—"), list);
-        let drop = r
-            .judges_drop(DROP_TOLERANCE)
-            .map_or(String::from("—"), |(median, monotone)| {
-                format!("{median:.2}, {}", if monotone { "yes" } else { "no" })
-            });
-        let others = r
-            .other_generators_hard
-            .map_or(String::from("—"), |x| format!("{x:.3}"));
-        md += &format!(
-            "| {} | {} | {} | {:.3} ({:.3} / {:.3}) | {control} | {drop} | {others} |\n",
-            r.run,
-            r.mode,
-            r.seed,
-            r.validation,
-            r.validation_rule_levels,
-            r.validation_generator_levels
-        );
-    }
-    md += &format!(
-        "\nBudget: {} validation levels × {} runs (half rule levels, half from {}); {} levels × {} runs per λ. Intervals: stratified bootstrap over seeds, {} resamples.\n",
-        results.budget.validation_tracks,
-        results.budget.validation_trials,
-        results.validation_generator,
-        results.budget.tracks,
-        results.budget.trials,
-        crate::bootstrap::RESAMPLES
-    );
-    md
 }
 
 #[cfg(test)]

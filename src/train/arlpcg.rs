@@ -398,6 +398,20 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         self.opponents[i] = opponent;
     }
 
+    /// Adds `reward` to match `i`'s Generator return and to a recorded decision: the one at
+    /// `decision`, or else the newest if it is still waiting for its reward.
+    fn pay_generator(&mut self, i: usize, decision: Option<usize>, reward: f32) {
+        self.generator_returns[i] += reward;
+        let recorded = &mut self.recorded[i];
+        let paid = match decision {
+            Some(k) => recorded.get_mut(k),
+            None => recorded.last_mut().filter(|d| !d.ended),
+        };
+        if let Some(paid) = paid {
+            paid.reward += reward;
+        }
+    }
+
     /// Recorded Generator decisions that are complete (their reward is final).
     pub fn completed_decisions(&self) -> usize {
         self.recorded
@@ -507,18 +521,28 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
             .collect();
         let mut finished = Vec::new();
         let mut turns = Vec::new();
+        let mut failed_unfinished = Vec::new();
         for (i, (step, generator_reward)) in steps.into_iter().enumerate() {
-            self.generator_returns[i] += generator_reward;
-            if let Some(last) = self.recorded[i].last_mut().filter(|d| !d.ended) {
-                last.reward += generator_reward;
-            }
+            self.pay_generator(i, None, generator_reward);
             out[i] = Transition {
                 reward: step.reward,
                 ended: step.outcome.is_some(),
                 success: step.outcome.map(|o| o == Outcome::Success),
             };
             match step.outcome {
-                Some(outcome) => finished.push((i, Some(outcome))),
+                Some(Outcome::Success) => finished.push((i, Some(Outcome::Success))),
+                Some(failure) if self.matches[i].is_complete() => {
+                    let owed = self.matches[i].failure_reward(&self.rules.rewards);
+                    self.pay_generator(i, None, owed);
+                    finished.push((i, Some(failure)));
+                }
+                Some(failure) => {
+                    // Judged only once the Generator has completed the level alone.
+                    self.matches[i].complete_alone();
+                    let pending = self.recorded[i].len().checked_sub(1);
+                    let decision = pending.filter(|&k| !self.recorded[i][k].ended);
+                    failed_unfinished.push((i, failure, decision));
+                }
                 None if self.matches[i].needs_piece() => turns.push(i),
                 None => {}
             }
@@ -535,11 +559,102 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
             };
             finished.push((i, None));
         }
+        // A failure on a level the Generator does not complete is no failure of the Solver's
+        // on one of its levels: the match ends as invalid, without the failure reward.
+        let unfinished: Vec<usize> = failed_unfinished.iter().map(|&(i, ..)| i).collect();
+        let doomed = self
+            .place_while_needed(unfinished)
+            .expect("the Generator's forward pass runs on the CPU");
+        for (i, failure, decision) in failed_unfinished {
+            if doomed.contains(&i) {
+                finished.push((i, None));
+            } else {
+                let owed = self.matches[i].failure_reward(&self.rules.rewards);
+                self.pay_generator(i, decision, owed);
+                finished.push((i, Some(failure)));
+            }
+        }
         let restarted: Vec<usize> = finished.iter().map(|&(i, _)| i).collect();
         for (i, outcome) in finished {
             self.restart(i, outcome);
         }
         self.first_pieces(restarted)
             .expect("the Generator's forward pass runs on the CPU");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+
+    use super::*;
+    use crate::game::PlatformGame;
+    use crate::rl::policy::ActorCritic;
+    use crate::rl::ppo::PpoConfig;
+    use crate::train::TrainConfig;
+    use crate::train::cards::{generator_shape, solver_shape};
+
+    /// An untrained Generator at λ = -1 against a Solver that stands still: every run fails
+    /// on the first block, long before the goal.
+    fn standing_still_matches(matches: usize) -> AdversarialEnvs<PlatformGame> {
+        let config = TrainConfig::default();
+        let game = crate::level::Game::Platform;
+        let policy = ActorCritic::new(generator_shape(&config, game), 3).unwrap();
+        policy
+            .set_log_std(config.generator.initial_log_std)
+            .unwrap();
+        let generator = Generator {
+            ppo: Ppo::new(PpoConfig::default(), policy).unwrap(),
+            norm: RunningNorm::new(observation_size::<PlatformGame>()),
+        };
+        let rules = MatchRules {
+            aux_values: vec![-1.0],
+            limits: BuildLimits::default_for::<PlatformGame>(),
+            obstacles: 0,
+            rewards: PlatformGame::default_rewards(),
+            snapshot_share: None,
+            paced_share: 0.0,
+        };
+        let mut envs = AdversarialEnvs::new(
+            matches,
+            generator,
+            ChaCha8Rng::seed_from_u64(3),
+            rules,
+            AdversarialRecord::default(),
+            Vec::new(),
+            solver_shape(&config, game).action_size(),
+        )
+        .unwrap();
+        envs.set_phase(Phase::Generator);
+        envs
+    }
+
+    #[test]
+    fn a_failure_is_judged_only_on_a_level_the_generator_completes_alone() {
+        let matches = 16;
+        let mut envs = standing_still_matches(matches);
+        let width =
+            solver_shape(&TrainConfig::default(), crate::level::Game::Platform).action_size();
+        let still = vec![0.0; matches * width];
+        let mut out = vec![Transition::default(); matches];
+        while envs.stats.episodes < 48 {
+            envs.step(&still, &mut out);
+        }
+        let stats = envs.take_stats();
+        let (judged, invalid) = (stats.judged[1], stats.invalid);
+        assert_eq!(stats.successes[1], 0, "it stood still");
+        assert!(
+            judged > 0 && invalid > 0,
+            "{judged} judged, {invalid} invalid"
+        );
+        assert_eq!(judged + invalid, stats.episodes);
+        // Standing on the start, the Solver only ever saw the first block: each judged level
+        // was completed to its goal (30 m away or more, blocks at most 10 m apart) by the
+        // Generator alone.
+        assert!(
+            stats.pieces[1] >= 3 * judged,
+            "{} blocks in {judged} judged levels",
+            stats.pieces[1]
+        );
     }
 }

@@ -188,12 +188,24 @@ impl Workspace {
         assert!(rows > 0 && rows <= self.rows, "minibatch of {rows} rows");
         assert_eq!(params.len(), self.layout.len);
         let x = batch.observations;
-        forward(params, &self.layout.actor, x, rows, &mut self.actor);
-        forward(params, &self.layout.critic, x, rows, &mut self.critic);
+        // The actor and the critic side by side: each pass's products get part of the threads,
+        // which a minibatch's small products use better than all of them (docs/speed.md).
+        let (layout, actor, critic) = (&self.layout, &mut self.actor, &mut self.critic);
+        rayon::join(
+            || forward(params, &layout.actor, x, rows, actor),
+            || forward(params, &layout.critic, x, rows, critic),
+        );
         let terms = self.loss_pass(params, batch, weights, rows);
-        let (layout, gradients) = (&self.layout, &mut self.gradients);
-        backward(params, gradients, &layout.actor, x, rows, &mut self.actor);
-        backward(params, gradients, &layout.critic, x, rows, &mut self.critic);
+        let (layout, actor, critic) = (&self.layout, &mut self.actor, &mut self.critic);
+        let critic_start = layout.critic[0].weight;
+        let (actor_gradients, critic_gradients) = self.gradients.split_at_mut(critic_start);
+        rayon::join(
+            || backward(params, (actor_gradients, 0), &layout.actor, x, rows, actor),
+            || {
+                let gradients = (critic_gradients, critic_start);
+                backward(params, gradients, &layout.critic, x, rows, critic)
+            },
+        );
         terms
     }
 
@@ -385,10 +397,10 @@ fn forward(
 }
 
 /// From the last layer's delta (filled by the loss), the gradients of every layer's weights
-/// and biases, written into `gradients`.
+/// and biases, written into `gradients`: the flat gradient vector from offset `start` on.
 fn backward(
     params: &[f32],
-    gradients: &mut [f32],
+    (gradients, start): (&mut [f32], usize),
     layers: &[Dense],
     input: &[f32],
     rows: usize,
@@ -411,7 +423,8 @@ fn backward(
         };
         let delta = &buffers.deltas[k][..rows * fan_out];
         // ∂W = xᵀ · δ: lhs element (i, r) is x[r][i].
-        let (weight_gradient, rest) = gradients[layer.weight..].split_at_mut(fan_in * fan_out);
+        let (weight_gradient, rest) =
+            gradients[layer.weight - start..].split_at_mut(fan_in * fan_out);
         matmul(
             weight_gradient,
             (fan_in, fan_out, rows),

@@ -1,12 +1,10 @@
 //! Plays a policy folder's Generator and Solver, both frozen, in matches built as training
 //! builds them (the Generator places the next piece when the Solver comes close to the newest;
 //! a placement that fails ends the match uncounted), and splits the judged matches by whether
-//! the Generator, left to go on alone, would have completed its level. Until commit 8581735 a
-//! failure on a level that would never have been completed counted in training's hard-match
-//! success (and paid the Generator's failure reward), with no counterpart in `eval`, which plays
-//! complete levels only. Training now judges a failure only on a level its Generator completes
-//! alone, as this does (docs/training.md, "What a match judges"): of the two successes printed,
-//! the second is what it counts.
+//! the Generator, left to go on alone, would have completed its level. A failure on a level
+//! that would never have been completed counts in training's hard-match success (and pays the
+//! Generator's failure reward) but has no counterpart in `eval`, which plays complete levels
+//! only (docs/training.md, "What the finish's stop counts").
 //!
 //! ```sh
 //! cargo run --release --example finish_matches -- platform policies/platform -1 600

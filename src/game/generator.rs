@@ -27,6 +27,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{GameSpec, SolverEnv, Step};
 use crate::level::Track;
+use crate::level::stats::Outcome;
 
 /// The weights of one aux input in the Generator's reward (paper eq. 1).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -253,9 +254,6 @@ pub struct Match<G: GeneratorGame> {
     env: Option<G::Env>,
     solver_seed: u64,
     complete: bool,
-    /// The Solver's run failed before the track was complete: the Generator goes on alone
-    /// ([`Match::complete_alone`]).
-    alone: bool,
     /// The furthest piece the Solver had left behind when the Generator was last paid.
     paid_up_to: usize,
     air_paid: u32,
@@ -273,7 +271,6 @@ impl<G: GeneratorGame> Match<G> {
             env: None,
             solver_seed,
             complete: false,
-            alone: false,
             paid_up_to: 0,
             air_paid: 0,
         }
@@ -341,23 +338,10 @@ impl<G: GeneratorGame> Match<G> {
         self.env.is_some()
     }
 
-    /// Whether it is the Generator's turn: at the start, whenever the Solver has come close
-    /// to the newest piece of an unfinished track, and after [`Match::complete_alone`] until
-    /// the track is complete.
+    /// Whether it is the Generator's turn: at the start, and whenever the Solver has come close
+    /// to the newest piece of an unfinished track.
     pub fn needs_piece(&self) -> bool {
-        !self.complete && (self.alone || self.env.as_ref().is_none_or(|env| G::wants_piece(env)))
-    }
-
-    /// Whether the track reaches the goal.
-    pub fn is_complete(&self) -> bool {
-        self.complete
-    }
-
-    /// After the Solver's run failed on an unfinished track: the Generator places the rest of
-    /// the track with the Solver no longer playing, so that the match tells whether the level
-    /// was one it would have completed (docs/training.md, "What a match judges").
-    pub fn complete_alone(&mut self) {
-        self.alone = true;
+        !self.complete && self.env.as_ref().is_none_or(|env| G::wants_piece(env))
     }
 
     /// The Generator's observation, into `out`.
@@ -378,7 +362,6 @@ impl<G: GeneratorGame> Match<G> {
         }
         self.complete = placement == Placement::Completed;
         match &mut self.env {
-            Some(_) if self.alone => {}
             Some(env) => G::extend_env(env, &self.build, self.complete),
             None => {
                 let mut env = G::open_env(&self.build, self.complete);
@@ -390,9 +373,7 @@ impl<G: GeneratorGame> Match<G> {
     }
 
     /// Steps the Solver; returns its step and the Generator's reward from it (progress toward
-    /// the goal and air time; when the run failed, the failure term is
-    /// [`Match::failure_reward`], paid once the level is known to be one the Generator
-    /// completes).
+    /// the goal, air time, and the failure term when the run failed).
     pub fn step_solver(
         &mut self,
         action: <G::Env as SolverEnv>::Action,
@@ -417,13 +398,11 @@ impl<G: GeneratorGame> Match<G> {
         if air > self.air_paid {
             generator += rewards.per_air_step(aux) * (air - self.air_paid) as f32;
         }
+        if step.outcome.is_some_and(|o| o != Outcome::Success) {
+            generator += rewards.on_failure(aux);
+        }
         self.air_paid = self.air_paid.max(air);
         (step, generator)
-    }
-
-    /// The Generator's reward for the Solver's failure, at the λ of the piece the Solver was on.
-    pub fn failure_reward(&self, rewards: &GeneratorRewards) -> f32 {
-        rewards.on_failure(self.piece_aux(G::furthest_piece(self.env())))
     }
 }
 

@@ -398,20 +398,6 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         self.opponents[i] = opponent;
     }
 
-    /// Adds `reward` to match `i`'s Generator return and to a recorded decision: the one at
-    /// `decision`, or else the newest if it is still waiting for its reward.
-    fn pay_generator(&mut self, i: usize, decision: Option<usize>, reward: f32) {
-        self.generator_returns[i] += reward;
-        let recorded = &mut self.recorded[i];
-        let paid = match decision {
-            Some(k) => recorded.get_mut(k),
-            None => recorded.last_mut().filter(|d| !d.ended),
-        };
-        if let Some(paid) = paid {
-            paid.reward += reward;
-        }
-    }
-
     /// Recorded Generator decisions that are complete (their reward is final).
     pub fn completed_decisions(&self) -> usize {
         self.recorded
@@ -521,28 +507,18 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
             .collect();
         let mut finished = Vec::new();
         let mut turns = Vec::new();
-        let mut failed_unfinished = Vec::new();
         for (i, (step, generator_reward)) in steps.into_iter().enumerate() {
-            self.pay_generator(i, None, generator_reward);
+            self.generator_returns[i] += generator_reward;
+            if let Some(last) = self.recorded[i].last_mut().filter(|d| !d.ended) {
+                last.reward += generator_reward;
+            }
             out[i] = Transition {
                 reward: step.reward,
                 ended: step.outcome.is_some(),
                 success: step.outcome.map(|o| o == Outcome::Success),
             };
             match step.outcome {
-                Some(Outcome::Success) => finished.push((i, Some(Outcome::Success))),
-                Some(failure) if self.matches[i].is_complete() => {
-                    let owed = self.matches[i].failure_reward(&self.rules.rewards);
-                    self.pay_generator(i, None, owed);
-                    finished.push((i, Some(failure)));
-                }
-                Some(failure) => {
-                    // Judged only once the Generator has completed the level alone.
-                    self.matches[i].complete_alone();
-                    let pending = self.recorded[i].len().checked_sub(1);
-                    let decision = pending.filter(|&k| !self.recorded[i][k].ended);
-                    failed_unfinished.push((i, failure, decision));
-                }
+                Some(outcome) => finished.push((i, Some(outcome))),
                 None if self.matches[i].needs_piece() => turns.push(i),
                 None => {}
             }
@@ -559,21 +535,6 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
             };
             finished.push((i, None));
         }
-        // A failure on a level the Generator does not complete is no failure of the Solver's
-        // on one of its levels: the match ends as invalid, without the failure reward.
-        let unfinished: Vec<usize> = failed_unfinished.iter().map(|&(i, ..)| i).collect();
-        let doomed = self
-            .place_while_needed(unfinished)
-            .expect("the Generator's forward pass runs on the CPU");
-        for (i, failure, decision) in failed_unfinished {
-            if doomed.contains(&i) {
-                finished.push((i, None));
-            } else {
-                let owed = self.matches[i].failure_reward(&self.rules.rewards);
-                self.pay_generator(i, decision, owed);
-                finished.push((i, Some(failure)));
-            }
-        }
         let restarted: Vec<usize> = finished.iter().map(|&(i, _)| i).collect();
         for (i, outcome) in finished {
             self.restart(i, outcome);
@@ -582,6 +543,3 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
             .expect("the Generator's forward pass runs on the CPU");
     }
 }
-
-#[cfg(test)]
-mod tests;

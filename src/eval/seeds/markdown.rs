@@ -1,6 +1,6 @@
 //! The report of `eval --runs` as markdown (seeds.md).
 
-use super::{DROP_TOLERANCE, ModeSummary, RunScores, SeedResults};
+use super::{DROP_TOLERANCE, Improvement, ModeSummary, RunScores, SeedResults};
 use crate::bootstrap::Estimate;
 
 /// Each ARLPCG Generator's λ = -1 levels: its own Solver's success (its controllability at
@@ -49,6 +49,27 @@ fn generator_by_generator(results: &SeedResults) -> String {
     md
 }
 
+/// The end of a table's header after its first `leading` columns: one column per λ, then the
+/// separator row.
+fn aux_columns(aux: &[f64], leading: usize) -> String {
+    let mut md = String::new();
+    for a in aux {
+        md += &format!(" λ = {a:+.1} |");
+    }
+    md += "\n|";
+    md += &"---|".repeat(leading + aux.len());
+    md += "\n";
+    md
+}
+
+/// A P(arlpcg > baseline) table's rows.
+fn improvement_rows(beats: &[Improvement], e: impl Fn(&Estimate) -> String) -> String {
+    beats
+        .iter()
+        .map(|b| format!("| {} | {} |\n", b.baseline, e(&b.probability)))
+        .collect()
+}
+
 /// The report as markdown.
 pub fn markdown(results: &SeedResults) -> String {
     let e = |x: &Estimate| format!("{:.3} [{:.3}, {:.3}]", x.value, x.ci95[0], x.ci95[1]);
@@ -67,9 +88,7 @@ pub fn markdown(results: &SeedResults) -> String {
     }
     if !results.arlpcg_beats.is_empty() {
         md += "\n| P(arlpcg > baseline) on validation | [95% CI] |\n|---|---|\n";
-        for b in &results.arlpcg_beats {
-            md += &format!("| {} | {} |\n", b.baseline, e(&b.probability));
-        }
+        md += &improvement_rows(&results.arlpcg_beats, e);
     }
     if !results.arlpcg_beats_on_other_generators.is_empty() {
         md += "\n## On other runs' Generators (λ = -1 levels of every ARLPCG Generator but the run's own)\n\n| mode | success: mean [95% CI] |\n|---|---|\n";
@@ -79,18 +98,11 @@ pub fn markdown(results: &SeedResults) -> String {
             }
         }
         md += "\n| P(arlpcg > baseline) on other runs' Generators | [95% CI] |\n|---|---|\n";
-        for b in &results.arlpcg_beats_on_other_generators {
-            md += &format!("| {} | {} |\n", b.baseline, e(&b.probability));
-        }
+        md += &improvement_rows(&results.arlpcg_beats_on_other_generators, e);
         md += &generator_by_generator(results);
     }
     md += "\n## Controllability over seeds (each run's own Generator and Solver)\n\n| mode |";
-    for aux in &results.aux {
-        md += &format!(" λ = {aux:+.1} |");
-    }
-    md += "\n|---|";
-    md += &"---|".repeat(results.aux.len());
-    md += "\n";
+    md += &aux_columns(&results.aux, 1);
     for m in &results.modes {
         if let Some(by_aux) = &m.controllability {
             md += &format!("| {} |", m.mode);
@@ -107,12 +119,7 @@ pub fn markdown(results: &SeedResults) -> String {
         .collect();
     if !judged.is_empty() {
         md += "\n## Controllability over seeds for the judges the runs never trained against\n\n| mode | judge |";
-        for aux in &results.aux {
-            md += &format!(" λ = {aux:+.1} |");
-        }
-        md += "\n|---|---|";
-        md += &"---|".repeat(results.aux.len());
-        md += "\n";
+        md += &aux_columns(&results.aux, 2);
         for m in judged {
             for j in &m.controllability_by_judge {
                 md += &format!("| {} | {} |", m.mode, j.judge);

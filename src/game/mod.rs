@@ -72,7 +72,7 @@ pub trait GameSpec: Send + Sync + 'static {
     const GAME: crate::level::Game;
     type Env: SolverEnv;
     /// The game's scripted (non-learning) player.
-    type Scripted: Scripted<Self::Env>;
+    type Scripted: Scripted<Self::Env> + Send + Sync;
     /// The Solver's observation, named parts in order.
     const OBSERVATION_LAYOUT: &'static [(&'static str, usize)];
     /// The Solver's continuous actions, in the policy's order...

@@ -32,6 +32,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             obstacles: config.generator.obstacles,
             rewards: config.generator.rewards.clone(),
             snapshot_share: config.generator.snapshot_share,
+            scripted_opponent: None,
             paced_share: match mode {
                 TrainMode::FixedAux => 0.0,
                 _ => config.generator.paced_share,
@@ -227,12 +228,19 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             update_columns(&update)
         )?;
         let ratio = |a: u32, b: u32| a as f64 / b.max(1) as f64;
-        let message = format!(
+        let mut message = format!(
             "generator: success easy {:.2} / hard {:.2}, invalid {:.2}",
             ratio(stats.successes[0], stats.judged[0]),
             ratio(stats.successes[1], stats.judged[1]),
             ratio(stats.invalid, stats.episodes)
         );
+        if stats.scripted_judged != [0, 0] {
+            message += &format!(
+                ", scripted opponent easy {:.2} / hard {:.2}",
+                ratio(stats.scripted_successes[0], stats.scripted_judged[0]),
+                ratio(stats.scripted_successes[1], stats.scripted_judged[1])
+            );
+        }
         Ok((message, stats))
     }
 }
@@ -271,6 +279,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         let in_finish = config.in_finish(steps);
         let finish = config.generator.finish;
         self.envs().rules.snapshot_share = schedule.snapshot_share;
+        self.envs().rules.scripted_opponent = schedule.scripted_opponent;
         match self.envs().state.phase {
             Phase::Solver => {
                 let rollout =

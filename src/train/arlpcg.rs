@@ -24,20 +24,24 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::game::SolverEnv;
 use crate::game::generator::{
     BuildLimits, GeneratorGame, GeneratorRewards, Match, MatchPacing, TrackBuild, observation_size,
 };
-use crate::level::stats::Outcome;
+use crate::game::{Scripted, SolverEnv};
+use crate::level::stats::{Outcome, Skill};
 use crate::rl::normalizer::RunningNorm;
 use crate::rl::policy::ActMode;
 use crate::rl::ppo::{Batch, Ppo, gae};
 use crate::rl::vec_env::{Transition, VecEnv};
 use crate::seeds::TRAINING_SEED_BASE;
+use crate::train::config::ScriptedOpponent;
 use crate::train::population::Snapshot;
 
 mod replay;
 pub use replay::{AdversarialRecord, MatchEvent, MatchLog, MatchesUnderWay};
+
+/// The scripted player of a match, with its skill.
+type ScriptedPlayer<G> = (Skill, <G as crate::game::GameSpec>::Scripted);
 
 /// Which agent is learning.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -91,6 +95,8 @@ pub struct MatchRules {
     /// The share of matches a snapshot plays (`None`: uniform over the current Solver and the
     /// snapshots).
     pub snapshot_share: Option<f64>,
+    /// The scripted player's share of the matches while the Generator learns (in a finish).
+    pub scripted_opponent: Option<ScriptedOpponent>,
     /// The share of matches whose λ changes along the track
     /// ([`GeneratorConfig::paced_share`](super::GeneratorConfig::paced_share)).
     pub paced_share: f64,
@@ -129,6 +135,12 @@ pub struct MatchStats {
     pub pieces: [u32; 2],
     pub feature_sums: [[f64; 2]; 2],
     pub air_steps: [u64; 2],
+    /// [easy, hard]: the matches the scripted opponent finished, and its successes (counted
+    /// apart: the finish's stops count the Solver's).
+    #[serde(default)]
+    pub scripted_judged: [u32; 2],
+    #[serde(default)]
+    pub scripted_successes: [u32; 2],
 }
 
 /// Many matches of the Generator against the Solver, as the Solver's environments.
@@ -150,6 +162,9 @@ pub struct AdversarialEnvs<G: GeneratorGame> {
     /// Per match, the snapshot that plays it while the Generator learns (`None`: the current
     /// Solver).
     opponents: Vec<Option<usize>>,
+    /// Per match, the scripted player (and its skill) that plays it while the Generator
+    /// learns, if one does.
+    scripted: Vec<Option<ScriptedPlayer<G>>>,
 }
 
 impl<G: GeneratorGame> AdversarialEnvs<G> {
@@ -177,6 +192,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             stats: MatchStats::default(),
             population,
             opponents: Vec::with_capacity(num_matches),
+            scripted: Vec::with_capacity(num_matches),
         };
         if let Some(under_way) = record.under_way {
             this.replay(num_matches, under_way, solver_action_size)
@@ -184,13 +200,14 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             return Ok(this);
         }
         for _ in 0..num_matches {
-            let (fresh, opponent) = this.next_match();
+            let (fresh, opponent, scripted) = this.next_match();
             this.logs.push(MatchLog {
                 seed: fresh.seed(),
                 events: Vec::new(),
             });
             this.matches.push(fresh);
             this.opponents.push(opponent);
+            this.scripted.push(scripted);
         }
         this.first_pieces((0..num_matches).collect())?;
         Ok(this)
@@ -237,8 +254,9 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         }
     }
 
-    /// The next match, and the snapshot that plays it while the Generator learns.
-    fn next_match(&mut self) -> (Match<G>, Option<usize>) {
+    /// The next match, and the snapshot or scripted player that plays it while the Generator
+    /// learns.
+    fn next_match(&mut self) -> (Match<G>, Option<usize>, Option<ScriptedPlayer<G>>) {
         let seed = TRAINING_SEED_BASE + self.state.episodes_started;
         self.state.episodes_started += 1;
         let (fresh, mut rng) = self.match_of(seed);
@@ -248,7 +266,14 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             (n, None) => Some(rng.random_range(0..=n)).filter(|&k| k < n),
             (n, Some(share)) => rng.random_bool(share).then(|| rng.random_range(0..n)),
         };
-        (fresh, opponent)
+        // Drawn only with a scripted opponent, so that runs without one keep their bytes.
+        let scripted = match self.rules.scripted_opponent {
+            Some(o) if opponent.is_none() && rng.random_bool(o.share) => {
+                Some((o.skill, G::scripted(seed, o.skill)))
+            }
+            _ => None,
+        };
+        (fresh, opponent, scripted)
     }
 
     /// The match of `seed` before its first piece (its build and λ drawn from the seed), and
@@ -367,12 +392,18 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
     fn restart(&mut self, i: usize, solver_outcome: Option<Outcome>) {
         let game = &self.matches[i];
         let aux = game.aux[0];
+        let by_scripted = self.learning() && self.scripted[i].is_some();
         let stats = &mut self.stats;
         stats.episodes += 1;
         stats.generator_return_sum += self.generator_returns[i] as f64;
         self.generator_returns[i] = 0.0;
         match solver_outcome {
             None => stats.invalid += 1,
+            Some(outcome) if by_scripted && aux != 0.0 && game.pacing().is_none() => {
+                let side = usize::from(aux < 0.0);
+                stats.scripted_judged[side] += 1;
+                stats.scripted_successes[side] += u32::from(outcome == Outcome::Success);
+            }
             Some(outcome) if aux != 0.0 && game.pacing().is_none() => {
                 let side = usize::from(aux < 0.0);
                 stats.judged[side] += 1;
@@ -389,13 +420,14 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         if let Some(last) = self.recorded[i].last_mut() {
             last.ended = true;
         }
-        let (fresh, opponent) = self.next_match();
+        let (fresh, opponent, scripted) = self.next_match();
         self.logs[i] = MatchLog {
             seed: fresh.seed(),
             events: Vec::new(),
         };
         self.matches[i] = fresh;
         self.opponents[i] = opponent;
+        self.scripted[i] = scripted;
     }
 
     /// Recorded Generator decisions that are complete (their reward is final).
@@ -495,14 +527,25 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
         let actions = replaced.as_deref().unwrap_or(actions);
         let width = actions.len() / self.matches.len();
         let rewards = &self.rules.rewards;
+        let learning = self.learning();
         let steps: Vec<(crate::game::Step, f32)> = self
             .matches
             .par_iter_mut()
             .zip(self.logs.par_iter_mut())
+            .zip(self.scripted.par_iter_mut())
             .zip(actions.par_chunks(width))
-            .map(|((game, log), row)| {
-                log.events.push(MatchEvent::Step(row.to_vec()));
-                game.step_solver(G::Env::action_from_policy_row(row), rewards)
+            .map(|(((game, log), scripted), row)| {
+                let action = match scripted.as_mut().filter(|_| learning) {
+                    Some((_, player)) => {
+                        log.events.push(MatchEvent::Scripted);
+                        player.act(game.env())
+                    }
+                    None => {
+                        log.events.push(MatchEvent::Step(row.to_vec()));
+                        G::Env::action_from_policy_row(row)
+                    }
+                };
+                game.step_solver(action, rewards)
             })
             .collect();
         let mut finished = Vec::new();

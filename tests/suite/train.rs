@@ -915,6 +915,81 @@ fn a_finish_generator_entropy_spreads_the_generator_in_the_finish_only() {
     );
 }
 
+/// `finish.scripted_opponent`: the scripted player plays a share of the finish's matches while
+/// its Generator learns. Every Generator row before the finish is the run without it, the
+/// finish's rows are not, and a run killed inside the finish's Generator phase (matches under
+/// way that the scripted player was playing) resumes to the bytes of one never stopped.
+#[test]
+fn a_finish_with_a_scripted_opponent_changes_the_finish_alone_and_resumes_to_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let finish = "solver_steps: 128\ngenerator_phase_steps: 96";
+    let scripted = format!("{finish}\nscripted_opponent: {{skill: median, share: 0.5}}");
+    let rows = |run: &Path| -> Vec<(u64, String)> {
+        std::fs::read_to_string(run.join("generator-metrics.csv"))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|row| {
+                let cells: Vec<&str> = row.split(',').collect();
+                let kept = [&cells[..3], &cells[6..]].concat().join(",");
+                (cells[1].parse().unwrap(), kept)
+            })
+            .collect()
+    };
+    let (plain_dir, whole_dir) = (dir.path().join("plain"), dir.path().join("whole"));
+    for d in [&plain_dir, &whole_dir] {
+        std::fs::create_dir(d).unwrap();
+    }
+    let plain = rows(&train_tiny_to_640(&plain_dir, &tiny_with_finish(finish)));
+    let whole = train_tiny_to_640(&whole_dir, &tiny_with_finish(&scripted));
+    let with_opponent = rows(&whole);
+    let split = |rows: &[(u64, String)]| -> (Vec<String>, Vec<String>) {
+        let (before, finish): (Vec<_>, Vec<_>) = rows.iter().partition(|r| r.0 < 640);
+        let text = |rows: Vec<&(u64, String)>| rows.into_iter().map(|r| r.1.clone()).collect();
+        (text(before), text(finish))
+    };
+    let (plain_before, plain_finish) = split(&plain);
+    let (before, in_finish) = split(&with_opponent);
+    assert_eq!(plain_before, before, "the opponent waits for the finish");
+    assert_eq!(
+        in_finish.len(),
+        6,
+        "the finish's Generator phase: six iterations"
+    );
+    assert_ne!(
+        plain_finish, in_finish,
+        "the scripted player changes the finish"
+    );
+
+    let config = dir.path().join("scripted.yaml");
+    std::fs::write(&config, tiny_with_finish(&scripted)).unwrap();
+    let killed = dir.path().join("killed");
+    let killed_s = killed.to_str().unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+        .args(["train", "--mode", "arlpcg", "--steps", "640", "--config"])
+        .args([config.to_str().unwrap(), "--out", killed_s])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Killed after the finish's third Generator iteration (the header, the rows before it).
+    let metrics = killed.join("generator-metrics.csv");
+    let kill_at = 1 + before.len() + 3;
+    let start = Instant::now();
+    while std::fs::read_to_string(&metrics).map_or(0, |text| text.lines().count()) < kill_at {
+        assert!(start.elapsed() < Duration::from_secs(120), "no progress");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        rows(&killed).len() < with_opponent.len(),
+        "killed inside the finish"
+    );
+    arlpcg_ok(&["train", "--mode", "arlpcg", "--out", killed_s, "--resume"]);
+    assert_same_training(&whole, &killed, &[SOLVER, GENERATOR]);
+}
+
 /// (global_step, learning_rate) of every metrics row.
 fn learning_rates(run: &Path) -> Vec<(u64, f64)> {
     let metrics = std::fs::read_to_string(run.join("metrics.csv")).unwrap();

@@ -5,9 +5,10 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::{AdversarialEnvs, AdversarialState, Decision, MatchStats};
-use crate::game::SolverEnv;
+use super::{AdversarialEnvs, AdversarialState, Decision, MatchStats, ScriptedPlayer};
 use crate::game::generator::{GeneratorGame, GeneratorRewards, Match};
+use crate::game::{Scripted, SolverEnv};
+use crate::level::stats::Skill;
 
 /// What a match has been through since it began: enough to play it again to where it is.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -24,6 +25,9 @@ pub enum MatchEvent {
     Place(Vec<f32>),
     /// The Solver (or the snapshot playing the match) took a step.
     Step(Vec<f32>),
+    /// The scripted player took a step: it acts on the world it sees, so a replay asks it
+    /// again.
+    Scripted,
 }
 
 /// The matches under way as a checkpoint stores them: per match its log, who plays it, the
@@ -33,6 +37,10 @@ pub enum MatchEvent {
 pub struct MatchesUnderWay {
     logs: Vec<MatchLog>,
     opponents: Vec<Option<usize>>,
+    /// Per match, the skill of the scripted player that plays it, if one does (empty: none
+    /// does).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    scripted: Vec<Option<Skill>>,
     generator_returns: Vec<f32>,
     recorded: Vec<Vec<Decision>>,
     stats: MatchStats,
@@ -56,6 +64,14 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             under_way: Some(MatchesUnderWay {
                 logs: self.logs.clone(),
                 opponents: self.opponents.clone(),
+                scripted: match self.scripted.iter().any(Option::is_some) {
+                    true => self
+                        .scripted
+                        .iter()
+                        .map(|p| p.as_ref().map(|p| p.0))
+                        .collect(),
+                    false => Vec::new(),
+                },
                 generator_returns: self.generator_returns.clone(),
                 recorded: self.recorded.clone(),
                 stats: self.stats.clone(),
@@ -92,6 +108,11 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
                 "a match is played by a snapshot beyond the {snapshots} kept"
             ));
         }
+        let scripted = match under_way.scripted.len() {
+            0 => vec![None; n],
+            len if len == n => under_way.scripted,
+            _ => return Err(format!("they are not {n}, one per match")),
+        };
         let shape = self.generator.ppo.policy.shape();
         let (d, width) = (shape.observation, shape.action_size());
         let decision_fits = |decision: &Decision| {
@@ -109,11 +130,16 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             ));
         }
         let rewards = &self.rules.rewards;
-        self.matches = under_way
+        let replayed: Vec<(Match<G>, Option<ScriptedPlayer<G>>)> = under_way
             .logs
             .par_iter()
-            .map(|log| self.replayed(log, width, solver_action_size, rewards))
+            .zip(scripted)
+            .map(|(log, skill)| {
+                let player = skill.map(|skill| (skill, G::scripted(log.seed, skill)));
+                self.replayed(log, player, width, solver_action_size, rewards)
+            })
             .collect::<Result<_, String>>()?;
+        (self.matches, self.scripted) = replayed.into_iter().unzip();
         self.logs = under_way.logs;
         self.opponents = under_way.opponents;
         self.generator_returns = under_way.generator_returns;
@@ -122,14 +148,16 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         Ok(())
     }
 
-    /// The match of `log` played again: built from its seed, then every event of it.
+    /// The match of `log` played again, with the scripted `player` that plays it if one does:
+    /// built from its seed, then every event of it.
     fn replayed(
         &self,
         log: &MatchLog,
+        mut player: Option<ScriptedPlayer<G>>,
         generator_width: usize,
         solver_width: usize,
         rewards: &GeneratorRewards,
-    ) -> Result<Match<G>, String> {
+    ) -> Result<(Match<G>, Option<ScriptedPlayer<G>>), String> {
         let (mut game, _) = self.match_of(log.seed);
         let fits =
             |row: &[f32], width: usize| row.len() == width && row.iter().all(|v| v.is_finite());
@@ -146,6 +174,18 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
                         return Err(format!("match {}: it ends before its last step", log.seed));
                     }
                 }
+                MatchEvent::Scripted if game.started() => {
+                    let Some((_, player)) = player.as_mut() else {
+                        return Err(format!(
+                            "match {}: a scripted step in a match no scripted player plays",
+                            log.seed
+                        ));
+                    };
+                    let action = player.act(game.env());
+                    if game.step_solver(action, rewards).0.outcome.is_some() {
+                        return Err(format!("match {}: it ends before its last step", log.seed));
+                    }
+                }
                 _ => {
                     return Err(format!(
                         "match {}: an action row of the wrong size, not finite, or a step before the first piece",
@@ -154,6 +194,6 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
                 }
             }
         }
-        Ok(game)
+        Ok((game, player))
     }
 }

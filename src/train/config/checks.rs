@@ -115,6 +115,12 @@ fn check_schedule(g: &GeneratorConfig) -> Result<(), String> {
         {
             return Err("finish.generator_entropy must be a number in [0, 1]".into());
         }
+        if g.finish
+            .scripted_opponent
+            .is_some_and(|o| !(o.share > 0.0 && o.share <= 1.0))
+        {
+            return Err("finish.scripted_opponent.share must be a number in (0, 1]".into());
+        }
         if g.ppo.anneal_lr {
             return Err(
                 "finish: the Generator's learning rate is annealed to 0 by the finish \

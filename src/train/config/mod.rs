@@ -11,6 +11,7 @@ use super::solver_envs::SolverMode;
 use crate::game::PlatformGame;
 use crate::game::generator::{GeneratorGame, GeneratorRewards};
 use crate::level::Game;
+use crate::level::stats::Skill;
 use crate::rl::ppo::PpoConfig;
 
 mod checks;
@@ -193,6 +194,20 @@ pub struct Finish {
     /// against the final Solver instead of refining those it already makes.
     #[serde(default)]
     pub generator_entropy: Option<f32>,
+    /// A scripted player that plays a share of the matches while the finish's Generator
+    /// learns, so that its failures pay the Generator as the final Solver's do (none: the final
+    /// Solver plays every match). The stops above count the final Solver's matches only.
+    #[serde(default)]
+    pub scripted_opponent: Option<ScriptedOpponent>,
+}
+
+/// The scripted player as the Generator's opponent in a finish ([`Finish::scripted_opponent`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScriptedOpponent {
+    pub skill: Skill,
+    /// The share of matches it plays, in (0, 1].
+    pub share: f64,
 }
 
 /// The default of [`Finish::hard_match_block`].
@@ -225,6 +240,7 @@ impl Finish {
         until_hard_success: None,
         hard_match_block: HARD_MATCH_BLOCK,
         generator_entropy: None,
+        scripted_opponent: None,
     };
 }
 
@@ -280,6 +296,7 @@ impl GeneratorConfig {
                 generator_phase_steps: stage.generator_phase_steps,
                 snapshot_share: stage.snapshot_share.or(self.snapshot_share),
                 generator_entropy: None,
+                scripted_opponent: None,
             },
             None => Schedule {
                 solver_learning_rate: None,
@@ -287,6 +304,7 @@ impl GeneratorConfig {
                 generator_phase_steps: self.generator_phase_steps,
                 snapshot_share: self.snapshot_share,
                 generator_entropy: None,
+                scripted_opponent: None,
             },
         }
     }
@@ -303,6 +321,8 @@ pub struct Schedule {
     pub snapshot_share: Option<f64>,
     /// The Generator's entropy bonus (`None`: `generator.ppo.ent_coef`).
     pub generator_entropy: Option<f32>,
+    /// The scripted player's share of the matches (`Finish::scripted_opponent`).
+    pub scripted_opponent: Option<ScriptedOpponent>,
 }
 
 impl Default for GeneratorConfig {
@@ -400,6 +420,7 @@ impl TrainConfig {
                 generator_phase_steps: finish.generator_phase_steps,
                 snapshot_share: Some(0.0),
                 generator_entropy: finish.generator_entropy,
+                scripted_opponent: finish.scripted_opponent,
             };
         }
         self.generator.schedule_at(solver_steps)

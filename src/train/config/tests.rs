@@ -132,6 +132,16 @@ fn out_of_range_generator_fields_are_named() {
             "finish.generator_entropy",
         ),
         (
+            "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, scripted_opponent: {skill: median, share: 0}}\n",
+            Game::Platform,
+            "finish.scripted_opponent.share must be a number in (0, 1]",
+        ),
+        (
+            "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, scripted_opponent: {skill: master, share: 0.5}}\n",
+            Game::Racing,
+            "unknown variant `master`",
+        ),
+        (
             "generator:\n  snapshot_share: 1.5\n",
             Game::Platform,
             "generator.snapshot_share must be a number in [0, 1]",

@@ -922,7 +922,9 @@ fn a_finish_generator_entropy_spreads_the_generator_in_the_finish_only() {
 #[test]
 fn a_finish_with_a_scripted_opponent_changes_the_finish_alone_and_resumes_to_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();
+    // The platform recipe's finish has the median controller: the plain run turns it off.
     let finish = "solver_steps: 128\ngenerator_phase_steps: 96";
+    let plain = format!("{finish}\nscripted_opponent: null");
     let scripted = format!("{finish}\nscripted_opponent: {{skill: median, share: 0.5}}");
     let rows = |run: &Path| -> Vec<(u64, String)> {
         std::fs::read_to_string(run.join("generator-metrics.csv"))
@@ -940,7 +942,7 @@ fn a_finish_with_a_scripted_opponent_changes_the_finish_alone_and_resumes_to_the
     for d in [&plain_dir, &whole_dir] {
         std::fs::create_dir(d).unwrap();
     }
-    let plain = rows(&train_tiny_to_640(&plain_dir, &tiny_with_finish(finish)));
+    let plain = rows(&train_tiny_to_640(&plain_dir, &tiny_with_finish(&plain)));
     let whole = train_tiny_to_640(&whole_dir, &tiny_with_finish(&scripted));
     let with_opponent = rows(&whole);
     let split = |rows: &[(u64, String)]| -> (Vec<String>, Vec<String>) {

@@ -98,8 +98,9 @@ pub struct EvalArgs {
     /// solver.safetensors, and generator.safetensors for adversarial runs; mode and seed from
     /// the card). Writes seeds.md and seeds.json to --out: per mode the IQM and mean validation
     /// success over seeds with 95% stratified-bootstrap intervals, each adversarial run's own
-    /// controllability and that of the judges it never trained against (the rule-pcg Solver of
-    /// the first --policies folder, the scripted median and expert), and P(arlpcg > baseline).
+    /// controllability and that of the outside judges (the rule-pcg Solver of the first
+    /// --policies folder, the scripted median and expert; the platform recipe's finish plays the
+    /// median), and P(arlpcg > baseline).
     /// The validation set's Generator levels come from the first --policies folder (default
     /// policies/<game>). With two ARLPCG runs or more, every Solver also plays the λ = -1
     /// levels of each ARLPCG run's Generator but its own, with P(arlpcg > baseline) there.

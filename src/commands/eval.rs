@@ -157,7 +157,7 @@ fn seeds(args: &EvalArgs) -> Result<()> {
             generator: generator.as_ref(),
         })
         .collect();
-    // The judges the runs never trained against, from the same folder.
+    // The outside judges, from the same folder.
     let judges = [
         Judge::Solver(TrainMode::RulePcg),
         Judge::Scripted(Skill::Median),

@@ -118,7 +118,7 @@ pub fn markdown(results: &SeedResults) -> String {
         .filter(|m| !m.controllability_by_judge.is_empty())
         .collect();
     if !judged.is_empty() {
-        md += "\n## Controllability over seeds for the judges the runs never trained against\n\n| mode | judge |";
+        md += "\n## Controllability over seeds for the outside judges (rule-pcg, scripted median and expert)\n\n| mode | judge |";
         md += &aux_columns(&results.aux, 2);
         for m in judged {
             for j in &m.controllability_by_judge {

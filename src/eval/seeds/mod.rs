@@ -43,8 +43,9 @@ pub struct RunScores {
     /// [`AUX_VALUES`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub controllability: Option<Vec<f64>>,
-    /// The same levels played by the judges the run never trained against (the rule-pcg
-    /// Solver of the evaluation's policies, the scripted player at median and expert skill).
+    /// The same levels played by the outside judges (the rule-pcg Solver of the evaluation's
+    /// policies, the scripted player at median and expert skill; the platform recipe's finish
+    /// plays the median controller, so for its runs that one is not a stranger).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub controllability_by_judge: Vec<JudgeCurve>,
     /// Mean success on the λ = -1 levels of the ARLPCG runs' Generators other than the run's
@@ -109,7 +110,7 @@ pub struct ModeSummary {
     /// Mean controllability success at each λ (adversarial modes).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub controllability: Option<Vec<Estimate>>,
-    /// The same for each judge the runs never trained against.
+    /// The same for each outside judge.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub controllability_by_judge: Vec<JudgeSummary>,
     /// Mean over seeds of [`RunScores::other_generators_hard`], when every seed has it.

@@ -11,8 +11,9 @@
 //!
 //! With a population, each match also draws who plays it while the Generator learns: the
 //! current Solver or one of its earlier [`Snapshot`]s, so that the Generator's failure reward
-//! comes from several networks and no single one's blind spot pays. While the Solver learns it
-//! plays every match itself.
+//! comes from several networks and no single one's blind spot pays. In a finish with a scripted
+//! opponent, a match may draw the game's scripted player instead, which acts on the world it
+//! sees. While the Solver learns it plays every match itself.
 //!
 //! Each match keeps the log of what it has been through (its seed, then every piece placed and
 //! every Solver step, as action rows); a checkpoint stores the logs with the Generator's

@@ -727,24 +727,45 @@ fn a_run_killed_while_its_generator_learns_resumes_to_the_same_bytes() {
     let whole = dir.path().join("whole");
     arlpcg_ok(&args(&whole).iter().map(String::as_str).collect::<Vec<_>>());
     let killed = dir.path().join("killed");
+    // The first Generator phase runs iterations 1 to 6: kill it after its third.
+    kill_after_generator_rows(&args(&killed), &killed, 3);
+    let killed_s = killed.to_str().unwrap();
+    arlpcg_ok(&["train", "--mode", "arlpcg", "--out", killed_s, "--resume"]);
+    assert_same_training(&whole, &killed, &[SOLVER, GENERATOR]);
+}
+
+/// Runs `arlpcg args` writing to `out` and kills it once its Generator metrics hold `rows`
+/// rows (a checkpoint after each iteration in the tiny configurations).
+fn kill_after_generator_rows(args: &[String], out: &Path, rows: usize) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
-        .args(args(&killed))
+        .args(args)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    // The first Generator phase runs iterations 1 to 6: kill it after its third.
-    let metrics = killed.join("generator-metrics.csv");
+    let metrics = out.join("generator-metrics.csv");
     let start = Instant::now();
-    while std::fs::read_to_string(&metrics).map_or(0, |text| text.lines().count()) < 4 {
+    // The header and `rows` rows.
+    while std::fs::read_to_string(&metrics).map_or(0, |text| text.lines().count()) < 1 + rows {
         assert!(start.elapsed() < Duration::from_secs(120), "no progress");
         std::thread::sleep(Duration::from_millis(2));
     }
     child.kill().unwrap();
     child.wait().unwrap();
-    let killed_s = killed.to_str().unwrap();
-    arlpcg_ok(&["train", "--mode", "arlpcg", "--out", killed_s, "--resume"]);
-    assert_same_training(&whole, &killed, &[SOLVER, GENERATOR]);
+}
+
+/// (solver_step, the columns that do not tell time, entropy) of each Generator metrics row.
+fn generator_metrics(run: &Path) -> Vec<(u64, String, f64)> {
+    std::fs::read_to_string(run.join("generator-metrics.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|row| {
+            let cells: Vec<&str> = row.split(',').collect();
+            let kept = [&cells[..3], &cells[6..]].concat().join(",");
+            (cells[1].parse().unwrap(), kept, cells[20].parse().unwrap())
+        })
+        .collect()
 }
 
 /// [`TINY_ADVERSARIAL`] with its finish replaced by `fields` (one `key: value` per line).
@@ -879,19 +900,7 @@ fn a_finish_generator_entropy_spreads_the_generator_in_the_finish_only() {
             "solver_steps: 128\ngenerator_phase_steps: 400{entropy}"
         ))
         .replace("  ppo:\n", "  ppo:\n    learning_rate: 0.01\n");
-        let out = train_tiny_to_640(dir.path(), &config);
-        // (solver_step, the columns that do not tell time, entropy) of each Generator row.
-        std::fs::read_to_string(out.join("generator-metrics.csv"))
-            .unwrap()
-            .lines()
-            .skip(1)
-            .map(|row| {
-                let cells: Vec<&str> = row.split(',').collect();
-                let steps: u64 = cells[1].parse().unwrap();
-                let kept = [&cells[..3], &cells[6..]].concat().join(",");
-                (steps, kept, cells[20].parse::<f64>().unwrap())
-            })
-            .collect::<Vec<_>>()
+        generator_metrics(&train_tiny_to_640(dir.path(), &config))
     };
     let (plain, spread) = (run(""), run("\ngenerator_entropy: 1.0"));
     let before = |rows: &[(u64, String, f64)]| -> Vec<String> {
@@ -927,15 +936,9 @@ fn a_finish_with_a_scripted_opponent_changes_the_finish_alone_and_resumes_to_the
     let plain = format!("{finish}\nscripted_opponent: null");
     let scripted = format!("{finish}\nscripted_opponent: {{skill: median, share: 0.5}}");
     let rows = |run: &Path| -> Vec<(u64, String)> {
-        std::fs::read_to_string(run.join("generator-metrics.csv"))
-            .unwrap()
-            .lines()
-            .skip(1)
-            .map(|row| {
-                let cells: Vec<&str> = row.split(',').collect();
-                let kept = [&cells[..3], &cells[6..]].concat().join(",");
-                (cells[1].parse().unwrap(), kept)
-            })
+        generator_metrics(run)
+            .into_iter()
+            .map(|(step, kept, _)| (step, kept))
             .collect()
     };
     let (plain_dir, whole_dir) = (dir.path().join("plain"), dir.path().join("whole"));
@@ -967,23 +970,13 @@ fn a_finish_with_a_scripted_opponent_changes_the_finish_alone_and_resumes_to_the
     std::fs::write(&config, tiny_with_finish(&scripted)).unwrap();
     let killed = dir.path().join("killed");
     let killed_s = killed.to_str().unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
-        .args(["train", "--mode", "arlpcg", "--steps", "640", "--config"])
-        .args([config.to_str().unwrap(), "--out", killed_s])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    // Killed after the finish's third Generator iteration (the header, the rows before it).
-    let metrics = killed.join("generator-metrics.csv");
-    let kill_at = 1 + before.len() + 3;
-    let start = Instant::now();
-    while std::fs::read_to_string(&metrics).map_or(0, |text| text.lines().count()) < kill_at {
-        assert!(start.elapsed() < Duration::from_secs(120), "no progress");
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    child.kill().unwrap();
-    child.wait().unwrap();
+    // Killed after the finish's third Generator iteration.
+    let args = ["train", "--mode", "arlpcg", "--steps", "640", "--config"]
+        .into_iter()
+        .chain([config.to_str().unwrap(), "--out", killed_s])
+        .map(String::from)
+        .collect::<Vec<_>>();
+    kill_after_generator_rows(&args, &killed, before.len() + 3);
     assert!(
         rows(&killed).len() < with_opponent.len(),
         "killed inside the finish"

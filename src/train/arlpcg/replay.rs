@@ -162,36 +162,34 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         let fits =
             |row: &[f32], width: usize| row.len() == width && row.iter().all(|v| v.is_finite());
         for event in &log.events {
-            match event {
+            let action = match event {
                 MatchEvent::Place(row) if fits(row, generator_width) => {
                     if game.place(row).is_invalid() {
                         return Err(format!("match {}: a placement is invalid", log.seed));
                     }
+                    continue;
                 }
                 MatchEvent::Step(row) if fits(row, solver_width) && game.started() => {
-                    let action = G::Env::action_from_policy_row(row);
-                    if game.step_solver(action, rewards).0.outcome.is_some() {
-                        return Err(format!("match {}: it ends before its last step", log.seed));
-                    }
+                    G::Env::action_from_policy_row(row)
                 }
-                MatchEvent::Scripted if game.started() => {
-                    let Some((_, player)) = player.as_mut() else {
+                MatchEvent::Scripted if game.started() => match player.as_mut() {
+                    Some((_, player)) => player.act(game.env()),
+                    None => {
                         return Err(format!(
                             "match {}: a scripted step in a match no scripted player plays",
                             log.seed
                         ));
-                    };
-                    let action = player.act(game.env());
-                    if game.step_solver(action, rewards).0.outcome.is_some() {
-                        return Err(format!("match {}: it ends before its last step", log.seed));
                     }
-                }
+                },
                 _ => {
                     return Err(format!(
                         "match {}: an action row of the wrong size, not finite, or a step before the first piece",
                         log.seed
                     ));
                 }
+            };
+            if game.step_solver(action, rewards).0.outcome.is_some() {
+                return Err(format!("match {}: it ends before its last step", log.seed));
             }
         }
         Ok((game, player))

@@ -424,29 +424,29 @@ impl HalfwaySplit {
     }
 }
 
-/// The difficulty along a level: the share of runs past each piece against the fraction of the
-/// way where the piece begins, and, on a paced level, the difficulty its λ asked for
-/// (`(1 - λ) / 2`: 0 easy, 1 hard).
+/// The difficulty along a level: the share of runs past each piece, piece by piece from the
+/// start, and, on a paced level, the difficulty its λ asked for (`(1 - λ) / 2`: 0 easy, 1 hard).
+/// Pieces are counted, not placed by the fraction of the way where they begin: a level that
+/// winds back and forth near the goal's distance would draw its line backwards.
 pub fn pacing_chart(name: &str, level: &Level, stats: &SolverStats) -> crate::chart::LineChart {
-    let fractions = level.piece_start_fractions();
+    let piece_numbers = (1..).map(f64::from);
     let passed = passed_by_piece(stats);
     let mut series = vec![crate::chart::Series {
         name: "runs past the piece".into(),
-        points: fractions.iter().copied().zip(passed).collect(),
+        points: piece_numbers.clone().zip(passed).collect(),
     }];
     if let Some(pacing) = &level.pacing {
         series.push(crate::chart::Series {
             name: "asked: (1-λ)/2".into(),
-            points: fractions
-                .iter()
+            points: piece_numbers
                 .zip(&pacing.piece_aux)
-                .map(|(&f, aux)| (f, aux.map_or(f64::NAN, |a| (1.0 - a) / 2.0)))
+                .map(|(n, aux)| (n, aux.map_or(f64::NAN, |a| (1.0 - a) / 2.0)))
                 .collect(),
         });
     }
     crate::chart::LineChart {
         title: format!("{name}: {} runs", stats.trials),
-        x_label: "fraction of the way to the goal where the piece begins".into(),
+        x_label: "piece, from the start".into(),
         y_label: "share".into(),
         series,
         y_range: Some((0.0, 1.0)),

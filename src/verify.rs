@@ -466,3 +466,44 @@ pub fn passed_by_piece(stats: &SolverStats) -> Vec<f64> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shipped easy-then-hard level winds back and forth near halfway, so its pieces'
+    /// fractions of the way are not in order; the chart still reads left to right.
+    #[test]
+    fn the_pacing_chart_counts_pieces_in_order_whatever_way_the_level_winds() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("levels/pacing/platform_seed102_curve-8c91a45e.yaml");
+        let level = crate::level::yaml::load(&path).unwrap();
+        let stats = level.stats.clone().unwrap();
+        let fractions = level.piece_start_fractions();
+        assert!(
+            fractions.windows(2).any(|w| w[1] < w[0]),
+            "a level whose pieces go back toward the start: {fractions:?}"
+        );
+        let chart = pacing_chart("seed102", &level, &stats);
+        assert_eq!(
+            chart.series.len(),
+            2,
+            "runs past each piece and the λ asked"
+        );
+        for series in &chart.series {
+            assert_eq!(series.points.len(), fractions.len(), "{}", series.name);
+            assert!(
+                series.points.windows(2).all(|w| w[1].0 > w[0].0),
+                "{}: x in order",
+                series.name
+            );
+        }
+        let passed: Vec<f64> = chart.series[0].points.iter().map(|p| p.1).collect();
+        assert!(passed.windows(2).all(|w| w[1] <= w[0]), "{passed:?}");
+        assert_eq!(
+            *passed.last().unwrap(),
+            stats.success_ratio,
+            "the last piece's share is the level's success"
+        );
+    }
+}

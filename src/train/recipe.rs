@@ -5,10 +5,11 @@
 //! paced matches and its finish.
 //! docs/training.md ("The recipe") says how each value was found.
 
-use super::config::{Finish, TrainConfig, TrainMode};
+use super::config::{Finish, ScriptedOpponent, TrainConfig, TrainMode};
 use crate::game::RacingGame;
 use crate::game::generator::GeneratorGame;
 use crate::level::Game;
+use crate::level::stats::Skill;
 
 /// The racing recipe's budget in Solver steps learned from ([`TrainConfig::steps`]; the
 /// platform's is the configuration's default, `config::PLATFORM_STEPS`).
@@ -51,6 +52,10 @@ pub const RACING_FINISH: Finish = Finish {
     generator_phase_steps: 800_000,
     generator_until_hard_success: Some(0.5),
     generator_entropy: Some(0.01),
+    scripted_opponent: Some(ScriptedOpponent {
+        skill: Skill::Median,
+        share: 0.5,
+    }),
     ..Finish::NONE
 };
 

@@ -99,8 +99,8 @@ pub struct EvalArgs {
     /// the card). Writes seeds.md and seeds.json to --out: per mode the IQM and mean validation
     /// success over seeds with 95% stratified-bootstrap intervals, each adversarial run's own
     /// controllability and that of the outside judges (the rule-pcg Solver of the first
-    /// --policies folder, the scripted median and expert; the platform recipe's finish plays the
-    /// median), and P(arlpcg > baseline).
+    /// --policies folder, the scripted median and expert; the recipe's finish plays the median
+    /// in both games), and P(arlpcg > baseline).
     /// The validation set's Generator levels come from the first --policies folder (default
     /// policies/<game>). With two ARLPCG runs or more, every Solver also plays the λ = -1
     /// levels of each ARLPCG run's Generator but its own, with P(arlpcg > baseline) there.
@@ -158,8 +158,9 @@ pub struct GenerateArgs {
     /// and within the character's or the car's ability).
     #[arg(long)]
     pub rules: bool,
-    /// Racing, with --rules: place this many obstacles between the start and the goal, which
-    /// the road goes around.
+    /// Racing: place this many obstacles between the start and the goal, which the road (of the
+    /// rules or of the Generator) goes around. The racing Generator trained with 3, and its
+    /// λ→success curve for --target-success is measured with 3.
     #[arg(long, value_name = "N", default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=200))]
     pub obstacles: u32,
     /// Use the trained Generator in this folder (generator.safetensors; --verify plays the

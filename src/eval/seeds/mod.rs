@@ -44,8 +44,8 @@ pub struct RunScores {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub controllability: Option<Vec<f64>>,
     /// The same levels played by the outside judges (the rule-pcg Solver of the evaluation's
-    /// policies, the scripted player at median and expert skill; the platform recipe's finish
-    /// plays the median controller, so for its runs that one is not a stranger).
+    /// policies, the scripted player at median and expert skill; the recipe's finish plays the
+    /// median player in both games, so for its runs that one is not a stranger).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub controllability_by_judge: Vec<JudgeCurve>,
     /// Mean success on the λ = -1 levels of the ARLPCG runs' Generators other than the run's

@@ -292,7 +292,7 @@ mod tests {
     use super::*;
     use crate::game::platform::generator::{GENERATOR_ACTIONS, GENERATOR_OBSERVATION_SIZE};
     use crate::game::rules::goal_and_start;
-    use crate::level::platform::heading_direction;
+    use crate::level::heading::heading_direction;
     use crate::rl::policy::PolicyShape;
 
     fn untrained() -> GeneratorPolicy {

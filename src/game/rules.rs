@@ -7,6 +7,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::game::platform::reach;
+use crate::level::heading;
 use crate::level::params::{self, quantize};
 use crate::level::platform::{self, BlockParams, Platform, PlatformTrack, Start};
 use crate::level::{Level, RulesConfig, Source, Track};
@@ -26,7 +27,7 @@ pub fn random_goal(rng: &mut ChaCha8Rng) -> [f64; 3] {
     let heading = rng.random_range(-180.0..180.0);
     let distance = rng.random_range(GOAL_DISTANCE.0..=GOAL_DISTANCE.1);
     let height = rng.random_range(GOAL_HEIGHT.0..=GOAL_HEIGHT.1);
-    let [x, z] = platform::heading_direction(heading);
+    let [x, z] = heading::heading_direction(heading);
     [
         quantize(distance * x),
         quantize(height),
@@ -143,7 +144,7 @@ fn draw(
     let (dx, dz) = (goal[0] - last.position[0], goal[2] - last.position[2]);
     let horizontal = dx.hypot(dz);
     let rise = goal[1] - last.position[1];
-    let to_goal = platform::direction_heading(dx, dz);
+    let to_goal = heading::direction_heading(dx, dz);
     let size = rng.random_range(params::BLOCK_SIZE.min..=params::BLOCK_SIZE.max);
     let finish = params::BLOCK_DISTANCE.check(horizontal).is_ok()
         && rise.abs() <= params::BLOCK_HEIGHT.max + platform::GOAL_REACH_VERTICAL;
@@ -161,7 +162,7 @@ fn draw(
         let distance = rng.random_range(params::BLOCK_DISTANCE.min..=longest);
         (distance, heading, climb)
     };
-    let angle = platform::wrap_degrees(heading - last.heading);
+    let angle = heading::wrap_degrees(heading - last.heading);
     BlockParams {
         distance: quantize(distance).clamp(params::BLOCK_DISTANCE.min, params::BLOCK_DISTANCE.max),
         angle: quantize(angle).clamp(params::BLOCK_ANGLE.min, params::BLOCK_ANGLE.max),

@@ -3,6 +3,7 @@
 //! nothing here touches the disk.
 
 pub mod gltf;
+pub mod heading;
 pub mod pacing;
 pub mod params;
 pub mod platform;

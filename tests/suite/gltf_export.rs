@@ -231,7 +231,7 @@ fn rotate_z(rotation: [f32; 4]) -> [f32; 3] {
 /// (the goal block, or across the road's end, with the reach that counts as success).
 #[test]
 fn spawn_and_finish_nodes_carry_start_heading_and_goal_reach() {
-    use arlpcg::level::platform::heading_direction;
+    use arlpcg::level::heading::heading_direction;
     let platform = level(6);
     let racing =
         arlpcg::game::racing::rules::racing_level(6, None, None, &Default::default()).unwrap();

@@ -1029,7 +1029,7 @@ fn generate_and_verify_with_a_run(dir: &Path, run: &str) {
     let said = stderr(&generated);
     assert!(said.contains("no valid level"), "{said}");
     let (_, start, _) = arlpcg::game::rules::goal_and_start(3, None);
-    let [x, z] = arlpcg::level::platform::heading_direction(start.heading);
+    let [x, z] = arlpcg::level::heading::heading_direction(start.heading);
     let generated = generate(&format!("{},0,{}", 7.5 * x, 7.5 * z));
     assert!(generated.status.success(), "{}", stderr(&generated));
     let level = arlpcg::level::yaml::load(&levels.join("platform_seed3_aux-0.50.yaml")).unwrap();
@@ -1414,7 +1414,7 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
 fn generate_racing_tracks_with_a_run(dir: &Path, run: &str) {
     let tracks = dir.join("tracks");
     let (_, heading, _, _) = arlpcg::game::racing::rules::goal_and_start(2, None, 0);
-    let [x, z] = arlpcg::level::platform::heading_direction(heading);
+    let [x, z] = arlpcg::level::heading::heading_direction(heading);
     let goal = format!("{},0,{}", 50.0 * x, 50.0 * z);
     let generated = arlpcg(&[
         "generate",

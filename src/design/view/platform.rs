@@ -9,7 +9,8 @@ use ratatui::widgets::canvas::{Canvas, Line as CanvasLine};
 
 use crate::design::app::App;
 use crate::level::Level;
-use crate::level::platform::{Platform, PlatformTrack, heading_direction};
+use crate::level::heading::heading_direction;
+use crate::level::platform::{Platform, PlatformTrack};
 
 use super::{bounds, draw_replay, piece_colours};
 

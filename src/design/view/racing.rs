@@ -11,7 +11,7 @@ use ratatui::widgets::canvas::{Canvas, Line as CanvasLine, Points};
 
 use crate::design::app::App;
 use crate::level::Level;
-use crate::level::platform::heading_direction;
+use crate::level::heading::heading_direction;
 use crate::level::racing::{Obstacle, RacingTrack};
 use crate::level::road::{ROAD_WIDTH, Road};
 

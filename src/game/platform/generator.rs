@@ -12,8 +12,9 @@ use crate::game::PlatformGame;
 use crate::game::generator::{BuildLimits, GeneratorGame, GeneratorRewards, Placement, TrackBuild};
 use crate::game::rules::goal_and_start;
 use crate::level::Track;
+use crate::level::heading::{direction_heading, wrap_degrees};
 use crate::level::params::{self, quantize};
-use crate::level::platform::{BlockParams, PlatformTrack, direction_heading, wrap_degrees};
+use crate::level::platform::{BlockParams, PlatformTrack};
 
 /// The named parts of the Generator's observation, in order, with their lengths (one aux input).
 pub const GENERATOR_OBSERVATION_LAYOUT: [(&str, usize); 9] = [
@@ -101,7 +102,7 @@ pub fn observe(
     let platforms = track.platforms();
     let last = track.last();
     let local = |point: [f64; 3]| -> [f64; 3] {
-        let [fx, fz] = crate::level::platform::heading_direction(last.heading);
+        let [fx, fz] = crate::level::heading::heading_direction(last.heading);
         let d = [
             point[0] - last.position[0],
             point[1] - last.position[1],

@@ -13,8 +13,8 @@ use crate::game::generator::{
     BuildLimits, DEFAULT_CURVE_OFFSET, GeneratorGame, GeneratorRewards, Placement, TrackBuild,
 };
 use crate::level::Track;
+use crate::level::heading::{direction_heading, heading_direction, wrap_degrees};
 use crate::level::params::{SEGMENT_CURVE, SEGMENT_HEIGHT, SEGMENT_LENGTH, quantize};
-use crate::level::platform::{direction_heading, heading_direction, wrap_degrees};
 use crate::level::racing::{self, Obstacle, RacingTrack, SegmentParams};
 use crate::level::road::{CROSSING_ARC, MIN_OBSTACLE_DISTANCE, MIN_SELF_DISTANCE, Road};
 use crate::level::stats::Outcome;

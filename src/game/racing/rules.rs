@@ -6,8 +6,8 @@
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use crate::level::heading::{direction_heading, heading_direction, wrap_degrees};
 use crate::level::params::{self, quantize};
-use crate::level::platform::{direction_heading, heading_direction, wrap_degrees};
 use crate::level::racing::{self, Obstacle, RacingRulesConfig, RacingTrack, SegmentParams};
 use crate::level::road::{MIN_OBSTACLE_DISTANCE, Road};
 use crate::level::{Level, Source, Track};

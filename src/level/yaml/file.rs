@@ -8,9 +8,10 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use super::{
     FORMAT_NAME, FORMAT_VERSION, Problem, TRANSFORM_TOLERANCE, invalid, line_of_item, line_of_key,
 };
+use crate::level::heading;
 use crate::level::pacing::{AuxCurve, Pacing};
 use crate::level::params::{self, ParamRange};
-use crate::level::platform::{self, BlockParams, PlatformTrack, Start};
+use crate::level::platform::{BlockParams, PlatformTrack, Start};
 use crate::level::racing::{Obstacle, RacingTrack, SegmentParams};
 use crate::level::{Game, Level, SolverStats, Source, Track};
 
@@ -322,7 +323,7 @@ impl LevelFile {
                 }
             }
             if let Some(heading) = block.heading {
-                let off = platform::wrap_degrees(heading.0 - placed.heading).abs();
+                let off = heading::wrap_degrees(heading.0 - placed.heading).abs();
                 if off > TRANSFORM_TOLERANCE {
                     return Err(invalid(
                         format!("{field}.heading"),

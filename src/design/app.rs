@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use ratatui::layout::Rect;
 
-use crate::level::heading::heading_direction;
+use crate::level::heading::{direction_heading, heading_direction, wrap_degrees};
 use crate::level::params::quantize;
 
 use crate::level::{Game, Level};
@@ -437,7 +437,7 @@ impl App {
         self.goal = GoalSetting::Custom {
             distance: (distance + d_distance).clamp(distances.0, distances.1),
             height: (height + d_height).clamp(heights.0, heights.1),
-            direction: crate::level::heading::wrap_degrees(direction + d_direction),
+            direction: wrap_degrees(direction + d_direction),
         };
         self.generate()
     }
@@ -454,7 +454,7 @@ impl App {
                 GoalSetting::Custom {
                     distance: x.hypot(z).round(),
                     height: y.round(),
-                    direction: crate::level::heading::direction_heading(x, z).round(),
+                    direction: direction_heading(x, z).round(),
                 }
             }
         };

@@ -217,7 +217,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         let row = generator_row(&stats);
         writeln!(
             self.generator_metrics,
-            "{},{},{},{:.2},{:.3},{:.3},{:.3e},{row},{}",
+            "{},{},{},{:.2},{:.3},{:.3},{:.3e},{row},{},{}",
             self.generator_iteration,
             self.solver.trainer.global_step,
             self.solver.trainer.env.state.generator_steps,
@@ -225,7 +225,8 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             t1 - t0,
             t2 - t1,
             learning_rate,
-            update_columns(&update)
+            update_columns(&update),
+            scripted_columns(&stats)
         )?;
         let ratio = |a: u32, b: u32| a as f64 / b.max(1) as f64;
         let mut message = format!(

@@ -37,7 +37,8 @@ pub(super) fn metric_series(text: &str, x: &str, name: &str, window: usize) -> V
 }
 
 /// `learning-curve.png`: the Solver's training success ratio against its steps (and, in the
-/// adversarial modes, its success on easy and hard Generator levels), smoothed over 10 updates.
+/// adversarial modes, its success on easy and hard Generator levels, and the scripted
+/// opponent's on hard ones in a finish that has one), smoothed over 10 updates.
 pub fn write_learning_curve(out: &Path) -> Result<()> {
     let read = |name: &str| read_text(&out.join(name)).unwrap_or_default();
     let solver = read(METRICS);
@@ -46,9 +47,14 @@ pub fn write_learning_curve(out: &Path) -> Result<()> {
         name: "Solver, training".into(),
         points: metric_series(&solver, "global_step", "success_ratio", 10),
     }];
-    for (column, name) in [("success_easy", "λ > 0"), ("success_hard", "λ < 0")] {
+    for (column, name) in [
+        ("success_easy", "λ > 0"),
+        ("success_hard", "λ < 0"),
+        ("scripted_success_hard", "scripted opponent, λ < 0"),
+    ] {
         let points = metric_series(&generator, "solver_step", column, 10);
-        if !points.is_empty() {
+        // The scripted opponent's column is NaN outside a finish that has one.
+        if points.iter().any(|p| p.1.is_finite()) {
             series.push(crate::chart::Series {
                 name: name.into(),
                 points,
@@ -103,12 +109,29 @@ pub(super) fn generator_row(s: &MatchStats) -> String {
     )
 }
 
-/// The header of `generator-metrics.csv` for game `G`: its piece features by name, and the
-/// Solver's mean steps in the air per match (0 on the platform game).
+/// The scripted opponent's columns of a Generator metrics row: its success at λ > 0 and λ < 0.
+pub(super) fn scripted_columns(s: &MatchStats) -> String {
+    let ratio = |a: u32, b: u32| {
+        if b == 0 {
+            f64::NAN
+        } else {
+            a as f64 / b as f64
+        }
+    };
+    format!(
+        "{:.4},{:.4}",
+        ratio(s.scripted_successes[0], s.scripted_judged[0]),
+        ratio(s.scripted_successes[1], s.scripted_judged[1])
+    )
+}
+
+/// The header of `generator-metrics.csv` for game `G`: its piece features by name, the
+/// Solver's mean steps in the air per match (0 on the platform game), and last the scripted
+/// opponent's success (NaN where it played no match: outside a finish that has one).
 pub(super) fn generator_metrics_header<G: GeneratorGame>() -> String {
     let [a, b] = G::PIECE_FEATURES;
     format!(
-        "iteration,solver_step,generator_step,wall_time_s,rollout_s,update_s,learning_rate,episodes,mean_return,invalid_ratio,success_easy,success_hard,{a}_easy,{a}_hard,{b}_easy,{b}_hard,air_steps_easy,air_steps_hard,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance"
+        "iteration,solver_step,generator_step,wall_time_s,rollout_s,update_s,learning_rate,episodes,mean_return,invalid_ratio,success_easy,success_hard,{a}_easy,{a}_hard,{b}_easy,{b}_hard,air_steps_easy,air_steps_hard,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance,scripted_success_easy,scripted_success_hard"
     )
 }
 
@@ -120,24 +143,60 @@ fn read_text(path: &Path) -> Option<String> {
 
 /// Drops metric rows written after the checkpoint a run resumes from, so the curve continues
 /// without a gap or a repeat.
+/// A file written before columns were appended to `header` gains them, empty in its rows.
 pub(super) fn truncate_metrics(path: &Path, header: &str, last_iteration: u64) -> Result<()> {
     let text = read_text(path).unwrap_or_else(|| format!("{header}\n"));
-    let kept: Vec<&str> = text
-        .lines()
-        .enumerate()
-        .filter(|(i, line)| {
-            *i == 0
-                || line
-                    .split(',')
+    let mut lines = text.lines();
+    let written = lines.next().unwrap_or(header);
+    let added = header
+        .strip_prefix(written)
+        .filter(|rest| rest.starts_with(','))
+        .map_or(0, |rest| rest.matches(',').count());
+    let mut kept = vec![if added > 0 { header } else { written }.to_string()];
+    kept.extend(
+        lines
+            .filter(|line| {
+                line.split(',')
                     .next()
                     .and_then(|it| it.parse::<u64>().ok())
                     .is_some_and(|it| it <= last_iteration)
-        })
-        .map(|(_, line)| line)
-        .collect();
+            })
+            .map(|line| format!("{line}{}", ",".repeat(added))),
+    );
     fsio::write_atomic(
         path,
         format!("{}\n", kept.join("\n")).as_bytes(),
         Overwrite::Allowed,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A resume keeps the rows up to its checkpoint; a file from before the scripted
+    /// opponent's columns gains them, empty in the rows it keeps.
+    #[test]
+    fn truncation_keeps_rows_to_the_checkpoint_and_appends_new_columns() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("generator-metrics.csv");
+        std::fs::write(&path, "iteration,a\n1,0.5\n2,0.6\n3,0.7\n").unwrap();
+        truncate_metrics(&path, "iteration,a,b,c", 2).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "iteration,a,b,c\n1,0.5,,\n2,0.6,,\n"
+        );
+        // A file of today's header stays as it was, less the rows after the checkpoint.
+        truncate_metrics(&path, "iteration,a,b,c", 1).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "iteration,a,b,c\n1,0.5,,\n"
+        );
+        // A header that is not an extension of the file's is left alone.
+        truncate_metrics(&path, "iteration,z", 1).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "iteration,a,b,c\n1,0.5,,\n"
+        );
+    }
 }

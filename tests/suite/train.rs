@@ -965,6 +965,45 @@ fn a_finish_with_a_scripted_opponent_changes_the_finish_alone_and_resumes_to_the
         plain_finish, in_finish,
         "the scripted player changes the finish"
     );
+    // Its success is in the last two columns (λ > 0, λ < 0): NaN where it played no match.
+    let opponent_success = |run: &Path| -> Vec<(u64, [f64; 2])> {
+        let text = std::fs::read_to_string(run.join("generator-metrics.csv")).unwrap();
+        let mut lines = text.lines();
+        assert!(
+            lines
+                .next()
+                .unwrap()
+                .ends_with(",scripted_success_easy,scripted_success_hard")
+        );
+        lines
+            .map(|row| {
+                let cells: Vec<&str> = row.split(',').collect();
+                let n = cells.len();
+                let cell = |k: usize| cells[k].parse::<f64>().unwrap();
+                (cells[1].parse().unwrap(), [cell(n - 2), cell(n - 1)])
+            })
+            .collect()
+    };
+    let played = |s: &[f64; 2]| s.iter().any(|x| x.is_finite());
+    let (opponent_before, opponent_finish): (Vec<_>, Vec<_>) = opponent_success(&whole)
+        .into_iter()
+        .partition(|r| r.0 < 640);
+    assert!(opponent_before.iter().all(|(_, s)| !played(s)));
+    assert!(
+        opponent_finish.iter().any(|(_, s)| played(s)),
+        "{opponent_finish:?}"
+    );
+    assert!(
+        opponent_finish
+            .iter()
+            .flat_map(|(_, s)| s)
+            .all(|x| !x.is_finite() || (0.0..=1.0).contains(x))
+    );
+    assert!(
+        opponent_success(&plain_dir.join("run"))
+            .iter()
+            .all(|(_, s)| !played(s))
+    );
 
     let config = dir.path().join("scripted.yaml");
     std::fs::write(&config, tiny_with_finish(&scripted)).unwrap();

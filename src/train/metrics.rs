@@ -90,9 +90,13 @@ pub(super) fn open_append(path: &Path) -> Result<std::fs::File> {
         .with_context(|| format!("cannot open {}", path.display()))
 }
 
+/// `a / b` for a metrics row: NaN when nothing was counted.
+fn ratio(a: f64, b: u32) -> f64 {
+    if b == 0 { f64::NAN } else { a / b as f64 }
+}
+
 /// The match columns of a Generator metrics row.
 pub(super) fn generator_row(s: &MatchStats) -> String {
-    let ratio = |a: f64, b: u32| if b == 0 { f64::NAN } else { a / b as f64 };
     format!(
         "{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.2},{:.2}",
         s.episodes,
@@ -111,17 +115,10 @@ pub(super) fn generator_row(s: &MatchStats) -> String {
 
 /// The scripted opponent's columns of a Generator metrics row: its success at λ > 0 and λ < 0.
 pub(super) fn scripted_columns(s: &MatchStats) -> String {
-    let ratio = |a: u32, b: u32| {
-        if b == 0 {
-            f64::NAN
-        } else {
-            a as f64 / b as f64
-        }
-    };
     format!(
         "{:.4},{:.4}",
-        ratio(s.scripted_successes[0], s.scripted_judged[0]),
-        ratio(s.scripted_successes[1], s.scripted_judged[1])
+        ratio(s.scripted_successes[0] as f64, s.scripted_judged[0]),
+        ratio(s.scripted_successes[1] as f64, s.scripted_judged[1])
     )
 }
 

@@ -581,6 +581,92 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     score_a_run_as_one_seed(dir.path(), out_s);
 }
 
+/// `generator.max_turn` above 90 is the platform Generator's own: its card records it, the
+/// policy built from the card keeps it, a resume cannot change it and a card beyond the
+/// sharp-turn table's 135° is refused.
+#[test]
+fn a_platform_generator_keeps_the_turn_limit_it_was_trained_with() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("sharp.yaml");
+    let sharp = TINY_ADVERSARIAL.replace("generator:\n", "generator:\n  max_turn: 135\n");
+    std::fs::write(&config, &sharp).unwrap();
+    let out = dir.path().join("run");
+    let out_s = out.to_str().unwrap();
+    arlpcg_ok(&[
+        "train",
+        "--mode",
+        "arlpcg",
+        "--steps",
+        "256",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out_s,
+    ]);
+    let path = out.join("generator.safetensors");
+    let (generator, card) = arlpcg::policies::load_generator(&path, Game::Platform).unwrap();
+    assert_eq!(card.max_turn, Some(135.0));
+    assert_eq!(generator.limits.max_turn, 135.0);
+    let yaml = std::fs::read_to_string(out.join("generator.yaml")).unwrap();
+    assert!(yaml.contains("max_turn: 135"), "{yaml}");
+    // A run at the default limit writes no such field: its card is the one of before.
+    let plain = dir.path().join("plain");
+    let tiny = dir.path().join("tiny.yaml");
+    std::fs::write(&tiny, TINY_ADVERSARIAL).unwrap();
+    arlpcg_ok(&[
+        "train",
+        "--mode",
+        "arlpcg",
+        "--steps",
+        "256",
+        "--config",
+        tiny.to_str().unwrap(),
+        "--out",
+        plain.to_str().unwrap(),
+    ]);
+    let (_, plain_card) =
+        arlpcg::policies::load_generator(&plain.join("generator.safetensors"), Game::Platform)
+            .unwrap();
+    assert_eq!(plain_card.max_turn, None);
+    // Resuming the sharp run with the default limit is refused, and changes nothing.
+    let before = std::fs::read(&path).unwrap();
+    let refused = arlpcg(&[
+        "train",
+        "--steps",
+        "512",
+        "--out",
+        out_s,
+        "--resume",
+        "--config",
+        tiny.to_str().unwrap(),
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    let message = stderr(&refused);
+    assert!(
+        message.contains("generator-checkpoint.safetensors")
+            && message.contains("trained with generator.max_turn 135, the configuration says 90"),
+        "{message}"
+    );
+    assert_eq!(std::fs::read(&path).unwrap(), before);
+    // A card that claims a turn beyond the measured table is refused by name.
+    let tampered = yaml.replace("max_turn: 135", "max_turn: 170");
+    let mut policy = load_network(&out, GENERATOR);
+    policy.card = serde_yaml::from_str(&tampered).unwrap();
+    let bad = dir.path().join("bad.safetensors");
+    std::fs::write(
+        &bad,
+        arlpcg::rl::checkpoint::policy_bytes(&policy.policy, &policy.card),
+    )
+    .unwrap();
+    let Err(error) = arlpcg::policies::load_generator(&bad, Game::Platform) else {
+        panic!("a card with max_turn 170 was loaded");
+    };
+    assert!(
+        format!("{error:#}").contains("card field max_turn is 170"),
+        "{error:#}"
+    );
+}
+
 /// A staged run with a finish, resumed with a larger budget (through its last stage and a
 /// second finish), gives the same bytes every time, on one thread or two: the weights of both
 /// networks and every metrics column but the clock's.

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use crate::game::generator::{DEFAULT_CURVE_OFFSET, DEFAULT_MAX_TURN};
 use crate::game::generator::{BuildLimits, GeneratorGame, observation_size};
+use crate::game::generator::{DEFAULT_CURVE_OFFSET, DEFAULT_MAX_TURN};
 use crate::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
 use crate::generation::GeneratorPolicy;
 use crate::level::{Game, PolicyRef};

@@ -76,7 +76,10 @@ fn the_documented_sharp_turn_table_is_what_the_simulation_measures() {
                 .is_some_and(|track| reach::successes(&track, 8, 0.3) < 8)
         })
     });
-    assert!(missed, "a {past} m gap on the level after a sharp turn is always made");
+    assert!(
+        missed,
+        "a {past} m gap on the level after a sharp turn is always made"
+    );
 }
 
 #[test]

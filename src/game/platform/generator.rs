@@ -77,9 +77,8 @@ pub fn block_from_action(
     let last = track.last();
     let (dx, dz) = (goal[0] - last.position[0], goal[2] - last.position[2]);
     let bearing = direction_heading(dx, dz);
-    block.angle = quantize(
-        wrap_degrees(bearing - last.heading + block.angle).clamp(-max_turn, max_turn),
-    );
+    block.angle =
+        quantize(wrap_degrees(bearing - last.heading + block.angle).clamp(-max_turn, max_turn));
     let rise = goal[1] - last.position[1];
     let on_course = rise * (block.distance / dx.hypot(dz).max(1e-6)).min(1.0);
     block.height = quantize(params::BLOCK_HEIGHT.clamp(on_course + block.height));
@@ -458,7 +457,12 @@ mod tests {
             "a right turn from heading 90 to the goal along +x"
         );
         assert_eq!(block.height, 1.5, "4 m over 20 m, for 7.5 m");
-        let steep = block_from_action(&track, [20.0, 40.0, 0.0], &[0.0, 0.0, 0.0, 1.0], DEFAULT_MAX_TURN);
+        let steep = block_from_action(
+            &track,
+            [20.0, 40.0, 0.0],
+            &[0.0, 0.0, 0.0, 1.0],
+            DEFAULT_MAX_TURN,
+        );
         assert_eq!(
             steep.height, 2.0,
             "clamped to the range of docs/spec.md §1.1"
@@ -473,10 +477,20 @@ mod tests {
         });
         // Longest, smallest, steepest up: 10 m between 4 m blocks would be a 6 m gap 2 m up,
         // where the reach table allows 4.25 m.
-        let far_up = block_from_action(&track, [60.0, 30.0, 0.0], &[1.0, 0.0, -1.0, 1.0], DEFAULT_MAX_TURN);
+        let far_up = block_from_action(
+            &track,
+            [60.0, 30.0, 0.0],
+            &[1.0, 0.0, -1.0, 1.0],
+            DEFAULT_MAX_TURN,
+        );
         assert_eq!(far_up.height, 2.0);
         assert_eq!(far_up.distance, 4.25 + 0.5 * (4.0 + 4.0));
-        let far_flat = block_from_action(&track, [60.0, 0.0, 0.0], &[1.0, 0.0, -1.0, 0.0], DEFAULT_MAX_TURN);
+        let far_flat = block_from_action(
+            &track,
+            [60.0, 0.0, 0.0],
+            &[1.0, 0.0, -1.0, 0.0],
+            DEFAULT_MAX_TURN,
+        );
         assert_eq!(far_flat.distance, 10.0, "a flat 6 m gap is within reach");
         let mut rng = ChaCha8Rng::seed_from_u64(4);
         let mut sharp = 0;

@@ -505,8 +505,8 @@ pub struct TrainArgs {
     pub pause_at: Option<u64>,
     /// Training configuration (YAML; see --print-config for every field and its default). With
     /// --resume it replaces the run's hyper-parameters from the checkpoint on (not `seed`,
-    /// `hidden`, `solver.num_envs`, `generator.max_pieces`, `generator.curve_offset` or
-    /// `generator.max_turn`); the old file is kept as config-until-step-N.yaml.
+    /// `hidden`, `solver.num_envs`, `generator.max_pieces` or `generator.curve_offset`); the old
+    /// file is kept as config-until-step-N.yaml.
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Folder of the run: config, checkpoint, metrics.csv, the trained policy and its card.

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
+use crate::game::generator::DEFAULT_CURVE_OFFSET;
 use crate::game::generator::{BuildLimits, GeneratorGame, observation_size};
-use crate::game::generator::{DEFAULT_CURVE_OFFSET, DEFAULT_MAX_TURN};
 use crate::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
 use crate::generation::GeneratorPolicy;
 use crate::level::{Game, PolicyRef};
@@ -75,7 +75,6 @@ pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, Polic
     let limits = BuildLimits {
         max_pieces: card.max_pieces.unwrap_or(default_max_pieces),
         curve_offset: card.curve_offset.unwrap_or(DEFAULT_CURVE_OFFSET),
-        max_turn: card.max_turn.unwrap_or(DEFAULT_MAX_TURN),
     };
     if !(1..=most_pieces).contains(&limits.max_pieces) {
         anyhow::bail!(
@@ -89,20 +88,6 @@ pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, Polic
             "{}: card field curve_offset is {}, not a number of degrees in [0, 180]",
             path.display(),
             limits.curve_offset
-        );
-    }
-    let sharpest = crate::game::platform::reach::SHARPEST_TURN;
-    if !(DEFAULT_MAX_TURN..=sharpest).contains(&limits.max_turn) {
-        anyhow::bail!(
-            "{}: card field max_turn is {}, not a number of degrees in [{DEFAULT_MAX_TURN}, {sharpest}]",
-            path.display(),
-            limits.max_turn
-        );
-    }
-    if game == Game::Racing && card.max_turn.is_some() {
-        anyhow::bail!(
-            "{}: card field max_turn is the platform Generator's; a racing card has none",
-            path.display()
         );
     }
     Ok((

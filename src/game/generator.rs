@@ -187,11 +187,6 @@ pub trait GeneratorGame: GameSpec {
 /// own.
 pub const DEFAULT_CURVE_OFFSET: f64 = 30.0;
 
-/// The sharpest turn, degrees, a platform Generator's block may take by default: the main reach
-/// table's (`reach::MAX_TURN`), as every platform Generator before `generator.max_turn` was
-/// trained. A Generator's card records its own.
-pub const DEFAULT_MAX_TURN: f64 = crate::game::platform::reach::MAX_TURN;
-
 /// What bounds a Generator's track besides its actions (a Generator's card records both).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BuildLimits {
@@ -200,10 +195,6 @@ pub struct BuildLimits {
     /// Racing: how far, in degrees, the curve action may ask to turn from the goal's bearing
     /// (`segment_from_action` in `src/game/racing/generator.rs`); the platform game ignores it.
     pub curve_offset: f64,
-    /// Platform: the sharpest turn, degrees off the last jump's direction, a block may take
-    /// (`block_from_action` in `src/game/platform/generator.rs`), [`DEFAULT_MAX_TURN`] up to
-    /// `reach::SHARPEST_TURN`; the racing game ignores it.
-    pub max_turn: f64,
 }
 
 impl BuildLimits {
@@ -212,7 +203,6 @@ impl BuildLimits {
         Self {
             max_pieces: G::DEFAULT_MAX_PIECES,
             curve_offset: DEFAULT_CURVE_OFFSET,
-            max_turn: DEFAULT_MAX_TURN,
         }
     }
 }

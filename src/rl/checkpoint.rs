@@ -67,10 +67,6 @@ pub struct PolicyCard {
     /// degrees (absent: 30, as every racing Generator before it was trained).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curve_offset: Option<f64>,
-    /// Platform Generators only: the sharpest turn its blocks may take off the last jump's
-    /// direction, degrees (absent: 90, as every platform Generator before it was trained).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub max_turn: Option<f64>,
 }
 
 /// How a policy was trained.
@@ -349,7 +345,6 @@ mod tests {
             results: HashMap::new(),
             max_pieces: None,
             curve_offset: None,
-            max_turn: None,
         }
     }
 

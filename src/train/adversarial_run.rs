@@ -28,7 +28,6 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             limits: BuildLimits {
                 max_pieces: config.generator.max_pieces,
                 curve_offset: config.generator.curve_offset,
-                max_turn: config.generator.max_turn,
             },
             obstacles: config.generator.obstacles,
             rewards: config.generator.rewards.clone(),
@@ -99,19 +98,6 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                      cannot change",
                     path.display(),
                     config.generator.curve_offset
-                );
-            }
-            let trained_turn = loaded
-                .card
-                .max_turn
-                .unwrap_or(crate::game::generator::DEFAULT_MAX_TURN);
-            if trained_turn != config.generator.max_turn {
-                anyhow::bail!(
-                    "{}: this Generator was trained with generator.max_turn {trained_turn}, the \
-                     configuration says {}; the turns it learned to place depend on it, so it \
-                     cannot change",
-                    path.display(),
-                    config.generator.max_turn
                 );
             }
             let matches: AdversarialRecord =

@@ -160,12 +160,6 @@ pub(super) fn card(
         max_pieces: (role == Role::Generator).then_some(config.generator.max_pieces),
         curve_offset: (role == Role::Generator && game == Game::Racing)
             .then_some(config.generator.curve_offset),
-        // Written only where it differs from the default, so that a Generator trained as
-        // before keeps the card (and the policy file, which holds the card) of before.
-        max_turn: (role == Role::Generator
-            && game == Game::Platform
-            && config.generator.max_turn != crate::game::generator::DEFAULT_MAX_TURN)
-            .then_some(config.generator.max_turn),
     }
 }
 

@@ -1,9 +1,7 @@
 //! The platform world (its determinism is in determinism.rs): the calibrated reach, observations and rewards as the
 //! Solver sees them, and how runs end.
 
-use arlpcg::game::platform::reach::{
-    self, REACH_HEIGHTS, REACH_TABLE, SHARP_REACH_TABLE, play_scripted, single_jump,
-};
+use arlpcg::game::platform::reach::{self, REACH_HEIGHTS, REACH_TABLE, play_scripted, single_jump};
 use arlpcg::game::platform::{OBSERVATION_SIZE, PlatformAction, PlatformEnv, SolverRewards};
 use arlpcg::level::platform::{BlockParams, PlatformTrack, Start};
 use arlpcg::level::stats::Outcome;
@@ -55,31 +53,6 @@ fn the_documented_reach_table_is_what_the_simulation_measures() {
     // Beyond the largest turn the table's own gap is not made every time.
     let sharp = reach::chained_jump(REACH_TABLE[4], 2.0, reach::MAX_TURN + 45.0);
     assert!(reach::successes(&sharp, 16, 0.3) < 16);
-}
-
-#[test]
-fn the_documented_sharp_turn_table_is_what_the_simulation_measures() {
-    assert_eq!(
-        reach::measure_sharp_reach(),
-        SHARP_REACH_TABLE,
-        "heights {REACH_HEIGHTS:?}: update SHARP_REACH_TABLE and docs/platform-physics.md"
-    );
-    // A turned jump is shorter than a straight one at every height but the lowest...
-    for (k, (sharp, straight)) in SHARP_REACH_TABLE.iter().zip(REACH_TABLE).enumerate() {
-        assert!(*sharp < straight, "height {}", REACH_HEIGHTS[k]);
-    }
-    // ...and one step past the table is missed after some entry, at some turn.
-    let past = SHARP_REACH_TABLE[2] + reach::REACH_STEP;
-    let missed = REACH_HEIGHTS.iter().any(|&entry| {
-        reach::SHARP_TURNS.iter().any(|&turn| {
-            reach::sharp_jump(entry, past, 0.0, turn)
-                .is_some_and(|track| reach::successes(&track, 8, 0.3) < 8)
-        })
-    });
-    assert!(
-        missed,
-        "a {past} m gap on the level after a sharp turn is always made"
-    );
 }
 
 #[test]

@@ -61,31 +61,26 @@ pub const DEFAULT_MAX_BLOCKS: usize = 30;
 
 /// A policy's action row (unbounded Gaussian samples) as the next block of `track` toward
 /// `goal`: each value is clipped to [-1, 1] and mapped onto its range (NaN becomes the middle),
-/// the turn added to the goal's bearing from the last block and kept within `max_turn` degrees
-/// of the last jump's direction, the height change to the climb that keeps the slope toward
-/// the goal (see [`GENERATOR_ACTIONS`]), the distance shortened to keep the edge gap within the
-/// reach table for that height change and turn ([`reach::max_gap_after_turn`]).
-pub fn block_from_action(
-    track: &PlatformTrack,
-    goal: [f64; 3],
-    row: &[f32],
-    max_turn: f64,
-) -> BlockParams {
+/// the turn added to the goal's bearing from the last block and kept within
+/// [`reach::MAX_TURN`] of the last jump's direction, the height change to the climb that keeps
+/// the slope toward the goal (see [`GENERATOR_ACTIONS`]), the distance shortened to keep the
+/// edge gap within the reach table ([`reach::max_gap`]) for that height change.
+pub fn block_from_action(track: &PlatformTrack, goal: [f64; 3], row: &[f32]) -> BlockParams {
     let unit = |v: f32| if v.is_nan() { 0.0 } else { v as f64 };
     let mut block =
         BlockParams::from_unit([unit(row[0]), unit(row[1]), unit(row[2]), unit(row[3])]);
     let last = track.last();
     let (dx, dz) = (goal[0] - last.position[0], goal[2] - last.position[2]);
     let bearing = direction_heading(dx, dz);
-    block.angle =
-        quantize(wrap_degrees(bearing - last.heading + block.angle).clamp(-max_turn, max_turn));
+    block.angle = quantize(
+        wrap_degrees(bearing - last.heading + block.angle).clamp(-reach::MAX_TURN, reach::MAX_TURN),
+    );
     let rise = goal[1] - last.position[1];
     let on_course = rise * (block.distance / dx.hypot(dz).max(1e-6)).min(1.0);
     block.height = quantize(params::BLOCK_HEIGHT.clamp(on_course + block.height));
     // Never beyond the character's reach: a longer jump makes a level impossible, not harder,
     // and a failure there teaches the Solver nothing.
-    let longest =
-        reach::max_gap_after_turn(block.height, block.angle) + 0.5 * (last.size + block.size);
+    let longest = reach::max_gap(block.height) + 0.5 * (last.size + block.size);
     block.distance = quantize(block.distance.min(longest));
     block
 }
@@ -152,8 +147,6 @@ pub struct PlatformBuild {
     pub track: PlatformTrack,
     pub goal: [f64; 3],
     pub max_blocks: usize,
-    /// The sharpest turn a block may take ([`BuildLimits::max_turn`]).
-    pub max_turn: f64,
 }
 
 impl TrackBuild for PlatformBuild {
@@ -173,7 +166,7 @@ impl TrackBuild for PlatformBuild {
         if self.track.block_count() >= self.max_blocks {
             return Placement::OutOfPieces;
         }
-        let block = block_from_action(&self.track, self.goal, row, self.max_turn);
+        let block = block_from_action(&self.track, self.goal, row);
         if self.track.push(block).is_err() {
             return Placement::Invalid;
         }
@@ -226,7 +219,6 @@ impl GeneratorGame for PlatformGame {
             track: PlatformTrack::new(start),
             goal,
             max_blocks: limits.max_pieces,
-            max_turn: limits.max_turn,
         };
         (build, rng)
     }
@@ -245,7 +237,6 @@ impl GeneratorGame for PlatformGame {
             track: PlatformTrack::new(*kept.start()),
             goal,
             max_blocks: limits.max_pieces,
-            max_turn: limits.max_turn,
         };
         for params in &kept.block_params()[..pieces] {
             build.track.push(*params).map_err(|e| e.to_string())?;
@@ -283,7 +274,7 @@ impl GeneratorGame for PlatformGame {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::game::generator::{DEFAULT_MAX_TURN, Match};
+    use crate::game::generator::Match;
     use crate::level::params::{BLOCK_DISTANCE, BLOCK_HEIGHT, BLOCK_SIZE};
     use crate::level::platform::Start;
     use crate::level::stats::Outcome;
@@ -326,7 +317,7 @@ mod tests {
             "a goal to the right is a negative turn"
         );
         let aim = aimed(&track, [20.0, 0.0, 0.0]);
-        let block = block_from_action(&track, [20.0, 0.0, 0.0], &aim, DEFAULT_MAX_TURN);
+        let block = block_from_action(&track, [20.0, 0.0, 0.0], &aim);
         assert!((block.angle + 90.0).abs() < 1e-3, "{block:?}");
     }
 
@@ -337,7 +328,6 @@ mod tests {
             track: PlatformTrack::new(Start::default()),
             goal,
             max_blocks: 30,
-            max_turn: DEFAULT_MAX_TURN,
         };
         let mut game = Match::<PlatformGame>::new(build, vec![1.0], 7);
         let rewards = GeneratorRewards::default();
@@ -389,7 +379,6 @@ mod tests {
             track: PlatformTrack::new(Start::default()),
             goal,
             max_blocks: 30,
-            max_turn: DEFAULT_MAX_TURN,
         };
         let pacing = MatchPacing {
             before,
@@ -450,19 +439,14 @@ mod tests {
             heading: 90.0,
             ..Start::default()
         });
-        let block = block_from_action(&track, [20.0, 4.0, 0.0], &[0.0; 4], DEFAULT_MAX_TURN);
+        let block = block_from_action(&track, [20.0, 4.0, 0.0], &[0.0; 4]);
         assert_eq!(block.distance, 7.5);
         assert_eq!(
             block.angle, -90.0,
             "a right turn from heading 90 to the goal along +x"
         );
         assert_eq!(block.height, 1.5, "4 m over 20 m, for 7.5 m");
-        let steep = block_from_action(
-            &track,
-            [20.0, 40.0, 0.0],
-            &[0.0, 0.0, 0.0, 1.0],
-            DEFAULT_MAX_TURN,
-        );
+        let steep = block_from_action(&track, [20.0, 40.0, 0.0], &[0.0, 0.0, 0.0, 1.0]);
         assert_eq!(
             steep.height, 2.0,
             "clamped to the range of docs/spec.md §1.1"
@@ -477,80 +461,25 @@ mod tests {
         });
         // Longest, smallest, steepest up: 10 m between 4 m blocks would be a 6 m gap 2 m up,
         // where the reach table allows 4.25 m.
-        let far_up = block_from_action(
-            &track,
-            [60.0, 30.0, 0.0],
-            &[1.0, 0.0, -1.0, 1.0],
-            DEFAULT_MAX_TURN,
-        );
+        let far_up = block_from_action(&track, [60.0, 30.0, 0.0], &[1.0, 0.0, -1.0, 1.0]);
         assert_eq!(far_up.height, 2.0);
         assert_eq!(far_up.distance, 4.25 + 0.5 * (4.0 + 4.0));
-        let far_flat = block_from_action(
-            &track,
-            [60.0, 0.0, 0.0],
-            &[1.0, 0.0, -1.0, 0.0],
-            DEFAULT_MAX_TURN,
-        );
+        let far_flat = block_from_action(&track, [60.0, 0.0, 0.0], &[1.0, 0.0, -1.0, 0.0]);
         assert_eq!(far_flat.distance, 10.0, "a flat 6 m gap is within reach");
         let mut rng = ChaCha8Rng::seed_from_u64(4);
-        let mut sharp = 0;
-        for k in 0..4000 {
-            let max_turn = if k % 2 == 0 {
-                DEFAULT_MAX_TURN
-            } else {
-                reach::SHARPEST_TURN
-            };
+        for _ in 0..2000 {
             let row: [f32; 4] = std::array::from_fn(|_| rng.random_range(-1.5..1.5));
-            // Goals ahead and behind, so that the turn toward them is often sharp.
-            let goal = [
-                rng.random_range(-60.0..60.0),
-                rng.random_range(-20.0..20.0),
-                rng.random_range(-60.0..60.0),
-            ];
-            let block = block_from_action(&track, goal, &row, max_turn);
+            let goal = [60.0, rng.random_range(-20.0..20.0), 10.0];
+            let block = block_from_action(&track, goal, &row);
             let placed = track.preview(&block);
             let gap = track.last().edge_gap(&placed);
-            assert!(block.angle.abs() <= max_turn, "{block:?}");
-            let reach = if block.angle.abs() > reach::MAX_TURN {
-                sharp += 1;
-                interpolated(&reach::SHARP_REACH_TABLE, block.height)
-            } else {
-                reach::max_gap(block.height)
-            };
-            assert!(gap <= reach + 1e-3, "{block:?}: gap {gap}");
+            assert!(
+                gap <= reach::max_gap(block.height) + 1e-3,
+                "{block:?}: gap {gap}"
+            );
+            assert!(block.angle.abs() <= reach::MAX_TURN, "{block:?}");
             assert!(BLOCK_DISTANCE.check(block.distance).is_ok(), "{block:?}");
         }
-        assert!(sharp > 100, "only {sharp} sharp turns drawn");
-    }
-
-    /// `table` over the reach table's heights, read at `height` linearly.
-    fn interpolated(table: &[f64; 5], height: f64) -> f64 {
-        let i = ((height + 2.0).floor() as usize).min(3);
-        let t = height + 2.0 - i as f64;
-        table[i] + t * (table[i + 1] - table[i])
-    }
-
-    #[test]
-    fn a_sharp_turn_is_taken_only_when_allowed_and_then_with_a_short_gap() {
-        let track = PlatformTrack::new(Start {
-            size: 4.0,
-            ..Start::default()
-        });
-        // The goal straight behind, 2 m up; the longest, steepest block toward it.
-        let goal = [-30.0, 2.0, 0.0];
-        let row = [1.0, 0.0, -1.0, 1.0];
-        let default = block_from_action(&track, goal, &row, DEFAULT_MAX_TURN);
-        assert_eq!(default.angle.abs(), 90.0);
-        assert_eq!(default.distance, reach::REACH_TABLE[4] + 4.0);
-        let sharp = block_from_action(&track, goal, &row, reach::SHARPEST_TURN);
-        assert_eq!(sharp.angle.abs(), reach::SHARPEST_TURN);
-        assert_eq!(sharp.height, 2.0);
-        // The sharp-turn table's 1 m gap 2 m up between 4 m blocks: 5 m, the shortest distance.
-        assert_eq!(reach::SHARP_REACH_TABLE[4], 1.0);
-        assert_eq!(
-            sharp.distance, 5.0,
-            "a climb after a sharp turn keeps to the sharp-turn table"
-        );
     }
 
     #[test]
@@ -568,7 +497,6 @@ mod tests {
             track,
             goal: [0.0, 0.0, 30.0],
             max_blocks: 4,
-            max_turn: DEFAULT_MAX_TURN,
         };
         let mut game = Match::<PlatformGame>::new(build, vec![-1.0], 1);
         let toward_goal = [-1.0, 0.0, 0.0, 0.0];

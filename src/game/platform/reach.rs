@@ -16,23 +16,12 @@ pub const REACH_TURNS: [f64; 5] = [-90.0, -45.0, 0.0, 45.0, 90.0];
 /// a fast landing a sharper one means stopping and turning back on the block, and the scripted
 /// controller fails it even across short gaps (`docs/platform-physics.md`, "Chained jumps").
 pub const MAX_TURN: f64 = 90.0;
-/// The sharpest turn, degrees, a Generator trained with `generator.max_turn` above
-/// [`MAX_TURN`] may take; the gap of such a turn is held to [`SHARP_REACH_TABLE`]. Beyond it the
-/// character has to stop and turn back on the block, and a 180° turn 2 m up is not made at all.
-pub const SHARPEST_TURN: f64 = 135.0;
-/// The turns, degrees, of the turned jump of a [`sharp_jump`] that [`SHARP_REACH_TABLE`] must clear.
-pub const SHARP_TURNS: [f64; 4] = [-135.0, -112.5, 112.5, 135.0];
 /// Largest edge gap, m, that the scripted controller (take-off jitter `REACH_JITTER`) clears in
 /// every one of `REACH_TRIALS` seeded runs of a [`chained_jump`] at every turn of `REACH_TURNS`,
 /// for each height change of `REACH_HEIGHTS`, measured in steps of `REACH_STEP` from 1 m up to
 /// the largest gap the parameter ranges allow (6 m). A jump right after a landing is harder
 /// than one from standstill on the start block, so this is the reach anywhere in a level.
 pub const REACH_TABLE: [f64; 5] = [6.0, 6.0, 6.0, 6.0, 4.25];
-/// Largest edge gap, m, for each height change of `REACH_HEIGHTS`, of a jump turned more than
-/// [`MAX_TURN`] (up to [`SHARPEST_TURN`]) right after the fastest landing the main table allows:
-/// a [`sharp_jump`] cleared in every one of `REACH_TRIALS` seeded scripted runs at every turn of
-/// [`SHARP_TURNS`] after every entry of the table (the longest jump at each height change).
-pub const SHARP_REACH_TABLE: [f64; 5] = [4.25, 3.75, 3.25, 2.5, 1.0];
 /// Resolution of the table, m.
 pub const REACH_STEP: f64 = 0.25;
 /// Seeded runs per table entry.
@@ -44,21 +33,6 @@ const GAP_RANGE: (f64, f64) = (1.0, 6.0);
 
 /// The largest makeable gap at a height change, interpolated from the table.
 pub fn max_gap(height: f64) -> f64 {
-    interpolate(&REACH_TABLE, height)
-}
-
-/// The largest makeable gap at a height change after a turn of `turn` degrees off the last
-/// jump's direction: [`max_gap`] up to [`MAX_TURN`], [`SHARP_REACH_TABLE`] beyond.
-pub fn max_gap_after_turn(height: f64, turn: f64) -> f64 {
-    if turn.abs() <= MAX_TURN {
-        max_gap(height)
-    } else {
-        interpolate(&SHARP_REACH_TABLE, height)
-    }
-}
-
-/// A table over `REACH_HEIGHTS`, interpolated linearly at `height` (clamped to the heights).
-fn interpolate(table: &[f64; 5], height: f64) -> f64 {
     let h = height.clamp(REACH_HEIGHTS[0], REACH_HEIGHTS[4]);
     let i = REACH_HEIGHTS
         .iter()
@@ -66,7 +40,7 @@ fn interpolate(table: &[f64; 5], height: f64) -> f64 {
         .unwrap_or(0)
         .min(3);
     let t = (h - REACH_HEIGHTS[i]) / (REACH_HEIGHTS[i + 1] - REACH_HEIGHTS[i]);
-    table[i] + t * (table[i + 1] - table[i])
+    REACH_TABLE[i] + t * (REACH_TABLE[i + 1] - REACH_TABLE[i])
 }
 
 /// A level of one jump: a 4 m start block, then a 4 m block `gap` metres away and `height`
@@ -95,20 +69,6 @@ pub fn chained_jump(gap: f64, height: f64, turn: f64) -> PlatformTrack {
         .expect("gap within [1, 6] m, height within [-2, 2] m, turn within [-90, 90] degrees");
     PlatformTrack::from_params(start, &[first, second])
         .expect("two 4 m blocks at least 5 m apart, turned at most 90 degrees, never overlap")
-}
-
-/// A level of two jumps: a 4 m start block, a 4 m block straight ahead at the table's longest
-/// gap for `entry_height` (the fastest landing the table allows there), then a 4 m block `gap`
-/// metres away and `height` metres up, `turn` degrees off the first jump's direction. The
-/// second jump is the one [`SHARP_REACH_TABLE`] measures. `None` when the blocks overlap.
-pub fn sharp_jump(entry_height: f64, gap: f64, height: f64, turn: f64) -> Option<PlatformTrack> {
-    let start = Start {
-        size: 4.0,
-        ..Start::default()
-    };
-    let entry = BlockParams::new(max_gap(entry_height) + 4.0, 0.0, 4.0, entry_height).ok()?;
-    let turned = BlockParams::new(gap + 4.0, turn, 4.0, height).ok()?;
-    PlatformTrack::from_params(start, &[entry, turned]).ok()
 }
 
 /// Plays one run of `env` with the scripted controller, seeded by `seed`.
@@ -143,46 +103,19 @@ pub fn successes(track: &PlatformTrack, trials: u64, jitter: f32) -> u64 {
 /// all `REACH_TRIALS` runs.
 pub fn measure_reach() -> [f64; 5] {
     REACH_HEIGHTS.map(|height| {
-        largest_cleared(|gap| {
-            REACH_TURNS
-                .iter()
-                .all(|&turn| always_cleared(&chained_jump(gap, height, turn)))
-        })
-    })
-}
-
-/// Measures the sharp-turn table: for each height change, the largest gap such that every
-/// [`sharp_jump`] up to it (in `REACH_STEP` steps from 1 m, at every turn of [`SHARP_TURNS`],
-/// after every entry of the main table) is cleared in all `REACH_TRIALS` runs. A pair of blocks
-/// that overlaps is no level and does not count against the gap.
-pub fn measure_sharp_reach() -> [f64; 5] {
-    REACH_HEIGHTS.map(|height| {
-        largest_cleared(|gap| {
-            REACH_HEIGHTS.iter().all(|&entry| {
-                SHARP_TURNS.iter().all(|&turn| {
-                    sharp_jump(entry, gap, height, turn).is_none_or(|track| always_cleared(&track))
-                })
-            })
-        })
-    })
-}
-
-/// Whether the scripted controller clears `track` in every one of `REACH_TRIALS` seeded runs.
-fn always_cleared(track: &PlatformTrack) -> bool {
-    successes(track, REACH_TRIALS, REACH_JITTER) == REACH_TRIALS
-}
-
-/// The largest gap of the scan (from `GAP_RANGE.0` in `REACH_STEP` steps) up to which every gap
-/// is `cleared`; one step below the range when the first is not.
-fn largest_cleared(cleared: impl Fn(f64) -> bool) -> f64 {
-    let steps = ((GAP_RANGE.1 - GAP_RANGE.0) / REACH_STEP).round() as usize;
-    let mut best = GAP_RANGE.0 - REACH_STEP;
-    for k in 0..=steps {
-        let gap = GAP_RANGE.0 + k as f64 * REACH_STEP;
-        if !cleared(gap) {
-            break;
+        let steps = ((GAP_RANGE.1 - GAP_RANGE.0) / REACH_STEP).round() as usize;
+        let mut best = GAP_RANGE.0 - REACH_STEP;
+        for k in 0..=steps {
+            let gap = GAP_RANGE.0 + k as f64 * REACH_STEP;
+            let cleared = REACH_TURNS.iter().all(|&turn| {
+                successes(&chained_jump(gap, height, turn), REACH_TRIALS, REACH_JITTER)
+                    == REACH_TRIALS
+            });
+            if !cleared {
+                break;
+            }
+            best = gap;
         }
-        best = gap;
-    }
-    best
+        best
+    })
 }

@@ -223,20 +223,6 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
             "curve_offset is the racing Generator's: the platform game has no curve (leave it at {default_offset})"
         ));
     }
-    let (default_turn, sharpest) = (
-        crate::game::generator::DEFAULT_MAX_TURN,
-        crate::game::platform::reach::SHARPEST_TURN,
-    );
-    if !(default_turn..=sharpest).contains(&g.max_turn) {
-        return Err(format!(
-            "max_turn must be a number of degrees in [{default_turn}, {sharpest}]"
-        ));
-    }
-    if game == Game::Racing && g.max_turn != default_turn {
-        return Err(format!(
-            "max_turn is the platform Generator's: a racing segment curves by its own range (leave it at {default_turn})"
-        ));
-    }
     if g.obstacles > crate::level::racing::MAX_OBSTACLES as u32 {
         return Err(format!(
             "obstacles must be at most {}",

@@ -109,13 +109,6 @@ pub struct GeneratorConfig {
     /// about 30° of the bearing; 90 (the racing default) lets it bend away from the goal and
     /// back. The platform game has no curve: there it stays 30.
     pub curve_offset: f64,
-    /// Platform: the sharpest turn, in degrees off the last jump's direction, that the
-    /// Generator's block may take, in [90, 135]. Up to 90° every gap of the reach table can be
-    /// jumped; a block turned further keeps its gap within the sharp-turn table (the character
-    /// lands fast and must turn back on the block: a 3.25 m gap on the level, 1 m 2 m up;
-    /// docs/platform-physics.md). Rule levels turn up to 180°. The racing game has no such
-    /// turn: there it stays 90.
-    pub max_turn: f64,
     /// Log standard deviation of the new Generator's actions (in [-1, 1] units). At 0 (std 1)
     /// its turns span ±180° and almost no track reaches its goal; -1.6 (std 0.2) starts it at
     /// ±36°, ±0.5 m of distance, ±0.4 m of height, and lets PPO widen what pays.
@@ -352,7 +345,6 @@ impl Default for GeneratorConfig {
             max_pieces: PlatformGame::DEFAULT_MAX_PIECES,
             obstacles: 0,
             curve_offset: crate::game::generator::DEFAULT_CURVE_OFFSET,
-            max_turn: crate::game::generator::DEFAULT_MAX_TURN,
             initial_log_std: -1.6,
             solver_warmup_steps: 500_000,
             solver_phase_steps: 100_000,

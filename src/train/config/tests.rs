@@ -71,8 +71,6 @@ fn the_platform_finish_follows_the_budget_and_stages_apply_from_their_step() {
     );
     let narrow = TrainConfig::parse_for("generator:\n  curve_offset: 30\n", Game::Racing).unwrap();
     assert_eq!(narrow.generator.curve_offset, 30.0);
-    let sharp = TrainConfig::parse_for("generator:\n  max_turn: 135\n", Game::Platform).unwrap();
-    assert_eq!(sharp.generator.max_turn, 135.0);
 }
 
 #[test]
@@ -92,21 +90,6 @@ fn out_of_range_generator_fields_are_named() {
             "generator:\n  curve_offset: 90\n",
             Game::Platform,
             "platform game has no curve",
-        ),
-        (
-            "generator:\n  max_turn: 180\n",
-            Game::Platform,
-            "in [90, 135]",
-        ),
-        (
-            "generator:\n  max_turn: .nan\n",
-            Game::Platform,
-            "in [90, 135]",
-        ),
-        (
-            "generator:\n  max_turn: 120\n",
-            Game::Racing,
-            "max_turn is the platform Generator's",
         ),
         (
             "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n  - {from_steps: 5, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n",

@@ -11,9 +11,9 @@ use std::path::Path;
 use std::sync::mpsc::channel;
 use std::time::{Duration, Instant};
 
-use arlpcg::design::app::{self, App, Message, Response};
-use arlpcg::design::{view, worker};
-use arlpcg::level::Game;
+use arlpcg::shells::design::app::{self, App, Message, Response};
+use arlpcg::shells::design::{view, worker};
+use arlpcg_core::level::Game;
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
 use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
@@ -27,7 +27,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn main() {
     // SAFETY: first thing in main, before any other thread exists.
-    unsafe { arlpcg::shell::fix_thread_count() };
+    unsafe { arlpcg::shells::common::fix_thread_count() };
     for game in [Game::Platform, Game::Racing] {
         for (key, what) in [('n', "new seed"), ('P', "pacing edit")] {
             measure(game, key, what);
@@ -44,10 +44,10 @@ fn measure(game: Game, pressed_key: char, what: &str) {
         "{game}, {what} (`{pressed_key}`): Generator {}, Solver {}",
         info.generator
             .as_ref()
-            .map_or("none (rules)", |p| p.card.training.mode.as_str()),
+            .map_or("none (rules)", |p| p.card.training.mode.name()),
         info.solver
             .as_ref()
-            .map_or("none (scripted)", |p| p.card.training.mode.as_str()),
+            .map_or("none (scripted)", |p| p.card.training.mode.name()),
     );
     let (tx, rx) = channel();
     let mut shelf = worker::GamePolicies::default();

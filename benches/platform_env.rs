@@ -5,8 +5,8 @@
 
 use std::time::{Duration, Instant};
 
-use arlpcg::game::platform::{OBSERVATION_SIZE, PlatformAction, PlatformEnv, SolverRewards};
-use arlpcg::game::rules;
+use arlpcg_core::game::platform::rules;
+use arlpcg_core::game::platform::{OBSERVATION_SIZE, PlatformAction, PlatformEnv, PlatformRewards};
 use rayon::prelude::*;
 
 /// A world with a cheap, seeded action source (a random policy, as early in training).
@@ -23,7 +23,7 @@ impl Worker {
             rules::platform_level(seed, None, None, &Default::default()).expect("rule level");
         let track = level.platform().expect("platform level");
         Self {
-            env: PlatformEnv::new(track, level.goal, SolverRewards::default()),
+            env: PlatformEnv::new(track, level.goal, PlatformRewards::default()),
             obs: vec![0.0; OBSERVATION_SIZE],
             state: seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1,
             episodes: 0,
@@ -75,7 +75,7 @@ fn measure(label: &str, budget: Duration, mut round: impl FnMut() -> u64) -> f64
 
 fn main() {
     // SAFETY: first thing in main, before any other thread exists.
-    unsafe { arlpcg::shell::fix_thread_count() };
+    unsafe { arlpcg::shells::common::fix_thread_count() };
     let budget = Duration::from_secs(3);
     let mut single = Worker::new(1);
     let one = measure("1 world, 1 thread", budget, || {

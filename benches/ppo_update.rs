@@ -7,8 +7,8 @@
 
 use std::time::Instant;
 
-use arlpcg::rl::policy::{ActorCritic, PolicyShape};
-use arlpcg::rl::ppo::{Batch, Ppo, PpoConfig};
+use arlpcg_core::rl::policy::{ActorCritic, PolicyShape};
+use arlpcg_core::rl::ppo::{Batch, Ppo, PpoConfig};
 use candle_core::{Device, Tensor};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -32,7 +32,7 @@ fn matmul_gflops(n: usize) -> f64 {
 
 fn main() {
     // SAFETY: first thing in main, before any other thread exists.
-    unsafe { arlpcg::shell::fix_thread_count() };
+    unsafe { arlpcg::shells::common::fix_thread_count() };
     let shape = PolicyShape {
         observation: 40,
         hidden: vec![512, 512],

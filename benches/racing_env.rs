@@ -6,10 +6,12 @@
 
 use std::time::{Duration, Instant};
 
-use arlpcg::game::racing::car::CarAction;
-use arlpcg::game::racing::{OBSERVATION_SIZE, RacingEnv, ScriptedDriver, SolverRewards, rules};
-use arlpcg::level::Track;
-use arlpcg::level::racing::RacingRulesConfig;
+use arlpcg_core::game::racing::car::CarAction;
+use arlpcg_core::game::racing::{
+    OBSERVATION_SIZE, RacingEnv, RacingRewards, ScriptedDriver, rules,
+};
+use arlpcg_core::level::Track;
+use arlpcg_core::level::racing::RacingRulesConfig;
 use rayon::prelude::*;
 
 /// How a worker picks its actions.
@@ -43,7 +45,7 @@ impl Worker {
             unreachable!("a racing level")
         };
         Self {
-            env: RacingEnv::new(track, level.goal, SolverRewards::default()),
+            env: RacingEnv::new(track, level.goal, RacingRewards::default()),
             obs: vec![0.0; OBSERVATION_SIZE],
             state: seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1,
             episodes: 0,
@@ -102,7 +104,7 @@ fn measure(label: &str, budget: Duration, mut round: impl FnMut() -> u64) -> f64
 
 fn main() {
     // SAFETY: first thing in main, before any other thread exists.
-    unsafe { arlpcg::shell::fix_thread_count() };
+    unsafe { arlpcg::shells::common::fix_thread_count() };
     let budget = Duration::from_secs(3);
     let single = |driver, observe, label: &str| {
         let mut worker = Worker::new(1, driver, observe);

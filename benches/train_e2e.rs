@@ -6,22 +6,22 @@
 
 use std::time::Instant;
 
-use arlpcg::game::PlatformGame;
-use arlpcg::rl::policy::{ActorCritic, PolicyShape};
-use arlpcg::rl::ppo::Ppo;
-use arlpcg::rl::vec_env::Trainer;
-use arlpcg::train::TrainConfig;
-use arlpcg::train::solver_envs::{SolverEnvs, SolverMode, SourceRecord};
+use arlpcg::services::train::TrainConfig;
+use arlpcg::services::train::solver_envs::{SolverEnvs, SolverMode, SourceRecord};
+use arlpcg_core::game::PlatformGame;
+use arlpcg_core::rl::policy::{ActorCritic, PolicyShape};
+use arlpcg_core::rl::ppo::Ppo;
+use arlpcg_core::rl::vec_env::Trainer;
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() {
     // SAFETY: first thing in main, before any other thread exists.
-    unsafe { arlpcg::shell::fix_thread_count() };
+    unsafe { arlpcg::shells::common::fix_thread_count() };
     let config = TrainConfig::default();
     let shape = PolicyShape {
-        observation: arlpcg::game::platform::OBSERVATION_SIZE,
+        observation: arlpcg_core::game::platform::OBSERVATION_SIZE,
         hidden: config.hidden.clone(),
         continuous: 2,
         binary: 1,

@@ -13,15 +13,15 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use arlpcg::game::facts::facts;
-use arlpcg::game::generator::{GeneratorGame, Match, Placement, TrackBuild, observation_size};
-use arlpcg::game::{PlatformGame, RacingGame, SolverEnv};
-use arlpcg::generation::GeneratorPolicy;
-use arlpcg::level::Game;
-use arlpcg::level::stats::Outcome;
-use arlpcg::policies::{GENERATOR_FILE, SOLVER_FILE, load_generator, load_solver};
-use arlpcg::rl::policy::ActMode;
-use arlpcg::verify::SolverPolicy;
+use arlpcg::services::generation::GeneratorPolicy;
+use arlpcg::services::policies::{GENERATOR_FILE, SOLVER_FILE, load_generator, load_solver};
+use arlpcg::services::verify::SolverPolicy;
+use arlpcg_core::game::facts::facts;
+use arlpcg_core::game::generator::{GeneratorGame, Match, Placement, TrackBuild, observation_size};
+use arlpcg_core::game::{PlatformGame, RacingGame, SolverEnv};
+use arlpcg_core::level::Game;
+use arlpcg_core::level::stats::Outcome;
+use arlpcg_core::rl::policy::ActMode;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;

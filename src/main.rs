@@ -8,13 +8,16 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() -> ExitCode {
     // SAFETY: first thing in main, before any other thread exists.
-    unsafe { arlpcg::shell::fix_thread_count() };
-    let cli = arlpcg::cli::Cli::parse();
-    match arlpcg::commands::run(cli) {
+    unsafe { arlpcg::shells::common::fix_thread_count() };
+    let cli = arlpcg::shells::cli::Cli::parse();
+    match arlpcg::shells::commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("error: {}", arlpcg::commands::one_line(&format!("{err:#}")));
-            ExitCode::from(arlpcg::commands::exit_code(&err))
+            eprintln!(
+                "error: {}",
+                arlpcg::shells::commands::one_line(&format!("{err:#}"))
+            );
+            ExitCode::from(arlpcg::shells::commands::exit_code(&err))
         }
     }
 }

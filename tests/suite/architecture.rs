@@ -1,29 +1,32 @@
-//! The layering docs/architecture.md describes, checked on the source: the core (levels, games,
-//! learning, training, evaluation, verification, generation) reads no clock, prints nothing,
-//! uses no global random generator and knows nothing of the shells above it, so the same inputs
-//! give the same bytes; and no function grows past 120 lines.
+//! The layering docs/architecture.md describes, checked where the compiler cannot check it.
+//! The crate boundary already refuses every import from `arlpcg_core` up into the services or
+//! the shells; these tests refuse the other "never"s: the pure parts read no clock, print
+//! nothing and use no global random generator (the same inputs give the same bytes); the
+//! services never reach up into the shells; the shells meet a game only through the game
+//! abstraction; inside the core, `level` stands alone and `game` and `rl` never meet; only the
+//! `train` command drives training; no two modules import each other; no function grows past
+//! 120 lines; and docs/architecture.md names every module there is.
 
 use std::path::{Path, PathBuf};
 
-/// The core's files and folders, under `src/`.
-const CORE: &[&str] = &[
-    "level",
-    "game",
-    "rl",
-    "train",
-    "eval",
-    "verify.rs",
-    "generation.rs",
-    "difficulty.rs",
-    "seeds.rs",
-    "onnx",
-    "panel.rs",
-    "rating.rs",
-    "bootstrap.rs",
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The pure parts, from the repository's root: the core crate and the services that compute.
+const PURE: &[&str] = &[
+    "crates/core/src",
+    "src/services/train",
+    "src/services/eval",
+    "src/services/onnx",
+    "src/services/verify.rs",
+    "src/services/generation.rs",
+    "src/services/difficulty.rs",
+    "src/services/panel.rs",
 ];
 
-/// What the core may not name, and why.
-const FORBIDDEN: &[(&str, &str)] = &[
+/// What the pure parts may not name, and why.
+const IMPURE: &[(&str, &str)] = &[
     ("Instant", "reads the clock"),
     ("SystemTime", "reads the clock"),
     ("println!", "prints"),
@@ -37,11 +40,79 @@ const FORBIDDEN: &[(&str, &str)] = &[
     ("std::env::var", "reads the environment (the shell's job)"),
     ("ctrlc", "handles signals (the shell's job)"),
     ("indicatif", "draws progress (the shell's job)"),
-    ("crate::shell", "reaches up into the shells"),
-    ("crate::cli", "reaches up into the shells"),
-    ("crate::commands", "reaches up into the shells"),
-    ("crate::design", "reaches up into the designer"),
     ("ratatui", "draws on a terminal"),
+];
+
+/// The layering's "never"s: in these files, this path may not be named (`except` the files
+/// whose path, from the repository's root, starts with one of these).
+struct Never {
+    within: &'static str,
+    names: &'static str,
+    why: &'static str,
+    except: &'static [&'static str],
+}
+
+const NEVER: &[Never] = &[
+    Never {
+        within: "src/services",
+        names: "crate::shells",
+        why: "a service reaches up into the shells",
+        except: &[],
+    },
+    Never {
+        within: "src/shells",
+        names: "arlpcg_core::game::platform",
+        why: "the shells meet a game through `GameSpec` and `game::facts`, not its own module",
+        except: &[],
+    },
+    Never {
+        within: "src/shells",
+        names: "arlpcg_core::game::racing",
+        why: "the shells meet a game through `GameSpec` and `game::facts`, not its own module",
+        except: &[],
+    },
+    Never {
+        within: "src/shells",
+        names: "arlpcg_core::game::platform::rules",
+        why: "the shells meet a game through `GameSpec` and `game::facts`, not its own module",
+        except: &[],
+    },
+    Never {
+        within: "src",
+        names: "services::train",
+        why: "training is driven by the `train` command alone (the card's types live in `rl`)",
+        except: &["src/services/train", "src/shells/commands/train.rs"],
+    },
+    Never {
+        within: "crates/core/src/level",
+        names: "crate::game",
+        why: "levels are data: the games build on them, not the other way",
+        except: &[],
+    },
+    Never {
+        within: "crates/core/src/level",
+        names: "crate::rl",
+        why: "levels are data: learning builds on them, not the other way",
+        except: &[],
+    },
+    Never {
+        within: "crates/core/src/rl",
+        names: "crate::game",
+        why: "learning knows no game: `game` and `rl` sit side by side on `level`",
+        except: &[],
+    },
+    Never {
+        within: "crates/core/src/game",
+        names: "crate::rl",
+        why: "a game knows no learner: `game` and `rl` sit side by side on `level`",
+        except: &[],
+    },
+    Never {
+        within: "crates/core/src/statistics",
+        names: "crate::",
+        why: "statistics are numbers in, numbers out",
+        except: &[],
+    },
 ];
 
 fn rust_files(path: &Path, into: &mut Vec<PathBuf>) {
@@ -54,43 +125,137 @@ fn rust_files(path: &Path, into: &mut Vec<PathBuf>) {
     }
 }
 
+/// The code lines of a file, numbered from 1: unit tests (which may print what they measure
+/// and build what they need) and comment lines left out.
+fn code_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let code = text.split("#[cfg(test)]").next().unwrap();
+    code.lines()
+        .enumerate()
+        .map(|(i, line)| (i + 1, line))
+        .filter(|(_, line)| !line.trim_start().starts_with("//"))
+}
+
 #[test]
-fn the_core_reads_no_clock_prints_nothing_and_knows_no_shell() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+fn the_pure_parts_read_no_clock_print_nothing_and_use_no_global_rng() {
     let mut files = Vec::new();
-    for part in CORE {
-        rust_files(&src.join(part), &mut files);
+    for part in PURE {
+        rust_files(&root().join(part), &mut files);
     }
     assert!(
-        files.len() > 40,
-        "the core's files are found ({})",
+        files.len() > 60,
+        "the pure files are found ({})",
         files.len()
     );
     let mut problems = Vec::new();
     for file in &files {
         let text = std::fs::read_to_string(file).unwrap();
-        // Unit tests may print what they measure.
-        let code = text.split("#[cfg(test)]").next().unwrap();
-        for (number, line) in code.lines().enumerate() {
-            let line = line.trim_start();
-            if line.starts_with("//") {
-                continue;
-            }
-            for (name, why) in FORBIDDEN {
+        for (number, line) in code_lines(&text) {
+            for (name, why) in IMPURE {
                 if line.contains(name) {
-                    problems.push(format!(
-                        "{}:{}: `{name}` {why}",
-                        file.strip_prefix(&src).unwrap().display(),
-                        number + 1
-                    ));
+                    let file = file.strip_prefix(root()).unwrap().display();
+                    problems.push(format!("{file}:{number}: `{name}` {why}"));
                 }
             }
         }
     }
     assert!(
         problems.is_empty(),
-        "the core must stay pure:\n{}",
+        "the pure parts must stay pure:\n{}",
         problems.join("\n")
+    );
+}
+
+/// Where `rule` is broken in the files under `dir` (paths from the repository's root).
+fn broken(rule: &Never, files: &[PathBuf]) -> Vec<String> {
+    let mut found = Vec::new();
+    for file in files {
+        let relative = file
+            .strip_prefix(root())
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        if rule.except.iter().any(|e| relative.starts_with(e)) {
+            continue;
+        }
+        let text = std::fs::read_to_string(file).unwrap();
+        for (number, line) in code_lines(&text) {
+            if line.contains(rule.names) {
+                found.push(format!(
+                    "{relative}:{number}: names `{}`: {}",
+                    rule.names, rule.why
+                ));
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn every_never_of_the_layering_holds() {
+    let mut problems = Vec::new();
+    for rule in NEVER {
+        let mut files = Vec::new();
+        rust_files(&root().join(rule.within), &mut files);
+        assert!(!files.is_empty(), "{} holds code", rule.within);
+        problems.extend(broken(rule, &files));
+    }
+    assert!(
+        problems.is_empty(),
+        "the layering is broken:\n{}",
+        problems.join("\n")
+    );
+    // The check sees imports: the `train` command names the training service, and a rule
+    // without its exception would catch it.
+    let command = [root().join("src/shells/commands/train.rs")];
+    let strict = Never {
+        except: &[],
+        ..NEVER[4]
+    };
+    assert!(!broken(&strict, &command).is_empty());
+}
+
+/// The modules of a layer: each file and folder directly under it (`mod.rs` and `lib.rs`
+/// aside), by name without `.rs`.
+fn modules_under(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir() || p.extension().is_some_and(|e| e == "rs"))
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .filter(|n| n != "mod" && n != "lib" && n != "main")
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn docs_architecture_names_every_module_of_every_layer() {
+    let doc = std::fs::read_to_string(root().join("docs/architecture.md")).unwrap();
+    let mut missing = Vec::new();
+    for (layer, prefix) in [
+        ("crates/core/src", "crates/core/src/"),
+        ("src/services", "src/services/"),
+        ("src/shells", "src/shells/"),
+    ] {
+        let modules = modules_under(&root().join(layer));
+        assert!(modules.len() >= 4, "{layer}: {modules:?}");
+        for module in modules {
+            if !doc.contains(&format!("`{module}")) {
+                missing.push(format!("{prefix}{module}"));
+            }
+        }
+    }
+    // src/ itself holds the two layers and the two crate roots, nothing else.
+    let top: Vec<String> = modules_under(&root().join("src"));
+    assert_eq!(
+        top,
+        ["services", "shells"],
+        "src/ holds only lib.rs, main.rs and the layers"
+    );
+    assert!(
+        missing.is_empty(),
+        "docs/architecture.md does not name these modules:\n{}",
+        missing.join("\n")
     );
 }
 
@@ -135,9 +300,9 @@ fn function_lengths(text: &str) -> Vec<(usize, usize)> {
 
 #[test]
 fn no_function_is_longer_than_120_lines() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = root();
     let mut files = Vec::new();
-    for part in ["src", "tests", "benches"] {
+    for part in ["src", "crates/core/src", "tests", "benches"] {
         rust_files(&root.join(part), &mut files);
     }
     let long: Vec<String> = files
@@ -200,14 +365,13 @@ fn names_module(text: &str, from: &str, to: &str) -> bool {
         .any(|line| paths.iter().any(|p| line.contains(p.as_str())))
 }
 
-#[test]
-fn no_two_modules_import_each_other() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+/// Module pairs of the crate whose sources are `src` that import each other.
+fn import_loops(src: &Path) -> Vec<String> {
     let mut files = Vec::new();
-    rust_files(&src, &mut files);
+    rust_files(src, &mut files);
     let modules: Vec<(String, String)> = files
         .iter()
-        .map(|f| (module_of(&src, f), std::fs::read_to_string(f).unwrap()))
+        .map(|f| (module_of(src, f), std::fs::read_to_string(f).unwrap()))
         .collect();
     let mut loops = Vec::new();
     for (i, (a, a_text)) in modules.iter().enumerate() {
@@ -222,12 +386,19 @@ fn no_two_modules_import_each_other() {
             }
         }
     }
+    loops
+}
+
+#[test]
+fn no_two_modules_import_each_other() {
+    let mut loops = import_loops(&root().join("src"));
+    loops.extend(import_loops(&root().join("crates/core/src")));
     assert!(
         loops.is_empty(),
         "modules that import each other (one should own what both need):\n{}",
         loops.join("\n")
     );
     // The check sees imports: level::road names level::racing.
-    let road = modules.iter().find(|(m, _)| m == "level::road").unwrap();
-    assert!(names_module(&road.1, "level::road", "level::racing"));
+    let road = std::fs::read_to_string(root().join("crates/core/src/level/road.rs")).unwrap();
+    assert!(names_module(&road, "level::road", "level::racing"));
 }

@@ -48,9 +48,9 @@ fn generate_is_reproducible_byte_for_byte_and_files_load_back() {
     assert_eq!(files_a.len(), 40);
     assert!(files_a == files_b, "two runs with the same seed differ");
     for (name, bytes) in files_a.iter().filter(|(n, _)| n.ends_with(".yaml")) {
-        let level = arlpcg::level::yaml::load(&a.path().join(name)).unwrap();
+        let level = arlpcg_core::level::yaml::load(&a.path().join(name)).unwrap();
         assert_eq!(
-            arlpcg::level::yaml::to_string(&level).as_bytes(),
+            arlpcg_core::level::yaml::to_string(&level).as_bytes(),
             bytes.as_slice(),
             "{name} does not read back to itself"
         );
@@ -809,7 +809,7 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
     let mut redraws = 0;
     for (name, _) in files_of(dir.path()) {
         let path = dir.path().join(&name);
-        let level = arlpcg::level::yaml::load(&path).unwrap();
+        let level = arlpcg_core::level::yaml::load(&path).unwrap();
         let stats = level.stats.clone().unwrap();
         assert!(stats.successes > 0, "{name}: no run completed it");
         assert!(stats.certificate.is_some(), "{name} has no certificate");
@@ -872,7 +872,7 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
     assert_eq!(files.len(), 1);
     let (name, _) = &files[0];
     assert!(name.starts_with("platform_seed1_"), "{name}");
-    let level = arlpcg::level::yaml::load(&dir.path().join(name)).unwrap();
+    let level = arlpcg_core::level::yaml::load(&dir.path().join(name)).unwrap();
     assert_ne!(
         level.seed,
         Some(1),
@@ -900,7 +900,7 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
         own.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let goal = arlpcg::level::yaml::load(&own.join("platform_seed1_aux-1.00.yaml"))
+    let goal = arlpcg_core::level::yaml::load(&own.join("platform_seed1_aux-1.00.yaml"))
         .unwrap()
         .goal;
     let goal = format!("{},{},{}", goal[0], goal[1], goal[2]);
@@ -953,7 +953,7 @@ fn target_success_levels_measure_within_the_band() {
     let mut auxes = Vec::new();
     for (name, _) in &files {
         assert!(name.ends_with("_success0.60.yaml"), "{name}");
-        let level = arlpcg::level::yaml::load(&dir.path().join(name)).unwrap();
+        let level = arlpcg_core::level::yaml::load(&dir.path().join(name)).unwrap();
         let stats = level.stats.unwrap();
         assert!(
             (stats.success_ratio - 0.6).abs() <= 0.1 + 1e-9,

@@ -6,12 +6,14 @@ use std::path::Path;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use arlpcg::design::app::{self, App, Effect, GoalSetting, LoadedInfo, Message, Overlay, Response};
-use arlpcg::design::layout::Areas;
-use arlpcg::design::view;
-use arlpcg::design::worker::{self, GamePolicies, Policies, Workers};
-use arlpcg::generation::LevelRequest;
-use arlpcg::level::{Game, yaml};
+use arlpcg::services::generation::LevelRequest;
+use arlpcg::shells::design::app::{
+    self, App, Effect, GoalSetting, LoadedInfo, Message, Overlay, Response,
+};
+use arlpcg::shells::design::layout::Areas;
+use arlpcg::shells::design::view;
+use arlpcg::shells::design::worker::{self, GamePolicies, Policies, Workers};
+use arlpcg_core::level::{Game, yaml};
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
 use ratatui::crossterm::event::{
@@ -102,8 +104,8 @@ fn starts_with_a_level_and_its_statistics() {
     h.settle();
     let level = h.app.level.clone().expect("a level is on screen");
     // Without policies the level on screen is the rule level of the designer's seed and λ.
-    let expected = arlpcg::generation::rules_level(
-        arlpcg::level::Game::Platform,
+    let expected = arlpcg::services::generation::rules_level(
+        arlpcg_core::level::Game::Platform,
         &LevelRequest::new(h.app.seed, Some(h.app.aux)),
     )
     .unwrap();
@@ -369,8 +371,8 @@ fn racing_tracks_are_designed_like_platform_levels() {
     h.settle();
     let level = h.app.level.clone().expect("a racing track at once");
     let request = LevelRequest::new(1, Some(1.0))
-        .obstacles(arlpcg::game::facts::facts(Game::Racing).scene_obstacles);
-    let expected = arlpcg::generation::rules_level(Game::Racing, &request).unwrap();
+        .obstacles(arlpcg_core::game::facts::facts(Game::Racing).scene_obstacles);
+    let expected = arlpcg::services::generation::rules_level(Game::Racing, &request).unwrap();
     assert_eq!(*level, expected, "the rules' track of the seed");
     let trials = h.app.trials.as_ref().unwrap();
     assert_eq!(trials.stats.as_ref().unwrap().trials, app::DEFAULT_TRIALS);
@@ -663,7 +665,7 @@ fn pacing_keys_set_a_curve_and_keep_a_prefix() {
     );
     assert!(matches!(
         after.source,
-        arlpcg::level::Source::Kept { pieces: 2, .. }
+        arlpcg_core::level::Source::Kept { pieces: 2, .. }
     ));
     assert!(
         h.app.export_stem().ends_with("_pacing-custom_keep2"),
@@ -698,14 +700,14 @@ fn the_judge_key_cycles_through_the_panel() {
             .and_then(|t| t.stats.as_ref())
             .unwrap();
         match &trials.solver {
-            arlpcg::level::SolverRef::Scripted { skill } => {
+            arlpcg_core::level::SolverRef::Scripted { skill } => {
                 assert_eq!(judge, format!("scripted-{skill}"));
                 assert!(
                     h.screen(80, 24)
                         .contains(&format!("Solver: scripted-{skill}"))
                 );
             }
-            arlpcg::level::SolverRef::Policy { policy } => {
+            arlpcg_core::level::SolverRef::Policy { policy } => {
                 assert!(policy.path.contains("solver"), "{}", policy.path);
             }
             other => panic!("{other:?}"),
@@ -735,7 +737,7 @@ fn the_whole_panel_plays_the_level_on_screen_and_the_export_records_it() {
     let mut h = Harness::shipped(dir.path());
     h.settle();
     h.key(KeyCode::Char('J'));
-    assert_eq!(h.app.panel, app::Panel::Judges);
+    assert_eq!(h.app.panel, app::SidePane::Judges);
     h.settle();
     let judging = h.app.judging.clone().expect("the panel played");
     let names: Vec<&str> = judging.judges.iter().map(|(n, _)| n.as_str()).collect();

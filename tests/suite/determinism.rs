@@ -2,7 +2,7 @@
 //! give the same run bit for bit (observations and rewards), and another start seed gives
 //! another run, so the check can fail.
 
-use arlpcg::game::{GameSpec, PlatformGame, RacingGame, Scripted, Skill, SolverEnv};
+use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, Scripted, Skill, SolverEnv};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 

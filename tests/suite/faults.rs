@@ -155,8 +155,8 @@ fn messages_name_the_field_and_exit_codes_tell_arguments_from_input() {
     let mut with_bom = b"\xef\xbb\xbf".to_vec();
     with_bom.extend(std::fs::read(&staircase).unwrap());
     assert_eq!(
-        arlpcg::level::yaml::parse(std::str::from_utf8(&with_bom).unwrap()).unwrap(),
-        arlpcg::level::yaml::load(&staircase).unwrap()
+        arlpcg_core::level::yaml::parse(std::str::from_utf8(&with_bom).unwrap()).unwrap(),
+        arlpcg_core::level::yaml::load(&staircase).unwrap()
     );
 
     let out = dir.path().join("never-made");
@@ -203,7 +203,9 @@ fn messages_name_the_field_and_exit_codes_tell_arguments_from_input() {
 }
 
 fn yaml_error(path: &Path) -> String {
-    arlpcg::level::yaml::load(path).unwrap_err().to_string()
+    arlpcg_core::level::yaml::load(path)
+        .unwrap_err()
+        .to_string()
 }
 
 /// Runs the binary with files limited to `kib` KiB (writes past it fail with "File too large",

@@ -2,13 +2,13 @@
 //! markers, names, extras, and world bounds that match the level.
 
 use crate::common::import_glb;
-use arlpcg::game::rules;
-use arlpcg::level::platform::BLOCK_THICKNESS;
-use arlpcg::level::scene::Scene;
-use arlpcg::level::{Level, RulesConfig, gltf as export};
+use arlpcg_core::game::platform::rules;
+use arlpcg_core::level::platform::BLOCK_THICKNESS;
+use arlpcg_core::level::scene::Scene;
+use arlpcg_core::level::{Level, PlatformRulesConfig, gltf as export};
 
 fn level(seed: u64) -> Level {
-    rules::platform_level(seed, Some(-1.0), None, &RulesConfig::default()).unwrap()
+    rules::platform_level(seed, Some(-1.0), None, &PlatformRulesConfig::default()).unwrap()
 }
 
 /// World-space bounds of every node's unit cube, from the file's own transforms.
@@ -163,11 +163,11 @@ fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
 #[test]
 fn every_mesh_faces_outward_and_its_winding_agrees_with_its_normals() {
     let platform = level(4);
-    let racing = arlpcg::game::racing::rules::racing_level(
+    let racing = arlpcg_core::game::racing::rules::racing_level(
         9,
         Some(0.0),
         None,
-        &arlpcg::level::racing::RacingRulesConfig {
+        &arlpcg_core::level::racing::RacingRulesConfig {
             obstacles: 6,
             ..Default::default()
         },
@@ -231,10 +231,10 @@ fn rotate_z(rotation: [f32; 4]) -> [f32; 3] {
 /// (the goal block, or across the road's end, with the reach that counts as success).
 #[test]
 fn spawn_and_finish_nodes_carry_start_heading_and_goal_reach() {
-    use arlpcg::level::heading::heading_direction;
+    use arlpcg_core::level::heading::heading_direction;
     let platform = level(6);
     let racing =
-        arlpcg::game::racing::rules::racing_level(6, None, None, &Default::default()).unwrap();
+        arlpcg_core::game::racing::rules::racing_level(6, None, None, &Default::default()).unwrap();
     for level in [platform, racing] {
         let glb = export::to_glb(&Scene::of_level(&level));
         let (document, _) = import_glb(&glb);
@@ -311,11 +311,11 @@ fn spawn_and_finish_nodes_carry_start_heading_and_goal_reach() {
 
 /// Racing rule track 9 with 6 obstacles (boxes and cylinders).
 fn racing_with_obstacles() -> Level {
-    arlpcg::game::racing::rules::racing_level(
+    arlpcg_core::game::racing::rules::racing_level(
         9,
         None,
         None,
-        &arlpcg::level::racing::RacingRulesConfig {
+        &arlpcg_core::level::racing::RacingRulesConfig {
             obstacles: 6,
             ..Default::default()
         },
@@ -402,7 +402,7 @@ fn every_solid_piece_has_a_collider_and_the_finish_a_trigger() {
 /// `-col` import hint, one for each collider of the physics extension; markers keep their names.
 #[test]
 fn collision_names_mark_exactly_the_solid_meshes() {
-    use arlpcg::level::scene::COLLISION_SUFFIX;
+    use arlpcg_core::level::scene::COLLISION_SUFFIX;
     for level in [level(5), racing_with_obstacles()] {
         let game = level.game();
         let nodes_of = |scene: Scene| {

@@ -4,10 +4,10 @@
 //! value, never a panic; the limits of `level::yaml_limits` and the file caps keep time and
 //! memory bounded (a case that hung or aborted before would stall or kill this test).
 
-use arlpcg::game::platform::OBSERVATION_SIZE;
-use arlpcg::level::{Game, yaml};
-use arlpcg::rl::checkpoint::{Role, load_policy};
-use arlpcg::train::TrainConfig;
+use arlpcg::services::train::TrainConfig;
+use arlpcg_core::game::platform::OBSERVATION_SIZE;
+use arlpcg_core::level::{Game, yaml};
+use arlpcg_core::rl::checkpoint::{Role, load_policy};
 use proptest::prelude::*;
 use serde_yaml::{Mapping, Value};
 

@@ -1,8 +1,8 @@
 //! Property tests of the level file: any valid level writes and reads back to itself, and the
 //! text is stable (writing what was read gives the same bytes).
 
-use arlpcg::level::platform::{BlockParams, PlatformTrack, Start};
-use arlpcg::level::{Level, Source, Track, params, yaml};
+use arlpcg_core::level::platform::{BlockParams, PlatformTrack, Start};
+use arlpcg_core::level::{Level, Source, Track, params, yaml};
 use proptest::prelude::*;
 
 fn block() -> impl Strategy<Value = BlockParams> {

@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use arlpcg::level::Game;
-use arlpcg::onnx::{self, Exported, Profile, example_observations, reference_outputs};
+use arlpcg::services::onnx::{self, Exported, Profile, example_observations, reference_outputs};
+use arlpcg_core::level::Game;
 use tract_onnx::prelude::*;
 
 use crate::common::{arlpcg, stderr};
@@ -86,7 +86,7 @@ fn every_shipped_policy_runs_in_tract_as_it_plays_here() {
         "expected the shipped policies: {policies:?}"
     );
     for path in &policies {
-        let (policy, card, reference) = arlpcg::policies::load_any(path).unwrap();
+        let (policy, card, reference) = arlpcg::services::policies::load_any(path).unwrap();
         // Observations the export did not see (its examples use seed 0).
         let observations = example_observations(&card.normalizer, ROWS, 1);
         for profile in [Profile::Plain, Profile::Mlagents] {
@@ -136,7 +136,7 @@ fn every_shipped_policy_runs_in_tract_as_it_plays_here() {
 #[test]
 fn mlagents_action_masks_decide_a_masked_branch() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform/solver.safetensors");
-    let (policy, card, reference) = arlpcg::policies::load_any(&path).unwrap();
+    let (policy, card, reference) = arlpcg::services::policies::load_any(&path).unwrap();
     assert_eq!(card.network.binary, 1, "the platform Solver jumps");
     let exported = onnx::export(&policy, &card, reference, Profile::Mlagents).unwrap();
     let observations = example_observations(&card.normalizer, ROWS, 2);

@@ -5,11 +5,11 @@
 
 use std::path::Path;
 
-use arlpcg::generation::{Lambda, LevelRequest, generator_level};
-use arlpcg::level::pacing::{AuxCurve, round_aux};
-use arlpcg::level::{Game, yaml};
-use arlpcg::policies::{load_generator, load_solver, policy_paths};
-use arlpcg::verify::{HalfwaySplit, Solver, verify};
+use arlpcg::services::generation::{AuxAsk, LevelRequest, generator_level};
+use arlpcg::services::policies::{load_generator, load_solver, policy_paths};
+use arlpcg::services::verify::{HalfwaySplit, Solver, verify};
+use arlpcg_core::level::pacing::{AuxCurve, round_aux};
+use arlpcg_core::level::{Game, yaml};
 
 use crate::common::{arlpcg, stderr};
 
@@ -27,8 +27,8 @@ fn each_piece_is_built_at_the_curves_value_where_it_begins_and_records_it() {
     for game in [Game::Platform, Game::Racing] {
         let (generator, _) = load_generator(&policy_paths(&shipped(game)).0, game).unwrap();
         let request = LevelRequest::new(3, None)
-            .obstacles(arlpcg::game::facts::facts(game).scene_obstacles)
-            .lambda(Lambda::Curve(curve.clone()));
+            .obstacles(arlpcg_core::game::facts::facts(game).scene_obstacles)
+            .aux(AuxAsk::Curve(curve.clone()));
         let level = generator_level(&generator, &request).unwrap();
         let pacing = level
             .pacing
@@ -72,8 +72,8 @@ fn the_shipped_racing_generator_makes_a_tracks_second_half_as_hard_as_the_curve_
         let mut split = HalfwaySplit::default();
         for seed in 100..106 {
             let request = LevelRequest::new(seed, None)
-                .obstacles(arlpcg::game::facts::facts(game).scene_obstacles)
-                .lambda(Lambda::Curve(AuxCurve::parse(curve).unwrap()));
+                .obstacles(arlpcg_core::game::facts::facts(game).scene_obstacles)
+                .aux(AuxAsk::Curve(AuxCurve::parse(curve).unwrap()));
             let level = generator_level(&generator, &request).unwrap();
             let stats = verify(&level, &Solver::Policy(&solver), 20, seed, &|| {}).unwrap();
             split.add(&level, &stats);
@@ -135,7 +135,9 @@ fn bad_curves_are_refused_with_the_reason() {
 
 #[test]
 fn a_piece_aux_without_a_curve_names_the_field() {
-    let level = arlpcg::game::rules::platform_level(5, None, None, &Default::default()).unwrap();
+    let level =
+        arlpcg_core::game::platform::rules::platform_level(5, None, None, &Default::default())
+            .unwrap();
     let text = yaml::to_string(&level).replacen("  height:", "  aux: -1.0\n  height:", 1);
     let err = yaml::parse(&text).unwrap_err().to_string();
     assert!(
@@ -247,7 +249,7 @@ fn a_kept_prefix_is_written_byte_for_byte_and_the_generator_builds_the_rest() {
         );
         let level = yaml::load(&second_file).unwrap();
         assert!(
-            matches!(&level.source, arlpcg::level::Source::Kept { pieces, .. } if *pieces as usize == keep),
+            matches!(&level.source, arlpcg_core::level::Source::Kept { pieces, .. } if *pieces as usize == keep),
             "{game}: {:?}",
             level.source
         );

@@ -1,8 +1,8 @@
 //! The panel of judges: the scripted player's skills apart on rule levels, `verify --panel`,
 //! `generate --panel` and `--judge`.
 
-use arlpcg::game::{GameSpec, PlatformGame, RacingGame, Skill};
-use arlpcg::verify::{Solver, verify};
+use arlpcg::services::verify::{Solver, verify};
+use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, Skill};
 
 use crate::common::{arlpcg, stderr};
 
@@ -135,11 +135,11 @@ fn generate_records_the_panel_and_the_rating_and_verifies_with_a_judge() {
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let path = out_dir.join("platform_seed100_aux-1.00.yaml");
-    let level = arlpcg::level::yaml::load(&path).unwrap();
+    let level = arlpcg_core::level::yaml::load(&path).unwrap();
     let stats = level.stats.unwrap();
     assert_eq!(
         stats.solver,
-        arlpcg::level::SolverRef::Scripted {
+        arlpcg_core::level::SolverRef::Scripted {
             skill: Skill::Median
         }
     );

@@ -1,13 +1,15 @@
 //! The platform world (its determinism is in determinism.rs): the calibrated reach, observations and rewards as the
 //! Solver sees them, and how runs end.
 
-use arlpcg::game::platform::reach::{self, REACH_HEIGHTS, REACH_TABLE, play_scripted, single_jump};
-use arlpcg::game::platform::{OBSERVATION_SIZE, PlatformAction, PlatformEnv, SolverRewards};
-use arlpcg::level::platform::{BlockParams, PlatformTrack, Start};
-use arlpcg::level::stats::Outcome;
+use arlpcg_core::game::platform::reach::{
+    self, REACH_HEIGHTS, REACH_TABLE, play_scripted, single_jump,
+};
+use arlpcg_core::game::platform::{OBSERVATION_SIZE, PlatformAction, PlatformEnv, PlatformRewards};
+use arlpcg_core::level::platform::{BlockParams, PlatformTrack, Start};
+use arlpcg_core::level::stats::Outcome;
 
 fn env_of(track: &PlatformTrack) -> PlatformEnv {
-    PlatformEnv::new(track, track.last().position, SolverRewards::default())
+    PlatformEnv::new(track, track.last().position, PlatformRewards::default())
 }
 
 #[test]
@@ -60,7 +62,7 @@ fn standing_still_runs_out_of_time_as_a_truncation_with_the_failure_penalty() {
     let track = single_jump(2.0, 0.0);
     let mut env = env_of(&track);
     env.reset(0);
-    let rewards = SolverRewards::default();
+    let rewards = PlatformRewards::default();
     let mut last = None;
     for _ in 0..100_000 {
         let step = env.step(PlatformAction::default());
@@ -107,7 +109,7 @@ fn running_off_the_edge_falls_and_moving_toward_the_goal_pays() {
         "running without jumping must fall into the gap"
     );
     // Running at the block paid per metre closed (less than the 8 m to its centre)...
-    let per_metre = SolverRewards::default().progress_per_metre;
+    let per_metre = PlatformRewards::default().progress_per_metre;
     let running: f32 = rewards.iter().take_while(|&&r| r >= 0.0).sum();
     assert!(
         running > per_metre && running < 8.0 * per_metre,
@@ -116,7 +118,7 @@ fn running_off_the_edge_falls_and_moving_toward_the_goal_pays() {
     // ...and the run ended with the failure penalty.
     let last = *rewards.last().unwrap();
     assert!(
-        last < SolverRewards::default().failure + per_metre,
+        last < PlatformRewards::default().failure + per_metre,
         "last reward {last}"
     );
 }

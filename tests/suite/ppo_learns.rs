@@ -2,9 +2,9 @@
 //! CartPole-v1 dynamics, the binary action head) and a continuous tracking task whose optimum is
 //! known exactly (the Gaussian head).
 
-use arlpcg::rl::policy::{ActMode, ActorCritic, PolicyShape};
-use arlpcg::rl::ppo::{Ppo, PpoConfig};
-use arlpcg::rl::vec_env::{Trainer, Transition, VecEnv};
+use arlpcg_core::rl::policy::{ActMode, ActorCritic, PolicyShape};
+use arlpcg_core::rl::ppo::{Ppo, PpoConfig};
+use arlpcg_core::rl::vec_env::{Trainer, Transition, VecEnv};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -3,15 +3,15 @@
 //! broken roads with the field and line, and glTF that reads back with the `gltf` crate.
 
 use crate::common::import_glb;
-use arlpcg::game::SolverEnv;
-use arlpcg::game::racing::car::CarAction;
-use arlpcg::game::racing::feasibility::test_track;
-use arlpcg::game::racing::{RacingEnv, SolverRewards, rules};
-use arlpcg::level::racing::{RacingRulesConfig, RacingTrack, SegmentParams};
-use arlpcg::level::scene::Scene;
-use arlpcg::level::stats::Outcome;
-use arlpcg::level::{Level, Track, gltf as export, yaml};
-use arlpcg::verify::{Solver, Summary, verify};
+use arlpcg::services::verify::{Solver, Summary, verify};
+use arlpcg_core::game::SolverEnv;
+use arlpcg_core::game::racing::car::CarAction;
+use arlpcg_core::game::racing::feasibility::test_track;
+use arlpcg_core::game::racing::{RacingEnv, RacingRewards, rules};
+use arlpcg_core::level::racing::{RacingRulesConfig, RacingTrack, SegmentParams};
+use arlpcg_core::level::scene::Scene;
+use arlpcg_core::level::stats::Outcome;
+use arlpcg_core::level::{Level, Track, gltf as export, yaml};
 
 fn rule_level(seed: u64, obstacles: u32) -> Level {
     let config = RacingRulesConfig {
@@ -33,7 +33,7 @@ fn track(level: &Level) -> &RacingTrack {
 #[test]
 fn a_cloned_environment_replays_a_fresh_ones_run() {
     let level = rule_level(5, 2);
-    let mut env = RacingEnv::new(track(&level), level.goal, SolverRewards::default());
+    let mut env = RacingEnv::new(track(&level), level.goal, RacingRewards::default());
     for _ in 0..50 {
         env.step(CarAction {
             throttle: 1.0,
@@ -42,7 +42,7 @@ fn a_cloned_environment_replays_a_fresh_ones_run() {
     }
     let mut clone = env.clone();
     clone.reset(3);
-    let mut again = RacingEnv::new(track(&level), level.goal, SolverRewards::default());
+    let mut again = RacingEnv::new(track(&level), level.goal, RacingRewards::default());
     again.reset(3);
     for _ in 0..100 {
         let action = CarAction {
@@ -62,7 +62,7 @@ fn a_cloned_environment_replays_a_fresh_ones_run() {
 fn the_car_stands_on_four_wheels_on_a_straight_and_drives_it() {
     let track = test_track(3, &[]);
     let goal = track.road().end().0;
-    let mut env = RacingEnv::new(&track, goal, SolverRewards::default());
+    let mut env = RacingEnv::new(&track, goal, RacingRewards::default());
     for _ in 0..60 {
         env.step(CarAction::default());
     }
@@ -91,7 +91,7 @@ fn rule_tracks_are_cleared_by_the_scripted_driver() {
             let level = rule_level(seed, (seed % 3) as u32);
             verify(
                 &level,
-                &Solver::Scripted(arlpcg::game::Skill::Expert),
+                &Solver::Scripted(arlpcg_core::game::Skill::Expert),
                 10,
                 0,
                 &|| {},
@@ -164,7 +164,7 @@ segments:
             .road()
             .end()
             .0
-            .map(arlpcg::level::params::quantize)
+            .map(arlpcg_core::level::params::quantize)
     );
     let problem = |text: &str| yaml::parse(text).unwrap_err().to_string();
     let looping = hand.to_string() + &"- {length: 30, curve: 30, height: 0}\n".repeat(12);
@@ -261,7 +261,7 @@ fn a_segment_can_be_built_from_the_generator_ranges_only() {
     assert!(SegmentParams::new(25.0, -30.0, 5.0).is_ok());
     // The environment's observation has the size its layout says, and finite values.
     let level = rule_level(1, 2);
-    let env = RacingEnv::new(track(&level), level.goal, SolverRewards::default());
+    let env = RacingEnv::new(track(&level), level.goal, RacingRewards::default());
     let mut observation = vec![f32::NAN; RacingEnv::OBSERVATION_SIZE];
     env.observe(&mut observation);
     assert!(observation.iter().all(|x| x.is_finite()), "{observation:?}");

@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use arlpcg::level::scene::Scene;
-use arlpcg::level::{gltf, yaml};
+use arlpcg_core::level::scene::Scene;
+use arlpcg_core::level::{gltf, yaml};
 
 fn yaml_files(dir: &Path, found: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {
@@ -44,10 +44,10 @@ fn every_shipped_level_loads_and_its_glb_is_current() {
 
 #[test]
 fn every_shipped_platform_policy_loads_and_its_card_matches() {
-    use arlpcg::game::platform::OBSERVATION_SIZE;
-    use arlpcg::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
-    use arlpcg::level::Game;
-    use arlpcg::rl::checkpoint::{PolicyCard, Role, load_policy};
+    use arlpcg_core::game::platform::OBSERVATION_SIZE;
+    use arlpcg_core::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
+    use arlpcg_core::level::Game;
+    use arlpcg_core::rl::checkpoint::{PolicyCard, Role, load_policy};
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
     let shipped = [
         (
@@ -102,7 +102,7 @@ fn every_shipped_platform_policy_loads_and_its_card_matches() {
             card, loaded.card,
             "{name}.yaml differs from the card inside {name}.safetensors"
         );
-        assert_eq!(card.training.mode, mode, "{name}");
+        assert_eq!(card.training.mode.name(), mode, "{name}");
         // A policy trained from uncommitted code cannot be reproduced: none ships.
         assert!(
             !card.training.commit.ends_with("-dirty"),
@@ -127,11 +127,11 @@ fn every_shipped_platform_policy_loads_and_its_card_matches() {
 /// trained to the budget from committed code, and each drives a held-out rule track to the end.
 #[test]
 fn the_shipped_racing_solvers_load_and_drive() {
-    use arlpcg::game::racing::OBSERVATION_SIZE;
-    use arlpcg::level::Game;
-    use arlpcg::verify::{Solver, verify};
+    use arlpcg::services::verify::{Solver, verify};
+    use arlpcg_core::game::racing::OBSERVATION_SIZE;
+    use arlpcg_core::level::Game;
     let level =
-        arlpcg::game::racing::rules::racing_level(3, None, None, &Default::default()).unwrap();
+        arlpcg_core::game::racing::rules::racing_level(3, None, None, &Default::default()).unwrap();
     for (file, mode) in [
         ("solver.safetensors", "arlpcg"),
         ("solver-rule-pcg.safetensors", "rule-pcg"),
@@ -141,8 +141,8 @@ fn the_shipped_racing_solvers_load_and_drive() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("policies/racing")
             .join(file);
-        let (solver, card) = arlpcg::policies::load_solver(&path, Game::Racing).unwrap();
-        assert_eq!(card.training.mode, mode);
+        let (solver, card) = arlpcg::services::policies::load_solver(&path, Game::Racing).unwrap();
+        assert_eq!(card.training.mode.name(), mode);
         assert_eq!(
             card.observation.iter().map(|(_, k)| k).sum::<usize>(),
             OBSERVATION_SIZE
@@ -165,10 +165,10 @@ fn the_shipped_racing_solvers_load_and_drive() {
             card.training.commit
         );
         // The card inside the file and the card beside it agree.
-        let beside: arlpcg::rl::checkpoint::PolicyCard =
+        let beside: arlpcg_core::rl::checkpoint::PolicyCard =
             serde_yaml::from_str(&std::fs::read_to_string(path.with_extension("yaml")).unwrap())
                 .unwrap();
-        let record = |c: &arlpcg::rl::checkpoint::PolicyCard| {
+        let record = |c: &arlpcg_core::rl::checkpoint::PolicyCard| {
             let t = &c.training;
             (t.mode.clone(), t.steps, t.commit.clone(), t.command.clone())
         };
@@ -185,10 +185,12 @@ fn the_shipped_racing_solvers_load_and_drive() {
 /// (`generate --target-success` screens each candidate with its first 20 runs) is the whole.
 #[test]
 fn each_verification_trial_is_the_run_recorded_from_its_seed() {
-    use arlpcg::game::{GameSpec, PlatformGame, RacingGame};
-    use arlpcg::level::Game;
-    use arlpcg::level::stats::TrialResult;
-    use arlpcg::verify::{Solver, Watch, record, stats_of, trial_results, verify_watched};
+    use arlpcg::services::verify::{
+        Solver, Watch, record, stats_of, trial_results, verify_watched,
+    };
+    use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame};
+    use arlpcg_core::level::Game;
+    use arlpcg_core::level::stats::TrialResult;
     use std::sync::Mutex;
     for (game, level) in [
         (Game::Platform, PlatformGame::rule_level(7).unwrap()),
@@ -198,7 +200,7 @@ fn each_verification_trial_is_the_run_recorded_from_its_seed() {
             .join("policies")
             .join(game.name())
             .join("solver.safetensors");
-        let (policy, _) = arlpcg::policies::load_solver(&path, game).unwrap();
+        let (policy, _) = arlpcg::services::policies::load_solver(&path, game).unwrap();
         let solver = Solver::Policy(&policy);
         let (trials, seed) = (12, 40);
         let played = Mutex::new(Vec::<TrialResult>::new());
@@ -215,7 +217,7 @@ fn each_verification_trial_is_the_run_recorded_from_its_seed() {
         let mut successes = 0;
         for i in 0..trials as u64 {
             let alone = record(&level, &solver, seed + i).unwrap().result;
-            successes += u32::from(alone.outcome == arlpcg::level::stats::Outcome::Success);
+            successes += u32::from(alone.outcome == arlpcg_core::level::stats::Outcome::Success);
             let at = played.iter().position(|r| *r == alone).unwrap_or_else(|| {
                 panic!("{game}: trial {i} played alone ({alone:?}) is none of the pool's runs")
             });
@@ -244,8 +246,9 @@ fn each_verification_trial_is_the_run_recorded_from_its_seed() {
 /// --seed 0` uses today.
 #[test]
 fn the_shipped_policies_were_trained_by_the_recipe() {
-    use arlpcg::level::Game;
-    use arlpcg::train::{TrainConfig, TrainMode};
+    use arlpcg::services::train::TrainConfig;
+    use arlpcg_core::level::Game;
+    use arlpcg_core::rl::checkpoint::TrainMode;
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     for game in [Game::Platform, Game::Racing] {
         let dir = root.join("policies").join(game.name());
@@ -256,7 +259,7 @@ fn the_shipped_policies_were_trained_by_the_recipe() {
             "solver-fixed-track.yaml",
             "solver-fixed-aux.yaml",
         ] {
-            let card: arlpcg::rl::checkpoint::PolicyCard =
+            let card: arlpcg_core::rl::checkpoint::PolicyCard =
                 serde_yaml::from_str(&std::fs::read_to_string(dir.join(file)).unwrap()).unwrap();
             let words: Vec<&str> = card.training.command.split_whitespace().collect();
             let out = words
@@ -289,7 +292,7 @@ fn the_shipped_policies_were_trained_by_the_recipe() {
                 game.name()
             );
             assert_eq!(
-                (card.training.mode.as_str(), card.training.seed),
+                (card.training.mode.name(), card.training.seed),
                 (mode, 0),
                 "{}/{file}",
                 game.name()

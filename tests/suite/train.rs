@@ -6,10 +6,10 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use arlpcg::game::platform::OBSERVATION_SIZE;
-use arlpcg::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
-use arlpcg::level::Game;
-use arlpcg::rl::checkpoint::{LoadedPolicy, Role, load_policy};
+use arlpcg_core::game::platform::OBSERVATION_SIZE;
+use arlpcg_core::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
+use arlpcg_core::level::Game;
+use arlpcg_core::rl::checkpoint::{LoadedPolicy, Role, load_policy};
 
 use crate::common::{arlpcg, arlpcg_ok, stderr};
 
@@ -156,7 +156,7 @@ fn the_card_records_the_whole_run(out: &Path, target: u64) {
     let policy = std::fs::read(out.join("solver.safetensors")).unwrap();
     let loaded = load_policy(&policy, Game::Platform, Role::Solver, OBSERVATION_SIZE).unwrap();
     assert_eq!(loaded.card.training.steps, target);
-    assert_eq!(loaded.card.training.mode, "fixed-track");
+    assert_eq!(loaded.card.training.mode.name(), "fixed-track");
     // The card names the command that started the run and each session that resumed it.
     assert!(
         loaded
@@ -387,15 +387,16 @@ fn a_fixed_aux_run_refuses_a_finish_that_waits_for_hard_matches() {
     // racing finish's stop is not filled in from the game's defaults.
     let text = String::from_utf8(defaults.stdout).unwrap();
     let read_back =
-        arlpcg::train::TrainConfig::parse_for(&text, arlpcg::level::Game::Racing).unwrap();
+        arlpcg::services::train::TrainConfig::parse_for(&text, arlpcg_core::level::Game::Racing)
+            .unwrap();
     assert_eq!(
         read_back,
-        arlpcg::train::TrainConfig::for_run(
-            arlpcg::level::Game::Racing,
-            arlpcg::train::TrainMode::FixedAux
+        arlpcg::services::train::TrainConfig::for_run(
+            arlpcg_core::level::Game::Racing,
+            arlpcg_core::rl::checkpoint::TrainMode::FixedAux
         )
     );
-    let defaults: arlpcg::train::TrainConfig = serde_yaml::from_str(&text).unwrap();
+    let defaults: arlpcg::services::train::TrainConfig = serde_yaml::from_str(&text).unwrap();
     assert_eq!(defaults.adversarial_budget(), defaults.steps);
 }
 
@@ -573,7 +574,10 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     assert!(resumed_population.last() > first_population.last());
     assert!(resumed_population.windows(2).all(|w| w[1] - w[0] >= 256));
     for network in [SOLVER, GENERATOR] {
-        assert_eq!(load_network(&out, network).card.training.mode, "arlpcg");
+        assert_eq!(
+            load_network(&out, network).card.training.mode.name(),
+            "arlpcg"
+        );
     }
     // The run's folder is a policies folder for every command that takes one.
     generate_and_verify_with_a_run(dir.path(), out_s);
@@ -1067,13 +1071,17 @@ fn generate_and_verify_with_a_run(dir: &Path, run: &str) {
     assert!(!generated.status.success());
     let said = stderr(&generated);
     assert!(said.contains("no valid level"), "{said}");
-    let (_, start, _) = arlpcg::game::rules::goal_and_start(3, None);
-    let [x, z] = arlpcg::level::heading::heading_direction(start.heading);
+    let (_, start, _) = arlpcg_core::game::platform::rules::goal_and_start(3, None);
+    let [x, z] = arlpcg_core::level::heading::heading_direction(start.heading);
     let generated = generate(&format!("{},0,{}", 7.5 * x, 7.5 * z));
     assert!(generated.status.success(), "{}", stderr(&generated));
-    let level = arlpcg::level::yaml::load(&levels.join("platform_seed3_aux-0.50.yaml")).unwrap();
+    let level =
+        arlpcg_core::level::yaml::load(&levels.join("platform_seed3_aux-0.50.yaml")).unwrap();
     assert_eq!(level.aux, Some(-0.5));
-    assert!(matches!(level.source, arlpcg::level::Source::Policy { .. }));
+    assert!(matches!(
+        level.source,
+        arlpcg_core::level::Source::Policy { .. }
+    ));
     let stats = level
         .stats
         .expect("--verify stores the Solver's statistics");
@@ -1305,7 +1313,7 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
         &bytes,
         Game::Racing,
         Role::Solver,
-        arlpcg::game::racing::OBSERVATION_SIZE,
+        arlpcg_core::game::racing::OBSERVATION_SIZE,
     )
     .unwrap();
     assert_eq!(loaded.card.continuous_actions, ["throttle", "steer"]);
@@ -1431,7 +1439,7 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
         &std::fs::read(out.join("generator.safetensors")).unwrap(),
         Game::Racing,
         Role::Generator,
-        arlpcg::game::generator::observation_size::<arlpcg::game::RacingGame>(),
+        arlpcg_core::game::generator::observation_size::<arlpcg_core::game::RacingGame>(),
     )
     .unwrap();
     assert_eq!(
@@ -1452,8 +1460,8 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
 /// within reach of even an untrained Generator.
 fn generate_racing_tracks_with_a_run(dir: &Path, run: &str) {
     let tracks = dir.join("tracks");
-    let (_, heading, _, _) = arlpcg::game::racing::rules::goal_and_start(2, None, 0);
-    let [x, z] = arlpcg::level::heading::heading_direction(heading);
+    let (_, heading, _, _) = arlpcg_core::game::racing::rules::goal_and_start(2, None, 0);
+    let [x, z] = arlpcg_core::level::heading::heading_direction(heading);
     let goal = format!("{},0,{}", 50.0 * x, 50.0 * z);
     let generated = arlpcg(&[
         "generate",
@@ -1476,8 +1484,11 @@ fn generate_racing_tracks_with_a_run(dir: &Path, run: &str) {
         tracks.to_str().unwrap(),
     ]);
     assert!(generated.status.success(), "{}", stderr(&generated));
-    let level = arlpcg::level::yaml::load(&tracks.join("racing_seed2_aux-1.00.yaml")).unwrap();
-    assert!(matches!(level.source, arlpcg::level::Source::Policy { .. }));
+    let level = arlpcg_core::level::yaml::load(&tracks.join("racing_seed2_aux-1.00.yaml")).unwrap();
+    assert!(matches!(
+        level.source,
+        arlpcg_core::level::Source::Policy { .. }
+    ));
     assert!(level.racing().is_some_and(|t| !t.segments.is_empty()));
     assert_eq!(level.stats.unwrap().trials, 2);
 }

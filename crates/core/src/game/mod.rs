@@ -1,0 +1,155 @@
+//! The games as deterministic simulations over rapier3d: the same level, seed and actions give
+//! the same trajectory, bit for bit. Nothing here prints, reads the clock or uses a global RNG.
+
+pub mod facts;
+pub mod generator;
+pub mod platform;
+pub mod racing;
+
+use crate::level::stats::Outcome;
+pub use crate::level::stats::Skill;
+
+/// What one decision led to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Step {
+    pub reward: f32,
+    /// The run ended by reaching the goal or failing (no value to bootstrap after it).
+    pub terminated: bool,
+    /// The run was cut by its time limit.
+    pub truncated: bool,
+    /// How the run ended, on its last step.
+    pub outcome: Option<Outcome>,
+}
+
+impl Step {
+    /// The step that ends a run with `outcome`: a time-out truncates it (a value to bootstrap
+    /// remains), every other ending terminates it.
+    pub fn finished(outcome: Outcome, reward: f32) -> Self {
+        Self {
+            reward,
+            terminated: outcome != Outcome::TimedOut,
+            truncated: outcome == Outcome::TimedOut,
+            outcome: Some(outcome),
+        }
+    }
+}
+
+/// What verification and the designer need from a game's Solver environment. Code written
+/// once over `E: SolverEnv` is compiled per game: nothing is dispatched per step.
+pub trait SolverEnv: Send + Sync + Sized {
+    /// One decision.
+    type Action: Copy + Send + Sync;
+    /// Length of the observation vector.
+    const OBSERVATION_SIZE: usize;
+
+    /// Starts a new run, seeded.
+    fn reset(&mut self, seed: u64);
+    /// Advances one decision.
+    fn step(&mut self, action: Self::Action) -> Step;
+    /// Writes the observation into `out` (`OBSERVATION_SIZE` values).
+    fn observe(&self, out: &mut [f32]);
+    /// The action a policy's output row stands for.
+    fn action_from_policy_row(row: &[f32]) -> Self::Action;
+    /// A uniformly random action (the random baseline).
+    fn random_action(rng: &mut rand_chacha::ChaCha8Rng) -> Self::Action;
+    /// The finished run as verification records it.
+    fn trial_result(&self, outcome: Outcome) -> crate::level::stats::TrialResult;
+    /// Where the player is (a recorded run's path).
+    fn marker(&self) -> [f32; 3];
+}
+
+/// A scripted player of environment `E`.
+pub trait Scripted<E: SolverEnv> {
+    fn act(&mut self, env: &E) -> E::Action;
+}
+
+/// One game as the layers above `game` see it: its Solver environment, the Solver's inputs and
+/// outputs as a policy card names them, and its rule-based levels. `train`, `verify` and the
+/// commands are written once over `G: GameSpec`; the command layer picks [`PlatformGame`] or
+/// [`RacingGame`] from a level's or an argument's [`Game`](crate::level::Game), once.
+pub trait GameSpec: Send + Sync + 'static {
+    const GAME: crate::level::Game;
+    type Env: SolverEnv;
+    /// The game's scripted (non-learning) player.
+    type Scripted: Scripted<Self::Env> + Send + Sync;
+    /// The Solver's observation, named parts in order.
+    const OBSERVATION_LAYOUT: &'static [(&'static str, usize)];
+    /// The Solver's continuous actions, in the policy's order...
+    const CONTINUOUS_ACTIONS: &'static [&'static str];
+    /// ...and its binary ones, after them.
+    const BINARY_ACTIONS: &'static [&'static str];
+
+    /// The Solver's environment on `level`, or `None` for a level of another game.
+    fn solver_env(level: &crate::level::Level) -> Option<Self::Env>;
+    /// The rule-based level of `seed` (its goal drawn from the seed), if the rules find one.
+    fn rule_level(seed: u64) -> Option<crate::level::Level>;
+    /// The scripted player of run `seed` at `skill`, as verification uses it.
+    fn scripted(seed: u64, skill: Skill) -> Self::Scripted;
+}
+
+/// The platform game: blocks to jump across.
+pub struct PlatformGame;
+
+/// The racing game: a car on a banked road.
+pub struct RacingGame;
+
+impl GameSpec for PlatformGame {
+    const GAME: crate::level::Game = crate::level::Game::Platform;
+    type Env = platform::PlatformEnv;
+    type Scripted = platform::ScriptedController;
+    const OBSERVATION_LAYOUT: &'static [(&'static str, usize)] = &platform::env::OBSERVATION_LAYOUT;
+    const CONTINUOUS_ACTIONS: &'static [&'static str] = &["forward", "turn"];
+    const BINARY_ACTIONS: &'static [&'static str] = &["jump"];
+
+    fn solver_env(level: &crate::level::Level) -> Option<platform::PlatformEnv> {
+        let track = level.platform()?;
+        Some(platform::PlatformEnv::new(
+            track,
+            level.goal,
+            platform::PlatformRewards::default(),
+        ))
+    }
+
+    fn rule_level(seed: u64) -> Option<crate::level::Level> {
+        platform::rules::platform_level(
+            seed,
+            None,
+            None,
+            &crate::level::PlatformRulesConfig::default(),
+        )
+        .ok()
+    }
+
+    fn scripted(seed: u64, skill: Skill) -> platform::ScriptedController {
+        let skill = platform::scripted::ControllerSkill::of(skill);
+        platform::ScriptedController::with_skill(seed, skill)
+    }
+}
+
+impl GameSpec for RacingGame {
+    const GAME: crate::level::Game = crate::level::Game::Racing;
+    type Env = racing::RacingEnv;
+    type Scripted = racing::ScriptedDriver;
+    const OBSERVATION_LAYOUT: &'static [(&'static str, usize)] = &racing::env::OBSERVATION_LAYOUT;
+    const CONTINUOUS_ACTIONS: &'static [&'static str] = &["throttle", "steer"];
+    const BINARY_ACTIONS: &'static [&'static str] = &[];
+
+    fn solver_env(level: &crate::level::Level) -> Option<racing::RacingEnv> {
+        let crate::level::Track::Racing(track) = &level.track else {
+            return None;
+        };
+        Some(racing::RacingEnv::new(
+            track,
+            level.goal,
+            racing::RacingRewards::default(),
+        ))
+    }
+
+    fn rule_level(seed: u64) -> Option<crate::level::Level> {
+        racing::rules::racing_level(seed, None, None, &Default::default()).ok()
+    }
+
+    fn scripted(seed: u64, skill: Skill) -> racing::ScriptedDriver {
+        racing::ScriptedDriver::with_skill(seed, racing::scripted::DriverSkill::of(skill))
+    }
+}

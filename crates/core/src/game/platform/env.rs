@@ -1,0 +1,370 @@
+//! The Solver's platform environment: reset with a level and a seed, step with an action, read
+//! the observation (state vector + height map), the reward (docs/spec.md §2) and how the run ended.
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rapier3d::math::Vector;
+
+use super::character::{Character, DECISION_DT, PlatformAction, RADIUS};
+use super::world::PlatformWorld;
+use crate::game::Step;
+use crate::level::PlatformTrack;
+use crate::level::platform::Platform;
+use crate::level::stats::Outcome;
+
+/// Rows and columns of the height map.
+pub const HEIGHT_MAP_SIDE: usize = 5;
+/// Ray offsets ahead of the character (its frame), m.
+const HEIGHT_MAP_FORWARD: [f32; HEIGHT_MAP_SIDE] = [-1.5, 0.0, 1.5, 3.0, 4.5];
+/// Ray offsets to the character's left, m.
+const HEIGHT_MAP_LEFT: [f32; HEIGHT_MAP_SIDE] = [-3.0, -1.5, 0.0, 1.5, 3.0];
+/// Rays start this far above the feet...
+const RAY_START_HEIGHT: f32 = 2.2;
+/// ...and see this far down.
+const RAY_LENGTH: f32 = 8.0;
+/// A run has fallen when its feet are this far below the lowest block.
+pub const FALL_MARGIN: f32 = 5.0;
+/// Time allowed for a level: this many seconds...
+const TIME_BASE_S: f32 = 10.0;
+/// ...plus this many per block.
+const TIME_PER_BLOCK_S: f32 = 4.0;
+
+/// The named parts of the observation vector, in order, with their lengths.
+pub const OBSERVATION_LAYOUT: [(&str, usize); 9] = [
+    ("goal_relative_position", 3),
+    ("goal_distance", 1),
+    ("next_block_relative_position", 3),
+    ("next_block_size", 1),
+    ("velocity", 3),
+    ("next_block_bearing_sin_cos", 2),
+    ("grounded", 1),
+    ("time_left", 1),
+    ("height_map", HEIGHT_MAP_SIDE * HEIGHT_MAP_SIDE),
+];
+
+/// Length of the state part (everything before the height map).
+const STATE_SIZE: usize = OBSERVATION_SIZE - HEIGHT_MAP_SIDE * HEIGHT_MAP_SIDE;
+
+/// Length of the observation vector.
+pub const OBSERVATION_SIZE: usize = {
+    let mut total = 0;
+    let mut i = 0;
+    while i < OBSERVATION_LAYOUT.len() {
+        total += OBSERVATION_LAYOUT[i].1;
+        i += 1;
+    }
+    total
+};
+
+/// The Solver's reward weights (docs/spec.md §2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlatformRewards {
+    /// Per metre of progress along the track toward the goal (negative when moving back).
+    pub progress_per_metre: f32,
+    /// On reaching the goal block.
+    pub success: f32,
+    /// On falling or running out of time.
+    pub failure: f32,
+}
+
+impl Default for PlatformRewards {
+    fn default() -> Self {
+        // A jump of a typical 7 m block pays about +7 and a fall costs 5, so attempting a jump
+        // pays once it succeeds about 40% of the time. (At 0.1 per metre the Solver learned to
+        // wait on the start block: a jump had to succeed 88% of the time to be worth a fall, and
+        // the time-out's penalty is discounted to nothing 1000 steps ahead.)
+        Self {
+            progress_per_metre: 1.0,
+            success: 10.0,
+            failure: -5.0,
+        }
+    }
+}
+
+/// One Solver run on one platform level.
+pub struct PlatformEnv {
+    world: PlatformWorld,
+    goal: Vector,
+    rewards: PlatformRewards,
+    /// Path length from each platform's top centre to the last one's, along the track.
+    path_after: Vec<f32>,
+    max_steps: u32,
+    /// The track is still growing (the Generator places blocks as the Solver advances): reaching
+    /// the last block is not yet success.
+    open: bool,
+    character: Character,
+    /// Highest platform index the character has stood on (0 is the start block).
+    furthest: usize,
+    steps: u32,
+    remaining: f32,
+    outcome: Option<Outcome>,
+}
+
+impl PlatformEnv {
+    /// The environment of a track leading to `goal`, with the character on the start block.
+    pub fn new(track: &PlatformTrack, goal: [f64; 3], rewards: PlatformRewards) -> Self {
+        let world = PlatformWorld::new(track);
+        let start = world.platforms()[0];
+        let mut env = Self {
+            world,
+            goal: Vector::new(goal[0] as f32, goal[1] as f32, goal[2] as f32),
+            rewards,
+            path_after: Vec::new(),
+            max_steps: 0,
+            open: false,
+            character: Character::new(start.top, start.heading),
+            furthest: 0,
+            steps: 0,
+            remaining: 0.0,
+            outcome: None,
+        };
+        env.measure_track();
+        env.reset(0);
+        env
+    }
+
+    /// The environment of a track the Generator is still building: it starts with `track`
+    /// (often just the start block) and grows with [`PlatformEnv::push_platform`].
+    pub fn open(track: &PlatformTrack, goal: [f64; 3], rewards: PlatformRewards) -> Self {
+        let mut env = Self::new(track, goal, rewards);
+        env.open = true;
+        env
+    }
+
+    /// Adds the Generator's next block. `closes`: it is the last one (it reaches the goal), so
+    /// standing on it is success. The run goes on where it was; its time limit grows.
+    pub fn push_platform(&mut self, platform: &Platform, closes: bool) {
+        self.world.push(platform);
+        self.open = !closes;
+        self.measure_track();
+        self.remaining = self.path_remaining();
+    }
+
+    /// Path lengths along the track and the time limit, from the platforms placed so far.
+    fn measure_track(&mut self) {
+        let tops: Vec<Vector> = self.world.platforms().iter().map(|p| p.top).collect();
+        self.path_after = vec![0.0; tops.len()];
+        for i in (0..tops.len() - 1).rev() {
+            self.path_after[i] = self.path_after[i + 1] + tops[i].distance(tops[i + 1]);
+        }
+        let blocks = (tops.len() - 1) as f32;
+        self.max_steps = ((TIME_BASE_S + TIME_PER_BLOCK_S * blocks) / DECISION_DT).ceil() as u32;
+    }
+
+    /// Whether the character stands on the newest block of a growing track: the Generator's
+    /// turn to place the next one.
+    pub fn awaits_platform(&self) -> bool {
+        self.open && self.outcome.is_none() && self.furthest == self.world.platforms().len() - 1
+    }
+
+    /// Starts a new run: the character stands on the start block, placed and turned at random
+    /// (seeded) within a metre of its centre and 90 degrees of the track's direction.
+    pub fn reset(&mut self, seed: u64) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let start = self.world.platforms()[0];
+        let reach = (0.5 * start.size - RADIUS - 0.5).clamp(0.0, 1.0);
+        let local = Vector::new(
+            rng.random_range(-reach..=reach),
+            0.0,
+            rng.random_range(-reach..=reach),
+        );
+        let offset = rapier3d::math::Rotation::from_rotation_y(start.heading) * local;
+        let yaw = start.heading + rng.random_range(-90.0f32..=90.0).to_radians();
+        self.character = Character::new(start.top + offset, yaw);
+        self.furthest = 0;
+        self.steps = 0;
+        self.outcome = None;
+        self.remaining = self.path_remaining();
+    }
+
+    /// Advances one decision.
+    pub fn step(&mut self, action: PlatformAction) -> Step {
+        if let Some(outcome) = self.outcome {
+            // A finished run stays finished.
+            return Step::finished(outcome, 0.0);
+        }
+        self.character.step(&self.world, action);
+        self.steps += 1;
+        if let Some(index) = self.standing_on() {
+            self.furthest = self.furthest.max(index);
+        }
+        let remaining = self.path_remaining();
+        let mut reward = self.rewards.progress_per_metre * (self.remaining - remaining);
+        self.remaining = remaining;
+        let last = self.world.platforms().len() - 1;
+        let outcome = if self.furthest == last && !self.open {
+            Some(Outcome::Success)
+        } else if self.character.feet.y < self.world.lowest_top() - FALL_MARGIN {
+            Some(Outcome::Fell)
+        } else if self.steps >= self.max_steps {
+            Some(Outcome::TimedOut)
+        } else {
+            None
+        };
+        match outcome {
+            Some(outcome) => {
+                reward += match outcome {
+                    Outcome::Success => self.rewards.success,
+                    Outcome::Fell | Outcome::TimedOut | Outcome::OffRoad | Outcome::Flipped => {
+                        self.rewards.failure
+                    }
+                };
+                self.outcome = Some(outcome);
+                Step::finished(outcome, reward)
+            }
+            None => Step {
+                reward,
+                terminated: false,
+                truncated: false,
+                outcome: None,
+            },
+        }
+    }
+
+    /// The platform the character stands on, if grounded on one.
+    fn standing_on(&self) -> Option<usize> {
+        if !self.character.grounded {
+            return None;
+        }
+        let feet = self.character.feet;
+        self.world
+            .platforms()
+            .iter()
+            .position(|p| (feet.y - p.top.y).abs() < 0.2 && p.covers(feet, RADIUS))
+    }
+
+    /// Index of the next platform to reach (the last one once the run has succeeded).
+    fn next_index(&self) -> usize {
+        (self.furthest + 1).min(self.world.platforms().len() - 1)
+    }
+
+    fn path_remaining(&self) -> f32 {
+        let last = self.world.platforms().len() - 1;
+        if self.furthest == last {
+            // Done, or waiting for the Generator's next block.
+            return 0.0;
+        }
+        let next = self.next_index();
+        self.character
+            .feet
+            .distance(self.world.platforms()[next].top)
+            + self.path_after[next]
+    }
+
+    /// Writes the observation (see [`OBSERVATION_LAYOUT`]) into `out`.
+    pub fn observe(&self, out: &mut [f32]) {
+        assert_eq!(
+            out.len(),
+            OBSERVATION_SIZE,
+            "observation buffer of the wrong size"
+        );
+        let c = &self.character;
+        let forward = c.facing();
+        let left = Vector::new(forward.z, 0.0, -forward.x);
+        let local = |v: Vector| [v.dot(forward), v.y, v.dot(left)];
+        let next = self.world.platforms()[self.next_index()];
+        let to_goal = self.goal - c.feet;
+        let to_next = next.top - c.feet;
+        let bearing = to_next.dot(left).atan2(to_next.dot(forward));
+        let state = local(to_goal)
+            .map(|x| x / 50.0)
+            .into_iter()
+            .chain([to_goal.length() / 50.0])
+            .chain(local(to_next).map(|x| x / 10.0))
+            .chain([next.size / 6.0])
+            .chain(local(c.velocity).map(|x| x / 10.0))
+            .chain([bearing.sin(), bearing.cos()])
+            .chain([if c.grounded { 1.0 } else { 0.0 }])
+            .chain([1.0 - self.steps as f32 / self.max_steps as f32]);
+        let (state_out, map) = out.split_at_mut(STATE_SIZE);
+        for (slot, value) in state_out.iter_mut().zip(state) {
+            *slot = value;
+        }
+        let origins = HEIGHT_MAP_FORWARD.iter().flat_map(|&f| {
+            HEIGHT_MAP_LEFT
+                .iter()
+                .map(move |&l| c.feet + forward * f + left * l + Vector::Y * RAY_START_HEIGHT)
+        });
+        self.world.cast_down(origins, RAY_LENGTH, map);
+        for depth in map.iter_mut() {
+            *depth = (RAY_START_HEIGHT - *depth) / 4.0;
+        }
+    }
+
+    /// The observation as a new vector.
+    pub fn observation(&self) -> Vec<f32> {
+        let mut out = vec![0.0; OBSERVATION_SIZE];
+        self.observe(&mut out);
+        out
+    }
+
+    pub fn character(&self) -> &Character {
+        &self.character
+    }
+
+    pub fn world(&self) -> &PlatformWorld {
+        &self.world
+    }
+
+    /// Highest platform index stood on so far (0 is the start block).
+    pub fn furthest(&self) -> usize {
+        self.furthest
+    }
+
+    /// Fraction of the blocks reached, in [0, 1].
+    pub fn progress(&self) -> f64 {
+        self.furthest as f64 / (self.world.platforms().len() - 1).max(1) as f64
+    }
+
+    pub fn steps(&self) -> u32 {
+        self.steps
+    }
+
+    pub fn outcome(&self) -> Option<Outcome> {
+        self.outcome
+    }
+}
+
+impl crate::game::SolverEnv for PlatformEnv {
+    type Action = PlatformAction;
+    const OBSERVATION_SIZE: usize = OBSERVATION_SIZE;
+
+    fn reset(&mut self, seed: u64) {
+        PlatformEnv::reset(self, seed);
+    }
+
+    fn step(&mut self, action: PlatformAction) -> Step {
+        PlatformEnv::step(self, action)
+    }
+
+    fn observe(&self, out: &mut [f32]) {
+        PlatformEnv::observe(self, out);
+    }
+
+    fn action_from_policy_row(row: &[f32]) -> PlatformAction {
+        PlatformAction::from_policy_row(row)
+    }
+
+    fn random_action(rng: &mut ChaCha8Rng) -> PlatformAction {
+        PlatformAction {
+            forward: rng.random_range(-1.0..=1.0),
+            turn: rng.random_range(-1.0..=1.0),
+            jump: rng.random_bool(0.5),
+        }
+    }
+
+    fn trial_result(&self, outcome: Outcome) -> crate::level::stats::TrialResult {
+        crate::level::stats::TrialResult {
+            outcome,
+            progress: self.progress(),
+            target_piece: self.furthest(),
+            steps: self.steps(),
+            air_steps: None,
+        }
+    }
+
+    fn marker(&self) -> [f32; 3] {
+        let f = self.character().feet;
+        [f.x, f.y, f.z]
+    }
+}

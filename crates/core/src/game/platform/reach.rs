@@ -1,0 +1,121 @@
+//! How far the character can jump: the reach table (largest makeable edge gap per height change),
+//! measured with the scripted controller in the real simulation on chained jumps (the second of
+//! two equal jumps, turned), and the function that measures it. `docs/platform-physics.md`
+//! prints the table; a test re-measures it.
+
+use super::env::{PlatformEnv, PlatformRewards};
+use super::scripted::ScriptedController;
+use crate::level::platform::{BlockParams, PlatformTrack, Start};
+use crate::level::stats::{Outcome, TrialResult};
+
+/// The height changes the table lists, m.
+pub const REACH_HEIGHTS: [f64; 5] = [-2.0, -1.0, 0.0, 1.0, 2.0];
+/// The turns, degrees, of the second jump of a [`chained_jump`] that the table must clear.
+pub const REACH_TURNS: [f64; 5] = [-90.0, -45.0, 0.0, 45.0, 90.0];
+/// The sharpest turn, degrees off the direction of the last jump, that stays within reach: after
+/// a fast landing a sharper one means stopping and turning back on the block, and the scripted
+/// controller fails it even across short gaps (`docs/platform-physics.md`, "Chained jumps").
+pub const MAX_TURN: f64 = 90.0;
+/// Largest edge gap, m, that the scripted controller (take-off jitter `REACH_JITTER`) clears in
+/// every one of `REACH_TRIALS` seeded runs of a [`chained_jump`] at every turn of `REACH_TURNS`,
+/// for each height change of `REACH_HEIGHTS`, measured in steps of `REACH_STEP` from 1 m up to
+/// the largest gap the parameter ranges allow (6 m). A jump right after a landing is harder
+/// than one from standstill on the start block, so this is the reach anywhere in a level.
+pub const REACH_TABLE: [f64; 5] = [6.0, 6.0, 6.0, 6.0, 4.25];
+/// Resolution of the table, m.
+pub const REACH_STEP: f64 = 0.25;
+/// Seeded runs per table entry.
+pub const REACH_TRIALS: u64 = 8;
+/// Take-off jitter of the scripted controller when measuring, m.
+pub const REACH_JITTER: f32 = 0.3;
+/// The gaps the table scans: the ranges allow edge gaps up to 6 m (10 m between 4 m blocks).
+const GAP_RANGE: (f64, f64) = (1.0, 6.0);
+
+/// The largest makeable gap at a height change, interpolated from the table.
+pub fn max_gap(height: f64) -> f64 {
+    let h = height.clamp(REACH_HEIGHTS[0], REACH_HEIGHTS[4]);
+    let i = REACH_HEIGHTS
+        .iter()
+        .rposition(|&x| x <= h)
+        .unwrap_or(0)
+        .min(3);
+    let t = (h - REACH_HEIGHTS[i]) / (REACH_HEIGHTS[i + 1] - REACH_HEIGHTS[i]);
+    REACH_TABLE[i] + t * (REACH_TABLE[i + 1] - REACH_TABLE[i])
+}
+
+/// A level of one jump: a 4 m start block, then a 4 m block `gap` metres away and `height`
+/// metres up.
+pub fn single_jump(gap: f64, height: f64) -> PlatformTrack {
+    let start = Start {
+        size: 4.0,
+        ..Start::default()
+    };
+    let block = BlockParams::new(gap + 4.0, 0.0, 4.0, height)
+        .expect("gap within [1, 6] m and height within [-2, 2] m");
+    PlatformTrack::from_params(start, &[block]).expect("one block never overlaps")
+}
+
+/// A level of two equal jumps: a 4 m start block, a 4 m block `gap` metres away and `height`
+/// metres up, then another the same gap and height further on, `turn` degrees off the first
+/// jump's direction. The second jump is the one the reach table measures.
+pub fn chained_jump(gap: f64, height: f64, turn: f64) -> PlatformTrack {
+    let start = Start {
+        size: 4.0,
+        ..Start::default()
+    };
+    let first = BlockParams::new(gap + 4.0, 0.0, 4.0, height)
+        .expect("gap within [1, 6] m and height within [-2, 2] m");
+    let second = BlockParams::new(gap + 4.0, turn, 4.0, height)
+        .expect("gap within [1, 6] m, height within [-2, 2] m, turn within [-90, 90] degrees");
+    PlatformTrack::from_params(start, &[first, second])
+        .expect("two 4 m blocks at least 5 m apart, turned at most 90 degrees, never overlap")
+}
+
+/// Plays one run of `env` with the scripted controller, seeded by `seed`.
+pub fn play_scripted(env: &mut PlatformEnv, seed: u64, jitter: f32) -> TrialResult {
+    env.reset(seed);
+    let mut controller = ScriptedController::new(seed, jitter);
+    loop {
+        let step = env.step(controller.act(env));
+        if let Some(outcome) = step.outcome {
+            return TrialResult {
+                outcome,
+                progress: env.progress(),
+                target_piece: env.furthest(),
+                steps: env.steps(),
+                air_steps: None,
+            };
+        }
+    }
+}
+
+/// How many of `trials` seeded scripted runs reach the last block of `track`.
+pub fn successes(track: &PlatformTrack, trials: u64, jitter: f32) -> u64 {
+    let goal = track.last().position;
+    let mut env = PlatformEnv::new(track, goal, PlatformRewards::default());
+    (0..trials)
+        .filter(|&seed| play_scripted(&mut env, seed, jitter).outcome == Outcome::Success)
+        .count() as u64
+}
+
+/// Measures the reach table: for each height change, the largest gap such that every chained
+/// jump up to it (in `REACH_STEP` steps from 1 m, at every turn of `REACH_TURNS`) is cleared in
+/// all `REACH_TRIALS` runs.
+pub fn measure_reach() -> [f64; 5] {
+    REACH_HEIGHTS.map(|height| {
+        let steps = ((GAP_RANGE.1 - GAP_RANGE.0) / REACH_STEP).round() as usize;
+        let mut best = GAP_RANGE.0 - REACH_STEP;
+        for k in 0..=steps {
+            let gap = GAP_RANGE.0 + k as f64 * REACH_STEP;
+            let cleared = REACH_TURNS.iter().all(|&turn| {
+                successes(&chained_jump(gap, height, turn), REACH_TRIALS, REACH_JITTER)
+                    == REACH_TRIALS
+            });
+            if !cleared {
+                break;
+            }
+            best = gap;
+        }
+        best
+    })
+}

@@ -1,0 +1,219 @@
+//! Rule-based level generation: the paper's Rule-PCG baseline, and a level source that needs no
+//! trained policy. Parameters are drawn at random within the range of docs/spec.md §1.1s, under rules that keep
+//! the level valid and playable: head (loosely) for the goal, never overlap an earlier block,
+//! keep every jump within the character's reach, end on a block that reaches the goal.
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use crate::game::platform::reach;
+use crate::level::heading;
+use crate::level::params::{self, quantize};
+use crate::level::platform::{self, BlockParams, Platform, PlatformTrack, Start};
+use crate::level::{Level, PlatformRulesConfig, Source, Track};
+
+/// Goals are drawn this far from the start, horizontally, m...
+pub const GOAL_DISTANCE: (f64, f64) = (30.0, 70.0);
+/// ...and this far above (or below) it, m.
+pub const GOAL_HEIGHT: (f64, f64) = (-6.0, 10.0);
+/// Candidate blocks drawn for each placement before the attempt is abandoned.
+const CANDIDATES: usize = 40;
+/// Whole-level attempts before giving up (never reached in practice: levels are found within a
+/// few attempts).
+const ATTEMPTS: usize = 1000;
+
+/// A goal drawn at random around the origin: any direction, `GOAL_DISTANCE` away, `GOAL_HEIGHT` up.
+pub fn random_goal(rng: &mut ChaCha8Rng) -> [f64; 3] {
+    let heading = rng.random_range(-180.0..180.0);
+    let distance = rng.random_range(GOAL_DISTANCE.0..=GOAL_DISTANCE.1);
+    let height = rng.random_range(GOAL_HEIGHT.0..=GOAL_HEIGHT.1);
+    let [x, z] = heading::heading_direction(heading);
+    [
+        quantize(distance * x),
+        quantize(height),
+        quantize(distance * z),
+    ]
+}
+
+/// The goal (drawn unless given) and start block of level `seed`, and the seeded stream the
+/// level's other draws continue from. Every level source draws them this way, so levels of the
+/// same seed lead to the same goal whoever builds them.
+pub fn goal_and_start(seed: u64, goal: Option<[f64; 3]>) -> ([f64; 3], Start, ChaCha8Rng) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let drawn = random_goal(&mut rng);
+    let start = Start {
+        heading: quantize(rng.random_range(-180.0..180.0)),
+        ..Start::default()
+    };
+    (goal.unwrap_or(drawn), start, rng)
+}
+
+/// Why the rules could not build a level.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "the rules found no valid level toward goal {goal:?} in {ATTEMPTS} attempts of at most {max_blocks} blocks"
+)]
+pub struct NoLevel {
+    pub goal: [f64; 3],
+    pub max_blocks: u32,
+}
+
+/// A rule-based platform level, reproducible from `seed`: the goal and start heading are drawn
+/// from it, unless `goal` is given. `aux` is recorded in the level; the rules do not use it.
+pub fn platform_level(
+    seed: u64,
+    aux: Option<f64>,
+    goal: Option<[f64; 3]>,
+    config: &PlatformRulesConfig,
+) -> Result<Level, NoLevel> {
+    platform_level_draw(seed, aux, goal, config, 0)
+}
+
+/// Draw number `draw` of level `seed`: the `draw`-th valid level (from 0) of the seed's stream,
+/// toward the same goal. Draw 0 is [`platform_level`].
+pub fn platform_level_draw(
+    seed: u64,
+    aux: Option<f64>,
+    goal: Option<[f64; 3]>,
+    config: &PlatformRulesConfig,
+    draw: u32,
+) -> Result<Level, NoLevel> {
+    let (goal, start, mut rng) = goal_and_start(seed, goal);
+    let mut skip = draw;
+    for _ in 0..ATTEMPTS {
+        if let Some(track) = attempt(&mut rng, start, goal, config) {
+            if skip > 0 {
+                skip -= 1;
+                continue;
+            }
+            return Ok(Level {
+                seed: Some(seed),
+                aux,
+                goal,
+                track: Track::Platform(track),
+                source: Source::Rules { rules: *config },
+                stats: None,
+                pacing: None,
+            });
+        }
+    }
+    Err(NoLevel {
+        goal,
+        max_blocks: config.max_blocks,
+    })
+}
+
+/// One try at a whole track; `None` when it gets stuck or runs out of blocks.
+fn attempt(
+    rng: &mut ChaCha8Rng,
+    start: Start,
+    goal: [f64; 3],
+    config: &PlatformRulesConfig,
+) -> Option<PlatformTrack> {
+    let mut track = PlatformTrack::new(start);
+    while track.block_count() < config.max_blocks as usize {
+        let placed = (0..CANDIDATES).any(|_| {
+            let candidate = draw(rng, track.last(), goal, config);
+            is_jumpable(track.last(), &track.preview(&candidate), config)
+                && track.push(candidate).is_ok()
+        });
+        if !placed {
+            return None;
+        }
+        if track.last().reaches(goal) {
+            return Some(track);
+        }
+    }
+    None
+}
+
+/// Whether the jump from `from` to `to` is within the character's reach, less the margin.
+fn is_jumpable(from: &Platform, to: &Platform, config: &PlatformRulesConfig) -> bool {
+    let rise = to.position[1] - from.position[1];
+    from.edge_gap(to) <= reach::max_gap(rise) - config.reach_margin
+}
+
+/// Draws one block's parameters: aimed at the goal when it is within one block's distance,
+/// otherwise heading for it within the configured spread, climbing toward its height.
+fn draw(
+    rng: &mut ChaCha8Rng,
+    last: &Platform,
+    goal: [f64; 3],
+    config: &PlatformRulesConfig,
+) -> BlockParams {
+    let (dx, dz) = (goal[0] - last.position[0], goal[2] - last.position[2]);
+    let horizontal = dx.hypot(dz);
+    let rise = goal[1] - last.position[1];
+    let to_goal = heading::direction_heading(dx, dz);
+    let size = rng.random_range(params::BLOCK_SIZE.min..=params::BLOCK_SIZE.max);
+    let finish = params::BLOCK_DISTANCE.check(horizontal).is_ok()
+        && rise.abs() <= params::BLOCK_HEIGHT.max + platform::GOAL_REACH_VERTICAL;
+    let (distance, heading, height) = if finish && rng.random_bool(0.8) {
+        let height = rise.clamp(params::BLOCK_HEIGHT.min, params::BLOCK_HEIGHT.max);
+        (horizontal, to_goal, height)
+    } else {
+        let spread = config.angle_spread.clamp(0.0, 180.0);
+        let heading = to_goal + rng.random_range(-spread..=spread);
+        let blocks_left = (horizontal / 7.5).max(1.0);
+        let climb = (rise / blocks_left + rng.random_range(-1.0..=1.0))
+            .clamp(params::BLOCK_HEIGHT.min, params::BLOCK_HEIGHT.max);
+        let longest = (reach::max_gap(climb) - config.reach_margin + 0.5 * (last.size + size))
+            .clamp(params::BLOCK_DISTANCE.min, params::BLOCK_DISTANCE.max);
+        let distance = rng.random_range(params::BLOCK_DISTANCE.min..=longest);
+        (distance, heading, climb)
+    };
+    let angle = heading::wrap_degrees(heading - last.heading);
+    BlockParams {
+        distance: quantize(distance).clamp(params::BLOCK_DISTANCE.min, params::BLOCK_DISTANCE.max),
+        angle: quantize(angle).clamp(params::BLOCK_ANGLE.min, params::BLOCK_ANGLE.max),
+        size: quantize(size),
+        height: quantize(height),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rule_levels_are_valid_reproducible_and_reach_their_goal() {
+        let config = PlatformRulesConfig::default();
+        for seed in 0..30 {
+            let level = platform_level(seed, None, None, &config).unwrap();
+            level.validate().unwrap();
+            let again = platform_level(seed, None, None, &config).unwrap();
+            assert_eq!(level, again, "seed {seed} is not reproducible");
+            let track = level.platform().unwrap();
+            for pair in track.platforms().windows(2) {
+                assert!(
+                    is_jumpable(&pair[0], &pair[1], &config),
+                    "seed {seed}: a jump out of reach"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn every_parameter_stays_in_its_range() {
+        for seed in 0..30 {
+            let level =
+                platform_level(seed, Some(0.5), None, &PlatformRulesConfig::default()).unwrap();
+            for b in level.platform().unwrap().block_params() {
+                BlockParams::new(b.distance, b.angle, b.size, b.height).unwrap();
+            }
+        }
+    }
+
+    #[test]
+    fn a_goal_high_above_the_start_gets_a_climbing_track() {
+        let level = platform_level(
+            3,
+            None,
+            Some([5.0, 10.0, 0.0]),
+            &PlatformRulesConfig::default(),
+        )
+        .unwrap();
+        let last = level.platform().unwrap().last();
+        assert!(last.position[1] >= 8.0, "{last:?}");
+    }
+}

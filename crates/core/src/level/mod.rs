@@ -1,0 +1,375 @@
+//! Levels as pure data: what a Generator (or the rules, or a designer's hand) built, where it came
+//! from, and what the Solver measured on it. Files in and out live in [`yaml`] and [`gltf`];
+//! nothing here touches the disk.
+
+pub mod gltf;
+pub mod heading;
+pub mod pacing;
+pub mod params;
+pub mod platform;
+pub mod racing;
+pub mod road;
+pub mod scene;
+pub mod stats;
+pub mod yaml;
+pub mod yaml_limits;
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+pub use platform::{BlockParams, Platform, PlatformTrack, Start};
+pub use racing::{Obstacle, RacingTrack, SegmentParams};
+pub use stats::{SolverRef, SolverStats};
+
+/// The two games of the paper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Game {
+    /// Jump across blocks to the goal block.
+    Platform,
+    /// Drive a banked road to the goal.
+    Racing,
+}
+
+impl Game {
+    pub fn name(self) -> &'static str {
+        match self {
+            Game::Platform => "platform",
+            Game::Racing => "racing",
+        }
+    }
+}
+
+impl std::str::FromStr for Game {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "platform" => Ok(Game::Platform),
+            "racing" => Ok(Game::Racing),
+            other => Err(format!(
+                "unknown game `{other}`: expected platform or racing"
+            )),
+        }
+    }
+}
+
+impl fmt::Display for Game {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The pieces of a level, one kind per game.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Track {
+    Platform(PlatformTrack),
+    Racing(RacingTrack),
+}
+
+/// A file a level depends on (a trained policy, or the level a prefix was kept from), pinned by
+/// the hash of its contents.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PolicyRef {
+    pub path: String,
+    pub sha256: String,
+}
+
+impl PolicyRef {
+    /// The file at `path` whose contents are `bytes`.
+    pub fn pinned(path: String, bytes: &[u8]) -> Self {
+        Self {
+            path,
+            sha256: sha256_hex(bytes),
+        }
+    }
+}
+
+/// The SHA-256 of `bytes`, as lowercase hex.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    sha2::Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// The settings of the rule-based generator (the paper's Rule-PCG baseline).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlatformRulesConfig {
+    /// Give up on a level (and draw another) after this many blocks without reaching the goal.
+    pub max_blocks: u32,
+    /// Each block's heading is drawn within this many degrees either side of the goal direction.
+    pub angle_spread: f64,
+    /// Jumps are kept this many metres shorter than the character's longest jump at that height.
+    pub reach_margin: f64,
+}
+
+impl PlatformRulesConfig {
+    /// Checks each setting's range (NaN fails): `Err("field: what it must be")`.
+    pub fn check(&self) -> Result<(), String> {
+        if !(1..=platform::MAX_BLOCKS as u32).contains(&self.max_blocks) {
+            return Err(format!(
+                "max_blocks {} must be within [1, {}]",
+                self.max_blocks,
+                platform::MAX_BLOCKS
+            ));
+        }
+        if !(0.0..=180.0).contains(&self.angle_spread) {
+            return Err(format!(
+                "angle_spread {} must be a number of degrees within [0, 180]",
+                params::show_number(self.angle_spread)
+            ));
+        }
+        if !(0.0..=MAX_REACH_MARGIN).contains(&self.reach_margin) {
+            return Err(format!(
+                "reach_margin {} must be a number of metres within [0, {MAX_REACH_MARGIN}]",
+                params::show_number(self.reach_margin)
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The largest `reach_margin` (metres): beyond it few jumps remain possible.
+pub const MAX_REACH_MARGIN: f64 = 3.0;
+
+impl Default for PlatformRulesConfig {
+    fn default() -> Self {
+        Self {
+            max_blocks: 40,
+            angle_spread: 60.0,
+            reach_margin: 0.5,
+        }
+    }
+}
+
+/// Where a level came from.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum Source {
+    /// Written by hand (the default for files that say nothing).
+    #[default]
+    Hand,
+    /// Drawn by the rule-based platform generator.
+    Rules { rules: PlatformRulesConfig },
+    /// Drawn by the rule-based racing generator.
+    #[serde(rename = "racing-rules")]
+    RacingRules { rules: racing::RacingRulesConfig },
+    /// Built by a trained Generator policy.
+    Policy { generator: PolicyRef },
+    /// The first `pieces` pieces kept from the level file `from`, the rest built by a trained
+    /// Generator (`generate --keep`); `aux` or `aux_curve` is the λ of the rest.
+    Kept {
+        pieces: u32,
+        from: PolicyRef,
+        generator: PolicyRef,
+    },
+}
+
+impl Source {
+    /// How many pieces were kept from another level (0 unless [`Source::Kept`]).
+    pub fn kept_pieces(&self) -> usize {
+        match self {
+            Source::Kept { pieces, .. } => *pieces as usize,
+            _ => 0,
+        }
+    }
+}
+
+/// A level of either game.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Level {
+    /// The seed it was generated from (none for hand-made levels).
+    pub seed: Option<u64>,
+    /// The aux input λ it was generated with (+1 easy, -1 hard).
+    pub aux: Option<f64>,
+    /// The point the track leads to.
+    pub goal: [f64; 3],
+    pub track: Track,
+    pub source: Source,
+    /// What the Solver measured on it, when it has been verified.
+    pub stats: Option<SolverStats>,
+    /// λ along the level, when it was built with an aux curve (then `aux` is none).
+    pub pacing: Option<pacing::Pacing>,
+}
+
+/// Straight-line distance between two points, m.
+pub fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+}
+
+/// A level that breaks a rule of its game.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum InvalidLevel {
+    #[error("the level has no {0}: it needs at least one")]
+    NoPieces(&'static str),
+    #[error(
+        "the last block (at {at:?}) does not reach the goal {goal:?}: it must be within {h} m horizontally and {v} m vertically",
+        h = platform::GOAL_REACH_HORIZONTAL,
+        v = platform::GOAL_REACH_VERTICAL
+    )]
+    GoalNotReached { at: [f64; 3], goal: [f64; 3] },
+    #[error(
+        "the road ends at {at:?}, which does not reach the goal {goal:?}: it must end within {h} m horizontally and {v} m vertically",
+        h = racing::GOAL_REACH_HORIZONTAL,
+        v = racing::GOAL_REACH_VERTICAL
+    )]
+    RoadShort { at: [f64; 3], goal: [f64; 3] },
+    #[error("{0}")]
+    Road(#[from] road::TrackError),
+    #[error("the level has {count} {what}: at most {max} are allowed")]
+    TooMany {
+        what: &'static str,
+        count: usize,
+        max: usize,
+    },
+    #[error("obstacles[{index}].{problem}")]
+    Obstacle { index: usize, problem: String },
+    #[error("{0}")]
+    Stats(String),
+    #[error("{0}")]
+    Source(String),
+    #[error("{0}")]
+    Pacing(String),
+}
+
+impl Level {
+    pub fn game(&self) -> Game {
+        match self.track {
+            Track::Platform(_) => Game::Platform,
+            Track::Racing(_) => Game::Racing,
+        }
+    }
+
+    /// The platform track, if this is a platform level.
+    pub fn platform(&self) -> Option<&PlatformTrack> {
+        match &self.track {
+            Track::Platform(track) => Some(track),
+            Track::Racing(_) => None,
+        }
+    }
+
+    pub fn racing(&self) -> Option<&racing::RacingTrack> {
+        match &self.track {
+            Track::Racing(track) => Some(track),
+            Track::Platform(_) => None,
+        }
+    }
+
+    /// How many pieces (blocks or segments) the level has.
+    pub fn piece_count(&self) -> usize {
+        match &self.track {
+            Track::Platform(track) => track.block_count(),
+            Track::Racing(track) => track.segments.len(),
+        }
+    }
+
+    /// Where each piece begins, as the fraction of the start-to-goal distance covered there
+    /// (straight-line distances to the goal, 0 at the start): where an aux curve is read.
+    pub fn piece_start_fractions(&self) -> Vec<f64> {
+        let starts: Vec<[f64; 3]> = match &self.track {
+            Track::Platform(track) => track.platforms()[..track.block_count()]
+                .iter()
+                .map(|p| p.position)
+                .collect(),
+            Track::Racing(track) => {
+                let road = track.road();
+                (0..track.segments.len())
+                    .map(|i| match i {
+                        0 => track.position,
+                        i => road.samples()[road.nearest_along(road.segment_start(i))].centre,
+                    })
+                    .collect()
+            }
+        };
+        let whole = starts.first().map_or(0.0, |&s| distance(s, self.goal));
+        starts
+            .iter()
+            .map(|&s| pacing::covered(whole, distance(s, self.goal)))
+            .collect()
+    }
+
+    /// Checks the rules that span the whole level (ranges and overlaps are checked as pieces are
+    /// built): the track reaches its goal and the statistics fit the track.
+    pub fn validate(&self) -> Result<(), InvalidLevel> {
+        match &self.track {
+            Track::Platform(track) => {
+                if track.block_count() == 0 {
+                    return Err(InvalidLevel::NoPieces("blocks"));
+                }
+                let last = track.last();
+                if !last.reaches(self.goal) {
+                    return Err(InvalidLevel::GoalNotReached {
+                        at: last.position,
+                        goal: self.goal,
+                    });
+                }
+            }
+            Track::Racing(track) => {
+                if track.segments.is_empty() {
+                    return Err(InvalidLevel::NoPieces("segments"));
+                }
+                let too_many = |what, count, max| {
+                    (count > max).then_some(InvalidLevel::TooMany { what, count, max })
+                };
+                if let Some(e) = too_many("segments", track.segments.len(), racing::MAX_SEGMENTS)
+                    .or_else(|| too_many("obstacles", track.obstacles.len(), racing::MAX_OBSTACLES))
+                {
+                    return Err(e);
+                }
+                for (index, obstacle) in track.obstacles.iter().enumerate() {
+                    obstacle
+                        .check()
+                        .map_err(|problem| InvalidLevel::Obstacle { index, problem })?;
+                }
+                track.check_geometry()?;
+                let (end, _) = track.road().end();
+                if !racing::reaches(end, self.goal) {
+                    return Err(InvalidLevel::RoadShort {
+                        at: end.map(params::quantize),
+                        goal: self.goal,
+                    });
+                }
+            }
+        }
+        match (&self.source, self.game()) {
+            (Source::Rules { rules }, Game::Platform) => rules.check(),
+            (Source::RacingRules { rules }, Game::Racing) => rules.check(),
+            (Source::Rules { .. }, Game::Racing) => {
+                Err("kind `rules` is for platform levels; racing levels use `racing-rules`".into())
+            }
+            (Source::RacingRules { .. }, Game::Platform) => {
+                Err("kind `racing-rules` is for racing levels; platform levels use `rules`".into())
+            }
+            (Source::Kept { pieces, .. }, _) if *pieces as usize > self.piece_count() => {
+                return Err(InvalidLevel::Source(format!(
+                    "pieces: {pieces} kept, but the level has {} pieces",
+                    self.piece_count()
+                )));
+            }
+            _ => Ok(()),
+        }
+        .map_err(|problem| InvalidLevel::Source(format!("rules.{problem}")))?;
+        if let Some(stats) = &self.stats {
+            stats
+                .check(self.piece_count())
+                .map_err(InvalidLevel::Stats)?;
+        }
+        if let Some(pacing) = &self.pacing {
+            if self.aux.is_some() {
+                return Err(InvalidLevel::Pacing(
+                    "a level has one λ (`aux`) or a curve (`aux_curve`), not both".into(),
+                ));
+            }
+            pacing
+                .check(self.piece_count(), self.source.kept_pieces())
+                .map_err(InvalidLevel::Pacing)?;
+        }
+        Ok(())
+    }
+}

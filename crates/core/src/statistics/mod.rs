@@ -1,0 +1,6 @@
+//! Statistics that do not belong to one level: estimates over training seeds with their
+//! intervals ([`over_seeds`]), and the difficulty rating of levels by a panel of judges
+//! ([`rating`]).
+
+pub mod over_seeds;
+pub mod rating;

@@ -1,0 +1,291 @@
+//! Difficulty a designer can trust: a Generator's λ → success curve with a given Solver, and
+//! the search that turns a wanted success rate into a level (`generate --target-success P`).
+//!
+//! One level's success at a λ varies a lot from seed to seed (the curve is an average), so the
+//! search starts at the λ the curve gives for `P` and then moves λ by how far each verified
+//! candidate missed, drawing a new level of the same seed and goal each time, until one
+//! measures within [`BAND`] of `P`. A seed's scene can rule a band out (seed 1's goal: no level
+//! of the shipped platform policies under 0.31), so after [`OWN_SCENE_CANDIDATES`] misses,
+//! unless the goal was given, each candidate is built from another seed's scene (the level
+//! records that seed). Each candidate plays [`SCREEN_TRIALS`] runs first and the rest only if
+//! their 95% interval still meets the band: a kept level's statistics are those of all its
+//! runs, the same as one verification of them all.
+
+use serde::{Deserialize, Serialize};
+
+use crate::services::generation::{self, GenerationError, GeneratorPolicy, LevelRequest};
+use crate::services::verify::{Solver, Watch, WrongGame, stats_of, trial_results, verify};
+use arlpcg_core::level::Level;
+use arlpcg_core::level::stats::{Outcome, wilson_interval};
+
+/// A kept level measures within this of the wanted success ratio.
+pub const BAND: f64 = 0.1;
+/// Candidates tried per level before giving up.
+pub const MAX_CANDIDATES: u32 = 48;
+/// Candidates from the seed's own scene before the search tries other seeds' scenes.
+pub const OWN_SCENE_CANDIDATES: u32 = 24;
+/// Runs a candidate plays before the search decides whether to play the rest.
+pub const SCREEN_TRIALS: u32 = 20;
+/// The λ values the curve is measured at, easy to hard.
+pub const CURVE_AUX: [f64; 9] = [1.0, 0.75, 0.5, 0.25, 0.0, -0.25, -0.5, -0.75, -1.0];
+/// Levels per λ and runs per level when measuring the curve.
+pub const CURVE_LEVELS: u32 = 8;
+pub const CURVE_TRIALS: u32 = 20;
+
+/// Mean success ratio of a Solver on a Generator's levels at each λ of [`CURVE_AUX`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Curve {
+    /// SHA-256 of the Generator and of the Solver it was measured with (for the scripted
+    /// player, its judge name: `scripted-median`).
+    pub generator_sha256: String,
+    pub solver_sha256: String,
+    /// (λ, mean success ratio), easy to hard.
+    pub points: Vec<(f64, f64)>,
+}
+
+impl Curve {
+    /// Checks a curve read back from a file: at least one point, their λ among [`CURVE_AUX`]
+    /// in its order (a λ where no level was built has none), each success a number within
+    /// [0, 1]. `Err("points[i]: ...")`.
+    pub fn check(&self) -> Result<(), String> {
+        if self.points.is_empty() {
+            return Err("points: none; a curve has a point per λ it was measured at".into());
+        }
+        let mut allowed = CURVE_AUX.iter();
+        for (i, &(aux, success)) in self.points.iter().enumerate() {
+            if !allowed.any(|&a| a == aux) {
+                return Err(format!(
+                    "points[{i}]: λ {} is not the next of {CURVE_AUX:?}",
+                    arlpcg_core::level::params::show_number(aux)
+                ));
+            }
+            if !(0.0..=1.0).contains(&success) {
+                return Err(format!(
+                    "points[{i}]: success {} must be a number within [0, 1]",
+                    arlpcg_core::level::params::show_number(success)
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Why no level was found.
+#[derive(Debug, thiserror::Error)]
+pub enum TargetError {
+    #[error(
+        "no level within ±{BAND} of success {target} in {MAX_CANDIDATES} candidates (closest: {closest:.2} at λ {aux:+.2})"
+    )]
+    Missed { target: f64, closest: f64, aux: f64 },
+    #[error("stopped while the λ→success curve was measured")]
+    Stopped,
+    #[error(transparent)]
+    Generation(#[from] GenerationError),
+    #[error(transparent)]
+    WrongGame(#[from] WrongGame),
+}
+
+/// Measures the curve: [`CURVE_LEVELS`] levels at each λ, [`CURVE_TRIALS`] runs each;
+/// `stopped` is asked before each level (a Ctrl-C ends the measurement with
+/// [`TargetError::Stopped`]).
+pub fn measure(
+    generator: &GeneratorPolicy,
+    solver: &Solver,
+    solver_sha256: &str,
+    stopped: &dyn Fn() -> bool,
+) -> Result<Curve, TargetError> {
+    let mut points = Vec::with_capacity(CURVE_AUX.len());
+    for aux in CURVE_AUX {
+        let mut total = 0.0;
+        let mut count = 0;
+        for k in 0..CURVE_LEVELS as u64 {
+            if stopped() {
+                return Err(TargetError::Stopped);
+            }
+            let seed = arlpcg_core::seed_ranges::CURVE_SEED_BASE + k;
+            let obstacles = arlpcg_core::game::facts::facts(generator.game).scene_obstacles;
+            let request = LevelRequest::new(seed, Some(aux)).obstacles(obstacles);
+            match generation::generator_level(generator, &request) {
+                Ok(level) => {
+                    total += verify(&level, solver, CURVE_TRIALS, seed, &|| {})?.success_ratio;
+                    count += 1;
+                }
+                Err(GenerationError::NoLevel { .. }) => {}
+                Err(e) => return Err(e.into()),
+            }
+        }
+        if count > 0 {
+            points.push((aux, (total / count as f64 * 1e4).round() / 1e4));
+        }
+    }
+    Ok(Curve {
+        generator_sha256: generator.reference.sha256.clone(),
+        solver_sha256: solver_sha256.to_string(),
+        points,
+    })
+}
+
+impl Curve {
+    /// The λ at which the curve passes `target` (linear between its points; the end λ when the
+    /// target is beyond what the curve spans). Where the curve is not monotone, the easiest
+    /// crossing wins.
+    pub fn aux_for(&self, target: f64) -> f64 {
+        let p = &self.points;
+        match p.len() {
+            0 => 0.0,
+            1 => p[0].0,
+            _ => {
+                for pair in p.windows(2) {
+                    let [(a0, s0), (a1, s1)] = [pair[0], pair[1]];
+                    let (lo, hi) = (s0.min(s1), s0.max(s1));
+                    if (lo..=hi).contains(&target) && hi > lo {
+                        return a0 + (target - s0) / (s1 - s0) * (a1 - a0);
+                    }
+                }
+                // Beyond the curve: the nearer end.
+                let first = p[0];
+                let last = p[p.len() - 1];
+                if (target - first.1).abs() <= (target - last.1).abs() {
+                    first.0
+                } else {
+                    last.0
+                }
+            }
+        }
+    }
+}
+
+/// A level of `seed` whose success, verified with `trials` runs, is within [`BAND`] of
+/// `target`: the search starts at the curve's λ and moves λ against each miss, each candidate
+/// a new draw of the seed, or of another seed after [`OWN_SCENE_CANDIDATES`] (unless `goal`
+/// is given). A candidate that no run completed is never kept.
+pub fn level_for(
+    generator: &GeneratorPolicy,
+    solver: &Solver,
+    curve: &Curve,
+    seed: u64,
+    goal: Option<[f64; 3]>,
+    target: f64,
+    trials: u32,
+) -> Result<Level, TargetError> {
+    let mut aux = curve.aux_for(target);
+    let mut closest = (f64::INFINITY, f64::NAN, aux);
+    let obstacles = arlpcg_core::game::facts::facts(generator.game).scene_obstacles;
+    for draw in 0..MAX_CANDIDATES {
+        let quantized = (aux * 1000.0).round() / 1000.0;
+        // Another seed supplies the whole scene (start, goal, obstacles), so it stays one the
+        // Generator was trained on; the level records that seed.
+        let candidate_seed = if goal.is_none() && draw >= OWN_SCENE_CANDIDATES {
+            seed ^ (u64::from(draw) << 48)
+        } else {
+            seed
+        };
+        let request = LevelRequest::new(candidate_seed, Some(quantized))
+            .goal(goal)
+            .obstacles(obstacles)
+            .draw(draw);
+        let mut level = match generation::generator_level(generator, &request) {
+            Ok(level) => level,
+            Err(GenerationError::NoLevel { .. }) => continue,
+            Err(e) => return Err(e.into()),
+        };
+        let stats = screened_stats(&level, solver, trials, seed, target)?;
+        let miss = stats.success_ratio - target;
+        if miss.abs() < closest.0 {
+            closest = (miss.abs(), stats.success_ratio, quantized);
+        }
+        if miss.abs() <= BAND + 1e-9 && stats.successes > 0 {
+            level.stats = Some(stats);
+            return Ok(level);
+        }
+        // Too easy (success above the target): lower λ; too hard: raise it.
+        aux = (aux - 1.2 * miss).clamp(-1.0, 1.0);
+    }
+    Err(TargetError::Missed {
+        target,
+        closest: closest.1,
+        aux: closest.2,
+    })
+}
+
+/// The statistics of `trials` runs of a candidate, or of its first [`SCREEN_TRIALS`] alone when
+/// their 95% interval lies outside [`BAND`] of `target` (the rest cannot bring it in, bar a
+/// 1-in-40 chance).
+fn screened_stats(
+    level: &Level,
+    solver: &Solver,
+    trials: u32,
+    seed: u64,
+    target: f64,
+) -> Result<arlpcg_core::level::stats::SolverStats, WrongGame> {
+    let watch = Watch {
+        on_trial: &|_| {},
+        stop: &|| false,
+    };
+    let unstopped = "a search without a stop condition plays every run";
+    let screen = SCREEN_TRIALS.min(trials);
+    let mut results =
+        trial_results(level, solver, 0..screen as u64, seed, &watch)?.expect(unstopped);
+    let successes = results
+        .iter()
+        .filter(|r| r.outcome == Outcome::Success)
+        .count() as u32;
+    let [low, high] = wilson_interval(successes, screen);
+    if high >= target - BAND && low <= target + BAND {
+        let rest = trial_results(level, solver, screen as u64..trials as u64, seed, &watch)?;
+        results.extend(rest.expect(unstopped));
+    }
+    Ok(stats_of(level, solver, seed, &results))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_damaged_curve_is_named_by_its_point() {
+        let curve = |points: Vec<(f64, f64)>| Curve {
+            generator_sha256: String::new(),
+            solver_sha256: String::new(),
+            points,
+        };
+        curve(vec![(1.0, 1.0), (0.0, 0.8), (-1.0, 0.3)])
+            .check()
+            .unwrap();
+        let cases = [
+            (vec![], "points: none"),
+            (vec![(1.0, 1.0), (0.5, f64::NAN)], "points[1]: success NaN"),
+            (vec![(1.0, 1.0), (0.5, 7.5)], "points[1]: success 7.5"),
+            (
+                vec![(0.0, 1.0), (0.5, 0.5)],
+                "points[1]: λ 0.5 is not the next",
+            ),
+            (vec![(f64::NAN, 1.0)], "points[0]: λ NaN"),
+        ];
+        for (points, expected) in cases {
+            let err = curve(points).check().unwrap_err();
+            assert!(err.starts_with(expected), "{err}");
+        }
+    }
+
+    fn curve(points: &[(f64, f64)]) -> Curve {
+        Curve {
+            generator_sha256: String::new(),
+            solver_sha256: String::new(),
+            points: points.to_vec(),
+        }
+    }
+
+    #[test]
+    fn aux_for_inverts_the_curve_and_clamps_beyond_it() {
+        let c = curve(&[(1.0, 0.95), (0.0, 0.75), (-1.0, 0.35)]);
+        assert!((c.aux_for(0.85) - 0.5).abs() < 1e-9);
+        assert!((c.aux_for(0.55) + 0.5).abs() < 1e-9);
+        assert_eq!(c.aux_for(0.99), 1.0);
+        assert_eq!(c.aux_for(0.1), -1.0);
+        // Not monotone: the easiest crossing.
+        let zigzag = curve(&[(1.0, 0.9), (0.0, 0.5), (-1.0, 0.7)]);
+        assert!((zigzag.aux_for(0.6) - 0.25).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,119 @@
+//! The levels an evaluation plays: Generator levels at each λ, the validation set, and the
+//! [`PlayLayout`] that describes them without the levels themselves.
+
+use crate::services::generation::{self, GeneratorPolicy, LevelRequest};
+use arlpcg_core::game::facts::{facts, piece_values};
+use arlpcg_core::level::Level;
+use arlpcg_core::seed_ranges::{EVAL_SEED_BASE, VALIDATION_AUX_STRIDE, VALIDATION_SEED_BASE};
+
+use super::{AUX_VALUES, Budget, NamedSolver, PlayLayout};
+
+/// Seeds tried per wanted level before the table notes a shortfall (the Generator may fail to
+/// reach a goal).
+const SEED_TRIES: u64 = 4;
+
+/// Generator levels at `aux`: `count` of them from seeds `base`, `base + 1`, ... (a seed whose
+/// level the Generator cannot build is skipped, within `SEED_TRIES` seeds per level).
+pub fn generator_levels(
+    generator: &GeneratorPolicy,
+    aux: f64,
+    base: u64,
+    count: u32,
+) -> Result<Vec<Level>, candle_core::Error> {
+    let mut levels = Vec::with_capacity(count as usize);
+    for seed in base..base + count as u64 * SEED_TRIES {
+        if levels.len() == count as usize {
+            break;
+        }
+        let request =
+            LevelRequest::new(seed, Some(aux)).obstacles(facts(generator.game).scene_obstacles);
+        match generation::generator_level(generator, &request) {
+            Ok(level) => levels.push(level),
+            // (No prefix is kept here, so `Keep` does not occur.)
+            Err(
+                generation::GenerationError::NoLevel { .. }
+                | generation::GenerationError::Keep { .. },
+            ) => {}
+            Err(generation::GenerationError::Network(e)) => return Err(e),
+        }
+    }
+    Ok(levels)
+}
+
+/// The validation set: rule levels and Generator levels (λ cycling through [`AUX_VALUES`]),
+/// half each.
+pub fn validation_levels(
+    generator: &GeneratorPolicy,
+    count: u32,
+) -> Result<Vec<Level>, candle_core::Error> {
+    let base = VALIDATION_SEED_BASE;
+    let rule_count = count / 2;
+    let game = generator.game;
+    let mut levels: Vec<Level> = (0..rule_count as u64)
+        .filter_map(|k| {
+            let request = LevelRequest::new(base + k, None).obstacles(facts(game).scene_obstacles);
+            generation::rules_level(game, &request).ok()
+        })
+        .collect();
+    let per_aux = (count - rule_count).div_ceil(AUX_VALUES.len() as u32);
+    for (k, &aux) in AUX_VALUES.iter().enumerate() {
+        let seeds = base + (1 + k as u64) * VALIDATION_AUX_STRIDE;
+        let wanted = per_aux.min(count - levels.len() as u32);
+        levels.extend(generator_levels(generator, aux, seeds, wanted)?);
+    }
+    Ok(levels)
+}
+
+/// Whether a level comes from the rules (the validation set's first half).
+pub fn is_rule_level(level: &Level) -> bool {
+    matches!(
+        level.source,
+        arlpcg_core::level::Source::Rules { .. } | arlpcg_core::level::Source::RacingRules { .. }
+    )
+}
+
+/// The levels of an evaluation and its layout.
+pub struct Levels {
+    pub by_aux: Vec<Vec<Level>>,
+    pub validation: Vec<Level>,
+    pub layout: PlayLayout,
+}
+
+/// Builds every level the evaluation plays (deterministic: the same Generator and budget give
+/// the same levels on every machine).
+pub fn levels(
+    generator: &GeneratorPolicy,
+    solvers: &[NamedSolver],
+    budget: Budget,
+) -> Result<Levels, candle_core::Error> {
+    let by_aux: Vec<Vec<Level>> = AUX_VALUES
+        .iter()
+        .map(|&aux| generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks))
+        .collect::<Result<_, _>>()?;
+    let validation = validation_levels(generator, budget.validation_tracks)?;
+    let game = generator.game;
+    let piece_means = by_aux
+        .iter()
+        .map(|levels| {
+            let pieces: Vec<Vec<f64>> = levels.iter().flat_map(piece_values).collect();
+            (!pieces.is_empty()).then(|| {
+                (0..facts(game).piece_columns.len())
+                    .map(|k| pieces.iter().map(|p| p[k]).sum::<f64>() / pieces.len() as f64)
+                    .collect()
+            })
+        })
+        .collect();
+    let layout = PlayLayout {
+        game,
+        levels_per_aux: by_aux.iter().map(Vec::len).collect(),
+        piece_means,
+        validation_levels: validation.len(),
+        validation_rule_levels: validation.iter().filter(|l| is_rule_level(l)).count(),
+        solvers: solvers.iter().map(|s| s.mode.clone()).collect(),
+    };
+    Ok(Levels {
+        by_aux,
+        validation,
+        layout,
+    })
+}

@@ -1,0 +1,553 @@
+//! Results over training seeds (`eval --runs`): each run folder's Solver on one shared
+//! validation set, each adversarial run's own pair on its controllability levels, then per
+//! mode the IQM and mean over seeds with stratified-bootstrap intervals, and the probability
+//! that the ARLPCG Solver beats each baseline on validation ([`arlpcg_core::statistics::over_seeds`]). With two
+//! ARLPCG runs or more, each Solver also plays the hardest levels (λ = -1) of the ARLPCG
+//! Generators it did not train with: a Generator's finish aims at its own Solver's failures,
+//! so its levels judge every Solver but that one as unseen levels.
+
+use std::collections::BTreeMap;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::services::generation::GeneratorPolicy;
+use crate::services::panel::JudgePanel;
+use crate::services::verify::{Solver, SolverPolicy, verify};
+use arlpcg_core::level::Level;
+use arlpcg_core::seed_ranges::EVAL_SEED_BASE;
+use arlpcg_core::statistics::over_seeds::{
+    Aggregate, Estimate, estimate, probability_of_improvement,
+};
+
+use super::{AUX_VALUES, Budget, generator_levels};
+
+mod markdown;
+pub use markdown::markdown;
+
+/// How much a judge's success may rise from one λ to the next harder one and still count as
+/// falling monotonically (the noise of the default budget).
+pub const DROP_TOLERANCE: f64 = 0.05;
+
+/// What one training run scored.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunScores {
+    /// The run's folder.
+    pub run: String,
+    pub mode: String,
+    pub seed: u64,
+    /// Mean success on the validation set's rule levels and on its Generator levels...
+    pub validation_rule_levels: f64,
+    pub validation_generator_levels: f64,
+    /// ...and on all of it.
+    pub validation: f64,
+    /// An adversarial run's own pair: its Solver on its Generator's levels at each λ of
+    /// [`AUX_VALUES`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub controllability: Option<Vec<f64>>,
+    /// The same levels played by the outside judges (the rule-pcg Solver of the evaluation's
+    /// policies, the scripted player at median and expert skill; the recipe's finish plays the
+    /// median player in both games, so for its runs that one is not a stranger).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub controllability_by_judge: Vec<JudgeCurve>,
+    /// Mean success on the λ = -1 levels of the ARLPCG runs' Generators other than the run's
+    /// own (none when there is no other)...
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub other_generators_hard: Option<f64>,
+    /// ...and on each of them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub on_other_generators: Vec<GeneratorScore>,
+}
+
+/// A Solver's mean success on the λ = -1 levels of one run's Generator.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GeneratorScore {
+    /// The Generator's run folder.
+    pub generator: String,
+    pub success_ratio: f64,
+}
+
+/// One judge's success at each λ of [`AUX_VALUES`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JudgeCurve {
+    pub judge: String,
+    pub success_ratio: Vec<f64>,
+}
+
+impl RunScores {
+    /// The median over the judges of their drop in success from λ = +1 to λ = -1, and whether
+    /// every judge's success falls monotonically (within `tolerance`); `None` without judges.
+    pub fn judges_drop(&self, tolerance: f64) -> Option<(f64, bool)> {
+        let mut drops: Vec<f64> = self
+            .controllability_by_judge
+            .iter()
+            .map(|c| c.success_ratio[0] - c.success_ratio[c.success_ratio.len() - 1])
+            .collect();
+        if drops.is_empty() {
+            return None;
+        }
+        drops.sort_by(f64::total_cmp);
+        let n = drops.len();
+        let median = if n % 2 == 1 {
+            drops[n / 2]
+        } else {
+            0.5 * (drops[n / 2 - 1] + drops[n / 2])
+        };
+        let monotone = self
+            .controllability_by_judge
+            .iter()
+            .all(|c| c.success_ratio.windows(2).all(|w| w[1] <= w[0] + tolerance));
+        Some((median, monotone))
+    }
+}
+
+/// One mode over its seeds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModeSummary {
+    pub mode: String,
+    pub seeds: Vec<u64>,
+    /// Validation success: IQM and mean over (half, seed), stratified by half.
+    pub validation_iqm: Estimate,
+    pub validation_mean: Estimate,
+    /// Mean controllability success at each λ (adversarial modes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub controllability: Option<Vec<Estimate>>,
+    /// The same for each outside judge.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub controllability_by_judge: Vec<JudgeSummary>,
+    /// Mean over seeds of [`RunScores::other_generators_hard`], when every seed has it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub other_generators_hard: Option<Estimate>,
+}
+
+/// One judge's mean success at each λ over a mode's seeds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JudgeSummary {
+    pub judge: String,
+    pub success_ratio: Vec<Estimate>,
+}
+
+/// P(arlpcg's validation success > the baseline's), over seeds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Improvement {
+    pub baseline: String,
+    pub probability: Estimate,
+}
+
+/// Everything `eval --runs` reports (`seeds.json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SeedResults {
+    pub budget: Budget,
+    /// The Generator whose levels make the validation set's other half.
+    pub validation_generator: String,
+    pub aux: Vec<f64>,
+    /// Each mode's runs, one entry per seed.
+    pub seeds: BTreeMap<String, Vec<RunScores>>,
+    pub modes: Vec<ModeSummary>,
+    pub arlpcg_beats: Vec<Improvement>,
+    /// P(arlpcg's success > the baseline's) on the other Generators' λ = -1 levels.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub arlpcg_beats_on_other_generators: Vec<Improvement>,
+}
+
+/// One run to score: its Solver, mode and seed, and its Generator when it has one.
+pub struct SeedRun<'a> {
+    pub folder: String,
+    pub mode: String,
+    pub seed: u64,
+    pub solver: &'a SolverPolicy,
+    pub generator: Option<&'a GeneratorPolicy>,
+}
+
+/// Plays the validation set (rule levels first, `rule_levels` of them) with every run's Solver,
+/// each adversarial run's own pair and the `judges` on its controllability levels, and every
+/// Solver on the λ = -1 levels of the ARLPCG Generators other than its run's own
+/// ([`other_generators_plays`] of them); `on_level` after each level played.
+pub fn score_runs(
+    runs: &[SeedRun],
+    judges: &JudgePanel,
+    validation: &[Level],
+    rule_levels: usize,
+    budget: Budget,
+    on_level: &(dyn Fn() + Sync),
+) -> Result<Vec<RunScores>, candle_core::Error> {
+    // Each level's success ratio with `solver`.
+    let play = |solver: &Solver, levels: &[Level], trials: u32| -> Vec<f64> {
+        levels
+            .par_iter()
+            .map(|level| {
+                let stats = verify(level, solver, trials, level.seed.unwrap_or(0), &|| {})
+                    .expect("runs are loaded for the evaluation's game");
+                on_level();
+                stats.success_ratio
+            })
+            .collect()
+    };
+    let mean = |xs: &[f64]| xs.iter().sum::<f64>() / xs.len().max(1) as f64;
+    // Each adversarial run's controllability levels, at every λ of AUX_VALUES, built once:
+    // its own pair and the judges play them, and every other run its λ = -1 ones.
+    let controllability_levels: Vec<Option<Vec<Vec<Level>>>> = runs
+        .iter()
+        .map(|run| {
+            run.generator
+                .map(|generator| {
+                    AUX_VALUES
+                        .iter()
+                        .map(|&aux| generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks))
+                        .collect::<Result<Vec<_>, _>>()
+                })
+                .transpose()
+        })
+        .collect::<Result<_, _>>()?;
+    let mut hard_levels: Vec<(&str, &[Level])> = runs
+        .iter()
+        .zip(&controllability_levels)
+        .filter(|(run, _)| run.mode == "arlpcg")
+        .filter_map(|(run, levels)| {
+            Some((run.folder.as_str(), levels.as_ref()?.last()?.as_slice()))
+        })
+        .collect();
+    // With one ARLPCG Generator there is no other to compare its own Solver on.
+    if hard_levels.len() < 2 {
+        hard_levels.clear();
+    }
+    runs.iter()
+        .zip(&controllability_levels)
+        .map(|(run, levels)| {
+            let own = Solver::Policy(run.solver);
+            let success = play(&own, validation, budget.validation_trials);
+            let (rules, generated) = success.split_at(rule_levels.min(success.len()));
+            let (controllability, controllability_by_judge) = match levels {
+                Some(levels) => {
+                    let own_curve = levels
+                        .iter()
+                        .map(|at| mean(&play(&own, at, budget.trials)))
+                        .collect();
+                    let curves = judges
+                        .names()
+                        .into_iter()
+                        .enumerate()
+                        .map(|(k, judge)| JudgeCurve {
+                            judge,
+                            success_ratio: levels
+                                .iter()
+                                .map(|at| mean(&play(&judges.solver(k), at, budget.trials)))
+                                .collect(),
+                        })
+                        .collect();
+                    (Some(own_curve), curves)
+                }
+                None => (None, Vec::new()),
+            };
+            let on_other_generators: Vec<GeneratorScore> = hard_levels
+                .iter()
+                .filter(|(folder, _)| *folder != run.folder)
+                .map(|(folder, levels)| GeneratorScore {
+                    generator: folder.to_string(),
+                    success_ratio: mean(&play(&own, levels, budget.trials)),
+                })
+                .collect();
+            Ok(RunScores {
+                run: run.folder.clone(),
+                mode: run.mode.clone(),
+                seed: run.seed,
+                validation_rule_levels: mean(rules),
+                validation_generator_levels: mean(generated),
+                validation: mean(&success),
+                controllability,
+                controllability_by_judge,
+                other_generators_hard: (!on_other_generators.is_empty()).then(|| {
+                    mean(
+                        &on_other_generators
+                            .iter()
+                            .map(|g| g.success_ratio)
+                            .collect::<Vec<_>>(),
+                    )
+                }),
+                on_other_generators,
+            })
+        })
+        .collect()
+}
+
+/// The levels [`score_runs`] plays on other Generators' λ = -1 levels for a run: `tracks` per
+/// ARLPCG Generator of `runs` but its own (`own`: the run is one of those), when there are at
+/// least two.
+pub fn other_generators_plays(arlpcg_generators: usize, own: bool, tracks: u32) -> u64 {
+    if arlpcg_generators < 2 {
+        return 0;
+    }
+    (arlpcg_generators - usize::from(own)) as u64 * tracks as u64
+}
+
+/// The summaries over seeds (pure: the same scores give the same bytes).
+pub fn summarize(budget: Budget, validation_generator: &str, runs: Vec<RunScores>) -> SeedResults {
+    let mut modes: Vec<String> = Vec::new();
+    for run in &runs {
+        if !modes.contains(&run.mode) {
+            modes.push(run.mode.clone());
+        }
+    }
+    fn of<'a>(runs: &'a [RunScores], mode: &'a str) -> impl Iterator<Item = &'a RunScores> {
+        runs.iter().filter(move |r| r.mode == mode)
+    }
+    let halves = |mode: &str| -> Vec<Vec<f64>> {
+        vec![
+            of(&runs, mode).map(|r| r.validation_rule_levels).collect(),
+            of(&runs, mode)
+                .map(|r| r.validation_generator_levels)
+                .collect(),
+        ]
+    };
+    // Every seed's success on the other Generators' hard levels, if every seed has one.
+    let hard = |mode: &str| -> Option<Vec<f64>> {
+        of(&runs, mode).map(|r| r.other_generators_hard).collect()
+    };
+    let summaries = modes
+        .iter()
+        .map(|mode| {
+            let controllability = of(&runs, mode)
+                .all(|r| r.controllability.is_some())
+                .then(|| {
+                    (0..AUX_VALUES.len())
+                        .map(|a| {
+                            let at: Vec<f64> = of(&runs, mode)
+                                .map(|r| r.controllability.as_ref().expect("checked")[a])
+                                .collect();
+                            estimate(&[at], Aggregate::Mean, a as u64)
+                        })
+                        .collect()
+                });
+            ModeSummary {
+                mode: mode.clone(),
+                seeds: of(&runs, mode).map(|r| r.seed).collect(),
+                validation_iqm: estimate(&halves(mode), Aggregate::Iqm, 0),
+                validation_mean: estimate(&halves(mode), Aggregate::Mean, 0),
+                controllability,
+                controllability_by_judge: judge_summaries(of(&runs, mode).collect()),
+                other_generators_hard: hard(mode)
+                    .map(|at| estimate(&[at], Aggregate::Mean, AUX_VALUES.len() as u64)),
+            }
+        })
+        .collect();
+    let arlpcg_beats = match modes.iter().any(|m| m == "arlpcg") {
+        true => modes
+            .iter()
+            .filter(|m| *m != "arlpcg")
+            .map(|baseline| Improvement {
+                baseline: baseline.clone(),
+                probability: probability_of_improvement(&halves("arlpcg"), &halves(baseline), 0),
+            })
+            .collect(),
+        false => Vec::new(),
+    };
+    let arlpcg_beats_on_other_generators = match hard("arlpcg") {
+        Some(arlpcg) => modes
+            .iter()
+            .filter(|m| *m != "arlpcg")
+            .filter_map(|baseline| {
+                Some(Improvement {
+                    baseline: baseline.clone(),
+                    probability: probability_of_improvement(
+                        std::slice::from_ref(&arlpcg),
+                        &[hard(baseline)?],
+                        0,
+                    ),
+                })
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    let mut seeds: BTreeMap<String, Vec<RunScores>> = BTreeMap::new();
+    for run in runs {
+        seeds.entry(run.mode.clone()).or_default().push(run);
+    }
+    SeedResults {
+        budget,
+        validation_generator: validation_generator.to_string(),
+        aux: AUX_VALUES.to_vec(),
+        seeds,
+        modes: summaries,
+        arlpcg_beats,
+        arlpcg_beats_on_other_generators,
+    }
+}
+
+/// Each judge's mean success at each λ over `runs` (the judges every run was played by).
+fn judge_summaries(runs: Vec<&RunScores>) -> Vec<JudgeSummary> {
+    let Some(first) = runs.first() else {
+        return Vec::new();
+    };
+    first
+        .controllability_by_judge
+        .iter()
+        .filter_map(|curve| {
+            let of_judge: Vec<&JudgeCurve> = runs
+                .iter()
+                .map(|r| {
+                    r.controllability_by_judge
+                        .iter()
+                        .find(|c| c.judge == curve.judge)
+                })
+                .collect::<Option<_>>()?;
+            let success_ratio = (0..curve.success_ratio.len())
+                .map(|a| {
+                    let at: Vec<f64> = of_judge.iter().map(|c| c.success_ratio[a]).collect();
+                    estimate(&[at], Aggregate::Mean, a as u64)
+                })
+                .collect();
+            Some(JudgeSummary {
+                judge: curve.judge.clone(),
+                success_ratio,
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(mode: &str, seed: u64, rules: f64, generated: f64) -> RunScores {
+        RunScores {
+            run: format!("runs/{mode}-{seed}"),
+            mode: mode.into(),
+            seed,
+            validation_rule_levels: rules,
+            validation_generator_levels: generated,
+            validation: 0.5 * (rules + generated),
+            controllability: (mode == "arlpcg").then(|| vec![1.0, 0.9, 0.8, 0.6, 0.5]),
+            controllability_by_judge: match mode {
+                "arlpcg" => vec![
+                    JudgeCurve {
+                        judge: "scripted-median".into(),
+                        success_ratio: vec![1.0, 0.95, 0.9, 0.8, 0.7],
+                    },
+                    JudgeCurve {
+                        judge: "scripted-expert".into(),
+                        success_ratio: vec![1.0, 1.0, 1.0, 0.98, 0.9 - 0.1 * seed as f64],
+                    },
+                ],
+                _ => Vec::new(),
+            },
+            other_generators_hard: None,
+            on_other_generators: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn modes_are_summarized_over_their_seeds() {
+        let runs = vec![
+            run("arlpcg", 0, 0.9, 0.8),
+            run("rule-pcg", 0, 0.8, 0.6),
+            run("arlpcg", 1, 0.92, 0.82),
+            run("rule-pcg", 1, 0.9, 0.7),
+            run("arlpcg", 2, 0.88, 0.78),
+        ];
+        let results = summarize(Budget::QUICK, "g", runs);
+        let names: Vec<&str> = results.modes.iter().map(|m| m.mode.as_str()).collect();
+        assert_eq!(names, ["arlpcg", "rule-pcg"]);
+        assert_eq!(results.modes[0].seeds, [0, 1, 2]);
+        let mean = results.modes[0].validation_mean;
+        assert!((mean.value - 0.85).abs() < 1e-12, "{mean:?}");
+        assert!(mean.ci95[0] <= mean.value && mean.value <= mean.ci95[1]);
+        let control = results.modes[0].controllability.as_ref().unwrap();
+        assert_eq!(control[4].value, 0.5);
+        assert!(results.modes[1].controllability.is_none());
+        // On the rule half arlpcg's seeds (0.9, 0.92, 0.88) against rule-pcg's (0.8, 0.9) win
+        // 4 pairs, tie 1 and lose 1 (0.75); on the Generator half they win all 6.
+        let p = &results.arlpcg_beats[0];
+        assert_eq!(p.baseline, "rule-pcg");
+        assert!(
+            (p.probability.value - (0.75 + 1.0) / 2.0).abs() < 1e-12,
+            "{p:?}"
+        );
+        // Each judge over the seeds, and each run's median drop over its judges.
+        let judges = &results.modes[0].controllability_by_judge;
+        assert_eq!(judges[0].judge, "scripted-median");
+        assert!((judges[0].success_ratio[4].value - 0.7).abs() < 1e-12);
+        assert!((judges[1].success_ratio[4].value - 0.8).abs() < 1e-12);
+        assert!(results.modes[1].controllability_by_judge.is_empty());
+        assert_eq!(results.seeds["arlpcg"].len(), 3);
+        assert_eq!(results.seeds["rule-pcg"][1].seed, 1);
+        let (median, monotone) = results.seeds["arlpcg"][0].judges_drop(0.05).unwrap();
+        assert!((median - 0.2).abs() < 1e-12 && monotone, "{median}");
+        assert_eq!(results.seeds["rule-pcg"][0].judges_drop(0.05), None);
+        let md = markdown(&results);
+        assert!(
+            md.contains("| arlpcg | 0, 1, 2 |") && md.contains("| rule-pcg |"),
+            "{md}"
+        );
+        assert!(md.contains("| arlpcg | scripted-expert |"), "{md}");
+        assert!(md.contains("| 0.20, yes | — |"), "{md}");
+        assert!(results.arlpcg_beats_on_other_generators.is_empty());
+        assert!(!md.contains("other runs' Generators"), "{md}");
+    }
+
+    /// On the other Generators' hard levels: the mean over each mode's seeds, and P(arlpcg
+    /// better) from those seeds alone; a baseline some seed of which lacks the figure is left
+    /// out.
+    #[test]
+    fn other_generators_hard_levels_are_summarized_over_seeds() {
+        // Two ARLPCG runs: each plays the other's Generator; rule-pcg's play both.
+        let on = |scores: &[(u64, f64)]| -> Vec<GeneratorScore> {
+            scores
+                .iter()
+                .map(|&(g, success_ratio)| GeneratorScore {
+                    generator: format!("runs/arlpcg-{g}"),
+                    success_ratio,
+                })
+                .collect()
+        };
+        let with = |mode: &str, seed: u64, scores: &[(u64, f64)]| {
+            let on_other_generators = on(scores);
+            let n = on_other_generators.len();
+            RunScores {
+                other_generators_hard: (mode != "fixed-track").then(|| {
+                    on_other_generators
+                        .iter()
+                        .map(|g| g.success_ratio)
+                        .sum::<f64>()
+                        / n as f64
+                }),
+                on_other_generators,
+                ..run(mode, seed, 0.9, 0.8)
+            }
+        };
+        let runs = vec![
+            with("arlpcg", 0, &[(1, 0.8)]),
+            with("arlpcg", 1, &[(0, 0.7)]),
+            with("rule-pcg", 0, &[(0, 0.7), (1, 0.8)]),
+            with("rule-pcg", 1, &[(0, 0.6), (1, 0.6)]),
+            with("fixed-track", 0, &[]),
+        ];
+        let results = summarize(Budget::QUICK, "g", runs);
+        let hard = results.modes[0].other_generators_hard.unwrap();
+        assert!((hard.value - 0.75).abs() < 1e-12, "{hard:?}");
+        assert!(results.modes[2].other_generators_hard.is_none());
+        // arlpcg (0.8, 0.7) against rule-pcg (0.75, 0.6): 3 of 4 pairs won.
+        let beats = &results.arlpcg_beats_on_other_generators;
+        assert_eq!(beats.len(), 1, "{beats:?}");
+        assert_eq!(beats[0].baseline, "rule-pcg");
+        assert!(
+            (beats[0].probability.value - 0.75).abs() < 1e-12,
+            "{beats:?}"
+        );
+        let md = markdown(&results);
+        assert!(md.contains("| arlpcg | 0.750 ["), "{md}");
+        assert!(md.contains("| 0.800 |"), "{md}");
+        // Generator 0's levels: its own Solver 0.5 (controllability at λ = -1), the other
+        // ARLPCG Solver 0.7, the rule-pcg Solvers (0.7 + 0.6) / 2; fixed-track played none.
+        assert!(
+            md.contains("| runs/arlpcg-0 | 0.500 | 0.700 | 0.650 | — |"),
+            "{md}"
+        );
+        assert!(
+            md.contains("| runs/arlpcg-1 | 0.500 | 0.800 | 0.700 | — |"),
+            "{md}"
+        );
+        assert_eq!(other_generators_plays(5, true, 20), 80);
+        assert_eq!(other_generators_plays(5, false, 20), 100);
+        assert_eq!(other_generators_plays(1, false, 20), 0);
+    }
+}

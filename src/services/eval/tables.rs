@@ -1,0 +1,322 @@
+//! The three tables, assembled from the layout and the statistics of every play.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::services::verify::Summary;
+use arlpcg_core::game::facts::facts;
+use arlpcg_core::level::Game;
+use arlpcg_core::level::stats::SolverStats;
+
+use super::{AUX_VALUES, Budget, Play, PlayLayout};
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ControllabilityRow {
+    pub aux: f64,
+    pub success_ratio: f64,
+    pub success_std: f64,
+    pub completed_by_any: f64,
+    /// The pieces' mean parameters, named by the game's piece columns (`avg_block_distance`, ...).
+    #[serde(flatten)]
+    pub pieces: BTreeMap<String, f64>,
+    /// Racing: mean seconds per run with the car in the air.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub air_time: Option<f64>,
+    pub tracks: usize,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GeneralizationRow {
+    pub mode: String,
+    pub success_ratio: f64,
+    /// Mean success on the validation set's rule levels (no Solver trained on these)...
+    pub success_rule_levels: f64,
+    /// ...and on its Generator levels (the ARLPCG Solver's own training distribution).
+    pub success_generator_levels: f64,
+    pub success_std: f64,
+    pub completed_by_any: f64,
+    /// Mean decisions of the successful runs.
+    pub avg_steps: f64,
+    pub tracks: usize,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CrossRow {
+    pub mode: String,
+    /// Success ratio at each λ of [`AUX_VALUES`], in that order.
+    pub success_ratio: Vec<f64>,
+}
+
+/// One judge at one λ: its success on the controllability levels (the cross table's plays).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JudgeRow {
+    pub judge: String,
+    pub aux: f64,
+    pub success_ratio: f64,
+    pub completed_by_any: f64,
+}
+
+/// Everything `eval` measures.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Results {
+    /// The game evaluated (the tables' columns and the paper's figures depend on it).
+    #[serde(skip)]
+    pub game: Game,
+    pub budget: Budget,
+    pub generator: String,
+    pub controllability: Vec<ControllabilityRow>,
+    pub generalization: Vec<GeneralizationRow>,
+    pub cross: Vec<CrossRow>,
+    /// Every judge (trained Solvers and the scripted player's skills) at every λ.
+    pub controllability_by_judge: Vec<JudgeRow>,
+}
+
+/// The tables from the layout and the statistics of every play (`stats[i]` of play `i`).
+pub fn assemble(
+    budget: Budget,
+    generator: &str,
+    layout: &PlayLayout,
+    stats: &[SolverStats],
+) -> Results {
+    let plays = layout.plays();
+    assert_eq!(plays.len(), stats.len(), "one statistics entry per play");
+    let summary = |wanted: &dyn Fn(&Play) -> bool| {
+        let chosen: Vec<SolverStats> = plays
+            .iter()
+            .zip(stats)
+            .filter(|(p, _)| wanted(p))
+            .map(|(_, s)| s.clone())
+            .collect();
+        if chosen.is_empty() {
+            return Summary {
+                levels: 0,
+                mean_success: f64::NAN,
+                std_success: f64::NAN,
+                completed_by_any: f64::NAN,
+                mean_progress: f64::NAN,
+                mean_success_steps: f64::NAN,
+            };
+        }
+        Summary::of(&chosen)
+    };
+    let controllability = AUX_VALUES
+        .iter()
+        .enumerate()
+        .map(|(a, &aux)| {
+            let s = summary(&|p| matches!(p, Play::Controllability { aux, .. } if *aux == a));
+            let pieces = facts(layout.game)
+                .piece_columns
+                .iter()
+                .enumerate()
+                .map(|(k, (name, _))| {
+                    let mean = layout.piece_means[a].as_ref().map_or(f64::NAN, |m| m[k]);
+                    (name.to_string(), mean)
+                })
+                .collect();
+            let air: Vec<f64> = plays
+                .iter()
+                .zip(stats)
+                .filter(|(p, _)| matches!(p, Play::Controllability { aux, .. } if *aux == a))
+                .filter_map(|(_, s)| s.mean_air_steps)
+                .collect();
+            let air_time = facts(layout.game)
+                .air_time_step
+                .map(|dt| dt * air.iter().sum::<f64>() / air.len().max(1) as f64);
+            ControllabilityRow {
+                aux,
+                success_ratio: s.mean_success,
+                success_std: s.std_success,
+                completed_by_any: s.completed_by_any,
+                pieces,
+                air_time,
+                tracks: layout.levels_per_aux[a],
+            }
+        })
+        .collect();
+    let mut generalization = Vec::new();
+    let mut cross = Vec::new();
+    let mut controllability_by_judge = Vec::new();
+    for (k, mode) in layout.solvers.iter().enumerate() {
+        let s = summary(&|p| matches!(p, Play::Generalization { solver, .. } if *solver == k));
+        let rules = layout.validation_rule_levels;
+        let on_rules = summary(
+            &|p| matches!(p, Play::Generalization { solver, level } if *solver == k && *level < rules),
+        );
+        let on_generator = summary(
+            &|p| matches!(p, Play::Generalization { solver, level } if *solver == k && *level >= rules),
+        );
+        generalization.push(GeneralizationRow {
+            mode: mode.clone(),
+            success_rule_levels: on_rules.mean_success,
+            success_generator_levels: on_generator.mean_success,
+            success_ratio: s.mean_success,
+            success_std: s.std_success,
+            completed_by_any: s.completed_by_any,
+            avg_steps: if s.completed_by_any > 0.0 {
+                s.mean_success_steps
+            } else {
+                f64::NAN
+            },
+            tracks: layout.validation_levels,
+        });
+        let by_aux: Vec<Summary> = (0..AUX_VALUES.len())
+            .map(|a| {
+                summary(
+                    &|p| matches!(p, Play::Cross { solver, aux, .. } if *solver == k && *aux == a),
+                )
+            })
+            .collect();
+        for (s, &aux) in by_aux.iter().zip(&AUX_VALUES) {
+            controllability_by_judge.push(JudgeRow {
+                judge: mode.clone(),
+                aux,
+                success_ratio: s.mean_success,
+                completed_by_any: s.completed_by_any,
+            });
+        }
+        let success_ratio = by_aux.iter().map(|s| s.mean_success).collect();
+        cross.push(CrossRow {
+            mode: mode.clone(),
+            success_ratio,
+        });
+    }
+    Results {
+        game: layout.game,
+        budget,
+        generator: generator.to_string(),
+        controllability,
+        generalization,
+        cross,
+        controllability_by_judge,
+    }
+}
+
+#[cfg(test)]
+pub(super) mod tests {
+    use super::*;
+    use arlpcg_core::level::SolverRef;
+    use arlpcg_core::level::stats::{Outcome, TrialResult};
+
+    /// Statistics of `successes` successful runs out of `trials` (the rest fell on piece 0).
+    pub(in crate::services::eval) fn stats(successes: u32, trials: u32) -> SolverStats {
+        let run = |outcome| TrialResult {
+            outcome,
+            progress: if outcome == Outcome::Success {
+                1.0
+            } else {
+                0.5
+            },
+            target_piece: 0,
+            steps: 100,
+            air_steps: Some(3),
+        };
+        let runs: Vec<TrialResult> = (0..trials)
+            .map(|i| {
+                run(if i < successes {
+                    Outcome::Success
+                } else {
+                    Outcome::Fell
+                })
+            })
+            .collect();
+        SolverStats::from_trials(
+            SolverRef::Scripted {
+                skill: arlpcg_core::game::Skill::Expert,
+            },
+            0,
+            2,
+            &runs,
+        )
+    }
+
+    /// Two Solvers (the ARLPCG one second), 1, 2, 0, 1, 1 levels at the five λ, a validation
+    /// set of one rule level and two Generator levels.
+    pub(in crate::services::eval) fn layout(game: Game) -> PlayLayout {
+        let columns = facts(game).piece_columns.len();
+        PlayLayout {
+            game,
+            levels_per_aux: vec![1, 2, 0, 1, 1],
+            piece_means: vec![
+                Some(vec![7.0; columns]),
+                Some(vec![8.0; columns]),
+                None,
+                Some(vec![9.0; columns]),
+                Some(vec![10.0; columns]),
+            ],
+            validation_levels: 3,
+            validation_rule_levels: 1,
+            solvers: vec!["rule-pcg".into(), "arlpcg".into()],
+        }
+    }
+
+    /// Each play's statistics chosen so every table cell is known: plays are numbered as
+    /// `PlayLayout::plays` lists them.
+    fn outcomes(layout: &PlayLayout) -> Vec<SolverStats> {
+        layout
+            .plays()
+            .iter()
+            .map(|play| match *play {
+                // Controllability: success 4/4 at λ = 1, then 2/4 and 0/4 at 0.5, ...
+                Play::Controllability { aux, level } => match (aux, level) {
+                    (0, _) => stats(4, 4),
+                    (1, 0) => stats(2, 4),
+                    (1, _) => stats(0, 4),
+                    _ => stats(1, 4),
+                },
+                Play::Generalization { solver, level } => {
+                    stats(if level < 1 { 4 } else { solver as u32 * 2 }, 4)
+                }
+                Play::Cross { solver, .. } => stats(solver as u32 + 1, 4),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn assemble_puts_every_play_in_its_cell() {
+        let layout = layout(Game::Racing);
+        let results = assemble(Budget::QUICK, "gen", &layout, &outcomes(&layout));
+        let success: Vec<f64> = results
+            .controllability
+            .iter()
+            .map(|r| r.success_ratio)
+            .collect();
+        assert_eq!(success[0], 1.0);
+        assert_eq!(success[1], 0.25, "the mean of 2/4 and 0/4");
+        assert!(success[2].is_nan(), "no level at λ = 0: nothing measured");
+        assert_eq!(&success[3..], &[0.25, 0.25]);
+        let second = &results.controllability[1];
+        assert_eq!(second.success_std, 0.25);
+        assert_eq!(second.completed_by_any, 0.5);
+        assert_eq!(second.tracks, 2);
+        assert_eq!(second.pieces["avg_segment_length"], 8.0);
+        // 3 air steps a run at 1/30 s a decision.
+        let air = second.air_time.expect("racing measures air time");
+        assert!((air - 0.1).abs() < 1e-6, "{air}");
+
+        let [rule, arlpcg] = &results.generalization[..] else {
+            panic!("one row per Solver")
+        };
+        assert_eq!(
+            (rule.mode.as_str(), arlpcg.mode.as_str()),
+            ("rule-pcg", "arlpcg")
+        );
+        assert_eq!(rule.success_rule_levels, 1.0);
+        assert_eq!(rule.success_generator_levels, 0.0);
+        assert_eq!(arlpcg.success_generator_levels, 0.5);
+        assert!((arlpcg.success_ratio - 2.0 / 3.0).abs() < 1e-12);
+        assert!(rule.avg_steps == 100.0 && rule.tracks == 3);
+
+        assert_eq!(results.cross[0].success_ratio[0], 0.25);
+        assert_eq!(results.cross[1].success_ratio[0], 0.5);
+        assert!(results.cross[1].success_ratio[2].is_nan());
+    }
+
+    #[test]
+    fn platform_tables_have_no_air_time() {
+        let layout = layout(Game::Platform);
+        let results = assemble(Budget::QUICK, "gen", &layout, &outcomes(&layout));
+        assert!(results.controllability.iter().all(|r| r.air_time.is_none()));
+        assert_eq!(results.controllability[0].pieces["avg_block_size"], 7.0);
+    }
+}

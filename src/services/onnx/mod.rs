@@ -1,0 +1,548 @@
+//! A trained policy's actor as an ONNX graph, for engines that run policies themselves (Unity
+//! through ML-Agents' Sentis/Inference Engine, Godot RL Agents, onnxruntime anywhere).
+//!
+//! The graph takes raw observations, as the game produces them: the observation normalizer is
+//! folded in as `Sub`, `Mul` and `Clip`, then the actor's layers are `Gemm` and `Relu`. It gives
+//! the deterministic actions the tool plays with (`verify` and the certificates): each
+//! continuous action is the Gaussian's mean clipped to [-1, 1], as the games clip it, and each
+//! binary action is on when its probability is at least one half. Opset 9 (the oldest the
+//! engines above read, and ML-Agents' own), IR version 4.
+//!
+//! Two profiles ([`Profile`]): `plain` names things after this tool (`observation`,
+//! `continuous_actions`, `binary_probabilities`, `binary_actions`); `mlagents` follows
+//! ML-Agents' model contract (version 3: `obs_0`, `action_masks`, `version_number`,
+//! `memory_size`, `continuous_actions`, `deterministic_continuous_actions`,
+//! `continuous_action_output_shape`, `discrete_actions`, `deterministic_discrete_actions`,
+//! `discrete_action_output_shape`), each binary action a discrete branch of two (0 off, 1 on).
+//! ML-Agents' `continuous_actions` and `discrete_actions` are samples in its own exports; here
+//! both are the deterministic actions.
+//!
+//! Beside the graph goes a [`Sidecar`] (JSON): the observation layout and the meaning of each
+//! action from the policy's card, and example rows with the outputs this tool computes for them,
+//! so an integration can check itself.
+
+mod builder;
+pub mod proto;
+
+use prost::Message;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+use arlpcg_core::level::PolicyRef;
+use arlpcg_core::rl::checkpoint::PolicyCard;
+use arlpcg_core::rl::normalizer::{CLIP, RunningNorm};
+use arlpcg_core::rl::policy::{ActMode, ActorCritic};
+use builder::{GraphBuilder, attribute_int, entry, value_info};
+use proto::*;
+
+/// The ONNX operator set the graphs use.
+pub const OPSET: i64 = 9;
+/// The IR version that goes with [`OPSET`].
+const IR_VERSION: i64 = 4;
+/// ML-Agents' model API version its contract's `version_number` carries.
+const MLAGENTS_API_VERSION: f32 = 3.0;
+/// How many example rows the sidecar carries.
+const EXAMPLE_ROWS: usize = 4;
+
+/// Whose names and outputs the graph follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Profile {
+    /// Names of this tool.
+    Plain,
+    /// ML-Agents' model contract, for Unity.
+    Mlagents,
+}
+
+impl Profile {
+    pub fn name(self) -> &'static str {
+        match self {
+            Profile::Plain => "plain",
+            Profile::Mlagents => "mlagents",
+        }
+    }
+
+    /// The name of the observation input.
+    pub fn observation_input(self) -> &'static str {
+        match self {
+            Profile::Plain => "observation",
+            Profile::Mlagents => "obs_0",
+        }
+    }
+}
+
+/// What the sidecar says about the graph: enough to wire it into a game without this tool.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Sidecar {
+    pub format: String,
+    pub version: u32,
+    pub profile: Profile,
+    pub opset: i64,
+    pub game: String,
+    pub role: String,
+    /// The policy file the graph was made from.
+    pub policy: PolicyRef,
+    pub training: SidecarTraining,
+    pub inputs: Vec<Port>,
+    pub outputs: Vec<Port>,
+    /// Observation rows (raw, as the game produces them) and what this tool computes for them,
+    /// output by output.
+    pub examples: Examples,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SidecarTraining {
+    pub mode: String,
+    pub steps: u64,
+    pub seed: u64,
+    pub command: String,
+}
+
+/// One input or output of the graph.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Port {
+    pub name: String,
+    /// `"batch"` for the rows, else a size.
+    pub shape: Vec<serde_json::Value>,
+    pub meaning: String,
+    /// What the columns of the last dimension hold, in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub columns: Vec<Columns>,
+}
+
+/// A named run of columns: `width` of them from `offset`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Columns {
+    pub name: String,
+    pub offset: usize,
+    pub width: usize,
+}
+
+/// Named runs of columns laid end to end.
+fn columns(named: impl IntoIterator<Item = (String, usize)>) -> Vec<Columns> {
+    let mut offset = 0;
+    named
+        .into_iter()
+        .map(|(name, width)| {
+            offset += width;
+            Columns {
+                name,
+                offset: offset - width,
+                width,
+            }
+        })
+        .collect()
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Examples {
+    pub observations: Vec<Vec<f32>>,
+    pub outputs: std::collections::BTreeMap<String, Vec<Vec<f32>>>,
+}
+
+/// The graph's bytes and its sidecar.
+pub struct Exported {
+    pub onnx: Vec<u8>,
+    pub sidecar: Sidecar,
+}
+
+/// Where the sidecar of the graph at `onnx` goes: the same name with `.json` added.
+pub fn sidecar_path(onnx: &std::path::Path) -> std::path::PathBuf {
+    let mut name = onnx.as_os_str().to_owned();
+    name.push(".json");
+    name.into()
+}
+
+/// An output of the graph: its dimensions (`None` the batch) and what the sidecar says of it.
+struct Output {
+    dims: Vec<Option<usize>>,
+    meaning: &'static str,
+    columns: Vec<Columns>,
+}
+
+const CONTINUOUS_MEANING: &str =
+    "the deterministic continuous actions (the Gaussian's mean clipped to [-1, 1])";
+
+/// One column per action name.
+fn action_columns(names: &[String]) -> Vec<Columns> {
+    columns(names.iter().map(|n| (n.clone(), 1)))
+}
+
+/// Exports the actor of `policy` (with its card's normalizer) in `profile`. Pure: the same
+/// policy gives the same bytes.
+pub fn export(
+    policy: &ActorCritic,
+    card: &PolicyCard,
+    reference: PolicyRef,
+    profile: Profile,
+) -> candle_core::Result<Exported> {
+    let shape = policy.shape();
+    let (observation, continuous, binary) = (shape.observation, shape.continuous, shape.binary);
+    let mut graph = GraphBuilder::default();
+    let input = profile.observation_input();
+    graph
+        .inputs
+        .push(value_info(input, &[None, Some(observation)]));
+    let head = actor_head(&mut graph, policy, &card.normalizer, input)?;
+    let mean = (continuous > 0).then(|| graph.columns(&head, 0, continuous));
+    let logits = (binary > 0).then(|| graph.columns(&head, continuous, continuous + binary));
+    let continuous_actions = mean.map(|m| graph.clip(&m, -1.0, 1.0));
+    let outputs = match profile {
+        Profile::Plain => plain_outputs(&mut graph, card, continuous_actions, logits),
+        Profile::Mlagents => mlagents_outputs(&mut graph, card, continuous_actions, logits),
+    };
+    for (name, output) in &outputs {
+        graph.outputs.push(value_info(name, &output.dims));
+    }
+    let model = ModelProto {
+        ir_version: IR_VERSION,
+        producer_name: "arlpcg".into(),
+        producer_version: env!("CARGO_PKG_VERSION").into(),
+        doc_string: format!(
+            "The actor of the {} {} trained in mode {} ({} steps, seed {}), from {} (SHA-256 {}).",
+            card.game,
+            card.role,
+            card.training.mode,
+            card.training.steps,
+            card.training.seed,
+            reference.path,
+            reference.sha256
+        ),
+        graph: Some(GraphProto {
+            node: graph.nodes,
+            name: format!("{}-{}", card.game, card.role),
+            initializer: graph.initializers,
+            doc_string: String::new(),
+            input: graph.inputs,
+            output: graph.outputs,
+        }),
+        opset_import: vec![OperatorSetIdProto {
+            domain: String::new(),
+            version: OPSET,
+        }],
+        metadata_props: vec![
+            entry("arlpcg.game", &card.game.to_string()),
+            entry("arlpcg.role", &card.role.to_string()),
+            entry("arlpcg.profile", profile.name()),
+            entry("arlpcg.policy_sha256", &reference.sha256),
+        ],
+    };
+    let mut inputs = vec![Port {
+        name: input.into(),
+        shape: dims_json(&[None, Some(observation)]),
+        meaning: "raw observations, as the game produces them (normalized inside the graph)".into(),
+        columns: columns(card.observation.clone()),
+    }];
+    if profile == Profile::Mlagents && binary > 0 {
+        inputs.push(Port {
+            name: "action_masks".into(),
+            shape: dims_json(&[None, Some(2 * binary)]),
+            meaning: "1 where a branch's option is allowed, 0 where masked; all ones to leave \
+                the policy free"
+                .into(),
+            columns: columns(
+                card.binary_actions
+                    .iter()
+                    .flat_map(|n| [(format!("{n}=off"), 1), (format!("{n}=on"), 1)]),
+            ),
+        });
+    }
+    let examples = examples(policy, card, profile)?;
+    Ok(Exported {
+        onnx: model.encode_to_vec(),
+        sidecar: Sidecar {
+            format: "arlpcg-onnx".into(),
+            version: 1,
+            profile,
+            opset: OPSET,
+            game: card.game.to_string(),
+            role: card.role.to_string(),
+            policy: reference,
+            training: SidecarTraining {
+                mode: card.training.mode.to_string(),
+                steps: card.training.steps,
+                seed: card.training.seed,
+                command: card.training.command.clone(),
+            },
+            inputs,
+            outputs: outputs
+                .into_iter()
+                .map(|(name, output)| Port {
+                    name,
+                    shape: dims_json(&output.dims),
+                    meaning: output.meaning.into(),
+                    columns: output.columns,
+                })
+                .collect(),
+            examples,
+        },
+    })
+}
+
+/// This tool's names: the continuous actions, and each binary action's probability and choice.
+fn plain_outputs(
+    graph: &mut GraphBuilder,
+    card: &PolicyCard,
+    continuous_actions: Option<String>,
+    logits: Option<String>,
+) -> Vec<(String, Output)> {
+    let mut outputs = Vec::new();
+    if let Some(actions) = continuous_actions {
+        graph.rename(&actions, "continuous_actions");
+        outputs.push((
+            "continuous_actions".into(),
+            Output {
+                dims: vec![None, Some(card.continuous_actions.len())],
+                meaning: CONTINUOUS_MEANING,
+                columns: action_columns(&card.continuous_actions),
+            },
+        ));
+    }
+    if let Some(logits) = logits {
+        let binary = card.binary_actions.len();
+        let probability = graph.node("Sigmoid", &[&logits], vec![]);
+        graph.rename(&probability, "binary_probabilities");
+        let zero = graph.constant_f32(&[1], &[0.0]);
+        let below = graph.node("Less", &[&logits, &zero], vec![]);
+        let on = graph.node("Not", &[&below], vec![]);
+        let actions = graph.node("Cast", &[&on], vec![attribute_int("to", FLOAT as i64)]);
+        graph.rename(&actions, "binary_actions");
+        outputs.push((
+            "binary_probabilities".into(),
+            Output {
+                dims: vec![None, Some(binary)],
+                meaning: "each binary action's probability of being on",
+                columns: action_columns(&card.binary_actions),
+            },
+        ));
+        outputs.push((
+            "binary_actions".into(),
+            Output {
+                dims: vec![None, Some(binary)],
+                meaning: "the deterministic binary actions: 1 when the probability is at least \
+                    0.5, else 0",
+                columns: action_columns(&card.binary_actions),
+            },
+        ));
+    }
+    outputs
+}
+
+/// ML-Agents' model contract (version 3): constants, then the continuous actions and each
+/// binary action as a discrete branch of two, masked by `action_masks`.
+fn mlagents_outputs(
+    graph: &mut GraphBuilder,
+    card: &PolicyCard,
+    continuous_actions: Option<String>,
+    logits: Option<String>,
+) -> Vec<(String, Output)> {
+    let mut outputs = Vec::new();
+    let constant = |graph: &mut GraphBuilder, name: &str, values: &[f32], meaning| {
+        let value = graph.constant_node(&[values.len()], values);
+        graph.rename(&value, name);
+        let output = Output {
+            dims: vec![Some(values.len())],
+            meaning,
+            columns: vec![],
+        };
+        (name.to_string(), output)
+    };
+    outputs.push(constant(
+        graph,
+        "version_number",
+        &[MLAGENTS_API_VERSION],
+        "ML-Agents' model API version",
+    ));
+    outputs.push(constant(
+        graph,
+        "memory_size",
+        &[0.0],
+        "no recurrent memory",
+    ));
+    if let Some(actions) = continuous_actions {
+        let continuous = card.continuous_actions.len();
+        let copy = graph.node("Identity", &[&actions], vec![]);
+        graph.rename(&actions, "continuous_actions");
+        graph.rename(&copy, "deterministic_continuous_actions");
+        for name in ["continuous_actions", "deterministic_continuous_actions"] {
+            let output = Output {
+                dims: vec![None, Some(continuous)],
+                meaning: CONTINUOUS_MEANING,
+                columns: action_columns(&card.continuous_actions),
+            };
+            outputs.push((name.into(), output));
+        }
+        outputs.push(constant(
+            graph,
+            "continuous_action_output_shape",
+            &[continuous as f32],
+            "how many continuous actions",
+        ));
+    }
+    if let Some(logits) = logits {
+        let binary = card.binary_actions.len();
+        graph
+            .inputs
+            .push(value_info("action_masks", &[None, Some(2 * binary)]));
+        let on_columns: Vec<i64> = (0..binary as i64).map(|k| 2 * k + 1).collect();
+        let off_columns: Vec<i64> = (0..binary as i64).map(|k| 2 * k).collect();
+        let allowed_on = graph.gather_columns("action_masks", &on_columns);
+        let allowed_off = graph.gather_columns("action_masks", &off_columns);
+        let on = graph.node("Sigmoid", &[&logits], vec![]);
+        let one = graph.constant_f32(&[1], &[1.0]);
+        let off = graph.node("Sub", &[&one, &on], vec![]);
+        let on = graph.node("Mul", &[&on, &allowed_on], vec![]);
+        let off = graph.node("Mul", &[&off, &allowed_off], vec![]);
+        let below = graph.node("Less", &[&on, &off], vec![]);
+        let chosen = graph.node("Not", &[&below], vec![]);
+        let actions = graph.node("Cast", &[&chosen], vec![attribute_int("to", FLOAT as i64)]);
+        let copy = graph.node("Identity", &[&actions], vec![]);
+        graph.rename(&actions, "discrete_actions");
+        graph.rename(&copy, "deterministic_discrete_actions");
+        for name in ["discrete_actions", "deterministic_discrete_actions"] {
+            let output = Output {
+                dims: vec![None, Some(binary)],
+                meaning: "one branch per binary action: 1 (on) when its probability, masked, \
+                    is at least that of 0 (off)",
+                columns: action_columns(&card.binary_actions),
+            };
+            outputs.push((name.into(), output));
+        }
+        outputs.push(constant(
+            graph,
+            "discrete_action_output_shape",
+            &vec![2.0; binary],
+            "each branch's size (2)",
+        ));
+    }
+    outputs
+}
+
+/// The normalizer and the actor's layers: the head's output (means, then logits).
+fn actor_head(
+    graph: &mut GraphBuilder,
+    policy: &ActorCritic,
+    normalizer: &RunningNorm,
+    input: &str,
+) -> candle_core::Result<String> {
+    let size = normalizer.size();
+    let mean: Vec<f32> = normalizer.mean.iter().map(|&m| m as f32).collect();
+    let scale: Vec<f32> = normalizer
+        .var
+        .iter()
+        .map(|v| (1.0 / (v + 1e-8).sqrt()) as f32)
+        .collect();
+    let mean = graph.constant_f32(&[size], &mean);
+    let scale = graph.constant_f32(&[size], &scale);
+    let centred = graph.node("Sub", &[input, &mean], vec![]);
+    let scaled = graph.node("Mul", &[&centred, &scale], vec![]);
+    let mut h = graph.clip(&scaled, -CLIP, CLIP);
+    let actor: Vec<_> = policy
+        .named_vars()
+        .into_iter()
+        .filter(|(name, _)| name.starts_with("actor."))
+        .collect();
+    let layers = actor.len() / 2;
+    for (k, pair) in actor.chunks(2).enumerate() {
+        let weight = pair[0].1.as_tensor();
+        let (fan_in, fan_out) = weight.dims2()?;
+        let weights = weight.flatten_all()?.to_vec1::<f32>()?;
+        let bias = pair[1].1.as_tensor().flatten_all()?.to_vec1::<f32>()?;
+        let weight = graph.constant_f32(&[fan_in, fan_out], &weights);
+        let bias = graph.constant_f32(&[fan_out], &bias);
+        h = graph.node("Gemm", &[&h, &weight, &bias], vec![]);
+        if k + 1 < layers {
+            h = graph.node("Relu", &[&h], vec![]);
+        }
+    }
+    Ok(h)
+}
+
+/// Example rows near the observations the policy was trained on (the normalizer's mean plus
+/// two standard deviations of seeded noise), and this tool's outputs for them, computed the way
+/// the tool plays: normalize, run the actor, choose deterministically.
+fn examples(
+    policy: &ActorCritic,
+    card: &PolicyCard,
+    profile: Profile,
+) -> candle_core::Result<Examples> {
+    let observations = example_observations(&card.normalizer, EXAMPLE_ROWS, 0);
+    let outputs = reference_outputs(policy, card, profile, &observations)?;
+    Ok(Examples {
+        observations: observations
+            .chunks(card.normalizer.size())
+            .map(<[f32]>::to_vec)
+            .collect(),
+        outputs,
+    })
+}
+
+/// `rows` observations drawn around the normalizer's statistics, from `seed`.
+pub fn example_observations(normalizer: &RunningNorm, rows: usize, seed: u64) -> Vec<f32> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut out = Vec::with_capacity(rows * normalizer.size());
+    for _ in 0..rows {
+        for (m, v) in normalizer.mean.iter().zip(&normalizer.var) {
+            let noise: f64 = StandardNormal.sample(&mut rng);
+            out.push((m + 2.0 * v.sqrt() * noise) as f32);
+        }
+    }
+    out
+}
+
+/// What each output of the graph should hold for `observations` (rows of raw observations),
+/// computed by this tool's own playing path; masks all allowed. Constant outputs are left out.
+pub fn reference_outputs(
+    policy: &ActorCritic,
+    card: &PolicyCard,
+    profile: Profile,
+    observations: &[f32],
+) -> candle_core::Result<std::collections::BTreeMap<String, Vec<Vec<f32>>>> {
+    let shape = policy.shape();
+    let (c, b) = (shape.continuous, shape.binary);
+    let mut normalized = observations.to_vec();
+    card.normalizer.normalize(&mut normalized);
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    let actions = policy.choose(&normalized, ActMode::Deterministic, &mut rng)?;
+    let head = policy.actor_head(&normalized)?;
+    let rows = |values: &[f32], width: usize, from: usize, to: usize, f: &dyn Fn(f32) -> f32| {
+        values
+            .chunks(width)
+            .map(|row| row[from..to].iter().map(|&v| f(v)).collect::<Vec<f32>>())
+            .collect::<Vec<_>>()
+    };
+    let continuous = rows(&actions, c + b, 0, c, &|v| v.clamp(-1.0, 1.0));
+    let binary = rows(&actions, c + b, c, c + b, &|v| v);
+    let probabilities = rows(&head, c + b, c, c + b, &|v| 1.0 / (1.0 + (-v).exp()));
+    let mut outputs = std::collections::BTreeMap::new();
+    let named: Vec<(&str, &Vec<Vec<f32>>, bool)> = match profile {
+        Profile::Plain => vec![
+            ("continuous_actions", &continuous, c > 0),
+            ("binary_probabilities", &probabilities, b > 0),
+            ("binary_actions", &binary, b > 0),
+        ],
+        Profile::Mlagents => vec![
+            ("continuous_actions", &continuous, c > 0),
+            ("deterministic_continuous_actions", &continuous, c > 0),
+            ("discrete_actions", &binary, b > 0),
+            ("deterministic_discrete_actions", &binary, b > 0),
+        ],
+    };
+    for (name, values, present) in named {
+        if present {
+            outputs.insert(name.to_string(), values.clone());
+        }
+    }
+    Ok(outputs)
+}
+
+fn dims_json(dims: &[Option<usize>]) -> Vec<serde_json::Value> {
+    dims.iter()
+        .map(|d| match d {
+            Some(size) => serde_json::json!(size),
+            None => serde_json::json!("batch"),
+        })
+        .collect()
+}

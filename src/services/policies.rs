@@ -1,0 +1,308 @@
+//! Loading trained policies from files: each pinned by the SHA-256 of its bytes (levels record
+//! it), checked for game, role and shape, with errors that name the file.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+
+use crate::services::generation::GeneratorPolicy;
+use crate::services::panel::{Judge, JudgePanel};
+use crate::services::verify::SolverPolicy;
+use arlpcg_core::game::generator::DEFAULT_CURVE_OFFSET;
+use arlpcg_core::game::generator::{BuildLimits, GeneratorGame, observation_size};
+use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
+use arlpcg_core::level::{Game, PolicyRef};
+use arlpcg_core::rl::checkpoint::TrainMode;
+use arlpcg_core::rl::checkpoint::{
+    LoadedPolicy, MAX_POLICY_BYTES, PolicyCard, Role, load_policy, read_card,
+};
+use arlpcg_core::rl::policy::ActorCritic;
+
+/// File names inside a policies folder.
+pub const GENERATOR_FILE: &str = "generator.safetensors";
+pub const SOLVER_FILE: &str = "solver.safetensors";
+
+fn load_pinned(
+    path: &Path,
+    game: Game,
+    role: Role,
+    observation: usize,
+) -> Result<(LoadedPolicy, PolicyRef)> {
+    let bytes =
+        crate::services::fsio::read_limited(path, MAX_POLICY_BYTES, &format!("{role} policy"))?;
+    let loaded = load_policy(&bytes, game, role, observation)
+        .with_context(|| format!("{}", path.display()))?;
+    Ok((
+        loaded,
+        PolicyRef::pinned(path.display().to_string(), &bytes),
+    ))
+}
+
+/// Loads a Solver policy of `game`.
+pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)> {
+    let observation = match game {
+        Game::Platform => <PlatformGame as GameSpec>::Env::OBSERVATION_SIZE,
+        Game::Racing => <RacingGame as GameSpec>::Env::OBSERVATION_SIZE,
+    };
+    let (loaded, reference) = load_pinned(path, game, Role::Solver, observation)?;
+    let card = loaded.card.clone();
+    Ok((
+        SolverPolicy {
+            game,
+            policy: loaded.policy,
+            normalizer: loaded.card.normalizer,
+            reference,
+        },
+        card,
+    ))
+}
+
+/// Loads a Generator policy of `game`.
+pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, PolicyCard)> {
+    let (observation, default_max_pieces, most_pieces) = match game {
+        Game::Platform => (
+            observation_size::<PlatformGame>(),
+            PlatformGame::DEFAULT_MAX_PIECES,
+            PlatformGame::MAX_PIECES,
+        ),
+        Game::Racing => (
+            observation_size::<RacingGame>(),
+            RacingGame::DEFAULT_MAX_PIECES,
+            RacingGame::MAX_PIECES,
+        ),
+    };
+    let (loaded, reference) = load_pinned(path, game, Role::Generator, observation)?;
+    let card = loaded.card.clone();
+    let limits = BuildLimits {
+        max_pieces: card.max_pieces.unwrap_or(default_max_pieces),
+        curve_offset: card.curve_offset.unwrap_or(DEFAULT_CURVE_OFFSET),
+    };
+    if !(1..=most_pieces).contains(&limits.max_pieces) {
+        anyhow::bail!(
+            "{}: card field max_pieces is {}, outside [1, {most_pieces}]",
+            path.display(),
+            limits.max_pieces
+        );
+    }
+    if !(0.0..=180.0).contains(&limits.curve_offset) {
+        anyhow::bail!(
+            "{}: card field curve_offset is {}, not a number of degrees in [0, 180]",
+            path.display(),
+            limits.curve_offset
+        );
+    }
+    Ok((
+        GeneratorPolicy {
+            game,
+            policy: loaded.policy,
+            limits,
+            normalizer: loaded.card.normalizer,
+            reference,
+        },
+        card,
+    ))
+}
+
+/// The file beside a policies folder's Generator that holds its λ→success curve with the
+/// Solver beside it.
+pub const CURVE_FILE: &str = "difficulty-curve.yaml";
+
+/// Where the λ→success curve of the Generator in `dir` with the Solver at `solver_path` is kept:
+/// [`CURVE_FILE`] for the folder's own Solver, else a file named after the other Solver and its
+/// SHA-256, so that measuring with another Solver never replaces the folder's own curve.
+pub fn curve_path(dir: &Path, solver_path: &Path, solver_sha256: &str) -> PathBuf {
+    let own = dir.join(SOLVER_FILE);
+    let same = match (own.canonicalize(), solver_path.canonicalize()) {
+        (Ok(own), Ok(solver)) => own == solver,
+        _ => own == solver_path,
+    };
+    if same {
+        return dir.join(CURVE_FILE);
+    }
+    let stem = solver_path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .filter(|s| {
+            s.chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        })
+        .unwrap_or("solver");
+    let short = solver_sha256.get(..12).unwrap_or(solver_sha256);
+    dir.join(format!("difficulty-curve-{stem}-{short}.yaml"))
+}
+
+/// The policy in `path`, whichever game and role its card names, loaded and checked as that
+/// game's Solver or Generator: its network, card and pinned reference.
+pub fn load_any(path: &Path) -> Result<(ActorCritic, PolicyCard, PolicyRef)> {
+    let bytes = crate::services::fsio::read_limited(path, MAX_POLICY_BYTES, "policy")?;
+    let card = read_card(&bytes).with_context(|| format!("{}", path.display()))?;
+    Ok(match card.role {
+        Role::Solver => {
+            let (solver, card) = load_solver(path, card.game)?;
+            (solver.policy, card, solver.reference)
+        }
+        Role::Generator => {
+            let (generator, card) = load_generator(path, card.game)?;
+            (generator.policy, card, generator.reference)
+        }
+    })
+}
+
+/// The λ→success curve of `generator` with `solver`, kept in `dir` (see [`curve_path`]): read
+/// when it was measured with these two policies (by SHA-256), else measured (`on_measure` is
+/// told first: it takes a while; `stopped` can end it) and kept there when the folder can be
+/// written.
+pub fn difficulty_curve(
+    dir: &Path,
+    generator: &GeneratorPolicy,
+    solver: &crate::services::verify::Solver,
+    on_measure: impl FnOnce(),
+    stopped: &dyn Fn() -> bool,
+) -> Result<crate::services::difficulty::Curve> {
+    use crate::services::verify::Solver;
+    // A Solver is known by its SHA-256; the scripted player (no file) by its judge name.
+    let (path, identity) = match solver {
+        Solver::Policy(p) => (
+            curve_path(dir, Path::new(&p.reference.path), &p.reference.sha256),
+            p.reference.sha256.clone(),
+        ),
+        Solver::Scripted(skill) => {
+            let name = Judge::Scripted(*skill).name();
+            (dir.join(format!("difficulty-curve-{name}.yaml")), name)
+        }
+        Solver::Random => anyhow::bail!("random actions have no difficulty curve to aim with"),
+    };
+    let current = |c: &crate::services::difficulty::Curve| {
+        c.generator_sha256 == generator.reference.sha256 && c.solver_sha256 == identity
+    };
+    if let Ok(bytes) = crate::services::fsio::read_limited(&path, 1 << 20, "difficulty curve")
+        && let Ok(curve) = serde_yaml::from_slice::<crate::services::difficulty::Curve>(&bytes)
+        && current(&curve)
+    {
+        // The curve of these very policies, damaged: say so rather than aim with it.
+        curve.check().map_err(|problem| {
+            anyhow::anyhow!(
+                "{}: {problem} (delete the file and it is measured again)",
+                path.display()
+            )
+        })?;
+        return Ok(curve);
+    }
+    on_measure();
+    let curve = crate::services::difficulty::measure(generator, solver, &identity, stopped)?;
+    // A folder that cannot be written only costs a new measurement next time.
+    let _ = crate::services::fsio::write_atomic(
+        &path,
+        serde_yaml::to_string(&curve)?.as_bytes(),
+        crate::services::fsio::Overwrite::Allowed,
+    );
+    Ok(curve)
+}
+
+/// The folder of the policies shipped for `game`: `policies/<game>`.
+pub fn shipped_dir(game: Game) -> PathBuf {
+    PathBuf::from("policies").join(game.name())
+}
+
+/// The Solver file of `judge` in a policies folder (`solver.safetensors` is the ARLPCG
+/// Solver, `solver-<mode>.safetensors` the others); `None` for the scripted player.
+pub fn judge_file(dir: &Path, judge: Judge) -> Option<PathBuf> {
+    match judge {
+        Judge::Solver(TrainMode::Arlpcg) => Some(dir.join(SOLVER_FILE)),
+        Judge::Solver(mode) => Some(dir.join(format!("solver-{}.safetensors", mode.name()))),
+        Judge::Scripted(_) => None,
+    }
+}
+
+/// The panel of judges `chosen` from the policies folder `dir` (by default every Solver judge
+/// whose file is there, and the scripted player at its three skills). A chosen Solver judge
+/// whose file is missing is an error naming it.
+pub fn load_panel(dir: &Path, game: Game, chosen: Option<&[Judge]>) -> Result<JudgePanel> {
+    let judges: Vec<Judge> = match chosen {
+        Some(chosen) => chosen.to_vec(),
+        None => Judge::ALL
+            .into_iter()
+            .filter(|&j| judge_file(dir, j).is_none_or(|p| p.exists()))
+            .collect(),
+    };
+    let mut panel = JudgePanel { judges: Vec::new() };
+    for judge in judges {
+        let policy = load_judge(dir, game, judge)?.map(|(policy, _)| policy);
+        panel.judges.push((judge, policy));
+    }
+    Ok(panel)
+}
+
+/// The Solver of `judge` in the policies folder `dir`, checked to be trained in the judge's
+/// mode; `None` for the scripted player.
+pub fn load_judge(
+    dir: &Path,
+    game: Game,
+    judge: Judge,
+) -> Result<Option<(SolverPolicy, PolicyCard)>> {
+    let Some(path) = judge_file(dir, judge) else {
+        return Ok(None);
+    };
+    let (policy, card) =
+        load_solver(&path, game).with_context(|| format!("judge {}", judge.name()))?;
+    if Judge::Solver(card.training.mode) != judge {
+        anyhow::bail!(
+            "judge {}: {} was trained in mode {}, not {}",
+            judge.name(),
+            path.display(),
+            card.training.mode,
+            judge.name()
+        );
+    }
+    Ok(Some((policy, card)))
+}
+
+/// The paths of the Generator and the Solver in a policies folder.
+pub fn policy_paths(dir: &Path) -> (PathBuf, PathBuf) {
+    (dir.join(GENERATOR_FILE), dir.join(SOLVER_FILE))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_the_folders_own_solver_uses_the_folders_curve_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let other = tempfile::tempdir().unwrap();
+        for path in [
+            dir.path().join(SOLVER_FILE),
+            dir.path().join("solver-rule-pcg.safetensors"),
+            other.path().join(SOLVER_FILE),
+        ] {
+            std::fs::write(path, b"weights").unwrap();
+        }
+        let own = curve_path(dir.path(), &dir.path().join(SOLVER_FILE), "ab12");
+        assert_eq!(own, dir.path().join(CURVE_FILE));
+        let spelled_otherwise = dir.path().join(".").join(SOLVER_FILE);
+        assert_eq!(
+            curve_path(dir.path(), &spelled_otherwise, "ab12"),
+            dir.path().join(CURVE_FILE)
+        );
+        let baseline = curve_path(
+            dir.path(),
+            &dir.path().join("solver-rule-pcg.safetensors"),
+            "0123456789abcdef",
+        );
+        assert_eq!(
+            baseline,
+            dir.path()
+                .join("difficulty-curve-solver-rule-pcg-0123456789ab.yaml")
+        );
+        // Another folder's Solver of the same file name: its own curve file, told apart by hash.
+        let foreign = curve_path(
+            dir.path(),
+            &other.path().join(SOLVER_FILE),
+            "fedcba9876543210",
+        );
+        assert_eq!(
+            foreign,
+            dir.path().join("difficulty-curve-solver-fedcba987654.yaml")
+        );
+    }
+}

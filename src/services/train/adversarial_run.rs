@@ -1,0 +1,386 @@
+//! An adversarial run: the Solver's run, whose environments hold the Generator, and the
+//! Generator's own phases, counters, metrics and checkpoint.
+
+use std::io::Write;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+use super::*;
+
+/// An adversarial run: the Solver's run, whose environments hold the Generator, and the
+/// Generator's own counters and metrics.
+pub(super) struct AdversarialRun<G: GeneratorGame> {
+    pub(super) solver: SolverRun<AdversarialEnvs<G>>,
+    pub(super) generator_iteration: u64,
+    pub(super) generator_metrics: std::fs::File,
+}
+
+impl<G: GeneratorGame> AdversarialRun<G> {
+    pub(super) fn rules(mode: TrainMode, config: &TrainConfig) -> MatchRules {
+        MatchRules {
+            aux_values: match mode {
+                TrainMode::FixedAux => vec![1.0],
+                _ => config.generator.aux_values.clone(),
+            },
+            limits: BuildLimits {
+                max_pieces: config.generator.max_pieces,
+                curve_offset: config.generator.curve_offset,
+            },
+            obstacles: config.generator.obstacles,
+            rewards: config.generator.rewards.clone(),
+            snapshot_share: config.generator.snapshot_share,
+            scripted_opponent: None,
+            paced_share: match mode {
+                TrainMode::FixedAux => 0.0,
+                _ => config.generator.paced_share,
+            },
+        }
+    }
+
+    pub(super) fn start(out: &Path, mode: TrainMode, config: TrainConfig) -> Result<Self> {
+        let build = |config: &TrainConfig, _: Option<serde_json::Value>| {
+            let policy = ActorCritic::new(
+                generator_shape(config, G::GAME),
+                config.seed.wrapping_add(1),
+            )?;
+            policy.set_log_std(config.generator.initial_log_std)?;
+            let generator = Generator {
+                ppo: Ppo::new(config.generator.ppo.clone(), policy)?,
+                norm: RunningNorm::new(observation_size::<G>()),
+            };
+            let rng = ChaCha8Rng::seed_from_u64(config.seed.wrapping_add(1));
+            AdversarialEnvs::new(
+                config.solver.num_envs,
+                generator,
+                rng,
+                Self::rules(mode, config),
+                AdversarialRecord::default(),
+                Vec::new(),
+                solver_shape(config, G::GAME).action_size(),
+            )
+        };
+        let solver = SolverRun::start(out, mode, config, build)?;
+        fsio::write_atomic(
+            &out.join(GENERATOR_METRICS),
+            format!("{}\n", generator_metrics_header::<G>()).as_bytes(),
+            Overwrite::Allowed,
+        )?;
+        Ok(Self {
+            solver,
+            generator_iteration: 0,
+            generator_metrics: open_append(&out.join(GENERATOR_METRICS))?,
+        })
+    }
+
+    pub(super) fn resume(out: &Path, mode: TrainMode, change: ConfigChange) -> Result<Self> {
+        let path = out.join(GENERATOR_CHECKPOINT);
+        if !path.exists() && out.join(CHECKPOINT).exists() {
+            // A Solver-only run: its checkpoint says which mode it was trained in.
+            read_checkpoint(&out.join(CHECKPOINT), G::GAME, Role::Solver, mode)?;
+        }
+        let (loaded, generator_state) = read_checkpoint(&path, G::GAME, Role::Generator, mode)?;
+        let generator_iteration = generator_state.iteration;
+        let record: PopulationRecord = match &generator_state.source {
+            serde_json::Value::Null => PopulationRecord::default(),
+            source => serde_json::from_value(source.clone())
+                .with_context(|| format!("{}: population", path.display()))?,
+        };
+        let build = move |config: &TrainConfig, source: Option<serde_json::Value>| {
+            if let Some(trained) = loaded.card.curve_offset
+                && trained != config.generator.curve_offset
+            {
+                anyhow::bail!(
+                    "{}: this Generator was trained with generator.curve_offset {trained}, the \
+                     configuration says {}; it maps its actions to curves by that offset, so it \
+                     cannot change",
+                    path.display(),
+                    config.generator.curve_offset
+                );
+            }
+            let matches: AdversarialRecord =
+                serde_json::from_value(source.unwrap_or_default()).context("match source")?;
+            let mut population =
+                population_from(&record, &loaded.tensors, &solver_shape(config, G::GAME))
+                    .map_err(|e| anyhow::anyhow!("{}: population: {e}", path.display()))?;
+            // A configuration that keeps fewer snapshots drops the oldest.
+            let surplus = population.len().saturating_sub(config.generator.population);
+            population.drain(..surplus);
+            let vars = loaded.policy.named_vars();
+            let mut ppo = Ppo::new(config.generator.ppo.clone(), loaded.policy)?;
+            ppo.adam
+                .restore(&vars, &loaded.tensors, generator_state.adam_step)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            let generator = Generator {
+                ppo,
+                norm: loaded.card.normalizer.clone(),
+            };
+            // The matches under way are replayed (none if the rules changed: fresh ones start).
+            AdversarialEnvs::new(
+                config.solver.num_envs,
+                generator,
+                generator_state.rng,
+                Self::rules(mode, config),
+                matches,
+                population,
+                solver_shape(config, G::GAME).action_size(),
+            )
+        };
+        let solver = SolverRun::resume(out, mode, change, build)?;
+        truncate_metrics(
+            &out.join(GENERATOR_METRICS),
+            &generator_metrics_header::<G>(),
+            generator_iteration,
+        )?;
+        Ok(Self {
+            solver,
+            generator_iteration,
+            generator_metrics: open_append(&out.join(GENERATOR_METRICS))?,
+        })
+    }
+
+    pub(super) fn envs(&mut self) -> &mut AdversarialEnvs<G> {
+        &mut self.solver.trainer.env
+    }
+
+    pub(super) fn generator_card(&self, wall_time_s: f64) -> PolicyCard {
+        let envs = &self.solver.trainer.env;
+        let mut card = card(
+            G::GAME,
+            Role::Generator,
+            self.solver.mode,
+            &self.solver.config,
+            &envs.generator.norm,
+            envs.state.generator_steps,
+            wall_time_s,
+        );
+        card.training.population = envs.population.iter().map(|s| s.solver_steps).collect();
+        record_commands(&mut card, &self.solver.commands);
+        card
+    }
+
+    /// Takes a snapshot of the Solver for the population when the last is
+    /// `population_every_steps` old (or there is none).
+    fn snapshot_if_due(&mut self) -> Result<()> {
+        let generator = &self.solver.config.generator;
+        let (keep, every) = (generator.population, generator.population_every_steps);
+        let trainer = &mut self.solver.trainer;
+        let now = trainer.global_step;
+        let due = trainer
+            .env
+            .population
+            .last()
+            .is_none_or(|last| now.saturating_sub(last.solver_steps) >= every);
+        if keep > 0 && due {
+            let snapshot = Snapshot::of(&trainer.ppo.policy, &trainer.norm, now)?;
+            trainer.env.add_snapshot(snapshot, keep);
+        }
+        Ok(())
+    }
+
+    /// Plays until a batch of Generator decisions is complete, and learns from it (with the
+    /// schedule's entropy bonus, if it sets one); returns its progress line and the statistics
+    /// of the matches that ended meanwhile.
+    pub(super) fn generator_iteration(
+        &mut self,
+        lr_scale: f64,
+        entropy: Option<f32>,
+        wall: &dyn Fn() -> f64,
+    ) -> Result<(String, MatchStats)> {
+        let config = self.solver.config.generator.ppo.clone();
+        let learning_rate = if config.anneal_lr {
+            config.learning_rate * lr_scale
+        } else {
+            config.learning_rate
+        };
+        let t0 = wall();
+        self.envs().take_stats();
+        while self.envs().completed_decisions() < config.batch_size() {
+            self.solver.trainer.play_tick()?;
+        }
+        let batch = self.envs().take_generator_batch();
+        let stats = self.envs().take_stats();
+        let t1 = wall();
+        let envs = self.envs();
+        envs.generator.ppo.config.ent_coef = entropy.unwrap_or(config.ent_coef);
+        let update = envs
+            .generator
+            .ppo
+            .update(&batch, learning_rate, &mut envs.rng)?;
+        let t2 = wall();
+        let decisions = batch.log_probs.len() as u64;
+        envs.state.generator_steps += decisions;
+        envs.state.phase_steps += decisions;
+        self.generator_iteration += 1;
+        let row = generator_row(&stats);
+        writeln!(
+            self.generator_metrics,
+            "{},{},{},{:.2},{:.3},{:.3},{:.3e},{row},{},{}",
+            self.generator_iteration,
+            self.solver.trainer.global_step,
+            self.solver.trainer.env.state.generator_steps,
+            wall(),
+            t1 - t0,
+            t2 - t1,
+            learning_rate,
+            update_columns(&update),
+            scripted_columns(&stats)
+        )?;
+        let ratio = |a: u32, b: u32| a as f64 / b.max(1) as f64;
+        let mut message = format!(
+            "generator: success easy {:.2} / hard {:.2}, invalid {:.2}",
+            ratio(stats.successes[0], stats.judged[0]),
+            ratio(stats.successes[1], stats.judged[1]),
+            ratio(stats.invalid, stats.episodes)
+        );
+        if stats.scripted_judged != [0, 0] {
+            message += &format!(
+                ", scripted opponent easy {:.2} / hard {:.2}",
+                ratio(stats.scripted_successes[0], stats.scripted_judged[0]),
+                ratio(stats.scripted_successes[1], stats.scripted_judged[1])
+            );
+        }
+        Ok((message, stats))
+    }
+}
+
+impl<G: GeneratorGame> Training for AdversarialRun<G> {
+    fn solver_steps(&self) -> u64 {
+        self.solver.trainer.global_step
+    }
+
+    fn budget(&self) -> u64 {
+        let config = &self.solver.config;
+        let budget = config.adversarial_budget();
+        match self.solver.trainer.env.state.finish_ended_at {
+            // A finish ended early by its catch-up's success, unless the budget has grown
+            // past where it ended (a resume with more steps trains on).
+            Some(at) if at > config.steps => at.min(budget),
+            _ => budget,
+        }
+    }
+
+    fn wall_before(&self) -> f64 {
+        self.solver.wall_before
+    }
+
+    fn add_session(&mut self, command: String) {
+        self.solver.commands.push(command);
+    }
+
+    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
+        let config = &self.solver.config;
+        let steps = self.solver.trainer.global_step;
+        // The stage in force where this iteration starts (a stage begins at a phase's end).
+        let schedule = config.schedule_at(steps);
+        let lr_scale = config.lr_scale(steps);
+        let warmup_steps = config.generator.solver_warmup_steps;
+        let in_finish = config.in_finish(steps);
+        let finish = config.generator.finish;
+        self.envs().rules.snapshot_share = schedule.snapshot_share;
+        self.envs().rules.scripted_opponent = schedule.scripted_opponent;
+        match self.envs().state.phase {
+            Phase::Solver => {
+                let rollout =
+                    self.solver
+                        .solver_iteration(lr_scale, schedule.solver_learning_rate, wall)?;
+                let phase_began = steps.saturating_sub(self.envs().state.phase_steps);
+                let catching_up = self.solver.config.in_finish(phase_began);
+                // A Solver phase under way when the finish begins ends with the finish's first
+                // iteration, so that the finish opens with the Generator's phase.
+                let opens_finish = in_finish && !catching_up;
+                let envs = self.envs();
+                envs.state.phase_steps += rollout.steps;
+                let ends = opens_finish || envs.state.phase_steps >= schedule.solver_phase_steps;
+                if let Some(target) = finish.until_hard_success
+                    && catching_up
+                {
+                    let now = self.solver.trainer.global_step;
+                    let envs = self.envs();
+                    let stats = envs.take_stats();
+                    if envs
+                        .count_hard_block(&stats, finish.hard_match_block)
+                        .is_some_and(|s| s >= target)
+                    {
+                        envs.state.finish_ended_at = Some(now);
+                    }
+                }
+                let warm = self.solver.trainer.global_step >= warmup_steps;
+                if warm && ends {
+                    self.snapshot_if_due()?;
+                    self.envs().set_phase(Phase::Generator);
+                }
+                Ok(format!(
+                    "solver: return {:.2}, success {:.2}",
+                    rollout.mean_return, rollout.success_ratio
+                ))
+            }
+            Phase::Generator => {
+                let (message, stats) =
+                    self.generator_iteration(lr_scale, schedule.generator_entropy, wall)?;
+                let envs = self.envs();
+                // In the finish, the phase may end early once the Solver fails enough.
+                let hard_enough = match finish.generator_until_hard_success {
+                    Some(target) if in_finish => envs
+                        .count_hard_block(&stats, finish.hard_match_block)
+                        .is_some_and(|s| s <= target),
+                    _ => false,
+                };
+                if hard_enough || envs.state.phase_steps >= schedule.generator_phase_steps {
+                    envs.set_phase(Phase::Solver);
+                }
+                Ok(message)
+            }
+        }
+    }
+
+    fn checkpoint_minutes(&self) -> f64 {
+        self.solver.config.checkpoint_minutes
+    }
+
+    fn save_checkpoint(&self, wall: f64) -> Result<()> {
+        let envs = &self.solver.trainer.env;
+        let (population, tensors) = population_record(&envs.population);
+        let state = TrainingState {
+            global_step: envs.state.generator_steps,
+            iteration: self.generator_iteration,
+            adam_step: envs.generator.ppo.adam.step,
+            wall_time_s: wall,
+            rng: envs.rng.clone(),
+            source: serde_json::to_value(population)?,
+            config: serde_json::to_value(&self.solver.config)?,
+            episode_returns: Vec::new(),
+        };
+        let card = self.generator_card(wall);
+        let bytes = checkpoint::checkpoint_bytes(&envs.generator.ppo, &card, &state, tensors);
+        let out = &self.solver.out;
+        // Both or neither: a resume needs the two networks of one iteration.
+        let mut batch = fsio::FileBatch::new();
+        batch.stage(&out.join(GENERATOR_CHECKPOINT), &bytes, Overwrite::Allowed)?;
+        let solver = self.solver.solver_checkpoint_bytes(wall)?;
+        batch.stage(&out.join(CHECKPOINT), &solver, Overwrite::Allowed)?;
+        batch.commit()
+    }
+
+    fn save_policies(&self, wall: f64) -> Result<()> {
+        let out = &self.solver.out;
+        save_policy_files(
+            out,
+            "generator",
+            &self.solver.trainer.env.generator.ppo.policy,
+            &self.generator_card(wall),
+        )?;
+        save_policy_files(
+            out,
+            "solver",
+            &self.solver.trainer.ppo.policy,
+            &self.solver.solver_card(wall),
+        )
+    }
+
+    fn out(&self) -> &Path {
+        &self.solver.out
+    }
+}

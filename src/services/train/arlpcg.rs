@@ -1,0 +1,589 @@
+//! The adversarial loop (ARLPCG), written once for both games: many [`Match`]es, each a Generator
+//! building a level while a Solver plays it, stepped together. Seen from the Solver's trainer
+//! this is a [`VecEnv`]: the Generator lives inside it and places pieces (one batched forward
+//! pass for every match that needs one) whenever Solvers come close to their newest piece.
+//!
+//! Training alternates phases (docs/spec.md §3): while the Solver learns, the Generator only runs
+//! inference; while the Generator learns, the Solver only runs inference and the Generator's
+//! decisions are recorded per match, to be learned from with PPO once enough have completed.
+//! Each match draws its goal, start (and racing obstacles) and λ from its own seed (episode
+//! counter from [`TRAINING_SEED_BASE`]), so runs are reproducible and resumable.
+//!
+//! With a population, each match also draws who plays it while the Generator learns: the
+//! current Solver or one of its earlier [`Snapshot`]s, so that the Generator's failure reward
+//! comes from several networks and no single one's blind spot pays. In a finish with a scripted
+//! opponent, a match may draw the game's scripted player instead, which acts on the world it
+//! sees. While the Solver learns it plays every match itself.
+//!
+//! Each match keeps the log of what it has been through (its seed, then every piece placed and
+//! every Solver step, as action rows); a checkpoint stores the logs with the Generator's
+//! pending decisions ([`MatchesUnderWay`]) and a resume replays them, so a resumed run goes on
+//! with the very matches it stopped in.
+
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::services::train::config::ScriptedOpponent;
+use crate::services::train::population::Snapshot;
+use arlpcg_core::game::generator::{
+    BuildLimits, GeneratorGame, GeneratorRewards, Match, MatchPacing, TrackBuild, observation_size,
+};
+use arlpcg_core::game::{Scripted, SolverEnv};
+use arlpcg_core::level::stats::{Outcome, Skill};
+use arlpcg_core::rl::normalizer::RunningNorm;
+use arlpcg_core::rl::policy::ActMode;
+use arlpcg_core::rl::ppo::{Batch, Ppo, gae};
+use arlpcg_core::rl::vec_env::{Transition, VecEnv};
+use arlpcg_core::seed_ranges::TRAINING_SEED_BASE;
+
+mod replay;
+pub use replay::{AdversarialRecord, MatchEvent, MatchLog, MatchesUnderWay};
+
+/// The scripted player of a match, with its skill.
+type ScriptedPlayer<G> = (Skill, <G as arlpcg_core::game::GameSpec>::Scripted);
+
+/// Which agent is learning.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Phase {
+    Solver,
+    Generator,
+}
+
+/// Progress of the match source and the phase schedule, saved in checkpoints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct AdversarialState {
+    /// Matches started so far (each gets its own seed).
+    pub episodes_started: u64,
+    pub phase: Phase,
+    /// Steps the learning agent has learned from in the current phase.
+    pub phase_steps: u64,
+    /// Generator decisions learned from, over the run.
+    pub generator_steps: u64,
+    /// The finish: the Solver's successes and finished hard matches (λ < 0) in the block being
+    /// counted (`Finish::generator_until_hard_success`, `Finish::until_hard_success`)...
+    #[serde(default, alias = "catch_up_block")]
+    pub hard_block: [u32; 2],
+    /// ...and the Solver steps where the catch-up ended the finish (none: it has not).
+    #[serde(default)]
+    pub finish_ended_at: Option<u64>,
+}
+
+impl Default for AdversarialState {
+    fn default() -> Self {
+        Self {
+            episodes_started: 0,
+            phase: Phase::Solver,
+            phase_steps: 0,
+            generator_steps: 0,
+            hard_block: [0, 0],
+            finish_ended_at: None,
+        }
+    }
+}
+
+/// What the matches are made of.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MatchRules {
+    /// λ is drawn uniformly from these for each match.
+    pub aux_values: Vec<f32>,
+    pub limits: BuildLimits,
+    /// Obstacles drawn into each racing match's scene.
+    pub obstacles: u32,
+    pub rewards: GeneratorRewards,
+    /// The share of matches a snapshot plays (`None`: uniform over the current Solver and the
+    /// snapshots).
+    pub snapshot_share: Option<f64>,
+    /// The scripted player's share of the matches while the Generator learns (in a finish).
+    pub scripted_opponent: Option<ScriptedOpponent>,
+    /// The share of matches whose λ changes along the track
+    /// ([`GeneratorConfig::paced_share`](super::GeneratorConfig::paced_share)).
+    pub paced_share: f64,
+}
+
+/// The Generator with its optimizer and normalizer.
+pub struct Generator {
+    pub ppo: Ppo,
+    pub norm: RunningNorm,
+}
+
+/// One recorded Generator decision.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct Decision {
+    observation: Vec<f32>,
+    action: Vec<f32>,
+    log_prob: f32,
+    value: f32,
+    /// Reward from this decision until the next one (still growing while it is the newest).
+    reward: f32,
+    /// The match ended before the next decision.
+    ended: bool,
+}
+
+/// Episode statistics since they were last taken, split by the sign of λ.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct MatchStats {
+    pub episodes: u32,
+    pub invalid: u32,
+    pub generator_return_sum: f64,
+    /// [easy (λ > 0), hard (λ < 0)]: finished (valid) matches, Solver successes, pieces placed,
+    /// the sums of the pieces' two features (`GeneratorGame::PIECE_FEATURES`), and the Solver's
+    /// steps in the air.
+    pub judged: [u32; 2],
+    pub successes: [u32; 2],
+    pub pieces: [u32; 2],
+    pub feature_sums: [[f64; 2]; 2],
+    pub air_steps: [u64; 2],
+    /// [easy, hard]: the matches the scripted opponent finished, and its successes (counted
+    /// apart: the finish's stops count the Solver's).
+    #[serde(default)]
+    pub scripted_judged: [u32; 2],
+    #[serde(default)]
+    pub scripted_successes: [u32; 2],
+}
+
+/// Many matches of the Generator against the Solver, as the Solver's environments.
+pub struct AdversarialEnvs<G: GeneratorGame> {
+    matches: Vec<Match<G>>,
+    /// Per match, what it has been through.
+    logs: Vec<MatchLog>,
+    pub generator: Generator,
+    /// Samples the Generator's actions and shuffles its minibatches.
+    pub rng: ChaCha8Rng,
+    pub rules: MatchRules,
+    pub state: AdversarialState,
+    /// Per match, the Generator decisions recorded while it learns (oldest first).
+    recorded: Vec<Vec<Decision>>,
+    generator_returns: Vec<f32>,
+    pub stats: MatchStats,
+    /// Earlier Solvers, oldest first.
+    pub population: Vec<Snapshot>,
+    /// Per match, the snapshot that plays it while the Generator learns (`None`: the current
+    /// Solver).
+    opponents: Vec<Option<usize>>,
+    /// Per match, the scripted player (and its skill) that plays it while the Generator
+    /// learns, if one does.
+    scripted: Vec<Option<ScriptedPlayer<G>>>,
+}
+
+impl<G: GeneratorGame> AdversarialEnvs<G> {
+    /// `num_matches` matches, continuing from `record`: its matches under way are replayed
+    /// (Solver action rows of `solver_action_size`); without them, fresh matches start and
+    /// each gets its first piece. `Err` says why a record's matches cannot be replayed.
+    pub fn new(
+        num_matches: usize,
+        generator: Generator,
+        rng: ChaCha8Rng,
+        rules: MatchRules,
+        record: AdversarialRecord,
+        population: Vec<Snapshot>,
+        solver_action_size: usize,
+    ) -> anyhow::Result<Self> {
+        let mut this = Self {
+            matches: Vec::with_capacity(num_matches),
+            logs: Vec::with_capacity(num_matches),
+            generator,
+            rng,
+            rules,
+            state: record.state,
+            recorded: vec![Vec::new(); num_matches],
+            generator_returns: vec![0.0; num_matches],
+            stats: MatchStats::default(),
+            population,
+            opponents: Vec::with_capacity(num_matches),
+            scripted: Vec::with_capacity(num_matches),
+        };
+        if let Some(under_way) = record.under_way {
+            this.replay(num_matches, under_way, solver_action_size)
+                .map_err(|problem| anyhow::anyhow!("matches under way: {problem}"))?;
+            return Ok(this);
+        }
+        for _ in 0..num_matches {
+            let (fresh, opponent, scripted) = this.next_match();
+            this.logs.push(MatchLog {
+                seed: fresh.seed(),
+                events: Vec::new(),
+            });
+            this.matches.push(fresh);
+            this.opponents.push(opponent);
+            this.scripted.push(scripted);
+        }
+        this.first_pieces((0..num_matches).collect())?;
+        Ok(this)
+    }
+
+    /// Lets the Generator place the first piece of the fresh matches `indices`; a match whose
+    /// first piece is invalid (a racing segment into an obstacle) is replaced by the next.
+    fn first_pieces(&mut self, mut indices: Vec<usize>) -> candle_core::Result<()> {
+        while !indices.is_empty() {
+            let invalid = self.place_while_needed(indices)?;
+            for &i in &invalid {
+                self.restart(i, None);
+            }
+            indices = invalid;
+        }
+        Ok(())
+    }
+
+    /// Lets the Generator place pieces in the matches `indices` until none wants another (a
+    /// racing road is built [`arlpcg_core::game::racing::generator::REQUEST_DISTANCE`] ahead of the
+    /// car, which can take more than one segment at the start); returns the matches that ended
+    /// because a placement was invalid.
+    fn place_while_needed(&mut self, mut indices: Vec<usize>) -> candle_core::Result<Vec<usize>> {
+        let mut ended = Vec::new();
+        while !indices.is_empty() {
+            let invalid = self.decide(&indices)?;
+            indices.retain(|i| !invalid.contains(i) && self.matches[*i].needs_piece());
+            ended.extend(invalid);
+        }
+        Ok(ended)
+    }
+
+    pub fn learning(&self) -> bool {
+        self.state.phase == Phase::Generator
+    }
+
+    /// Switches phase; recordings of the Generator start afresh when it starts learning.
+    pub fn set_phase(&mut self, phase: Phase) {
+        self.state.phase = phase;
+        self.state.phase_steps = 0;
+        self.state.hard_block = [0, 0];
+        for recorded in &mut self.recorded {
+            recorded.clear();
+        }
+    }
+
+    /// The next match, and the snapshot or scripted player that plays it while the Generator
+    /// learns.
+    fn next_match(&mut self) -> (Match<G>, Option<usize>, Option<ScriptedPlayer<G>>) {
+        let seed = TRAINING_SEED_BASE + self.state.episodes_started;
+        self.state.episodes_started += 1;
+        let (fresh, mut rng) = self.match_of(seed);
+        let snapshots = self.population.len();
+        let opponent = match (snapshots, self.rules.snapshot_share) {
+            (0, _) => None,
+            (n, None) => Some(rng.random_range(0..=n)).filter(|&k| k < n),
+            (n, Some(share)) => rng.random_bool(share).then(|| rng.random_range(0..n)),
+        };
+        // Drawn only with a scripted opponent, so that runs without one keep their bytes.
+        let scripted = match self.rules.scripted_opponent {
+            Some(o) if opponent.is_none() && rng.random_bool(o.share) => {
+                Some((o.skill, G::scripted(seed, o.skill)))
+            }
+            _ => None,
+        };
+        (fresh, opponent, scripted)
+    }
+
+    /// The match of `seed` before its first piece (its build and λ drawn from the seed), and
+    /// the seed's generator, to draw on from.
+    fn match_of(&self, seed: u64) -> (Match<G>, ChaCha8Rng) {
+        let (build, mut rng) = G::new_build(seed, None, self.rules.limits, self.rules.obstacles);
+        let values = &self.rules.aux_values;
+        let aux = values[rng.random_range(0..values.len())];
+        let fresh = Match::new(build, vec![aux], seed);
+        // Drawn only when pacing is on, so that runs without it keep their bytes.
+        if self.rules.paced_share > 0.0 && rng.random_bool(self.rules.paced_share) {
+            let pacing = MatchPacing {
+                before: aux,
+                after: values[rng.random_range(0..values.len())],
+                switch: rng.random_range(0.25..=0.75),
+            };
+            return (fresh.paced(pacing), rng);
+        }
+        (fresh, rng)
+    }
+
+    /// Adds a snapshot of the Solver, the oldest leaving beyond `keep`; the matches it played
+    /// go to the current Solver.
+    pub fn add_snapshot(&mut self, snapshot: Snapshot, keep: usize) {
+        self.population.push(snapshot);
+        while self.population.len() > keep {
+            self.population.remove(0);
+            for opponent in &mut self.opponents {
+                *opponent = opponent.and_then(|k| k.checked_sub(1));
+            }
+        }
+    }
+
+    /// The actions with those of the matches that snapshots play replaced by the snapshots'
+    /// (one batched forward pass per snapshot), while the Generator learns.
+    fn with_opponents(&mut self, actions: &[f32]) -> candle_core::Result<Option<Vec<f32>>> {
+        if !self.learning() || self.opponents.iter().all(Option::is_none) {
+            return Ok(None);
+        }
+        let width = actions.len() / self.matches.len();
+        let d = G::Env::OBSERVATION_SIZE;
+        let mut replaced = actions.to_vec();
+        for (k, snapshot) in self.population.iter().enumerate() {
+            let played: Vec<usize> = (0..self.matches.len())
+                .filter(|&i| self.opponents[i] == Some(k))
+                .collect();
+            if played.is_empty() {
+                continue;
+            }
+            let mut observations = vec![0.0; played.len() * d];
+            for (&i, row) in played.iter().zip(observations.chunks_mut(d)) {
+                self.matches[i].env().observe(row);
+            }
+            snapshot.norm.normalize(&mut observations);
+            // Playing, not learning: the actor alone, with the random numbers `act` would draw.
+            let actions = snapshot
+                .policy
+                .choose(&observations, ActMode::Sample, &mut self.rng)?;
+            for (n, &i) in played.iter().enumerate() {
+                replaced[i * width..(i + 1) * width]
+                    .copy_from_slice(&actions[n * width..(n + 1) * width]);
+            }
+        }
+        Ok(Some(replaced))
+    }
+
+    /// Lets the Generator place a piece in each of the matches `indices`; returns the matches
+    /// that ended because the placement was invalid.
+    fn decide(&mut self, indices: &[usize]) -> candle_core::Result<Vec<usize>> {
+        if indices.is_empty() {
+            return Ok(Vec::new());
+        }
+        let d = observation_size::<G>();
+        let mut observations = vec![0.0; indices.len() * d];
+        for (&i, row) in indices.iter().zip(observations.chunks_mut(d)) {
+            self.matches[i].observe_generator(row);
+        }
+        let learning = self.learning();
+        if learning {
+            self.generator.norm.update(&observations);
+        }
+        self.generator.norm.normalize(&mut observations);
+        let acted = self
+            .generator
+            .ppo
+            .policy
+            .act(&observations, ActMode::Sample, &mut self.rng)?;
+        let width = acted.actions.len() / indices.len();
+        let mut ended = Vec::new();
+        for (k, &i) in indices.iter().enumerate() {
+            let action = &acted.actions[k * width..(k + 1) * width];
+            let game = &mut self.matches[i];
+            let invalid = game.place(action).is_invalid();
+            self.logs[i].events.push(MatchEvent::Place(action.to_vec()));
+            let mut reward = self.rules.rewards.per_piece(game.placed_aux());
+            if invalid {
+                reward += self.rules.rewards.invalid;
+                ended.push(i);
+            }
+            self.generator_returns[i] += reward;
+            if learning {
+                self.recorded[i].push(Decision {
+                    observation: observations[k * d..(k + 1) * d].to_vec(),
+                    action: action.to_vec(),
+                    log_prob: acted.log_probs[k],
+                    value: acted.values[k],
+                    reward,
+                    ended: invalid,
+                });
+            }
+        }
+        Ok(ended)
+    }
+
+    /// Ends match `i` (recording its statistics) and starts the next one in its place.
+    fn restart(&mut self, i: usize, solver_outcome: Option<Outcome>) {
+        let game = &self.matches[i];
+        let aux = game.aux[0];
+        let by_scripted = self.learning() && self.scripted[i].is_some();
+        let stats = &mut self.stats;
+        stats.episodes += 1;
+        stats.generator_return_sum += self.generator_returns[i] as f64;
+        self.generator_returns[i] = 0.0;
+        match solver_outcome {
+            None => stats.invalid += 1,
+            Some(outcome) if by_scripted && aux != 0.0 && game.pacing().is_none() => {
+                let side = usize::from(aux < 0.0);
+                stats.scripted_judged[side] += 1;
+                stats.scripted_successes[side] += u32::from(outcome == Outcome::Success);
+            }
+            Some(outcome) if aux != 0.0 && game.pacing().is_none() => {
+                let side = usize::from(aux < 0.0);
+                stats.judged[side] += 1;
+                stats.successes[side] += u32::from(outcome == Outcome::Success);
+                for features in game.build().piece_features() {
+                    stats.pieces[side] += 1;
+                    stats.feature_sums[side][0] += features[0];
+                    stats.feature_sums[side][1] += features[1];
+                }
+                stats.air_steps[side] += u64::from(G::air_steps(game.env()));
+            }
+            Some(_) => {}
+        }
+        if let Some(last) = self.recorded[i].last_mut() {
+            last.ended = true;
+        }
+        let (fresh, opponent, scripted) = self.next_match();
+        self.logs[i] = MatchLog {
+            seed: fresh.seed(),
+            events: Vec::new(),
+        };
+        self.matches[i] = fresh;
+        self.opponents[i] = opponent;
+        self.scripted[i] = scripted;
+    }
+
+    /// Recorded Generator decisions that are complete (their reward is final).
+    pub fn completed_decisions(&self) -> usize {
+        self.recorded
+            .iter()
+            .map(|r| r.len() - usize::from(r.last().is_some_and(|d| !d.ended)))
+            .sum()
+    }
+
+    /// Takes the completed decisions as a PPO batch (advantages by GAE along each match's
+    /// sequence of decisions); a decision still waiting for its reward stays for the next batch.
+    pub fn take_generator_batch(&mut self) -> Batch {
+        let config = &self.generator.ppo.config;
+        let mut batch = Batch {
+            observations: Vec::new(),
+            actions: Vec::new(),
+            log_probs: Vec::new(),
+            advantages: Vec::new(),
+            returns: Vec::new(),
+            values: Vec::new(),
+        };
+        for recorded in &mut self.recorded {
+            let pending = recorded.last().filter(|d| !d.ended).cloned();
+            if pending.is_some() {
+                recorded.pop();
+            }
+            if !recorded.is_empty() {
+                let rewards: Vec<f32> = recorded.iter().map(|d| d.reward).collect();
+                let values: Vec<f32> = recorded.iter().map(|d| d.value).collect();
+                let ended: Vec<bool> = recorded.iter().map(|d| d.ended).collect();
+                let last_value = pending.as_ref().map_or(0.0, |d| d.value);
+                let (advantages, returns) = gae(
+                    &rewards,
+                    &values,
+                    &ended,
+                    &[last_value],
+                    config.gamma,
+                    config.gae_lambda,
+                );
+                for d in recorded.iter() {
+                    batch.observations.extend_from_slice(&d.observation);
+                    batch.actions.extend_from_slice(&d.action);
+                    batch.log_probs.push(d.log_prob);
+                    batch.values.push(d.value);
+                }
+                batch.advantages.extend(advantages);
+                batch.returns.extend(returns);
+            }
+            recorded.clear();
+            recorded.extend(pending);
+        }
+        batch
+    }
+
+    /// The match statistics gathered since the last call.
+    pub fn take_stats(&mut self) -> MatchStats {
+        std::mem::take(&mut self.stats)
+    }
+
+    /// Adds the hard matches (λ < 0) of `stats` to the block being counted; once the block
+    /// holds `block_size` of them, returns the Solver's success ratio over it and begins a
+    /// new one.
+    pub fn count_hard_block(&mut self, stats: &MatchStats, block_size: u32) -> Option<f64> {
+        let block = &mut self.state.hard_block;
+        block[0] += stats.successes[1];
+        block[1] += stats.judged[1];
+        if block[1] < block_size {
+            return None;
+        }
+        let ratio = f64::from(block[0]) / f64::from(block[1]);
+        *block = [0, 0];
+        Some(ratio)
+    }
+}
+
+impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
+    fn num_envs(&self) -> usize {
+        self.matches.len()
+    }
+
+    fn observation_size(&self) -> usize {
+        G::Env::OBSERVATION_SIZE
+    }
+
+    fn observe(&mut self, out: &mut [f32]) {
+        self.matches
+            .par_iter()
+            .zip(out.par_chunks_mut(G::Env::OBSERVATION_SIZE))
+            .for_each(|(game, row)| game.env().observe(row));
+    }
+
+    fn step(&mut self, actions: &[f32], out: &mut [Transition]) {
+        let replaced = self
+            .with_opponents(actions)
+            .expect("the snapshots' forward pass runs on the CPU");
+        let actions = replaced.as_deref().unwrap_or(actions);
+        let width = actions.len() / self.matches.len();
+        let rewards = &self.rules.rewards;
+        let learning = self.learning();
+        let steps: Vec<(arlpcg_core::game::Step, f32)> = self
+            .matches
+            .par_iter_mut()
+            .zip(self.logs.par_iter_mut())
+            .zip(self.scripted.par_iter_mut())
+            .zip(actions.par_chunks(width))
+            .map(|(((game, log), scripted), row)| {
+                let action = match scripted.as_mut().filter(|_| learning) {
+                    Some((_, player)) => {
+                        log.events.push(MatchEvent::Scripted);
+                        player.act(game.env())
+                    }
+                    None => {
+                        log.events.push(MatchEvent::Step(row.to_vec()));
+                        G::Env::action_from_policy_row(row)
+                    }
+                };
+                game.step_solver(action, rewards)
+            })
+            .collect();
+        let mut finished = Vec::new();
+        let mut turns = Vec::new();
+        for (i, (step, generator_reward)) in steps.into_iter().enumerate() {
+            self.generator_returns[i] += generator_reward;
+            if let Some(last) = self.recorded[i].last_mut().filter(|d| !d.ended) {
+                last.reward += generator_reward;
+            }
+            out[i] = Transition {
+                reward: step.reward,
+                ended: step.outcome.is_some(),
+                success: step.outcome.map(|o| o == Outcome::Success),
+            };
+            match step.outcome {
+                Some(outcome) => finished.push((i, Some(outcome))),
+                None if self.matches[i].needs_piece() => turns.push(i),
+                None => {}
+            }
+        }
+        // A failed placement ends the match: the Solver's run is cut, not failed.
+        let invalid = self
+            .place_while_needed(turns)
+            .expect("the Generator's forward pass runs on the CPU");
+        for i in invalid {
+            out[i] = Transition {
+                reward: out[i].reward,
+                ended: true,
+                success: None,
+            };
+            finished.push((i, None));
+        }
+        let restarted: Vec<usize> = finished.iter().map(|&(i, _)| i).collect();
+        for (i, outcome) in finished {
+            self.restart(i, outcome);
+        }
+        self.first_pieces(restarted)
+            .expect("the Generator's forward pass runs on the CPU");
+    }
+}

@@ -1,0 +1,229 @@
+//! What a trained policy says about itself: its shape from the game and the configuration, its
+//! card (game, role, inputs and outputs, how it was trained, from which commit), the files it is
+//! saved as, and checkpoints read back for resuming.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+
+use super::*;
+
+/// What a game's Solver observes and does, as a policy card names it.
+pub(super) struct SolverIo {
+    observation: &'static [(&'static str, usize)],
+    continuous: &'static [&'static str],
+    binary: &'static [&'static str],
+}
+
+impl SolverIo {
+    fn of(game: Game) -> Self {
+        fn io<G: GameSpec>() -> SolverIo {
+            SolverIo {
+                observation: G::OBSERVATION_LAYOUT,
+                continuous: G::CONTINUOUS_ACTIONS,
+                binary: G::BINARY_ACTIONS,
+            }
+        }
+        match game {
+            Game::Platform => io::<PlatformGame>(),
+            Game::Racing => io::<RacingGame>(),
+        }
+    }
+
+    fn observation_size(&self) -> usize {
+        self.observation.iter().map(|(_, k)| k).sum()
+    }
+}
+
+/// The Solver's policy shape.
+pub(super) fn solver_shape(config: &TrainConfig, game: Game) -> PolicyShape {
+    let io = SolverIo::of(game);
+    PolicyShape {
+        observation: io.observation_size(),
+        hidden: config.hidden.clone(),
+        continuous: io.continuous.len(),
+        binary: io.binary.len(),
+    }
+}
+
+/// What a game's Generator observes and does, as a policy card names it.
+pub(super) struct GeneratorIo {
+    observation: &'static [(&'static str, usize)],
+    actions: &'static [&'static str],
+}
+
+impl GeneratorIo {
+    fn of(game: Game) -> Self {
+        fn io<G: GeneratorGame>() -> GeneratorIo {
+            GeneratorIo {
+                observation: G::GENERATOR_OBSERVATION_LAYOUT,
+                actions: G::GENERATOR_ACTIONS,
+            }
+        }
+        match game {
+            Game::Platform => io::<PlatformGame>(),
+            Game::Racing => io::<RacingGame>(),
+        }
+    }
+
+    fn observation_size(&self) -> usize {
+        self.observation.iter().map(|(_, k)| k).sum()
+    }
+}
+
+/// The Generator's policy shape.
+pub(super) fn generator_shape(config: &TrainConfig, game: Game) -> PolicyShape {
+    let io = GeneratorIo::of(game);
+    PolicyShape {
+        observation: io.observation_size(),
+        hidden: config.hidden.clone(),
+        continuous: io.actions.len(),
+        binary: 0,
+    }
+}
+
+/// Records the run's sessions in `card`: `commands[0]` started it, the others resumed it.
+pub(super) fn record_commands(card: &mut PolicyCard, commands: &[String]) {
+    if let Some((first, later)) = commands.split_first() {
+        card.training.command = first.clone();
+        card.training.resumed_with = later.to_vec();
+    }
+}
+
+/// The sessions a loaded card records, oldest first (a card from before `resumed_with` holds
+/// only its last session's command).
+pub(super) fn recorded_commands(card: &PolicyCard) -> Vec<String> {
+    std::iter::once(card.training.command.clone())
+        .filter(|command| !command.is_empty())
+        .chain(card.training.resumed_with.iter().cloned())
+        .collect()
+}
+
+/// A policy card for a policy trained by this run (its commands are set by
+/// [`record_commands`]).
+pub(super) fn card(
+    game: Game,
+    role: Role,
+    mode: TrainMode,
+    config: &TrainConfig,
+    normalizer: &RunningNorm,
+    steps: u64,
+    wall_time_s: f64,
+) -> PolicyCard {
+    let names = |list: &[&str]| list.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let layout = |list: &[(&str, usize)]| {
+        list.iter()
+            .map(|(n, k)| (n.to_string(), *k))
+            .collect::<Vec<_>>()
+    };
+    let (observation, continuous_actions, binary_actions, network) = match role {
+        Role::Solver => {
+            let io = SolverIo::of(game);
+            (
+                layout(io.observation),
+                names(io.continuous),
+                names(io.binary),
+                solver_shape(config, game),
+            )
+        }
+        Role::Generator => {
+            let io = GeneratorIo::of(game);
+            (
+                layout(io.observation),
+                names(io.actions),
+                Vec::new(),
+                generator_shape(config, game),
+            )
+        }
+    };
+    PolicyCard {
+        format: checkpoint::POLICY_FORMAT.into(),
+        version: checkpoint::POLICY_VERSION,
+        game,
+        role,
+        observation,
+        continuous_actions,
+        binary_actions,
+        network,
+        normalizer: normalizer.clone(),
+        training: TrainingRecord {
+            mode,
+            steps,
+            wall_time_s: (wall_time_s * 10.0).round() / 10.0,
+            seed: config.seed,
+            commit: git_commit(),
+            command: String::new(),
+            resumed_with: Vec::new(),
+            population: Vec::new(),
+        },
+        results: Default::default(),
+        max_pieces: (role == Role::Generator).then_some(config.generator.max_pieces),
+        curve_offset: (role == Role::Generator && game == Game::Racing)
+            .then_some(config.generator.curve_offset),
+    }
+}
+
+/// Writes a policy and its YAML card (`<name>.safetensors`, `<name>.yaml`) into `out`.
+pub(super) fn save_policy_files(
+    out: &Path,
+    name: &str,
+    policy: &ActorCritic,
+    card: &PolicyCard,
+) -> Result<()> {
+    fsio::write_atomic(
+        &out.join(format!("{name}.safetensors")),
+        &checkpoint::policy_bytes(policy, card),
+        Overwrite::Allowed,
+    )?;
+    fsio::write_atomic(
+        &out.join(format!("{name}.yaml")),
+        serde_yaml::to_string(card)?.as_bytes(),
+        Overwrite::Allowed,
+    )
+}
+
+/// The game and mode of the run whose checkpoint is `path`: what `--resume` continues when
+/// `--game` or `--mode` is not given.
+pub(super) fn checkpoint_identity(path: &Path) -> Result<(Game, TrainMode)> {
+    let bytes =
+        crate::services::fsio::read_limited(path, checkpoint::MAX_POLICY_BYTES, "checkpoint")
+            .context("cannot resume")?;
+    let card = checkpoint::read_card(&bytes).with_context(|| format!("{}", path.display()))?;
+    Ok((card.game, card.training.mode))
+}
+
+/// Reads a checkpoint of `role`, checking that it was trained in `mode`.
+pub(super) fn read_checkpoint(
+    path: &Path,
+    game: Game,
+    role: Role,
+    mode: TrainMode,
+) -> Result<(checkpoint::LoadedPolicy, TrainingState)> {
+    let bytes =
+        crate::services::fsio::read_limited(path, checkpoint::MAX_POLICY_BYTES, "checkpoint")
+            .context("cannot resume")?;
+    let observation = match role {
+        Role::Solver => SolverIo::of(game).observation_size(),
+        Role::Generator => GeneratorIo::of(game).observation_size(),
+    };
+    let loaded = checkpoint::load_policy(&bytes, game, role, observation)
+        .with_context(|| format!("{}", path.display()))?;
+    let state = loaded
+        .training_state()
+        .with_context(|| format!("{}", path.display()))?;
+    if loaded.card.training.mode != mode {
+        bail!(
+            "{} was trained with --mode {}, not {}",
+            path.display(),
+            loaded.card.training.mode,
+            mode.name()
+        );
+    }
+    Ok((loaded, state))
+}
+
+/// The commit the binary was built from (build.rs): `-dirty` when its code differed from it,
+/// "unknown" when built outside a git checkout.
+pub(super) fn git_commit() -> String {
+    env!("ARLPCG_COMMIT").to_string()
+}

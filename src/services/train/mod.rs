@@ -1,0 +1,256 @@
+//! The training runs, in the paper's four modes: the Solver (of either game)
+//! alone on rule levels (`rule-pcg`) or on a small fixed set (`fixed-track`), and the adversarial
+//! loop with a Generator (`arlpcg`, λ drawn per match; `fixed-aux`, λ = 1).
+//!
+//! A run lives in its output folder: `config.yaml`, `checkpoint.safetensors` (the Solver;
+//! written atomically every few minutes, on Ctrl-C and at the end), `metrics.csv` (one row per
+//! Solver update), the final `solver.safetensors` with its card `solver.yaml`, and for the
+//! adversarial modes `generator-checkpoint.safetensors`, `generator-metrics.csv` and
+//! `generator.safetensors` + `generator.yaml`. `--resume` continues from the checkpoints.
+//!
+//! This is the core that `arlpcg train` (`src/commands/train.rs`) drives: [`open`] starts or
+//! resumes a run, [`Training`] steps it one iteration at a time and saves it. The shell owns the
+//! clock, signals, progress and printing; nothing here reads the clock or prints.
+
+mod adversarial_run;
+pub mod arlpcg;
+mod cards;
+mod config;
+mod metrics;
+pub mod population;
+mod recipe;
+pub mod solver_envs;
+mod solver_run;
+
+pub use config::{GeneratorConfig, TrainConfig};
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+
+use crate::services::fsio::{self, Overwrite};
+use adversarial_run::AdversarialRun;
+use arlpcg::{AdversarialEnvs, AdversarialRecord, Generator, MatchRules, MatchStats, Phase};
+use arlpcg_core::game::generator::{BuildLimits, GeneratorGame, observation_size};
+use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame};
+use arlpcg_core::level::Game;
+use arlpcg_core::rl::checkpoint::{
+    self, PolicyCard, Role, TrainMode, TrainingRecord, TrainingState,
+};
+use arlpcg_core::rl::normalizer::RunningNorm;
+use arlpcg_core::rl::policy::{ActorCritic, PolicyShape};
+use arlpcg_core::rl::ppo::{Ppo, UpdateStats};
+use arlpcg_core::rl::vec_env::{RolloutStats, Trainer, VecEnv};
+use cards::*;
+use config::{check_config, check_resumable_change, load_config};
+pub use metrics::write_learning_curve;
+use metrics::*;
+use population::{PopulationRecord, Snapshot, population_from, population_record};
+use solver_envs::{SolverEnvs, SourceRecord};
+use solver_run::*;
+
+pub(super) const CHECKPOINT: &str = "checkpoint.safetensors";
+/// The file a training session holds in its run folder while it runs (the shell's: see
+/// `commands/train.rs`); it does not make a folder a run.
+pub const LOCK_FILE: &str = "train.lock";
+pub(super) const GENERATOR_CHECKPOINT: &str = "generator-checkpoint.safetensors";
+pub(super) const METRICS: &str = "metrics.csv";
+/// The key under which a checkpoint's `source` holds the episodes or matches under way
+/// ([`SourceRecord`], [`AdversarialRecord`]).
+pub(super) const UNDER_WAY: &str = "under_way";
+pub(super) const GENERATOR_METRICS: &str = "generator-metrics.csv";
+pub(super) const METRICS_HEADER: &str = "iteration,global_step,wall_time_s,steps_per_s,rollout_s,update_s,learning_rate,episodes,mean_return,success_ratio,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance";
+
+/// The run in `out`: started afresh with `config` (the game's defaults when `None`; `seed` and
+/// `steps`, if given, replace its seed and budget), or with `resume` continued from its
+/// checkpoints (`config` and `steps`, if given, replace its hyper-parameters and budget from
+/// here on). The caller installs the thread pool the run's environments and updates use.
+pub fn open(
+    game: Option<Game>,
+    mode: Option<TrainMode>,
+    out: &Path,
+    config: Option<&Path>,
+    seed: Option<u64>,
+    steps: Option<u64>,
+    resume: bool,
+) -> Result<Box<dyn Training>> {
+    let (game, mode) = if resume {
+        resumed_identity(out, game, mode)?
+    } else {
+        (
+            game.unwrap_or(Game::Platform),
+            mode.unwrap_or(TrainMode::RulePcg),
+        )
+    };
+    let config = if resume {
+        Start::Resume(ConfigChange {
+            config: config.map(|path| load_config(path, game)).transpose()?,
+            seed,
+            steps,
+        })
+    } else {
+        if out.join(CHECKPOINT).exists() {
+            bail!(
+                "{} already holds a training run: add --resume to continue it, or choose another --out",
+                out.display()
+            );
+        }
+        if out.exists() && !out.is_dir() {
+            bail!("--out {} is not a folder", out.display());
+        }
+        if let Some(name) = fsio::first_entry(out, &[LOCK_FILE])? {
+            bail!(
+                "{} is not empty (it holds {name}): a new run starts in a new or empty folder, so that no policy or card is replaced; choose another --out",
+                out.display()
+            );
+        }
+        let mut config = match config {
+            Some(path) => {
+                let config = load_config(path, game)?;
+                // fixed-aux plays no hard match, so a finish that waits for them never ends.
+                let finish = config.generator.finish;
+                if mode == TrainMode::FixedAux
+                    && finish.solver_steps > 0
+                    && finish.generator_until_hard_success.is_some()
+                {
+                    bail!(
+                        "{}: generator.finish.generator_until_hard_success: fixed-aux plays only \
+                         λ = 1 matches, so its Solver fails no hard one and the finish's \
+                         Generator phase would run to its cap; set it to null, or the finish's \
+                         solver_steps to 0",
+                        path.display()
+                    );
+                }
+                config
+            }
+            None => TrainConfig::for_run(game, mode),
+        };
+        if let Some(seed) = seed {
+            config.seed = seed;
+        }
+        if let Some(steps) = steps {
+            config.steps = steps;
+        }
+        Start::New(config)
+    };
+    match (config::solver_only(mode), game) {
+        (Some(source), Game::Platform) => solver_run::<PlatformGame>(out, mode, source, config),
+        (Some(source), Game::Racing) => solver_run::<RacingGame>(out, mode, source, config),
+        (None, Game::Platform) => adversarial_run::<PlatformGame>(out, mode, config),
+        (None, Game::Racing) => adversarial_run::<RacingGame>(out, mode, config),
+    }
+}
+
+/// The game and mode a resumed run goes on with: its checkpoint's, which `--game` and `--mode`,
+/// when given, must name.
+fn resumed_identity(
+    out: &Path,
+    game: Option<Game>,
+    mode: Option<TrainMode>,
+) -> Result<(Game, TrainMode)> {
+    let path = out.join(CHECKPOINT);
+    if !path.exists() {
+        bail!(
+            "{} holds no checkpoint to resume: start the run without --resume",
+            out.display()
+        );
+    }
+    let (run_game, run_mode) = checkpoint_identity(&path)?;
+    if game.is_some_and(|game| game != run_game) || mode.is_some_and(|mode| mode != run_mode) {
+        bail!(
+            "{} is a {run_game} {} run: resume it with --game {run_game} --mode {}, or leave both out",
+            out.display(),
+            run_mode.name(),
+            run_mode.name()
+        );
+    }
+    Ok((run_game, run_mode))
+}
+
+/// How a session opens its run: a new one with its configuration, or a resumed one with what
+/// changes in its stored configuration.
+enum Start {
+    New(TrainConfig),
+    Resume(ConfigChange),
+}
+
+/// What a resumed run changes in its configuration: `--config` replaces all of it, `--steps`
+/// the budget. `--seed` may be given again (the run's first command plus `--resume`), but it
+/// cannot change.
+#[derive(Debug, Default)]
+pub(super) struct ConfigChange {
+    pub config: Option<TrainConfig>,
+    pub seed: Option<u64>,
+    pub steps: Option<u64>,
+}
+
+impl ConfigChange {
+    /// The resumed run's configuration, from the one it stored.
+    pub(super) fn apply(self, stored: &TrainConfig) -> TrainConfig {
+        let mut new = self.config.unwrap_or_else(|| stored.clone());
+        if let Some(seed) = self.seed {
+            new.seed = seed;
+        }
+        if let Some(steps) = self.steps {
+            new.steps = steps;
+        }
+        new
+    }
+}
+
+/// Trains a Generator of game `G` against its Solver (the adversarial modes), starting or
+/// resuming.
+fn adversarial_run<G: GeneratorGame>(
+    out: &Path,
+    mode: TrainMode,
+    start: Start,
+) -> Result<Box<dyn Training>> {
+    Ok(Box::new(match start {
+        Start::New(config) => AdversarialRun::<G>::start(out, mode, config)?,
+        Start::Resume(change) => AdversarialRun::<G>::resume(out, mode, change)?,
+    }))
+}
+
+/// Trains a Solver of game `G` alone (the Solver-only modes), starting or resuming.
+fn solver_run<G: GameSpec>(
+    out: &Path,
+    mode: TrainMode,
+    source: solver_envs::SolverMode,
+    start: Start,
+) -> Result<Box<dyn Training>> {
+    let build = |config: &TrainConfig, state: Option<serde_json::Value>| {
+        let record: SourceRecord = match state {
+            Some(json) => serde_json::from_value(json).context("level source")?,
+            None => SourceRecord::default(),
+        };
+        let action_size = solver_shape(config, G::GAME).action_size();
+        SolverEnvs::<G>::new(source, config.solver.num_envs, record, action_size)
+            .map_err(|problem| anyhow::anyhow!("level source: {problem}"))
+    };
+    Ok(Box::new(match start {
+        Start::New(config) => SolverRun::start(out, mode, config, build)?,
+        Start::Resume(change) => SolverRun::resume(out, mode, change, build)?,
+    }))
+}
+
+/// What the training loop drives: one iteration at a time, checkpoints, the final policies.
+pub trait Training {
+    /// Solver environment steps taken so far...
+    fn solver_steps(&self) -> u64;
+    /// ...and the run's budget of them ([`TrainConfig::steps`], plus an adversarial run's
+    /// finish).
+    fn budget(&self) -> u64;
+    /// Wall-clock seconds of earlier sessions.
+    fn wall_before(&self) -> f64;
+    /// Records this session's command line in the run's cards (the shell names it: the core
+    /// reads no process arguments).
+    fn add_session(&mut self, command: String);
+    /// One PPO iteration (of whichever agent learns now); returns the progress bar's message.
+    /// `wall` is the clock the shell lends: the run's wall-clock seconds over every session,
+    /// for the metrics' time columns.
+    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String>;
+    fn checkpoint_minutes(&self) -> f64;
+    fn save_checkpoint(&self, wall: f64) -> Result<()>;
+    fn save_policies(&self, wall: f64) -> Result<()>;
+    fn out(&self) -> &Path;
+}

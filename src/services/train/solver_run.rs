@@ -1,0 +1,286 @@
+//! A Solver training run: its PPO learner over its environments, started or resumed from a
+//! checkpoint, one iteration (rollout, update, metrics row) at a time.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+
+use super::*;
+
+/// Environments whose progress is saved in checkpoints.
+pub(super) trait Resumable: VecEnv {
+    /// The game the environments play.
+    const GAME: Game;
+    fn source_state(&self) -> serde_json::Value;
+}
+
+impl<G: GameSpec> Resumable for SolverEnvs<G> {
+    const GAME: Game = G::GAME;
+    fn source_state(&self) -> serde_json::Value {
+        serde_json::to_value(self.record()).expect("source states serialize")
+    }
+}
+
+impl<G: GeneratorGame> Resumable for AdversarialEnvs<G> {
+    const GAME: Game = G::GAME;
+    fn source_state(&self) -> serde_json::Value {
+        serde_json::to_value(self.record()).expect("source states serialize")
+    }
+}
+
+/// A Solver training run in progress (the Solver-only modes, and the Solver of the adversarial
+/// ones, whose environments hold the Generator).
+pub(super) struct SolverRun<E: Resumable> {
+    pub(super) out: PathBuf,
+    pub(super) mode: TrainMode,
+    pub(super) config: TrainConfig,
+    pub(super) trainer: Trainer<E>,
+    pub(super) iteration: u64,
+    pub(super) wall_before: f64,
+    pub(super) metrics: std::fs::File,
+    /// Each session's command line, the first one's first (the shell names them).
+    pub(super) commands: Vec<String>,
+}
+
+impl<E: Resumable> SolverRun<E> {
+    pub(super) fn start(
+        out: &Path,
+        mode: TrainMode,
+        config: TrainConfig,
+        build: impl FnOnce(&TrainConfig, Option<serde_json::Value>) -> Result<E>,
+    ) -> Result<Self> {
+        std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+        fsio::write_atomic(
+            &out.join("config.yaml"),
+            serde_yaml::to_string(&config)?.as_bytes(),
+            Overwrite::Allowed,
+        )?;
+        fsio::write_atomic(
+            &out.join(METRICS),
+            format!("{METRICS_HEADER}\n").as_bytes(),
+            Overwrite::Allowed,
+        )?;
+        let policy = ActorCritic::new(solver_shape(&config, E::GAME), config.seed)?;
+        let ppo = Ppo::new(config.solver.clone(), policy)?;
+        let envs = build(&config, None)?;
+        let trainer = Trainer::new(ppo, envs, config.seed);
+        Ok(Self {
+            metrics: open_append(&out.join(METRICS))?,
+            out: out.to_path_buf(),
+            mode,
+            config,
+            trainer,
+            iteration: 0,
+            wall_before: 0.0,
+            commands: Vec::new(),
+        })
+    }
+
+    /// Resumes the run in `out`; `change` (from `--config`, `--steps`) replaces its
+    /// configuration from here on, the old one kept as `config-until-step-N.yaml`.
+    pub(super) fn resume(
+        out: &Path,
+        mode: TrainMode,
+        change: ConfigChange,
+        build: impl FnOnce(&TrainConfig, Option<serde_json::Value>) -> Result<E>,
+    ) -> Result<Self> {
+        let path = out.join(CHECKPOINT);
+        let (loaded, state) = read_checkpoint(&path, E::GAME, Role::Solver, mode)?;
+        let stored: TrainConfig = serde_json::from_value(state.config.clone())
+            .with_context(|| format!("{}: configuration", path.display()))?;
+        // As strict as --config: a tampered checkpoint must not allocate or divide by its numbers.
+        check_config(&stored, E::GAME).map_err(|problem| {
+            anyhow::anyhow!("{}: stored configuration: {problem}", path.display())
+        })?;
+        let config = change.apply(&stored);
+        check_resumable_change(&stored, &config).map_err(|problem| {
+            anyhow::anyhow!(
+                "--resume with --config or --seed: {problem} (the run in {})",
+                out.display()
+            )
+        })?;
+        if config != stored {
+            fsio::write_atomic(
+                &out.join(format!("config-until-step-{}.yaml", state.global_step)),
+                serde_yaml::to_string(&stored)?.as_bytes(),
+                Overwrite::Never,
+            )?;
+            fsio::write_atomic(
+                &out.join("config.yaml"),
+                serde_yaml::to_string(&config)?.as_bytes(),
+                Overwrite::Allowed,
+            )?;
+        }
+        let vars = loaded.policy.named_vars();
+        let mut ppo = Ppo::new(config.solver.clone(), loaded.policy)?;
+        ppo.adam
+            .restore(&vars, &loaded.tensors, state.adam_step)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        // The episodes under way go on where they were, unless the configuration changes
+        // (other rules, other rewards): then fresh ones start.
+        let mut source = state.source.clone();
+        let same_rules = TrainConfig {
+            steps: stored.steps,
+            ..config.clone()
+        } == stored;
+        if !same_rules && let Some(fields) = source.as_object_mut() {
+            fields.remove(UNDER_WAY);
+        }
+        let replayed = source.get(UNDER_WAY).is_some();
+        let envs = build(&config, Some(source)).with_context(|| format!("{}", path.display()))?;
+        let mut trainer = Trainer::new(ppo, envs, config.seed);
+        trainer.norm = loaded.card.normalizer.clone();
+        trainer.rng = state.rng;
+        trainer.global_step = state.global_step;
+        if replayed {
+            if state.episode_returns.len() != trainer.episode_returns.len() {
+                bail!(
+                    "{}: {} episode returns for {} episodes under way",
+                    path.display(),
+                    state.episode_returns.len(),
+                    trainer.episode_returns.len()
+                );
+            }
+            trainer.episode_returns = state.episode_returns.clone();
+        }
+        truncate_metrics(&out.join(METRICS), METRICS_HEADER, state.iteration)?;
+        Ok(Self {
+            metrics: open_append(&out.join(METRICS))?,
+            out: out.to_path_buf(),
+            mode,
+            config,
+            trainer,
+            iteration: state.iteration,
+            wall_before: state.wall_time_s,
+            commands: recorded_commands(&loaded.card),
+        })
+    }
+
+    pub(super) fn save_solver_checkpoint(&self, wall_time_s: f64) -> Result<()> {
+        let bytes = self.solver_checkpoint_bytes(wall_time_s)?;
+        fsio::write_atomic(&self.out.join(CHECKPOINT), &bytes, Overwrite::Allowed)
+    }
+
+    pub(super) fn solver_checkpoint_bytes(&self, wall_time_s: f64) -> Result<Vec<u8>> {
+        let state = TrainingState {
+            global_step: self.trainer.global_step,
+            iteration: self.iteration,
+            adam_step: self.trainer.ppo.adam.step,
+            wall_time_s,
+            rng: self.trainer.rng.clone(),
+            source: self.trainer.env.source_state(),
+            config: serde_json::to_value(&self.config)?,
+            episode_returns: self.trainer.episode_returns.clone(),
+        };
+        let card = self.solver_card(wall_time_s);
+        Ok(checkpoint::checkpoint_bytes(
+            &self.trainer.ppo,
+            &card,
+            &state,
+            Vec::new(),
+        ))
+    }
+
+    pub(super) fn solver_card(&self, wall_time_s: f64) -> PolicyCard {
+        let mut card = card(
+            E::GAME,
+            Role::Solver,
+            self.mode,
+            &self.config,
+            &self.trainer.norm,
+            self.trainer.global_step,
+            wall_time_s,
+        );
+        record_commands(&mut card, &self.commands);
+        card
+    }
+
+    /// Collects a rollout, updates the Solver, logs a metrics row.
+    pub(super) fn solver_iteration(
+        &mut self,
+        lr_scale: f64,
+        stage_rate: Option<f64>,
+        wall: &dyn Fn() -> f64,
+    ) -> Result<RolloutStats> {
+        let learning_rate = match stage_rate {
+            Some(rate) => rate,
+            None if self.config.solver.anneal_lr => self.config.solver.learning_rate * lr_scale,
+            None => self.config.solver.learning_rate,
+        };
+        let t0 = wall();
+        let (batch, rollout) = self.trainer.collect()?;
+        let t1 = wall();
+        let update = self.trainer.learn(&batch, learning_rate)?;
+        let t2 = wall();
+        self.iteration += 1;
+        let (rollout_s, update_s) = (t1 - t0, t2 - t1);
+        writeln!(
+            self.metrics,
+            "{},{},{:.2},{:.1},{:.3},{:.3},{:.3e},{},{:.4},{:.4},{}",
+            self.iteration,
+            self.trainer.global_step,
+            wall(),
+            rollout.steps as f64 / (rollout_s + update_s),
+            rollout_s,
+            update_s,
+            learning_rate,
+            rollout.episodes,
+            rollout.mean_return,
+            rollout.success_ratio,
+            update_columns(&update)
+        )?;
+        Ok(rollout)
+    }
+}
+
+impl<G: GameSpec> Training for SolverRun<SolverEnvs<G>> {
+    fn solver_steps(&self) -> u64 {
+        self.trainer.global_step
+    }
+
+    fn budget(&self) -> u64 {
+        self.config.steps
+    }
+
+    fn wall_before(&self) -> f64 {
+        self.wall_before
+    }
+
+    fn add_session(&mut self, command: String) {
+        self.commands.push(command);
+    }
+
+    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
+        let t0 = wall();
+        let lr_scale = self.config.lr_scale(self.trainer.global_step);
+        let rollout = self.solver_iteration(lr_scale, None, wall)?;
+        Ok(format!(
+            "return {:.2}, success {:.2}, {:.0} steps/s",
+            rollout.mean_return,
+            rollout.success_ratio,
+            rollout.steps as f64 / (wall() - t0)
+        ))
+    }
+
+    fn checkpoint_minutes(&self) -> f64 {
+        self.config.checkpoint_minutes
+    }
+
+    fn save_checkpoint(&self, wall: f64) -> Result<()> {
+        self.save_solver_checkpoint(wall)
+    }
+
+    fn save_policies(&self, wall: f64) -> Result<()> {
+        save_policy_files(
+            &self.out,
+            "solver",
+            &self.trainer.ppo.policy,
+            &self.solver_card(wall),
+        )
+    }
+
+    fn out(&self) -> &Path {
+        &self.out
+    }
+}

@@ -1,0 +1,496 @@
+//! `arlpcg generate`: levels from a trained Generator or from the rules, optionally verified by
+//! the Solver, written as files named after game, seed and aux.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use anyhow::{Context, Result, bail};
+use rayon::prelude::*;
+
+use crate::services::difficulty;
+use crate::services::fsio::{self, Overwrite};
+use crate::services::generation::{self, AuxAsk, GeneratorPolicy, KeptPrefix, LevelRequest};
+use crate::services::level_files::{Format, LevelFiles, file_stem, render};
+use crate::services::panel::{Judge, JudgePanel, rate};
+use crate::services::policies::{
+    load_generator, load_judge, load_panel, load_solver, policy_paths,
+};
+use crate::services::verify::{self, Solver, SolverPolicy, verify};
+use crate::shells::cli::{GenerateArgs, KeepArg, default_solver};
+use arlpcg_core::game::Skill;
+use arlpcg_core::level::stats::PanelStats;
+use arlpcg_core::level::{Game, Level};
+
+pub fn run(args: &GenerateArgs) -> Result<()> {
+    let seeds = check_arguments(args)?;
+    let keep = args
+        .keep
+        .as_ref()
+        .map(|keep| kept_prefix(keep, args.game))
+        .transpose()?;
+    let verify_trials = args.verify.or(args.target_success.map(|_| TARGET_TRIALS));
+    let generator = match &args.policies {
+        Some(dir) => Some(load_generator(&policy_paths(dir).0, args.game)?.0),
+        None => None,
+    };
+    let solver = chosen_solver(args, verify_trials)?;
+    let panel = match args.panel {
+        true => Some(load_panel(&policies_dir(args), args.game, None)?),
+        false => None,
+    };
+    let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
+    let plans: Vec<(u64, LevelFiles)> = seeds
+        .iter()
+        .map(|&seed| {
+            (
+                seed,
+                LevelFiles::new(&args.out, &stem(args, seed), &formats)
+                    .with_collision_names(args.collision_names),
+            )
+        })
+        .collect();
+    // Ctrl-C stops generating; the levels finished so far are still written.
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    // Every level is built (and verified) before the first file is written: a level that
+    // cannot be built leaves the folder as it was, and --force replaces nothing. Several
+    // levels are in flight at once; each depends only on its seed, so the files do not depend
+    // on the number of threads.
+    let skill = match args.judge {
+        Some(Judge::Scripted(skill)) => skill,
+        _ => Skill::Expert,
+    };
+    let who = solver
+        .as_ref()
+        .map_or(Solver::Scripted(skill), Solver::Policy);
+    let curve = target_curve(args, generator.as_ref(), &who, &stop)?;
+    let mut levels = build_levels(
+        args,
+        &plans,
+        keep.as_ref(),
+        generator.as_ref(),
+        &who,
+        curve.as_ref(),
+        verify_trials,
+        &stop,
+    )?;
+    if let Some(panel) = &panel {
+        play_panel(
+            panel,
+            &mut levels,
+            verify_trials.unwrap_or(TARGET_TRIALS),
+            &stop,
+        );
+    }
+    // The folder is made only now, and removed again if the batch fails.
+    let made_folder = !args.out.exists();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let written = write_batch(args, &levels, &plans);
+    if written.is_err() && made_folder {
+        let _ = std::fs::remove_dir(&args.out); // only if empty
+    }
+    let (staged, kept) = written?;
+    let files = staged + kept;
+    let unchanged = match kept {
+        0 => String::new(),
+        k => format!(", {k} of them already there and identical"),
+    };
+    if levels.len() < plans.len() {
+        return Err(crate::shells::common::Interrupted(format!(
+            "interrupted (Ctrl-C): wrote the {} of {} levels finished before it ({files} files{unchanged}) to {}; run the same command again to finish",
+            levels.len(),
+            plans.len(),
+            args.out.display()
+        ))
+        .into());
+    }
+    let share = match args.shard {
+        Some(shard) => format!(" (shard {}/{} of {})", shard.index, shard.count, args.count),
+        None => String::new(),
+    };
+    println!(
+        "wrote {} levels{share} ({files} files{unchanged}) to {}",
+        plans.len(),
+        args.out.display()
+    );
+    report_verification(&levels);
+    Ok(())
+}
+
+/// What verification did across the batch: redrawn, unsolved and uncertified levels.
+fn report_verification(levels: &[Level]) {
+    let stats: Vec<_> = levels.iter().filter_map(|l| l.stats.as_ref()).collect();
+    let redrawn: Vec<u32> = stats.iter().map(|s| s.redraws).filter(|&r| r > 0).collect();
+    if !redrawn.is_empty() {
+        println!(
+            "redrew {} levels that no run completed ({} draws replaced)",
+            redrawn.len(),
+            redrawn.iter().sum::<u32>()
+        );
+    }
+    let unsolved = stats.iter().filter(|s| s.successes == 0).count();
+    if unsolved > 0 {
+        println!("kept {unsolved} levels that no run completed (--allow-unsolved)");
+    }
+    let uncertified = stats
+        .iter()
+        .filter(|s| s.successes > 0 && s.certificate.is_none())
+        .count();
+    if uncertified > 0 {
+        println!(
+            "{uncertified} levels have no certificate: no single run succeeded within the search (their success ratio is tiny)"
+        );
+    }
+}
+
+/// With `--target-success`: the policies' λ→success curve, read from beside them or measured
+/// once (Ctrl-C in `stop` ends the measurement: exit 130, nothing written).
+/// The folder the judges come from: --policies, else the shipped policies of the game.
+fn policies_dir(args: &GenerateArgs) -> PathBuf {
+    args.policies
+        .clone()
+        .unwrap_or_else(|| crate::services::policies::shipped_dir(args.game))
+}
+
+/// Plays every level with every judge of `panel` (seeds as --verify's) and rates them together.
+/// Levels a Ctrl-C left unplayed are dropped from the end, as unbuilt ones are.
+fn play_panel(panel: &JudgePanel, levels: &mut Vec<Level>, trials: u32, stop: &AtomicBool) {
+    let runs = (levels.len() * panel.judges.len()) as u64 * trials as u64;
+    let bar = crate::shells::common::progress_bar(runs, "panel runs");
+    let played: Vec<Option<PanelStats>> = levels
+        .par_iter()
+        .map(|level| {
+            let seed = level.stats.as_ref().map_or(0, |s| s.seed);
+            let watch = verify::Watch {
+                on_trial: &|_| bar.inc(1),
+                stop: &|| stop.load(Ordering::SeqCst),
+            };
+            crate::services::panel::play(panel, level, trials, seed, &watch, &|_, _| {})
+                .expect("judges are loaded for the batch's game")
+        })
+        .collect();
+    bar.finish_and_clear();
+    let done = played.iter().take_while(|p| p.is_some()).count();
+    levels.truncate(done);
+    let mut panels: Vec<PanelStats> = played.into_iter().flatten().take(done).collect();
+    rate(&mut panels.iter_mut().collect::<Vec<_>>());
+    for (level, panel) in levels.iter_mut().zip(panels) {
+        if let Some(stats) = level.stats.as_mut() {
+            stats.panel = Some(panel);
+        }
+    }
+}
+
+fn target_curve(
+    args: &GenerateArgs,
+    generator: Option<&GeneratorPolicy>,
+    solver: &Solver,
+    stop: &AtomicBool,
+) -> Result<Option<difficulty::Curve>> {
+    let (Some(_), Some(generator), Some(dir)) = (args.target_success, generator, &args.policies)
+    else {
+        return Ok(None);
+    };
+    let announce = || {
+        eprintln!(
+            "measuring the policies' λ→success curve ({} λ values × {} levels × {} runs), once",
+            difficulty::CURVE_AUX.len(),
+            difficulty::CURVE_LEVELS,
+            difficulty::CURVE_TRIALS
+        )
+    };
+    crate::services::policies::difficulty_curve(dir, generator, solver, announce, &|| {
+        stop.load(Ordering::SeqCst)
+    })
+    .map(Some)
+    .map_err(|e| match e.downcast_ref::<difficulty::TargetError>() {
+        Some(difficulty::TargetError::Stopped) => crate::shells::common::Interrupted(
+            "interrupted (Ctrl-C) while the λ→success curve was measured; nothing was written"
+                .into(),
+        )
+        .into(),
+        _ => e,
+    })
+}
+
+/// The checks on the arguments alone, before any file is read (exit 2 on a misfit); returns
+/// the seeds of the levels to make (this shard's).
+fn check_arguments(args: &GenerateArgs) -> Result<Vec<u64>> {
+    let usage = |message: &str| Err(crate::shells::common::UsageError(message.into()).into());
+    if args.target_success.is_some() && args.policies.is_none() {
+        return usage("--target-success needs --policies: a Generator that λ steers");
+    }
+    if args.obstacles > 0 && args.game != Game::Racing {
+        return usage("--obstacles is for racing tracks (--game racing)");
+    }
+    if args.aux_curve.is_some() && args.policies.is_none() {
+        return usage("--aux-curve needs --policies: the rules know no λ, a Generator follows it");
+    }
+    if args.keep.is_some() && args.obstacles > 0 {
+        return usage(
+            "--obstacles with --keep: the kept level's scene (start, goal, obstacles) stays",
+        );
+    }
+    if args.policies.is_some()
+        && args.aux.is_none()
+        && args.aux_curve.is_none()
+        && args.target_success.is_none()
+    {
+        return usage(
+            "--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard), --aux-curve CURVE or --target-success P",
+        );
+    }
+    if args.solver_policy.is_some() && args.verify.is_none() && args.target_success.is_none() {
+        return usage("--solver-policy plays --verify N or --target-success P; give one of them");
+    }
+    if args.out.exists() && !args.out.is_dir() {
+        anyhow::bail!("--out {} is not a folder", args.out.display());
+    }
+    (0..args.count as u64)
+        .filter(|&i| args.shard.is_none_or(|shard| shard.owns(i)))
+        .map(|i| args.seed.checked_add(i))
+        .collect::<Option<_>>()
+        .ok_or_else(|| {
+            crate::shells::common::UsageError(format!(
+                "--seed {} plus --count {} overflows a 64-bit seed",
+                args.seed, args.count
+            ))
+            .into()
+        })
+}
+
+/// Writes the files of `levels`, all or none: each level is rendered and staged beside its
+/// target one at a time (memory stays bounded), then all are renamed into place. Files that
+/// exist already and are identical are left alone (a re-run finishes a batch); others are
+/// refused unless --force. Returns (files written, files left as they were).
+fn write_batch(
+    args: &GenerateArgs,
+    levels: &[Level],
+    plans: &[(u64, LevelFiles)],
+) -> Result<(usize, usize)> {
+    fsio::remove_stale_temps(&args.out, std::time::SystemTime::now())?;
+    let mut batch = fsio::FileBatch::new();
+    let mut kept = 0;
+    let nothing = "nothing was written";
+    for (level, (_, files)) in levels.iter().zip(plans) {
+        // A .gltf after the .bin it names.
+        for (path, bytes) in render(level, files).into_iter().rev() {
+            fsio::check_not_in_the_way(&path).with_context(|| nothing.to_string())?;
+            let overwrite = match std::fs::read(&path) {
+                Ok(existing) if existing == bytes => {
+                    kept += 1;
+                    continue;
+                }
+                Ok(_) if !args.force => bail!(
+                    "{} already exists with other contents (use --force to overwrite it); {nothing}",
+                    path.display()
+                ),
+                Ok(_) => Overwrite::Allowed,
+                // Absent when checked: written only if still absent (another run may get there
+                // first, and its file is not replaced).
+                Err(_) => Overwrite::Never,
+            };
+            batch
+                .stage(&path, &bytes, overwrite)
+                .with_context(|| nothing.to_string())?;
+        }
+    }
+    let staged = batch.len();
+    batch.commit()?;
+    Ok((staged, kept))
+}
+
+/// Runs per candidate of `--target-success` without `--verify`.
+const TARGET_TRIALS: u32 = 100;
+
+/// The level with a certificate in its statistics: single runs from the trials' seeds on, so a
+/// level some trial completed is certified within a few runs unless its success ratio is tiny.
+fn certified(mut level: Level, solver: &Solver, seed: u64) -> Result<Level> {
+    if let Some(stats) = &level.stats
+        && stats.successes > 0
+    {
+        let seeds = (0..2 * stats.trials as u64).map(|k| seed.wrapping_add(k));
+        let certificate = verify::certify(&level, solver, seeds)?;
+        if let Some(stats) = &mut level.stats {
+            stats.certificate = certificate;
+        }
+    }
+    Ok(level)
+}
+
+/// The level `--keep` names, read and checked, and the pieces to keep of it.
+fn kept_prefix(keep: &KeepArg, game: Game) -> Result<KeptPrefix> {
+    let (level, from) = arlpcg_core::level::yaml::load_pinned(&keep.level)?;
+    if level.game() != game {
+        anyhow::bail!(
+            "{}: a {} level, but this run generates {game} levels (--game {})",
+            keep.level.display(),
+            level.game(),
+            level.game()
+        );
+    }
+    if keep.pieces > level.piece_count() {
+        anyhow::bail!(
+            "{}: --keep asks for {} pieces, but the level has {}",
+            keep.level.display(),
+            keep.pieces,
+            level.piece_count()
+        );
+    }
+    Ok(KeptPrefix {
+        level: Arc::new(level),
+        pieces: keep.pieces,
+        from,
+    })
+}
+
+/// A level's file name: game, seed and λ, or the success rate asked for, or `curve` and a
+/// short hash of the aux curve (its text is in the file); `_keepK` when K pieces were kept.
+fn stem(args: &GenerateArgs, seed: u64) -> String {
+    let kept = match &args.keep {
+        Some(keep) => format!("_keep{}", keep.pieces),
+        None => String::new(),
+    };
+    stem_of_lambda(args, seed) + &kept
+}
+
+fn stem_of_lambda(args: &GenerateArgs, seed: u64) -> String {
+    match (args.target_success, &args.aux_curve) {
+        (Some(target), _) => format!("{}_seed{seed}_success{target:.2}", args.game),
+        (None, Some(curve)) => {
+            let hash = arlpcg_core::level::sha256_hex(curve.to_string().as_bytes());
+            format!("{}_seed{seed}_curve-{}", args.game, &hash[..8])
+        }
+        (None, None) => file_stem(args.game, seed, args.aux),
+    }
+}
+
+/// Draws of one seed tried before `generate --verify` gives up on finding a level that some
+/// run completes.
+pub const MAX_DRAWS: u32 = 10;
+
+/// Level `seed` (its `draw`-th draw) from the Generator when there is one, else from the rules.
+fn build(
+    args: &GenerateArgs,
+    keep: Option<&KeptPrefix>,
+    generator: Option<&GeneratorPolicy>,
+    seed: u64,
+    draw: u32,
+) -> Result<Level> {
+    let mut request = LevelRequest::new(seed, args.aux)
+        .goal(args.goal)
+        .obstacles(args.obstacles)
+        .draw(draw);
+    if let Some(curve) = &args.aux_curve {
+        request = request.aux(AuxAsk::Curve(curve.clone()));
+    }
+    if let Some(keep) = keep {
+        request = request.keep(keep.clone());
+    }
+    Ok(match generator {
+        Some(generator) => generation::generator_level(generator, &request)?,
+        None => generation::rules_level(args.game, &request)?,
+    })
+}
+
+/// Level `seed`, verified when asked: a draw that no run completes is replaced by the seed's
+/// next draw (unless --allow-unsolved), and a kept level carries a certificate.
+fn build_verified(
+    args: &GenerateArgs,
+    keep: Option<&KeptPrefix>,
+    generator: Option<&GeneratorPolicy>,
+    solver: &Solver,
+    seed: u64,
+) -> Result<Level> {
+    let Some(trials) = args.verify else {
+        return build(args, keep, generator, seed, 0);
+    };
+    for draw in 0..MAX_DRAWS {
+        let mut level = build(args, keep, generator, seed, draw)?;
+        let mut stats = verify(&level, solver, trials, seed, &|| {})?;
+        if stats.successes == 0 && !args.allow_unsolved {
+            continue;
+        }
+        stats.redraws = draw;
+        level.stats = Some(stats);
+        return certified(level, solver, seed);
+    }
+    bail!(
+        "none of the {MAX_DRAWS} levels drawn for this seed was completed by any of {trials} runs (--allow-unsolved keeps the first anyway)"
+    )
+}
+
+/// The Solver that plays `--verify` and `--target-success`: the judge asked for, the file asked
+/// for, the one beside the Generator, or the shipped one; none for the scripted player or when
+/// nothing is verified.
+fn chosen_solver(args: &GenerateArgs, verify_trials: Option<u32>) -> Result<Option<SolverPolicy>> {
+    let shipped = default_solver(args.game);
+    Ok(match (verify_trials, args.judge, &args.solver_policy) {
+        (None, _, _) => None,
+        // A Solver judge's policy; none for the scripted player.
+        (Some(_), Some(judge), _) => {
+            load_judge(&policies_dir(args), args.game, judge)?.map(|(policy, _)| policy)
+        }
+        (Some(_), None, Some(path)) => Some(load_solver(path, args.game)?.0),
+        (Some(_), None, None) => match &args.policies {
+            Some(dir) => Some(load_solver(&policy_paths(dir).1, args.game)?.0),
+            None if shipped.exists() => Some(load_solver(&shipped, args.game)?.0),
+            None => None,
+        },
+    })
+}
+
+/// Builds (and verifies) the level of every plan, several at once; after a Ctrl-C, the levels
+/// finished before it, a prefix of the batch, so that a re-run resumes it.
+#[allow(clippy::too_many_arguments)]
+fn build_levels(
+    args: &GenerateArgs,
+    plans: &[(u64, LevelFiles)],
+    keep: Option<&KeptPrefix>,
+    generator: Option<&GeneratorPolicy>,
+    who: &Solver,
+    curve: Option<&difficulty::Curve>,
+    verify_trials: Option<u32>,
+    stop: &AtomicBool,
+) -> Result<Vec<Level>> {
+    let bar = crate::shells::common::progress_bar(plans.len() as u64, "generating");
+    let built: Vec<Option<Result<Level>>> = plans
+        .par_iter()
+        .map(|(seed, _)| {
+            if stop.load(Ordering::SeqCst) {
+                return None;
+            }
+            let level = match (args.target_success, curve, generator) {
+                (Some(target), Some(curve), Some(generator)) => difficulty::level_for(
+                    generator,
+                    who,
+                    curve,
+                    *seed,
+                    args.goal,
+                    target,
+                    verify_trials.unwrap_or(TARGET_TRIALS),
+                )
+                .map_err(anyhow::Error::from)
+                .and_then(|level| certified(level, who, *seed)),
+                _ => build_verified(args, keep, generator, who, *seed),
+            };
+            bar.inc(1);
+            Some(level.with_context(|| format!("seed {seed} (nothing was written)")))
+        })
+        .collect();
+    bar.finish_and_clear();
+    // The levels finished before a Ctrl-C: a prefix of the batch, so that a re-run resumes it.
+    let mut levels = Vec::with_capacity(plans.len());
+    for level in built {
+        match level {
+            Some(level) => levels.push(level?),
+            None => break,
+        }
+    }
+    Ok(levels)
+}

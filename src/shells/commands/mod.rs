@@ -1,0 +1,54 @@
+//! The subcommands: each resolves its arguments, runs the pure core, reports and writes files.
+//! Errors come back as `anyhow` errors with the file and field named; `main` turns them into
+//! one line and a non-zero exit code.
+
+mod eval;
+mod export;
+mod export_policy;
+mod generate;
+mod train;
+mod verify;
+
+pub use crate::shells::common::{Interrupted, UsageError, exit_code};
+pub use verify::one_line;
+
+use anyhow::Result;
+
+use crate::shells::cli::{Cli, Command};
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Some(Command::Generate(args)) => generate::run(&args),
+        Some(Command::Export(args)) => export::run(&args),
+        Some(Command::ExportPolicy(args)) => export_policy::run(&args),
+        Some(Command::Verify(args)) => verify::run(&args),
+        Some(Command::Eval(args)) => eval::run(&args),
+        Some(Command::Train(args)) => train::run(&args),
+        Some(Command::Design(args)) => design(args),
+        None => {
+            use std::io::IsTerminal;
+            if std::io::stdin().is_terminal() && std::io::stdout().is_terminal() {
+                design(crate::shells::cli::DesignArgs {
+                    game: arlpcg_core::level::Game::Platform,
+                    policies: None,
+                    out: "levels".into(),
+                    seed: 1,
+                })
+            } else {
+                use clap::CommandFactory;
+                Cli::command().print_long_help()?;
+                Ok(())
+            }
+        }
+    }
+}
+
+fn design(args: crate::shells::cli::DesignArgs) -> Result<()> {
+    crate::shells::design::run(crate::shells::design::DesignOptions {
+        game: args.game,
+        policies: args.policies,
+        out: args.out,
+        seed: args.seed,
+    })
+}

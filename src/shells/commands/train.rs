@@ -1,0 +1,190 @@
+//! `arlpcg train`: the shell around the training core ([`crate::services::train`]). It owns what the core
+//! must not touch: the clock, signals (Ctrl-C, and SIGTERM and SIGHUP as schedulers send them:
+//! each saves a checkpoint and stops), the progress bar and what is printed.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+
+use crate::services::train::{self, TrainConfig, Training};
+use crate::shells::cli::TrainArgs;
+use crate::shells::common::{Interrupted, UsageError};
+
+pub fn run(args: &TrainArgs) -> Result<()> {
+    if args.print_config {
+        print!(
+            "{}",
+            serde_yaml::to_string(&TrainConfig::for_run(
+                args.game.unwrap_or(arlpcg_core::level::Game::Platform),
+                args.mode
+                    .map_or(arlpcg_core::rl::checkpoint::TrainMode::RulePcg, Into::into)
+            ))?
+        );
+        return Ok(());
+    }
+    let usage = |message: &str| anyhow::Error::from(UsageError(message.into()));
+    let out = args.out.as_ref().ok_or_else(|| {
+        usage("--out DIR is required: where the run's checkpoint, metrics and policy go")
+    })?;
+    // One session per run folder: a second (a resume started twice) would interleave
+    // checkpoints. Taken before anything in the folder is touched; a folder that does not
+    // exist yet is locked as soon as the run has made it (a refused run makes none).
+    let lock = out.is_dir().then(|| RunLock::take(out)).transpose()?;
+    // Temporary files a killed session left (a checkpoint half written) go first.
+    let stale = crate::services::fsio::remove_stale_temps(out, std::time::SystemTime::now())?;
+    if stale > 0 {
+        eprintln!(
+            "removed {stale} temporary files a stopped run left in {}",
+            out.display()
+        );
+    }
+    let pool = crate::shells::common::thread_pool(args.threads)?;
+    pool.install(|| {
+        let mut run = train::open(
+            args.game,
+            args.mode.map(Into::into),
+            out,
+            args.config.as_deref(),
+            args.seed,
+            args.steps,
+            args.resume,
+        )?;
+        let _lock = match lock {
+            Some(lock) => lock,
+            None => RunLock::take(out)?,
+        };
+        run.add_session(
+            std::iter::once("arlpcg".to_string())
+                .chain(std::env::args().skip(1))
+                .collect::<Vec<_>>()
+                .join(" "),
+        );
+        train_loop(run.as_mut(), args.minutes, args.pause_at)
+    })
+}
+
+/// Iterates `run` until its budget of Solver steps, `minutes` of this session, `pause_at` Solver
+/// steps, or a signal; checkpoints on the run's interval and at the end, then writes the
+/// policies.
+fn train_loop(run: &mut dyn Training, minutes: Option<f64>, pause_at: Option<u64>) -> Result<()> {
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        // A second handler cannot be installed (tests run several runs in one process).
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    let session = Instant::now();
+    let wall_before = run.wall_before();
+    let wall = || wall_before + session.elapsed().as_secs_f64();
+    let mut last_checkpoint = Instant::now();
+    let total = run.budget();
+    let bar = crate::shells::common::progress_bar(total, "training");
+    bar.set_position(run.solver_steps());
+    loop {
+        // The budget may end early (a finish whose catch-up reached its success).
+        let done_by_steps = run.solver_steps() >= run.budget();
+        let done_by_time = minutes.is_some_and(|m| session.elapsed().as_secs_f64() >= m * 60.0);
+        let paused = pause_at.is_some_and(|at| run.solver_steps() >= at);
+        if done_by_steps || done_by_time || paused || stop.load(Ordering::SeqCst) {
+            break;
+        }
+        let message = run.iterate(&wall).with_context(|| {
+            format!(
+                "training stopped at {} Solver steps; the last checkpoint in {} is kept \
+                 (--resume, with --config for a smaller learning rate, continues from it)",
+                run.solver_steps(),
+                run.out().display()
+            )
+        })?;
+        bar.set_message(message);
+        bar.set_position(run.solver_steps());
+        if last_checkpoint.elapsed().as_secs_f64() >= run.checkpoint_minutes() * 60.0 {
+            run.save_checkpoint(wall())?;
+            train::write_learning_curve(run.out())?;
+            last_checkpoint = Instant::now();
+        }
+    }
+    bar.finish_and_clear();
+    let wall = wall();
+    run.save_checkpoint(wall)?;
+    run.save_policies(wall)?;
+    train::write_learning_curve(run.out())?;
+    let summary = format!(
+        "at {} Solver steps after {:.1} min in all; checkpoints and policies in {}",
+        run.solver_steps(),
+        wall / 60.0,
+        run.out().display()
+    );
+    if stop.load(Ordering::SeqCst) {
+        println!("stopped (Ctrl-C or a termination signal) {summary}");
+        return Err(Interrupted(format!(
+            "training interrupted; its checkpoint is saved: --resume continues it ({})",
+            run.out().display()
+        ))
+        .into());
+    }
+    if run.solver_steps() < run.budget() {
+        println!("paused {summary} (--resume goes on)");
+    } else {
+        println!("finished {summary}");
+    }
+    Ok(())
+}
+
+/// The run folder's lock: [`train::LOCK_FILE`] holding this process's id, removed when the
+/// session ends. A lock whose process is gone (a killed session) is taken over; the check reads
+/// `/proc`, so where there is none every lock counts as gone.
+struct RunLock {
+    path: std::path::PathBuf,
+}
+
+impl RunLock {
+    fn take(out: &std::path::Path) -> Result<Self> {
+        let path = out.join(train::LOCK_FILE);
+        let ours = std::process::id();
+        loop {
+            match std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&path)
+            {
+                Ok(mut file) => {
+                    use std::io::Write;
+                    writeln!(file, "{ours}")
+                        .with_context(|| format!("cannot write {}", path.display()))?;
+                    return Ok(Self { path });
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let holder = std::fs::read_to_string(&path)
+                        .ok()
+                        .and_then(|text| text.trim().parse::<u32>().ok());
+                    if let Some(pid) = holder
+                        && pid != ours
+                        && std::path::Path::new(&format!("/proc/{pid}")).exists()
+                    {
+                        anyhow::bail!(
+                            "{} is in use by another training session (process {pid}); wait for \
+                             it to finish or stop it (Ctrl-C saves its checkpoint) before resuming",
+                            out.display()
+                        );
+                    }
+                    // Its session is gone: the lock is stale.
+                    std::fs::remove_file(&path).with_context(|| {
+                        format!("cannot remove the stale lock {}", path.display())
+                    })?;
+                }
+                Err(e) => {
+                    return Err(e).with_context(|| format!("cannot create {}", path.display()));
+                }
+            }
+        }
+    }
+}
+
+impl Drop for RunLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
+}

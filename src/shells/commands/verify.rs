@@ -1,0 +1,461 @@
+//! `arlpcg verify`: play each level many times and report the Solver's statistics, then a
+//! summary over all the levels.
+
+use std::collections::HashMap;
+use std::collections::hash_map::Entry;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use serde_json::json;
+
+use crate::services::panel::{JudgePanel, rate};
+use crate::services::policies::{load_panel, load_solver};
+use crate::services::verify::{
+    HalfwaySplit, Solver, SolverPolicy, Summary, Watch, passed_by_piece, verify,
+};
+use crate::shells::cli::{Judges, SolverChoice, VerifyArgs, default_solver};
+use arlpcg_core::game::Skill;
+use arlpcg_core::game::facts::facts;
+use arlpcg_core::level::stats::{Outcome, PanelStats, SolverRef, SolverStats};
+use arlpcg_core::level::yaml;
+use arlpcg_core::level::{Game, Level};
+
+pub fn run(args: &VerifyArgs) -> Result<()> {
+    if args.replay {
+        return replay(args);
+    }
+    if let Some(judges) = &args.panel {
+        return panel(args, judges);
+    }
+    if args.chart.is_some() && args.levels.len() != 1 {
+        return Err(crate::shells::common::UsageError(
+            "--chart draws one level: give one level file".into(),
+        )
+        .into());
+    }
+    if let Some(chart) = &args.chart
+        && chart.extension().is_none_or(|e| e != "png")
+    {
+        return Err(crate::shells::common::UsageError(format!(
+            "--chart {}: the file name must end in .png",
+            chart.display()
+        ))
+        .into());
+    }
+    let mut solvers = Solvers::default();
+    let mut failed = 0;
+    let mut all = Vec::new();
+    let mut halfway = HalfwaySplit::default();
+    for path in &args.levels {
+        let outcome = yaml::load(path)
+            .map_err(anyhow::Error::from)
+            .and_then(|level| {
+                let game = level.game();
+                solvers.resolve(game, args)?;
+                let solver = solvers.get(game);
+                let bar = crate::shells::common::progress_bar(
+                    args.trials as u64,
+                    &path.display().to_string(),
+                );
+                let stats = verify(&level, &solver, args.trials, args.seed, &|| bar.inc(1))?;
+                bar.finish_and_clear();
+                Ok((level, stats))
+            });
+        match outcome {
+            Ok((level, stats)) => {
+                if args.json {
+                    println!("{}", to_json(path, &level, &stats));
+                } else {
+                    println!("{}", describe(path, &level, &stats));
+                }
+                halfway.add(&level, &stats);
+                if let Some(chart) = &args.chart {
+                    let name = path.file_stem().unwrap_or_default().to_string_lossy();
+                    let png = crate::services::verify::pacing_chart(&name, &level, &stats).to_png();
+                    crate::services::fsio::write_atomic(
+                        chart,
+                        &png,
+                        crate::services::fsio::Overwrite::Never,
+                    )?;
+                    eprintln!("wrote {}", chart.display());
+                }
+                all.push(stats);
+            }
+            Err(err) => {
+                failed += 1;
+                eprintln!("error: {}", one_line(&format!("{err:#}")));
+            }
+        }
+    }
+    if all.len() > 1 && !args.json {
+        let s = Summary::of(&all);
+        let steps = match s.completed_by_any > 0.0 {
+            true => format!("{:.0}", s.mean_success_steps),
+            false => "n/a".into(),
+        };
+        println!(
+            "{} levels: success ratio {:.3} ± {:.3} (mean ± std over levels), completed by at least one run {:.2}, mean progress {:.2}, mean steps of successful runs {steps}",
+            s.levels, s.mean_success, s.std_success, s.completed_by_any, s.mean_progress
+        );
+        let [before, past] = halfway.per_piece();
+        if halfway.failures.iter().sum::<u64>() > 0 {
+            println!(
+                "failures per piece {before:.2} before the halfway point ({} pieces), {past:.2} past it ({} pieces): {:.0}% of the {} failures fall past it",
+                halfway.pieces[0],
+                halfway.pieces[1],
+                100.0 * halfway.share_past(),
+                halfway.failures.iter().sum::<u64>()
+            );
+        }
+    }
+    if failed > 0 {
+        anyhow::bail!(
+            "{failed} of {} level files could not be verified",
+            args.levels.len()
+        );
+    }
+    Ok(())
+}
+
+/// `verify --replay`: each level's certificate run, again, with the Solver that recorded it.
+fn replay(args: &VerifyArgs) -> Result<()> {
+    let mut failed = 0;
+    for path in &args.levels {
+        let outcome = yaml::load(path)
+            .map_err(anyhow::Error::from)
+            .and_then(|level| replay_one(&level));
+        match outcome {
+            Ok(said) => println!("{}: {said}", path.display()),
+            Err(err) => {
+                failed += 1;
+                report_error(path, &err);
+            }
+        }
+    }
+    if failed > 0 {
+        anyhow::bail!(
+            "{failed} of {} certificates did not replay",
+            args.levels.len()
+        );
+    }
+    Ok(())
+}
+
+fn replay_one(level: &arlpcg_core::level::Level) -> Result<String> {
+    let stats = level
+        .stats
+        .as_ref()
+        .context("no statistics: verify the level first (generate --verify N)")?;
+    let seed = stats
+        .certificate
+        .context("its statistics record no certificate (no successful run was found)")?;
+    let loaded;
+    let solver = match &stats.solver {
+        SolverRef::Scripted { skill } => Solver::Scripted(*skill),
+        SolverRef::Random => Solver::Random,
+        SolverRef::Policy { policy } => {
+            loaded = load_solver(Path::new(&policy.path), level.game())?.0;
+            if loaded.reference.sha256 != policy.sha256 {
+                anyhow::bail!(
+                    "{} is not the policy that recorded the certificate (its SHA-256 differs)",
+                    policy.path
+                );
+            }
+            Solver::Policy(&loaded)
+        }
+    };
+    let run = crate::services::verify::record(level, &solver, seed)?;
+    if run.result.outcome != Outcome::Success {
+        anyhow::bail!(
+            "the certificate run (seed {seed}) did not succeed with the {}: it {}",
+            stats.solver.describe(),
+            run.result.outcome.describe()
+        );
+    }
+    Ok(format!(
+        "the certificate run (seed {seed}) succeeds again with the {} in {} decisions",
+        stats.solver.describe(),
+        run.result.steps
+    ))
+}
+
+/// `verify --panel`: every level played by every judge, then rated over judges × levels (the
+/// levels of each game together).
+fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
+    let mut panels: HashMap<Game, JudgePanel> = HashMap::new();
+    let mut rated: Vec<(&Path, Game, PanelStats)> = Vec::new();
+    let mut failed = 0;
+    for path in &args.levels {
+        let outcome = yaml::load(path)
+            .map_err(anyhow::Error::from)
+            .and_then(|level| {
+                let game = level.game();
+                let panel = match panels.entry(game) {
+                    Entry::Occupied(known) => known.into_mut(),
+                    Entry::Vacant(new) => {
+                        let dir = args
+                            .policies
+                            .clone()
+                            .unwrap_or_else(|| crate::services::policies::shipped_dir(game));
+                        let chosen = (!chosen.0.is_empty()).then_some(chosen.0.as_slice());
+                        let panel = load_panel(&dir, game, chosen)?;
+                        if !args.json {
+                            eprintln!("{game} panel: {}", panel.names().join(", "));
+                        }
+                        new.insert(panel)
+                    }
+                };
+                let runs = args.trials as u64 * panel.judges.len() as u64;
+                let bar = crate::shells::common::progress_bar(runs, &path.display().to_string());
+                let watch = Watch {
+                    on_trial: &|_| bar.inc(1),
+                    stop: &|| false,
+                };
+                let played = crate::services::panel::play(
+                    panel,
+                    &level,
+                    args.trials,
+                    args.seed,
+                    &watch,
+                    &|_, _| {},
+                )?
+                .expect("a panel without a stop condition plays to the end");
+                bar.finish_and_clear();
+                Ok((game, played))
+            });
+        match outcome {
+            Ok((game, stats)) => rated.push((path, game, stats)),
+            Err(err) => {
+                failed += 1;
+                report_error(path, &err);
+            }
+        }
+    }
+    for game in [Game::Platform, Game::Racing] {
+        let mut of_game: Vec<&mut PanelStats> = rated
+            .iter_mut()
+            .filter(|(_, g, _)| *g == game)
+            .map(|(_, _, s)| s)
+            .collect();
+        if of_game.is_empty() {
+            continue;
+        }
+        let abilities = rate(&mut of_game);
+        if !args.json {
+            let shown: Vec<String> = abilities
+                .iter()
+                .map(|(name, theta)| format!("{name} {theta:+.2}"))
+                .collect();
+            println!("{game} judges' ability θ (logits): {}", shown.join(", "));
+        }
+    }
+    for (path, _, stats) in &rated {
+        let rating = stats.rating.expect("rated above");
+        if args.json {
+            let ratios: serde_json::Map<String, serde_json::Value> = stats
+                .judges
+                .iter()
+                .map(|j| (j.judge.clone(), json!(j.success_ratio)))
+                .collect();
+            println!(
+                "{}",
+                json!({
+                    "level": path.display().to_string(),
+                    "seed": stats.seed,
+                    "trials": stats.trials,
+                    "panel": ratios,
+                    "panel_ci95": stats.judges.iter().map(|j| (j.judge.clone(), json!(j.ci95))).collect::<serde_json::Map<_, _>>(),
+                    "rating": {"b": rating.b, "ci95": rating.ci95, "levels": rating.levels},
+                })
+            );
+        } else {
+            let judges: Vec<String> = stats
+                .judges
+                .iter()
+                .map(|j| format!("{} {:.2}", j.judge, j.success_ratio))
+                .collect();
+            println!(
+                "{}: difficulty b {:+.2} (95% CI {:+.2} to {:+.2}); {}",
+                path.display(),
+                rating.b,
+                rating.ci95[0],
+                rating.ci95[1],
+                judges.join(", ")
+            );
+        }
+    }
+    if failed > 0 {
+        anyhow::bail!(
+            "{failed} of {} level files could not be verified",
+            args.levels.len()
+        );
+    }
+    Ok(())
+}
+
+/// The Solver of each game met so far, resolved from the arguments once per game.
+#[derive(Default)]
+struct Solvers {
+    resolved: HashMap<Game, Resolved>,
+}
+
+enum Resolved {
+    Policy(Box<SolverPolicy>),
+    Scripted(Skill),
+    Random,
+}
+
+impl Solvers {
+    /// Resolves the Solver for levels of `game` (once), and says who plays.
+    fn resolve(&mut self, game: Game, args: &VerifyArgs) -> Result<()> {
+        if self.resolved.contains_key(&game) {
+            return Ok(());
+        }
+        let shipped = default_solver(game);
+        let policy = args.policy.clone().unwrap_or_else(|| shipped.clone());
+        let choice = args
+            .solver
+            .unwrap_or(if args.policy.is_some() || shipped.exists() {
+                SolverChoice::Policy
+            } else {
+                SolverChoice::ScriptedExpert
+            });
+        let resolved = match choice {
+            SolverChoice::Policy => Resolved::Policy(Box::new(load_solver(&policy, game)?.0)),
+            SolverChoice::Random => Resolved::Random,
+            scripted => Resolved::Scripted(scripted.skill().expect("the other choices")),
+        };
+        if !args.json {
+            let who = match &resolved {
+                Resolved::Policy(p) => format!("policy {}", p.reference.path),
+                Resolved::Scripted(_) if args.solver.is_none() => format!(
+                    "scripted player (no trained Solver at {})",
+                    shipped.display()
+                ),
+                Resolved::Scripted(skill) => format!("scripted player ({skill})"),
+                Resolved::Random => "random actions".into(),
+            };
+            eprintln!("{game} solver: {who}");
+        }
+        self.resolved.insert(game, resolved);
+        Ok(())
+    }
+
+    fn get(&self, game: Game) -> Solver<'_> {
+        match &self.resolved[&game] {
+            Resolved::Policy(p) => Solver::Policy(p),
+            Resolved::Scripted(skill) => Solver::Scripted(*skill),
+            Resolved::Random => Solver::Random,
+        }
+    }
+}
+
+fn to_json(path: &Path, level: &Level, s: &SolverStats) -> serde_json::Value {
+    let game = level.game();
+    let mut value = json!({
+        "level": path.display().to_string(),
+        "solver": s.solver.describe(),
+        "seed": s.seed,
+        "trials": s.trials,
+        "successes": s.successes,
+        "success_ratio": s.success_ratio,
+        "ci95": s.ci95,
+        "mean_progress": s.mean_progress,
+        "mean_success_steps": s.mean_success_steps,
+        "fell": s.fell,
+        "timed_out": s.timed_out,
+    });
+    match game {
+        Game::Platform => value["failures_by_block"] = json!(s.failures_by_piece),
+        Game::Racing => {
+            value["off_road"] = json!(s.off_road);
+            value["flipped"] = json!(s.flipped);
+            value["mean_air_steps"] = json!(s.mean_air_steps);
+            value["failures_by_segment"] = json!(s.failures_by_piece);
+        }
+    }
+    if let Some(pacing) = &level.pacing {
+        value["aux_curve"] = json!(pacing.curve.to_string());
+        value["aux_by_piece"] = json!(pacing.piece_aux);
+        value["passed_by_piece"] = json!(
+            passed_by_piece(s)
+                .iter()
+                .map(|p| round2(*p))
+                .collect::<Vec<_>>()
+        );
+    }
+    value
+}
+
+fn round2(x: f64) -> f64 {
+    (x * 100.0).round() / 100.0
+}
+
+fn describe(path: &Path, level: &Level, s: &SolverStats) -> String {
+    let game = level.game();
+    let mut text = format!(
+        "{}: {}/{} succeeded, success ratio {:.2} (95% CI {:.2}-{:.2}), mean progress {:.2}",
+        path.display(),
+        s.successes,
+        s.trials,
+        s.success_ratio,
+        s.ci95[0],
+        s.ci95[1],
+        s.mean_progress
+    );
+    let failures: Vec<String> = s
+        .failures_by_piece
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| **n > 0)
+        .map(|(i, n)| format!("{} {i}: {n}", facts(game).piece))
+        .collect();
+    if let (Some(air), Some(dt)) = (s.mean_air_steps, facts(game).air_time_step) {
+        text += &format!(", mean air time {:.2} s", air * dt);
+    }
+    if !failures.is_empty() {
+        let causes = match game {
+            Game::Platform => format!("fell {}, out of time {}", s.fell, s.timed_out),
+            Game::Racing => format!(
+                "off the road {}, flipped {}, out of time {}",
+                s.off_road, s.flipped, s.timed_out
+            ),
+        };
+        text += &format!(
+            "\n  failed {} {} ({causes})",
+            facts(game).failed_at,
+            failures.join(", ")
+        );
+    }
+    if let Some(pacing) = &level.pacing {
+        let passed: Vec<String> = passed_by_piece(s)
+            .iter()
+            .zip(&pacing.piece_aux)
+            .map(|(p, aux)| match aux {
+                Some(aux) => format!("{p:.2} (λ {aux:+.2})"),
+                None => format!("{p:.2} (kept)"),
+            })
+            .collect();
+        text += &format!(
+            "\n  aux curve {}; runs past each {}: {}",
+            pacing.curve,
+            facts(game).piece,
+            passed.join(", ")
+        );
+    }
+    text
+}
+
+/// Prints a level file's error on one line.
+fn report_error(path: &Path, err: &anyhow::Error) {
+    eprintln!(
+        "error: {}: {}",
+        path.display(),
+        one_line(&format!("{err:#}"))
+    );
+}
+
+/// Folds a multi-line error message onto one line.
+pub fn one_line(message: &str) -> String {
+    message.split_whitespace().collect::<Vec<_>>().join(" ")
+}

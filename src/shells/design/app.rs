@@ -1,0 +1,525 @@
+//! The designer's state and its pure update: `update(state, message) -> effects`. Keys, mouse,
+//! ticks and the worker's answers come in as [`Message`]s; the work to do goes out as
+//! [`Effect`]s, which the shell hands to the worker threads. Nothing here touches the terminal,
+//! the file system or a clock, so key scripts drive it in tests.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use ratatui::layout::Rect;
+
+use arlpcg_core::level::heading::{direction_heading, heading_direction, wrap_degrees};
+use arlpcg_core::level::params::quantize;
+
+use crate::services::verify::Recording;
+use arlpcg_core::level::{Game, Level};
+
+use super::layout::Areas;
+
+mod input;
+pub mod judging;
+mod messages;
+pub mod pacing;
+mod policies;
+mod responses;
+mod trials;
+
+pub use messages::{Effect, ExportOutcome, Message, Response};
+pub use trials::Trials;
+
+pub use policies::{JudgeSwitch, LoadedInfo, PolicyInfo};
+
+/// Steps of the λ slider (keys), and its range.
+pub const AUX_STEP: f64 = 0.1;
+/// The λ values of a sweep.
+pub const SWEEP_AUX: [f64; 9] = [-1.0, -0.75, -0.5, -0.25, 0.0, 0.25, 0.5, 0.75, 1.0];
+/// Trials per λ in a sweep.
+pub const SWEEP_TRIALS: u32 = 40;
+/// Default Solver trials on each generated level.
+pub const DEFAULT_TRIALS: u32 = 100;
+/// Most trials one level may be given from the prompt.
+pub const MAX_TRIALS: u32 = 10_000;
+/// Replay steps shown per tick (the game runs at 50 steps/s; ticks come every ~33 ms).
+pub const REPLAY_STEPS_PER_TICK: usize = 2;
+
+/// Where the goal comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GoalSetting {
+    /// Drawn from the seed, as the rules and the Generator draw it.
+    FromSeed,
+    /// Set by the designer: horizontal distance (m), height above the start (m), direction
+    /// (degrees, the heading convention of level files).
+    Custom {
+        distance: f64,
+        height: f64,
+        direction: f64,
+    },
+}
+
+impl GoalSetting {
+    /// The goal position, or `None` to draw it from the seed.
+    pub fn position(&self) -> Option<[f64; 3]> {
+        match *self {
+            GoalSetting::FromSeed => None,
+            GoalSetting::Custom {
+                distance,
+                height,
+                direction,
+            } => {
+                let [x, z] = heading_direction(direction);
+                Some([quantize(distance * x), height, quantize(distance * z)])
+            }
+        }
+    }
+}
+
+/// A prompt being typed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PromptKind {
+    Seed,
+    Trials,
+    Policies,
+    Target,
+    Curve,
+}
+
+impl PromptKind {
+    pub fn label(self) -> &'static str {
+        match self {
+            PromptKind::Seed => "seed",
+            PromptKind::Trials => "Solver trials per level",
+            PromptKind::Target => "target success rate, 0.05-0.95 (empty: back to the λ slider)",
+            PromptKind::Policies => "policies folder, or a Generator/Solver .safetensors file",
+            PromptKind::Curve => "aux curve, fraction:λ, ... (e.g. 0:1, 0.5:1, 0.6:-1, 1:-1)",
+        }
+    }
+}
+
+/// What covers the screen, if anything.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Overlay {
+    None,
+    Help,
+    /// The loaded policies' cards.
+    Cards,
+    Prompt {
+        kind: PromptKind,
+        text: String,
+    },
+    /// Export would overwrite these files.
+    ConfirmOverwrite {
+        paths: Vec<PathBuf>,
+    },
+}
+
+/// What the bottom-right panel shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SidePane {
+    Failures,
+    Sweep,
+    /// The whole panel of judges on the level on screen.
+    Judges,
+}
+
+/// A recorded run being played back.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Replay {
+    pub seed: u64,
+    pub recording: Recording,
+    /// Index into the recording's path.
+    pub frame: usize,
+}
+
+/// One λ of a sweep: its success ratio, or why it has none.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SweepPoint {
+    Pending,
+    Success(f64),
+    NoLevel(String),
+}
+
+/// A λ sweep for the seed and goal it was started with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sweep {
+    pub id: u64,
+    pub seed: u64,
+    pub points: Vec<(f64, SweepPoint)>,
+}
+
+/// Everything the designer shows and remembers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct App {
+    pub game: Game,
+    /// The policies of the game on screen...
+    pub policies: LoadedInfo,
+    /// ...and of the other game (Tab swaps them).
+    pub other_policies: LoadedInfo,
+    pub aux: f64,
+    /// Target-success mode: the success rate asked for (λ follows the level found).
+    pub target: Option<f64>,
+    /// λ along the level (instead of the slider's one λ).
+    pub pacing: Option<pacing::PacingChoice>,
+    /// The prefix every regeneration keeps.
+    pub kept: Option<crate::services::generation::KeptPrefix>,
+    pub seed: u64,
+    pub goal: GoalSetting,
+    pub trials_wanted: u32,
+    pub out_dir: PathBuf,
+    /// The level on screen.
+    pub level: Option<Arc<Level>>,
+    /// The id of the newest generation asked for; the level on screen answers it when equal.
+    pub requested: u64,
+    pub shown: u64,
+    pub generation_error: Option<String>,
+    pub trials: Option<Trials>,
+    pub replay: Option<Replay>,
+    /// The recording asked for (request id, run seed), until it arrives.
+    recording: Option<(u64, u64)>,
+    replays: u64,
+    pub sweep: Option<Sweep>,
+    pub judging: Option<judging::Judging>,
+    pub panel: SidePane,
+    /// Selected block (index into the level's blocks).
+    pub selected: Option<usize>,
+    pub overlay: Overlay,
+    /// The latest message for the footer, and whether it reports a problem.
+    pub status: Option<(String, bool)>,
+    pub size: Rect,
+    /// Whether the mouse is dragging the slider.
+    dragging: bool,
+    next_id: u64,
+    pub quit: bool,
+}
+
+impl App {
+    /// A designer for `game` that will show a level as soon as the first effects run.
+    pub fn new(game: Game, policies: LoadedInfo, seed: u64, out_dir: PathBuf) -> Self {
+        Self {
+            game,
+            policies,
+            other_policies: LoadedInfo::default(),
+            aux: 1.0,
+            target: None,
+            pacing: None,
+            kept: None,
+            seed,
+            goal: GoalSetting::FromSeed,
+            trials_wanted: DEFAULT_TRIALS,
+            out_dir,
+            level: None,
+            requested: 0,
+            shown: 0,
+            generation_error: None,
+            trials: None,
+            replay: None,
+            recording: None,
+            replays: 0,
+            sweep: None,
+            judging: None,
+            panel: SidePane::Failures,
+            selected: None,
+            overlay: Overlay::None,
+            status: None,
+            size: Rect::new(0, 0, 80, 24),
+            dragging: false,
+            next_id: 1,
+            quit: false,
+        }
+    }
+
+    /// The first effects: generate the level for the starting settings.
+    pub fn start(&mut self) -> Vec<Effect> {
+        self.generate()
+    }
+
+    fn id(&mut self) -> u64 {
+        let id = self.next_id;
+        self.next_id += 1;
+        id
+    }
+
+    /// Whether a generation is in flight.
+    pub fn generating(&self) -> bool {
+        self.requested != self.shown
+    }
+
+    fn generate(&mut self) -> Vec<Effect> {
+        let id = self.id();
+        self.requested = id;
+        self.replay = None;
+        self.recording = None;
+        if let Some(target) = self.target {
+            return vec![Effect::Target {
+                id,
+                game: self.game,
+                seed: self.seed,
+                goal: self.goal.position(),
+                target,
+                trials: self.trials_wanted,
+            }];
+        }
+        vec![Effect::Generate {
+            id,
+            game: self.game,
+            seed: self.seed,
+            aux: self.aux,
+            goal: self.goal.position(),
+            curve: self.pacing.as_ref().map(|p| p.curve.clone()),
+            keep: self.kept.clone(),
+        }]
+    }
+
+    /// Tab: the other game, with its own policies, from the same seed and λ (a goal set by hand
+    /// goes back to the seed's: the games' goals lie at different distances).
+    pub(super) fn switch_game(&mut self) -> Vec<Effect> {
+        self.game = match self.game {
+            Game::Platform => Game::Racing,
+            Game::Racing => Game::Platform,
+        };
+        std::mem::swap(&mut self.policies, &mut self.other_policies);
+        self.goal = GoalSetting::FromSeed;
+        self.kept = None;
+        if self.policies.generator.is_none() {
+            self.pacing = None;
+        }
+        self.level = None;
+        self.trials = None;
+        self.sweep = None;
+        self.selected = None;
+        self.generation_error = None;
+        self.generate()
+    }
+
+    fn set_aux(&mut self, aux: f64) -> Vec<Effect> {
+        let aux = (aux.clamp(-1.0, 1.0) * 100.0).round() / 100.0;
+        if aux == self.aux && self.target.is_none() {
+            return Vec::new();
+        }
+        // Moving the slider leaves target-success mode and pacing.
+        self.target = None;
+        if self.pacing.take().is_some() {
+            self.say("one λ again (P: pacing presets)");
+        }
+        self.aux = aux;
+        self.generate()
+    }
+
+    /// Target-success mode on (`Some`) or off: a Generator is needed to steer.
+    pub(super) fn set_target(&mut self, target: Option<f64>) -> Vec<Effect> {
+        if target.is_some() && self.policies.generator.is_none() {
+            self.complain(
+                "a success target needs a Generator (p loads one): rule levels have no λ to steer",
+            );
+            return Vec::new();
+        }
+        self.target = target;
+        if target.is_some() {
+            // The search steers one λ over the whole level.
+            self.pacing = None;
+            self.kept = None;
+        }
+        if let Some(p) = target {
+            self.say(format!(
+                "searching λ for success {p:.2} ± 0.1 ({} runs a candidate)",
+                self.trials_wanted
+            ));
+        }
+        self.generate()
+    }
+
+    fn say(&mut self, text: impl Into<String>) {
+        self.status = Some((text.into(), false));
+    }
+
+    fn complain(&mut self, text: impl Into<String>) {
+        self.status = Some((text.into(), true));
+    }
+
+    /// The file stem exports use: game, seed and λ (or the pacing preset), and the pieces kept.
+    pub fn export_stem(&self) -> String {
+        let mut stem = match &self.pacing {
+            Some(choice) => format!(
+                "{}_seed{}_pacing-{}",
+                self.game,
+                self.seed,
+                choice.name.replace(' ', "-")
+            ),
+            None => crate::services::level_files::file_stem(self.game, self.seed, Some(self.aux)),
+        };
+        if let Some(kept) = &self.kept {
+            stem += &format!("_keep{}", kept.pieces);
+        }
+        stem
+    }
+
+    fn export(&mut self, overwrite: bool) -> Vec<Effect> {
+        let Some(level) = &self.level else {
+            self.complain("no level to export yet");
+            return Vec::new();
+        };
+        let mut level = Level::clone(level);
+        level.stats = self.trials.as_ref().and_then(|t| t.stats.clone());
+        match &mut level.stats {
+            Some(stats) => stats.panel = self.panel_on_screen(),
+            None => self.say("exporting without Solver statistics (trials still running)"),
+        }
+        vec![Effect::Export {
+            level: Box::new(level),
+            dir: self.out_dir.join(self.game.name()),
+            stem: self.export_stem(),
+            overwrite,
+        }]
+    }
+
+    fn record(&mut self) -> Vec<Effect> {
+        let Some(level) = self.level.clone() else {
+            return Vec::new();
+        };
+        let id = self.id();
+        self.replays += 1;
+        let seed = level
+            .seed
+            .unwrap_or(0)
+            .wrapping_add(1_000_000 + self.replays);
+        self.replay = None;
+        self.recording = Some((id, seed));
+        self.say(format!("recording a run (seed {seed})"));
+        vec![Effect::Record { id, level, seed }]
+    }
+
+    fn sweep(&mut self) -> Vec<Effect> {
+        let id = self.id();
+        self.sweep = Some(Sweep {
+            id,
+            seed: self.seed,
+            points: SWEEP_AUX
+                .iter()
+                .map(|&a| (a, SweepPoint::Pending))
+                .collect(),
+        });
+        self.panel = SidePane::Sweep;
+        vec![Effect::Sweep {
+            id,
+            game: self.game,
+            seed: self.seed,
+            goal: self.goal.position(),
+            auxes: SWEEP_AUX.to_vec(),
+            trials: SWEEP_TRIALS,
+        }]
+    }
+
+    fn adjust_goal(&mut self, d_steps: f64, d_height: f64, d_direction: f64) -> Vec<Effect> {
+        let GoalSetting::Custom {
+            distance,
+            height,
+            direction,
+        } = self.goal
+        else {
+            self.complain("the goal is drawn from the seed: press g to set it by hand");
+            return Vec::new();
+        };
+        // Within the ranges the game's rules draw goals from, in the game's key steps.
+        let facts = arlpcg_core::game::facts::facts(self.game);
+        let (distances, heights) = (facts.goal_distance, facts.goal_height);
+        let d_distance = d_steps * facts.goal_distance_step;
+        self.goal = GoalSetting::Custom {
+            distance: (distance + d_distance).clamp(distances.0, distances.1),
+            height: (height + d_height).clamp(heights.0, heights.1),
+            direction: wrap_degrees(direction + d_direction),
+        };
+        self.generate()
+    }
+
+    fn toggle_goal(&mut self) -> Vec<Effect> {
+        self.goal = match self.goal {
+            GoalSetting::Custom { .. } => GoalSetting::FromSeed,
+            GoalSetting::FromSeed => {
+                // Start from the goal on screen, so the level changes only when adjusted.
+                let [x, y, z] = self
+                    .level
+                    .as_ref()
+                    .map_or([0.0, 0.0, 50.0], |level| level.goal);
+                GoalSetting::Custom {
+                    distance: x.hypot(z).round(),
+                    height: y.round(),
+                    direction: direction_heading(x, z).round(),
+                }
+            }
+        };
+        self.generate()
+    }
+
+    fn select(&mut self, delta: isize) {
+        let blocks = self.level.as_ref().map_or(0, |l| l.piece_count());
+        if blocks == 0 {
+            self.selected = None;
+            return;
+        }
+        let next = match self.selected {
+            None if delta > 0 => 0,
+            None => blocks - 1,
+            Some(i) => (i as isize + delta).rem_euclid(blocks as isize) as usize,
+        };
+        self.selected = Some(next);
+    }
+
+    fn start_trials(&mut self) -> Vec<Effect> {
+        let Some(level) = self.level.clone() else {
+            return Vec::new();
+        };
+        let id = self.id();
+        self.trials = Some(Trials {
+            id,
+            wanted: self.trials_wanted,
+            results: Vec::new(),
+            stats: None,
+            error: None,
+        });
+        vec![Effect::Trials {
+            id,
+            seed: level.seed.unwrap_or(0),
+            level,
+            trials: self.trials_wanted,
+        }]
+    }
+
+    fn tick(&mut self) {
+        if let Some(replay) = &mut self.replay {
+            let last = replay.recording.path.len().saturating_sub(1);
+            replay.frame = (replay.frame + REPLAY_STEPS_PER_TICK).min(last);
+        }
+    }
+}
+
+/// The designer's update: applies `message` to `app` and returns the work it asks for.
+pub fn update(app: &mut App, message: Message) -> Vec<Effect> {
+    match message {
+        Message::Key(key) => app.key(key),
+        Message::Mouse(mouse) => app.mouse(mouse),
+        Message::Resize { width, height } => {
+            app.size = Rect::new(0, 0, width, height);
+            Vec::new()
+        }
+        Message::Tick => {
+            app.tick();
+            Vec::new()
+        }
+        Message::Worker(response) => app.response(response),
+    }
+}
+
+/// The λ under column `column` of the slider track `slider` (-1 at its left end, +1 at its right).
+pub fn slider_aux(slider: Rect, column: u16) -> f64 {
+    let span = slider.width.saturating_sub(1).max(1) as f64;
+    let t = (column.saturating_sub(slider.x) as f64 / span).clamp(0.0, 1.0);
+    ((-1.0 + 2.0 * t) * 20.0).round() / 20.0
+}
+
+/// The next seed `n` draws: a fixed scramble of the current one (SplitMix64), so key scripts
+/// are reproducible.
+pub fn next_seed(seed: u64) -> u64 {
+    let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    (z ^ (z >> 31)) % 1_000_000
+}

@@ -1,0 +1,213 @@
+//! The designer's input: keys (with the prompts they open) and the mouse on the λ slider, as
+//! changes of [`App`] and the effects they ask for.
+
+use ratatui::crossterm::event::{
+    KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEvent, MouseEventKind,
+};
+use ratatui::layout::Position;
+
+use super::*;
+
+impl App {
+    pub(super) fn key(&mut self, key: KeyEvent) -> Vec<Effect> {
+        if key.kind == KeyEventKind::Release {
+            return Vec::new();
+        }
+        if key.modifiers.contains(KeyModifiers::CONTROL) && key.code == KeyCode::Char('c') {
+            self.quit = true;
+            return Vec::new();
+        }
+        match std::mem::replace(&mut self.overlay, Overlay::None) {
+            Overlay::None => {}
+            Overlay::Help | Overlay::Cards => {
+                if !matches!(key.code, KeyCode::Char('q')) {
+                    return Vec::new();
+                }
+            }
+            Overlay::Prompt { kind, text } => return self.prompt_key(kind, text, key),
+            Overlay::ConfirmOverwrite { .. } => {
+                if matches!(key.code, KeyCode::Char('y' | 'Y')) {
+                    return self.export(true);
+                }
+                self.say("export cancelled: nothing written");
+                return Vec::new();
+            }
+        }
+        self.status = None;
+        match key.code {
+            KeyCode::Char('q') | KeyCode::Esc => {
+                self.quit = true;
+                Vec::new()
+            }
+            KeyCode::Char('?') => {
+                self.overlay = Overlay::Help;
+                Vec::new()
+            }
+            KeyCode::Char('c') => {
+                self.overlay = Overlay::Cards;
+                Vec::new()
+            }
+            KeyCode::Char('j') => {
+                self.say("switching judge".to_string());
+                vec![Effect::NextJudge {
+                    game: self.game,
+                    after: self.policies.judge(),
+                    folder: self.policies.folder(self.game),
+                }]
+            }
+            KeyCode::Tab => self.switch_game(),
+            KeyCode::Left => self.set_aux(self.aux - AUX_STEP),
+            KeyCode::Right => self.set_aux(self.aux + AUX_STEP),
+            KeyCode::Home => self.set_aux(-1.0),
+            KeyCode::End => self.set_aux(1.0),
+            KeyCode::Enter | KeyCode::Char(' ') => self.generate(),
+            KeyCode::Char('n') => {
+                self.seed = next_seed(self.seed);
+                self.generate()
+            }
+            KeyCode::Char('s') => self.open_prompt(PromptKind::Seed),
+            KeyCode::Char('t') => self.open_prompt(PromptKind::Trials),
+            KeyCode::Char('T') => self.open_prompt(PromptKind::Target),
+            KeyCode::Char('p') => self.open_prompt(PromptKind::Policies),
+            KeyCode::Char('g') => self.toggle_goal(),
+            KeyCode::Char('d') => self.adjust_goal(-1.0, 0.0, 0.0),
+            KeyCode::Char('D') => self.adjust_goal(1.0, 0.0, 0.0),
+            KeyCode::Char('h') => self.adjust_goal(0.0, -1.0, 0.0),
+            KeyCode::Char('H') => self.adjust_goal(0.0, 1.0, 0.0),
+            KeyCode::Char('a') => self.adjust_goal(0.0, 0.0, -15.0),
+            KeyCode::Char('A') => self.adjust_goal(0.0, 0.0, 15.0),
+            KeyCode::Up => {
+                self.select(-1);
+                Vec::new()
+            }
+            KeyCode::Down => {
+                self.select(1);
+                Vec::new()
+            }
+            KeyCode::Char('r') => self.record(),
+            KeyCode::Char('w') => self.sweep(),
+            KeyCode::Char('v') => {
+                self.panel = match self.panel {
+                    SidePane::Failures => SidePane::Sweep,
+                    SidePane::Sweep => SidePane::Judges,
+                    SidePane::Judges => SidePane::Failures,
+                };
+                self.judge_if_shown()
+            }
+            KeyCode::Char('J') => self.judge_level(),
+            KeyCode::Char('x') => self.export(false),
+            KeyCode::Char('P') => self.next_pacing(),
+            KeyCode::Char('C') => self.open_prompt(PromptKind::Curve),
+            KeyCode::Char('k') => self.keep_prefix(),
+            KeyCode::Char('K') => self.release_prefix(),
+            _ => Vec::new(),
+        }
+    }
+
+    fn open_prompt(&mut self, kind: PromptKind) -> Vec<Effect> {
+        let text = match kind {
+            PromptKind::Seed => self.seed.to_string(),
+            PromptKind::Trials => self.trials_wanted.to_string(),
+            PromptKind::Target => self.target.map_or(String::new(), |t| format!("{t}")),
+            PromptKind::Policies => String::new(),
+            PromptKind::Curve => self
+                .pacing
+                .as_ref()
+                .map_or(String::new(), |p| p.curve.to_string()),
+        };
+        self.overlay = Overlay::Prompt { kind, text };
+        Vec::new()
+    }
+
+    fn prompt_key(&mut self, kind: PromptKind, mut text: String, key: KeyEvent) -> Vec<Effect> {
+        match key.code {
+            KeyCode::Esc => return Vec::new(),
+            KeyCode::Enter => return self.submit(kind, text.trim()),
+            KeyCode::Backspace => {
+                text.pop();
+            }
+            KeyCode::Char(c) if text.chars().count() < 200 => text.push(c),
+            _ => {}
+        }
+        self.overlay = Overlay::Prompt { kind, text };
+        Vec::new()
+    }
+
+    fn submit(&mut self, kind: PromptKind, text: &str) -> Vec<Effect> {
+        match kind {
+            PromptKind::Seed => match text.parse::<u64>() {
+                Ok(seed) => {
+                    self.seed = seed;
+                    self.generate()
+                }
+                Err(_) => {
+                    self.complain(format!("seed `{text}`: give a whole number ≥ 0"));
+                    Vec::new()
+                }
+            },
+            PromptKind::Trials => match text.parse::<u32>() {
+                Ok(n) if (1..=MAX_TRIALS).contains(&n) => {
+                    self.trials_wanted = n;
+                    self.start_trials()
+                }
+                _ => {
+                    self.complain(format!(
+                        "trials `{text}`: give a number from 1 to {MAX_TRIALS}"
+                    ));
+                    Vec::new()
+                }
+            },
+            PromptKind::Target if text.trim().is_empty() => {
+                if self.target.is_none() {
+                    return Vec::new();
+                }
+                self.say("back to the λ slider");
+                self.set_target(None)
+            }
+            PromptKind::Target => match text.trim().parse::<f64>() {
+                Ok(p) if (0.05..=0.95).contains(&p) => self.set_target(Some(p)),
+                _ => {
+                    self.complain(format!(
+                        "target `{text}`: give a success rate from 0.05 to 0.95 (e.g. 0.6)"
+                    ));
+                    Vec::new()
+                }
+            },
+            PromptKind::Curve if text.is_empty() => Vec::new(),
+            PromptKind::Curve => self.submit_curve(text),
+            PromptKind::Policies if text.is_empty() => Vec::new(),
+            PromptKind::Policies => {
+                self.say(format!("loading {text}"));
+                vec![Effect::Load {
+                    path: PathBuf::from(text),
+                    game: self.game,
+                }]
+            }
+        }
+    }
+
+    /// Starts the trials on the level on screen.
+    pub(super) fn mouse(&mut self, mouse: MouseEvent) -> Vec<Effect> {
+        if self.overlay != Overlay::None {
+            return Vec::new();
+        }
+        let slider = Areas::of(self.size).slider;
+        let at = Position::new(mouse.column, mouse.row);
+        match mouse.kind {
+            MouseEventKind::Down(MouseButton::Left) if slider.contains(at) => {
+                self.dragging = true;
+                self.set_aux(slider_aux(slider, mouse.column))
+            }
+            MouseEventKind::Drag(MouseButton::Left) if self.dragging => {
+                self.set_aux(slider_aux(slider, mouse.column))
+            }
+            MouseEventKind::Up(_) => {
+                self.dragging = false;
+                Vec::new()
+            }
+            MouseEventKind::ScrollUp if slider.contains(at) => self.set_aux(self.aux + AUX_STEP),
+            MouseEventKind::ScrollDown if slider.contains(at) => self.set_aux(self.aux - AUX_STEP),
+            _ => Vec::new(),
+        }
+    }
+}

@@ -1,0 +1,122 @@
+//! The whole panel on the level on screen (`J`, and the `v` panel that shows it): every judge
+//! of the policies' folder plays the level, and the level is rated on the Rasch scale, with the
+//! figures `arlpcg verify LEVEL --panel --trials 40` gives for the exported file. An export of
+//! a level the panel has measured records the panel in its statistics.
+
+use super::*;
+use arlpcg_core::level::stats::PanelStats;
+
+/// Runs per judge.
+pub const PANEL_TRIALS: u32 = 40;
+/// The seed of each judge's first run (`verify`'s default).
+pub const PANEL_SEED: u64 = 0;
+
+/// One judge's runs, as they come in.
+#[derive(Debug, Clone, PartialEq)]
+pub enum JudgePoint {
+    Pending,
+    Played { success_ratio: f64, ci95: [f64; 2] },
+}
+
+/// The panel on one level.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Judging {
+    pub id: u64,
+    /// The level it measures: a new level is measured afresh.
+    pub level: Arc<Level>,
+    /// Each judge's name and runs (empty until the panel is loaded).
+    pub judges: Vec<(String, JudgePoint)>,
+    /// Every judge's statistics and the level's rating, once all have played.
+    pub stats: Option<PanelStats>,
+    /// Why the panel could not play (a Solver file of the wrong game, say).
+    pub error: Option<String>,
+}
+
+/// What the worker reports of a panel's play.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PanelUpdate {
+    /// The judges, in the order they play.
+    Judges(Vec<String>),
+    Played {
+        index: usize,
+        success_ratio: f64,
+        ci95: [f64; 2],
+    },
+    /// All have played: the panel with the level's rating.
+    Rated(Box<PanelStats>),
+    Failed(String),
+}
+
+impl App {
+    /// `J`: the whole panel plays the level on screen; the bottom-right panel shows it.
+    pub(super) fn judge_level(&mut self) -> Vec<Effect> {
+        self.panel = SidePane::Judges;
+        let Some(level) = self.level.clone() else {
+            self.complain("no level for the panel to play yet");
+            return Vec::new();
+        };
+        let id = self.id();
+        self.judging = Some(Judging {
+            id,
+            level: level.clone(),
+            judges: Vec::new(),
+            stats: None,
+            error: None,
+        });
+        vec![Effect::Panel {
+            id,
+            level,
+            folder: self.policies.folder(self.game),
+            trials: PANEL_TRIALS,
+        }]
+    }
+
+    /// The panel, when it is shown, follows the level on screen.
+    pub(super) fn judge_if_shown(&mut self) -> Vec<Effect> {
+        let measured = self.judging.as_ref().map(|j| &j.level);
+        if self.panel == SidePane::Judges && measured != self.level.as_ref() {
+            self.judge_level()
+        } else {
+            Vec::new()
+        }
+    }
+
+    pub(super) fn panel_update(&mut self, id: u64, update: PanelUpdate) {
+        let Some(judging) = self.judging.as_mut().filter(|j| j.id == id) else {
+            return;
+        };
+        match update {
+            PanelUpdate::Judges(names) => {
+                judging.judges = names
+                    .into_iter()
+                    .map(|n| (n, JudgePoint::Pending))
+                    .collect();
+            }
+            PanelUpdate::Played {
+                index,
+                success_ratio,
+                ci95,
+            } => {
+                if let Some(slot) = judging.judges.get_mut(index) {
+                    slot.1 = JudgePoint::Played {
+                        success_ratio,
+                        ci95,
+                    };
+                }
+            }
+            PanelUpdate::Rated(stats) => judging.stats = Some(*stats),
+            PanelUpdate::Failed(problem) => {
+                judging.error = Some(problem.clone());
+                self.complain(format!("the panel could not play: {problem}"));
+            }
+        }
+    }
+
+    /// The panel's statistics on the level on screen, once complete.
+    pub(super) fn panel_on_screen(&self) -> Option<PanelStats> {
+        let judging = self.judging.as_ref()?;
+        (Some(&judging.level) == self.level.as_ref())
+            .then(|| judging.stats.clone())
+            .flatten()
+    }
+}

@@ -1,0 +1,139 @@
+//! What flows through the designer's update: [`Message`]s in (keys, mouse, ticks, the worker's
+//! [`Response`]s) and [`Effect`]s out (the work the shell hands to the worker threads).
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use ratatui::crossterm::event::{KeyEvent, MouseEvent};
+
+use super::{JudgeSwitch, LoadedInfo, SweepPoint, judging};
+use crate::services::panel::Judge;
+use crate::services::verify::Recording;
+use arlpcg_core::level::stats::{SolverStats, TrialResult};
+use arlpcg_core::level::{Game, Level};
+
+/// A message from the user (through the terminal) or from the worker.
+#[derive(Debug, Clone)]
+pub enum Message {
+    Key(KeyEvent),
+    Mouse(MouseEvent),
+    Resize {
+        width: u16,
+        height: u16,
+    },
+    /// Animation clock (about 30 per second).
+    Tick,
+    Worker(Response),
+}
+
+/// The worker's answers; each names the request it answers.
+#[derive(Debug, Clone)]
+pub enum Response {
+    Level {
+        id: u64,
+        result: Result<Arc<Level>, String>,
+    },
+    Trial {
+        id: u64,
+        result: TrialResult,
+    },
+    TrialsDone {
+        id: u64,
+        stats: Box<SolverStats>,
+    },
+    /// The trials could not be played (the Solver does not fit the level, say).
+    TrialsFailed {
+        id: u64,
+        problem: String,
+    },
+    Recorded {
+        id: u64,
+        result: Result<Box<Recording>, String>,
+    },
+    SweepPoint {
+        id: u64,
+        index: usize,
+        point: SweepPoint,
+    },
+    /// Export done (the paths written), refused because files exist, or failed.
+    Exported(ExportOutcome),
+    Loaded(Result<Box<LoadedInfo>, String>),
+    Judged(Result<Box<JudgeSwitch>, String>),
+    Panel {
+        id: u64,
+        update: judging::PanelUpdate,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum ExportOutcome {
+    Written(Vec<PathBuf>),
+    WouldOverwrite(Vec<PathBuf>),
+    Failed(String),
+}
+
+/// Work for the worker threads.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Effect {
+    Generate {
+        id: u64,
+        game: Game,
+        seed: u64,
+        aux: f64,
+        goal: Option<[f64; 3]>,
+        /// λ along the level instead of `aux`.
+        curve: Option<arlpcg_core::level::pacing::AuxCurve>,
+        /// Pieces kept from an earlier level.
+        keep: Option<crate::services::generation::KeptPrefix>,
+    },
+    Trials {
+        id: u64,
+        level: Arc<Level>,
+        trials: u32,
+        seed: u64,
+    },
+    Record {
+        id: u64,
+        level: Arc<Level>,
+        seed: u64,
+    },
+    Sweep {
+        id: u64,
+        game: Game,
+        seed: u64,
+        goal: Option<[f64; 3]>,
+        auxes: Vec<f64>,
+        trials: u32,
+    },
+    Export {
+        level: Box<Level>,
+        dir: PathBuf,
+        stem: String,
+        overwrite: bool,
+    },
+    /// Policies of `game` from a folder or one file.
+    Load { path: PathBuf, game: Game },
+    /// The next judge after `after` whose Solver is in `folder` (or a scripted skill) plays.
+    NextJudge {
+        game: Game,
+        after: Judge,
+        folder: PathBuf,
+    },
+    /// Every judge whose Solver is in `folder`, and the scripted skills, play `level`.
+    Panel {
+        id: u64,
+        level: Arc<Level>,
+        folder: PathBuf,
+        trials: u32,
+    },
+    /// A level of `game` whose success, measured with `trials` runs, is within ±0.1 of `target`
+    /// (the search of `generate --target-success`).
+    Target {
+        id: u64,
+        game: Game,
+        seed: u64,
+        goal: Option<[f64; 3]>,
+        target: f64,
+        trials: u32,
+    },
+}

@@ -1,0 +1,139 @@
+//! `arlpcg design` (and `arlpcg` with no arguments): the designer's terminal UI.
+//!
+//! Three parts, as docs/architecture.md asks: the state and its pure `update` ([`app`]), the drawing
+//! that only reads it ([`view`], on the areas of [`layout`]), and this thin shell, which owns
+//! the terminal, turns terminal events and worker answers into messages, and hands the effects
+//! to the worker threads ([`worker`]).
+
+pub mod app;
+pub mod layout;
+pub mod view;
+pub mod worker;
+
+use std::path::PathBuf;
+use std::sync::mpsc::{Receiver, channel};
+use std::time::Duration;
+
+use anyhow::{Context, Result};
+use ratatui::DefaultTerminal;
+use ratatui::crossterm::event::{self, DisableMouseCapture, EnableMouseCapture, Event};
+use ratatui::crossterm::execute;
+
+use app::{App, LoadedInfo, Message, Response};
+use arlpcg_core::level::Game;
+use worker::{GamePolicies, Policies, Workers};
+
+/// Time between animation ticks.
+const TICK: Duration = Duration::from_millis(33);
+
+/// What `arlpcg design` was asked for.
+pub struct DesignOptions {
+    pub game: Game,
+    /// The policies folder; `None`: the shipped ones (`policies/<game>`), or rules and the
+    /// scripted controller when they are missing.
+    pub policies: Option<PathBuf>,
+    pub out: PathBuf,
+    pub seed: u64,
+}
+
+/// The policies the designer starts on for `game`, and a note when it falls back to rules and
+/// the scripted player. `--policies` is for the game the designer opens on; the other game
+/// starts on its shipped policies.
+fn starting_policies(
+    options: &DesignOptions,
+    game: Game,
+) -> Result<(Policies, LoadedInfo, Option<String>)> {
+    match options.policies.as_ref().filter(|_| game == options.game) {
+        Some(path) => {
+            let (policies, info) = worker::load(path, game)
+                .with_context(|| format!("--policies {}", path.display()))?;
+            Ok((policies, info, None))
+        }
+        None => {
+            let shipped = crate::services::policies::shipped_dir(game);
+            match worker::load(&shipped, game) {
+                Ok((policies, info)) => Ok((policies, info, None)),
+                Err(e) => Ok((
+                    Policies::default(),
+                    LoadedInfo::default(),
+                    Some(format!(
+                        "no shipped policies ({e:#}): rule levels and the scripted controller; p loads others"
+                    )),
+                )),
+            }
+        }
+    }
+}
+
+/// Runs the designer until the user quits.
+pub fn run(options: DesignOptions) -> Result<()> {
+    let (policies, info, note) = starting_policies(&options, options.game)?;
+    let other_game = match options.game {
+        Game::Platform => Game::Racing,
+        Game::Racing => Game::Platform,
+    };
+    let (other_policies, other_info, _) = starting_policies(&options, other_game)?;
+    let mut shelf = GamePolicies::default();
+    *shelf.of_mut(options.game) = policies;
+    *shelf.of_mut(other_game) = other_policies;
+    let (answers, responses) = channel();
+    let workers = Workers::start(shelf, answers);
+    let mut app = App::new(options.game, info, options.seed, options.out);
+    app.other_policies = other_info;
+    if let Some(note) = note {
+        app.status = Some((note, true));
+    }
+    // Mouse capture off on panic too; ratatui's own hook (installed by init) restores the rest.
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let _ = execute!(std::io::stdout(), DisableMouseCapture);
+        previous(info);
+    }));
+    let mut terminal = ratatui::try_init().context("cannot open the terminal for the designer")?;
+    let result = execute!(std::io::stdout(), EnableMouseCapture)
+        .context("cannot enable the mouse")
+        .and_then(|()| event_loop(&mut terminal, &mut app, &workers, &responses));
+    let _ = execute!(std::io::stdout(), DisableMouseCapture);
+    ratatui::restore();
+    result
+}
+
+fn event_loop(
+    terminal: &mut DefaultTerminal,
+    app: &mut App,
+    workers: &Workers,
+    responses: &Receiver<Response>,
+) -> Result<()> {
+    let size = terminal.size()?;
+    app::update(
+        app,
+        Message::Resize {
+            width: size.width,
+            height: size.height,
+        },
+    );
+    for effect in app.start() {
+        workers.submit(effect);
+    }
+    while !app.quit {
+        terminal.draw(|frame| view::render(app, frame))?;
+        let message = if event::poll(TICK)? {
+            match event::read()? {
+                Event::Key(key) => Message::Key(key),
+                Event::Mouse(mouse) => Message::Mouse(mouse),
+                Event::Resize(width, height) => Message::Resize { width, height },
+                _ => continue,
+            }
+        } else {
+            Message::Tick
+        };
+        let mut effects = app::update(app, message);
+        while let Ok(response) = responses.try_recv() {
+            effects.extend(app::update(app, Message::Worker(response)));
+        }
+        for effect in effects {
+            workers.submit(effect);
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,564 @@
+//! Drawing the designer: reads the state, never changes it.
+
+use ratatui::Frame;
+use ratatui::layout::Rect;
+use ratatui::style::{Color, Style, Stylize};
+use ratatui::symbols::Marker;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::canvas::{Context, Points};
+use ratatui::widgets::{
+    Axis, Bar, BarChart, BarGroup, Block, Chart, Dataset, GraphType, Paragraph, Wrap,
+};
+
+mod judges;
+mod overlay;
+mod platform;
+mod racing;
+
+use super::app::{App, GoalSetting, PolicyInfo, SidePane, SweepPoint};
+use super::layout::{Areas, SLIDER_LEFT, SLIDER_RIGHT, fits};
+use crate::services::panel::Judge;
+use arlpcg_core::level::stats::Outcome;
+use arlpcg_core::level::{Game, Level, Track};
+use arlpcg_core::rl::checkpoint::Role;
+
+/// The key map, as the help overlay and the README show it.
+pub const KEYS: [(&str, &str); 22] = [
+    (
+        "← →  (mouse: click/drag)",
+        "λ down/up by 0.1 (-1 hard ... +1 easy)",
+    ),
+    ("Home End", "λ = -1 / λ = +1"),
+    ("Enter, Space", "generate again (same settings: same level)"),
+    ("n s", "draw a new seed / type a seed"),
+    ("g", "goal: from the seed / set by hand"),
+    ("d D", "goal distance -5 / +5 m, racing 20 (goal by hand)"),
+    ("h H", "goal height -1 / +1 m"),
+    ("a A", "goal direction -15° / +15°"),
+    ("↑ ↓", "select a block/segment: its parameters in stats"),
+    ("t", "Solver trials per level (default 100)"),
+    ("T", "target success rate: λ is searched for it"),
+    ("r", "replay one Solver run on the map"),
+    ("w", "λ sweep: success against λ for this seed and goal"),
+    ("v", "bottom-right panel: failures / λ sweep / judges"),
+    ("P C", "pacing: next preset / type a curve fraction:λ, ..."),
+    ("k K", "keep pieces up to the selected one / let go"),
+    ("x", "export YAML (with the Solver statistics) + .glb"),
+    ("p", "load policies (a folder or one .safetensors file)"),
+    ("c j J", "cards / next judge plays trials / all judges play"),
+    ("Tab", "game: platform / racing"),
+    ("?", "this help (any key closes it)"),
+    ("q, Esc", "quit"),
+];
+
+const HINTS: &str = "←→ λ  ⏎ generate  n seed  r replay  w sweep  x export  p load  ? help  q quit";
+
+pub fn render(app: &App, frame: &mut Frame) {
+    let screen = frame.area();
+    if !fits(screen) {
+        let text = format!(
+            "The designer needs a terminal of at least 80×24 (this one is {}×{}).",
+            screen.width, screen.height
+        );
+        frame.render_widget(Paragraph::new(text).wrap(Wrap { trim: true }), screen);
+        return;
+    }
+    let areas = Areas::of(screen);
+    header(app, frame, areas.header);
+    controls(app, frame, &areas);
+    match app.level.as_deref() {
+        Some(level) => match &level.track {
+            Track::Platform(track) => {
+                platform::map(app, level, track, frame, areas.map);
+                platform::profile(app, level, track, frame, areas.profile);
+            }
+            Track::Racing(track) => {
+                let road = track.road();
+                racing::map(app, level, track, &road, frame, areas.map);
+                racing::profile(app, level, &road, frame, areas.profile);
+            }
+        },
+        None => {
+            let text = match &app.generation_error {
+                Some(problem) => problem.clone(),
+                None => "generating…".to_string(),
+            };
+            frame.render_widget(
+                Paragraph::new(text)
+                    .wrap(Wrap { trim: true })
+                    .block(Block::bordered().title(" level ")),
+                areas.map,
+            );
+        }
+    }
+    stats(app, frame, areas.stats);
+    match app.panel {
+        SidePane::Failures => failures(app, frame, areas.panel),
+        SidePane::Sweep => sweep(app, frame, areas.panel),
+        SidePane::Judges => judges::judges(app, frame, areas.panel),
+    }
+    footer(app, frame, areas.footer);
+    overlay::overlay(app, frame, screen);
+}
+
+fn policy_label(info: &Option<PolicyInfo>, none: &str) -> String {
+    match info {
+        Some(p) => format!(
+            "{} {}",
+            p.card.training.mode,
+            millions(p.card.training.steps)
+        ),
+        None => none.to_string(),
+    }
+}
+
+fn millions(steps: u64) -> String {
+    if steps >= 100_000 {
+        format!("{:.1}M", steps as f64 / 1e6)
+    } else {
+        format!("{}k", steps / 1000)
+    }
+}
+
+/// What a policy's training budget counts: the Solver's steps, the Generator's pieces.
+fn budget_unit(role: Role, game: Game) -> &'static str {
+    match role {
+        Role::Solver => "steps",
+        Role::Generator => piece_name(game, true),
+    }
+}
+
+/// What a piece of `game` is called.
+fn piece_name(game: Game, plural: bool) -> &'static str {
+    arlpcg_core::game::facts::facts(game).piece_name(plural)
+}
+
+fn header(app: &App, frame: &mut Frame, area: Rect) {
+    let game = |g: Game| {
+        let style = if app.game == g {
+            Style::new().reversed()
+        } else {
+            Style::new().dim()
+        };
+        Span::styled(format!(" {} ", g.name()), style)
+    };
+    let mut line = Line::from(vec![
+        Span::styled(" arlpcg designer ", Style::new().bold()),
+        game(Game::Platform),
+        game(Game::Racing),
+    ]);
+    // The training budgets, in each policy's own unit, where the width allows.
+    let mode = |info: &Option<PolicyInfo>, none: &str| match info {
+        Some(p) => {
+            let t = &p.card.training;
+            let budget = format!(
+                " {} {}",
+                millions(t.steps),
+                budget_unit(p.card.role, p.card.game)
+            );
+            (t.mode.to_string(), budget)
+        }
+        None => (none.to_string(), String::new()),
+    };
+    let (generator, generator_budget) = mode(&app.policies.generator, "rules");
+    let scripted = Judge::Scripted(app.policies.skill).name();
+    let (solver, solver_budget) = mode(&app.policies.solver, &scripted);
+    let long =
+        format!("  Generator: {generator}{generator_budget}  Solver: {solver}{solver_budget}");
+    let policies = if line.width() + long.chars().count() <= area.width as usize {
+        long
+    } else {
+        format!("  Generator: {generator}  Solver: {solver}")
+    };
+    line.push_span(Span::raw(policies));
+    frame.render_widget(Paragraph::new(line), area);
+}
+
+fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
+    frame.render_widget(
+        Block::bordered().title(" λ (aux): how hard the Generator builds "),
+        areas.controls,
+    );
+    let width = areas.slider.width as usize;
+    let mut slider = match &app.pacing {
+        // The curve from start to goal, taller where it is harder.
+        Some(choice) => {
+            let profile: String = (0..width)
+                .map(|i| {
+                    let aux = choice
+                        .curve
+                        .at(i as f64 / width.saturating_sub(1).max(1) as f64);
+                    let level = ((1.0 - aux) / 2.0 * 7.0).round() as usize;
+                    ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'][level.min(7)]
+                })
+                .collect();
+            // Labels as wide as the slider's; the preset and its curve on the settings line.
+            Line::from(vec![
+                Span::raw(format!("{:<w$}", "start", w = SLIDER_LEFT.chars().count())),
+                Span::styled(profile, Style::new().fg(Color::Magenta)),
+                Span::raw(format!("{:>w$}", "goal", w = SLIDER_RIGHT.chars().count())),
+                Span::styled("  pacing", Style::new().bold()),
+            ])
+        }
+        None => {
+            let knob =
+                (((app.aux + 1.0) / 2.0) * (width.saturating_sub(1)) as f64).round() as usize;
+            let track: String = (0..width)
+                .map(|i| match i.cmp(&knob) {
+                    std::cmp::Ordering::Less => '━',
+                    std::cmp::Ordering::Equal => '●',
+                    std::cmp::Ordering::Greater => '─',
+                })
+                .collect();
+            Line::from(vec![
+                Span::raw(SLIDER_LEFT).red(),
+                Span::styled(track, Style::new().fg(Color::Cyan)),
+                Span::raw(SLIDER_RIGHT).green(),
+                Span::styled(format!("  λ {:+.2}", app.aux), Style::new().bold()),
+            ])
+        }
+    };
+    if let Some(kept) = &app.kept {
+        slider.push_span(Span::styled(
+            format!("  keeping {}", kept.pieces),
+            Style::new().fg(Color::Blue),
+        ));
+    }
+    if let Some(target) = app.target {
+        slider.push_span(Span::styled(
+            format!(" for success {target:.2}"),
+            Style::new().fg(Color::Cyan),
+        ));
+    }
+    let row = Rect {
+        width: areas.controls.width.saturating_sub(2),
+        x: areas.controls.x + 1,
+        ..areas.slider
+    };
+    frame.render_widget(Paragraph::new(slider), row);
+    let goal = match (app.goal, app.level.as_deref()) {
+        (GoalSetting::Custom { .. }, _) | (_, None) => describe_goal(app.goal.position()),
+        (GoalSetting::FromSeed, Some(level)) => describe_goal(Some(level.goal)),
+    };
+    let origin = match app.goal {
+        GoalSetting::FromSeed => "from seed",
+        GoalSetting::Custom { .. } => "by hand",
+    };
+    let mut settings = Line::from(vec![
+        Span::raw("seed "),
+        Span::styled(app.seed.to_string(), Style::new().bold()),
+        Span::raw(format!("   goal ({origin}) {goal}")),
+        Span::raw(format!("   trials {}", app.trials_wanted)).dim(),
+    ]);
+    if let Some(choice) = &app.pacing {
+        settings.push_span(Span::styled(
+            format!("   {}: {}", choice.name, choice.curve),
+            Style::new().fg(Color::Magenta),
+        ));
+    }
+    frame.render_widget(Paragraph::new(settings), areas.settings);
+}
+
+fn describe_goal(goal: Option<[f64; 3]>) -> String {
+    match goal {
+        Some([x, y, z]) => format!("{:.0} m away, {:+.0} m up", x.hypot(z), y),
+        None => "drawn from the seed".into(),
+    }
+}
+
+/// Square bounds around `points` for a canvas of `area` (braille: 2×4 dots a cell), padded.
+fn bounds(points: &[[f64; 2]], area: Rect, pad: f64) -> ([f64; 2], [f64; 2]) {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in points {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let dots = [
+        (area.width.saturating_sub(2).max(1) * 2) as f64,
+        (area.height.saturating_sub(2).max(1) * 4) as f64,
+    ];
+    let span = [hi[0] - lo[0] + 2.0 * pad, hi[1] - lo[1] + 2.0 * pad];
+    let per_dot = (span[0] / dots[0]).max(span[1] / dots[1]);
+    let centre = [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0];
+    let half = [per_dot * dots[0] / 2.0, per_dot * dots[1] / 2.0];
+    (
+        [centre[0] - half[0], centre[0] + half[0]],
+        [centre[1] - half[1], centre[1] + half[1]],
+    )
+}
+
+fn draw_replay(app: &App, ctx: &mut Context, project: impl Fn(&[f32; 3]) -> [f64; 2]) {
+    let Some(replay) = &app.replay else {
+        return;
+    };
+    let path = &replay.recording.path[..=replay.frame];
+    let trail: Vec<(f64, f64)> = path
+        .iter()
+        .map(|f| {
+            let [x, y] = project(f);
+            (x, y)
+        })
+        .collect();
+    ctx.draw(&Points {
+        coords: &trail,
+        color: Color::Magenta,
+    });
+    ctx.layer();
+    if let Some(&(x, y)) = trail.last() {
+        ctx.print(x, y, "@".magenta().bold());
+    }
+}
+
+fn stats(app: &App, frame: &mut Frame, area: Rect) {
+    let scripted = Judge::Scripted(app.policies.skill).name();
+    let solver = policy_label(&app.policies.solver, &scripted);
+    let mut lines = Vec::new();
+    match &app.trials {
+        Some(t) => {
+            let running = if t.stats.is_some() || t.error.is_some() {
+                ""
+            } else {
+                " …"
+            };
+            lines.push(Line::from(format!(
+                "trials {}/{}  successes {}{running}",
+                t.done(),
+                t.wanted,
+                t.successes()
+            )));
+            match t.success() {
+                Some((ratio, [lo, hi])) => lines.push(Line::from(vec![
+                    Span::raw("success "),
+                    Span::styled(format!("{ratio:.2}"), Style::new().bold()),
+                    Span::raw(format!("  95% [{lo:.2}, {hi:.2}]")),
+                ])),
+                None => lines.push(Line::from("success …")),
+            }
+            if let Some(progress) = t.mean_progress() {
+                lines.push(Line::from(match app.game {
+                    Game::Platform => format!(
+                        "progress {:.2}  fell {}  timeout {}",
+                        progress,
+                        t.count(Outcome::Fell),
+                        t.count(Outcome::TimedOut)
+                    ),
+                    Game::Racing => format!(
+                        "progress {:.2}  off road {}  flipped {}  timeout {}",
+                        progress,
+                        t.count(Outcome::OffRoad),
+                        t.count(Outcome::Flipped),
+                        t.count(Outcome::TimedOut)
+                    ),
+                }));
+            }
+            if let Some(air) = t.mean_air_seconds(app.game) {
+                lines.push(Line::from(format!("air time {air:.2} s per run")));
+            }
+            if let Some(problem) = &t.error {
+                lines.push(Line::from(format!("stopped: {problem}").red()));
+            }
+        }
+        None => lines.push(Line::from("no trials yet")),
+    }
+    if let Some(level) = &app.level {
+        lines.push(Line::from(source_line(level)).dim());
+        if let Some(track) = level.racing() {
+            racing::stats(app, track, &mut lines);
+        }
+        if let Some(track) = level.platform() {
+            let blocks = track.block_params();
+            let n = blocks.len().max(1) as f64;
+            lines.push(Line::from(format!(
+                "mean jump {:.1} m, block {:.1} m",
+                blocks.iter().map(|b| b.distance).sum::<f64>() / n,
+                blocks.iter().map(|b| b.size).sum::<f64>() / n,
+            )));
+            if let Some(b) = app.selected.and_then(|i| blocks.get(i).map(|b| (i, b))) {
+                let (i, b) = b;
+                let failures = app
+                    .trials
+                    .as_ref()
+                    .map_or(0, |t| t.failures_by_block(blocks.len())[i]);
+                lines.push(
+                    Line::from(format!(
+                        "block {i}: jump {:.1} m, turn {:+.0}°",
+                        b.distance, b.angle
+                    ))
+                    .cyan(),
+                );
+                lines.push(
+                    Line::from(format!(
+                        "  size {:.1} m, up {:+.1} m, {failures} fell",
+                        b.size, b.height
+                    ))
+                    .cyan(),
+                );
+            }
+        }
+    }
+    if app.generating() {
+        lines.push(Line::from("generating…").yellow());
+    }
+    frame.render_widget(
+        Paragraph::new(lines).block(Block::bordered().title(format!(" Solver: {solver} "))),
+        area,
+    );
+}
+
+/// The colour of λ: green at +1 (easy), yellow at 0, red at -1 (hard).
+fn aux_colour(aux: f64) -> Color {
+    let hard = ((1.0 - aux) / 2.0).clamp(0.0, 1.0);
+    let red = (255.0 * (2.0 * hard).min(1.0)) as u8;
+    let green = (255.0 * (2.0 * (1.0 - hard)).min(1.0)) as u8;
+    Color::Rgb(red, green, 40)
+}
+
+/// The colour of each of `pieces` pieces (blocks, segments): the selected one cyan; on a paced
+/// level each by the λ it was built at (kept pieces without one blue), else by its share of
+/// the failures so far.
+fn piece_colours(app: &App, pieces: usize) -> Vec<Color> {
+    if let Some(pacing) = app.level.as_ref().and_then(|l| l.pacing.as_ref()) {
+        return (0..pieces)
+            .map(|i| match pacing.piece_aux.get(i) {
+                _ if app.selected == Some(i) => Color::Cyan,
+                Some(Some(aux)) => aux_colour(*aux),
+                _ => Color::Blue,
+            })
+            .collect();
+    }
+    let failures = app
+        .trials
+        .as_ref()
+        .map(|t| t.failures_by_block(pieces))
+        .unwrap_or_else(|| vec![0; pieces]);
+    let most = failures.iter().copied().max().unwrap_or(0);
+    failures
+        .iter()
+        .enumerate()
+        .map(|(i, &f)| {
+            if app.selected == Some(i) {
+                Color::Cyan
+            } else if f == 0 {
+                Color::White
+            } else if f * 2 >= most {
+                Color::Red
+            } else {
+                Color::Yellow
+            }
+        })
+        .collect()
+}
+
+fn source_line(level: &Level) -> String {
+    match &level.source {
+        arlpcg_core::level::Source::Policy { .. } => "Generator level".into(),
+        arlpcg_core::level::Source::Rules { .. }
+        | arlpcg_core::level::Source::RacingRules { .. } => "rule level (no Generator)".into(),
+        arlpcg_core::level::Source::Hand => "made by hand".into(),
+        arlpcg_core::level::Source::Kept { pieces, .. } => {
+            format!("{pieces} pieces kept, the rest by the Generator")
+        }
+    }
+}
+
+fn failures(app: &App, frame: &mut Frame, area: Rect) {
+    let block = Block::bordered().title(format!(
+        " failures per {} (v: sweep) ",
+        piece_name(app.game, false)
+    ));
+    let (Some(level), Some(trials)) = (&app.level, &app.trials) else {
+        frame.render_widget(block, area);
+        return;
+    };
+    let counts = trials.failures_by_block(level.piece_count());
+    if counts.iter().all(|&c| c == 0) {
+        let text = if trials.done() == 0 {
+            "waiting for the first runs"
+        } else {
+            "no run has failed so far"
+        };
+        frame.render_widget(Paragraph::new(text).block(block), area);
+        return;
+    }
+    let piece_aux = |i: usize| level.pacing.as_ref()?.piece_aux.get(i).copied().flatten();
+    let bars: Vec<Bar> = counts
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| {
+            let style = match piece_aux(i) {
+                _ if app.selected == Some(i) => Style::new().cyan(),
+                // Beside the map's colours: where the curve asked for it to be hard.
+                Some(aux) => Style::new().fg(aux_colour(aux)),
+                None => Style::new().red(),
+            };
+            Bar::default()
+                .value(c as u64)
+                .text_value(String::new())
+                .style(style)
+        })
+        .collect();
+    let inner = area.width.saturating_sub(2) as usize;
+    let gap = usize::from(counts.len() * 2 <= inner);
+    let width = ((inner / counts.len().max(1)).saturating_sub(gap)).clamp(1, 3) as u16;
+    let chart = BarChart::default()
+        .block(block)
+        .data(BarGroup::default().bars(&bars))
+        .bar_width(width)
+        .bar_gap(gap as u16);
+    frame.render_widget(chart, area);
+}
+
+fn sweep(app: &App, frame: &mut Frame, area: Rect) {
+    let Some(sweep) = &app.sweep else {
+        frame.render_widget(
+            Paragraph::new("press w to sweep λ for this seed and goal")
+                .wrap(Wrap { trim: true })
+                .block(Block::bordered().title(" λ sweep (v: panel) ")),
+            area,
+        );
+        return;
+    };
+    let points: Vec<(f64, f64)> = sweep
+        .points
+        .iter()
+        .filter_map(|(aux, p)| match p {
+            SweepPoint::Success(s) => Some((*aux, *s)),
+            _ => None,
+        })
+        .collect();
+    let pending = sweep
+        .points
+        .iter()
+        .filter(|(_, p)| *p == SweepPoint::Pending)
+        .count();
+    let title = if pending > 0 {
+        format!(" λ sweep, seed {} ({pending} to go) ", sweep.seed)
+    } else {
+        format!(" λ sweep, seed {} ", sweep.seed)
+    };
+    let dataset = Dataset::default()
+        .marker(Marker::Braille)
+        .graph_type(GraphType::Line)
+        .style(Style::new().cyan())
+        .data(&points);
+    let chart = Chart::new(vec![dataset])
+        .block(Block::bordered().title(title))
+        .x_axis(
+            Axis::default()
+                .bounds([-1.0, 1.0])
+                .labels(["-1", "0", "+1"]),
+        )
+        .y_axis(Axis::default().bounds([0.0, 1.0]).labels(["0", "0.5", "1"]));
+    frame.render_widget(chart, area);
+}
+
+fn footer(app: &App, frame: &mut Frame, area: Rect) {
+    let line = match &app.status {
+        Some((text, true)) => Line::from(text.as_str()).red(),
+        Some((text, false)) => Line::from(text.as_str()).yellow(),
+        None => Line::from(HINTS).dim(),
+    };
+    frame.render_widget(Paragraph::new(line), area);
+}

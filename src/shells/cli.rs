@@ -56,6 +56,35 @@ pub enum Command {
     /// Train a Solver, alone or against a Generator, with PPO (checkpointed, resumable,
     /// stoppable with Ctrl-C).
     Train(TrainArgs),
+    /// Write docs/results.md from the committed results (results/<game>/*.json) and the
+    /// shipped policies' cards, or check that it is current; draw runs' learning curves.
+    Report(ReportArgs),
+}
+
+#[derive(Debug, Args)]
+#[command(after_help = "Examples:\n  \
+    arlpcg report                      # writes docs/results.md\n  \
+    arlpcg report --check              # exit 1 if docs/results.md is not what it would write\n  \
+    arlpcg report --curves runs/platform-rule-pcg-s0 runs/racing-rule-pcg-s0")]
+pub struct ReportArgs {
+    /// The results folder: each game's results.json and seeds.json, and further seeds tables
+    /// in its subfolders (results/<game>/NAME/seeds.json).
+    #[arg(long, default_value = "results")]
+    pub results: PathBuf,
+    /// The shipped policies, whose cards the page quotes.
+    #[arg(long, default_value = "policies")]
+    pub policies: PathBuf,
+    /// The page to write.
+    #[arg(long, default_value = "docs/results.md")]
+    pub out: PathBuf,
+    /// Write nothing; exit 1 (naming the first line that differs) when the page is not what
+    /// this command would write.
+    #[arg(long, conflicts_with = "curves")]
+    pub check: bool,
+    /// Instead of the page: draw learning-curve.png in each of these run folders from its
+    /// metrics (curves are not kept in git).
+    #[arg(long, num_args = 1..)]
+    pub curves: Vec<PathBuf>,
 }
 
 #[derive(Debug, Args)]

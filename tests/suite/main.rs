@@ -17,5 +17,6 @@ mod panel;
 mod platform_game;
 mod ppo_learns;
 mod racing_game;
+mod report;
 mod shipped;
 mod train;

@@ -1,7 +1,7 @@
 //! Pacing: λ along a level (`generate --aux-curve`). Each piece is built at the curve's value
 //! where it begins and records it; the shipped racing Generator follows a λ that changes
 //! within a level in a track's second half (the recipe's platform one does so weakly:
-//! docs/results.md, "Pacing"); bad curves are refused with the reason.
+//! measured at 93fa40a, whose docs/results.md had a "Pacing" section); bad curves are refused with the reason.
 
 use std::path::Path;
 
@@ -60,7 +60,7 @@ fn each_piece_is_built_at_the_curves_value_where_it_begins_and_records_it() {
 
 /// The shipped racing Generator follows λ late in a track: the second half of an easy-then-hard
 /// track fails more often than that of a hard-then-easy one. It does not make a track's start
-/// hard (likely because a car starts from rest; docs/results.md, "A Solver that keeps
+/// hard (likely because a car starts from rest; docs/results.md at 93fa40a, "A Solver that keeps
 /// learning"), so where the failures fall is not asked of the first half.
 #[test]
 fn the_shipped_racing_generator_makes_a_tracks_second_half_as_hard_as_the_curve_asks() {
@@ -84,7 +84,7 @@ fn the_shipped_racing_generator_makes_a_tracks_second_half_as_hard_as_the_curve_
     let hard_then_easy = split("0:-1, 0.5:-1, 0.5001:1, 1:1");
     // Measured with the pair whose finish played the median driver too: 0.63 failures per
     // piece past halfway (22 on 35 pieces, 20 runs each) against 0.33 (13 on 39); over 20
-    // tracks of 100 runs, 3.76 against 1.98 (docs/results.md, "Pacing"). A λ = +1 second half
+    // tracks of 100 runs, 3.76 against 1.98 (measured at 93fa40a, whose docs/results.md had a "Pacing" section). A λ = +1 second half
     // after a hard first one fails more than a flat +1 track's (0.36), but half as often as a
     // λ = -1 one.
     let past = [easy_then_hard.per_piece()[1], hard_then_easy.per_piece()[1]];

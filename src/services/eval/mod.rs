@@ -18,6 +18,7 @@
 
 mod levels;
 mod merge;
+pub mod page;
 mod plays;
 mod report;
 pub mod seeds;

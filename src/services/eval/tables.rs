@@ -11,7 +11,7 @@ use arlpcg_core::level::stats::SolverStats;
 
 use super::{AUX_VALUES, Budget, Play, PlayLayout};
 
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct ControllabilityRow {
     pub aux: f64,
     pub success_ratio: f64,
@@ -21,12 +21,12 @@ pub struct ControllabilityRow {
     #[serde(flatten)]
     pub pieces: BTreeMap<String, f64>,
     /// Racing: mean seconds per run with the car in the air.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub air_time: Option<f64>,
     pub tracks: usize,
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct GeneralizationRow {
     pub mode: String,
     pub success_ratio: f64,
@@ -41,7 +41,7 @@ pub struct GeneralizationRow {
     pub tracks: usize,
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct CrossRow {
     pub mode: String,
     /// Success ratio at each λ of [`AUX_VALUES`], in that order.
@@ -49,7 +49,7 @@ pub struct CrossRow {
 }
 
 /// One judge at one λ: its success on the controllability levels (the cross table's plays).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct JudgeRow {
     pub judge: String,
     pub aux: f64,
@@ -58,10 +58,11 @@ pub struct JudgeRow {
 }
 
 /// Everything `eval` measures.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct Results {
-    /// The game evaluated (the tables' columns and the paper's figures depend on it).
-    #[serde(skip)]
+    /// The game evaluated (the tables' columns and the paper's figures depend on it). Not in
+    /// results.json, whose folder names the game: [`Results::read`] sets it.
+    #[serde(skip, default = "unread_game")]
     pub game: Game,
     pub budget: Budget,
     pub generator: String,
@@ -70,6 +71,20 @@ pub struct Results {
     pub cross: Vec<CrossRow>,
     /// Every judge (trained Solvers and the scripted player's skills) at every λ.
     pub controllability_by_judge: Vec<JudgeRow>,
+}
+
+/// What a [`Results`] read from JSON holds until [`Results::read`] sets the game.
+fn unread_game() -> Game {
+    Game::Platform
+}
+
+impl Results {
+    /// A game's results.json, as `eval` wrote it.
+    pub fn read(game: Game, json: &[u8]) -> serde_json::Result<Results> {
+        let mut results: Results = serde_json::from_slice(json)?;
+        results.game = game;
+        Ok(results)
+    }
 }
 
 /// The tables from the layout and the statistics of every play (`stats[i]` of play `i`).

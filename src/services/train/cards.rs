@@ -222,8 +222,8 @@ pub(super) fn read_checkpoint(
     Ok((loaded, state))
 }
 
-/// The commit the binary was built from (build.rs): `-dirty` when its code differed from it,
-/// "unknown" when built outside a git checkout.
+/// The last commit that changed the code the binary was built from (build.rs): `-dirty` when
+/// its code differed from it, "unknown" when built outside a git checkout.
 pub(super) fn git_commit() -> String {
     env!("ARLPCG_COMMIT").to_string()
 }

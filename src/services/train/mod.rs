@@ -8,7 +8,7 @@
 //! adversarial modes `generator-checkpoint.safetensors`, `generator-metrics.csv` and
 //! `generator.safetensors` + `generator.yaml`. `--resume` continues from the checkpoints.
 //!
-//! This is the core that `arlpcg train` (`src/commands/train.rs`) drives: [`open`] starts or
+//! This is the core that `arlpcg train` (`src/shells/commands/train.rs`) drives: [`open`] starts or
 //! resumes a run, [`Training`] steps it one iteration at a time and saves it. The shell owns the
 //! clock, signals, progress and printing; nothing here reads the clock or prints.
 

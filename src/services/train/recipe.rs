@@ -3,7 +3,7 @@
 //! default (config/mod.rs: its budget and finish); racing's differs in its budget, the Solver's
 //! discount and constant learning rate, the Generator's phases, rewards and curve offset, its
 //! paced matches and its finish.
-//! docs/training.md ("The recipe") says how each value was found.
+//! docs/decisions.md says why each value is what it is.
 
 use super::config::{Finish, ScriptedOpponent, TrainConfig};
 use arlpcg_core::game::RacingGame;
@@ -12,43 +12,29 @@ use arlpcg_core::level::Game;
 use arlpcg_core::level::stats::Skill;
 use arlpcg_core::rl::checkpoint::TrainMode;
 
-/// The racing recipe's budget in Solver steps learned from ([`TrainConfig::steps`]; the
-/// platform's is the configuration's default, `config::PLATFORM_STEPS`).
+/// The racing recipe's budget in Solver steps learned from ([`TrainConfig::steps`]).
+/// Why: docs/decisions.md#d11.
 pub const RACING_STEPS: u64 = 5_000_000;
-/// Racing Generator phases are short: each segment costs the Solver (and its snapshots) about
-/// 40 steps of driving without learning, and these phases were 73% of a 10M run's time at 10k.
+/// Racing Generator phases, in segments. Why: docs/decisions.md#d11.
 pub const RACING_GENERATOR_PHASE_STEPS: u64 = 4_096;
 
 /// The share of racing matches whose λ changes along the track
-/// ([`GeneratorConfig::paced_share`](super::GeneratorConfig::paced_share)). Without them the
-/// recipe's Generator put its difficulty late in the track whatever λ asked there (a λ of -1 on
-/// the first half and +1 on the second: every failure past halfway; docs/results.md, "A finish
-/// without a catch-up"), so `generate --aux-curve` could not pace it.
+/// ([`GeneratorConfig::paced_share`](super::GeneratorConfig::paced_share)). Why:
+/// docs/decisions.md#d12.
 pub const RACING_PACED_SHARE: f64 = 0.5;
 
 /// The racing Solver's discount (docs/spec.md §3: γ 0.998; its runs are hundreds of steps
 /// longer than a platform run).
 pub const RACING_SOLVER_GAMMA: f32 = 0.998;
 
-/// Whether the racing Solver's learning rate anneals to 0 over the budget: it does not, it stays
-/// at 3e-4 like the Generator's. Annealed (6e-5 at 4M of 5M), the Generator went on learning
-/// against a Solver that hardly did, and what it found was that one network's blind spot:
-/// its own Solver 0.29 at λ = -1, every other judge flat or rising. Constant, the Solver leads
-/// until the finish, and the finish's hard tracks are hard for the judges it never met too
-/// (docs/results.md, "Seed 0 of the paced recipe" and "A Solver that keeps learning").
+/// Whether the racing Solver's learning rate anneals to 0 over the budget: it stays at 3e-4.
+/// Why: docs/decisions.md#d10.
 pub const RACING_SOLVER_ANNEAL_LR: bool = false;
 
-/// The racing recipe's finish: one Generator phase against the final Solver, frozen, and the
-/// scripted driver at median skill, each driving half the matches, until the Solver succeeds on
-/// only half of its own hard matches (counted over blocks of 32; at most 800k track segments),
-/// then one frozen Solver iteration and the run ends. In that phase the Generator's entropy
-/// bonus is 0.01 (the run's is 0.001), so that it keeps trying new tracks. Against the Solver
-/// alone, the same 5M made tracks hard for that Solver and hardly for anyone else (judges'
-/// median drop 0.14); with the driver's failures paying too, 0.61, and the Solver second on
-/// validation instead of third (docs/results.md, "A finish against the scripted driver").
-/// Earlier finishes let the Solver catch up at 1e-4 after the Generator's phase; each time it
-/// then drove 84-89% of the evaluation's λ = -1 tracks (target at most 70%; docs/results.md,
-/// "A finish with a catch-up" and after).
+/// The racing recipe's finish: one Generator phase, entropy bonus 0.01, against the final
+/// Solver, frozen, and the median scripted driver, each driving half the matches, until the
+/// Solver succeeds on half its hard matches (blocks of 32; at most 800k segments), then one
+/// frozen Solver iteration. Why: docs/decisions.md#d6 to #d9.
 pub const RACING_FINISH: Finish = Finish {
     // Two frozen Solver iterations: the one that opens the finish, then one after the
     // Generator's phase.
@@ -86,9 +72,7 @@ impl TrainConfig {
     }
 
     /// The defaults for training `game` in `mode`: the game's, without the finish in
-    /// `fixed-aux`. Its matches are all at λ = 1, so its Generator has no hard tracks to make
-    /// against the frozen Solver, and the racing finish's stop (the Solver failing half its
-    /// hard matches) would never come: the phase would run to its cap.
+    /// `fixed-aux` (docs/decisions.md#d14).
     pub fn for_run(game: Game, mode: TrainMode) -> TrainConfig {
         let mut config = Self::for_game(game);
         if mode == TrainMode::FixedAux {

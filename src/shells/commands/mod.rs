@@ -6,6 +6,7 @@ mod eval;
 mod export;
 mod export_policy;
 mod generate;
+mod report;
 mod train;
 mod verify;
 
@@ -24,6 +25,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::ExportPolicy(args)) => export_policy::run(&args),
         Some(Command::Verify(args)) => verify::run(&args),
         Some(Command::Eval(args)) => eval::run(&args),
+        Some(Command::Report(args)) => report::run(&args),
         Some(Command::Train(args)) => train::run(&args),
         Some(Command::Design(args)) => design(args),
         None => {

@@ -193,7 +193,7 @@ pub struct BuildLimits {
     /// The piece budget (the Generator's observation counts down from it).
     pub max_pieces: usize,
     /// Racing: how far, in degrees, the curve action may ask to turn from the goal's bearing
-    /// (`segment_from_action` in `src/game/racing/generator.rs`); the platform game ignores it.
+    /// (`segment_from_action` in `crates/core/src/game/racing/generator.rs`); the platform game ignores it.
     pub curve_offset: f64,
 }
 

@@ -116,7 +116,7 @@ pub struct SolverStats {
     pub panel: Option<PanelStats>,
 }
 
-/// A level played by a panel of judges (src/panel.rs): each judge's success, and the level's
+/// A level played by a panel of judges (src/services/panel.rs): each judge's success, and the level's
 /// difficulty b fitted over judges × levels.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -146,7 +146,7 @@ pub struct JudgeStats {
     pub ci95: [f64; 2],
 }
 
-/// A level's difficulty on the Rasch scale (src/rating.rs): P(judge completes it) =
+/// A level's difficulty on the Rasch scale (crates/core/src/statistics/rating.rs): P(judge completes it) =
 /// σ(θ_judge − b), in logits; one more means half the odds for every judge.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

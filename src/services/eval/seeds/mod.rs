@@ -30,7 +30,7 @@ pub use markdown::markdown;
 pub const DROP_TOLERANCE: f64 = 0.05;
 
 /// What one training run scored.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct RunScores {
     /// The run's folder.
     pub run: String,
@@ -43,24 +43,24 @@ pub struct RunScores {
     pub validation: f64,
     /// An adversarial run's own pair: its Solver on its Generator's levels at each λ of
     /// [`AUX_VALUES`].
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub controllability: Option<Vec<f64>>,
     /// The same levels played by the outside judges (the rule-pcg Solver of the evaluation's
     /// policies, the scripted player at median and expert skill; the recipe's finish plays the
     /// median player in both games, so for its runs that one is not a stranger).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub controllability_by_judge: Vec<JudgeCurve>,
     /// Mean success on the λ = -1 levels of the ARLPCG runs' Generators other than the run's
     /// own (none when there is no other)...
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub other_generators_hard: Option<f64>,
     /// ...and on each of them.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub on_other_generators: Vec<GeneratorScore>,
 }
 
 /// A Solver's mean success on the λ = -1 levels of one run's Generator.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct GeneratorScore {
     /// The Generator's run folder.
     pub generator: String,
@@ -68,7 +68,7 @@ pub struct GeneratorScore {
 }
 
 /// One judge's success at each λ of [`AUX_VALUES`].
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct JudgeCurve {
     pub judge: String,
     pub success_ratio: Vec<f64>,
@@ -102,7 +102,7 @@ impl RunScores {
 }
 
 /// One mode over its seeds.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct ModeSummary {
     pub mode: String,
     pub seeds: Vec<u64>,
@@ -110,32 +110,32 @@ pub struct ModeSummary {
     pub validation_iqm: Estimate,
     pub validation_mean: Estimate,
     /// Mean controllability success at each λ (adversarial modes).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub controllability: Option<Vec<Estimate>>,
     /// The same for each outside judge.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub controllability_by_judge: Vec<JudgeSummary>,
     /// Mean over seeds of [`RunScores::other_generators_hard`], when every seed has it.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub other_generators_hard: Option<Estimate>,
 }
 
 /// One judge's mean success at each λ over a mode's seeds.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct JudgeSummary {
     pub judge: String,
     pub success_ratio: Vec<Estimate>,
 }
 
 /// P(arlpcg's validation success > the baseline's), over seeds.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct Improvement {
     pub baseline: String,
     pub probability: Estimate,
 }
 
 /// Everything `eval --runs` reports (`seeds.json`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct SeedResults {
     pub budget: Budget,
     /// The Generator whose levels make the validation set's other half.
@@ -146,7 +146,7 @@ pub struct SeedResults {
     pub modes: Vec<ModeSummary>,
     pub arlpcg_beats: Vec<Improvement>,
     /// P(arlpcg's success > the baseline's) on the other Generators' λ = -1 levels.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub arlpcg_beats_on_other_generators: Vec<Improvement>,
 }
 

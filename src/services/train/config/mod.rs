@@ -36,7 +36,7 @@ pub struct TrainConfig {
     pub seed: u64,
     /// The run's budget: Solver environment steps in all, over every `--resume` (`--steps`
     /// sets it). Annealed learning rates fall to 0 over it. The default is the recipe's
-    /// (platform 8M, racing 10M): every mode of a game learns for the same budget.
+    /// (platform 8M, racing 5M): every mode of a game learns for the same budget.
     pub steps: u64,
     /// Hidden layer sizes of the actors and critics of both agents (the paper: 2 × 512).
     pub hidden: Vec<usize>,
@@ -294,7 +294,7 @@ impl Default for GeneratorConfig {
         Self {
             // What trained the shipped Generators: a constant 3e-4 and a little entropy. The
             // paper's 2e-4, annealed, without an entropy bonus, gave Generators that λ did not
-            // steer (docs/training.md).
+            // steer (docs/decisions.md#d3).
             ppo: PpoConfig {
                 learning_rate: 3e-4,
                 anneal_lr: false,
@@ -329,21 +329,10 @@ const MAX_CONFIG_BYTES: u64 = 1 << 20;
 /// The platform recipe's budget in Solver steps learned from ([`TrainConfig::steps`]).
 pub const PLATFORM_STEPS: u64 = 8_000_000;
 
-/// The platform recipe's finish: after its 8M steps the Solver is frozen and the Generator
-/// trains on against it (no snapshots) and the scripted controller at median skill, each
-/// playing half of the matches, in one phase with an entropy bonus of 0.01, until the Solver
-/// succeeds on at most 40% of its own hard matches (counted over blocks of 64; at most 1M
-/// Generator steps), then one frozen Solver iteration. Against the Solver alone the finish's
-/// hard levels were hard for that Solver and hardly for anyone else (the median controller 0.92
-/// at λ = 1, 0.77 at -1); with the controller's failures paying too, the same 8M give 0.94 →
-/// 0.08 for it and 0.95 → 0.04 for the rule-pcg Solver (docs/results.md, "A finish against the
-/// scripted player"). Against the population alone the
-/// Generator finds nothing its own Solver cannot do (λ = -1 levels succeed 0.93-0.97 of the
-/// time). Four fixed 100k phases at the run's bonus, the finish before this one, left one seed
-/// in five flat (0.98 at λ = -1) and took another to 0.14, hard for its own Solver alone
-/// (the other judges' median drop 0.01); the stop
-/// ends the phase where the Solver fails, however fast or slow the Generator gets there
-/// (docs/training.md, "The recipe").
+/// The platform recipe's finish: one Generator phase, entropy bonus 0.01, against the final
+/// Solver, frozen (no snapshots), and the median scripted controller, each playing half the
+/// matches, until the Solver succeeds on at most 40% of its hard matches (blocks of 64; at most
+/// 1M Generator steps), then one frozen Solver iteration. Why: docs/decisions.md#d5 to #d8.
 pub const PLATFORM_FINISH: Finish = Finish {
     solver_steps: 16_384,
     generator_phase_steps: 1_000_000,

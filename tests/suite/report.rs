@@ -1,0 +1,66 @@
+//! docs/results.md is what `arlpcg report` writes from the committed results and cards; the
+//! check fails on a page that differs, naming the line; curves are drawn from a run's metrics.
+
+use crate::common::{arlpcg, arlpcg_ok, stderr};
+
+#[test]
+fn the_committed_results_page_is_what_report_writes() {
+    // Integration tests run in the package's root, where the committed files are.
+    let output = arlpcg(&["report", "--check"]);
+    assert!(
+        output.status.success(),
+        "docs/results.md is stale: run `cargo run --release -- report` and commit it\n{}",
+        stderr(&output)
+    );
+    let page = std::fs::read_to_string("docs/results.md").unwrap();
+    assert!(page.lines().count() <= 200, "the page stays short");
+    // Its figures are the JSON's: the shipped platform Solver's validation success.
+    assert!(page.contains("| arlpcg | 0.931 ± 0.154 |"), "{page}");
+}
+
+#[test]
+fn a_page_that_differs_fails_the_check_naming_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let page = dir.path().join("results.md");
+    let page_arg = page.to_str().unwrap();
+    arlpcg_ok(&["report", "--out", page_arg]);
+    arlpcg_ok(&["report", "--check", "--out", page_arg]);
+    let written = std::fs::read_to_string(&page).unwrap();
+    let edited = written.replacen("0.931 ± 0.154", "0.990 ± 0.154", 1);
+    assert_ne!(edited, written);
+    std::fs::write(&page, &edited).unwrap();
+    let output = arlpcg(&["report", "--check", "--out", page_arg]);
+    assert_eq!(output.status.code(), Some(1));
+    let line = 1 + written
+        .lines()
+        .position(|l| l.contains("0.931 ± 0.154"))
+        .unwrap();
+    assert!(
+        stderr(&output).contains(&format!("line {line} ")),
+        "{}",
+        stderr(&output)
+    );
+    // The check wrote nothing.
+    assert_eq!(std::fs::read_to_string(&page).unwrap(), edited);
+}
+
+#[test]
+fn curves_are_drawn_from_a_runs_metrics() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        "runs/platform-rule-pcg-s0/metrics.csv",
+        dir.path().join("metrics.csv"),
+    )
+    .unwrap();
+    arlpcg_ok(&["report", "--curves", dir.path().to_str().unwrap()]);
+    let png = std::fs::read(dir.path().join("learning-curve.png")).unwrap();
+    assert!(
+        png.starts_with(b"\x89PNG") && png.len() > 10_000,
+        "{}",
+        png.len()
+    );
+    // A folder without metrics is refused by name.
+    let empty = tempfile::tempdir().unwrap();
+    let output = arlpcg(&["report", "--curves", empty.path().to_str().unwrap()]);
+    assert!(!output.status.success());
+}

@@ -69,3 +69,32 @@ pub unsafe fn fix_thread_count() {
         unsafe { std::env::set_var("RAYON_NUM_THREADS", threads.to_string()) };
     }
 }
+
+/// The code this binary runs, for the cards of the policies it trains: the last commit that
+/// changed the code (src/, crates/, Cargo.toml, Cargo.lock) in the checkout it was built from,
+/// `-dirty` when the code differs from that commit, "unknown" without git or that checkout.
+/// Read when a run starts, not at build time, so that a commit recompiles nothing.
+pub fn code_commit() -> String {
+    const CODE: [&str; 4] = ["src", "crates", "Cargo.toml", "Cargo.lock"];
+    let git = |args: &[&str]| {
+        let out = std::process::Command::new("git")
+            .arg("-C")
+            .arg(env!("CARGO_MANIFEST_DIR"))
+            .args(args)
+            .args(["--"])
+            .args(CODE)
+            .stderr(std::process::Stdio::null())
+            .output()
+            .ok()?;
+        out.status
+            .success()
+            .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
+    };
+    match git(&["log", "-1", "--format=%h", "--abbrev=7"]).filter(|c| !c.is_empty()) {
+        Some(commit) if git(&["status", "--porcelain"]).is_some_and(|s| !s.is_empty()) => {
+            format!("{commit}-dirty")
+        }
+        Some(commit) => commit,
+        None => "unknown".into(),
+    }
+}

@@ -170,7 +170,7 @@ fn the_shipped_racing_solvers_load_and_drive() {
                 .unwrap();
         let record = |c: &arlpcg_core::rl::checkpoint::PolicyCard| {
             let t = &c.training;
-            (t.mode.clone(), t.steps, t.commit.clone(), t.command.clone())
+            (t.mode, t.steps, t.commit.clone(), t.command.clone())
         };
         assert_eq!(record(&beside), record(&card));
         let stats = verify(&level, &Solver::Policy(&solver), 8, 0, &|| {}).unwrap();

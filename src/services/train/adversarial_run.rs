@@ -157,7 +157,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             wall_time_s,
         );
         card.training.population = envs.population.iter().map(|s| s.solver_steps).collect();
-        record_commands(&mut card, &self.solver.commands);
+        record_commands(&mut card, &self.solver.commands, &self.solver.commit);
         card
     }
 
@@ -266,8 +266,9 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         self.solver.wall_before
     }
 
-    fn add_session(&mut self, command: String) {
+    fn add_session(&mut self, command: String, commit: String) {
         self.solver.commands.push(command);
+        self.solver.commit = commit;
     }
 
     fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {

@@ -83,7 +83,8 @@ pub(super) fn generator_shape(config: &TrainConfig, game: Game) -> PolicyShape {
 }
 
 /// Records the run's sessions in `card`: `commands[0]` started it, the others resumed it.
-pub(super) fn record_commands(card: &mut PolicyCard, commands: &[String]) {
+pub(super) fn record_commands(card: &mut PolicyCard, commands: &[String], commit: &str) {
+    card.training.commit = commit.to_string();
     if let Some((first, later)) = commands.split_first() {
         card.training.command = first.clone();
         card.training.resumed_with = later.to_vec();
@@ -99,7 +100,7 @@ pub(super) fn recorded_commands(card: &PolicyCard) -> Vec<String> {
         .collect()
 }
 
-/// A policy card for a policy trained by this run (its commands are set by
+/// A policy card for a policy trained by this run (its commands and commit are set by
 /// [`record_commands`]).
 pub(super) fn card(
     game: Game,
@@ -151,7 +152,7 @@ pub(super) fn card(
             steps,
             wall_time_s: (wall_time_s * 10.0).round() / 10.0,
             seed: config.seed,
-            commit: git_commit(),
+            commit: String::new(),
             command: String::new(),
             resumed_with: Vec::new(),
             population: Vec::new(),
@@ -220,10 +221,4 @@ pub(super) fn read_checkpoint(
         );
     }
     Ok((loaded, state))
-}
-
-/// The last commit that changed the code the binary was built from (build.rs): `-dirty` when
-/// its code differed from it, "unknown" when built outside a git checkout.
-pub(super) fn git_commit() -> String {
-    env!("ARLPCG_COMMIT").to_string()
 }

@@ -242,9 +242,10 @@ pub trait Training {
     fn budget(&self) -> u64;
     /// Wall-clock seconds of earlier sessions.
     fn wall_before(&self) -> f64;
-    /// Records this session's command line in the run's cards (the shell names it: the core
-    /// reads no process arguments).
-    fn add_session(&mut self, command: String);
+    /// Records this session's command line and the commit of the code it runs (the last commit
+    /// that changed it, `-dirty` for changes since) in the run's cards; the shell names both,
+    /// the core reads no process arguments and runs no git.
+    fn add_session(&mut self, command: String, commit: String);
     /// One PPO iteration (of whichever agent learns now); returns the progress bar's message.
     /// `wall` is the clock the shell lends: the run's wall-clock seconds over every session,
     /// for the metrics' time columns.

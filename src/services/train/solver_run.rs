@@ -41,6 +41,8 @@ pub(super) struct SolverRun<E: Resumable> {
     pub(super) metrics: std::fs::File,
     /// Each session's command line, the first one's first (the shell names them).
     pub(super) commands: Vec<String>,
+    /// The commit of this session's code ([`Training::add_session`]).
+    pub(super) commit: String,
 }
 
 impl<E: Resumable> SolverRun<E> {
@@ -74,6 +76,7 @@ impl<E: Resumable> SolverRun<E> {
             iteration: 0,
             wall_before: 0.0,
             commands: Vec::new(),
+            commit: String::new(),
         })
     }
 
@@ -154,6 +157,7 @@ impl<E: Resumable> SolverRun<E> {
             iteration: state.iteration,
             wall_before: state.wall_time_s,
             commands: recorded_commands(&loaded.card),
+            commit: loaded.card.training.commit.clone(),
         })
     }
 
@@ -192,7 +196,7 @@ impl<E: Resumable> SolverRun<E> {
             self.trainer.global_step,
             wall_time_s,
         );
-        record_commands(&mut card, &self.commands);
+        record_commands(&mut card, &self.commands, &self.commit);
         card
     }
 
@@ -247,8 +251,9 @@ impl<G: GameSpec> Training for SolverRun<SolverEnvs<G>> {
         self.wall_before
     }
 
-    fn add_session(&mut self, command: String) {
+    fn add_session(&mut self, command: String, commit: String) {
         self.commands.push(command);
+        self.commit = commit;
     }
 
     fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {

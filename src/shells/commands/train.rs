@@ -60,6 +60,7 @@ pub fn run(args: &TrainArgs) -> Result<()> {
                 .chain(std::env::args().skip(1))
                 .collect::<Vec<_>>()
                 .join(" "),
+            crate::shells::common::code_commit(),
         );
         train_loop(run.as_mut(), args.minutes, args.pause_at)
     })

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use crate::common::{arlpcg, stderr};
+use crate::common::{arlpcg, fails_with, stderr};
 
 fn generate(dir: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
@@ -157,12 +157,7 @@ fn generate_names_files_by_game_seed_and_aux_and_never_overwrites() {
             "--count", "2", "--seed", "6", "--aux", "-0.5", "--format", "yaml",
         ],
     );
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        stderr(&out).contains("already exists with other contents (use --force"),
-        "{}",
-        stderr(&out)
-    );
+    fails_with(&out, 1, "already exists with other contents (use --force");
     assert_eq!(files_of(dir.path()), before);
     let out = generate(
         dir.path(),
@@ -259,8 +254,7 @@ fn export_writes_glb_and_gltf_with_bin() {
         "--out",
         existing.to_str().unwrap(),
     ]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(stderr(&out).contains("already exists"));
+    fails_with(&out, 1, "already exists");
     let out = arlpcg(&["export", level.to_str().unwrap(), "--out", "level.obj"]);
     assert!(
         stderr(&out).contains("must end in .glb or .gltf"),
@@ -453,12 +447,7 @@ fn dir_with_level(bytes: &[u8]) -> (tempfile::TempDir, PathBuf) {
 #[test]
 fn a_missing_level_file_is_named() {
     let out = arlpcg(&["verify", "/no/such/level.yaml", "--solver", "scripted"]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        stderr(&out).contains("/no/such/level.yaml: cannot read the file"),
-        "{}",
-        stderr(&out)
-    );
+    fails_with(&out, 1, "/no/such/level.yaml: cannot read the file");
 }
 
 #[test]
@@ -486,19 +475,9 @@ fn a_generator_of_the_other_game_is_refused_by_name() {
 #[test]
 fn bad_arguments_are_usage_errors() {
     let out = arlpcg(&["generate", "--rules", "--out", "x", "--aux", "3"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(
-        stderr(&out).contains("aux 3 is out of range [-1, 1]"),
-        "{}",
-        stderr(&out)
-    );
+    fails_with(&out, 2, "aux 3 is out of range [-1, 1]");
     let out = arlpcg(&["generate", "--rules", "--obstacles", "3", "--out", "x"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(
-        stderr(&out).contains("--obstacles is for racing tracks"),
-        "{}",
-        stderr(&out)
-    );
+    fails_with(&out, 2, "--obstacles is for racing tracks");
 }
 
 /// Arguments that cannot go together are usage errors (exit 2) as clap's own are; a missing
@@ -532,12 +511,7 @@ fn arguments_that_do_not_fit_together_exit_2() {
         );
     }
     let out = arlpcg(&["eval", "--policies", "/nonexistent", "--out", "x"]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        stderr(&out).contains("--policies /nonexistent: no such folder"),
-        "{}",
-        stderr(&out)
-    );
+    fails_with(&out, 1, "--policies /nonexistent: no such folder");
 }
 
 /// `--aux=-0` is λ = 0: the same file name and the same bytes as `--aux 0`.
@@ -639,12 +613,7 @@ fn a_batch_that_fails_writes_nothing_and_overwrites_nothing() {
             "--count", "3", "--format", "yaml", "--force", "--goal", "0,300,5",
         ],
     );
-    assert_eq!(failed.status.code(), Some(1), "{}", stderr(&failed));
-    assert!(
-        stderr(&failed).contains("nothing was written"),
-        "{}",
-        stderr(&failed)
-    );
+    fails_with(&failed, 1, "nothing was written");
     assert_eq!(files_of(dir.path()), before);
 }
 
@@ -751,12 +720,7 @@ fn sharded_eval_merges_into_the_unsharded_results() {
         );
     }
     let out = merge(&["part0", "part2"], "short");
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        stderr(&out).contains("shard 1/3 is missing"),
-        "{}",
-        stderr(&out)
-    );
+    fails_with(&out, 1, "shard 1/3 is missing");
     let other_dir = at("other");
     let made = arlpcg(&[
         "eval",
@@ -775,12 +739,7 @@ fn sharded_eval_merges_into_the_unsharded_results() {
     ]);
     assert!(made.status.success(), "{}", stderr(&made));
     let out = merge(&["part0", "other", "part2"], "mixed");
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        stderr(&out).contains("their budget differ"),
-        "{}",
-        stderr(&out)
-    );
+    fails_with(&out, 1, "their budget differ");
 }
 
 /// With --verify no level that no run completed is handed out: such draws are replaced by the
@@ -832,15 +791,9 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
     let forged = format!("{}{}{}", &text[..at], "0".repeat(64), &text[at + 64..]);
     std::fs::write(first, forged).unwrap();
     let out = arlpcg(&["verify", "--replay", first]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(
-        stderr(&out).contains("is not the policy that recorded the certificate"),
-        "{}",
-        stderr(&out)
-    );
+    fails_with(&out, 1, "is not the policy that recorded the certificate");
     let out = arlpcg(&["verify", "--replay", "levels/hand/staircase.yaml"]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(stderr(&out).contains("no statistics"), "{}", stderr(&out));
+    fails_with(&out, 1, "no statistics");
     let out = arlpcg(&["generate", "--rules", "--allow-unsolved", "--out", "x"]);
     assert_eq!(out.status.code(), Some(2));
 }
@@ -916,12 +869,7 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
         "--out",
         dir.path().join("given").to_str().unwrap(),
     ]);
-    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert!(
-        stderr(&out).contains("no level within ±0.1 of success 0.2"),
-        "{}",
-        stderr(&out)
-    );
+    fails_with(&out, 1, "no level within ±0.1 of success 0.2");
 }
 
 #[test]
@@ -1034,10 +982,5 @@ fn generate_verifies_with_the_solver_policy_it_is_given() {
         "--out",
         out,
     ]);
-    assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
-    assert!(
-        stderr(&refused).contains("--solver-policy"),
-        "{}",
-        stderr(&refused)
-    );
+    fails_with(&refused, 2, "--solver-policy");
 }

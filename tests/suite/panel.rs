@@ -4,7 +4,7 @@
 use arlpcg::services::verify::{Solver, verify};
 use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, Skill};
 
-use crate::common::{arlpcg, stderr};
+use crate::common::{arlpcg, fails_with, stderr};
 
 /// Mean success of each skill, weakest first, on `levels` rule levels of `G`, `trials` runs each.
 fn skill_success<G: GameSpec>(levels: u64, trials: u32) -> Vec<f64> {
@@ -104,8 +104,7 @@ fn verify_panel_reports_every_judge_and_rates_the_levels_together() {
     assert_eq!(names, ["arlpcg", "scripted-median"]);
 
     let bad = arlpcg(&["verify", levels[0], "--panel", "scripted-wizard"]);
-    assert_eq!(bad.status.code(), Some(2));
-    assert!(stderr(&bad).contains("scripted-expert"), "{}", stderr(&bad));
+    fails_with(&bad, 2, "scripted-expert");
 }
 
 #[test]

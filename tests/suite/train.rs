@@ -11,7 +11,7 @@ use arlpcg_core::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
 use arlpcg_core::level::Game;
 use arlpcg_core::rl::checkpoint::{LoadedPolicy, Role, load_policy};
 
-use crate::common::{arlpcg, arlpcg_ok, stderr};
+use crate::common::{arlpcg, arlpcg_ok, fails_with, stderr};
 
 const TINY: &str = "\
 seed: 3
@@ -193,12 +193,7 @@ fn a_live_lock_refuses_a_second_session(out: &Path) {
         out_s,
         "--resume",
     ]);
-    assert_eq!(busy.status.code(), Some(1));
-    assert!(
-        stderr(&busy).contains("in use by another training session"),
-        "{}",
-        stderr(&busy)
-    );
+    fails_with(&busy, 1, "in use by another training session");
     assert_eq!(curve(out), before);
 }
 
@@ -213,19 +208,13 @@ fn wrong_resumes_are_refused(out_s: &str) {
         "--out",
         out_s,
     ]);
-    assert_eq!(refused.status.code(), Some(1));
-    assert!(stderr(&refused).contains("add --resume"));
+    fails_with(&refused, 1, "add --resume");
     // A resume with another mode or game is refused, naming the run's own.
     for other in [["--mode", "rule-pcg"], ["--game", "racing"]] {
         let refused = arlpcg(&[
             "train", other[0], other[1], "--steps", "100", "--out", out_s, "--resume",
         ]);
-        assert_eq!(refused.status.code(), Some(1));
-        assert!(
-            stderr(&refused).contains("is a platform fixed-track run"),
-            "{}",
-            stderr(&refused)
-        );
+        fails_with(&refused, 1, "is a platform fixed-track run");
     }
     // A resume with another seed is refused by name; the run's own seed may be given again.
     let refused = arlpcg(&[
@@ -238,12 +227,7 @@ fn wrong_resumes_are_refused(out_s: &str) {
         out_s,
         "--resume",
     ]);
-    assert_eq!(refused.status.code(), Some(1));
-    assert!(
-        stderr(&refused).contains("seed cannot change"),
-        "{}",
-        stderr(&refused)
-    );
+    fails_with(&refused, 1, "seed cannot change");
 }
 
 #[test]
@@ -1232,8 +1216,7 @@ fn score_a_run_as_one_seed(dir: &Path, run: &str) {
         "--out",
         dir.join("twice").to_str().unwrap(),
     ]);
-    assert_eq!(twice.status.code(), Some(1), "{}", stderr(&twice));
-    assert!(stderr(&twice).contains("twice"), "{}", stderr(&twice));
+    fails_with(&twice, 1, "twice");
     assert!(!dir.join("twice").exists());
 }
 

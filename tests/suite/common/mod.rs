@@ -63,3 +63,10 @@ pub fn import_glb(glb: &[u8]) -> (gltf::Document, Vec<Vec<u8>>) {
         .collect();
     (document, buffers)
 }
+
+/// Asserts that a run exited with `code` and said `message` on stderr (both shown if not).
+pub fn fails_with(output: &Output, code: i32, message: &str) {
+    let err = stderr(output);
+    assert_eq!(output.status.code(), Some(code), "{err}");
+    assert!(err.contains(message), "expected `{message}` in:\n{err}");
+}

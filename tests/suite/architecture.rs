@@ -89,6 +89,12 @@ const NEVER: &[Never] = &[
         ],
     },
     Never {
+        within: "src/services/train",
+        names: "use super::*",
+        why: "train/ imports by name: one namespace over its files hides who needs what",
+        except: &["src/services/train/config/tests.rs"],
+    },
+    Never {
         within: "crates/core/src/level",
         names: "crate::game",
         why: "levels are data: the games build on them, not the other way",

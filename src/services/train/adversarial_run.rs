@@ -4,11 +4,29 @@
 use std::io::Write;
 use std::path::Path;
 
+use super::arlpcg::{AdversarialEnvs, AdversarialRecord, Generator, MatchRules, MatchStats, Phase};
+use super::cards::{
+    card, generator_shape, read_checkpoint, record_commands, save_policy_files, solver_shape,
+};
+use super::config::TrainConfig;
+use super::metrics::{
+    generator_metrics_header, generator_row, open_append, scripted_columns, truncate_metrics,
+    update_columns,
+};
+use super::population::{PopulationRecord, Snapshot, population_from, population_record};
+use super::solver_run::SolverRun;
+use super::{CHECKPOINT, ConfigChange, GENERATOR_CHECKPOINT, GENERATOR_METRICS, Training};
+use crate::services::fsio;
+use crate::services::fsio::Overwrite;
 use anyhow::{Context, Result};
+use arlpcg_core::game::generator::{BuildLimits, GeneratorGame, observation_size};
+use arlpcg_core::rl::checkpoint;
+use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingState};
+use arlpcg_core::rl::normalizer::RunningNorm;
+use arlpcg_core::rl::policy::ActorCritic;
+use arlpcg_core::rl::ppo::Ppo;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-
-use super::*;
 
 /// An adversarial run: the Solver's run, whose environments hold the Generator, and the
 /// Generator's own counters and metrics.

@@ -4,9 +4,17 @@
 
 use std::path::Path;
 
+use super::config::TrainConfig;
+use crate::services::fsio;
+use crate::services::fsio::Overwrite;
 use anyhow::{Context, Result, bail};
-
-use super::*;
+use arlpcg_core::game::generator::GeneratorGame;
+use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame};
+use arlpcg_core::level::Game;
+use arlpcg_core::rl::checkpoint;
+use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingRecord, TrainingState};
+use arlpcg_core::rl::normalizer::RunningNorm;
+use arlpcg_core::rl::policy::{ActorCritic, PolicyShape};
 
 /// What a game's Solver observes and does, as a policy card names it.
 pub(super) struct SolverIo {

@@ -3,9 +3,13 @@
 
 use std::path::Path;
 
+use super::arlpcg::MatchStats;
+use super::{GENERATOR_METRICS, METRICS};
+use crate::services::fsio;
+use crate::services::fsio::Overwrite;
 use anyhow::{Context, Result};
-
-use super::*;
+use arlpcg_core::game::generator::GeneratorGame;
+use arlpcg_core::rl::ppo::UpdateStats;
 
 /// Column `name` of a metrics CSV as (x column, value) pairs, smoothed over `window` rows.
 pub(super) fn metric_series(text: &str, x: &str, name: &str, window: usize) -> Vec<(f64, f64)> {

@@ -28,26 +28,17 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 
-use crate::services::fsio::{self, Overwrite};
+use crate::services::fsio;
 use adversarial_run::AdversarialRun;
-use arlpcg::{AdversarialEnvs, AdversarialRecord, Generator, MatchRules, MatchStats, Phase};
-use arlpcg_core::game::generator::{BuildLimits, GeneratorGame, observation_size};
+use arlpcg_core::game::generator::GeneratorGame;
 use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame};
 use arlpcg_core::level::Game;
-use arlpcg_core::rl::checkpoint::{
-    self, PolicyCard, Role, TrainMode, TrainingRecord, TrainingState,
-};
-use arlpcg_core::rl::normalizer::RunningNorm;
-use arlpcg_core::rl::policy::{ActorCritic, PolicyShape};
-use arlpcg_core::rl::ppo::{Ppo, UpdateStats};
-use arlpcg_core::rl::vec_env::{RolloutStats, Trainer, VecEnv};
-use cards::*;
-use config::{check_config, check_resumable_change, load_config};
+use arlpcg_core::rl::checkpoint::TrainMode;
+use cards::{checkpoint_identity, solver_shape};
+use config::load_config;
 pub use metrics::write_learning_curve;
-use metrics::*;
-use population::{PopulationRecord, Snapshot, population_from, population_record};
 use solver_envs::{SolverEnvs, SourceRecord};
-use solver_run::*;
+use solver_run::SolverRun;
 
 pub(super) const CHECKPOINT: &str = "checkpoint.safetensors";
 /// The file a training session holds in its run folder while it runs (the shell's: see

@@ -4,9 +4,26 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use super::arlpcg::AdversarialEnvs;
+use super::cards::{
+    card, read_checkpoint, record_commands, recorded_commands, save_policy_files, solver_shape,
+};
+use super::config::{TrainConfig, check_config, check_resumable_change};
+use super::metrics::{open_append, truncate_metrics, update_columns};
+use super::solver_envs::SolverEnvs;
+use super::{CHECKPOINT, ConfigChange, METRICS, METRICS_HEADER, Training, UNDER_WAY};
+use crate::services::fsio;
+use crate::services::fsio::Overwrite;
+use anyhow::bail;
 use anyhow::{Context, Result};
-
-use super::*;
+use arlpcg_core::game::GameSpec;
+use arlpcg_core::game::generator::GeneratorGame;
+use arlpcg_core::level::Game;
+use arlpcg_core::rl::checkpoint;
+use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingState};
+use arlpcg_core::rl::policy::ActorCritic;
+use arlpcg_core::rl::ppo::Ppo;
+use arlpcg_core::rl::vec_env::{RolloutStats, Trainer, VecEnv};
 
 /// Environments whose progress is saved in checkpoints.
 pub(super) trait Resumable: VecEnv {

@@ -25,7 +25,7 @@ use arlpcg_core::rl::checkpoint::TrainMode;
         steered by one knob, the aux input λ (+1 easy, -1 hard), or from rule-based generation.",
     after_help = "Examples:\n  \
         arlpcg                      (the designer, on the shipped policies)\n  \
-        arlpcg design --policies runs/platform-solver-arlpcg-reach --out levels/mine\n  \
+        arlpcg design --policies runs/my-arlpcg --out levels/mine\n  \
         arlpcg generate --policies policies/platform --aux -0.5 --verify 100 --out levels/mine\n  \
         arlpcg generate --game platform --rules --count 20 --seed 1 --out levels/mine\n  \
         arlpcg generate --game racing --rules --obstacles 3 --count 20 --out tracks\n  \
@@ -90,7 +90,7 @@ pub struct ReportArgs {
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     arlpcg design\n  \
-    arlpcg design --policies runs/platform-solver-arlpcg-reach --out levels/mine --seed 7")]
+    arlpcg design --policies runs/my-arlpcg --out levels/mine --seed 7")]
 pub struct DesignArgs {
     /// Which game.
     #[arg(long, default_value = "platform", value_parser = parse_game)]
@@ -111,7 +111,7 @@ pub struct DesignArgs {
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     arlpcg eval --policies policies/platform --out results/platform\n  \
-    arlpcg eval --policies runs/platform-solver-arlpcg-reach runs/platform-solver-rule-pcg --full --out results/full\n  \
+    arlpcg eval --policies runs/my-arlpcg runs/my-rule-pcg --full --out results/full\n  \
     arlpcg eval --policies policies/platform --shard 0/3 --out parts/0   (and 1/3, 2/3 elsewhere)\n  \
     arlpcg eval --merge parts/0 parts/1 parts/2 --out results/platform")]
 pub struct EvalArgs {

@@ -18,16 +18,16 @@ use super::layout::Areas;
 
 mod input;
 pub mod judging;
+mod loaded;
 mod messages;
 pub mod pacing;
-mod policies;
 mod responses;
 mod trials;
 
 pub use messages::{Effect, ExportOutcome, Message, Response};
 pub use trials::Trials;
 
-pub use policies::{JudgeSwitch, LoadedInfo, PolicyInfo};
+pub use loaded::{JudgeSwitch, LoadedInfo, PolicyInfo};
 
 /// Steps of the λ slider (keys), and its range.
 pub const AUX_STEP: f64 = 0.1;

@@ -559,7 +559,7 @@ fn target_success_mode_finds_a_level_in_band() {
     assert!((success - 0.6).abs() <= 0.1 + 1e-9, "measured {success}");
     assert!(h.screen(80, 24).contains("for success 0.60"));
     h.key(KeyCode::Right);
-    assert_eq!(h.app.target, None, "the slider leaves target mode");
+    assert_eq!(h.app.ask.target(), None, "the slider leaves target mode");
     assert!(matches!(h.pending[..], [Effect::Generate { .. }]));
 }
 
@@ -635,14 +635,14 @@ fn pacing_keys_set_a_curve_and_keep_a_prefix() {
     insta::assert_snapshot!("pacing_ramp_up_120x36", h.screen(120, 36));
     // The next preset, then a typed curve, then a bad one.
     h.key(KeyCode::Char('P'));
-    assert_eq!(h.app.pacing.as_ref().unwrap().name, "ramp down");
+    assert_eq!(h.app.ask.pacing().unwrap().name, "ramp down");
     h.key(KeyCode::Char('C'));
     for _ in 0..20 {
         h.key(KeyCode::Backspace);
     }
     h.keys("0:-1, 0.5:-1, 0.6:1, 1:1");
     h.key(KeyCode::Enter);
-    assert_eq!(h.app.pacing.as_ref().unwrap().name, "custom");
+    assert_eq!(h.app.ask.pacing().unwrap().name, "custom");
     h.key(KeyCode::Char('C'));
     h.keys(", 0.2:1");
     h.key(KeyCode::Enter);
@@ -676,7 +676,7 @@ fn pacing_keys_set_a_curve_and_keep_a_prefix() {
     assert!(h.app.kept.is_none());
     // The slider: one λ again.
     h.key(KeyCode::Left);
-    assert!(h.app.pacing.is_none());
+    assert!(h.app.ask.pacing().is_none());
     h.settle();
     assert!(h.app.level.as_ref().unwrap().pacing.is_none());
 }

@@ -112,6 +112,37 @@ pub enum Overlay {
     },
 }
 
+/// What difficulty the designer asks the Generator for. One field, so that asking for one
+/// leaves the others (the CLI's `--aux`, `--target-success` and `--aux-curve` likewise exclude
+/// each other).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Ask {
+    /// One λ for the whole level, the slider's.
+    Slider,
+    /// A success rate: λ is searched for a level the Solver clears within ±0.1 of it.
+    Success(f64),
+    /// λ along the level.
+    Pacing(pacing::PacingChoice),
+}
+
+impl Ask {
+    /// The success rate asked for, in target-success mode.
+    pub fn target(&self) -> Option<f64> {
+        match self {
+            Ask::Success(target) => Some(*target),
+            _ => None,
+        }
+    }
+
+    /// The curve asked for, when pacing.
+    pub fn pacing(&self) -> Option<&pacing::PacingChoice> {
+        match self {
+            Ask::Pacing(choice) => Some(choice),
+            _ => None,
+        }
+    }
+}
+
 /// What the bottom-right panel shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SidePane {
@@ -154,11 +185,10 @@ pub struct App {
     pub policies: LoadedInfo,
     /// ...and of the other game (Tab swaps them).
     pub other_policies: LoadedInfo,
+    /// The slider's λ (in target-success mode, the λ of the level found).
     pub aux: f64,
-    /// Target-success mode: the success rate asked for (λ follows the level found).
-    pub target: Option<f64>,
-    /// λ along the level (instead of the slider's one λ).
-    pub pacing: Option<pacing::PacingChoice>,
+    /// What difficulty is asked for: the slider's λ, a success rate, or λ along the level.
+    pub ask: Ask,
     /// The prefix every regeneration keeps.
     pub kept: Option<crate::services::generation::KeptPrefix>,
     pub seed: u64,
@@ -199,8 +229,7 @@ impl App {
             policies,
             other_policies: LoadedInfo::default(),
             aux: 1.0,
-            target: None,
-            pacing: None,
+            ask: Ask::Slider,
             kept: None,
             seed,
             goal: GoalSetting::FromSeed,
@@ -248,7 +277,7 @@ impl App {
         self.requested = id;
         self.replay = None;
         self.recording = None;
-        if let Some(target) = self.target {
+        if let Some(target) = self.ask.target() {
             return vec![Effect::Target {
                 id,
                 game: self.game,
@@ -264,7 +293,7 @@ impl App {
             seed: self.seed,
             aux: self.aux,
             goal: self.goal.position(),
-            curve: self.pacing.as_ref().map(|p| p.curve.clone()),
+            curve: self.ask.pacing().map(|p| p.curve.clone()),
             keep: self.kept.clone(),
         }]
     }
@@ -279,8 +308,8 @@ impl App {
         std::mem::swap(&mut self.policies, &mut self.other_policies);
         self.goal = GoalSetting::FromSeed;
         self.kept = None;
-        if self.policies.generator.is_none() {
-            self.pacing = None;
+        if self.policies.generator.is_none() && self.ask.pacing().is_some() {
+            self.ask = Ask::Slider;
         }
         self.level = None;
         self.trials = None;
@@ -292,12 +321,13 @@ impl App {
 
     fn set_aux(&mut self, aux: f64) -> Vec<Effect> {
         let aux = (aux.clamp(-1.0, 1.0) * 100.0).round() / 100.0;
-        if aux == self.aux && self.target.is_none() {
+        if aux == self.aux && self.ask.target().is_none() {
             return Vec::new();
         }
         // Moving the slider leaves target-success mode and pacing.
-        self.target = None;
-        if self.pacing.take().is_some() {
+        let was_paced = self.ask.pacing().is_some();
+        self.ask = Ask::Slider;
+        if was_paced {
             self.say("one λ again (P: pacing presets)");
         }
         self.aux = aux;
@@ -312,11 +342,14 @@ impl App {
             );
             return Vec::new();
         }
-        self.target = target;
-        if target.is_some() {
+        match target {
             // The search steers one λ over the whole level.
-            self.pacing = None;
-            self.kept = None;
+            Some(target) => {
+                self.ask = Ask::Success(target);
+                self.kept = None;
+            }
+            None if self.ask.target().is_some() => self.ask = Ask::Slider,
+            None => {}
         }
         if let Some(p) = target {
             self.say(format!(
@@ -337,7 +370,7 @@ impl App {
 
     /// The file stem exports use: game, seed and λ (or the pacing preset), and the pieces kept.
     pub fn export_stem(&self) -> String {
-        let mut stem = match &self.pacing {
+        let mut stem = match self.ask.pacing() {
             Some(choice) => format!(
                 "{}_seed{}_pacing-{}",
                 self.game,

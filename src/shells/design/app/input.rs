@@ -108,11 +108,11 @@ impl App {
         let text = match kind {
             PromptKind::Seed => self.seed.to_string(),
             PromptKind::Trials => self.trials_wanted.to_string(),
-            PromptKind::Target => self.target.map_or(String::new(), |t| format!("{t}")),
+            PromptKind::Target => self.ask.target().map_or(String::new(), |t| format!("{t}")),
             PromptKind::Policies => String::new(),
             PromptKind::Curve => self
-                .pacing
-                .as_ref()
+                .ask
+                .pacing()
                 .map_or(String::new(), |p| p.curve.to_string()),
         };
         self.overlay = Overlay::Prompt { kind, text };
@@ -158,7 +158,7 @@ impl App {
                 }
             },
             PromptKind::Target if text.trim().is_empty() => {
-                if self.target.is_none() {
+                if self.ask.target().is_none() {
                     return Vec::new();
                 }
                 self.say("back to the λ slider");

@@ -34,7 +34,7 @@ fn preset(k: usize) -> PacingChoice {
 impl App {
     /// `P`: the next preset (after the last, back to one λ from the slider).
     pub(super) fn next_pacing(&mut self) -> Vec<Effect> {
-        let next = match &self.pacing {
+        let next = match self.ask.pacing() {
             None => Some(0),
             Some(choice) => PRESETS
                 .iter()
@@ -69,8 +69,7 @@ impl App {
             Some(choice) => self.say(format!("pacing: {} ({})", choice.name, choice.curve)),
             None => self.say(format!("one λ again: {:+.2}", self.aux)),
         }
-        self.pacing = pacing;
-        self.target = None;
+        self.ask = pacing.map_or(Ask::Slider, Ask::Pacing);
         self.generate()
     }
 
@@ -95,7 +94,9 @@ impl App {
             "keeping the first {pieces} {}: K lets go",
             arlpcg_core::game::facts::facts(self.game).pieces
         ));
-        self.target = None;
+        if self.ask.target().is_some() {
+            self.ask = Ask::Slider;
+        }
         self.generate()
     }
 

@@ -180,7 +180,7 @@ fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
         areas.controls,
     );
     let width = areas.slider.width as usize;
-    let mut slider = match &app.pacing {
+    let mut slider = match app.ask.pacing() {
         // The curve from start to goal, taller where it is harder.
         Some(choice) => {
             let profile: String = (0..width)
@@ -224,7 +224,7 @@ fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
             Style::new().fg(Color::Blue),
         ));
     }
-    if let Some(target) = app.target {
+    if let Some(target) = app.ask.target() {
         slider.push_span(Span::styled(
             format!(" for success {target:.2}"),
             Style::new().fg(Color::Cyan),
@@ -250,7 +250,7 @@ fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
         Span::raw(format!("   goal ({origin}) {goal}")),
         Span::raw(format!("   trials {}", app.trials_wanted)).dim(),
     ]);
-    if let Some(choice) = &app.pacing {
+    if let Some(choice) = app.ask.pacing() {
         settings.push_span(Span::styled(
             format!("   {}: {}", choice.name, choice.curve),
             Style::new().fg(Color::Magenta),

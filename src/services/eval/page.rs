@@ -55,25 +55,21 @@ fn game_section(page: &GamePage) -> String {
     md += "```\n\n";
     md += &demoted(&super::report::markdown(&page.results));
     md += "\n";
-    let over_seeds = sections(
-        &seeds::markdown(&page.seeds),
+    // The seeds' own budget line is the tables' above; its intervals are the header's.
+    md += &demoted(
         &[
-            "Validation success",
-            "Controllability over seeds (",
-            "Each run",
-        ],
+            seeds::markdown::validation(&page.seeds),
+            seeds::markdown::controllability(&page.seeds),
+            seeds::markdown::each_run(&page.seeds),
+        ]
+        .join("\n"),
     );
-    // Its budget is the tables' above, its intervals the header's.
-    let over_seeds: Vec<&str> = over_seeds
-        .lines()
-        .filter(|l| !l.starts_with("Budget: "))
-        .collect();
-    md += &demoted(over_seeds.join("\n").trim_end());
     for (folder, more) in &page.more_seeds {
         md += &format!("\n### Over seeds: `{folder}`\n\n");
-        md += &sections(&seeds::markdown(more), &["Validation success"])
+        // Its table without its own heading and the blank line after it.
+        md += &seeds::markdown::validation(more)
             .lines()
-            .skip(2) // its own heading and the blank line after it
+            .skip(2)
             .map(|l| format!("{l}\n"))
             .collect::<String>();
     }
@@ -137,16 +133,6 @@ fn budget_flags(budget: Budget) -> String {
     )
 }
 
-/// The `## ` sections of `md` whose titles start with one of `keep`, in `md`'s order.
-fn sections(md: &str, keep: &[&str]) -> String {
-    md.split("\n## ")
-        .map(|s| s.strip_prefix("## ").unwrap_or(s))
-        .filter(|s| keep.iter().any(|k| s.starts_with(k)))
-        .map(|s| format!("## {}\n", s.trim_end()))
-        .collect::<Vec<_>>()
-        .join("\n")
-}
-
 /// `md` with every `## ` heading one level down, under the game's.
 fn demoted(md: &str) -> String {
     md.lines()
@@ -169,12 +155,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn sections_keep_the_asked_ones_in_order() {
-        let md = "## A one\n\nx\n\n## B two\n\ny\n\n## C three\n\nz\n";
-        assert_eq!(
-            sections(md, &["C", "A"]),
-            "## A one\n\nx\n\n## C three\n\nz\n"
-        );
+    fn headings_go_one_level_down() {
         assert_eq!(demoted("## A\nx\n"), "### A\nx\n");
     }
 }

@@ -45,7 +45,7 @@ pub(super) const CHECKPOINT: &str = "checkpoint.safetensors";
 /// `commands/train.rs`); it does not make a folder a run.
 pub const LOCK_FILE: &str = "train.lock";
 pub(super) const GENERATOR_CHECKPOINT: &str = "generator-checkpoint.safetensors";
-pub(super) const METRICS: &str = "metrics.csv";
+pub const METRICS: &str = "metrics.csv";
 /// The key under which a checkpoint's `source` holds the episodes or matches under way
 /// ([`SourceRecord`], [`AdversarialRecord`]).
 pub(super) const UNDER_WAY: &str = "under_way";

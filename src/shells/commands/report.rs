@@ -14,8 +14,8 @@ use crate::shells::cli::ReportArgs;
 use arlpcg_core::level::Game;
 use arlpcg_core::rl::checkpoint::PolicyCard;
 
-/// The largest results or card file read.
-const MAX_JSON_BYTES: u64 = 64 * 1024 * 1024;
+/// The largest results file, card or page read.
+const MAX_FILE_BYTES: u64 = 64 * 1024 * 1024;
 
 /// The shipped policies a game's table lists, in its order.
 const POLICIES: [&str; 5] = [
@@ -56,7 +56,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
 
 /// Fails naming the first line where the committed page differs from `page`.
 fn check(path: &Path, page: &str) -> Result<()> {
-    let committed = fsio::read_limited(path, MAX_JSON_BYTES, "results page")?;
+    let committed = fsio::read_limited(path, MAX_FILE_BYTES, "results page")?;
     let committed = String::from_utf8_lossy(&committed);
     if committed == page {
         println!("{} is current", path.display());
@@ -106,7 +106,7 @@ fn read_game(game: Game, results: &Path, policies: &Path) -> Result<GamePage> {
 }
 
 fn read(path: &Path) -> Result<Vec<u8>> {
-    fsio::read_limited(path, MAX_JSON_BYTES, "results file")
+    fsio::read_limited(path, MAX_FILE_BYTES, "results file")
 }
 
 fn read_seeds(path: &Path) -> Result<SeedResults> {

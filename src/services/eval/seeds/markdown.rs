@@ -1,6 +1,6 @@
 //! The report of `eval --runs` as markdown (seeds.md).
 
-use super::{DROP_TOLERANCE, Improvement, ModeSummary, RunScores, SeedResults};
+use super::{DROP_TOLERANCE, Improvement, RunScores, SeedResults};
 use arlpcg_core::statistics::over_seeds::Estimate;
 
 /// Each ARLPCG Generator's λ = -1 levels: its own Solver's success (its controllability at
@@ -70,9 +70,37 @@ fn improvement_rows(beats: &[Improvement], e: impl Fn(&Estimate) -> String) -> S
         .collect()
 }
 
-/// The report as markdown.
+/// An estimate with its interval, as every table here prints it.
+fn estimate(x: &Estimate) -> String {
+    format!("{:.3} [{:.3}, {:.3}]", x.value, x.ci95[0], x.ci95[1])
+}
+
+/// The report as markdown: every section below, in order.
 pub fn markdown(results: &SeedResults) -> String {
-    let e = |x: &Estimate| format!("{:.3} [{:.3}, {:.3}]", x.value, x.ci95[0], x.ci95[1]);
+    let mut md = validation(results);
+    if !results.arlpcg_beats_on_other_generators.is_empty() {
+        md += "\n";
+        md += &other_generators(results);
+    }
+    md += "\n";
+    md += &controllability(results);
+    if results
+        .modes
+        .iter()
+        .any(|m| !m.controllability_by_judge.is_empty())
+    {
+        md += "\n";
+        md += &outside_judges(results);
+    }
+    md += "\n";
+    md += &each_run(results);
+    md += "\n";
+    md += &budget(results);
+    md
+}
+
+/// Validation success per mode over its seeds, and P(arlpcg > baseline) there.
+pub fn validation(results: &SeedResults) -> String {
     let mut md = String::from(
         "## Validation success over training seeds\n\n| mode | seeds | IQM [95% CI] | mean [95% CI] |\n|---|---|---|---|\n",
     );
@@ -82,62 +110,79 @@ pub fn markdown(results: &SeedResults) -> String {
             "| {} | {} | {} | {} |\n",
             m.mode,
             seeds.join(", "),
-            e(&m.validation_iqm),
-            e(&m.validation_mean)
+            estimate(&m.validation_iqm),
+            estimate(&m.validation_mean)
         );
     }
     if !results.arlpcg_beats.is_empty() {
         md += "\n| P(arlpcg > baseline) on validation | [95% CI] |\n|---|---|\n";
-        md += &improvement_rows(&results.arlpcg_beats, e);
+        md += &improvement_rows(&results.arlpcg_beats, estimate);
     }
-    if !results.arlpcg_beats_on_other_generators.is_empty() {
-        md += "\n## On other runs' Generators (λ = -1 levels of every ARLPCG Generator but the run's own)\n\n| mode | success: mean [95% CI] |\n|---|---|\n";
-        for m in &results.modes {
-            if let Some(hard) = &m.other_generators_hard {
-                md += &format!("| {} | {} |\n", m.mode, e(hard));
-            }
+    md
+}
+
+/// Every Solver on the other ARLPCG runs' λ = -1 levels.
+pub fn other_generators(results: &SeedResults) -> String {
+    let mut md = String::from(
+        "## On other runs' Generators (λ = -1 levels of every ARLPCG Generator but the run's own)\n\n| mode | success: mean [95% CI] |\n|---|---|\n",
+    );
+    for m in &results.modes {
+        if let Some(hard) = &m.other_generators_hard {
+            md += &format!("| {} | {} |\n", m.mode, estimate(hard));
         }
-        md += "\n| P(arlpcg > baseline) on other runs' Generators | [95% CI] |\n|---|---|\n";
-        md += &improvement_rows(&results.arlpcg_beats_on_other_generators, e);
-        md += &generator_by_generator(results);
     }
-    md += "\n## Controllability over seeds (each run's own Generator and Solver)\n\n| mode |";
+    md += "\n| P(arlpcg > baseline) on other runs' Generators | [95% CI] |\n|---|---|\n";
+    md += &improvement_rows(&results.arlpcg_beats_on_other_generators, estimate);
+    md += &generator_by_generator(results);
+    md
+}
+
+/// Each adversarial mode's own pair at each λ, over its seeds.
+pub fn controllability(results: &SeedResults) -> String {
+    let mut md = String::from(
+        "## Controllability over seeds (each run's own Generator and Solver)\n\n| mode |",
+    );
     md += &aux_columns(&results.aux, 1);
     for m in &results.modes {
         if let Some(by_aux) = &m.controllability {
             md += &format!("| {} |", m.mode);
             for x in by_aux {
-                md += &format!(" {} |", e(x));
+                md += &format!(" {} |", estimate(x));
             }
             md += "\n";
         }
     }
-    let judged: Vec<&ModeSummary> = results
-        .modes
-        .iter()
-        .filter(|m| !m.controllability_by_judge.is_empty())
-        .collect();
-    if !judged.is_empty() {
-        md += "\n## Controllability over seeds for the outside judges (rule-pcg, scripted median and expert)\n\n| mode | judge |";
-        md += &aux_columns(&results.aux, 2);
-        for m in judged {
-            for j in &m.controllability_by_judge {
-                md += &format!("| {} | {} |", m.mode, j.judge);
-                for x in &j.success_ratio {
-                    md += &format!(" {} |", e(x));
-                }
-                md += "\n";
+    md
+}
+
+/// The judges the runs never trained against, on each mode's levels at each λ.
+pub fn outside_judges(results: &SeedResults) -> String {
+    let mut md = String::from(
+        "## Controllability over seeds for the outside judges (rule-pcg, scripted median and expert)\n\n| mode | judge |",
+    );
+    md += &aux_columns(&results.aux, 2);
+    for m in results.modes.iter() {
+        for j in &m.controllability_by_judge {
+            md += &format!("| {} | {} |", m.mode, j.judge);
+            for x in &j.success_ratio {
+                md += &format!(" {} |", estimate(x));
             }
+            md += "\n";
         }
     }
+    md
+}
+
+/// One row per run: its validation, controllability, judges' drop and other Generators.
+pub fn each_run(results: &SeedResults) -> String {
     let list = |xs: &[f64]| {
         xs.iter()
             .map(|x| format!("{x:.2}"))
             .collect::<Vec<_>>()
             .join(", ")
     };
-    md += &format!(
-        "\n## Each run\n\n| run | mode | seed | validation (rule / Generator levels) | controllability λ = +1 … -1 | judges' median drop, all monotone (±{DROP_TOLERANCE}) | other Generators' λ = -1 |\n|---|---|---|---|---|---|---|\n"
+    let mut md = format!(
+        "## Each run\n\n| run | mode | seed | validation (rule / Generator levels) | controllability λ = +1 … -1 | judges' median drop, all monotone (±{DROP_TOLERANCE}) | other Generators' λ = -1 |\n|---|---|---|---|---|---|---|\n"
     );
     for r in results.seeds.values().flatten() {
         let control = r.controllability.as_deref().map_or(String::from("—"), list);
@@ -159,14 +204,18 @@ pub fn markdown(results: &SeedResults) -> String {
             r.validation_generator_levels
         );
     }
-    md += &format!(
-        "\nBudget: {} validation levels × {} runs (half rule levels, half from {}); {} levels × {} runs per λ. Intervals: stratified bootstrap over seeds, {} resamples.\n",
+    md
+}
+
+/// What was played, and how the intervals were drawn.
+pub fn budget(results: &SeedResults) -> String {
+    format!(
+        "Budget: {} validation levels × {} runs (half rule levels, half from {}); {} levels × {} runs per λ. Intervals: stratified bootstrap over seeds, {} resamples.\n",
         results.budget.validation_tracks,
         results.budget.validation_trials,
         results.validation_generator,
         results.budget.tracks,
         results.budget.trials,
         arlpcg_core::statistics::over_seeds::RESAMPLES
-    );
-    md
+    )
 }

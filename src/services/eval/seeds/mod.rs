@@ -22,7 +22,7 @@ use arlpcg_core::statistics::over_seeds::{
 
 use super::{AUX_VALUES, Budget, generator_levels};
 
-mod markdown;
+pub mod markdown;
 pub use markdown::markdown;
 
 /// How much a judge's success may rise from one λ to the next harder one and still count as

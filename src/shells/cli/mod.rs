@@ -5,11 +5,17 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+mod values;
+pub use values::{Judges, KeepArg, Shard};
+use values::{
+    parse_aux, parse_game, parse_judges, parse_keep, parse_minutes, parse_point, parse_profile,
+    parse_shard, parse_target,
+};
+
 use crate::services::panel::Judge;
 use arlpcg_core::game::Skill;
 use arlpcg_core::level::Game;
 use arlpcg_core::level::pacing::AuxCurve;
-use arlpcg_core::level::params;
 use arlpcg_core::rl::checkpoint::TrainMode;
 
 #[derive(Debug, Parser)]
@@ -271,63 +277,6 @@ pub struct GenerateArgs {
     pub shard: Option<Shard>,
 }
 
-/// One of K equal shares of a batch (`--shard I/K`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Shard {
-    pub index: u64,
-    pub count: u64,
-}
-
-impl Shard {
-    /// Whether item `i` of the batch belongs to this shard.
-    pub fn owns(&self, i: u64) -> bool {
-        i % self.count == self.index
-    }
-}
-
-fn parse_target(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(p) if p > 0.0 && p < 1.0 => Ok(p),
-        _ => Err(format!(
-            "`{s}` is not a success ratio strictly between 0 and 1"
-        )),
-    }
-}
-
-/// `--keep LEVEL.yaml:K`: the level file and how many of its pieces to keep.
-#[derive(Debug, Clone, PartialEq)]
-pub struct KeepArg {
-    pub level: PathBuf,
-    pub pieces: usize,
-}
-
-fn parse_keep(s: &str) -> Result<KeepArg, String> {
-    let (path, pieces) = s.rsplit_once(':').ok_or_else(|| {
-        format!("`{s}` is not LEVEL.yaml:K (the level file, then how many of its pieces to keep)")
-    })?;
-    let pieces = pieces.trim().parse().map_err(|_| {
-        format!("`{s}`: after the last `:` comes the number of pieces to keep, not `{pieces}`")
-    })?;
-    if path.is_empty() {
-        return Err(format!("`{s}`: the level file is missing before `:`"));
-    }
-    Ok(KeepArg {
-        level: PathBuf::from(path),
-        pieces,
-    })
-}
-
-fn parse_shard(s: &str) -> Result<Shard, String> {
-    let bad = || format!("`{s}` is not I/K with 0 <= I < K (e.g. 0/4 .. 3/4)");
-    let (i, k) = s.split_once('/').ok_or_else(bad)?;
-    let index: u64 = i.trim().parse().map_err(|_| bad())?;
-    let count: u64 = k.trim().parse().map_err(|_| bad())?;
-    if count == 0 || index >= count {
-        return Err(bad());
-    }
-    Ok(Shard { index, count })
-}
-
 #[derive(Debug, Args)]
 pub struct ExportArgs {
     /// The level file (.yaml).
@@ -367,14 +316,6 @@ pub struct ExportPolicyArgs {
     /// Replace files that already exist.
     #[arg(long)]
     pub force: bool,
-}
-
-fn parse_profile(s: &str) -> Result<crate::services::onnx::Profile, String> {
-    match s {
-        "plain" => Ok(crate::services::onnx::Profile::Plain),
-        "mlagents" => Ok(crate::services::onnx::Profile::Mlagents),
-        _ => Err(format!("unknown profile {s}: plain or mlagents")),
-    }
 }
 
 impl From<FormatArg> for crate::services::level_files::Format {
@@ -489,18 +430,6 @@ pub struct VerifyArgs {
     pub policies: Option<PathBuf>,
 }
 
-/// The judges a panel is asked for (empty: the default panel).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Judges(pub Vec<Judge>);
-
-fn parse_judges(s: &str) -> Result<Judges, String> {
-    s.split(',')
-        .filter(|name| !name.trim().is_empty())
-        .map(Judge::parse)
-        .collect::<Result<Vec<_>, _>>()
-        .map(Judges)
-}
-
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     arlpcg train --game platform --mode arlpcg --seed 1 --out runs/platform-arlpcg-s1\n  \
@@ -555,39 +484,6 @@ pub struct TrainArgs {
     /// Worker threads for environments and networks (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
     pub threads: Option<u64>,
-}
-
-fn parse_minutes(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(m) if m.is_finite() && m > 0.0 => Ok(m),
-        _ => Err(format!("`{s}` is not a positive number of minutes")),
-    }
-}
-
-fn parse_game(s: &str) -> Result<Game, String> {
-    s.parse()
-}
-
-fn parse_aux(s: &str) -> Result<f64, String> {
-    let value: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    // -0 is 0: the same level, file name and YAML.
-    params::AUX.check(value + 0.0).map_err(|e| e.to_string())
-}
-
-fn parse_point(s: &str) -> Result<[f64; 3], String> {
-    let parts: Vec<&str> = s.split(',').collect();
-    let [x, y, z] = parts.as_slice() else {
-        return Err(format!("`{s}` is not x,y,z"));
-    };
-    let mut point = [0.0; 3];
-    for (slot, part) in point.iter_mut().zip([x, y, z]) {
-        let value: f64 = part
-            .trim()
-            .parse()
-            .map_err(|_| format!("`{part}` is not a number"))?;
-        *slot = params::COORDINATE.check(value).map_err(|e| e.to_string())?;
-    }
-    Ok(point)
 }
 
 #[cfg(test)]

@@ -1,0 +1,118 @@
+//! The command line's values as text: each option's parser, with the one-line reason a value is
+//! refused, and the small types they make.
+
+use std::path::PathBuf;
+
+use crate::services::panel::Judge;
+use arlpcg_core::level::Game;
+use arlpcg_core::level::params;
+
+/// One of K equal shares of a batch (`--shard I/K`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    pub index: u64,
+    pub count: u64,
+}
+
+impl Shard {
+    /// Whether item `i` of the batch belongs to this shard.
+    pub fn owns(&self, i: u64) -> bool {
+        i % self.count == self.index
+    }
+}
+
+pub(super) fn parse_target(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(p) if p > 0.0 && p < 1.0 => Ok(p),
+        _ => Err(format!(
+            "`{s}` is not a success ratio strictly between 0 and 1"
+        )),
+    }
+}
+
+/// `--keep LEVEL.yaml:K`: the level file and how many of its pieces to keep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeepArg {
+    pub level: PathBuf,
+    pub pieces: usize,
+}
+
+pub(super) fn parse_keep(s: &str) -> Result<KeepArg, String> {
+    let (path, pieces) = s.rsplit_once(':').ok_or_else(|| {
+        format!("`{s}` is not LEVEL.yaml:K (the level file, then how many of its pieces to keep)")
+    })?;
+    let pieces = pieces.trim().parse().map_err(|_| {
+        format!("`{s}`: after the last `:` comes the number of pieces to keep, not `{pieces}`")
+    })?;
+    if path.is_empty() {
+        return Err(format!("`{s}`: the level file is missing before `:`"));
+    }
+    Ok(KeepArg {
+        level: PathBuf::from(path),
+        pieces,
+    })
+}
+
+pub(super) fn parse_shard(s: &str) -> Result<Shard, String> {
+    let bad = || format!("`{s}` is not I/K with 0 <= I < K (e.g. 0/4 .. 3/4)");
+    let (i, k) = s.split_once('/').ok_or_else(bad)?;
+    let index: u64 = i.trim().parse().map_err(|_| bad())?;
+    let count: u64 = k.trim().parse().map_err(|_| bad())?;
+    if count == 0 || index >= count {
+        return Err(bad());
+    }
+    Ok(Shard { index, count })
+}
+
+pub(super) fn parse_profile(s: &str) -> Result<crate::services::onnx::Profile, String> {
+    match s {
+        "plain" => Ok(crate::services::onnx::Profile::Plain),
+        "mlagents" => Ok(crate::services::onnx::Profile::Mlagents),
+        _ => Err(format!("unknown profile {s}: plain or mlagents")),
+    }
+}
+
+/// The judges a panel is asked for (empty: the default panel).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Judges(pub Vec<Judge>);
+
+pub(super) fn parse_judges(s: &str) -> Result<Judges, String> {
+    s.split(',')
+        .filter(|name| !name.trim().is_empty())
+        .map(Judge::parse)
+        .collect::<Result<Vec<_>, _>>()
+        .map(Judges)
+}
+
+pub(super) fn parse_minutes(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(m) if m.is_finite() && m > 0.0 => Ok(m),
+        _ => Err(format!("`{s}` is not a positive number of minutes")),
+    }
+}
+
+pub(super) fn parse_game(s: &str) -> Result<Game, String> {
+    s.parse()
+}
+
+pub(super) fn parse_aux(s: &str) -> Result<f64, String> {
+    let value: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    // -0 is 0: the same level, file name and YAML.
+    params::AUX.check(value + 0.0).map_err(|e| e.to_string())
+}
+
+pub(super) fn parse_point(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let [x, y, z] = parts.as_slice() else {
+        return Err(format!("`{s}` is not x,y,z"));
+    };
+    let mut point = [0.0; 3];
+    for (slot, part) in point.iter_mut().zip([x, y, z]) {
+        let value: f64 = part
+            .trim()
+            .parse()
+            .map_err(|_| format!("`{part}` is not a number"))?;
+        *slot = params::COORDINATE.check(value).map_err(|e| e.to_string())?;
+    }
+    Ok(point)
+}

@@ -35,6 +35,45 @@ pub enum AuxAsk {
     Curve(AuxCurve),
 }
 
+/// What difficulty a designer asks for, one shape for `generate` (`--aux`, `--aux-curve`,
+/// `--target-success`, which exclude each other), the designer (its slider, pacing curve or
+/// success target) and its worker: a λ or a curve of λ for the Generator, or a success rate
+/// that `difficulty::level_for` searches λ for.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Ask {
+    Aux(f64),
+    Curve(AuxCurve),
+    Success(f64),
+}
+
+impl Ask {
+    /// The λ the Generator builds at; none when a success rate is asked for (the search
+    /// chooses λ).
+    pub fn aux(&self) -> Option<AuxAsk> {
+        match self {
+            Ask::Aux(aux) => Some(AuxAsk::Flat(*aux)),
+            Ask::Curve(curve) => Some(AuxAsk::Curve(curve.clone())),
+            Ask::Success(_) => None,
+        }
+    }
+
+    /// The success rate asked for.
+    pub fn success(&self) -> Option<f64> {
+        match self {
+            Ask::Success(target) => Some(*target),
+            _ => None,
+        }
+    }
+
+    /// The curve of λ asked for.
+    pub fn curve(&self) -> Option<&AuxCurve> {
+        match self {
+            Ask::Curve(curve) => Some(curve),
+            _ => None,
+        }
+    }
+}
+
 /// Which level to build: the seed its goal and the Generator's samples are drawn from, λ, and
 /// what the seed would otherwise draw.
 #[derive(Debug, Clone, PartialEq)]

@@ -6,7 +6,7 @@ use std::path::Path;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use arlpcg::services::generation::LevelRequest;
+use arlpcg::services::generation::{Ask, LevelRequest};
 use arlpcg::shells::design::app::{
     self, App, Effect, GoalSetting, LoadedInfo, Message, Overlay, Response,
 };
@@ -151,7 +151,7 @@ fn slider_keys_and_mouse_change_lambda_and_regenerate() {
     h.settle();
     h.key(KeyCode::Left);
     assert_eq!(h.app.aux, 0.9);
-    assert!(matches!(h.pending[..], [Effect::Generate { aux, .. }] if aux == 0.9));
+    assert!(matches!(h.pending[..], [Effect::Generate { ask: Ask::Aux(aux), .. }] if aux == 0.9));
     h.key(KeyCode::Right);
     h.key(KeyCode::Right);
     assert_eq!(h.app.aux, 1.0, "clamped at +1");
@@ -453,10 +453,10 @@ fn newer_requests_supersede_older_ones() {
         id,
         game: Game::Platform,
         seed: id,
-        aux: 0.0,
         goal: None,
-        curve: None,
+        ask: Ask::Aux(0.0),
         keep: None,
+        trials: 100,
     };
     workers.submit(generate(101));
     loop {
@@ -546,7 +546,9 @@ fn target_success_mode_finds_a_level_in_band() {
     h.key(KeyCode::Char('T'));
     h.keys("0.6");
     h.key(KeyCode::Enter);
-    assert!(matches!(h.pending[..], [Effect::Target { target, .. }] if target == 0.6));
+    assert!(
+        matches!(h.pending[..], [Effect::Generate { ask: Ask::Success(target), .. }] if target == 0.6)
+    );
     h.settle();
     let level = h.app.level.clone().expect("a level in the band");
     assert_eq!(
@@ -559,7 +561,7 @@ fn target_success_mode_finds_a_level_in_band() {
     assert!((success - 0.6).abs() <= 0.1 + 1e-9, "measured {success}");
     assert!(h.screen(80, 24).contains("for success 0.60"));
     h.key(KeyCode::Right);
-    assert_eq!(h.app.ask.target(), None, "the slider leaves target mode");
+    assert_eq!(h.app.ask.success(), None, "the slider leaves target mode");
     assert!(matches!(h.pending[..], [Effect::Generate { .. }]));
 }
 
@@ -620,7 +622,7 @@ fn pacing_keys_set_a_curve_and_keep_a_prefix() {
     h.settle();
     h.key(KeyCode::Char('P'));
     assert!(
-        matches!(&h.pending[..], [Effect::Generate { curve: Some(c), .. }] if c.to_string() == "0:1, 1:-1"),
+        matches!(&h.pending[..], [Effect::Generate { ask: Ask::Curve(c), .. }] if c.to_string() == "0:1, 1:-1"),
         "{:?}",
         h.pending
     );
@@ -635,14 +637,20 @@ fn pacing_keys_set_a_curve_and_keep_a_prefix() {
     insta::assert_snapshot!("pacing_ramp_up_120x36", h.screen(120, 36));
     // The next preset, then a typed curve, then a bad one.
     h.key(KeyCode::Char('P'));
-    assert_eq!(h.app.ask.pacing().unwrap().name, "ramp down");
+    assert_eq!(
+        arlpcg::shells::design::app::pacing::preset_name(h.app.ask.curve().unwrap()),
+        "ramp down"
+    );
     h.key(KeyCode::Char('C'));
     for _ in 0..20 {
         h.key(KeyCode::Backspace);
     }
     h.keys("0:-1, 0.5:-1, 0.6:1, 1:1");
     h.key(KeyCode::Enter);
-    assert_eq!(h.app.ask.pacing().unwrap().name, "custom");
+    assert_eq!(
+        arlpcg::shells::design::app::pacing::preset_name(h.app.ask.curve().unwrap()),
+        "custom"
+    );
     h.key(KeyCode::Char('C'));
     h.keys(", 0.2:1");
     h.key(KeyCode::Enter);
@@ -676,7 +684,7 @@ fn pacing_keys_set_a_curve_and_keep_a_prefix() {
     assert!(h.app.kept.is_none());
     // The slider: one λ again.
     h.key(KeyCode::Left);
-    assert!(h.app.ask.pacing().is_none());
+    assert!(h.app.ask.curve().is_none());
     h.settle();
     assert!(h.app.level.as_ref().unwrap().pacing.is_none());
 }

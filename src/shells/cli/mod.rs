@@ -12,6 +12,7 @@ use values::{
     parse_shard, parse_target,
 };
 
+use crate::services::generation::Ask;
 use crate::services::panel::Judge;
 use arlpcg_core::game::Skill;
 use arlpcg_core::level::Game;
@@ -316,6 +317,18 @@ pub struct ExportPolicyArgs {
     /// Replace files that already exist.
     #[arg(long)]
     pub force: bool,
+}
+
+impl GenerateArgs {
+    /// What difficulty is asked for (clap refuses two of `--aux`, `--aux-curve` and
+    /// `--target-success` together); none for rule levels that record no λ.
+    pub fn ask(&self) -> Option<Ask> {
+        match (self.target_success, &self.aux_curve, self.aux) {
+            (Some(target), _, _) => Some(Ask::Success(target)),
+            (None, Some(curve), _) => Some(Ask::Curve(curve.clone())),
+            (None, None, aux) => aux.map(Ask::Aux),
+        }
+    }
 }
 
 impl From<FormatArg> for crate::services::level_files::Format {

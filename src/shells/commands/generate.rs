@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use crate::services::difficulty;
 use crate::services::fsio::{self, Overwrite};
-use crate::services::generation::{self, AuxAsk, GeneratorPolicy, KeptPrefix, LevelRequest};
+use crate::services::generation::{self, Ask, GeneratorPolicy, KeptPrefix, LevelRequest};
 use crate::services::level_files::{Format, LevelFiles, file_stem, render};
 use crate::services::panel::{Judge, JudgePanel, rate};
 use crate::services::policies::{
@@ -29,7 +29,10 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         .as_ref()
         .map(|keep| kept_prefix(keep, args.game))
         .transpose()?;
-    let verify_trials = args.verify.or(args.target_success.map(|_| TARGET_TRIALS));
+    let ask = args.ask();
+    let verify_trials = args
+        .verify
+        .or(ask.as_ref().and_then(Ask::success).map(|_| TARGET_TRIALS));
     let generator = match &args.policies {
         Some(dir) => Some(load_generator(&policy_paths(dir).0, args.game)?.0),
         None => None,
@@ -192,7 +195,8 @@ fn target_curve(
     solver: &Solver,
     stop: &AtomicBool,
 ) -> Result<Option<difficulty::Curve>> {
-    let (Some(_), Some(generator), Some(dir)) = (args.target_success, generator, &args.policies)
+    let (Some(Ask::Success(_)), Some(generator), Some(dir)) =
+        (args.ask(), generator, &args.policies)
     else {
         return Ok(None);
     };
@@ -222,13 +226,15 @@ fn target_curve(
 /// the seeds of the levels to make (this shard's).
 fn check_arguments(args: &GenerateArgs) -> Result<Vec<u64>> {
     let usage = |message: &str| Err(crate::shells::common::UsageError(message.into()).into());
-    if args.target_success.is_some() && args.policies.is_none() {
+    let ask = args.ask();
+    let success = ask.as_ref().and_then(Ask::success);
+    if success.is_some() && args.policies.is_none() {
         return usage("--target-success needs --policies: a Generator that λ steers");
     }
     if args.obstacles > 0 && args.game != Game::Racing {
         return usage("--obstacles is for racing tracks (--game racing)");
     }
-    if args.aux_curve.is_some() && args.policies.is_none() {
+    if ask.as_ref().and_then(Ask::curve).is_some() && args.policies.is_none() {
         return usage("--aux-curve needs --policies: the rules know no λ, a Generator follows it");
     }
     if args.keep.is_some() && args.obstacles > 0 {
@@ -236,16 +242,12 @@ fn check_arguments(args: &GenerateArgs) -> Result<Vec<u64>> {
             "--obstacles with --keep: the kept level's scene (start, goal, obstacles) stays",
         );
     }
-    if args.policies.is_some()
-        && args.aux.is_none()
-        && args.aux_curve.is_none()
-        && args.target_success.is_none()
-    {
+    if args.policies.is_some() && ask.is_none() {
         return usage(
             "--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard), --aux-curve CURVE or --target-success P",
         );
     }
-    if args.solver_policy.is_some() && args.verify.is_none() && args.target_success.is_none() {
+    if args.solver_policy.is_some() && args.verify.is_none() && success.is_none() {
         return usage("--solver-policy plays --verify N or --target-success P; give one of them");
     }
     if args.out.exists() && !args.out.is_dir() {
@@ -360,13 +362,14 @@ fn stem(args: &GenerateArgs, seed: u64) -> String {
 }
 
 fn stem_of_lambda(args: &GenerateArgs, seed: u64) -> String {
-    match (args.target_success, &args.aux_curve) {
-        (Some(target), _) => format!("{}_seed{seed}_success{target:.2}", args.game),
-        (None, Some(curve)) => {
+    match args.ask() {
+        Some(Ask::Success(target)) => format!("{}_seed{seed}_success{target:.2}", args.game),
+        Some(Ask::Curve(curve)) => {
             let hash = arlpcg_core::level::sha256_hex(curve.to_string().as_bytes());
             format!("{}_seed{seed}_curve-{}", args.game, &hash[..8])
         }
-        (None, None) => file_stem(args.game, seed, args.aux),
+        Some(Ask::Aux(aux)) => file_stem(args.game, seed, Some(aux)),
+        None => file_stem(args.game, seed, None),
     }
 }
 
@@ -382,12 +385,12 @@ fn build(
     seed: u64,
     draw: u32,
 ) -> Result<Level> {
-    let mut request = LevelRequest::new(seed, args.aux)
+    let mut request = LevelRequest::new(seed, None)
         .goal(args.goal)
         .obstacles(args.obstacles)
         .draw(draw);
-    if let Some(curve) = &args.aux_curve {
-        request = request.aux(AuxAsk::Curve(curve.clone()));
+    if let Some(aux) = args.ask().as_ref().and_then(Ask::aux) {
+        request = request.aux(aux);
     }
     if let Some(keep) = keep {
         request = request.keep(keep.clone());
@@ -465,7 +468,7 @@ fn build_levels(
             if stop.load(Ordering::SeqCst) {
                 return None;
             }
-            let level = match (args.target_success, curve, generator) {
+            let level = match (args.ask().as_ref().and_then(Ask::success), curve, generator) {
                 (Some(target), Some(curve), Some(generator)) => difficulty::level_for(
                     generator,
                     who,

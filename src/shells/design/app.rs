@@ -11,6 +11,7 @@ use ratatui::layout::Rect;
 use arlpcg_core::level::heading::{direction_heading, heading_direction, wrap_degrees};
 use arlpcg_core::level::params::quantize;
 
+use crate::services::generation::Ask;
 use crate::services::verify::Recording;
 use arlpcg_core::level::{Game, Level};
 
@@ -112,37 +113,6 @@ pub enum Overlay {
     },
 }
 
-/// What difficulty the designer asks the Generator for. One field, so that asking for one
-/// leaves the others (the CLI's `--aux`, `--target-success` and `--aux-curve` likewise exclude
-/// each other).
-#[derive(Debug, Clone, PartialEq)]
-pub enum Ask {
-    /// One λ for the whole level, the slider's.
-    Slider,
-    /// A success rate: λ is searched for a level the Solver clears within ±0.1 of it.
-    Success(f64),
-    /// λ along the level.
-    Pacing(pacing::PacingChoice),
-}
-
-impl Ask {
-    /// The success rate asked for, in target-success mode.
-    pub fn target(&self) -> Option<f64> {
-        match self {
-            Ask::Success(target) => Some(*target),
-            _ => None,
-        }
-    }
-
-    /// The curve asked for, when pacing.
-    pub fn pacing(&self) -> Option<&pacing::PacingChoice> {
-        match self {
-            Ask::Pacing(choice) => Some(choice),
-            _ => None,
-        }
-    }
-}
-
 /// What the bottom-right panel shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SidePane {
@@ -229,7 +199,7 @@ impl App {
             policies,
             other_policies: LoadedInfo::default(),
             aux: 1.0,
-            ask: Ask::Slider,
+            ask: Ask::Aux(1.0),
             kept: None,
             seed,
             goal: GoalSetting::FromSeed,
@@ -277,24 +247,14 @@ impl App {
         self.requested = id;
         self.replay = None;
         self.recording = None;
-        if let Some(target) = self.ask.target() {
-            return vec![Effect::Target {
-                id,
-                game: self.game,
-                seed: self.seed,
-                goal: self.goal.position(),
-                target,
-                trials: self.trials_wanted,
-            }];
-        }
         vec![Effect::Generate {
             id,
             game: self.game,
             seed: self.seed,
-            aux: self.aux,
             goal: self.goal.position(),
-            curve: self.ask.pacing().map(|p| p.curve.clone()),
+            ask: self.ask.clone(),
             keep: self.kept.clone(),
+            trials: self.trials_wanted,
         }]
     }
 
@@ -308,8 +268,8 @@ impl App {
         std::mem::swap(&mut self.policies, &mut self.other_policies);
         self.goal = GoalSetting::FromSeed;
         self.kept = None;
-        if self.policies.generator.is_none() && self.ask.pacing().is_some() {
-            self.ask = Ask::Slider;
+        if self.policies.generator.is_none() && self.ask.curve().is_some() {
+            self.ask = Ask::Aux(self.aux);
         }
         self.level = None;
         self.trials = None;
@@ -321,12 +281,12 @@ impl App {
 
     fn set_aux(&mut self, aux: f64) -> Vec<Effect> {
         let aux = (aux.clamp(-1.0, 1.0) * 100.0).round() / 100.0;
-        if aux == self.aux && self.ask.target().is_none() {
+        if self.ask == Ask::Aux(aux) {
             return Vec::new();
         }
         // Moving the slider leaves target-success mode and pacing.
-        let was_paced = self.ask.pacing().is_some();
-        self.ask = Ask::Slider;
+        let was_paced = self.ask.curve().is_some();
+        self.ask = Ask::Aux(aux);
         if was_paced {
             self.say("one λ again (P: pacing presets)");
         }
@@ -348,7 +308,7 @@ impl App {
                 self.ask = Ask::Success(target);
                 self.kept = None;
             }
-            None if self.ask.target().is_some() => self.ask = Ask::Slider,
+            None if self.ask.success().is_some() => self.ask = Ask::Aux(self.aux),
             None => {}
         }
         if let Some(p) = target {
@@ -370,12 +330,12 @@ impl App {
 
     /// The file stem exports use: game, seed and λ (or the pacing preset), and the pieces kept.
     pub fn export_stem(&self) -> String {
-        let mut stem = match self.ask.pacing() {
-            Some(choice) => format!(
+        let mut stem = match self.ask.curve() {
+            Some(curve) => format!(
                 "{}_seed{}_pacing-{}",
                 self.game,
                 self.seed,
-                choice.name.replace(' ', "-")
+                pacing::preset_name(curve).replace(' ', "-")
             ),
             None => crate::services::level_files::file_stem(self.game, self.seed, Some(self.aux)),
         };

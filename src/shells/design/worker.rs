@@ -141,9 +141,7 @@ enum Slot {
 
 fn slot(effect: &Effect) -> (Slot, u64) {
     match effect {
-        Effect::Generate { id, .. } | Effect::Target { id, .. } | Effect::Trials { id, .. } => {
-            (Slot::Level, *id)
-        }
+        Effect::Generate { id, .. } | Effect::Trials { id, .. } => (Slot::Level, *id),
         Effect::Record { id, .. } => (Slot::Record, *id),
         Effect::Sweep { id, .. } => (Slot::Sweep, *id),
         Effect::Panel { id, .. } => (Slot::Panel, *id),
@@ -247,21 +245,27 @@ pub fn perform(
             id,
             game,
             seed,
-            aux,
             goal,
-            curve,
+            ask,
             keep,
+            trials,
         } => {
-            let mut request = LevelRequest::new(seed, Some(aux)).goal(goal);
-            if let Some(curve) = curve {
-                request = request.aux(crate::services::generation::AuxAsk::Curve(curve));
-            }
-            if let Some(keep) = keep {
-                request = request.keep(keep);
-            }
+            let result = match (ask.success(), ask.aux()) {
+                (Some(target), _) => target_level(shelf.of(game), seed, goal, target, trials),
+                (None, aux) => {
+                    let mut request = LevelRequest::new(seed, None).goal(goal);
+                    if let Some(aux) = aux {
+                        request = request.aux(aux);
+                    }
+                    if let Some(keep) = keep {
+                        request = request.keep(keep);
+                    }
+                    shelf.of(game).level(game, request)
+                }
+            };
             send(Response::Level {
                 id,
-                result: shelf.of(game).level(game, request).map(Arc::new),
+                result: result.map(Arc::new),
             })
         }
         Effect::Trials {
@@ -302,17 +306,6 @@ pub fn perform(
             stem,
             overwrite,
         } => send(Response::Exported(export(&level, &dir, &stem, overwrite))),
-        Effect::Target {
-            id,
-            game,
-            seed,
-            goal,
-            target,
-            trials,
-        } => send(Response::Level {
-            id,
-            result: target_level(shelf.of(game), seed, goal, target, trials).map(Arc::new),
-        }),
         Effect::NextJudge {
             game,
             after,

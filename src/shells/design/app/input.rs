@@ -108,12 +108,9 @@ impl App {
         let text = match kind {
             PromptKind::Seed => self.seed.to_string(),
             PromptKind::Trials => self.trials_wanted.to_string(),
-            PromptKind::Target => self.ask.target().map_or(String::new(), |t| format!("{t}")),
+            PromptKind::Target => self.ask.success().map_or(String::new(), |t| format!("{t}")),
             PromptKind::Policies => String::new(),
-            PromptKind::Curve => self
-                .ask
-                .pacing()
-                .map_or(String::new(), |p| p.curve.to_string()),
+            PromptKind::Curve => self.ask.curve().map_or(String::new(), ToString::to_string),
         };
         self.overlay = Overlay::Prompt { kind, text };
         Vec::new()
@@ -158,7 +155,7 @@ impl App {
                 }
             },
             PromptKind::Target if text.trim().is_empty() => {
-                if self.ask.target().is_none() {
+                if self.ask.success().is_none() {
                     return Vec::new();
                 }
                 self.say("back to the λ slider");

@@ -75,16 +75,17 @@ pub enum ExportOutcome {
 /// Work for the worker threads.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Effect {
+    /// A level of `game` as `ask` says: at a λ or along a curve of λ (after the pieces kept
+    /// from an earlier level), or one whose success, measured with `trials` runs, is within
+    /// ±0.1 of a rate (the search of `generate --target-success`).
     Generate {
         id: u64,
         game: Game,
         seed: u64,
-        aux: f64,
         goal: Option<[f64; 3]>,
-        /// λ along the level instead of `aux`.
-        curve: Option<arlpcg_core::level::pacing::AuxCurve>,
-        /// Pieces kept from an earlier level.
+        ask: crate::services::generation::Ask,
         keep: Option<crate::services::generation::KeptPrefix>,
+        trials: u32,
     },
     Trials {
         id: u64,
@@ -124,16 +125,6 @@ pub enum Effect {
         id: u64,
         level: Arc<Level>,
         folder: PathBuf,
-        trials: u32,
-    },
-    /// A level of `game` whose success, measured with `trials` runs, is within ±0.1 of `target`
-    /// (the search of `generate --target-success`).
-    Target {
-        id: u64,
-        game: Game,
-        seed: u64,
-        goal: Option<[f64; 3]>,
-        target: f64,
         trials: u32,
     },
 }

@@ -7,14 +7,6 @@ use crate::services::generation::KeptPrefix;
 use arlpcg_core::level::PolicyRef;
 use arlpcg_core::level::pacing::AuxCurve;
 
-/// λ along the level the designer asks the Generator for.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PacingChoice {
-    /// The preset's name, or `custom`.
-    pub name: &'static str,
-    pub curve: AuxCurve,
-}
-
 /// The presets `P` cycles through, after the plain slider.
 pub const PRESETS: [(&str, &str); 4] = [
     ("ramp up", "0:1, 1:-1"),
@@ -23,22 +15,24 @@ pub const PRESETS: [(&str, &str); 4] = [
     ("breather", "0:-1, 0.7:-1, 0.8:1, 1:1"),
 ];
 
-fn preset(k: usize) -> PacingChoice {
-    let (name, text) = PRESETS[k];
-    PacingChoice {
-        name,
-        curve: AuxCurve::parse(text).expect("the presets parse"),
-    }
+fn preset(k: usize) -> AuxCurve {
+    AuxCurve::parse(PRESETS[k].1).expect("the presets parse")
+}
+
+/// The name of the preset `curve` is, or `custom`.
+pub fn preset_name(curve: &AuxCurve) -> &'static str {
+    (0..PRESETS.len())
+        .find(|&k| preset(k) == *curve)
+        .map_or("custom", |k| PRESETS[k].0)
 }
 
 impl App {
     /// `P`: the next preset (after the last, back to one λ from the slider).
     pub(super) fn next_pacing(&mut self) -> Vec<Effect> {
-        let next = match self.ask.pacing() {
+        let next = match self.ask.curve() {
             None => Some(0),
-            Some(choice) => PRESETS
-                .iter()
-                .position(|(name, _)| *name == choice.name)
+            Some(curve) => (0..PRESETS.len())
+                .position(|k| preset(k) == *curve)
                 .map(|k| k + 1)
                 .filter(|&k| k < PRESETS.len()),
         };
@@ -48,10 +42,7 @@ impl App {
     /// A curve typed at the `C` prompt.
     pub(super) fn submit_curve(&mut self, text: &str) -> Vec<Effect> {
         match AuxCurve::parse(text) {
-            Ok(curve) => self.set_pacing(Some(PacingChoice {
-                name: "custom",
-                curve,
-            })),
+            Ok(curve) => self.set_pacing(Some(curve)),
             Err(problem) => {
                 self.complain(format!("aux curve: {problem}"));
                 Vec::new()
@@ -60,16 +51,16 @@ impl App {
     }
 
     /// Pacing on (`Some`) or off: a Generator is needed to follow a curve.
-    pub(super) fn set_pacing(&mut self, pacing: Option<PacingChoice>) -> Vec<Effect> {
+    pub(super) fn set_pacing(&mut self, pacing: Option<AuxCurve>) -> Vec<Effect> {
         if pacing.is_some() && self.policies.generator.is_none() {
             self.complain("pacing needs a Generator (p loads one): rule levels have no λ");
             return Vec::new();
         }
         match &pacing {
-            Some(choice) => self.say(format!("pacing: {} ({})", choice.name, choice.curve)),
+            Some(curve) => self.say(format!("pacing: {} ({curve})", preset_name(curve))),
             None => self.say(format!("one λ again: {:+.2}", self.aux)),
         }
-        self.ask = pacing.map_or(Ask::Slider, Ask::Pacing);
+        self.ask = pacing.map_or(Ask::Aux(self.aux), Ask::Curve);
         self.generate()
     }
 
@@ -94,8 +85,8 @@ impl App {
             "keeping the first {pieces} {}: K lets go",
             arlpcg_core::game::facts::facts(self.game).pieces
         ));
-        if self.ask.target().is_some() {
-            self.ask = Ask::Slider;
+        if self.ask.success().is_some() {
+            self.ask = Ask::Aux(self.aux);
         }
         self.generate()
     }

@@ -82,7 +82,7 @@ impl App {
                 self.generation_error = None;
                 self.selected = self.selected.filter(|&i| i < level.piece_count());
                 // In target-success mode the slider shows the λ the search found.
-                if let (Some(_), Some(aux)) = (self.ask.target(), level.aux) {
+                if let (Some(_), Some(aux)) = (self.ask.success(), level.aux) {
                     self.aux = aux;
                 }
                 self.level = Some(level);

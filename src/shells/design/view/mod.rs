@@ -180,14 +180,12 @@ fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
         areas.controls,
     );
     let width = areas.slider.width as usize;
-    let mut slider = match app.ask.pacing() {
+    let mut slider = match app.ask.curve() {
         // The curve from start to goal, taller where it is harder.
-        Some(choice) => {
+        Some(curve) => {
             let profile: String = (0..width)
                 .map(|i| {
-                    let aux = choice
-                        .curve
-                        .at(i as f64 / width.saturating_sub(1).max(1) as f64);
+                    let aux = curve.at(i as f64 / width.saturating_sub(1).max(1) as f64);
                     let level = ((1.0 - aux) / 2.0 * 7.0).round() as usize;
                     ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'][level.min(7)]
                 })
@@ -224,7 +222,7 @@ fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
             Style::new().fg(Color::Blue),
         ));
     }
-    if let Some(target) = app.ask.target() {
+    if let Some(target) = app.ask.success() {
         slider.push_span(Span::styled(
             format!(" for success {target:.2}"),
             Style::new().fg(Color::Cyan),
@@ -250,9 +248,9 @@ fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
         Span::raw(format!("   goal ({origin}) {goal}")),
         Span::raw(format!("   trials {}", app.trials_wanted)).dim(),
     ]);
-    if let Some(choice) = app.ask.pacing() {
+    if let Some(curve) = app.ask.curve() {
         settings.push_span(Span::styled(
-            format!("   {}: {}", choice.name, choice.curve),
+            format!("   {}: {curve}", super::app::pacing::preset_name(curve)),
             Style::new().fg(Color::Magenta),
         ));
     }

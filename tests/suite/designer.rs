@@ -254,7 +254,10 @@ fn replay_sweep_and_trial_count() {
     h.key(KeyCode::Char('w'));
     h.settle();
     let sweep = h.app.sweep.clone().expect("a sweep");
-    assert_eq!(sweep.points.len(), app::SWEEP_AUX.len());
+    assert_eq!(
+        sweep.points.len(),
+        arlpcg::shells::design::app::sweep::SWEEP_AUX.len()
+    );
     // Rule levels do not depend on λ, so every point of their sweep measures the same level
     // with the same trials: one success ratio, whatever λ says.
     let ratios: Vec<f64> = sweep

@@ -11,31 +11,29 @@ use ratatui::layout::Rect;
 use arlpcg_core::level::heading::{direction_heading, heading_direction, wrap_degrees};
 use arlpcg_core::level::params::quantize;
 
-use crate::services::generation::Ask;
+pub use crate::services::generation::Ask;
 use crate::services::verify::Recording;
 use arlpcg_core::level::{Game, Level};
 
 use super::layout::Areas;
 
 mod input;
-pub mod judging;
+pub mod judges;
 mod loaded;
 mod messages;
 pub mod pacing;
 mod responses;
-mod trials;
+pub mod sweep;
+pub mod trials;
 
 pub use messages::{Effect, ExportOutcome, Message, Response};
 pub use trials::Trials;
 
 pub use loaded::{JudgeSwitch, LoadedInfo, PolicyInfo};
+pub use sweep::{Sweep, SweepPoint};
 
 /// Steps of the λ slider (keys), and its range.
 pub const AUX_STEP: f64 = 0.1;
-/// The λ values of a sweep.
-pub const SWEEP_AUX: [f64; 9] = [-1.0, -0.75, -0.5, -0.25, 0.0, 0.25, 0.5, 0.75, 1.0];
-/// Trials per λ in a sweep.
-pub const SWEEP_TRIALS: u32 = 40;
 /// Default Solver trials on each generated level.
 pub const DEFAULT_TRIALS: u32 = 100;
 /// Most trials one level may be given from the prompt.
@@ -131,22 +129,6 @@ pub struct Replay {
     pub frame: usize,
 }
 
-/// One λ of a sweep: its success ratio, or why it has none.
-#[derive(Debug, Clone, PartialEq)]
-pub enum SweepPoint {
-    Pending,
-    Success(f64),
-    NoLevel(String),
-}
-
-/// A λ sweep for the seed and goal it was started with.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Sweep {
-    pub id: u64,
-    pub seed: u64,
-    pub points: Vec<(f64, SweepPoint)>,
-}
-
 /// Everything the designer shows and remembers.
 #[derive(Debug, Clone, PartialEq)]
 pub struct App {
@@ -177,7 +159,7 @@ pub struct App {
     recording: Option<(u64, u64)>,
     replays: u64,
     pub sweep: Option<Sweep>,
-    pub judging: Option<judging::Judging>,
+    pub judging: Option<judges::Judging>,
     pub panel: SidePane,
     /// Selected block (index into the level's blocks).
     pub selected: Option<usize>,
@@ -380,27 +362,6 @@ impl App {
         vec![Effect::Record { id, level, seed }]
     }
 
-    fn sweep(&mut self) -> Vec<Effect> {
-        let id = self.id();
-        self.sweep = Some(Sweep {
-            id,
-            seed: self.seed,
-            points: SWEEP_AUX
-                .iter()
-                .map(|&a| (a, SweepPoint::Pending))
-                .collect(),
-        });
-        self.panel = SidePane::Sweep;
-        vec![Effect::Sweep {
-            id,
-            game: self.game,
-            seed: self.seed,
-            goal: self.goal.position(),
-            auxes: SWEEP_AUX.to_vec(),
-            trials: SWEEP_TRIALS,
-        }]
-    }
-
     fn adjust_goal(&mut self, d_steps: f64, d_height: f64, d_direction: f64) -> Vec<Effect> {
         let GoalSetting::Custom {
             distance,
@@ -454,26 +415,6 @@ impl App {
             Some(i) => (i as isize + delta).rem_euclid(blocks as isize) as usize,
         };
         self.selected = Some(next);
-    }
-
-    fn start_trials(&mut self) -> Vec<Effect> {
-        let Some(level) = self.level.clone() else {
-            return Vec::new();
-        };
-        let id = self.id();
-        self.trials = Some(Trials {
-            id,
-            wanted: self.trials_wanted,
-            results: Vec::new(),
-            stats: None,
-            error: None,
-        });
-        vec![Effect::Trials {
-            id,
-            seed: level.seed.unwrap_or(0),
-            level,
-            trials: self.trials_wanted,
-        }]
     }
 
     fn tick(&mut self) {

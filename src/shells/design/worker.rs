@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex};
 
 use anyhow::Result;
 
-use super::app::judging::{PANEL_SEED, PanelUpdate};
+use super::app::judges::{PANEL_SEED, PanelUpdate};
 use super::app::{
     Effect, ExportOutcome, JudgeSwitch, LoadedInfo, PolicyInfo, Response, SweepPoint,
 };

@@ -6,7 +6,8 @@ use std::sync::Arc;
 
 use ratatui::crossterm::event::{KeyEvent, MouseEvent};
 
-use super::{JudgeSwitch, LoadedInfo, SweepPoint, judging};
+use super::judges;
+use super::{JudgeSwitch, LoadedInfo, SweepPoint};
 use crate::services::panel::Judge;
 use crate::services::verify::Recording;
 use arlpcg_core::level::stats::{SolverStats, TrialResult};
@@ -61,7 +62,7 @@ pub enum Response {
     Judged(Result<Box<JudgeSwitch>, String>),
     Panel {
         id: u64,
-        update: judging::PanelUpdate,
+        update: judges::PanelUpdate,
     },
 }
 

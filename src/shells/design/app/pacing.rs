@@ -2,7 +2,11 @@
 //! locked prefix (`k` keeps every piece up to the selected one, `K` lets go) that every
 //! regeneration keeps.
 
-use super::*;
+use ratatui::style::{Color, Style};
+use ratatui::text::{Line, Span};
+
+use super::super::layout::{SLIDER_LEFT, SLIDER_RIGHT};
+use super::{App, Ask, Effect};
 use crate::services::generation::KeptPrefix;
 use arlpcg_core::level::PolicyRef;
 use arlpcg_core::level::pacing::AuxCurve;
@@ -99,4 +103,31 @@ impl App {
         self.say("the whole level is generated again");
         self.generate()
     }
+}
+
+/// The slider's line while pacing: the curve from start to goal, `width` characters, taller
+/// where it is harder.
+pub(crate) fn curve_line(curve: &AuxCurve, width: usize) -> Line<'static> {
+    let profile: String = (0..width)
+        .map(|i| {
+            let aux = curve.at(i as f64 / width.saturating_sub(1).max(1) as f64);
+            let level = ((1.0 - aux) / 2.0 * 7.0).round() as usize;
+            ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'][level.min(7)]
+        })
+        .collect();
+    // Labels as wide as the slider's; the preset and its curve on the settings line.
+    Line::from(vec![
+        Span::raw(format!("{:<w$}", "start", w = SLIDER_LEFT.chars().count())),
+        Span::styled(profile, Style::new().fg(Color::Magenta)),
+        Span::raw(format!("{:>w$}", "goal", w = SLIDER_RIGHT.chars().count())),
+        Span::styled("  pacing", Style::new().bold()),
+    ])
+}
+
+/// The colour of λ: green at +1 (easy), yellow at 0, red at -1 (hard).
+pub fn aux_colour(aux: f64) -> Color {
+    let hard = ((1.0 - aux) / 2.0).clamp(0.0, 1.0);
+    let red = (255.0 * (2.0 * hard).min(1.0)) as u8;
+    let green = (255.0 * (2.0 * (1.0 - hard)).min(1.0)) as u8;
+    Color::Rgb(red, green, 40)
 }

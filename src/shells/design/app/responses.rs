@@ -31,11 +31,7 @@ impl App {
                 Vec::new()
             }
             Response::SweepPoint { id, index, point } => {
-                if let Some(sweep) = self.sweep.as_mut().filter(|s| s.id == id)
-                    && let Some(slot) = sweep.points.get_mut(index)
-                {
-                    slot.1 = point;
-                }
+                self.sweep_point(id, index, point);
                 Vec::new()
             }
             Response::Exported(outcome) => {

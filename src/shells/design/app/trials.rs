@@ -1,6 +1,13 @@
 //! The Solver's trials on the level on screen, as they come in: counts, the success ratio with
 //! its interval, progress, air time and the failures per piece.
 
+use ratatui::Frame;
+use ratatui::layout::Rect;
+use ratatui::style::Style;
+use ratatui::widgets::{Bar, BarChart, BarGroup, Block, Paragraph};
+
+use super::pacing::aux_colour;
+use super::{App, Effect};
 use arlpcg_core::level::Game;
 use arlpcg_core::level::stats::{Outcome, SolverStats, TrialResult, wilson_interval};
 
@@ -69,4 +76,76 @@ impl Trials {
         }
         failures
     }
+}
+
+impl App {
+    /// The Solver's trials on the level on screen, from the first.
+    pub(super) fn start_trials(&mut self) -> Vec<Effect> {
+        let Some(level) = self.level.clone() else {
+            return Vec::new();
+        };
+        let id = self.id();
+        self.trials = Some(Trials {
+            id,
+            wanted: self.trials_wanted,
+            results: Vec::new(),
+            stats: None,
+            error: None,
+        });
+        vec![Effect::Trials {
+            id,
+            seed: level.seed.unwrap_or(0),
+            level,
+            trials: self.trials_wanted,
+        }]
+    }
+}
+
+/// The bottom-right panel's first view: the failures on each piece, coloured by the λ the
+/// piece was built at when the level is paced.
+pub(crate) fn draw_failures(app: &App, frame: &mut Frame, area: Rect) {
+    let block = Block::bordered().title(format!(
+        " failures per {} (v: sweep) ",
+        arlpcg_core::game::facts::facts(app.game).piece_name(false)
+    ));
+    let (Some(level), Some(trials)) = (&app.level, &app.trials) else {
+        frame.render_widget(block, area);
+        return;
+    };
+    let counts = trials.failures_by_block(level.piece_count());
+    if counts.iter().all(|&c| c == 0) {
+        let text = if trials.done() == 0 {
+            "waiting for the first runs"
+        } else {
+            "no run has failed so far"
+        };
+        frame.render_widget(Paragraph::new(text).block(block), area);
+        return;
+    }
+    let piece_aux = |i: usize| level.pacing.as_ref()?.piece_aux.get(i).copied().flatten();
+    let bars: Vec<Bar> = counts
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| {
+            let style = match piece_aux(i) {
+                _ if app.selected == Some(i) => Style::new().cyan(),
+                // Beside the map's colours: where the curve asked for it to be hard.
+                Some(aux) => Style::new().fg(aux_colour(aux)),
+                None => Style::new().red(),
+            };
+            Bar::default()
+                .value(c as u64)
+                .text_value(String::new())
+                .style(style)
+        })
+        .collect();
+    let inner = area.width.saturating_sub(2) as usize;
+    let gap = usize::from(counts.len() * 2 <= inner);
+    let width = ((inner / counts.len().max(1)).saturating_sub(gap)).clamp(1, 3) as u16;
+    let chart = BarChart::default()
+        .block(block)
+        .data(BarGroup::default().bars(&bars))
+        .bar_width(width)
+        .bar_gap(gap as u16);
+    frame.render_widget(chart, area);
 }

@@ -3,19 +3,16 @@
 use ratatui::Frame;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Style, Stylize};
-use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::canvas::{Context, Points};
-use ratatui::widgets::{
-    Axis, Bar, BarChart, BarGroup, Block, Chart, Dataset, GraphType, Paragraph, Wrap,
-};
+use ratatui::widgets::{Block, Paragraph, Wrap};
 
-mod judges;
 mod overlay;
 mod platform;
 mod racing;
 
-use super::app::{App, GoalSetting, PolicyInfo, SidePane, SweepPoint};
+use super::app::pacing::aux_colour;
+use super::app::{App, GoalSetting, PolicyInfo, SidePane};
 use super::layout::{Areas, SLIDER_LEFT, SLIDER_RIGHT, fits};
 use crate::services::panel::Judge;
 use arlpcg_core::level::stats::Outcome;
@@ -93,9 +90,9 @@ pub fn render(app: &App, frame: &mut Frame) {
     }
     stats(app, frame, areas.stats);
     match app.panel {
-        SidePane::Failures => failures(app, frame, areas.panel),
-        SidePane::Sweep => sweep(app, frame, areas.panel),
-        SidePane::Judges => judges::judges(app, frame, areas.panel),
+        SidePane::Failures => super::app::trials::draw_failures(app, frame, areas.panel),
+        SidePane::Sweep => super::app::sweep::draw(app, frame, areas.panel),
+        SidePane::Judges => super::app::judges::draw(app, frame, areas.panel),
     }
     footer(app, frame, areas.footer);
     overlay::overlay(app, frame, screen);
@@ -129,7 +126,7 @@ fn budget_unit(role: Role, game: Game) -> &'static str {
 }
 
 /// What a piece of `game` is called.
-fn piece_name(game: Game, plural: bool) -> &'static str {
+pub(super) fn piece_name(game: Game, plural: bool) -> &'static str {
     arlpcg_core::game::facts::facts(game).piece_name(plural)
 }
 
@@ -182,22 +179,7 @@ fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
     let width = areas.slider.width as usize;
     let mut slider = match app.ask.curve() {
         // The curve from start to goal, taller where it is harder.
-        Some(curve) => {
-            let profile: String = (0..width)
-                .map(|i| {
-                    let aux = curve.at(i as f64 / width.saturating_sub(1).max(1) as f64);
-                    let level = ((1.0 - aux) / 2.0 * 7.0).round() as usize;
-                    ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'][level.min(7)]
-                })
-                .collect();
-            // Labels as wide as the slider's; the preset and its curve on the settings line.
-            Line::from(vec![
-                Span::raw(format!("{:<w$}", "start", w = SLIDER_LEFT.chars().count())),
-                Span::styled(profile, Style::new().fg(Color::Magenta)),
-                Span::raw(format!("{:>w$}", "goal", w = SLIDER_RIGHT.chars().count())),
-                Span::styled("  pacing", Style::new().bold()),
-            ])
-        }
+        Some(curve) => super::app::pacing::curve_line(curve, width),
         None => {
             let knob =
                 (((app.aux + 1.0) / 2.0) * (width.saturating_sub(1)) as f64).round() as usize;
@@ -405,14 +387,6 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
     );
 }
 
-/// The colour of λ: green at +1 (easy), yellow at 0, red at -1 (hard).
-fn aux_colour(aux: f64) -> Color {
-    let hard = ((1.0 - aux) / 2.0).clamp(0.0, 1.0);
-    let red = (255.0 * (2.0 * hard).min(1.0)) as u8;
-    let green = (255.0 * (2.0 * (1.0 - hard)).min(1.0)) as u8;
-    Color::Rgb(red, green, 40)
-}
-
 /// The colour of each of `pieces` pieces (blocks, segments): the selected one cyan; on a paced
 /// level each by the λ it was built at (kept pieces without one blue), else by its share of
 /// the failures so far.
@@ -459,97 +433,6 @@ fn source_line(level: &Level) -> String {
             format!("{pieces} pieces kept, the rest by the Generator")
         }
     }
-}
-
-fn failures(app: &App, frame: &mut Frame, area: Rect) {
-    let block = Block::bordered().title(format!(
-        " failures per {} (v: sweep) ",
-        piece_name(app.game, false)
-    ));
-    let (Some(level), Some(trials)) = (&app.level, &app.trials) else {
-        frame.render_widget(block, area);
-        return;
-    };
-    let counts = trials.failures_by_block(level.piece_count());
-    if counts.iter().all(|&c| c == 0) {
-        let text = if trials.done() == 0 {
-            "waiting for the first runs"
-        } else {
-            "no run has failed so far"
-        };
-        frame.render_widget(Paragraph::new(text).block(block), area);
-        return;
-    }
-    let piece_aux = |i: usize| level.pacing.as_ref()?.piece_aux.get(i).copied().flatten();
-    let bars: Vec<Bar> = counts
-        .iter()
-        .enumerate()
-        .map(|(i, &c)| {
-            let style = match piece_aux(i) {
-                _ if app.selected == Some(i) => Style::new().cyan(),
-                // Beside the map's colours: where the curve asked for it to be hard.
-                Some(aux) => Style::new().fg(aux_colour(aux)),
-                None => Style::new().red(),
-            };
-            Bar::default()
-                .value(c as u64)
-                .text_value(String::new())
-                .style(style)
-        })
-        .collect();
-    let inner = area.width.saturating_sub(2) as usize;
-    let gap = usize::from(counts.len() * 2 <= inner);
-    let width = ((inner / counts.len().max(1)).saturating_sub(gap)).clamp(1, 3) as u16;
-    let chart = BarChart::default()
-        .block(block)
-        .data(BarGroup::default().bars(&bars))
-        .bar_width(width)
-        .bar_gap(gap as u16);
-    frame.render_widget(chart, area);
-}
-
-fn sweep(app: &App, frame: &mut Frame, area: Rect) {
-    let Some(sweep) = &app.sweep else {
-        frame.render_widget(
-            Paragraph::new("press w to sweep λ for this seed and goal")
-                .wrap(Wrap { trim: true })
-                .block(Block::bordered().title(" λ sweep (v: panel) ")),
-            area,
-        );
-        return;
-    };
-    let points: Vec<(f64, f64)> = sweep
-        .points
-        .iter()
-        .filter_map(|(aux, p)| match p {
-            SweepPoint::Success(s) => Some((*aux, *s)),
-            _ => None,
-        })
-        .collect();
-    let pending = sweep
-        .points
-        .iter()
-        .filter(|(_, p)| *p == SweepPoint::Pending)
-        .count();
-    let title = if pending > 0 {
-        format!(" λ sweep, seed {} ({pending} to go) ", sweep.seed)
-    } else {
-        format!(" λ sweep, seed {} ", sweep.seed)
-    };
-    let dataset = Dataset::default()
-        .marker(Marker::Braille)
-        .graph_type(GraphType::Line)
-        .style(Style::new().cyan())
-        .data(&points);
-    let chart = Chart::new(vec![dataset])
-        .block(Block::bordered().title(title))
-        .x_axis(
-            Axis::default()
-                .bounds([-1.0, 1.0])
-                .labels(["-1", "0", "+1"]),
-        )
-        .y_axis(Axis::default().bounds([0.0, 1.0]).labels(["0", "0.5", "1"]));
-    frame.render_widget(chart, area);
 }
 
 fn footer(app: &App, frame: &mut Frame, area: Rect) {

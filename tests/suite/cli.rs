@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use crate::common::{arlpcg, fails_with, stderr};
+use crate::common::{arlpcg, arlpcg_ok, fails_with, stderr};
 
 fn generate(dir: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
@@ -67,7 +67,7 @@ fn generate_is_reproducible_byte_for_byte_and_files_load_back() {
 fn racing_tracks_are_reproducible_and_the_scripted_driver_clears_them() {
     let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
     for dir in [&a, &b] {
-        let out = arlpcg(&[
+        arlpcg_ok(&[
             "generate",
             "--game",
             "racing",
@@ -81,7 +81,6 @@ fn racing_tracks_are_reproducible_and_the_scripted_driver_clears_them() {
             "--out",
             dir.path().to_str().unwrap(),
         ]);
-        assert!(out.status.success(), "{}", stderr(&out));
     }
     let files = files_of(a.path());
     assert_eq!(files.len(), 40);
@@ -96,8 +95,7 @@ fn racing_tracks_are_reproducible_and_the_scripted_driver_clears_them() {
         .map(|(n, _)| a.path().join(n).display().to_string())
         .collect();
     args.extend(levels.iter().map(String::as_str));
-    let out = arlpcg(&args);
-    assert!(out.status.success(), "{}", stderr(&out));
+    let out = arlpcg_ok(&args);
     let ratios: Vec<f64> = String::from_utf8_lossy(&out.stdout)
         .lines()
         .map(|line| {
@@ -232,14 +230,13 @@ fn export_writes_glb_and_gltf_with_bin() {
     let exports = gltf_export_dir();
     for name in ["cli_export.glb", "cli_export.gltf"] {
         let target = exports.join(name);
-        let out = arlpcg(&[
+        arlpcg_ok(&[
             "export",
             level.to_str().unwrap(),
             "--out",
             target.to_str().unwrap(),
             "--force",
         ]);
-        assert!(out.status.success(), "{}", stderr(&out));
     }
     assert!(exports.join("cli_export.bin").exists());
     // The exported .glb equals the one generate wrote: one exporter.
@@ -272,7 +269,7 @@ fn verify_reports_json_with_the_documented_keys() {
             .success()
     );
     let level = dir.path().join("platform_seed2.yaml");
-    let out = arlpcg(&[
+    let out = arlpcg_ok(&[
         "verify",
         level.to_str().unwrap(),
         "--trials",
@@ -281,7 +278,6 @@ fn verify_reports_json_with_the_documented_keys() {
         "--solver",
         "scripted",
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
     let line = String::from_utf8(out.stdout).unwrap();
     let report: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
     for key in [
@@ -416,8 +412,7 @@ fn hand_broken_level_files_get_one_clear_line_and_a_non_zero_exit() {
         )
     };
     let good = dir_with_level(stats("1.0", "1.0").as_bytes());
-    let out = arlpcg(&["verify", good.1.to_str().unwrap(), "--solver", "scripted"]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    arlpcg_ok(&["verify", good.1.to_str().unwrap(), "--solver", "scripted"]);
     good.0.close().unwrap();
     assert_rejected(
         "ratio.yaml",
@@ -529,8 +524,7 @@ fn minus_zero_aux_is_zero() {
 
 #[test]
 fn running_without_a_command_prints_usage() {
-    let out = arlpcg(&[]);
-    assert!(out.status.success());
+    let out = arlpcg_ok(&[]);
     let text = String::from_utf8(out.stdout).unwrap();
     for word in ["generate", "export", "verify", "Examples"] {
         assert!(text.contains(word), "usage lacks {word}: {text}");
@@ -655,7 +649,7 @@ fn ctrl_c_in_a_batch_keeps_finished_levels_and_no_temporaries() {
     );
     for (name, _) in files.iter().filter(|(n, _)| n.ends_with(".yaml")) {
         let path = dir.path().join(name);
-        let check = arlpcg(&[
+        arlpcg_ok(&[
             "verify",
             path.to_str().unwrap(),
             "--solver",
@@ -663,7 +657,6 @@ fn ctrl_c_in_a_batch_keeps_finished_levels_and_no_temporaries() {
             "--trials",
             "1",
         ]);
-        assert!(check.status.success(), "{name}: {}", stderr(&check));
     }
 }
 
@@ -722,7 +715,7 @@ fn sharded_eval_merges_into_the_unsharded_results() {
     let out = merge(&["part0", "part2"], "short");
     fails_with(&out, 1, "shard 1/3 is missing");
     let other_dir = at("other");
-    let made = arlpcg(&[
+    arlpcg_ok(&[
         "eval",
         "--policies",
         "policies/platform",
@@ -737,7 +730,6 @@ fn sharded_eval_merges_into_the_unsharded_results() {
         "--out",
         &other_dir,
     ]);
-    assert!(made.status.success(), "{}", stderr(&made));
     let out = merge(&["part0", "other", "part2"], "mixed");
     fails_with(&out, 1, "their budget differ");
 }
@@ -747,7 +739,7 @@ fn sharded_eval_merges_into_the_unsharded_results() {
 #[test]
 fn verified_levels_are_completable_and_their_certificates_replay() {
     let dir = tempfile::tempdir().unwrap();
-    let out = arlpcg(&[
+    let out = arlpcg_ok(&[
         "generate",
         "--policies",
         "policies/platform",
@@ -762,7 +754,6 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
         "--out",
         dir.path().to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
     let said = String::from_utf8_lossy(&out.stdout);
     let mut levels = Vec::new();
     let mut redraws = 0;
@@ -780,8 +771,7 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
     assert!(said.contains("redrew"), "{said}");
     let mut args = vec!["verify", "--replay"];
     args.extend(levels.iter().map(String::as_str));
-    let out = arlpcg(&args);
-    assert!(out.status.success(), "{}", stderr(&out));
+    let out = arlpcg_ok(&args);
     let replayed = String::from_utf8_lossy(&out.stdout);
     assert_eq!(replayed.matches("succeeds again").count(), 12, "{replayed}");
     // A certificate recorded by another policy is refused by name.
@@ -805,7 +795,7 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
 #[test]
 fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band() {
     let dir = tempfile::tempdir().unwrap();
-    let out = arlpcg(&[
+    arlpcg_ok(&[
         "generate",
         "--policies",
         "policies/platform",
@@ -820,7 +810,6 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
         "--out",
         dir.path().to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
     let files = files_of(dir.path());
     assert_eq!(files.len(), 1);
     let (name, _) = &files[0];
@@ -839,7 +828,7 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
     );
     // Given the goal, the search keeps to it, and seed 1's goal rules 0.2 out (closest 0.31).
     let own = dir.path().join("own");
-    let out = arlpcg(&[
+    arlpcg_ok(&[
         "generate",
         "--policies",
         "policies/platform",
@@ -852,7 +841,6 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
         "--out",
         own.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
     let goal = arlpcg_core::level::yaml::load(&own.join("platform_seed1_aux-1.00.yaml"))
         .unwrap()
         .goal;
@@ -875,7 +863,7 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
 #[test]
 fn target_success_levels_measure_within_the_band() {
     let dir = tempfile::tempdir().unwrap();
-    let out = arlpcg(&[
+    let out = arlpcg_ok(&[
         "generate",
         "--policies",
         "policies/platform",
@@ -890,7 +878,6 @@ fn target_success_levels_measure_within_the_band() {
         "--out",
         dir.path().to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
     assert!(
         !stderr(&out).contains("measuring"),
         "the shipped policies' curve is current: {}",
@@ -950,7 +937,7 @@ fn generate_verifies_with_the_solver_policy_it_is_given() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let policies = root.join("policies/platform");
     let other = policies.join("solver-rule-pcg.safetensors");
-    let output = arlpcg(&[
+    arlpcg_ok(&[
         "generate",
         "--policies",
         policies.to_str().unwrap(),
@@ -965,7 +952,6 @@ fn generate_verifies_with_the_solver_policy_it_is_given() {
         "--out",
         out,
     ]);
-    assert!(output.status.success(), "{}", stderr(&output));
     let yaml = std::fs::read_to_string(dir.path().join("platform_seed0_aux+1.00.yaml")).unwrap();
     let stats = &yaml[yaml.find("stats:").expect("verified")..];
     assert!(stats.contains("solver-rule-pcg.safetensors"), "{stats}");

@@ -7,7 +7,7 @@ use arlpcg::services::onnx::{self, Exported, Profile, example_observations, refe
 use arlpcg_core::level::Game;
 use tract_onnx::prelude::*;
 
-use crate::common::{arlpcg, stderr};
+use crate::common::{arlpcg, arlpcg_ok, stderr};
 
 const ROWS: usize = 64;
 
@@ -169,8 +169,7 @@ fn export_policy_writes_the_graph_and_its_sidecar_once() {
         env!("CARGO_MANIFEST_DIR"),
         "/policies/racing/solver.safetensors"
     );
-    let first = arlpcg(&["export-policy", policy, "--out", out_arg]);
-    assert!(first.status.success(), "{}", stderr(&first));
+    arlpcg_ok(&["export-policy", policy, "--out", out_arg]);
     let bytes = std::fs::read(&out).unwrap();
     let sidecar: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("racing.onnx.json")).unwrap())
@@ -183,8 +182,7 @@ fn export_policy_writes_the_graph_and_its_sidecar_once() {
     let again = arlpcg(&["export-policy", policy, "--out", out_arg]);
     assert!(!again.status.success());
     assert!(stderr(&again).contains("racing.onnx"), "{}", stderr(&again));
-    let forced = arlpcg(&["export-policy", policy, "--out", out_arg, "--force"]);
-    assert!(forced.status.success(), "{}", stderr(&forced));
+    arlpcg_ok(&["export-policy", policy, "--out", out_arg, "--force"]);
     assert_eq!(std::fs::read(&out).unwrap(), bytes);
 
     // Not a policy, or not an .onnx name: a clear error, nothing written.

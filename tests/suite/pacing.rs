@@ -11,7 +11,7 @@ use arlpcg::services::verify::{HalfwaySplit, Solver, verify};
 use arlpcg_core::level::pacing::{AuxCurve, round_aux};
 use arlpcg_core::level::{Game, yaml};
 
-use crate::common::{arlpcg, stderr};
+use crate::common::{arlpcg, arlpcg_ok, stderr};
 
 const EASY_THEN_HARD: &str = "0:1, 0.5:1, 0.5001:-1, 1:-1";
 
@@ -185,7 +185,7 @@ fn a_kept_prefix_is_written_byte_for_byte_and_the_generator_builds_the_rest() {
         let policies = shipped(game);
         let policies = policies.to_str().unwrap();
         let first = dir.path().join(format!("{game}-first"));
-        let output = arlpcg(&[
+        arlpcg_ok(&[
             "generate",
             "--game",
             game.name(),
@@ -202,14 +202,13 @@ fn a_kept_prefix_is_written_byte_for_byte_and_the_generator_builds_the_rest() {
             "--out",
             first.to_str().unwrap(),
         ]);
-        assert!(output.status.success(), "{}", stderr(&output));
         let first_file = only_file(&first);
         let first_text = std::fs::read_to_string(&first_file).unwrap();
         let first_items = items(&first_text, key);
         let keep = first_items.len() / 2;
         assert!(keep >= 1, "{first_text}");
         let second = dir.path().join(format!("{game}-second"));
-        let output = arlpcg(&[
+        arlpcg_ok(&[
             "generate",
             "--game",
             game.name(),
@@ -227,7 +226,6 @@ fn a_kept_prefix_is_written_byte_for_byte_and_the_generator_builds_the_rest() {
             "--out",
             second.to_str().unwrap(),
         ]);
-        assert!(output.status.success(), "{game}: {}", stderr(&output));
         let second_file = only_file(&second);
         assert!(
             second_file
@@ -324,10 +322,9 @@ fn verify_draws_the_difficulty_along_one_level() {
     let chart_s = chart.to_str().unwrap();
     let policy = shipped(Game::Platform).join("solver.safetensors");
     let policy = policy.to_str().unwrap();
-    let output = arlpcg(&[
+    let output = arlpcg_ok(&[
         "verify", level, "--trials", "20", "--policy", policy, "--chart", chart_s,
     ]);
-    assert!(output.status.success(), "{}", stderr(&output));
     assert!(std::fs::read(&chart).unwrap().starts_with(b"\x89PNG"));
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(stdout.contains("runs past each block: "), "{stdout}");

@@ -4,7 +4,7 @@
 use arlpcg::services::verify::{Solver, verify};
 use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, Skill};
 
-use crate::common::{arlpcg, fails_with, stderr};
+use crate::common::{arlpcg, arlpcg_ok, fails_with};
 
 /// Mean success of each skill, weakest first, on `levels` rule levels of `G`, `trials` runs each.
 fn skill_success<G: GameSpec>(levels: u64, trials: u32) -> Vec<f64> {
@@ -59,8 +59,7 @@ fn verify_panel_reports_every_judge_and_rates_the_levels_together() {
     ];
     let mut args = vec!["verify", "--panel", "--trials", "12", "--json"];
     args.extend(levels);
-    let out = arlpcg(&args);
-    assert!(out.status.success(), "{}", stderr(&out));
+    let out = arlpcg_ok(&args);
     let rows: Vec<serde_json::Value> = String::from_utf8(out.stdout)
         .unwrap()
         .lines()
@@ -89,7 +88,7 @@ fn verify_panel_reports_every_judge_and_rates_the_levels_together() {
         "the λ = 1 level rates easier than the λ = -1 one"
     );
 
-    let some = arlpcg(&[
+    let some = arlpcg_ok(&[
         "verify",
         levels[0],
         "--panel",
@@ -98,7 +97,6 @@ fn verify_panel_reports_every_judge_and_rates_the_levels_together() {
         "4",
         "--json",
     ]);
-    assert!(some.status.success(), "{}", stderr(&some));
     let row: serde_json::Value = serde_json::from_slice(&some.stdout).unwrap();
     let names: Vec<&String> = row["panel"].as_object().unwrap().keys().collect();
     assert_eq!(names, ["arlpcg", "scripted-median"]);
@@ -111,7 +109,7 @@ fn verify_panel_reports_every_judge_and_rates_the_levels_together() {
 fn generate_records_the_panel_and_the_rating_and_verifies_with_a_judge() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("rated");
-    let out = arlpcg(&[
+    arlpcg_ok(&[
         "generate",
         "--game",
         "platform",
@@ -132,7 +130,6 @@ fn generate_records_the_panel_and_the_rating_and_verifies_with_a_judge() {
         "--out",
         out_dir.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", stderr(&out));
     let path = out_dir.join("platform_seed100_aux-1.00.yaml");
     let level = arlpcg_core::level::yaml::load(&path).unwrap();
     let stats = level.stats.unwrap();

@@ -105,7 +105,7 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
     wrong_resumes_are_refused(out_s);
 
     let target = state.global_step + 3 * 128;
-    let resumed = arlpcg(&[
+    arlpcg_ok(&[
         "train",
         "--mode",
         "fixed-track",
@@ -117,7 +117,6 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
         "--threads",
         "2",
     ]);
-    assert!(resumed.status.success(), "{}", stderr(&resumed));
     assert!(!lock.exists(), "a finished session removes its lock");
     let after = curve(&out);
     // The rows up to the checkpoint are kept, later ones (written after it) dropped and redone.
@@ -1235,10 +1234,9 @@ fn a_resumed_run_takes_new_hyper_parameters_but_not_a_new_shape() {
             "--resume",
         ])
     };
-    let first = arlpcg(&[
+    arlpcg_ok(&[
         "train", "--mode", "rule-pcg", "--steps", "128", "--config", config_s, "--out", out_s,
     ]);
-    assert!(first.status.success(), "{}", stderr(&first));
 
     let reshaped = dir.path().join("reshaped.yaml");
     std::fs::write(
@@ -1271,7 +1269,7 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
     std::fs::write(&config, TINY).unwrap();
     let out = dir.path().join("run");
     let out_s = out.to_str().unwrap();
-    let trained = arlpcg(&[
+    arlpcg_ok(&[
         "train",
         "--game",
         "racing",
@@ -1284,10 +1282,8 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
         "--out",
         out_s,
     ]);
-    assert!(trained.status.success(), "{}", stderr(&trained));
     // A resume takes the game and mode from the run.
-    let resumed = arlpcg(&["train", "--steps", "512", "--out", out_s, "--resume"]);
-    assert!(resumed.status.success(), "{}", stderr(&resumed));
+    arlpcg_ok(&["train", "--steps", "512", "--out", out_s, "--resume"]);
     assert_eq!(curve(&out).last().map(|r| r.1), Some(512));
     let stored = std::fs::read_to_string(out.join("config.yaml")).unwrap();
     assert!(stored.contains("gamma: 0.998"), "{stored}");
@@ -1304,7 +1300,7 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
     assert!(load_policy(&bytes, Game::Platform, Role::Solver, OBSERVATION_SIZE).is_err());
 
     let tracks = dir.path().join("tracks");
-    let made = arlpcg(&[
+    arlpcg_ok(&[
         "generate",
         "--game",
         "racing",
@@ -1312,9 +1308,8 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
         "--out",
         tracks.to_str().unwrap(),
     ]);
-    assert!(made.status.success());
     let policy = out.join("solver.safetensors");
-    let played = arlpcg(&[
+    let played = arlpcg_ok(&[
         "verify",
         tracks.join("racing_seed0.yaml").to_str().unwrap(),
         "--policy",
@@ -1323,7 +1318,6 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
         "4",
         "--json",
     ]);
-    assert!(played.status.success(), "{}", stderr(&played));
     let report: serde_json::Value = serde_json::from_slice(&played.stdout).unwrap();
     assert_eq!(report["trials"], 4);
     let refused = arlpcg(&[
@@ -1357,8 +1351,7 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
         } else {
             args.extend(["--config", config.to_str().unwrap()]);
         }
-        let run = arlpcg(&args);
-        assert!(run.status.success(), "{}", stderr(&run));
+        arlpcg_ok(&args);
     };
     train("512", false);
     let generator_before = generator_rows(&out);
@@ -1446,7 +1439,7 @@ fn generate_racing_tracks_with_a_run(dir: &Path, run: &str) {
     let (_, heading, _, _) = arlpcg_core::game::racing::rules::goal_and_start(2, None, 0);
     let [x, z] = arlpcg_core::level::heading::heading_direction(heading);
     let goal = format!("{},0,{}", 50.0 * x, 50.0 * z);
-    let generated = arlpcg(&[
+    arlpcg_ok(&[
         "generate",
         "--game",
         "racing",
@@ -1466,7 +1459,6 @@ fn generate_racing_tracks_with_a_run(dir: &Path, run: &str) {
         "--out",
         tracks.to_str().unwrap(),
     ]);
-    assert!(generated.status.success(), "{}", stderr(&generated));
     let level = arlpcg_core::level::yaml::load(&tracks.join("racing_seed2_aux-1.00.yaml")).unwrap();
     assert!(matches!(
         level.source,
@@ -1479,7 +1471,7 @@ fn generate_racing_tracks_with_a_run(dir: &Path, run: &str) {
 /// `eval` of a racing run: the racing columns and the paper's racing figures.
 fn evaluate_a_racing_run(dir: &Path, run: &str) {
     let results = dir.join("results");
-    let evaluated = arlpcg(&[
+    arlpcg_ok(&[
         "eval",
         "--game",
         "racing",
@@ -1494,7 +1486,6 @@ fn evaluate_a_racing_run(dir: &Path, run: &str) {
         "--out",
         results.to_str().unwrap(),
     ]);
-    assert!(evaluated.status.success(), "{}", stderr(&evaluated));
     let json: serde_json::Value = crate::common::results_json(&results);
     let rows = json["controllability"].as_array().unwrap();
     assert_eq!(rows.len(), 5);
@@ -1545,7 +1536,7 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
     std::fs::write(&config, TINY).unwrap();
     let out = dir.path().join("run");
     let out_s = out.to_str().unwrap();
-    let trained = arlpcg(&[
+    arlpcg_ok(&[
         "train",
         "--mode",
         "fixed-track",
@@ -1556,7 +1547,6 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
         "--out",
         out_s,
     ]);
-    assert!(trained.status.success(), "{}", stderr(&trained));
     let checkpoint = out.join("checkpoint.safetensors");
     let cases: [(&str, serde_json::Value, &str); 2] = [
         ("num_envs", serde_json::json!(100_000_000), "num_envs"),

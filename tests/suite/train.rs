@@ -2,7 +2,7 @@
 //! curve continues (no restart, no gap, no repeat); runs refuse to clobber each other; the
 //! trained policy loads with its card.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -39,12 +39,19 @@ fn curve(dir: &Path) -> Vec<(u64, u64)> {
         .collect()
 }
 
+/// A scratch folder holding the training configuration `config` (`tiny.yaml`), the folder
+/// itself, and the path of a run folder in it (`run`, not made yet).
+fn scratch(config: &str) -> (tempfile::TempDir, PathBuf, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("tiny.yaml");
+    std::fs::write(&path, config).unwrap();
+    let out = dir.path().join("run");
+    (dir, path, out)
+}
+
 #[test]
 fn a_killed_run_resumes_where_its_checkpoint_stopped() {
-    let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("tiny.yaml");
-    std::fs::write(&config, TINY).unwrap();
-    let out = dir.path().join("run");
+    let (_dir, config, out) = scratch(TINY);
     let out_s = out.to_str().unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
         .args([
@@ -515,10 +522,7 @@ fn generator_rows(dir: &Path) -> usize {
 
 #[test]
 fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels() {
-    let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("tiny.yaml");
-    std::fs::write(&config, TINY_ADVERSARIAL).unwrap();
-    let out = dir.path().join("run");
+    let (dir, config, out) = scratch(TINY_ADVERSARIAL);
     let out_s = out.to_str().unwrap();
     let config_s = config.to_str().unwrap();
     arlpcg_ok(&[
@@ -1223,10 +1227,7 @@ fn score_a_run_as_one_seed(dir: &Path, run: &str) {
 /// fields that fix the networks, the matches or the seed stream.
 #[test]
 fn a_resumed_run_takes_new_hyper_parameters_but_not_a_new_shape() {
-    let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("tiny.yaml");
-    std::fs::write(&config, TINY).unwrap();
-    let out = dir.path().join("run");
+    let (dir, config, out) = scratch(TINY);
     let (config_s, out_s) = (config.to_str().unwrap(), out.to_str().unwrap());
     let train = |steps: &str, config: &str| {
         arlpcg(&[
@@ -1264,10 +1265,7 @@ fn a_resumed_run_takes_new_hyper_parameters_but_not_a_new_shape() {
 /// on racing tracks and refuses it on a platform level.
 #[test]
 fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
-    let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("tiny.yaml");
-    std::fs::write(&config, TINY).unwrap();
-    let out = dir.path().join("run");
+    let (dir, config, out) = scratch(TINY);
     let out_s = out.to_str().unwrap();
     arlpcg_ok(&[
         "train",
@@ -1337,10 +1335,7 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
 /// writes the racing tables with air time and segment statistics.
 #[test]
 fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
-    let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("tiny.yaml");
-    std::fs::write(&config, TINY_ADVERSARIAL).unwrap();
-    let out = dir.path().join("run");
+    let (dir, config, out) = scratch(TINY_ADVERSARIAL);
     let out_s = out.to_str().unwrap();
     let train = |steps: &str, resume: bool| {
         let mut args = vec![
@@ -1531,10 +1526,7 @@ fn tamper_training_state(path: &Path, change: impl Fn(&mut serde_json::Value)) {
 
 #[test]
 fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume() {
-    let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("tiny.yaml");
-    std::fs::write(&config, TINY).unwrap();
-    let out = dir.path().join("run");
+    let (_dir, config, out) = scratch(TINY);
     let out_s = out.to_str().unwrap();
     arlpcg_ok(&[
         "train",

@@ -171,6 +171,17 @@ impl ActorCritic {
         &self.shape
     }
 
+    /// The first trainable tensor's values (tests compare networks by it).
+    #[cfg(test)]
+    pub(crate) fn first_weights(&self) -> Vec<f32> {
+        self.named_vars()[0]
+            .1
+            .as_tensor()
+            .flatten_all()
+            .and_then(|t| t.to_vec1::<f32>())
+            .expect("a tensor of f32")
+    }
+
     /// Every trainable tensor with a stable name (for saving, loading and the optimizer).
     pub fn named_vars(&self) -> Vec<(String, Var)> {
         let mut vars = Vec::new();
@@ -461,16 +472,7 @@ mod tests {
         let a = ActorCritic::new(shape(), 9).unwrap();
         let b = ActorCritic::new(shape(), 9).unwrap();
         let c = ActorCritic::new(shape(), 10).unwrap();
-        let first = |p: &ActorCritic| {
-            p.named_vars()[0]
-                .1
-                .as_tensor()
-                .flatten_all()
-                .unwrap()
-                .to_vec1::<f32>()
-                .unwrap()
-        };
-        assert_eq!(first(&a), first(&b));
-        assert_ne!(first(&a), first(&c));
+        assert_eq!(a.first_weights(), b.first_weights());
+        assert_ne!(a.first_weights(), c.first_weights());
     }
 }

@@ -133,7 +133,7 @@ fn ppo_balances_cartpole() {
     let iterations = 120; // 122,880 steps
     let mut best = 0.0f32;
     for i in 0..iterations {
-        let (batch, _) = trainer.collect().unwrap();
+        let (batch, _, _) = trainer.collect(&|| 0.0).unwrap();
         let lr = config.learning_rate * (1.0 - i as f64 / iterations as f64);
         trainer.learn(&batch, lr).unwrap();
         if i >= 40 && i % 10 == 9 {
@@ -220,7 +220,7 @@ fn ppo_learns_a_continuous_task_to_its_known_optimum() {
     let mut trainer = Trainer::new(ppo, envs, 2);
     let iterations = 150;
     for i in 0..iterations {
-        let (batch, _) = trainer.collect().unwrap();
+        let (batch, _, _) = trainer.collect(&|| 0.0).unwrap();
         trainer
             .learn(
                 &batch,

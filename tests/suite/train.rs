@@ -24,6 +24,39 @@ ppo:
   num_minibatches: 2
 ";
 
+/// The columns the clock writes into a metrics file (two runs of the same bytes differ there):
+/// wall time, steps/s, rollout and update seconds, and the time split.
+const CLOCK_COLUMNS: [&str; 11] = [
+    "wall_time_s",
+    "steps_per_s",
+    "rollout_s",
+    "update_s",
+    "env_s",
+    "forward_s",
+    "generator_s",
+    "gae_s",
+    "copies_s",
+    "iteration_s",
+    "update_mfu",
+];
+
+/// The rows of a metrics file (header included) without the clock's columns; none without
+/// the file.
+fn without_clock(path: &Path) -> Option<Vec<String>> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next()?.split(',').collect();
+    let kept: Vec<usize> = (0..header.len())
+        .filter(|&k| !CLOCK_COLUMNS.contains(&header[k]))
+        .collect();
+    let pick = |cells: Vec<&str>| kept.iter().map(|&k| cells[k]).collect::<Vec<_>>().join(",");
+    Some(
+        std::iter::once(pick(header.clone()))
+            .chain(lines.map(|row| pick(row.split(',').collect())))
+            .collect(),
+    )
+}
+
 /// (iteration, global_step) of every metrics row.
 fn curve(dir: &Path) -> Vec<(u64, u64)> {
     let text = std::fs::read_to_string(dir.join("metrics.csv")).unwrap();
@@ -625,22 +658,9 @@ fn assert_same_training(one: &Path, two: &Path, networks: &[(&str, Role, usize)]
         };
         assert_eq!(weights(one), weights(two), "{}", network.0);
     }
-    // Metrics without the clock's columns (wall time, steps/s, rollout and update seconds).
-    for (file, clock) in [("metrics.csv", 2..6), ("generator-metrics.csv", 3..6)] {
-        let rows = |run: &Path| -> Option<Vec<String>> {
-            let text = std::fs::read_to_string(run.join(file)).ok()?;
-            let rows = text.lines().map(|row| {
-                let cells: Vec<&str> = row.split(',').collect();
-                let kept: Vec<&str> = cells
-                    .iter()
-                    .enumerate()
-                    .filter(|(k, _)| !clock.contains(k))
-                    .map(|(_, c)| *c)
-                    .collect();
-                kept.join(",")
-            });
-            Some(rows.collect())
-        };
+    // Metrics without the clock's columns.
+    for file in ["metrics.csv", "generator-metrics.csv"] {
+        let rows = |run: &Path| without_clock(&run.join(file));
         assert_eq!(rows(one), rows(two), "{file}");
     }
 }
@@ -747,14 +767,21 @@ fn kill_after_generator_rows(args: &[String], out: &Path, rows: usize) {
 
 /// (solver_step, the columns that do not tell time, entropy) of each Generator metrics row.
 fn generator_metrics(run: &Path) -> Vec<(u64, String, f64)> {
-    std::fs::read_to_string(run.join("generator-metrics.csv"))
-        .unwrap()
-        .lines()
+    let path = run.join("generator-metrics.csv");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let entropy = header.iter().position(|c| *c == "entropy").unwrap();
+    let kept = without_clock(&path).unwrap();
+    text.lines()
+        .zip(kept)
         .skip(1)
-        .map(|row| {
+        .map(|(row, kept)| {
             let cells: Vec<&str> = row.split(',').collect();
-            let kept = [&cells[..3], &cells[6..]].concat().join(",");
-            (cells[1].parse().unwrap(), kept, cells[20].parse().unwrap())
+            (
+                cells[1].parse().unwrap(),
+                kept,
+                cells[entropy].parse().unwrap(),
+            )
         })
         .collect()
 }
@@ -956,22 +983,18 @@ fn a_finish_with_a_scripted_opponent_changes_the_finish_alone_and_resumes_to_the
         plain_finish, in_finish,
         "the scripted player changes the finish"
     );
-    // Its success is in the last two columns (λ > 0, λ < 0): NaN where it played no match.
+    // Its success on matches at λ > 0 and λ < 0: NaN where it played no match.
     let opponent_success = |run: &Path| -> Vec<(u64, [f64; 2])> {
         let text = std::fs::read_to_string(run.join("generator-metrics.csv")).unwrap();
         let mut lines = text.lines();
-        assert!(
-            lines
-                .next()
-                .unwrap()
-                .ends_with(",scripted_success_easy,scripted_success_hard")
-        );
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let at = |name: &str| header.iter().position(|c| *c == name).unwrap();
+        let (easy, hard) = (at("scripted_success_easy"), at("scripted_success_hard"));
         lines
             .map(|row| {
                 let cells: Vec<&str> = row.split(',').collect();
-                let n = cells.len();
                 let cell = |k: usize| cells[k].parse::<f64>().unwrap();
-                (cells[1].parse().unwrap(), [cell(n - 2), cell(n - 1)])
+                (cells[1].parse().unwrap(), [cell(easy), cell(hard)])
             })
             .collect()
     };
@@ -1571,6 +1594,77 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
             std::fs::read(&checkpoint).unwrap(),
             tampered,
             "{field}: left as it was"
+        );
+    }
+}
+
+/// Where training time goes: every metrics row of both agents splits its iteration into
+/// buckets (env, forward, generator, gae, update, copies) that add up to the iteration's
+/// measured time within 5% over the run, none negative; the cards carry the run's split and
+/// the update's MFU, and `train` says both when it ends.
+#[test]
+fn the_time_buckets_add_up_to_each_iteration_and_reach_the_cards() {
+    let (_dir, config, out) = scratch(TINY_ADVERSARIAL);
+    let trained = arlpcg_ok(&[
+        "train",
+        "--mode",
+        "arlpcg",
+        "--steps",
+        "512",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&trained.stdout);
+    assert!(
+        said.contains("time, all sessions: env ") && said.contains("GFLOP/s matmul peak"),
+        "{said}"
+    );
+    let buckets = [
+        "env_s",
+        "forward_s",
+        "generator_s",
+        "gae_s",
+        "update_s",
+        "copies_s",
+    ];
+    let mut run_total = 0.0;
+    for file in ["metrics.csv", "generator-metrics.csv"] {
+        let text = std::fs::read_to_string(out.join(file)).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let at = |name: &str| header.iter().position(|c| *c == name).unwrap();
+        let (mut split, mut measured) = (0.0, 0.0);
+        for row in lines {
+            let cells: Vec<f64> = row.split(',').map(|c| c.parse().unwrap()).collect();
+            for bucket in buckets {
+                assert!(cells[at(bucket)] >= 0.0, "{file}: {bucket} < 0 in {row}");
+            }
+            split += buckets.iter().map(|b| cells[at(b)]).sum::<f64>();
+            measured += cells[at("iteration_s")];
+            assert!((0.0..=1.5).contains(&cells[at("update_mfu")]), "{row}");
+        }
+        assert!(measured > 0.0, "{file}");
+        assert!(
+            (split - measured).abs() <= 0.05 * measured,
+            "{file}: buckets {split:.6} s, iterations {measured:.6} s"
+        );
+        run_total += measured;
+    }
+    for card in ["solver.yaml", "generator.yaml"] {
+        let text = std::fs::read_to_string(out.join(card)).unwrap();
+        let card: serde_yaml::Value = serde_yaml::from_str(&text).unwrap();
+        let split = &card["training"]["time_split"];
+        let total: f64 = buckets.iter().map(|b| split[*b].as_f64().unwrap()).sum();
+        // The card's seconds are rounded to tenths.
+        assert!(
+            (total - run_total).abs() <= 0.05 * run_total + 0.35,
+            "{card:?}"
+        );
+        assert!(
+            card["training"]["update_mfu"].as_f64().unwrap() > 0.0,
+            "{text}"
         );
     }
 }

@@ -10,8 +10,8 @@ use super::cards::{
 };
 use super::config::TrainConfig;
 use super::metrics::{
-    generator_metrics_header, generator_row, open_append, scripted_columns, truncate_metrics,
-    update_columns,
+    generator_metrics_header, generator_row, open_append, scripted_columns, time_columns,
+    truncate_metrics, update_columns,
 };
 use super::population::{PopulationRecord, Snapshot, population_from, population_record};
 use super::solver_run::SolverRun;
@@ -25,6 +25,7 @@ use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingState};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::ActorCritic;
 use arlpcg_core::rl::ppo::Ppo;
+use arlpcg_core::rl::timing::{TimeSplit, update_flops_per_sample};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -176,6 +177,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         );
         card.training.population = envs.population.iter().map(|s| s.solver_steps).collect();
         record_commands(&mut card, &self.solver.commands, &self.solver.commit);
+        self.solver.record_time(&mut card);
         card
     }
 
@@ -214,13 +216,16 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             config.learning_rate
         };
         let t0 = wall();
+        let mut time = TimeSplit::default();
         self.envs().take_stats();
         while self.envs().completed_decisions() < config.batch_size() {
-            self.solver.trainer.play_tick()?;
+            time.add(&self.solver.trainer.play_tick(wall)?);
         }
+        let before_batch = wall();
         let batch = self.envs().take_generator_batch();
         let stats = self.envs().take_stats();
         let t1 = wall();
+        time.copies_s += t1 - before_batch;
         let envs = self.envs();
         envs.generator.ppo.config.ent_coef = entropy.unwrap_or(config.ent_coef);
         let update = envs
@@ -228,14 +233,21 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             .ppo
             .update(&batch, learning_rate, &mut envs.rng)?;
         let t2 = wall();
+        time.update_s = t2 - t1;
+        time.update_flops = f64::from(update.gradient_steps)
+            * config.minibatch_size() as f64
+            * update_flops_per_sample(envs.generator.ppo.policy.shape());
         let decisions = batch.log_probs.len() as u64;
         envs.state.generator_steps += decisions;
         envs.state.phase_steps += decisions;
         self.generator_iteration += 1;
         let row = generator_row(&stats);
+        time.copies_s += wall() - t2;
+        let iteration_s = wall() - t0;
+        self.solver.time.add(&time);
         writeln!(
             self.generator_metrics,
-            "{},{},{},{:.2},{:.3},{:.3},{:.3e},{row},{},{}",
+            "{},{},{},{:.2},{:.6},{:.6},{:.3e},{row},{},{},{},{iteration_s:.6},{:.3}",
             self.generator_iteration,
             self.solver.trainer.global_step,
             self.solver.trainer.env.state.generator_steps,
@@ -244,7 +256,9 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             t2 - t1,
             learning_rate,
             update_columns(&update),
-            scripted_columns(&stats)
+            scripted_columns(&stats),
+            time_columns(&time),
+            time.update_mfu(self.solver.matmul_peak),
         )?;
         let ratio = |a: u32, b: u32| a as f64 / b.max(1) as f64;
         let mut message = format!(
@@ -287,6 +301,17 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
     fn add_session(&mut self, command: String, commit: String) {
         self.solver.commands.push(command);
         self.solver.commit = commit;
+    }
+
+    fn set_matmul_peak(&mut self, flops: f64) {
+        self.solver.matmul_peak = flops;
+    }
+
+    fn time_split(&self) -> (TimeSplit, f64) {
+        (
+            self.solver.time,
+            self.solver.time.update_mfu(self.solver.matmul_peak),
+        )
     }
 
     fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
@@ -332,8 +357,10 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                     self.envs().set_phase(Phase::Generator);
                 }
                 Ok(format!(
-                    "solver: return {:.2}, success {:.2}",
-                    rollout.mean_return, rollout.success_ratio
+                    "solver: return {:.2}, success {:.2}, {}",
+                    rollout.mean_return,
+                    rollout.success_ratio,
+                    self.solver.time.largest_two()
                 ))
             }
             Phase::Generator => {
@@ -350,7 +377,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                 if hard_enough || envs.state.phase_steps >= schedule.generator_phase_steps {
                     envs.set_phase(Phase::Solver);
                 }
-                Ok(message)
+                Ok(format!("{message}, {}", self.solver.time.largest_two()))
             }
         }
     }
@@ -371,6 +398,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
             source: serde_json::to_value(population)?,
             config: serde_json::to_value(&self.solver.config)?,
             episode_returns: Vec::new(),
+            time_split: self.solver.time,
         };
         let card = self.generator_card(wall);
         let bytes = checkpoint::checkpoint_bytes(&envs.generator.ppo, &card, &state, tensors);

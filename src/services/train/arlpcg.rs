@@ -35,6 +35,7 @@ use arlpcg_core::level::stats::{Outcome, Skill};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::ActMode;
 use arlpcg_core::rl::ppo::{Batch, Ppo, gae};
+use arlpcg_core::rl::timing::{Clock, InnerTime};
 use arlpcg_core::rl::vec_env::{Transition, VecEnv};
 use arlpcg_core::seed_ranges::TRAINING_SEED_BASE;
 
@@ -522,9 +523,15 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
     }
 
     fn step(&mut self, actions: &[f32], out: &mut [Transition]) {
+        self.step_timed(actions, out, &|| 0.0);
+    }
+
+    fn step_timed(&mut self, actions: &[f32], out: &mut [Transition], clock: Clock) -> InnerTime {
+        let start = clock();
         let replaced = self
             .with_opponents(actions)
             .expect("the snapshots' forward pass runs on the CPU");
+        let opponents_done = clock();
         let actions = replaced.as_deref().unwrap_or(actions);
         let width = actions.len() / self.matches.len();
         let rewards = &self.rules.rewards;
@@ -568,6 +575,7 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
             }
         }
         // A failed placement ends the match: the Solver's run is cut, not failed.
+        let generator_start = clock();
         let invalid = self
             .place_while_needed(turns)
             .expect("the Generator's forward pass runs on the CPU");
@@ -585,5 +593,9 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
         }
         self.first_pieces(restarted)
             .expect("the Generator's forward pass runs on the CPU");
+        InnerTime {
+            forward_s: opponents_done - start,
+            generator_s: clock() - generator_start,
+        }
     }
 }

@@ -164,6 +164,8 @@ pub(super) fn card(
             command: String::new(),
             resumed_with: Vec::new(),
             population: Vec::new(),
+            time_split: None,
+            update_mfu: None,
         },
         results: Default::default(),
         max_pieces: (role == Role::Generator).then_some(config.generator.max_pieces),

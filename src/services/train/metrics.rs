@@ -10,6 +10,7 @@ use crate::services::fsio::Overwrite;
 use anyhow::{Context, Result};
 use arlpcg_core::game::generator::GeneratorGame;
 use arlpcg_core::rl::ppo::UpdateStats;
+use arlpcg_core::rl::timing::TimeSplit;
 
 /// Column `name` of a metrics CSV as (x column, value) pairs, smoothed over `window` rows.
 pub(super) fn metric_series(text: &str, x: &str, name: &str, window: usize) -> Vec<(f64, f64)> {
@@ -132,7 +133,7 @@ pub(super) fn scripted_columns(s: &MatchStats) -> String {
 pub(super) fn generator_metrics_header<G: GeneratorGame>() -> String {
     let [a, b] = G::PIECE_FEATURES;
     format!(
-        "iteration,solver_step,generator_step,wall_time_s,rollout_s,update_s,learning_rate,episodes,mean_return,invalid_ratio,success_easy,success_hard,{a}_easy,{a}_hard,{b}_easy,{b}_hard,air_steps_easy,air_steps_hard,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance,scripted_success_easy,scripted_success_hard"
+        "iteration,solver_step,generator_step,wall_time_s,rollout_s,update_s,learning_rate,episodes,mean_return,invalid_ratio,success_easy,success_hard,{a}_easy,{a}_hard,{b}_easy,{b}_hard,air_steps_easy,air_steps_hard,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance,scripted_success_easy,scripted_success_hard,env_s,forward_s,generator_s,gae_s,copies_s,iteration_s,update_mfu"
     )
 }
 
@@ -140,6 +141,16 @@ pub(super) fn generator_metrics_header<G: GeneratorGame>() -> String {
 fn read_text(path: &Path) -> Option<String> {
     crate::services::fsio::check_regular(path, "metrics file").ok()?;
     std::fs::read_to_string(path).ok()
+}
+
+/// The columns of a metrics row that say where its time went: seconds per bucket.
+pub(super) fn time_columns(time: &TimeSplit) -> String {
+    time.buckets()
+        .iter()
+        .filter(|(name, _)| *name != "update")
+        .map(|(_, s)| format!("{s:.6}"))
+        .collect::<Vec<_>>()
+        .join(",")
 }
 
 /// Drops metric rows written after the checkpoint a run resumes from, so the curve continues

@@ -50,7 +50,7 @@ pub const METRICS: &str = "metrics.csv";
 /// ([`SourceRecord`], [`AdversarialRecord`]).
 pub(super) const UNDER_WAY: &str = "under_way";
 pub(super) const GENERATOR_METRICS: &str = "generator-metrics.csv";
-pub(super) const METRICS_HEADER: &str = "iteration,global_step,wall_time_s,steps_per_s,rollout_s,update_s,learning_rate,episodes,mean_return,success_ratio,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance";
+pub(super) const METRICS_HEADER: &str = "iteration,global_step,wall_time_s,steps_per_s,rollout_s,update_s,learning_rate,episodes,mean_return,success_ratio,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance,env_s,forward_s,generator_s,gae_s,copies_s,iteration_s,update_mfu";
 
 /// The run in `out`: started afresh with `config` (the game's defaults when `None`; `seed` and
 /// `steps`, if given, replace its seed and budget), or with `resume` continued from its
@@ -237,6 +237,11 @@ pub trait Training {
     /// that changed it, `-dirty` for changes since) in the run's cards; the shell names both,
     /// the core reads no process arguments and runs no git.
     fn add_session(&mut self, command: String, commit: String);
+    /// This session's matrix-product peak in FLOP/s, which the update's MFU is read against
+    /// (the shell measures it: [`arlpcg_core::rl::fused::matmul_peak_flops`]).
+    fn set_matmul_peak(&mut self, flops: f64);
+    /// Where the run's time went so far, over every session, and the update's MFU.
+    fn time_split(&self) -> (arlpcg_core::rl::timing::TimeSplit, f64);
     /// One PPO iteration (of whichever agent learns now); returns the progress bar's message.
     /// `wall` is the clock the shell lends: the run's wall-clock seconds over every session,
     /// for the metrics' time columns.

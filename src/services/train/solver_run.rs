@@ -9,7 +9,7 @@ use super::cards::{
     card, read_checkpoint, record_commands, recorded_commands, save_policy_files, solver_shape,
 };
 use super::config::{TrainConfig, check_config, check_resumable_change};
-use super::metrics::{open_append, truncate_metrics, update_columns};
+use super::metrics::{open_append, time_columns, truncate_metrics, update_columns};
 use super::solver_envs::SolverEnvs;
 use super::{CHECKPOINT, ConfigChange, METRICS, METRICS_HEADER, Training, UNDER_WAY};
 use crate::services::fsio;
@@ -23,6 +23,7 @@ use arlpcg_core::rl::checkpoint;
 use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingState};
 use arlpcg_core::rl::policy::ActorCritic;
 use arlpcg_core::rl::ppo::Ppo;
+use arlpcg_core::rl::timing::{TimeSplit, update_flops_per_sample};
 use arlpcg_core::rl::vec_env::{RolloutStats, Trainer, VecEnv};
 
 /// Environments whose progress is saved in checkpoints.
@@ -60,6 +61,10 @@ pub(super) struct SolverRun<E: Resumable> {
     pub(super) commands: Vec<String>,
     /// The commit of this session's code ([`Training::add_session`]).
     pub(super) commit: String,
+    /// Where the run's time went, over every session (both agents' iterations).
+    pub(super) time: TimeSplit,
+    /// This session's matrix-product peak in FLOP/s ([`Training::set_matmul_peak`]; 0: none).
+    pub(super) matmul_peak: f64,
 }
 
 impl<E: Resumable> SolverRun<E> {
@@ -94,6 +99,8 @@ impl<E: Resumable> SolverRun<E> {
             wall_before: 0.0,
             commands: Vec::new(),
             commit: String::new(),
+            time: TimeSplit::default(),
+            matmul_peak: 0.0,
         })
     }
 
@@ -175,6 +182,8 @@ impl<E: Resumable> SolverRun<E> {
             wall_before: state.wall_time_s,
             commands: recorded_commands(&loaded.card),
             commit: loaded.card.training.commit.clone(),
+            time: state.time_split,
+            matmul_peak: 0.0,
         })
     }
 
@@ -193,6 +202,7 @@ impl<E: Resumable> SolverRun<E> {
             source: self.trainer.env.source_state(),
             config: serde_json::to_value(&self.config)?,
             episode_returns: self.trainer.episode_returns.clone(),
+            time_split: self.time,
         };
         let card = self.solver_card(wall_time_s);
         Ok(checkpoint::checkpoint_bytes(
@@ -214,7 +224,15 @@ impl<E: Resumable> SolverRun<E> {
             wall_time_s,
         );
         record_commands(&mut card, &self.commands, &self.commit);
+        self.record_time(&mut card);
         card
+    }
+
+    /// The run's time split and the update's MFU, into `card`.
+    pub(super) fn record_time(&self, card: &mut PolicyCard) {
+        card.training.time_split = Some(self.time.rounded());
+        card.training.update_mfu = (self.matmul_peak > 0.0)
+            .then(|| (self.time.update_mfu(self.matmul_peak) * 1000.0).round() / 1000.0);
     }
 
     /// Collects a rollout, updates the Solver, logs a metrics row.
@@ -230,15 +248,22 @@ impl<E: Resumable> SolverRun<E> {
             None => self.config.solver.learning_rate,
         };
         let t0 = wall();
-        let (batch, rollout) = self.trainer.collect()?;
+        let (batch, rollout, mut time) = self.trainer.collect(wall)?;
         let t1 = wall();
         let update = self.trainer.learn(&batch, learning_rate)?;
         let t2 = wall();
+        time.update_s = t2 - t1;
+        time.update_flops = f64::from(update.gradient_steps)
+            * self.config.solver.minibatch_size() as f64
+            * update_flops_per_sample(self.trainer.ppo.policy.shape());
         self.iteration += 1;
         let (rollout_s, update_s) = (t1 - t0, t2 - t1);
+        time.copies_s += wall() - t2;
+        let iteration_s = wall() - t0;
+        self.time.add(&time);
         writeln!(
             self.metrics,
-            "{},{},{:.2},{:.1},{:.3},{:.3},{:.3e},{},{:.4},{:.4},{}",
+            "{},{},{:.2},{:.1},{:.6},{:.6},{:.3e},{},{:.4},{:.4},{},{},{iteration_s:.6},{:.3}",
             self.iteration,
             self.trainer.global_step,
             wall(),
@@ -249,7 +274,9 @@ impl<E: Resumable> SolverRun<E> {
             rollout.episodes,
             rollout.mean_return,
             rollout.success_ratio,
-            update_columns(&update)
+            update_columns(&update),
+            time_columns(&time),
+            time.update_mfu(self.matmul_peak),
         )?;
         Ok(rollout)
     }
@@ -273,15 +300,24 @@ impl<G: GameSpec> Training for SolverRun<SolverEnvs<G>> {
         self.commit = commit;
     }
 
+    fn set_matmul_peak(&mut self, flops: f64) {
+        self.matmul_peak = flops;
+    }
+
+    fn time_split(&self) -> (TimeSplit, f64) {
+        (self.time, self.time.update_mfu(self.matmul_peak))
+    }
+
     fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
         let t0 = wall();
         let lr_scale = self.config.lr_scale(self.trainer.global_step);
         let rollout = self.solver_iteration(lr_scale, None, wall)?;
         Ok(format!(
-            "return {:.2}, success {:.2}, {:.0} steps/s",
+            "return {:.2}, success {:.2}, {:.0} steps/s, {}",
             rollout.mean_return,
             rollout.success_ratio,
-            rollout.steps as f64 / (wall() - t0)
+            rollout.steps as f64 / (wall() - t0),
+            self.time.largest_two()
         ))
     }
 

@@ -66,6 +66,10 @@ pub fn run(args: &TrainArgs) -> Result<()> {
     })
 }
 
+/// The matrix product (`n × n × n`) whose rate is this machine's peak, measured at the start of
+/// each session (about 0.1 s on two threads).
+const PEAK_PROBE_SIZE: usize = 1024;
+
 /// Iterates `run` until its budget of Solver steps, `minutes` of this session, `pause_at` Solver
 /// steps, or a signal; checkpoints on the run's interval and at the end, then writes the
 /// policies.
@@ -77,6 +81,9 @@ fn train_loop(run: &mut dyn Training, minutes: Option<f64>, pause_at: Option<u64
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
     let session = Instant::now();
+    let seconds = || session.elapsed().as_secs_f64();
+    let peak = arlpcg_core::rl::fused::matmul_peak_flops(PEAK_PROBE_SIZE, 3, &seconds);
+    run.set_matmul_peak(peak);
     let wall_before = run.wall_before();
     let wall = || wall_before + session.elapsed().as_secs_f64();
     let mut last_checkpoint = Instant::now();
@@ -117,6 +124,18 @@ fn train_loop(run: &mut dyn Training, minutes: Option<f64>, pause_at: Option<u64
         run.solver_steps(),
         wall / 60.0,
         run.out().display()
+    );
+    let (time, mfu) = run.time_split();
+    let shares: Vec<String> = time
+        .buckets()
+        .iter()
+        .map(|(name, s)| format!("{name} {:.0}%", 100.0 * s / time.total().max(1e-9)))
+        .collect();
+    println!(
+        "time, all sessions: {} (update at {:.0}% of this machine's {:.0} GFLOP/s matmul peak)",
+        shares.join(", "),
+        100.0 * mfu,
+        peak / 1e9
     );
     if stop.load(Ordering::SeqCst) {
         println!("stopped (Ctrl-C or a termination signal) {summary}");

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::normalizer::RunningNorm;
 use super::policy::{ActorCritic, PolicyShape};
 use super::ppo::Ppo;
+use super::timing::TimeSplit;
 use crate::level::Game;
 
 /// The `format` of every policy card.
@@ -132,6 +133,13 @@ pub struct TrainingRecord {
     /// Solver it played was taken, oldest first (the current Solver played too).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub population: Vec<u64>,
+    /// Where the run's time went, over every session (both agents' iterations).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_split: Option<TimeSplit>,
+    /// The update's FLOPs per second over the matrix-product peak of the last session's
+    /// machine ([`crate::rl::fused::matmul_peak_flops`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub update_mfu: Option<f64>,
 }
 
 /// Everything needed to continue a training run where it stopped.
@@ -150,6 +158,9 @@ pub struct TrainingState {
     /// Each environment's return so far in its episode under way (none: start afresh).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub episode_returns: Vec<f32>,
+    /// Where the run's time went so far, over every session.
+    #[serde(default)]
+    pub time_split: TimeSplit,
 }
 
 /// Why a policy or checkpoint could not be read.
@@ -384,6 +395,8 @@ mod tests {
                 command: String::new(),
                 resumed_with: Vec::new(),
                 population: Vec::new(),
+                time_split: None,
+                update_mfu: None,
             },
             results: HashMap::new(),
             max_pieces: None,

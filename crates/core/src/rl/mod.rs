@@ -1,8 +1,8 @@
 //! Game-agnostic learning: the actor-critic on candle ([`policy`]), [`ppo`] with its hand-written
 //! forward/backward pass ([`fused`]) and optimizer ([`adam`]), running observation normalization
-//! ([`normalizer`]), the rollout loop over many environments ([`vec_env`]), policy and checkpoint
-//! files ([`checkpoint`]) and candle's thread count ([`threads`]). Nothing here reads the clock or
-//! prints.
+//! ([`normalizer`]), the rollout loop over many environments ([`vec_env`]), where its time goes
+//! ([`timing`], with a clock the caller lends) and policy and checkpoint files ([`checkpoint`]).
+//! Nothing here reads the clock or prints.
 
 pub mod adam;
 pub mod checkpoint;
@@ -10,4 +10,5 @@ pub mod fused;
 pub mod normalizer;
 pub mod policy;
 pub mod ppo;
+pub mod timing;
 pub mod vec_env;

@@ -7,6 +7,7 @@ use rand_chacha::ChaCha8Rng;
 use super::normalizer::RunningNorm;
 use super::policy::{ActMode, Acted};
 use super::ppo::{Batch, Ppo, UpdateStats, gae};
+use super::timing::{Clock, InnerTime, TimeSplit};
 
 /// What one environment's step led to. Finished episodes are reset by the environment.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -26,6 +27,14 @@ pub trait VecEnv {
     fn observe(&mut self, out: &mut [f32]);
     /// Steps environment `i` with action row `i` and records its transition in `out[i]`.
     fn step(&mut self, actions: &[f32], out: &mut [Transition]);
+    /// [`VecEnv::step`], with the seconds by `clock` of the work inside it that is not the
+    /// environments' own (other policies' forward passes, a Generator's work); environments
+    /// without such work have none to report.
+    fn step_timed(&mut self, actions: &[f32], out: &mut [Transition], clock: Clock) -> InnerTime {
+        let _ = clock;
+        self.step(actions, out);
+        InnerTime::default()
+    }
 }
 
 /// Episode statistics of one rollout.
@@ -67,8 +76,13 @@ impl<E: VecEnv> Trainer<E> {
         }
     }
 
-    /// Plays `num_steps` ticks of every environment with the current policy.
-    pub fn collect(&mut self) -> candle_core::Result<(Batch, RolloutStats)> {
+    /// Plays `num_steps` ticks of every environment with the current policy; `clock` times
+    /// the rollout's buckets (its `update_s` stays 0).
+    pub fn collect(
+        &mut self,
+        clock: Clock,
+    ) -> candle_core::Result<(Batch, RolloutStats, TimeSplit)> {
+        let mut time = TimeSplit::default();
         let (n, d) = (self.env.num_envs(), self.env.observation_size());
         let steps = self.ppo.config.num_steps;
         let action_size = self.ppo.policy.shape().action_size();
@@ -84,10 +98,22 @@ impl<E: VecEnv> Trainer<E> {
         let mut ended = Vec::with_capacity(steps * n);
         let mut transitions = vec![Transition::default(); n];
         let (mut episodes, mut return_sum, mut successes, mut judged) = (0u32, 0.0f64, 0u32, 0u32);
+        let mut t = clock();
+        let mut lap = |bucket: &mut f64| {
+            let now = clock();
+            *bucket += now - t;
+            t = now;
+        };
         for _ in 0..steps {
             self.norm.update(&self.observations);
+            lap(&mut time.copies_s);
             let (normalized, acted) = self.act_sampled()?;
-            self.env.step(&acted.actions, &mut transitions);
+            lap(&mut time.forward_s);
+            let inner = self.env.step_timed(&acted.actions, &mut transitions, clock);
+            lap(&mut time.env_s);
+            time.env_s -= inner.forward_s + inner.generator_s;
+            time.forward_s += inner.forward_s;
+            time.generator_s += inner.generator_s;
             for (e, t) in transitions.iter().enumerate() {
                 self.episode_returns[e] += t.reward;
                 rewards.push(t.reward);
@@ -106,11 +132,12 @@ impl<E: VecEnv> Trainer<E> {
             batch.actions.extend_from_slice(&acted.actions);
             batch.log_probs.extend_from_slice(&acted.log_probs);
             batch.values.extend_from_slice(&acted.values);
+            lap(&mut time.copies_s);
             self.env.observe(&mut self.observations);
+            lap(&mut time.env_s);
         }
-        let mut normalized = self.observations.clone();
-        self.norm.normalize(&mut normalized);
-        let last_values = self.ppo.policy.values(&normalized)?;
+        let last_values = self.ppo.policy.values(&self.normalized())?;
+        lap(&mut time.forward_s);
         let (advantages, returns) = gae(
             &rewards,
             &batch.values,
@@ -121,6 +148,7 @@ impl<E: VecEnv> Trainer<E> {
         );
         batch.advantages = advantages;
         batch.returns = returns;
+        lap(&mut time.gae_s);
         let collected = (steps * n) as u64;
         self.global_step += collected;
         let stats = RolloutStats {
@@ -137,7 +165,7 @@ impl<E: VecEnv> Trainer<E> {
                 f32::NAN
             },
         };
-        Ok((batch, stats))
+        Ok((batch, stats, time))
     }
 
     /// The current observations normalized (the normalizer itself stays as it is).
@@ -162,13 +190,21 @@ impl<E: VecEnv> Trainer<E> {
     /// learned from these steps, so the critic is not run (in a racing finish the networks
     /// were about a quarter of the Generator phase's time); the actions are those a learning
     /// tick would choose, from the same random numbers.
-    pub fn play_tick(&mut self) -> candle_core::Result<()> {
+    pub fn play_tick(&mut self, clock: Clock) -> candle_core::Result<TimeSplit> {
+        let mut time = TimeSplit::default();
+        let start = clock();
         let actions = self
             .ppo
             .policy
             .choose(&self.normalized(), ActMode::Sample, &mut self.rng)?;
+        let chosen = clock();
+        time.forward_s = chosen - start;
         let mut transitions = vec![Transition::default(); self.env.num_envs()];
-        self.env.step(&actions, &mut transitions);
+        let inner = self.env.step_timed(&actions, &mut transitions, clock);
+        let stepped = clock();
+        time.env_s = stepped - chosen - inner.forward_s - inner.generator_s;
+        time.forward_s += inner.forward_s;
+        time.generator_s = inner.generator_s;
         for (e, t) in transitions.iter().enumerate() {
             self.episode_returns[e] = if t.ended {
                 0.0
@@ -176,8 +212,11 @@ impl<E: VecEnv> Trainer<E> {
                 self.episode_returns[e] + t.reward
             };
         }
+        let counted = clock();
+        time.copies_s = counted - stepped;
         self.env.observe(&mut self.observations);
-        Ok(())
+        time.env_s += clock() - counted;
+        Ok(time)
     }
 
     /// One PPO update on `batch`.

@@ -314,6 +314,33 @@ impl Workspace {
     }
 }
 
+/// This machine's own matrix-product rate in FLOP/s: the best of `runs` products of two
+/// `size × size` matrices on the kernels and threads the update uses, timed by `clock`. The
+/// update's model-FLOPs utilisation is read against it ([`crate::rl::timing::TimeSplit::update_mfu`]).
+pub fn matmul_peak_flops(size: usize, runs: usize, clock: crate::rl::timing::Clock) -> f64 {
+    let lhs = vec![1.0f32; size * size];
+    let rhs = vec![0.5f32; size * size];
+    let mut dst = vec![0.0f32; size * size];
+    let mut best = 0.0f64;
+    for _ in 0..runs {
+        let start = clock();
+        matmul(
+            &mut dst,
+            (size, size, size),
+            &lhs,
+            (size, 1),
+            &rhs,
+            (size, 1),
+            false,
+        );
+        let seconds = clock() - start;
+        if seconds > 0.0 {
+            best = best.max(2.0 * (size as f64).powi(3) / seconds);
+        }
+    }
+    best
+}
+
 /// `dst[rows × n] = lhs · rhs` (`read_dst`: `+=`), with explicit strides: element (i, j) of a
 /// matrix `m` lies at `m[i * row_stride + j * col_stride]`.
 #[allow(clippy::too_many_arguments)]

@@ -1,0 +1,157 @@
+//! Where training time goes: each iteration's seconds split into buckets, measured with a clock
+//! the caller lends (the core reads none), and the model-FLOPs arithmetic of the PPO update.
+
+use serde::{Deserialize, Serialize};
+
+use super::policy::PolicyShape;
+
+/// A clock in seconds, lent by the shell; `&|| 0.0` measures nothing.
+pub type Clock<'a> = &'a dyn Fn() -> f64;
+
+/// Seconds of an iteration (or of a whole run), by what they were spent on.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSplit {
+    /// Stepping the environments: physics, ray casts, observations.
+    pub env_s: f64,
+    /// The learning agent's forward passes while it plays (actions, values), and those of
+    /// the policies that play beside it (earlier Solvers, the frozen Solver).
+    pub forward_s: f64,
+    /// The Generator's work inside the matches: its decisions (their forward passes) and the
+    /// pieces and matches they make.
+    pub generator_s: f64,
+    /// Advantages and returns.
+    pub gae_s: f64,
+    /// The PPO update (every epoch and minibatch).
+    pub update_s: f64,
+    /// Copies into the batch, the observation normalizer, episode bookkeeping, metrics.
+    pub copies_s: f64,
+    /// Floating-point operations of the update's matrix products (forward and backward).
+    pub update_flops: f64,
+}
+
+impl TimeSplit {
+    /// The buckets by name, in the order metrics and the progress line use.
+    pub fn buckets(&self) -> [(&'static str, f64); 6] {
+        [
+            ("env", self.env_s),
+            ("forward", self.forward_s),
+            ("generator", self.generator_s),
+            ("gae", self.gae_s),
+            ("update", self.update_s),
+            ("copies", self.copies_s),
+        ]
+    }
+
+    /// Seconds in all buckets.
+    pub fn total(&self) -> f64 {
+        self.buckets().iter().map(|(_, s)| s).sum()
+    }
+
+    /// Adds `other`'s seconds and FLOPs to these.
+    pub fn add(&mut self, other: &TimeSplit) {
+        self.env_s += other.env_s;
+        self.forward_s += other.forward_s;
+        self.generator_s += other.generator_s;
+        self.gae_s += other.gae_s;
+        self.update_s += other.update_s;
+        self.copies_s += other.copies_s;
+        self.update_flops += other.update_flops;
+    }
+
+    /// The same, seconds rounded to tenths (for a card).
+    pub fn rounded(&self) -> TimeSplit {
+        let tenth = |s: f64| (s * 10.0).round() / 10.0;
+        TimeSplit {
+            env_s: tenth(self.env_s),
+            forward_s: tenth(self.forward_s),
+            generator_s: tenth(self.generator_s),
+            gae_s: tenth(self.gae_s),
+            update_s: tenth(self.update_s),
+            copies_s: tenth(self.copies_s),
+            update_flops: self.update_flops,
+        }
+    }
+
+    /// The two largest buckets with their shares of the total, as the progress line shows
+    /// them (`update 62%, env 21%`).
+    pub fn largest_two(&self) -> String {
+        let total = self.total().max(f64::MIN_POSITIVE);
+        let mut buckets = self.buckets();
+        buckets.sort_by(|a, b| b.1.total_cmp(&a.1));
+        format!(
+            "{} {:.0}%, {} {:.0}%",
+            buckets[0].0,
+            100.0 * buckets[0].1 / total,
+            buckets[1].0,
+            100.0 * buckets[1].1 / total
+        )
+    }
+
+    /// The update's model-FLOPs utilisation: its FLOPs per second over `peak_flops`, the
+    /// machine's own matrix-product rate ([`super::fused::matmul_peak_flops`]); 0 without an
+    /// update or a peak.
+    pub fn update_mfu(&self, peak_flops: f64) -> f64 {
+        if self.update_s > 0.0 && peak_flops > 0.0 {
+            self.update_flops / self.update_s / peak_flops
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Seconds spent inside one `VecEnv::step` on work that is not the environments' own.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct InnerTime {
+    /// Forward passes of other policies (earlier Solvers playing some matches).
+    pub forward_s: f64,
+    /// A Generator's decisions and the matches it restarts.
+    pub generator_s: f64,
+}
+
+/// FLOPs of one sample through the update of a network of `shape`: per dense layer of
+/// `in × out`, 2·in·out forward, 2·in·out for the weights' gradient and 2·in·out for the
+/// input's (none for the first layer, whose input is the observation), actor and critic.
+pub fn update_flops_per_sample(shape: &PolicyShape) -> f64 {
+    let network = |out: usize| {
+        let sizes = shape.layer_sizes(out);
+        let products: Vec<f64> = sizes.windows(2).map(|w| (w[0] * w[1]) as f64).collect();
+        6.0 * products.iter().sum::<f64>() - 2.0 * products.first().copied().unwrap_or(0.0)
+    };
+    network(shape.action_size()) + network(1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_largest_buckets_and_the_mfu_read_off_the_split() {
+        let split = TimeSplit {
+            env_s: 2.0,
+            forward_s: 1.0,
+            update_s: 6.0,
+            copies_s: 1.0,
+            update_flops: 3e11,
+            ..TimeSplit::default()
+        };
+        assert_eq!(split.total(), 10.0);
+        assert_eq!(split.largest_two(), "update 60%, env 20%");
+        assert!((split.update_mfu(1e11) - 0.5).abs() < 1e-12);
+        assert_eq!(TimeSplit::default().update_mfu(1e11), 0.0);
+    }
+
+    #[test]
+    fn update_flops_count_every_layer_of_both_networks() {
+        let shape = PolicyShape {
+            observation: 10,
+            hidden: vec![4],
+            continuous: 2,
+            binary: 0,
+        };
+        // Actor 10·4 + 4·2 (a log-std takes no product), critic 10·4 + 4·1.
+        let actor = 6.0 * (40.0 + 8.0) - 2.0 * 40.0;
+        let critic = 6.0 * (40.0 + 4.0) - 2.0 * 40.0;
+        assert_eq!(update_flops_per_sample(&shape), actor + critic);
+    }
+}

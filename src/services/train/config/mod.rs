@@ -233,8 +233,7 @@ impl Default for TrainConfig {
             hidden: vec![512, 512],
             checkpoint_minutes: 5.0,
             solver: PpoConfig {
-                learning_rate: SOLVER_LEARNING_RATE,
-                update_epochs: SOLVER_UPDATE_EPOCHS,
+                learning_rate: 3e-4,
                 gamma: 0.99,
                 num_envs: 64,
                 num_steps: 128,
@@ -329,12 +328,6 @@ const MAX_CONFIG_BYTES: u64 = 1 << 20;
 
 /// The platform recipe's budget in Solver steps learned from ([`TrainConfig::steps`]).
 pub const PLATFORM_STEPS: u64 = 8_000_000;
-
-/// The Solver's PPO update makes one pass over each batch (the paper's PPO: four)...
-/// Why: docs/decisions.md#d15.
-pub const SOLVER_UPDATE_EPOCHS: usize = 1;
-/// ...at twice the paper's learning rate (3e-4), annealed to 0 over the budget.
-pub const SOLVER_LEARNING_RATE: f64 = 6e-4;
 
 /// The platform recipe's finish: one Generator phase, entropy bonus 0.01, against the final
 /// Solver, frozen (no snapshots), and the median scripted controller, each playing half the

@@ -3,8 +3,9 @@
 use ratatui::Frame;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Style, Stylize};
+use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
-use ratatui::widgets::canvas::{Context, Points};
+use ratatui::widgets::canvas::{Canvas, Context, Points};
 use ratatui::widgets::{Block, Paragraph, Wrap};
 
 mod overlay;
@@ -244,6 +245,24 @@ fn describe_goal(goal: Option<[f64; 3]>) -> String {
         Some([x, y, z]) => format!("{:.0} m away, {:+.0} m up", x.hypot(z), y),
         None => "drawn from the seed".into(),
     }
+}
+
+/// A top-down map titled `title`, square around `points` (padded by `pad` metres), drawn in
+/// braille by `paint`.
+fn map_canvas<F: Fn(&mut Context)>(
+    title: String,
+    points: &[[f64; 2]],
+    area: Rect,
+    pad: f64,
+    paint: F,
+) -> Canvas<'static, F> {
+    let (x_bounds, y_bounds) = bounds(points, area, pad);
+    Canvas::default()
+        .block(Block::bordered().title(title))
+        .marker(Marker::Braille)
+        .x_bounds(x_bounds)
+        .y_bounds(y_bounds)
+        .paint(paint)
 }
 
 /// Square bounds around `points` for a canvas of `area` (braille: 2×4 dots a cell), padded.

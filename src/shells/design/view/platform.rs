@@ -12,7 +12,7 @@ use arlpcg_core::level::Level;
 use arlpcg_core::level::heading::heading_direction;
 use arlpcg_core::level::platform::{Platform, PlatformTrack};
 
-use super::{bounds, draw_replay, piece_colours};
+use super::{draw_replay, map_canvas, piece_colours};
 
 /// The corners of a block's top, `[x, z]`, in order around it.
 fn corners(p: &Platform) -> [[f64; 2]; 4] {
@@ -39,30 +39,24 @@ pub(super) fn map(app: &App, level: &Level, track: &PlatformTrack, frame: &mut F
     let colours = platform_colours(app, track.block_count());
     let mut points: Vec<[f64; 2]> = platforms.iter().flat_map(corners).collect();
     points.push([level.goal[0], level.goal[2]]);
-    let (x_bounds, y_bounds) = bounds(&points, area, 2.0);
     let title = format!(
         " top-down: {} blocks, goal {:.0} m ",
         track.block_count(),
         level.goal[0].hypot(level.goal[2])
     );
-    let canvas = Canvas::default()
-        .block(Block::bordered().title(title))
-        .marker(Marker::Braille)
-        .x_bounds(x_bounds)
-        .y_bounds(y_bounds)
-        .paint(|ctx| {
-            for (p, &colour) in platforms.iter().zip(&colours) {
-                let c = corners(p);
-                for k in 0..4 {
-                    let (a, b) = (c[k], c[(k + 1) % 4]);
-                    ctx.draw(&CanvasLine::new(a[0], a[1], b[0], b[1], colour));
-                }
+    let canvas = map_canvas(title, &points, area, 2.0, |ctx| {
+        for (p, &colour) in platforms.iter().zip(&colours) {
+            let c = corners(p);
+            for k in 0..4 {
+                let (a, b) = (c[k], c[(k + 1) % 4]);
+                ctx.draw(&CanvasLine::new(a[0], a[1], b[0], b[1], colour));
             }
-            draw_replay(app, ctx, |f| [f[0] as f64, f[2] as f64]);
-            ctx.print(level.goal[0], level.goal[2], "G".green().bold());
-            let start = platforms[0].position;
-            ctx.print(start[0], start[2], "S".blue().bold());
-        });
+        }
+        draw_replay(app, ctx, |f| [f[0] as f64, f[2] as f64]);
+        ctx.print(level.goal[0], level.goal[2], "G".green().bold());
+        let start = platforms[0].position;
+        ctx.print(start[0], start[2], "S".blue().bold());
+    });
     frame.render_widget(canvas, area);
 }
 

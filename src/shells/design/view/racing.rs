@@ -15,7 +15,7 @@ use arlpcg_core::level::heading::heading_direction;
 use arlpcg_core::level::racing::{Obstacle, RacingTrack};
 use arlpcg_core::level::road::{ROAD_WIDTH, Road};
 
-use super::{bounds, draw_replay, piece_colours};
+use super::{draw_replay, map_canvas, piece_colours};
 
 /// The racing track's statistics and the selected segment, for the stats panel.
 pub(super) fn stats(app: &App, track: &RacingTrack, lines: &mut Vec<Line>) {
@@ -96,49 +96,43 @@ pub(super) fn map(
     points.push([level.goal[0], level.goal[2]]);
     let outlines: Vec<Vec<[f64; 2]>> = track.obstacles.iter().map(obstacle_outline).collect();
     points.extend(outlines.iter().flatten());
-    let (x_bounds, y_bounds) = bounds(&points, area, 5.0);
     let title = format!(
         " top-down: {} segments, {:.0} m of road, goal {:.0} m ",
         track.segments.len(),
         road.length(),
         level.goal[0].hypot(level.goal[2])
     );
-    let canvas = Canvas::default()
-        .block(Block::bordered().title(title))
-        .marker(Marker::Braille)
-        .x_bounds(x_bounds)
-        .y_bounds(y_bounds)
-        .paint(|ctx| {
-            for outline in &outlines {
-                for k in 0..outline.len() {
-                    let (a, b) = (outline[k], outline[(k + 1) % outline.len()]);
-                    ctx.draw(&CanvasLine::new(a[0], a[1], b[0], b[1], Color::DarkGray));
-                }
+    let canvas = map_canvas(title, &points, area, 5.0, |ctx| {
+        for outline in &outlines {
+            for k in 0..outline.len() {
+                let (a, b) = (outline[k], outline[(k + 1) % outline.len()]);
+                ctx.draw(&CanvasLine::new(a[0], a[1], b[0], b[1], Color::DarkGray));
             }
-            for pair in edges.windows(2) {
-                let (a, b) = (&pair[0], &pair[1]);
-                let colour = colours.get(b.2).copied().unwrap_or(Color::White);
-                ctx.draw(&CanvasLine::new(a.0[0], a.0[2], b.0[0], b.0[2], colour));
-                ctx.draw(&CanvasLine::new(a.1[0], a.1[2], b.1[0], b.1[2], colour));
-            }
-            let banked: Vec<(f64, f64)> = road
-                .samples()
-                .iter()
-                .enumerate()
-                .filter(|(i, p)| {
-                    let degrees = p.bank.abs().to_degrees();
-                    degrees >= 10.0 || (degrees >= 4.0 && i % 2 == 0)
-                })
-                .map(|(_, p)| (p.centre[0], p.centre[2]))
-                .collect();
-            ctx.draw(&Points {
-                coords: &banked,
-                color: Color::LightBlue,
-            });
-            draw_replay(app, ctx, |f| [f[0] as f64, f[2] as f64]);
-            ctx.print(level.goal[0], level.goal[2], "G".green().bold());
-            ctx.print(track.position[0], track.position[2], "S".blue().bold());
+        }
+        for pair in edges.windows(2) {
+            let (a, b) = (&pair[0], &pair[1]);
+            let colour = colours.get(b.2).copied().unwrap_or(Color::White);
+            ctx.draw(&CanvasLine::new(a.0[0], a.0[2], b.0[0], b.0[2], colour));
+            ctx.draw(&CanvasLine::new(a.1[0], a.1[2], b.1[0], b.1[2], colour));
+        }
+        let banked: Vec<(f64, f64)> = road
+            .samples()
+            .iter()
+            .enumerate()
+            .filter(|(i, p)| {
+                let degrees = p.bank.abs().to_degrees();
+                degrees >= 10.0 || (degrees >= 4.0 && i % 2 == 0)
+            })
+            .map(|(_, p)| (p.centre[0], p.centre[2]))
+            .collect();
+        ctx.draw(&Points {
+            coords: &banked,
+            color: Color::LightBlue,
         });
+        draw_replay(app, ctx, |f| [f[0] as f64, f[2] as f64]);
+        ctx.print(level.goal[0], level.goal[2], "G".green().bold());
+        ctx.print(track.position[0], track.position[2], "S".blue().bold());
+    });
     frame.render_widget(canvas, area);
 }
 

@@ -14,7 +14,7 @@ use arlpcg_core::game::PlatformGame;
 use arlpcg_core::rl::fused::matmul_peak_flops;
 use arlpcg_core::rl::policy::{ActorCritic, PolicyShape};
 use arlpcg_core::rl::ppo::{Ppo, PpoConfig};
-use arlpcg_core::rl::timing::{TimeSplit, update_flops_per_sample};
+use arlpcg_core::rl::timing::TimeSplit;
 use arlpcg_core::rl::vec_env::Trainer;
 
 #[global_allocator]
@@ -42,9 +42,7 @@ fn iteration(
     let start = clock();
     let update = trainer.learn(&batch, 1e-4).unwrap();
     time.update_s = clock() - start;
-    time.update_flops = f64::from(update.gradient_steps)
-        * trainer.ppo.config.minibatch_size() as f64
-        * update_flops_per_sample(trainer.ppo.policy.shape());
+    time.update_flops = trainer.ppo.update_flops(&update);
     time
 }
 
@@ -90,17 +88,12 @@ fn main() {
         let steps = 6.0 * ppo.batch_size() as f64;
         let rate = steps / split.total();
         rates.push(rate);
-        let shares: Vec<String> = split
-            .buckets()
-            .iter()
-            .map(|(bucket, s)| format!("{bucket} {:.0}%", 100.0 * s / split.total()))
-            .collect();
         println!(
             "  {name} ({} epochs x {} minibatches of {}): {rate:.0} env steps/s; {}; update at {:.0}% of the {:.0} GFLOP/s matmul peak",
             ppo.update_epochs,
             ppo.num_minibatches,
             ppo.minibatch_size(),
-            shares.join(", "),
+            split.shares(),
             100.0 * split.update_mfu(peak),
             peak / 1e9
         );

@@ -25,7 +25,7 @@ use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingState};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::ActorCritic;
 use arlpcg_core::rl::ppo::Ppo;
-use arlpcg_core::rl::timing::{TimeSplit, update_flops_per_sample};
+use arlpcg_core::rl::timing::TimeSplit;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -234,9 +234,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             .update(&batch, learning_rate, &mut envs.rng)?;
         let t2 = wall();
         time.update_s = t2 - t1;
-        time.update_flops = f64::from(update.gradient_steps)
-            * config.minibatch_size() as f64
-            * update_flops_per_sample(envs.generator.ppo.policy.shape());
+        time.update_flops = envs.generator.ppo.update_flops(&update);
         let decisions = batch.log_probs.len() as u64;
         envs.state.generator_steps += decisions;
         envs.state.phase_steps += decisions;

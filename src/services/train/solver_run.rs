@@ -23,7 +23,7 @@ use arlpcg_core::rl::checkpoint;
 use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingState};
 use arlpcg_core::rl::policy::ActorCritic;
 use arlpcg_core::rl::ppo::Ppo;
-use arlpcg_core::rl::timing::{TimeSplit, update_flops_per_sample};
+use arlpcg_core::rl::timing::TimeSplit;
 use arlpcg_core::rl::vec_env::{RolloutStats, Trainer, VecEnv};
 
 /// Environments whose progress is saved in checkpoints.
@@ -253,9 +253,7 @@ impl<E: Resumable> SolverRun<E> {
         let update = self.trainer.learn(&batch, learning_rate)?;
         let t2 = wall();
         time.update_s = t2 - t1;
-        time.update_flops = f64::from(update.gradient_steps)
-            * self.config.solver.minibatch_size() as f64
-            * update_flops_per_sample(self.trainer.ppo.policy.shape());
+        time.update_flops = self.trainer.ppo.update_flops(&update);
         self.iteration += 1;
         let (rollout_s, update_s) = (t1 - t0, t2 - t1);
         time.copies_s += wall() - t2;

@@ -126,14 +126,9 @@ fn train_loop(run: &mut dyn Training, minutes: Option<f64>, pause_at: Option<u64
         run.out().display()
     );
     let (time, mfu) = run.time_split();
-    let shares: Vec<String> = time
-        .buckets()
-        .iter()
-        .map(|(name, s)| format!("{name} {:.0}%", 100.0 * s / time.total().max(1e-9)))
-        .collect();
     println!(
         "time, all sessions: {} (update at {:.0}% of this machine's {:.0} GFLOP/s matmul peak)",
-        shares.join(", "),
+        time.shares(),
         100.0 * mfu,
         peak / 1e9
     );

@@ -234,6 +234,14 @@ impl Ppo {
         })
     }
 
+    /// The FLOPs of the matrix products of an update that made `update`'s gradient steps
+    /// (for its MFU, [`super::timing::TimeSplit::update_mfu`]).
+    pub fn update_flops(&self, update: &UpdateStats) -> f64 {
+        f64::from(update.gradient_steps)
+            * self.config.minibatch_size() as f64
+            * super::timing::update_flops_per_sample(self.policy.shape())
+    }
+
     /// Learns from one batch at `learning_rate`: `update_epochs` passes of shuffled minibatches,
     /// each one fused forward/backward pass ([`super::fused`]) and one Adam step. The policy's
     /// parameters are read before the first minibatch and written back after the last.

@@ -73,6 +73,24 @@ impl TimeSplit {
         }
     }
 
+    /// Adds a `seconds`-long [`super::vec_env::VecEnv::step`] whose `inner` work was not the
+    /// environments' own.
+    pub fn add_step(&mut self, seconds: f64, inner: InnerTime) {
+        self.env_s += seconds - inner.forward_s - inner.generator_s;
+        self.forward_s += inner.forward_s;
+        self.generator_s += inner.generator_s;
+    }
+
+    /// Every bucket's share of the total (`env 23%, forward 45%, ...`).
+    pub fn shares(&self) -> String {
+        let total = self.total().max(f64::MIN_POSITIVE);
+        self.buckets()
+            .iter()
+            .map(|(name, s)| format!("{name} {:.0}%", 100.0 * s / total))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
     /// The two largest buckets with their shares of the total, as the progress line shows
     /// them (`update 62%, env 21%`).
     pub fn largest_two(&self) -> String {
@@ -97,6 +115,29 @@ impl TimeSplit {
         } else {
             0.0
         }
+    }
+}
+
+/// Laps of a lent clock: each [`Stopwatch::lap`] is the time since the one before.
+pub struct Stopwatch<'a> {
+    clock: Clock<'a>,
+    last: f64,
+}
+
+impl<'a> Stopwatch<'a> {
+    pub fn new(clock: Clock<'a>) -> Self {
+        Self {
+            clock,
+            last: clock(),
+        }
+    }
+
+    /// Seconds since the last lap (or the start).
+    pub fn lap(&mut self) -> f64 {
+        let now = (self.clock)();
+        let seconds = now - self.last;
+        self.last = now;
+        seconds
     }
 }
 

@@ -7,7 +7,7 @@ use rand_chacha::ChaCha8Rng;
 use super::normalizer::RunningNorm;
 use super::policy::{ActMode, Acted};
 use super::ppo::{Batch, Ppo, UpdateStats, gae};
-use super::timing::{Clock, InnerTime, TimeSplit};
+use super::timing::{Clock, InnerTime, Stopwatch, TimeSplit};
 
 /// What one environment's step led to. Finished episodes are reset by the environment.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -98,22 +98,14 @@ impl<E: VecEnv> Trainer<E> {
         let mut ended = Vec::with_capacity(steps * n);
         let mut transitions = vec![Transition::default(); n];
         let (mut episodes, mut return_sum, mut successes, mut judged) = (0u32, 0.0f64, 0u32, 0u32);
-        let mut t = clock();
-        let mut lap = |bucket: &mut f64| {
-            let now = clock();
-            *bucket += now - t;
-            t = now;
-        };
+        let mut watch = Stopwatch::new(clock);
         for _ in 0..steps {
             self.norm.update(&self.observations);
-            lap(&mut time.copies_s);
+            time.copies_s += watch.lap();
             let (normalized, acted) = self.act_sampled()?;
-            lap(&mut time.forward_s);
+            time.forward_s += watch.lap();
             let inner = self.env.step_timed(&acted.actions, &mut transitions, clock);
-            lap(&mut time.env_s);
-            time.env_s -= inner.forward_s + inner.generator_s;
-            time.forward_s += inner.forward_s;
-            time.generator_s += inner.generator_s;
+            time.add_step(watch.lap(), inner);
             for (e, t) in transitions.iter().enumerate() {
                 self.episode_returns[e] += t.reward;
                 rewards.push(t.reward);
@@ -132,12 +124,12 @@ impl<E: VecEnv> Trainer<E> {
             batch.actions.extend_from_slice(&acted.actions);
             batch.log_probs.extend_from_slice(&acted.log_probs);
             batch.values.extend_from_slice(&acted.values);
-            lap(&mut time.copies_s);
+            time.copies_s += watch.lap();
             self.env.observe(&mut self.observations);
-            lap(&mut time.env_s);
+            time.env_s += watch.lap();
         }
         let last_values = self.ppo.policy.values(&self.normalized())?;
-        lap(&mut time.forward_s);
+        time.forward_s += watch.lap();
         let (advantages, returns) = gae(
             &rewards,
             &batch.values,
@@ -148,7 +140,7 @@ impl<E: VecEnv> Trainer<E> {
         );
         batch.advantages = advantages;
         batch.returns = returns;
-        lap(&mut time.gae_s);
+        time.gae_s += watch.lap();
         let collected = (steps * n) as u64;
         self.global_step += collected;
         let stats = RolloutStats {
@@ -192,19 +184,15 @@ impl<E: VecEnv> Trainer<E> {
     /// tick would choose, from the same random numbers.
     pub fn play_tick(&mut self, clock: Clock) -> candle_core::Result<TimeSplit> {
         let mut time = TimeSplit::default();
-        let start = clock();
+        let mut watch = Stopwatch::new(clock);
         let actions = self
             .ppo
             .policy
             .choose(&self.normalized(), ActMode::Sample, &mut self.rng)?;
-        let chosen = clock();
-        time.forward_s = chosen - start;
+        time.forward_s += watch.lap();
         let mut transitions = vec![Transition::default(); self.env.num_envs()];
         let inner = self.env.step_timed(&actions, &mut transitions, clock);
-        let stepped = clock();
-        time.env_s = stepped - chosen - inner.forward_s - inner.generator_s;
-        time.forward_s += inner.forward_s;
-        time.generator_s = inner.generator_s;
+        time.add_step(watch.lap(), inner);
         for (e, t) in transitions.iter().enumerate() {
             self.episode_returns[e] = if t.ended {
                 0.0
@@ -212,10 +200,9 @@ impl<E: VecEnv> Trainer<E> {
                 self.episode_returns[e] + t.reward
             };
         }
-        let counted = clock();
-        time.copies_s = counted - stepped;
+        time.copies_s += watch.lap();
         self.env.observe(&mut self.observations);
-        time.env_s += clock() - counted;
+        time.env_s += watch.lap();
         Ok(time)
     }
 

@@ -3,8 +3,9 @@
 //! goal); the Generator builds each piece at the curve's value where that piece begins.
 //!
 //! Written as control points `fraction:λ`, separated by commas: `0:1, 0.5:1, 0.6:-1, 1:-1` is
-//! easy up to halfway, then hard. Before the first point and after the last, λ stays at that
-//! point's value.
+//! easy up to halfway, then hard. Two points at one fraction make a step: `0:1, 0.5:1, 0.5:-1,
+//! 1:-1` is easy up to halfway (the first point's λ holds at the step itself), hard after it.
+//! Before the first point and after the last, λ stays at that point's value.
 
 use std::fmt;
 
@@ -18,7 +19,8 @@ pub const MAX_POINTS: usize = 32;
 /// λ as a function of the fraction of the way to the goal.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AuxCurve {
-    /// `(fraction, λ)`, fractions strictly increasing within [0, 1], λ within [-1, 1].
+    /// `(fraction, λ)`, fractions increasing within [0, 1] (two equal ones at most: a step),
+    /// λ within [-1, 1].
     points: Vec<(f64, f64)>,
 }
 
@@ -55,8 +57,9 @@ impl AuxCurve {
         Self::new(points)
     }
 
-    /// A curve through `points`, checked: 1 to [`MAX_POINTS`] points, fractions strictly
-    /// increasing within [0, 1], every λ within [-1, 1] (NaN fails).
+    /// A curve through `points`, checked: 1 to [`MAX_POINTS`] points, fractions increasing
+    /// within [0, 1] (at most two points at one fraction: a step), every λ within [-1, 1] (NaN
+    /// fails).
     pub fn new(points: Vec<(f64, f64)>) -> Result<Self, String> {
         if points.is_empty() || points.len() > MAX_POINTS {
             return Err(format!(
@@ -77,10 +80,15 @@ impl AuxCurve {
                 ));
             }
             AUX.check(aux).map_err(|e| format!("{at}: {e}"))?;
-            if i > 0 && fraction <= points[i - 1].0 {
+            if i > 0 && fraction < points[i - 1].0 {
                 return Err(format!(
                     "{at}: fractions must increase from point to point (the previous is {})",
                     show_number(points[i - 1].0)
+                ));
+            }
+            if i > 1 && fraction == points[i - 2].0 {
+                return Err(format!(
+                    "{at}: three points at one fraction; a step takes two (`0.5:1, 0.5:-1`)"
                 ));
             }
         }
@@ -100,7 +108,7 @@ impl AuxCurve {
         }
         for pair in self.points.windows(2) {
             let ((x0, y0), (x1, y1)) = (pair[0], pair[1]);
-            if fraction <= x1 {
+            if fraction <= x1 && x1 > x0 {
                 return y0 + (y1 - y0) * (fraction - x0) / (x1 - x0);
             }
         }
@@ -219,6 +227,18 @@ mod tests {
     }
 
     #[test]
+    fn two_points_at_one_fraction_make_a_step() {
+        let step = AuxCurve::parse("0:1, 0.5:1, 0.5:-1, 1:-1").unwrap();
+        assert_eq!(step.at(0.25), 1.0);
+        assert_eq!(step.at(0.5), 1.0, "the first point's λ holds at the step");
+        assert_eq!(step.at(0.5 + 1e-9), -1.0);
+        assert_eq!(step.at(0.75), -1.0);
+        let at_start = AuxCurve::parse("0:1, 0:-1").unwrap();
+        assert_eq!((at_start.at(0.0), at_start.at(0.1)), (1.0, -1.0));
+        assert_eq!(AuxCurve::parse(&step.to_string()).unwrap(), step);
+    }
+
+    #[test]
     fn a_curve_reads_back_what_it_writes() {
         let curve = AuxCurve::parse(" 0:1,0.5:1 , 0.6:-1, 1:-1").unwrap();
         assert_eq!(curve.to_string(), "0:1, 0.5:1, 0.6:-1, 1:-1");
@@ -236,7 +256,7 @@ mod tests {
             ("0:1, 1:2", "out of range"),
             ("-0.1:1", "within [0, 1]"),
             ("0:1, 1.5:1", "within [0, 1]"),
-            ("0:1, 0.5:0, 0.5:-1", "must increase"),
+            ("0:1, 0.5:0, 0.5:-1, 0.5:1", "three points at one fraction"),
             ("0.6:1, 0.4:-1", "must increase"),
         ];
         for (text, expected) in cases {

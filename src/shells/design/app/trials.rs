@@ -2,8 +2,9 @@
 //! its interval, progress, air time and the failures per piece.
 
 use ratatui::Frame;
-use ratatui::layout::Rect;
-use ratatui::style::Style;
+use ratatui::layout::{Alignment, Constraint, Layout, Rect};
+use ratatui::style::{Style, Stylize};
+use ratatui::text::Line;
 use ratatui::widgets::{Bar, BarChart, BarGroup, Block, Paragraph};
 
 use super::pacing::aux_colour;
@@ -63,6 +64,12 @@ impl Trials {
     }
 
     /// Failed runs per block so far (`blocks` blocks), as `SolverStats::failures_by_piece`.
+    /// The piece with the most failures (the first of equals); none before a run fails.
+    pub fn most_failed(failures: &[u32]) -> Option<usize> {
+        let most = *failures.iter().max()?;
+        (most > 0).then(|| failures.iter().position(|&f| f == most))?
+    }
+
     pub fn failures_by_block(&self, blocks: usize) -> Vec<u32> {
         let mut failures = vec![0; blocks];
         for r in self
@@ -104,16 +111,14 @@ impl App {
 /// The bottom-right panel's first view: the failures on each piece, coloured by the λ the
 /// piece was built at when the level is paced.
 pub(crate) fn draw_failures(app: &App, frame: &mut Frame, area: Rect) {
-    let block = Block::bordered().title(format!(
-        " failures per {} (v: sweep) ",
-        arlpcg_core::game::facts::facts(app.game).piece_name(false)
-    ));
+    let piece = arlpcg_core::game::facts::facts(app.game).piece_name(false);
+    let block = Block::bordered().title(format!(" failures per {piece} (v: sweep) "));
     let (Some(level), Some(trials)) = (&app.level, &app.trials) else {
         frame.render_widget(block, area);
         return;
     };
     let counts = trials.failures_by_block(level.piece_count());
-    if counts.iter().all(|&c| c == 0) {
+    let Some(worst) = Trials::most_failed(&counts) else {
         let text = if trials.done() == 0 {
             "waiting for the first runs"
         } else {
@@ -121,7 +126,13 @@ pub(crate) fn draw_failures(app: &App, frame: &mut Frame, area: Rect) {
         };
         frame.render_widget(Paragraph::new(text).block(block), area);
         return;
-    }
+    };
+    let failed: u32 = counts.iter().sum();
+    let most = counts[worst];
+    let block = block.title_bottom(format!(
+        " most: {piece} {worst}, {most} of {failed} ({:.0}%) ",
+        100.0 * f64::from(most) / f64::from(failed)
+    ));
     let piece_aux = |i: usize| level.pacing.as_ref()?.piece_aux.get(i).copied().flatten();
     let bars: Vec<Bar> = counts
         .iter()
@@ -134,18 +145,61 @@ pub(crate) fn draw_failures(app: &App, frame: &mut Frame, area: Rect) {
                 None => Style::new().red(),
             };
             Bar::default()
-                .value(c as u64)
+                .value(u64::from(c))
                 .text_value(String::new())
                 .style(style)
         })
         .collect();
-    let inner = area.width.saturating_sub(2) as usize;
-    let gap = usize::from(counts.len() * 2 <= inner);
-    let width = ((inner / counts.len().max(1)).saturating_sub(gap)).clamp(1, 3) as u16;
+    let inner = block.inner(area);
+    frame.render_widget(block, area);
+    // The count axis on the left (the highest bar's count at its top, 0 at the bottom), the
+    // piece numbers under the bars.
+    let [y_axis, plot] = Layout::horizontal([
+        Constraint::Length(most.to_string().len() as u16 + 1),
+        Constraint::Min(1),
+    ])
+    .areas(inner);
+    let [bars_area, x_axis] =
+        Layout::vertical([Constraint::Min(1), Constraint::Length(1)]).areas(plot);
+    let columns = bars_area.width as usize;
+    let gap = usize::from(counts.len() * 2 <= columns);
+    let width = ((columns / counts.len().max(1)).saturating_sub(gap)).clamp(1, 3);
     let chart = BarChart::default()
-        .block(block)
         .data(BarGroup::default().bars(&bars))
-        .bar_width(width)
+        .max(u64::from(most))
+        .bar_width(width as u16)
         .bar_gap(gap as u16);
-    frame.render_widget(chart, area);
+    frame.render_widget(chart, bars_area);
+    let mut counts_axis = vec![Line::from(most.to_string()); 1];
+    counts_axis.resize(bars_area.height.saturating_sub(1) as usize, Line::default());
+    counts_axis.push(Line::from("0"));
+    frame.render_widget(
+        Paragraph::new(counts_axis)
+            .alignment(Alignment::Right)
+            .dark_gray(),
+        Rect {
+            height: bars_area.height,
+            ..y_axis
+        },
+    );
+    frame.render_widget(
+        Paragraph::new(piece_numbers(counts.len(), width + gap, columns)).dark_gray(),
+        x_axis,
+    );
+}
+
+/// The piece numbers under bars `stride` columns apart: every number that fits, at least one
+/// space between two, each starting under its bar.
+fn piece_numbers(pieces: usize, stride: usize, columns: usize) -> String {
+    let mut axis = String::new();
+    for i in 0..pieces {
+        let at = i * stride;
+        let label = i.to_string();
+        let room = axis.is_empty() || at > axis.len();
+        if room && at + label.len() <= columns {
+            axis.push_str(&" ".repeat(at - axis.len()));
+            axis.push_str(&label);
+        }
+    }
+    axis
 }

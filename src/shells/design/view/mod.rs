@@ -406,6 +406,15 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
     );
 }
 
+/// The piece (of `pieces`) on which most of the Solver's runs so far failed; the maps mark it.
+fn most_failed_piece(app: &App, pieces: usize) -> Option<usize> {
+    let trials = app.trials.as_ref()?;
+    crate::shells::design::app::trials::Trials::most_failed(&trials.failures_by_block(pieces))
+}
+
+/// The mark the maps print on the piece that fails most.
+const MOST_FAILED_MARK: &str = "✕";
+
 /// The colour of each of `pieces` pieces (blocks, segments): the selected one cyan; on a paced
 /// level each by the λ it was built at (kept pieces without one blue), else by its share of
 /// the failures so far.

@@ -12,7 +12,7 @@ use arlpcg_core::level::Level;
 use arlpcg_core::level::heading::heading_direction;
 use arlpcg_core::level::platform::{Platform, PlatformTrack};
 
-use super::{draw_replay, map_canvas, piece_colours};
+use super::{MOST_FAILED_MARK, draw_replay, map_canvas, most_failed_piece, piece_colours};
 
 /// The corners of a block's top, `[x, z]`, in order around it.
 fn corners(p: &Platform) -> [[f64; 2]; 4] {
@@ -37,6 +37,7 @@ fn platform_colours(app: &App, blocks: usize) -> Vec<Color> {
 pub(super) fn map(app: &App, level: &Level, track: &PlatformTrack, frame: &mut Frame, area: Rect) {
     let platforms = track.platforms();
     let colours = platform_colours(app, track.block_count());
+    let most_failed = most_failed_piece(app, track.block_count());
     let mut points: Vec<[f64; 2]> = platforms.iter().flat_map(corners).collect();
     points.push([level.goal[0], level.goal[2]]);
     let title = format!(
@@ -53,6 +54,9 @@ pub(super) fn map(app: &App, level: &Level, track: &PlatformTrack, frame: &mut F
             }
         }
         draw_replay(app, ctx, |f| [f[0] as f64, f[2] as f64]);
+        if let Some(p) = most_failed.and_then(|i| platforms.get(i + 1)) {
+            ctx.print(p.position[0], p.position[2], MOST_FAILED_MARK.red().bold());
+        }
         ctx.print(level.goal[0], level.goal[2], "G".green().bold());
         let start = platforms[0].position;
         ctx.print(start[0], start[2], "S".blue().bold());

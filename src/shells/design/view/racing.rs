@@ -15,7 +15,7 @@ use arlpcg_core::level::heading::heading_direction;
 use arlpcg_core::level::racing::{Obstacle, RacingTrack};
 use arlpcg_core::level::road::{ROAD_WIDTH, Road};
 
-use super::{draw_replay, map_canvas, piece_colours};
+use super::{MOST_FAILED_MARK, draw_replay, map_canvas, most_failed_piece, piece_colours};
 
 /// The racing track's statistics and the selected segment, for the stats panel.
 pub(super) fn stats(app: &App, track: &RacingTrack, lines: &mut Vec<Line>) {
@@ -83,6 +83,7 @@ pub(super) fn map(
     area: Rect,
 ) {
     let colours = piece_colours(app, track.segments.len());
+    let most_failed = most_failed_piece(app, track.segments.len());
     let half = 0.5 * ROAD_WIDTH;
     let edges: Vec<([f64; 3], [f64; 3], usize, f64)> = road
         .samples()
@@ -130,6 +131,14 @@ pub(super) fn map(
             color: Color::LightBlue,
         });
         draw_replay(app, ctx, |f| [f[0] as f64, f[2] as f64]);
+        let worst = most_failed.map(|i| road.samples().iter().filter(move |p| p.segment == i));
+        if let Some(middle) = worst.and_then(|on| on.clone().nth(on.count() / 2)) {
+            ctx.print(
+                middle.centre[0],
+                middle.centre[2],
+                MOST_FAILED_MARK.red().bold(),
+            );
+        }
         ctx.print(level.goal[0], level.goal[2], "G".green().bold());
         ctx.print(track.position[0], track.position[2], "S".blue().bold());
     });

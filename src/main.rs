@@ -11,9 +11,13 @@ fn main() -> ExitCode {
     unsafe { arlpcg::shells::common::fix_thread_count() };
     let cli = arlpcg::shells::cli::Cli::parse();
     match arlpcg::shells::commands::run(cli) {
+        // What the command wrote to files is whole; what it had left to say had nowhere to go.
+        Ok(()) if arlpcg::shells::common::stdout_closed() => {
+            ExitCode::from(arlpcg::shells::common::BROKEN_PIPE_EXIT)
+        }
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!(
+            arlpcg::warn!(
                 "error: {}",
                 arlpcg::shells::commands::one_line(&format!("{err:#}"))
             );

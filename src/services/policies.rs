@@ -22,16 +22,32 @@ use arlpcg_core::rl::policy::ActorCritic;
 pub const GENERATOR_FILE: &str = "generator.safetensors";
 pub const SOLVER_FILE: &str = "solver.safetensors";
 
+/// What a policy of one game and role must act with: `(continuous, binary)` action names.
+type Actions = (&'static [&'static str], &'static [&'static str]);
+
 fn load_pinned(
     path: &Path,
-    game: Game,
-    role: Role,
+    (game, role): (Game, Role),
     observation: usize,
+    (continuous, binary): Actions,
 ) -> Result<(LoadedPolicy, PolicyRef)> {
     let bytes =
         crate::services::fsio::read_limited(path, MAX_POLICY_BYTES, &format!("{role} policy"))?;
     let loaded = load_policy(&bytes, game, role, observation)
         .with_context(|| format!("{}", path.display()))?;
+    let network = &loaded.card.network;
+    if (network.continuous, network.binary) != (continuous.len(), binary.len()) {
+        anyhow::bail!(
+            "{}: card field network has {} continuous and {} binary actions, but the {game} {role} acts with {} ({}) and {} ({})",
+            path.display(),
+            network.continuous,
+            network.binary,
+            continuous.len(),
+            continuous.join(", "),
+            binary.len(),
+            binary.join(", ")
+        );
+    }
     Ok((
         loaded,
         PolicyRef::pinned(path.display().to_string(), &bytes),
@@ -40,11 +56,20 @@ fn load_pinned(
 
 /// Loads a Solver policy of `game`.
 pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)> {
-    let observation = match game {
-        Game::Platform => <PlatformGame as GameSpec>::Env::OBSERVATION_SIZE,
-        Game::Racing => <RacingGame as GameSpec>::Env::OBSERVATION_SIZE,
+    let (observation, actions): (usize, Actions) = match game {
+        Game::Platform => (
+            <PlatformGame as GameSpec>::Env::OBSERVATION_SIZE,
+            (
+                PlatformGame::CONTINUOUS_ACTIONS,
+                PlatformGame::BINARY_ACTIONS,
+            ),
+        ),
+        Game::Racing => (
+            <RacingGame as GameSpec>::Env::OBSERVATION_SIZE,
+            (RacingGame::CONTINUOUS_ACTIONS, RacingGame::BINARY_ACTIONS),
+        ),
     };
-    let (loaded, reference) = load_pinned(path, game, Role::Solver, observation)?;
+    let (loaded, reference) = load_pinned(path, (game, Role::Solver), observation, actions)?;
     let card = loaded.card.clone();
     Ok((
         SolverPolicy {
@@ -59,19 +84,22 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
 
 /// Loads a Generator policy of `game`.
 pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, PolicyCard)> {
-    let (observation, default_max_pieces, most_pieces) = match game {
+    let (observation, actions, default_max_pieces, most_pieces) = match game {
         Game::Platform => (
             observation_size::<PlatformGame>(),
+            PlatformGame::GENERATOR_ACTIONS,
             PlatformGame::DEFAULT_MAX_PIECES,
             PlatformGame::MAX_PIECES,
         ),
         Game::Racing => (
             observation_size::<RacingGame>(),
+            RacingGame::GENERATOR_ACTIONS,
             RacingGame::DEFAULT_MAX_PIECES,
             RacingGame::MAX_PIECES,
         ),
     };
-    let (loaded, reference) = load_pinned(path, game, Role::Generator, observation)?;
+    let (loaded, reference) =
+        load_pinned(path, (game, Role::Generator), observation, (actions, &[]))?;
     let card = loaded.card.clone();
     let limits = BuildLimits {
         max_pieces: card.max_pieces.unwrap_or(default_max_pieces),

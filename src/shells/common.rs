@@ -16,6 +16,56 @@ pub struct UsageError(pub String);
 #[error("{0}")]
 pub struct Interrupted(pub String);
 
+/// Whether a write to standard output has failed (a closed pipe, `| head`): what is left to
+/// say is dropped, commands that stream lines stop early, and the process exits
+/// [`BROKEN_PIPE_EXIT`].
+static STDOUT_CLOSED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// The exit code after standard output closed: 128 + SIGPIPE, as a shell reports a command a
+/// closed pipe ended.
+pub const BROKEN_PIPE_EXIT: u8 = 141;
+
+/// Writes to standard output; a failed write (a closed pipe) is remembered, never a panic.
+/// [`say!`](crate::say) is the `println!` of the commands.
+pub fn say(text: std::fmt::Arguments) {
+    use std::io::Write;
+    if stdout_closed() {
+        return;
+    }
+    let mut out = std::io::stdout().lock();
+    if out.write_fmt(text).and_then(|()| out.flush()).is_err() {
+        STDOUT_CLOSED.store(true, std::sync::atomic::Ordering::SeqCst);
+    }
+}
+
+/// Writes to standard error, dropping the text where it cannot be written (a closed pipe).
+/// [`warn!`](crate::warn) is the `eprintln!` of the commands.
+pub fn warn(text: std::fmt::Arguments) {
+    use std::io::Write;
+    let _ = std::io::stderr().lock().write_fmt(text);
+}
+
+/// Whether standard output has closed (see [`say`]).
+pub fn stdout_closed() -> bool {
+    STDOUT_CLOSED.load(std::sync::atomic::Ordering::SeqCst)
+}
+
+/// `println!` to standard output through [`say`]: a closed pipe ends nothing.
+#[macro_export]
+macro_rules! say {
+    ($($arg:tt)*) => {
+        $crate::shells::common::say(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+/// `eprintln!` through [`warn`]: a closed standard error ends nothing.
+#[macro_export]
+macro_rules! warn {
+    ($($arg:tt)*) => {
+        $crate::shells::common::warn(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
 /// The exit code for an error: 2 for a [`UsageError`], 130 for [`Interrupted`], 1 for the rest.
 pub fn exit_code(err: &anyhow::Error) -> u8 {
     if err.downcast_ref::<UsageError>().is_some() {

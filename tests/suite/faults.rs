@@ -365,3 +365,70 @@ fn ctrl_c_stops_the_difficulty_curve_measurement_at_once() {
         "no partial curve kept"
     );
 }
+
+/// Runs the binary with its standard output (or, with `close_stderr`, its standard error)
+/// closed before it writes: the pipe's reading end is dropped at once.
+fn arlpcg_into_closed_pipe(args: &[&str], close_stderr: bool) -> Output {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_arlpcg"));
+    command.args(args).stdin(Stdio::null());
+    command.stdout(Stdio::piped()).stderr(Stdio::piped());
+    let mut child = command.spawn().expect("the binary runs");
+    match close_stderr {
+        true => drop(child.stderr.take()),
+        false => drop(child.stdout.take()),
+    }
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+fn a_closed_pipe_ends_every_command_quietly_with_its_files_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = |name: &str| dir.path().join(name).display().to_string();
+    let level = shipped_level();
+    let shipped = |file: &str| {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(file)
+            .display()
+            .to_string()
+    };
+    let (batch, glb, onnx) = (out("batch"), out("level.glb"), out("solver.onnx"));
+    let policy = shipped("policies/platform/solver.safetensors");
+    let commands: Vec<Vec<&str>> = vec![
+        vec!["verify", "--trials", "2", &level, &level, &level],
+        vec!["verify", "--trials", "2", "--json", &level, &level],
+        vec!["verify", "--replay", &level, &level],
+        vec!["verify", "--panel", "--trials", "2", &level],
+        vec![
+            "generate", "--rules", "--count", "3", "--seed", "4", "--out", &batch,
+        ],
+        vec!["export", &level, "--out", &glb],
+        vec!["export-policy", &policy, "--out", &onnx],
+        vec!["train", "--print-config"],
+        vec!["--help"],
+    ];
+    for args in &commands {
+        let output = arlpcg_into_closed_pipe(args, false);
+        let code = output.status.code();
+        assert!(
+            matches!(code, Some(0 | 141)),
+            "{args:?} into a closed pipe: exit {code:?}, {}",
+            stderr(&output)
+        );
+        assert!(!stderr(&output).contains("panicked"), "{args:?}");
+    }
+    // What they wrote is whole: the levels load, the exports are there.
+    let levels: Vec<PathBuf> = std::fs::read_dir(&batch)
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .filter(|path| path.extension().is_some_and(|e| e == "yaml"))
+        .collect();
+    assert_eq!(levels.len(), 3, "three levels");
+    for path in levels {
+        arlpcg_core::level::yaml::load(&path).expect("a whole level");
+    }
+    assert!(Path::new(&glb).is_file() && Path::new(&onnx).is_file());
+    // An error said to a closed standard error still exits 1, not a panic's 101.
+    let missing = out("missing.yaml");
+    let output = arlpcg_into_closed_pipe(&["verify", &missing], true);
+    assert_eq!(output.status.code(), Some(1));
+}

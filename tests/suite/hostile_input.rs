@@ -263,3 +263,102 @@ proptest! {
         let _ = load_policy(&bytes, Game::Platform, Role::Solver, OBSERVATION_SIZE);
     }
 }
+
+/// A policy file whose card says `edit`'s lie: written with the weights `shape` asks for.
+fn policy_with_card(
+    dir: &std::path::Path,
+    name: &str,
+    shape: Option<arlpcg_core::rl::policy::PolicyShape>,
+    edit: impl FnOnce(&mut arlpcg_core::rl::checkpoint::PolicyCard),
+) -> String {
+    let loaded = load_policy(
+        &shipped_solver(),
+        Game::Platform,
+        Role::Solver,
+        OBSERVATION_SIZE,
+    )
+    .unwrap();
+    let mut card = loaded.card.clone();
+    edit(&mut card);
+    let policy = match shape {
+        Some(shape) => {
+            card.network = shape.clone();
+            arlpcg_core::rl::policy::ActorCritic::new(shape, 1).unwrap()
+        }
+        None => loaded.policy,
+    };
+    let path = dir.join(name);
+    std::fs::write(
+        &path,
+        arlpcg_core::rl::checkpoint::policy_bytes(&policy, &card),
+    )
+    .unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn a_card_that_disagrees_with_its_weights_or_its_game_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let level = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/levels/platform/platform_seed7_aux+0.50.yaml"
+    );
+    let solver_shape = |continuous, binary| arlpcg_core::rl::policy::PolicyShape {
+        observation: OBSERVATION_SIZE,
+        hidden: vec![8],
+        continuous,
+        binary,
+    };
+    let cases = [
+        (
+            policy_with_card(dir.path(), "five.safetensors", None, |c| {
+                c.continuous_actions = (0..5).map(|k| format!("a{k}")).collect();
+            }),
+            "continuous_actions names 5",
+        ),
+        (
+            policy_with_card(dir.path(), "wide.safetensors", None, |c| {
+                c.observation = vec![("everything".into(), 2500)];
+            }),
+            "observation names 2500",
+        ),
+        (
+            policy_with_card(
+                dir.path(),
+                "none.safetensors",
+                Some(solver_shape(0, 0)),
+                |c| {
+                    c.continuous_actions.clear();
+                    c.binary_actions.clear();
+                },
+            ),
+            "0 continuous and 0 binary actions",
+        ),
+        (
+            policy_with_card(
+                dir.path(),
+                "swapped.safetensors",
+                Some(solver_shape(1, 2)),
+                |c| {
+                    c.continuous_actions = vec!["forward".into()];
+                    c.binary_actions = vec!["turn".into(), "jump".into()];
+                },
+            ),
+            "1 continuous and 2 binary actions",
+        ),
+    ];
+    for (policy, expected) in &cases {
+        for args in [
+            vec!["verify", "--trials", "1", "--policy", policy, level],
+            vec!["export-policy", policy, "--out", "/nonexistent-dir/x.onnx"],
+        ] {
+            let output = crate::common::arlpcg(&args);
+            let err = crate::common::stderr(&output);
+            assert_eq!(output.status.code(), Some(1), "{args:?}: {err}");
+            assert!(
+                err.contains(expected) && err.contains(policy.as_str()),
+                "{args:?}: {err}"
+            );
+        }
+    }
+}

@@ -76,7 +76,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     }
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
-    eprintln!(
+    crate::warn!(
         "generator {}; solvers: {}",
         generator_path.display(),
         named
@@ -209,8 +209,8 @@ fn seeds(args: &EvalArgs) -> Result<()> {
         overwrite,
     )?;
     batch.commit()?;
-    println!("{markdown}");
-    println!(
+    crate::say!("{markdown}");
+    crate::say!(
         "wrote {} and {}",
         targets[0].display(),
         targets[1].display()
@@ -234,8 +234,8 @@ fn write_results(results: &eval::Results, out: &Path, overwrite: Overwrite) -> R
         batch.stage(&out.join(name), bytes, overwrite)?;
     }
     batch.commit()?;
-    println!("{markdown}");
-    println!("wrote {} files to {}", files.len(), out.display());
+    crate::say!("{markdown}");
+    crate::say!("wrote {} files to {}", files.len(), out.display());
     Ok(())
 }
 
@@ -282,7 +282,7 @@ fn load_solvers(args: &EvalArgs) -> Result<Vec<(String, SolverPolicy)>> {
                 .iter()
                 .find(|(m, _)| *m == card.training.mode.name())
             {
-                eprintln!(
+                crate::warn!(
                     "note: {} skipped: a {mode} Solver is already loaded",
                     path.display()
                 );
@@ -338,7 +338,7 @@ fn write_shard(
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     fsio::write_atomic(&path, &serde_json::to_vec(&part)?, overwrite)?;
-    println!(
+    crate::say!(
         "wrote shard {}/{} ({} of the evaluation's plays) to {}",
         shard.index,
         shard.count,

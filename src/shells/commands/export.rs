@@ -41,7 +41,7 @@ pub fn run(args: &ExportArgs) -> Result<()> {
     files.check_writable(overwrite)?;
     write_level_files(&level, &files, overwrite)?;
     for path in files.paths() {
-        println!("wrote {}", path.display());
+        crate::say!("wrote {}", path.display());
     }
     Ok(())
 }

@@ -31,7 +31,7 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
     batch.stage(&args.out, &exported.onnx, overwrite)?;
     batch.stage(&sidecar_path, sidecar.as_bytes(), overwrite)?;
     batch.commit()?;
-    println!(
+    crate::say!(
         "wrote {} ({} {}, profile {}, opset {}) and {}",
         args.out.display(),
         card.game,

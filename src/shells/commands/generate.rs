@@ -116,7 +116,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         Some(shard) => format!(" (shard {}/{} of {})", shard.index, shard.count, args.count),
         None => String::new(),
     };
-    println!(
+    crate::say!(
         "wrote {} levels{share} ({files} files{unchanged}) to {}",
         plans.len(),
         args.out.display()
@@ -130,7 +130,7 @@ fn report_verification(levels: &[Level]) {
     let stats: Vec<_> = levels.iter().filter_map(|l| l.stats.as_ref()).collect();
     let redrawn: Vec<u32> = stats.iter().map(|s| s.redraws).filter(|&r| r > 0).collect();
     if !redrawn.is_empty() {
-        println!(
+        crate::say!(
             "redrew {} levels that no run completed ({} draws replaced)",
             redrawn.len(),
             redrawn.iter().sum::<u32>()
@@ -138,14 +138,14 @@ fn report_verification(levels: &[Level]) {
     }
     let unsolved = stats.iter().filter(|s| s.successes == 0).count();
     if unsolved > 0 {
-        println!("kept {unsolved} levels that no run completed (--allow-unsolved)");
+        crate::say!("kept {unsolved} levels that no run completed (--allow-unsolved)");
     }
     let uncertified = stats
         .iter()
         .filter(|s| s.successes > 0 && s.certificate.is_none())
         .count();
     if uncertified > 0 {
-        println!(
+        crate::say!(
             "{uncertified} levels have no certificate: no single run succeeded within the search (their success ratio is tiny)"
         );
     }
@@ -201,7 +201,7 @@ fn target_curve(
         return Ok(None);
     };
     let announce = || {
-        eprintln!(
+        crate::warn!(
             "measuring the policies' λ→success curve ({} λ values × {} levels × {} runs), once",
             difficulty::CURVE_AUX.len(),
             difficulty::CURVE_LEVELS,

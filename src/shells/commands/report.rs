@@ -37,7 +37,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
             }
             train::write_learning_curve(run)
                 .with_context(|| format!("{}: cannot draw its learning curve", run.display()))?;
-            println!("{}", run.join("learning-curve.png").display());
+            crate::say!("{}", run.join("learning-curve.png").display());
         }
         return Ok(());
     }
@@ -50,7 +50,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         return check(&args.out, &page);
     }
     fsio::write_atomic(&args.out, page.as_bytes(), Overwrite::Allowed)?;
-    println!("{} ({} lines)", args.out.display(), page.lines().count());
+    crate::say!("{} ({} lines)", args.out.display(), page.lines().count());
     Ok(())
 }
 
@@ -59,7 +59,7 @@ fn check(path: &Path, page: &str) -> Result<()> {
     let committed = fsio::read_limited(path, MAX_FILE_BYTES, "results page")?;
     let committed = String::from_utf8_lossy(&committed);
     if committed == page {
-        println!("{} is current", path.display());
+        crate::say!("{} is current", path.display());
         return Ok(());
     }
     let line = committed

@@ -14,14 +14,14 @@ use crate::shells::common::{Interrupted, UsageError};
 
 pub fn run(args: &TrainArgs) -> Result<()> {
     if args.print_config {
-        print!(
+        crate::shells::common::say(format_args!(
             "{}",
             serde_yaml::to_string(&TrainConfig::for_run(
                 args.game.unwrap_or(arlpcg_core::level::Game::Platform),
                 args.mode
                     .map_or(arlpcg_core::rl::checkpoint::TrainMode::RulePcg, Into::into)
             ))?
-        );
+        ));
         return Ok(());
     }
     let usage = |message: &str| anyhow::Error::from(UsageError(message.into()));
@@ -35,7 +35,7 @@ pub fn run(args: &TrainArgs) -> Result<()> {
     // Temporary files a killed session left (a checkpoint half written) go first.
     let stale = crate::services::fsio::remove_stale_temps(out, std::time::SystemTime::now())?;
     if stale > 0 {
-        eprintln!(
+        crate::warn!(
             "removed {stale} temporary files a stopped run left in {}",
             out.display()
         );
@@ -126,14 +126,14 @@ fn train_loop(run: &mut dyn Training, minutes: Option<f64>, pause_at: Option<u64
         run.out().display()
     );
     let (time, mfu) = run.time_split();
-    println!(
+    crate::say!(
         "time, all sessions: {} (update at {:.0}% of this machine's {:.0} GFLOP/s matmul peak)",
         time.shares(),
         100.0 * mfu,
         peak / 1e9
     );
     if stop.load(Ordering::SeqCst) {
-        println!("stopped (Ctrl-C or a termination signal) {summary}");
+        crate::say!("stopped (Ctrl-C or a termination signal) {summary}");
         return Err(Interrupted(format!(
             "training interrupted; its checkpoint is saved: --resume continues it ({})",
             run.out().display()
@@ -141,9 +141,9 @@ fn train_loop(run: &mut dyn Training, minutes: Option<f64>, pause_at: Option<u64
         .into());
     }
     if run.solver_steps() < run.budget() {
-        println!("paused {summary} (--resume goes on)");
+        crate::say!("paused {summary} (--resume goes on)");
     } else {
-        println!("finished {summary}");
+        crate::say!("finished {summary}");
     }
     Ok(())
 }

@@ -47,6 +47,9 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
     let mut all = Vec::new();
     let mut halfway = HalfwaySplit::default();
     for path in &args.levels {
+        if crate::shells::common::stdout_closed() {
+            break; // nobody reads the rest
+        }
         let outcome = yaml::load(path)
             .map_err(anyhow::Error::from)
             .and_then(|level| {
@@ -64,9 +67,9 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
         match outcome {
             Ok((level, stats)) => {
                 if args.json {
-                    println!("{}", to_json(path, &level, &stats));
+                    crate::say!("{}", to_json(path, &level, &stats));
                 } else {
-                    println!("{}", describe(path, &level, &stats));
+                    crate::say!("{}", describe(path, &level, &stats));
                 }
                 halfway.add(&level, &stats);
                 if let Some(chart) = &args.chart {
@@ -77,13 +80,13 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
                         &png,
                         crate::services::fsio::Overwrite::Never,
                     )?;
-                    eprintln!("wrote {}", chart.display());
+                    crate::warn!("wrote {}", chart.display());
                 }
                 all.push(stats);
             }
             Err(err) => {
                 failed += 1;
-                eprintln!("error: {}", one_line(&format!("{err:#}")));
+                crate::warn!("error: {}", one_line(&format!("{err:#}")));
             }
         }
     }
@@ -93,13 +96,17 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
             true => format!("{:.0}", s.mean_success_steps),
             false => "n/a".into(),
         };
-        println!(
+        crate::say!(
             "{} levels: success ratio {:.3} ± {:.3} (mean ± std over levels), completed by at least one run {:.2}, mean progress {:.2}, mean steps of successful runs {steps}",
-            s.levels, s.mean_success, s.std_success, s.completed_by_any, s.mean_progress
+            s.levels,
+            s.mean_success,
+            s.std_success,
+            s.completed_by_any,
+            s.mean_progress
         );
         let [before, past] = halfway.per_piece();
         if halfway.failures.iter().sum::<u64>() > 0 {
-            println!(
+            crate::say!(
                 "failures per piece {before:.2} before the halfway point ({} pieces), {past:.2} past it ({} pieces): {:.0}% of the {} failures fall past it",
                 halfway.pieces[0],
                 halfway.pieces[1],
@@ -121,11 +128,14 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
 fn replay(args: &VerifyArgs) -> Result<()> {
     let mut failed = 0;
     for path in &args.levels {
+        if crate::shells::common::stdout_closed() {
+            break; // nobody reads the rest
+        }
         let outcome = yaml::load(path)
             .map_err(anyhow::Error::from)
             .and_then(|level| replay_one(&level));
         match outcome {
-            Ok(said) => println!("{}: {said}", path.display()),
+            Ok(said) => crate::say!("{}: {said}", path.display()),
             Err(err) => {
                 failed += 1;
                 report_error(path, &err);
@@ -186,6 +196,9 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
     let mut rated: Vec<(&Path, Game, PanelStats)> = Vec::new();
     let mut failed = 0;
     for path in &args.levels {
+        if crate::shells::common::stdout_closed() {
+            break; // nobody reads the rest
+        }
         let outcome = yaml::load(path)
             .map_err(anyhow::Error::from)
             .and_then(|level| {
@@ -200,7 +213,7 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
                         let chosen = (!chosen.0.is_empty()).then_some(chosen.0.as_slice());
                         let panel = load_panel(&dir, game, chosen)?;
                         if !args.json {
-                            eprintln!("{game} panel: {}", panel.names().join(", "));
+                            crate::warn!("{game} panel: {}", panel.names().join(", "));
                         }
                         new.insert(panel)
                     }
@@ -246,7 +259,7 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
                 .iter()
                 .map(|(name, theta)| format!("{name} {theta:+.2}"))
                 .collect();
-            println!("{game} judges' ability θ (logits): {}", shown.join(", "));
+            crate::say!("{game} judges' ability θ (logits): {}", shown.join(", "));
         }
     }
     for (path, _, stats) in &rated {
@@ -257,7 +270,7 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
                 .iter()
                 .map(|j| (j.judge.clone(), json!(j.success_ratio)))
                 .collect();
-            println!(
+            crate::say!(
                 "{}",
                 json!({
                     "level": path.display().to_string(),
@@ -274,7 +287,7 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
                 .iter()
                 .map(|j| format!("{} {:.2}", j.judge, j.success_ratio))
                 .collect();
-            println!(
+            crate::say!(
                 "{}: difficulty b {:+.2} (95% CI {:+.2} to {:+.2}); {}",
                 path.display(),
                 rating.b,
@@ -335,7 +348,7 @@ impl Solvers {
                 Resolved::Scripted(skill) => format!("scripted player ({skill})"),
                 Resolved::Random => "random actions".into(),
             };
-            eprintln!("{game} solver: {who}");
+            crate::warn!("{game} solver: {who}");
         }
         self.resolved.insert(game, resolved);
         Ok(())
@@ -448,7 +461,7 @@ fn describe(path: &Path, level: &Level, s: &SolverStats) -> String {
 
 /// Prints a level file's error on one line.
 fn report_error(path: &Path, err: &anyhow::Error) {
-    eprintln!(
+    crate::warn!(
         "error: {}: {}",
         path.display(),
         one_line(&format!("{err:#}"))

@@ -252,6 +252,34 @@ fn check_normalizer(norm: &RunningNorm) -> Result<(), PolicyError> {
     Err(PolicyError::Card(problem.into()))
 }
 
+/// The card's own lists must agree with its network: as many named observation values, and
+/// continuous and binary actions, as the network has inputs and outputs of each kind.
+fn check_card_agrees(card: &PolicyCard) -> Result<(), PolicyError> {
+    let network = &card.network;
+    let observed: usize = card.observation.iter().map(|(_, n)| n).sum();
+    let problem = if observed != network.observation {
+        format!(
+            "card field observation names {observed} values, its network observes {}",
+            network.observation
+        )
+    } else if card.continuous_actions.len() != network.continuous {
+        format!(
+            "card field continuous_actions names {} actions, its network has {}",
+            card.continuous_actions.len(),
+            network.continuous
+        )
+    } else if card.binary_actions.len() != network.binary {
+        format!(
+            "card field binary_actions names {} actions, its network has {}",
+            card.binary_actions.len(),
+            network.binary
+        )
+    } else {
+        return Ok(());
+    };
+    Err(PolicyError::Card(problem))
+}
+
 /// Sets `var` to the tensor `name` of `tensors`, checked for the variable's shape and for finite
 /// values.
 pub fn restore_var(
@@ -334,6 +362,7 @@ pub fn load_policy(
         )));
     }
     check_normalizer(&card.normalizer)?;
+    check_card_agrees(&card)?;
     if card.network.hidden.len() > MAX_HIDDEN_LAYERS {
         return Err(PolicyError::Card(format!(
             "its network has {} hidden layers, more than {MAX_HIDDEN_LAYERS}",

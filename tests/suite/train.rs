@@ -131,8 +131,9 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
         killed.to_string()
     );
     a_live_lock_refuses_a_second_session(&out);
-    // The stale lock does not hold (the sessions below take it over).
-    std::fs::write(&lock, format!("{killed}\n")).unwrap();
+    // A stale lock does not hold (the sessions below take it over): its process is gone, or
+    // its number now belongs to another program (this test's own).
+    std::fs::write(&lock, format!("{}\n", std::process::id())).unwrap();
     let checkpoint = std::fs::read(out.join("checkpoint.safetensors")).unwrap();
     let saved = load_policy(&checkpoint, Game::Platform, Role::Solver, OBSERVATION_SIZE).unwrap();
     let state = saved.training_state().unwrap();
@@ -216,12 +217,20 @@ fn the_card_records_the_whole_run(out: &Path, target: u64) {
     assert_eq!(card["role"], "solver");
 }
 
-/// A lock held by a live process (this test's) refuses a second session and changes nothing.
+/// A lock held by a live process refuses a second session, naming the lock file, and changes
+/// nothing. The holder is util-linux's `flock`, which takes the lock a session takes.
 fn a_live_lock_refuses_a_second_session(out: &Path) {
     let lock = out.join("train.lock");
     let before = curve(out);
     let out_s = out.to_str().unwrap();
-    std::fs::write(&lock, format!("{}\n", std::process::id())).unwrap();
+    // `-o`: the lock stays with `flock` itself (not its `sleep`), so killing it lets go.
+    let mut holder = Command::new("flock")
+        .arg("-o")
+        .arg(&lock)
+        .args(["sleep", "60"])
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(300));
     let busy = arlpcg(&[
         "train",
         "--mode",
@@ -232,7 +241,10 @@ fn a_live_lock_refuses_a_second_session(out: &Path) {
         out_s,
         "--resume",
     ]);
+    holder.kill().unwrap();
+    holder.wait().unwrap();
     fails_with(&busy, 1, "in use by another training session");
+    assert!(stderr(&busy).contains("train.lock"), "{}", stderr(&busy));
     assert_eq!(curve(out), before);
 }
 
@@ -1667,4 +1679,35 @@ fn the_time_buckets_add_up_to_each_iteration_and_reach_the_cards() {
             "{text}"
         );
     }
+}
+
+#[test]
+fn two_new_runs_into_one_folder_leave_one_run_whole() {
+    let (_dir, config, out) = scratch(TINY);
+    let start = |seed: &str| {
+        Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+            .args(["train", "--mode", "fixed-track", "--steps", "2000"])
+            .args(["--seed", seed, "--config", config.to_str().unwrap()])
+            .args(["--out", out.to_str().unwrap(), "--threads", "1"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let (first, second) = (start("1"), start("2"));
+    let results = [
+        first.wait_with_output().unwrap(),
+        second.wait_with_output().unwrap(),
+    ];
+    let won: Vec<usize> = (0..2).filter(|&k| results[k].status.success()).collect();
+    assert_eq!(won.len(), 1, "exactly one run goes on");
+    let lost = &results[1 - won[0]];
+    assert_eq!(lost.status.code(), Some(1), "{}", stderr(lost));
+    let policy = std::fs::read(out.join("solver.safetensors")).unwrap();
+    let loaded = load_policy(&policy, Game::Platform, Role::Solver, OBSERVATION_SIZE).unwrap();
+    assert_eq!(
+        loaded.card.training.seed,
+        won[0] as u64 + 1,
+        "the folder holds the winner's run"
+    );
 }

@@ -28,10 +28,21 @@ pub fn run(args: &TrainArgs) -> Result<()> {
     let out = args.out.as_ref().ok_or_else(|| {
         usage("--out DIR is required: where the run's checkpoint, metrics and policy go")
     })?;
-    // One session per run folder: a second (a resume started twice) would interleave
-    // checkpoints. Taken before anything in the folder is touched; a folder that does not
-    // exist yet is locked as soon as the run has made it (a refused run makes none).
-    let lock = out.is_dir().then(|| RunLock::take(out)).transpose()?;
+    // Ctrl-C and SIGTERM from here on stop the run at its next safe point, with a checkpoint.
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        // A second handler cannot be installed (tests run several runs in one process).
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    if out.exists() && !out.is_dir() {
+        return Err(usage(&format!("--out {} is not a folder", out.display())));
+    }
+    // One session per run folder: two (two new runs, a resume started twice) would interleave
+    // or replace each other's files. The folder is made, if need be, and locked before
+    // anything is written in it; a run refused after that takes away the folder it made.
+    let made = make_run_folder(out)?;
+    let lock = RunLock::take(out)?;
     // Temporary files a killed session left (a checkpoint half written) go first.
     let stale = crate::services::fsio::remove_stale_temps(out, std::time::SystemTime::now())?;
     if stale > 0 {
@@ -42,7 +53,7 @@ pub fn run(args: &TrainArgs) -> Result<()> {
     }
     let pool = crate::shells::common::thread_pool(args.threads)?;
     pool.install(|| {
-        let mut run = train::open(
+        let opened = train::open(
             args.game,
             args.mode.map(Into::into),
             out,
@@ -50,11 +61,18 @@ pub fn run(args: &TrainArgs) -> Result<()> {
             args.seed,
             args.steps,
             args.resume,
-        )?;
-        let _lock = match lock {
-            Some(lock) => lock,
-            None => RunLock::take(out)?,
+        );
+        let mut run = match opened {
+            Ok(run) => run,
+            Err(err) => {
+                drop(lock);
+                if made {
+                    let _ = std::fs::remove_dir(out); // only while it is still empty
+                }
+                return Err(err);
+            }
         };
+        let _lock = lock;
         run.add_session(
             std::iter::once("arlpcg".to_string())
                 .chain(std::env::args().skip(1))
@@ -62,8 +80,25 @@ pub fn run(args: &TrainArgs) -> Result<()> {
                 .join(" "),
             crate::shells::common::code_commit(),
         );
-        train_loop(run.as_mut(), args.minutes, args.pause_at)
+        train_loop(run.as_mut(), args.minutes, args.pause_at, &stop)
     })
+}
+
+/// Makes the run folder `out` (and the folders above it) unless it exists; whether it made it.
+fn make_run_folder(out: &std::path::Path) -> Result<bool> {
+    if out.is_dir() {
+        return Ok(false);
+    }
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent)
+            .with_context(|| format!("cannot create {}", parent.display()))?;
+    }
+    match std::fs::create_dir(out) {
+        Ok(()) => Ok(true),
+        // Another run made it a moment ago: the lock decides which of the two goes on.
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && out.is_dir() => Ok(false),
+        Err(e) => Err(e).with_context(|| format!("cannot create {}", out.display())),
+    }
 }
 
 /// The matrix product (`n × n × n`) whose rate is this machine's peak, measured at the start of
@@ -71,15 +106,14 @@ pub fn run(args: &TrainArgs) -> Result<()> {
 const PEAK_PROBE_SIZE: usize = 1024;
 
 /// Iterates `run` until its budget of Solver steps, `minutes` of this session, `pause_at` Solver
-/// steps, or a signal; checkpoints on the run's interval and at the end, then writes the
+/// steps, or a signal (`stop`); checkpoints on the run's interval and at the end, then writes the
 /// policies.
-fn train_loop(run: &mut dyn Training, minutes: Option<f64>, pause_at: Option<u64>) -> Result<()> {
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        // A second handler cannot be installed (tests run several runs in one process).
-        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
-    }
+fn train_loop(
+    run: &mut dyn Training,
+    minutes: Option<f64>,
+    pause_at: Option<u64>,
+    stop: &AtomicBool,
+) -> Result<()> {
     let session = Instant::now();
     let seconds = || session.elapsed().as_secs_f64();
     let peak = arlpcg_core::rl::fused::matmul_peak_flops(PEAK_PROBE_SIZE, 3, &seconds);
@@ -148,53 +182,52 @@ fn train_loop(run: &mut dyn Training, minutes: Option<f64>, pause_at: Option<u64
     Ok(())
 }
 
-/// The run folder's lock: [`train::LOCK_FILE`] holding this process's id, removed when the
-/// session ends. A lock whose process is gone (a killed session) is taken over; the check reads
-/// `/proc`, so where there is none every lock counts as gone.
+/// The run folder's lock: [`train::LOCK_FILE`], locked (`flock`) while the session runs and
+/// holding its process id for messages; removed when the session ends. The operating system
+/// lets go of the lock when the process ends however it ends, so a killed session's file does
+/// not hold, whatever process now has its number.
 struct RunLock {
     path: std::path::PathBuf,
+    /// Holds the lock while it is open.
+    _file: std::fs::File,
 }
 
 impl RunLock {
     fn take(out: &std::path::Path) -> Result<Self> {
+        use std::io::{Read, Seek, Write};
         let path = out.join(train::LOCK_FILE);
-        let ours = std::process::id();
-        loop {
-            match std::fs::OpenOptions::new()
-                .write(true)
-                .create_new(true)
-                .open(&path)
-            {
-                Ok(mut file) => {
-                    use std::io::Write;
-                    writeln!(file, "{ours}")
-                        .with_context(|| format!("cannot write {}", path.display()))?;
-                    return Ok(Self { path });
-                }
-                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                    let holder = std::fs::read_to_string(&path)
-                        .ok()
-                        .and_then(|text| text.trim().parse::<u32>().ok());
-                    if let Some(pid) = holder
-                        && pid != ours
-                        && std::path::Path::new(&format!("/proc/{pid}")).exists()
-                    {
-                        anyhow::bail!(
-                            "{} is in use by another training session (process {pid}); wait for \
-                             it to finish or stop it (Ctrl-C saves its checkpoint) before resuming",
-                            out.display()
-                        );
-                    }
-                    // Its session is gone: the lock is stale.
-                    std::fs::remove_file(&path).with_context(|| {
-                        format!("cannot remove the stale lock {}", path.display())
-                    })?;
-                }
-                Err(e) => {
-                    return Err(e).with_context(|| format!("cannot create {}", path.display()));
-                }
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&path)
+            .with_context(|| format!("cannot create {}", path.display()))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                let mut holder = String::new();
+                let _ = file.read_to_string(&mut holder);
+                let holder = match holder.trim() {
+                    "" => String::new(),
+                    pid => format!(" (process {pid})"),
+                };
+                anyhow::bail!(
+                    "{} is in use by another training session{holder}, which holds {}; wait for \
+                     it to finish or stop it (Ctrl-C saves its checkpoint)",
+                    out.display(),
+                    path.display()
+                );
+            }
+            Err(std::fs::TryLockError::Error(e)) => {
+                return Err(e).with_context(|| format!("cannot lock {}", path.display()));
             }
         }
+        file.set_len(0)
+            .and_then(|()| file.rewind())
+            .and_then(|()| writeln!(file, "{}", std::process::id()))
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(Self { path, _file: file })
     }
 }
 

@@ -10,11 +10,22 @@ use crate::level::scene::{Physics, Scene};
 pub const OMI_BODY: &str = "OMI_physics_body";
 pub const OMI_SHAPE: &str = "OMI_physics_shape";
 
+/// An `OMI_physics_shape` cylinder: `radiusBottom` and `radiusTop` as the current
+/// specification reads them, and `radius` as Godot 4 reads them.
+fn cylinder(radius: f64, height: f64) -> serde_json::Value {
+    serde_json::json!({
+        "radius": radius,
+        "radiusBottom": radius,
+        "radiusTop": radius,
+        "height": height,
+    })
+}
+
 /// Colliders and the finish trigger as the `OMI_physics_shape` / `OMI_physics_body` extensions
 /// (used, not required; Godot 4 imports them as static bodies and areas): a box collider node
 /// beside each block and box obstacle (unscaled, as physics engines want), a cylinder beside each
-/// cylinder obstacle, the road segments' own meshes as triangle meshes, a cylinder trigger on the
-/// finish zone. Collider nodes are pushed after `nodes`' existing ones.
+/// cylinder obstacle, the road segments' own meshes as triangle meshes beside each segment, a
+/// cylinder trigger on the finish zone. Collider nodes are pushed after `nodes`' existing ones.
 pub(super) fn physics(
     scene: &Scene,
     root: &mut json::Root,
@@ -51,11 +62,21 @@ pub(super) fn physics(
     for (mesh, &(node, mesh_index)) in scene.meshes.iter().zip(mesh_nodes) {
         match mesh.physics {
             Physics::SolidMesh => {
+                // On a node of its own beside the visible one, as the boxes: Godot 4 turns a
+                // node that holds a collider into a body and drops the mesh on it.
                 let index = shape(serde_json::json!({
                     "type": "trimesh",
                     "trimesh": {"mesh": mesh_index.value()},
                 }));
-                root.nodes[node.value()].extensions = body("collider", index);
+                let visible = &root.nodes[node.value()];
+                extra_nodes.push(json::Node {
+                    name: Some(format!("{}_collider", mesh.name)),
+                    translation: visible.translation,
+                    rotation: visible.rotation,
+                    scale: visible.scale,
+                    extensions: body("collider", index),
+                    ..Default::default()
+                });
             }
             Physics::SolidCylinder {
                 base,
@@ -64,7 +85,7 @@ pub(super) fn physics(
             } => {
                 let index = shape(serde_json::json!({
                     "type": "cylinder",
-                    "cylinder": {"radius": radius, "height": height},
+                    "cylinder": cylinder(radius, height),
                 }));
                 extra_nodes.push(json::Node {
                     name: Some(format!("{}_collider", mesh.name)),
@@ -80,7 +101,7 @@ pub(super) fn physics(
         if let Physics::TriggerCylinder { radius, height } = point.physics {
             let index = shape(serde_json::json!({
                 "type": "cylinder",
-                "cylinder": {"radius": radius, "height": height},
+                "cylinder": cylinder(radius, height),
             }));
             root.nodes[node.value()].extensions = body("trigger", index);
         }

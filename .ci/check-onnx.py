@@ -36,7 +36,14 @@ def check(path):
         worst = max(worst, error)
         if not error < TOLERANCE:
             raise SystemExit(f"{path}: output {name} is off by {error} (tolerance {TOLERANCE})")
+    for port in sidecar["outputs"]:
+        expected_type = np.int64 if port.get("element_type") == "int64" else np.float32
+        if results[port["name"]].dtype != expected_type:
+            raise SystemExit(f"{path}: output {port['name']} is {results[port['name']].dtype}")
     if sidecar["profile"] == "mlagents":
+        for name in ["discrete_actions", "deterministic_discrete_actions"]:
+            if name in results and results[name].dtype != np.int64:
+                raise SystemExit(f"{path}: ML-Agents' {name} must be int64")
         if results["version_number"].tolist() != [3.0] or results["memory_size"].tolist() != [0.0]:
             raise SystemExit(f"{path}: ML-Agents version_number/memory_size are not [3]/[0]")
     print(f"{path}: checker passed, onnxruntime {onnxruntime.__version__} max abs error {worst:.2e}")

@@ -72,6 +72,12 @@ fn run_tract(
         .iter()
         .zip(outputs.iter())
         .map(|(port, value)| {
+            // ML-Agents' discrete actions are integers, as the sidecar says; compared as floats.
+            let integers = port.element_type.as_deref() == Some("int64");
+            // (tract may carry int64 as its symbolic-dimension integers, TDim)
+            let integer = matches!(value.datum_type(), DatumType::I64 | DatumType::TDim);
+            assert_eq!(integer, integers, "{}: {:?}", port.name, value.datum_type());
+            let value = value.cast_to::<f32>().unwrap();
             let values = value.to_plain_array_view::<f32>().unwrap();
             (port.name.clone(), values.iter().copied().collect())
         })

@@ -145,11 +145,16 @@ pub(super) fn entry(key: &str, value: &str) -> StringStringEntryProto {
 
 /// A float tensor value; `None` dimensions are the batch.
 pub(super) fn value_info(name: &str, dims: &[Option<usize>]) -> ValueInfoProto {
+    typed_value_info(name, dims, FLOAT)
+}
+
+/// A tensor value of `element` type (an ONNX `TensorProto.DataType`).
+pub(super) fn typed_value_info(name: &str, dims: &[Option<usize>], element: i32) -> ValueInfoProto {
     ValueInfoProto {
         name: name.into(),
         r#type: Some(TypeProto {
             tensor_type: Some(TensorTypeProto {
-                elem_type: FLOAT,
+                elem_type: element,
                 shape: Some(TensorShapeProto {
                     dim: dims
                         .iter()

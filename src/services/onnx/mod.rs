@@ -34,7 +34,7 @@ use arlpcg_core::level::PolicyRef;
 use arlpcg_core::rl::checkpoint::PolicyCard;
 use arlpcg_core::rl::normalizer::{CLIP, RunningNorm};
 use arlpcg_core::rl::policy::{ActMode, ActorCritic};
-use builder::{GraphBuilder, attribute_int, entry, value_info};
+use builder::{GraphBuilder, attribute_int, entry, typed_value_info, value_info};
 use proto::*;
 
 /// The ONNX operator set the graphs use.
@@ -107,6 +107,10 @@ pub struct Port {
     /// `"batch"` for the rows, else a size.
     pub shape: Vec<serde_json::Value>,
     pub meaning: String,
+    /// The elements' type where they are not 32-bit floats (`int64`: ML-Agents' discrete
+    /// actions).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub element_type: Option<String>,
     /// What the columns of the last dimension hold, in order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub columns: Vec<Columns>,
@@ -160,6 +164,8 @@ struct Output {
     dims: Vec<Option<usize>>,
     meaning: &'static str,
     columns: Vec<Columns>,
+    /// 64-bit integers rather than floats.
+    int64: bool,
 }
 
 const CONTINUOUS_MEANING: &str =
@@ -194,7 +200,10 @@ pub fn export(
         Profile::Mlagents => mlagents_outputs(&mut graph, card, continuous_actions, logits),
     };
     for (name, output) in &outputs {
-        graph.outputs.push(value_info(name, &output.dims));
+        let element = if output.int64 { INT64 } else { FLOAT };
+        graph
+            .outputs
+            .push(typed_value_info(name, &output.dims, element));
     }
     let model = ModelProto {
         ir_version: IR_VERSION,
@@ -233,6 +242,7 @@ pub fn export(
         name: input.into(),
         shape: dims_json(&[None, Some(observation)]),
         meaning: "raw observations, as the game produces them (normalized inside the graph)".into(),
+        element_type: None,
         columns: columns(card.observation.clone()),
     }];
     if profile == Profile::Mlagents && binary > 0 {
@@ -242,6 +252,7 @@ pub fn export(
             meaning: "1 where a branch's option is allowed, 0 where masked; all ones to leave \
                 the policy free"
                 .into(),
+            element_type: None,
             columns: columns(
                 card.binary_actions
                     .iter()
@@ -273,6 +284,7 @@ pub fn export(
                     name,
                     shape: dims_json(&output.dims),
                     meaning: output.meaning.into(),
+                    element_type: output.int64.then(|| "int64".into()),
                     columns: output.columns,
                 })
                 .collect(),
@@ -297,6 +309,7 @@ fn plain_outputs(
                 dims: vec![None, Some(card.continuous_actions.len())],
                 meaning: CONTINUOUS_MEANING,
                 columns: action_columns(&card.continuous_actions),
+                int64: false,
             },
         ));
     }
@@ -315,6 +328,7 @@ fn plain_outputs(
                 dims: vec![None, Some(binary)],
                 meaning: "each binary action's probability of being on",
                 columns: action_columns(&card.binary_actions),
+                int64: false,
             },
         ));
         outputs.push((
@@ -324,6 +338,7 @@ fn plain_outputs(
                 meaning: "the deterministic binary actions: 1 when the probability is at least \
                     0.5, else 0",
                 columns: action_columns(&card.binary_actions),
+                int64: false,
             },
         ));
     }
@@ -346,6 +361,7 @@ fn mlagents_outputs(
             dims: vec![Some(values.len())],
             meaning,
             columns: vec![],
+            int64: false,
         };
         (name.to_string(), output)
     };
@@ -371,6 +387,7 @@ fn mlagents_outputs(
                 dims: vec![None, Some(continuous)],
                 meaning: CONTINUOUS_MEANING,
                 columns: action_columns(&card.continuous_actions),
+                int64: false,
             };
             outputs.push((name.into(), output));
         }
@@ -397,7 +414,8 @@ fn mlagents_outputs(
         let off = graph.node("Mul", &[&off, &allowed_off], vec![]);
         let below = graph.node("Less", &[&on, &off], vec![]);
         let chosen = graph.node("Not", &[&below], vec![]);
-        let actions = graph.node("Cast", &[&chosen], vec![attribute_int("to", FLOAT as i64)]);
+        // Integers, as ML-Agents' own exporter writes them and its runtime reads them.
+        let actions = graph.node("Cast", &[&chosen], vec![attribute_int("to", INT64 as i64)]);
         let copy = graph.node("Identity", &[&actions], vec![]);
         graph.rename(&actions, "discrete_actions");
         graph.rename(&copy, "deterministic_discrete_actions");
@@ -407,6 +425,7 @@ fn mlagents_outputs(
                 meaning: "one branch per binary action: 1 (on) when its probability, masked, \
                     is at least that of 0 (off)",
                 columns: action_columns(&card.binary_actions),
+                int64: true,
             };
             outputs.push((name.into(), output));
         }

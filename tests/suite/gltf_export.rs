@@ -3,7 +3,10 @@
 
 use crate::common::import_glb;
 use arlpcg_core::game::platform::rules;
+use arlpcg_core::level::Track;
 use arlpcg_core::level::platform::BLOCK_THICKNESS;
+use arlpcg_core::level::racing::FINISH_LENGTH;
+use arlpcg_core::level::road::ROAD_WIDTH;
 use arlpcg_core::level::scene::Scene;
 use arlpcg_core::level::{Level, PlatformRulesConfig, gltf as export};
 
@@ -397,12 +400,99 @@ fn every_solid_piece_has_a_collider_and_the_finish_a_trigger() {
         assert!(solid > level.piece_count(), "{game}: {solid} solid nodes");
         let trigger = named("finish_zone").expect("a finish zone");
         let shape = shape_of(trigger, "trigger").unwrap();
-        assert_eq!(shape["type"], "cylinder");
-        both_radius_forms(shape);
-        assert!(
-            shape["cylinder"]["radius"].as_f64().unwrap() >= 3.0,
-            "{shape}"
-        );
+        assert_eq!(shape["type"], "box");
+        finish_zone_is_where_the_game_counts_success(&level, trigger, &shape["box"]["size"]);
+    }
+}
+
+/// The finish trigger is the success region: the goal block's top (platform), the road's last
+/// 3 m across its width (racing), in the trigger node's own frame.
+fn finish_zone_is_where_the_game_counts_success(
+    level: &Level,
+    trigger: &serde_json::Value,
+    size: &serde_json::Value,
+) {
+    let number = |v: &serde_json::Value| v.as_f64().unwrap();
+    let size: Vec<f64> = size.as_array().unwrap().iter().map(number).collect();
+    let t: Vec<f64> = trigger["translation"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(number)
+        .collect();
+    let q: Vec<f64> = trigger["rotation"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(number)
+        .collect();
+    // A world point in the trigger's frame: q⁻¹ · (p − t) for a unit quaternion [x, y, z, w].
+    let local = |p: [f64; 3]| {
+        let v = [p[0] - t[0], p[1] - t[1], p[2] - t[2]];
+        let (u, w) = ([-q[0], -q[1], -q[2]], q[3]);
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let c = cross(u, v);
+        let c2 = cross(u, c);
+        [0, 1, 2].map(|k| v[k] + 2.0 * (w * c[k] + c2[k]))
+    };
+    let inside = |p: [f64; 3]| {
+        let l = local(p);
+        (0..3).all(|k| l[k].abs() <= 0.5 * size[k] + 1e-4)
+    };
+    match &level.track {
+        Track::Platform(track) => {
+            let goal = track.last();
+            assert_eq!(
+                size,
+                vec![goal.size, 2.0, goal.size],
+                "the goal block's top"
+            );
+            let half = 0.5 * goal.size - 1e-3;
+            let top = goal.position;
+            for (a, c) in [
+                (-1.0, -1.0),
+                (-1.0, 1.0),
+                (1.0, -1.0),
+                (1.0, 1.0),
+                (0.0, 0.0),
+            ] {
+                let [fx, fz] = arlpcg_core::level::heading::heading_direction(goal.heading);
+                let p = [
+                    top[0] + half * (a * fx - c * fz),
+                    top[1] + 0.01,
+                    top[2] + half * (a * fz + c * fx),
+                ];
+                assert!(inside(p), "every corner of the goal block's top: {p:?}");
+            }
+            let before = &track.platforms()[track.platforms().len() - 2];
+            assert!(!inside([
+                before.position[0],
+                before.position[1] + 0.01,
+                before.position[2]
+            ]));
+        }
+        Track::Racing(track) => {
+            let road = track.road();
+            assert_eq!(size, vec![ROAD_WIDTH, 6.0, FINISH_LENGTH]);
+            // Points `back` metres before the road's end, `across` from its centre line.
+            let end = road.samples()[road.samples().len() - 1];
+            let at = |back: f64, across: f64| {
+                let (p, f) = (end.across(across), end.forward());
+                [0, 1, 2].map(|k| p[k] - back * f[k])
+            };
+            for across in [-0.49 * ROAD_WIDTH, 0.0, 0.49 * ROAD_WIDTH] {
+                assert!(inside(at(0.1, across)), "the road's end, {across} m across");
+                assert!(inside(at(FINISH_LENGTH - 0.1, across)), "3 m before it");
+                assert!(!inside(at(FINISH_LENGTH + 0.5, across)), "3.5 m before it");
+                assert!(!inside(at(0.0, across + ROAD_WIDTH)), "beside the road");
+            }
+        }
     }
 }
 

@@ -15,6 +15,8 @@ pub const MAX_OBSTACLES: usize = 200;
 pub const GOAL_REACH_HORIZONTAL: f64 = 12.0;
 /// ...and vertically, m.
 pub const GOAL_REACH_VERTICAL: f64 = 6.0;
+/// A run succeeds on the last this many metres of a complete road, within its edges.
+pub const FINISH_LENGTH: f64 = 3.0;
 
 /// The Generator's action for one road segment.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -101,10 +101,10 @@ pub enum Physics {
         radius: f64,
         height: f64,
     },
-    /// Not solid: a zone an engine reports entering (the finish: within reach of the goal).
-    TriggerCylinder {
-        radius: f64,
-        height: f64,
+    /// Not solid: a box (its size in the node's own frame, local +Z along the heading) that an
+    /// engine reports entering: the finish, where the game counts a run a success.
+    TriggerBox {
+        size: [f64; 3],
     },
     /// Only to look at (markers).
     None,
@@ -234,18 +234,62 @@ fn spawn_and_finish(level: &Level) -> Vec<ScenePoint> {
             }),
             physics: Physics::None,
         },
-        // What counts as arriving, as an engine's trigger: within reach of the goal point.
-        ScenePoint {
-            name: "finish_zone".into(),
-            position: level.goal,
-            heading: 0.0,
-            extras: json!({"kind": "finish_zone"}),
-            physics: Physics::TriggerCylinder {
-                radius: horizontal,
-                height: 2.0 * vertical,
-            },
-        },
+        finish_zone(level),
     ]
+}
+
+/// How tall the platform finish zone is above the goal block's top, m (the character is 1.8 m).
+pub const PLATFORM_FINISH_ZONE_HEIGHT: f64 = 2.0;
+/// How far the racing finish zone reaches below and above the road's centre line, m.
+pub const RACING_FINISH_ZONE_BELOW: f64 = 2.0;
+pub const RACING_FINISH_ZONE_ABOVE: f64 = 4.0;
+
+/// Where the game counts a run a success, as an engine's trigger: the goal block's top (the
+/// character stands on it), or the road's last [`super::racing::FINISH_LENGTH`] metres across its
+/// width (the car on the road there).
+fn finish_zone(level: &Level) -> ScenePoint {
+    let (position, heading, size, rule) = match &level.track {
+        Track::Platform(track) => {
+            let goal = track.last();
+            let height = PLATFORM_FINISH_ZONE_HEIGHT;
+            (
+                [
+                    goal.position[0],
+                    goal.position[1] + 0.5 * height,
+                    goal.position[2],
+                ],
+                goal.heading,
+                [goal.size, height, goal.size],
+                "the character stands on the goal block's top",
+            )
+        }
+        Track::Racing(track) => {
+            let road = track.road();
+            let length = super::racing::FINISH_LENGTH;
+            // Back from the road's end along its heading (3 m of road bend by at most 4.5°).
+            let end = road.samples()[road.samples().len() - 1];
+            let forward = end.forward();
+            let height = RACING_FINISH_ZONE_BELOW + RACING_FINISH_ZONE_ABOVE;
+            let centre = [0, 1, 2].map(|k| end.centre[k] - 0.5 * length * forward[k]);
+            (
+                [
+                    centre[0],
+                    centre[1] + 0.5 * height - RACING_FINISH_ZONE_BELOW,
+                    centre[2],
+                ],
+                end.heading.to_degrees(),
+                [super::road::ROAD_WIDTH, height, length],
+                "the car is on the road within its last 3 m",
+            )
+        }
+    };
+    ScenePoint {
+        name: "finish_zone".into(),
+        position,
+        heading,
+        extras: json!({"kind": "finish_zone", "success": rule, "size_m": size}),
+        physics: Physics::TriggerBox { size },
+    }
 }
 
 fn marker(name: &str, base: [f64; 3], height: f64, material: Material) -> SceneNode {

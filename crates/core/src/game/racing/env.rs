@@ -39,8 +39,6 @@ const BELOW_ROAD: f64 = 4.0;
 const FLIP_UP: f32 = 0.3;
 /// ...for this many seconds.
 const FLIP_S: f32 = 1.0;
-/// The run succeeds this close to the end of the road, m.
-const FINISH_MARGIN: f64 = 3.0;
 /// Time allowed: this many seconds...
 const TIME_BASE_S: f64 = 10.0;
 /// ...plus the road's length at this speed, m/s.
@@ -242,20 +240,22 @@ impl RacingEnv {
         } else {
             0
         };
-        let outcome =
-            if self.complete && along >= self.road.length() - FINISH_MARGIN && !beyond_edge {
-                Some(Outcome::Success)
-            } else if position[1] < sample.centre[1] - BELOW_ROAD
-                || self.loose_steps as f32 * DECISION_DT >= OFF_ROAD_S
-            {
-                Some(Outcome::OffRoad)
-            } else if self.flipped_steps as f32 * DECISION_DT >= FLIP_S {
-                Some(Outcome::Flipped)
-            } else if self.steps >= self.max_steps {
-                Some(Outcome::TimedOut)
-            } else {
-                None
-            };
+        let outcome = if self.complete
+            && along >= self.road.length() - crate::level::racing::FINISH_LENGTH
+            && !beyond_edge
+        {
+            Some(Outcome::Success)
+        } else if position[1] < sample.centre[1] - BELOW_ROAD
+            || self.loose_steps as f32 * DECISION_DT >= OFF_ROAD_S
+        {
+            Some(Outcome::OffRoad)
+        } else if self.flipped_steps as f32 * DECISION_DT >= FLIP_S {
+            Some(Outcome::Flipped)
+        } else if self.steps >= self.max_steps {
+            Some(Outcome::TimedOut)
+        } else {
+            None
+        };
         match outcome {
             Some(outcome) => {
                 reward += if outcome == Outcome::Success {

@@ -25,7 +25,7 @@ fn cylinder(radius: f64, height: f64) -> serde_json::Value {
 /// (used, not required; Godot 4 imports them as static bodies and areas): a box collider node
 /// beside each block and box obstacle (unscaled, as physics engines want), a cylinder beside each
 /// cylinder obstacle, the road segments' own meshes as triangle meshes beside each segment, a
-/// cylinder trigger on the finish zone. Collider nodes are pushed after `nodes`' existing ones.
+/// box trigger on the finish zone (where the game counts success). Collider nodes are pushed after `nodes`' existing ones.
 pub(super) fn physics(
     scene: &Scene,
     root: &mut json::Root,
@@ -98,11 +98,8 @@ pub(super) fn physics(
         }
     }
     for (point, &node) in scene.points.iter().zip(point_nodes) {
-        if let Physics::TriggerCylinder { radius, height } = point.physics {
-            let index = shape(serde_json::json!({
-                "type": "cylinder",
-                "cylinder": cylinder(radius, height),
-            }));
+        if let Physics::TriggerBox { size } = point.physics {
+            let index = shape(serde_json::json!({"type": "box", "box": {"size": size}}));
             root.nodes[node.value()].extensions = body("trigger", index);
         }
     }

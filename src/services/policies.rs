@@ -246,6 +246,12 @@ pub fn judge_file(dir: &Path, judge: Judge) -> Option<PathBuf> {
 /// whose file is there, and the scripted player at its three skills). A chosen Solver judge
 /// whose file is missing is an error naming it.
 pub fn load_panel(dir: &Path, game: Game, chosen: Option<&[Judge]>) -> Result<JudgePanel> {
+    if !dir.is_dir() {
+        anyhow::bail!(
+            "{}: no such policies folder (the panel's Solvers are read from it)",
+            dir.display()
+        );
+    }
     let judges: Vec<Judge> = match chosen {
         Some(chosen) => chosen.to_vec(),
         None => Judge::ALL

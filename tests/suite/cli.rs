@@ -970,3 +970,87 @@ fn generate_verifies_with_the_solver_policy_it_is_given() {
     ]);
     fails_with(&refused, 2, "--solver-policy");
 }
+
+#[test]
+fn options_that_would_do_nothing_or_count_twice_are_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let out = out.to_str().unwrap();
+    let level = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/levels/platform/platform_seed7_aux+0.50.yaml"
+    );
+    let keep = format!("{level}:2");
+    let chart = dir.path().join("chart.png");
+    std::fs::write(&chart, b"a chart already").unwrap();
+    let chart = chart.to_str().unwrap();
+    let nowhere = dir.path().join("nowhere");
+    let nowhere = nowhere.to_str().unwrap();
+    let cases: [(Vec<&str>, i32, &str); 6] = [
+        (
+            vec!["generate", "--rules", "--keep", &keep, "--out", out],
+            2,
+            "--keep needs --policies",
+        ),
+        (
+            vec![
+                "generate",
+                "--rules",
+                "--judge",
+                "scripted-median",
+                "--out",
+                out,
+            ],
+            2,
+            "--judge plays --verify",
+        ),
+        (
+            vec![
+                "verify",
+                "--panel",
+                "scripted-median,scripted-median",
+                level,
+            ],
+            2,
+            "scripted-median is named twice",
+        ),
+        (
+            vec![
+                "verify",
+                "--panel",
+                "--policies",
+                nowhere,
+                "--trials",
+                "1",
+                level,
+            ],
+            1,
+            "no such policies folder",
+        ),
+        (
+            vec![
+                "generate",
+                "--policies",
+                "policies/platform",
+                "--target-success",
+                "-0.5",
+                "--out",
+                out,
+            ],
+            2,
+            "`-0.5` is not a success ratio",
+        ),
+        (
+            vec!["verify", "--chart", chart, level],
+            1,
+            "already exists: verify writes a new chart",
+        ),
+    ];
+    for (args, code, message) in cases {
+        let output = arlpcg(&args);
+        fails_with(&output, code, message);
+        assert!(!stderr(&output).contains("--force"), "{args:?}");
+    }
+    assert!(!dir.path().join("out").exists(), "nothing written");
+    assert_eq!(std::fs::read(chart).unwrap(), b"a chart already");
+}

@@ -265,7 +265,7 @@ pub struct GenerateArgs {
     /// (λ and draws) until its measured success is within ±0.1 of P; the λ used is recorded.
     /// Verifies with 100 runs unless --verify says otherwise. The policies' λ→success curve is
     /// measured once and kept as difficulty-curve.yaml beside them.
-    #[arg(long, value_name = "P", value_parser = parse_target, conflicts_with = "aux")]
+    #[arg(long, value_name = "P", allow_hyphen_values = true, value_parser = parse_target, conflicts_with = "aux")]
     pub target_success: Option<f64>,
     /// With --verify, keep a level that no run completed. By default it is redrawn (the next
     /// level of the seed, toward the same goal), and each level records one successful run's

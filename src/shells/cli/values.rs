@@ -77,11 +77,20 @@ pub(super) fn parse_profile(s: &str) -> Result<crate::services::onnx::Profile, S
 pub struct Judges(pub Vec<Judge>);
 
 pub(super) fn parse_judges(s: &str) -> Result<Judges, String> {
-    s.split(',')
+    let judges = s
+        .split(',')
         .filter(|name| !name.trim().is_empty())
         .map(Judge::parse)
-        .collect::<Result<Vec<_>, _>>()
-        .map(Judges)
+        .collect::<Result<Vec<_>, _>>()?;
+    for (k, judge) in judges.iter().enumerate() {
+        if judges[..k].contains(judge) {
+            return Err(format!(
+                "{} is named twice: each judge counts once in the rating",
+                judge.name()
+            ));
+        }
+    }
+    Ok(Judges(judges))
 }
 
 pub(super) fn parse_minutes(s: &str) -> Result<f64, String> {

@@ -250,6 +250,12 @@ fn check_arguments(args: &GenerateArgs) -> Result<Vec<u64>> {
     if args.solver_policy.is_some() && args.verify.is_none() && success.is_none() {
         return usage("--solver-policy plays --verify N or --target-success P; give one of them");
     }
+    if args.judge.is_some() && args.verify.is_none() && success.is_none() {
+        return usage("--judge plays --verify N or --target-success P; give one of them");
+    }
+    if args.keep.is_some() && args.policies.is_none() {
+        return usage("--keep needs --policies: a Generator continues the kept pieces");
+    }
     if args.out.exists() && !args.out.is_dir() {
         anyhow::bail!("--out {} is not a folder", args.out.display());
     }

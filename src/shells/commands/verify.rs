@@ -42,6 +42,13 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
         ))
         .into());
     }
+    if let Some(chart) = args.chart.as_ref().filter(|c| c.exists()) {
+        anyhow::bail!(
+            "--chart {} already exists: verify writes a new chart and replaces none; remove it \
+             or name another file",
+            chart.display()
+        );
+    }
     let mut solvers = Solvers::default();
     let mut failed = 0;
     let mut all = Vec::new();

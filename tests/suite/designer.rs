@@ -811,3 +811,26 @@ fn the_whole_panel_plays_the_level_on_screen_and_the_export_records_it() {
         "the same rating"
     );
 }
+
+/// Under `NO_COLOR` (the shell sets `App::colour` from it) every cell is drawn in the
+/// terminal's own colours, with the same text.
+#[test]
+fn no_color_draws_the_same_screen_without_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    h.settle();
+    let cells = |h: &Harness| {
+        let mut terminal = Terminal::new(TestBackend::new(120, 36)).unwrap();
+        terminal.draw(|f| view::render(&h.app, f)).unwrap();
+        terminal.backend().buffer().content.clone()
+    };
+    let coloured = cells(&h);
+    let plain_colour = |c: &ratatui::buffer::Cell| {
+        c.fg == ratatui::style::Color::Reset && c.bg == ratatui::style::Color::Reset
+    };
+    assert!(!coloured.iter().all(plain_colour), "colours by default");
+    let text = h.screen(120, 36);
+    h.app.colour = false;
+    assert!(cells(&h).iter().all(plain_colour));
+    assert_eq!(h.screen(120, 36), text, "the same text");
+}

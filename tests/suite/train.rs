@@ -1608,6 +1608,34 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
             "{field}: left as it was"
         );
     }
+    // The numbers a resume carries on are checked too: a wall time that would reach the card
+    // as -inf, a negative bucket.
+    let numbers: [(&str, &str, serde_json::Value); 2] = [
+        ("wall_time_s", "", serde_json::json!(-1e308)),
+        ("time_split", "env_s", serde_json::json!(-5.0)),
+    ];
+    for (field, inner, value) in numbers {
+        std::fs::write(&checkpoint, &original).unwrap();
+        tamper_training_state(&checkpoint, |state| match inner {
+            "" => state[field] = value.clone(),
+            inner => state[field][inner] = value.clone(),
+        });
+        let resumed = arlpcg(&[
+            "train",
+            "--mode",
+            "fixed-track",
+            "--steps",
+            "512",
+            "--out",
+            out_s,
+            "--resume",
+        ]);
+        let named = match inner {
+            "" => field.to_string(),
+            inner => format!("{field}.{inner}"),
+        };
+        fails_with(&resumed, 1, &format!("training state: {named} is"));
+    }
 }
 
 /// Where training time goes: every metrics row of both agents splits its iteration into

@@ -170,6 +170,8 @@ pub struct App {
     /// Whether the mouse is dragging the slider.
     dragging: bool,
     next_id: u64,
+    /// Whether the screen is drawn in colour (not under `NO_COLOR`).
+    pub colour: bool,
     pub quit: bool,
 }
 
@@ -204,6 +206,7 @@ impl App {
             size: Rect::new(0, 0, 80, 24),
             dragging: false,
             next_id: 1,
+            colour: true,
             quit: false,
         }
     }

@@ -79,6 +79,8 @@ pub fn run(options: DesignOptions) -> Result<()> {
     let (answers, responses) = channel();
     let workers = Workers::start(shelf, answers);
     let mut app = App::new(options.game, info, options.seed, options.out);
+    // https://no-color.org: present and not empty.
+    app.colour = std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty());
     app.other_policies = other_info;
     if let Some(note) = note {
         app.status = Some((note, true));

@@ -163,6 +163,30 @@ pub struct TrainingState {
     pub time_split: TimeSplit,
 }
 
+impl TrainingState {
+    /// The numbers a resume carries on are checked like user input: seconds finite and not
+    /// negative, episode returns finite. `Err` names the field.
+    pub fn check(&self) -> Result<(), String> {
+        let split = &self.time_split;
+        let numbers = std::iter::once(("wall_time_s".to_string(), self.wall_time_s))
+            .chain(
+                split
+                    .buckets()
+                    .map(|(name, value)| (format!("time_split.{name}_s"), value)),
+            )
+            .chain([("time_split.update_flops".into(), split.update_flops)]);
+        for (name, value) in numbers {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(format!("{name} is {value}, not a finite number >= 0"));
+            }
+        }
+        if self.episode_returns.iter().any(|r| !r.is_finite()) {
+            return Err("episode_returns holds a value that is not a finite number".into());
+        }
+        Ok(())
+    }
+}
+
 /// Why a policy or checkpoint could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum PolicyError {
@@ -234,7 +258,12 @@ impl LoadedPolicy {
     /// The training state, for checkpoints.
     pub fn training_state(&self) -> Result<TrainingState, PolicyError> {
         let text = self.training.as_ref().ok_or(PolicyError::NoTrainingState)?;
-        serde_json::from_str(text).map_err(|e| PolicyError::Card(format!("training state: {e}")))
+        let state: TrainingState = serde_json::from_str(text)
+            .map_err(|e| PolicyError::Card(format!("training state: {e}")))?;
+        state
+            .check()
+            .map_err(|problem| PolicyError::Card(format!("training state: {problem}")))?;
+        Ok(state)
     }
 }
 

@@ -52,6 +52,16 @@ pub const KEYS: [(&str, &str); 22] = [
 const HINTS: &str = "←→ λ  ⏎ generate  n seed  r replay  w sweep  x export  p load  ? help  q quit";
 
 pub fn render(app: &App, frame: &mut Frame) {
+    draw_screen(app, frame);
+    if !app.colour {
+        // NO_COLOR: every cell in the terminal's own colours; bold and reversed stay.
+        for cell in frame.buffer_mut().content.iter_mut() {
+            cell.set_fg(Color::Reset).set_bg(Color::Reset);
+        }
+    }
+}
+
+fn draw_screen(app: &App, frame: &mut Frame) {
     let screen = frame.area();
     if !fits(screen) {
         let text = format!(

@@ -14,23 +14,27 @@ fn level(seed: u64) -> Level {
     rules::platform_level(seed, Some(-1.0), None, &PlatformRulesConfig::default()).unwrap()
 }
 
+/// `q · v · q⁻¹`: `v` turned by the unit quaternion `q` = [x, y, z, w].
+fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
+    let u = [q[0], q[1], q[2]];
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let uv = cross(u, v);
+    let uuv = cross(u, uv);
+    [0, 1, 2].map(|k| v[k] + 2.0 * (q[3] * uv[k] + uuv[k]))
+}
+
 /// World-space bounds of every node's unit cube, from the file's own transforms.
 fn node_bounds(node: &gltf::Node) -> ([f32; 3], [f32; 3]) {
     let (t, r, s) = node.transform().decomposed();
     let rotate = |v: [f32; 3]| {
-        // q * v * q^-1 for a unit quaternion [x, y, z, w].
-        let [x, y, z, w] = r;
-        let u = [x, y, z];
-        let cross = |a: [f32; 3], b: [f32; 3]| {
-            [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ]
-        };
-        let uv = cross(u, v);
-        let uuv = cross(u, uv);
-        [0, 1, 2].map(|k| v[k] + 2.0 * (w * uv[k] + uuv[k]))
+        let turned = rotate(r.map(f64::from), v.map(f64::from));
+        turned.map(|c| c as f32)
     };
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
@@ -426,20 +430,10 @@ fn finish_zone_is_where_the_game_counts_success(
         .iter()
         .map(number)
         .collect();
-    // A world point in the trigger's frame: q⁻¹ · (p − t) for a unit quaternion [x, y, z, w].
+    // A world point in the trigger's frame: q⁻¹ · (p − t).
     let local = |p: [f64; 3]| {
         let v = [p[0] - t[0], p[1] - t[1], p[2] - t[2]];
-        let (u, w) = ([-q[0], -q[1], -q[2]], q[3]);
-        let cross = |a: [f64; 3], b: [f64; 3]| {
-            [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ]
-        };
-        let c = cross(u, v);
-        let c2 = cross(u, c);
-        [0, 1, 2].map(|k| v[k] + 2.0 * (w * c[k] + c2[k]))
+        rotate([-q[0], -q[1], -q[2], q[3]], v)
     };
     let inside = |p: [f64; 3]| {
         let l = local(p);

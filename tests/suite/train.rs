@@ -1580,13 +1580,8 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
         ("num_minibatches", serde_json::json!(0), "num_minibatches"),
     ];
     let original = std::fs::read(&checkpoint).unwrap();
-    for (field, value, expected) in cases {
-        std::fs::write(&checkpoint, &original).unwrap();
-        tamper_training_state(&checkpoint, |state| {
-            state["config"]["solver"][field] = value.clone()
-        });
-        let tampered = std::fs::read(&checkpoint).unwrap();
-        let resumed = arlpcg(&[
+    let resume = || {
+        arlpcg(&[
             "train",
             "--mode",
             "fixed-track",
@@ -1595,7 +1590,15 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
             "--out",
             out_s,
             "--resume",
-        ]);
+        ])
+    };
+    for (field, value, expected) in cases {
+        std::fs::write(&checkpoint, &original).unwrap();
+        tamper_training_state(&checkpoint, |state| {
+            state["config"]["solver"][field] = value.clone()
+        });
+        let tampered = std::fs::read(&checkpoint).unwrap();
+        let resumed = resume();
         let err = stderr(&resumed);
         assert_eq!(resumed.status.code(), Some(1), "{field}: {err}");
         assert!(
@@ -1620,16 +1623,7 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
             "" => state[field] = value.clone(),
             inner => state[field][inner] = value.clone(),
         });
-        let resumed = arlpcg(&[
-            "train",
-            "--mode",
-            "fixed-track",
-            "--steps",
-            "512",
-            "--out",
-            out_s,
-            "--resume",
-        ]);
+        let resumed = resume();
         let named = match inner {
             "" => field.to_string(),
             inner => format!("{field}.{inner}"),

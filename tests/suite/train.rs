@@ -1256,6 +1256,27 @@ fn score_a_run_as_one_seed(dir: &Path, run: &str) {
     ]);
     fails_with(&twice, 1, "twice");
     assert!(!dir.join("twice").exists());
+    // Nor is a copy of its folder under another name.
+    let copy = dir.join("copy");
+    std::fs::create_dir(&copy).unwrap();
+    for entry in std::fs::read_dir(run_dir).unwrap() {
+        let entry = entry.unwrap();
+        if entry.file_type().unwrap().is_file() {
+            std::fs::copy(entry.path(), copy.join(entry.file_name())).unwrap();
+        }
+    }
+    let copied = arlpcg(&[
+        "eval",
+        "--runs",
+        run_dir,
+        copy.to_str().unwrap(),
+        "--policies",
+        run_dir,
+        "--out",
+        dir.join("copied").to_str().unwrap(),
+    ]);
+    fails_with(&copied, 1, "one run counted as two seeds");
+    assert!(!dir.join("copied").exists());
 }
 
 /// `--resume --config` replaces the hyper-parameters (the old file is kept) but refuses the

@@ -139,7 +139,7 @@ fn seeds(args: &EvalArgs) -> Result<()> {
             );
         }
     }
-    let mut loaded = Vec::new();
+    let mut loaded: Vec<(&PathBuf, SolverPolicy, _, Option<GeneratorPolicy>)> = Vec::new();
     for dir in &args.runs {
         let (solver, card) =
             load_solver(&dir.join(crate::services::policies::SOLVER_FILE), args.game)?;
@@ -148,6 +148,18 @@ fn seeds(args: &EvalArgs) -> Result<()> {
             true => Some(load_generator(&generator_file, args.game)?.0),
             false => None,
         };
+        // A copied folder is the same run under another name: its Solver's bytes tell.
+        if let Some((first, ..)) = loaded
+            .iter()
+            .find(|(_, other, ..)| other.reference.sha256 == solver.reference.sha256)
+        {
+            bail!(
+                "--runs: {} holds the same Solver as {} (SHA-256 {}): one run counted as two seeds",
+                dir.display(),
+                first.display(),
+                solver.reference.sha256
+            );
+        }
         loaded.push((dir, solver, card, generator));
     }
     let runs: Vec<eval::seeds::SeedRun> = loaded

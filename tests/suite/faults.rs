@@ -432,3 +432,34 @@ fn a_closed_pipe_ends_every_command_quietly_with_its_files_whole() {
     let output = arlpcg_into_closed_pipe(&["verify", &missing], true);
     assert_eq!(output.status.code(), Some(1));
 }
+
+/// Ctrl-C during a long `--verify` stops the trials under way: the command ends at once (exit
+/// 130), writing no level it did not finish.
+#[test]
+fn ctrl_c_stops_a_long_verification_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+        .args(["generate", "--rules", "--count", "2", "--verify", "1000000"])
+        .args(["--out", out.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let sent = Instant::now();
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let output = child.wait_with_output().unwrap();
+    assert!(
+        sent.elapsed() < Duration::from_secs(5),
+        "took {:?}",
+        sent.elapsed()
+    );
+    assert_eq!(output.status.code(), Some(130), "{}", stderr(&output));
+    let written = std::fs::read_dir(&out).map_or(0, |files| files.count());
+    assert_eq!(written, 0, "no unfinished level");
+}

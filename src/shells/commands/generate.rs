@@ -16,7 +16,7 @@ use crate::services::panel::{Judge, JudgePanel, rate};
 use crate::services::policies::{
     load_generator, load_judge, load_panel, load_solver, policy_paths,
 };
-use crate::services::verify::{self, Solver, SolverPolicy, verify};
+use crate::services::verify::{self, Solver, SolverPolicy};
 use crate::shells::cli::{GenerateArgs, KeepArg, default_solver};
 use arlpcg_core::game::Skill;
 use arlpcg_core::level::stats::PanelStats;
@@ -415,19 +415,27 @@ fn build_verified(
     generator: Option<&GeneratorPolicy>,
     solver: &Solver,
     seed: u64,
-) -> Result<Level> {
+    stop: &AtomicBool,
+) -> Result<Option<Level>> {
     let Some(trials) = args.verify else {
-        return build(args, keep, generator, seed, 0);
+        return build(args, keep, generator, seed, 0).map(Some);
+    };
+    // Ctrl-C abandons the trials under way within a tick: the level is not finished.
+    let watch = verify::Watch {
+        on_trial: &|_| {},
+        stop: &|| stop.load(Ordering::SeqCst),
     };
     for draw in 0..MAX_DRAWS {
         let mut level = build(args, keep, generator, seed, draw)?;
-        let mut stats = verify(&level, solver, trials, seed, &|| {})?;
+        let Some(mut stats) = verify::verify_watched(&level, solver, trials, seed, &watch)? else {
+            return Ok(None);
+        };
         if stats.successes == 0 && !args.allow_unsolved {
             continue;
         }
         stats.redraws = draw;
         level.stats = Some(stats);
-        return certified(level, solver, seed);
+        return certified(level, solver, seed).map(Some);
     }
     bail!(
         "none of the {MAX_DRAWS} levels drawn for this seed was completed by any of {trials} runs (--allow-unsolved keeps the first anyway)"
@@ -485,11 +493,14 @@ fn build_levels(
                     verify_trials.unwrap_or(TARGET_TRIALS),
                 )
                 .map_err(anyhow::Error::from)
-                .and_then(|level| certified(level, who, *seed)),
-                _ => build_verified(args, keep, generator, who, *seed),
+                .and_then(|level| certified(level, who, *seed))
+                .map(Some),
+                _ => build_verified(args, keep, generator, who, *seed, stop),
             };
             bar.inc(1);
-            Some(level.with_context(|| format!("seed {seed} (nothing was written)")))
+            level
+                .with_context(|| format!("seed {seed} (nothing was written)"))
+                .transpose()
         })
         .collect();
     bar.finish_and_clear();

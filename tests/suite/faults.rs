@@ -439,7 +439,7 @@ fn a_closed_pipe_ends_every_command_quietly_with_its_files_whole() {
 fn ctrl_c_stops_a_long_verification_at_once() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+    let child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
         .args(["generate", "--rules", "--count", "2", "--verify", "1000000"])
         .args(["--out", out.to_str().unwrap()])
         .stdout(Stdio::null())

@@ -9,6 +9,20 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 fn main() -> ExitCode {
     // SAFETY: first thing in main, before any other thread exists.
     unsafe { arlpcg::shells::common::fix_thread_count() };
+    // Levels, cards and sidecars record paths and commands as UTF-8 text: an argument that is
+    // not UTF-8 could not be recorded as given, so it is refused before anything happens.
+    if let Some((k, arg)) = std::env::args_os()
+        .enumerate()
+        .skip(1)
+        .find(|(_, arg)| arg.to_str().is_none())
+    {
+        arlpcg::warn!(
+            "error: argument {k} ({}) is not valid UTF-8: arlpcg records paths and commands as \
+             UTF-8 text in levels and cards; rename the file or folder",
+            arg.to_string_lossy()
+        );
+        return ExitCode::from(2);
+    }
     let cli = arlpcg::shells::cli::Cli::parse();
     match arlpcg::shells::commands::run(cli) {
         // What the command wrote to files is whole; what it had left to say had nowhere to go.

@@ -463,3 +463,30 @@ fn ctrl_c_stops_a_long_verification_at_once() {
     let written = std::fs::read_dir(&out).map_or(0, |files| files.count());
     assert_eq!(written, 0, "no unfinished level");
 }
+
+/// A path that is not UTF-8 could not be recorded as given (levels and cards are UTF-8 text):
+/// every command refuses it at the start, naming it, and makes nothing.
+#[test]
+fn an_argument_that_is_not_utf8_is_refused_before_anything_is_made() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let odd = dir.path().join(std::ffi::OsStr::from_bytes(b"run-\xff"));
+    for command in [
+        vec!["train", "--steps", "10", "--out"],
+        vec!["export", &shipped_level(), "--out"],
+        vec!["generate", "--rules", "--out"],
+    ] {
+        let output = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+            .args(&command)
+            .arg(&odd)
+            .output()
+            .unwrap();
+        let err = stderr(&output);
+        assert_eq!(output.status.code(), Some(2), "{command:?}: {err}");
+        assert!(
+            err.contains("not valid UTF-8") && err.contains("run-"),
+            "{err}"
+        );
+        assert!(!odd.exists(), "{command:?}: nothing made");
+    }
+}

@@ -23,7 +23,19 @@ fn main() -> ExitCode {
         );
         return ExitCode::from(2);
     }
-    let cli = arlpcg::shells::cli::Cli::parse();
+    let cli = match arlpcg::shells::cli::Cli::try_parse() {
+        Ok(cli) => cli,
+        // A usage error quotes the argument it refuses: a huge one is cut down to its ends.
+        Err(e) if e.use_stderr() => {
+            let text = e.render().to_string();
+            arlpcg::warn!(
+                "{}",
+                arlpcg::shells::common::cut_long_lines(text.trim_end())
+            );
+            return ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2));
+        }
+        Err(e) => e.exit(), // --help and --version
+    };
     match arlpcg::shells::commands::run(cli) {
         // What the command wrote to files is whole; what it had left to say had nowhere to go.
         Ok(()) if arlpcg::shells::common::stdout_closed() => {

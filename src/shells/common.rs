@@ -45,6 +45,31 @@ pub fn warn(text: std::fmt::Arguments) {
     let _ = std::io::stderr().lock().write_fmt(text);
 }
 
+/// The most characters of one line of a message; a longer line (a huge argument quoted back)
+/// keeps its two ends.
+const MESSAGE_LINE_CHARS: usize = 400;
+
+/// `text` with every line longer than [`MESSAGE_LINE_CHARS`] cut down to its first 200 and last
+/// 100 characters around a note of how many went.
+pub fn cut_long_lines(text: &str) -> String {
+    text.lines()
+        .map(|line| {
+            let chars: Vec<char> = line.chars().collect();
+            if chars.len() <= MESSAGE_LINE_CHARS {
+                return line.to_string();
+            }
+            let (head, tail) = (&chars[..200], &chars[chars.len() - 100..]);
+            format!(
+                "{} … ({} characters left out) … {}",
+                head.iter().collect::<String>(),
+                chars.len() - 300,
+                tail.iter().collect::<String>()
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 /// Whether standard output has closed (see [`say`]).
 pub fn stdout_closed() -> bool {
     STDOUT_CLOSED.load(std::sync::atomic::Ordering::SeqCst)

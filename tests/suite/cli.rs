@@ -1054,3 +1054,26 @@ fn options_that_would_do_nothing_or_count_twice_are_refused_by_name() {
     assert!(!dir.path().join("out").exists(), "nothing written");
     assert_eq!(std::fs::read(chart).unwrap(), b"a chart already");
 }
+
+/// A usage error quotes the argument it refuses; a huge one (a 25,000-point curve, 125 KB) is
+/// cut down to its ends, and the reason still shows.
+#[test]
+fn a_huge_refused_argument_is_not_echoed_whole() {
+    let curve = vec!["0:0"; 25_000].join(", ");
+    let output = arlpcg(&[
+        "generate",
+        "--policies",
+        "policies/platform",
+        "--aux-curve",
+        &curve,
+        "--out",
+        "never-written",
+    ]);
+    fails_with(&output, 2, "an aux curve has 1 to 32 points, not 25000");
+    assert!(
+        stderr(&output).len() < 1_000,
+        "{} bytes",
+        stderr(&output).len()
+    );
+    assert!(!Path::new("never-written").exists());
+}

@@ -28,6 +28,17 @@ fn arlpcg_within(args: &[&str], limit: Duration) -> Output {
     child.wait_with_output().unwrap()
 }
 
+/// Sends Ctrl-C (SIGINT) to `child`; when it was sent.
+fn interrupt(child: &std::process::Child) -> Instant {
+    let sent = Instant::now();
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    sent
+}
+
 /// A FIFO at `path`, or `None` (and a message) where `mkfifo` is not available.
 fn fifo(path: &Path) -> Option<PathBuf> {
     let made = Command::new("mkfifo").arg(path).status();
@@ -340,12 +351,7 @@ fn ctrl_c_stops_the_difficulty_curve_measurement_at_once() {
         );
     }
     std::thread::sleep(Duration::from_millis(300));
-    let sent = Instant::now();
-    let killed = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(killed.success());
+    let sent = interrupt(&child);
     let mut rest = String::new();
     std::io::Read::read_to_string(&mut stderr, &mut rest).unwrap();
     let status = child.wait().unwrap();
@@ -447,12 +453,7 @@ fn ctrl_c_stops_a_long_verification_at_once() {
         .spawn()
         .unwrap();
     std::thread::sleep(Duration::from_millis(1500));
-    let sent = Instant::now();
-    let killed = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(killed.success());
+    let sent = interrupt(&child);
     let output = child.wait_with_output().unwrap();
     assert!(
         sent.elapsed() < Duration::from_secs(5),

@@ -216,7 +216,8 @@ pub struct GenerateArgs {
     /// λ along the level instead of one λ (with --policies): control points `fraction:λ`,
     /// where fraction is the share of the start-to-goal distance covered (0 start, 1 goal),
     /// linear between points. "0:1, 0.5:1, 0.6:-1, 1:-1" is easy up to halfway, then hard;
-    /// two points at one fraction are a step ("0:1, 0.5:1, 0.5:-1, 1:-1"). Each piece records the λ it was built at.
+    /// two points at one fraction are a step ("0:1, 0.5:1, 0.5:-1, 1:-1"). Each piece records
+    /// the λ it was built at.
     #[arg(long, value_name = "CURVE", allow_hyphen_values = true, value_parser = AuxCurve::parse, conflicts_with_all = ["aux", "target_success"])]
     pub aux_curve: Option<AuxCurve>,
     /// Keep the first K pieces of an existing level (generated or hand-written) and let the

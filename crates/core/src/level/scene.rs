@@ -239,10 +239,10 @@ fn spawn_and_finish(level: &Level) -> Vec<ScenePoint> {
 }
 
 /// How tall the platform finish zone is above the goal block's top, m (the character is 1.8 m).
-pub const PLATFORM_FINISH_ZONE_HEIGHT: f64 = 2.0;
+const PLATFORM_FINISH_ZONE_HEIGHT: f64 = 2.0;
 /// How far the racing finish zone reaches below and above the road's centre line, m.
-pub const RACING_FINISH_ZONE_BELOW: f64 = 2.0;
-pub const RACING_FINISH_ZONE_ABOVE: f64 = 4.0;
+const RACING_FINISH_ZONE_BELOW: f64 = 2.0;
+const RACING_FINISH_ZONE_ABOVE: f64 = 4.0;
 
 /// Where the game counts a run a success, as an engine's trigger: the goal block's top (the
 /// character stands on it), or the road's last [`super::racing::FINISH_LENGTH`] metres across its
@@ -260,7 +260,7 @@ fn finish_zone(level: &Level) -> ScenePoint {
                 ],
                 goal.heading,
                 [goal.size, height, goal.size],
-                "the character stands on the goal block's top",
+                "the character stands on the goal block's top".to_string(),
             )
         }
         Track::Racing(track) => {
@@ -279,7 +279,7 @@ fn finish_zone(level: &Level) -> ScenePoint {
                 ],
                 end.heading.to_degrees(),
                 [super::road::ROAD_WIDTH, height, length],
-                "the car is on the road within its last 3 m",
+                format!("the car is on the road within its last {length} m"),
             )
         }
     };

@@ -131,8 +131,9 @@ pub(super) fn map(
             color: Color::LightBlue,
         });
         draw_replay(app, ctx, |f| [f[0] as f64, f[2] as f64]);
-        let worst = most_failed.map(|i| road.samples().iter().filter(move |p| p.segment == i));
-        if let Some(middle) = worst.and_then(|on| on.clone().nth(on.count() / 2)) {
+        if let Some(i) = most_failed {
+            let (first, last) = road.segment_samples(i);
+            let middle = road.samples()[(first + last) / 2];
             ctx.print(
                 middle.centre[0],
                 middle.centre[2],

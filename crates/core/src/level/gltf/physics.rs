@@ -25,7 +25,8 @@ fn cylinder(radius: f64, height: f64) -> serde_json::Value {
 /// (used, not required; Godot 4 imports them as static bodies and areas): a box collider node
 /// beside each block and box obstacle (unscaled, as physics engines want), a cylinder beside each
 /// cylinder obstacle, the road segments' own meshes as triangle meshes beside each segment, a
-/// box trigger on the finish zone (where the game counts success). Collider nodes are pushed after `nodes`' existing ones.
+/// box trigger on the finish zone (where the game counts success). Collider nodes are pushed
+/// after `nodes`' existing ones.
 pub(super) fn physics(
     scene: &Scene,
     root: &mut json::Root,

@@ -75,15 +75,45 @@ impl Curve {
 #[derive(Debug, thiserror::Error)]
 pub enum TargetError {
     #[error(
-        "no level within ±{BAND} of success {target} in {MAX_CANDIDATES} candidates (closest: {closest:.2} at λ {aux:+.2})"
+        "no level within ±{BAND} of success {target} in {MAX_CANDIDATES} candidates (closest: {closest:.2} at λ {aux:+.2}){}",
+        set_aside(*.uncompleted, *.unbuilt)
     )]
-    Missed { target: f64, closest: f64, aux: f64 },
+    Missed {
+        target: f64,
+        closest: f64,
+        aux: f64,
+        /// Candidates within the band that no run completed: never kept.
+        uncompleted: u32,
+        /// Draws that did not reach the goal within the piece budget.
+        unbuilt: u32,
+    },
     #[error("stopped while the λ→success curve was measured")]
     Stopped,
     #[error(transparent)]
     Generation(#[from] GenerationError),
     #[error(transparent)]
     WrongGame(#[from] WrongGame),
+}
+
+/// What a missed search set aside, for its message: a target near 0 is missed because a level
+/// that no run completes is never kept.
+fn set_aside(uncompleted: u32, unbuilt: u32) -> String {
+    let mut parts = Vec::new();
+    if uncompleted > 0 {
+        parts.push(format!(
+            "{uncompleted} candidates within it were set aside because no run completed them (a \
+             level is kept only if the Solver completes it; ask for a higher success)"
+        ));
+    }
+    if unbuilt > 0 {
+        parts.push(format!(
+            "{unbuilt} draws did not reach the goal within the piece budget"
+        ));
+    }
+    match parts.is_empty() {
+        true => String::new(),
+        false => format!("; {}", parts.join("; ")),
+    }
 }
 
 /// Measures the curve: [`CURVE_LEVELS`] levels at each λ, [`CURVE_TRIALS`] runs each;
@@ -171,6 +201,7 @@ pub fn level_for(
 ) -> Result<Level, TargetError> {
     let mut aux = curve.aux_for(target);
     let mut closest = (f64::INFINITY, f64::NAN, aux);
+    let (mut uncompleted, mut unbuilt) = (0, 0);
     let obstacles = arlpcg_core::game::facts::facts(generator.game).scene_obstacles;
     for draw in 0..MAX_CANDIDATES {
         let quantized = (aux * 1000.0).round() / 1000.0;
@@ -187,7 +218,10 @@ pub fn level_for(
             .draw(draw);
         let mut level = match generation::generator_level(generator, &request) {
             Ok(level) => level,
-            Err(GenerationError::NoLevel { .. }) => continue,
+            Err(GenerationError::NoLevel { .. }) => {
+                unbuilt += 1;
+                continue;
+            }
             Err(e) => return Err(e.into()),
         };
         let stats = screened_stats(&level, solver, trials, seed, target)?;
@@ -195,9 +229,12 @@ pub fn level_for(
         if miss.abs() < closest.0 {
             closest = (miss.abs(), stats.success_ratio, quantized);
         }
-        if miss.abs() <= BAND + 1e-9 && stats.successes > 0 {
-            level.stats = Some(stats);
-            return Ok(level);
+        if miss.abs() <= BAND + 1e-9 {
+            if stats.successes > 0 {
+                level.stats = Some(stats);
+                return Ok(level);
+            }
+            uncompleted += 1;
         }
         // Too easy (success above the target): lower λ; too hard: raise it.
         aux = (aux - 1.2 * miss).clamp(-1.0, 1.0);
@@ -206,6 +243,8 @@ pub fn level_for(
         target,
         closest: closest.1,
         aux: closest.2,
+        uncompleted,
+        unbuilt,
     })
 }
 
@@ -242,6 +281,31 @@ fn screened_stats(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A missed target names the candidates set aside because no run completed them (why a
+    /// target near 0 is missed), and says nothing of them when there were none.
+    #[test]
+    fn a_missed_target_names_the_candidates_no_run_completed() {
+        let missed = |uncompleted, unbuilt| {
+            TargetError::Missed {
+                target: 0.02,
+                closest: 0.0,
+                aux: -1.0,
+                uncompleted,
+                unbuilt,
+            }
+            .to_string()
+        };
+        let plain = missed(0, 0);
+        assert!(plain.ends_with("(closest: 0.00 at λ -1.00)"), "{plain}");
+        let redrawn = missed(7, 2);
+        assert!(
+            redrawn.contains("7 candidates within it were set aside because no run completed them")
+                && redrawn.contains("ask for a higher success")
+                && redrawn.contains("2 draws did not reach the goal"),
+            "{redrawn}"
+        );
+    }
 
     #[test]
     fn a_damaged_curve_is_named_by_its_point() {

@@ -224,6 +224,30 @@ fn is_our_temp(name: &str) -> bool {
 /// its temporaries within seconds.
 pub const STALE_TEMP_AGE: std::time::Duration = std::time::Duration::from_secs(600);
 
+/// Holds folder `dir` for one writer at a time (an advisory `flock` on the folder itself, so no
+/// lock file is left behind): two batches written into one folder at once would check, stage and
+/// roll back over each other's files. Waits while another process holds it, after calling
+/// `on_wait` once. The lock goes with the returned handle, or with the process however it ends.
+/// Where a folder cannot be opened as a file (not on Unix), nothing is locked.
+pub fn lock_folder(dir: &Path, on_wait: impl FnOnce()) -> Result<Option<std::fs::File>> {
+    let Ok(handle) = std::fs::File::open(dir) else {
+        return Ok(None);
+    };
+    match handle.try_lock() {
+        Ok(()) => {}
+        Err(std::fs::TryLockError::WouldBlock) => {
+            on_wait();
+            handle
+                .lock()
+                .with_context(|| format!("cannot lock {}", dir.display()))?;
+        }
+        Err(std::fs::TryLockError::Error(e)) => {
+            return Err(e).with_context(|| format!("cannot lock {}", dir.display()));
+        }
+    }
+    Ok(Some(handle))
+}
+
 /// Removes the temporary files a killed run left in `dir` (older than [`STALE_TEMP_AGE`],
 /// so another run's file being written is never touched); returns how many went. `now` is the
 /// caller's clock.

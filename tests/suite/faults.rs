@@ -109,6 +109,43 @@ fn generate_leaves_a_fifo_where_its_file_should_go_alone() {
     assert_eq!(names.len(), 1, "nothing written beside it");
 }
 
+/// Two `generate` runs into one folder write one after the other: while another holds the
+/// folder, a run says it waits and writes nothing (its checks, staging and any rollback cannot
+/// interleave with the other's), then writes its files when the folder is free.
+#[test]
+fn a_batch_waits_while_another_run_writes_into_its_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let held = std::fs::File::open(dir.path()).unwrap();
+    held.lock().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+        .args([
+            "generate", "--rules", "--count", "2", "--format", "yaml", "--out", out,
+        ])
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    let mut stderr_pipe = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    std::io::BufRead::read_line(&mut stderr_pipe, &mut line).unwrap();
+    assert!(
+        line.contains("waiting for another arlpcg run that is writing into"),
+        "{line}"
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "written while held"
+    );
+    drop(held);
+    let status = child.wait().unwrap();
+    assert!(status.success());
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+}
+
 #[test]
 fn a_new_training_run_never_starts_in_a_folder_holding_files() {
     let dir = tempfile::tempdir().unwrap();

@@ -279,6 +279,39 @@ fn wrong_resumes_are_refused(out_s: &str) {
         "--resume",
     ]);
     fails_with(&refused, 1, "seed cannot change");
+    files_of_another_run_are_refused(Path::new(out_s));
+}
+
+/// A run folder holding another run's files (another game's `config.yaml`, metrics of other
+/// columns) is refused by the file's name, and resumes once its own files are back.
+fn files_of_another_run_are_refused(out: &Path) {
+    let resume = [
+        "train",
+        "--steps",
+        "100",
+        "--out",
+        out.to_str().unwrap(),
+        "--resume",
+    ];
+    let racing = arlpcg_ok(&["train", "--game", "racing", "--print-config"]).stdout;
+    let metrics = "racing,columns\n1,2\n";
+    for (name, foreign) in [
+        ("config.yaml", &racing[..]),
+        ("metrics.csv", metrics.as_bytes()),
+    ] {
+        let path = out.join(name);
+        let own = std::fs::read(&path).unwrap();
+        std::fs::write(&path, foreign).unwrap();
+        let refused = arlpcg(&resume);
+        fails_with(&refused, 1, "holds files of two different runs");
+        assert!(stderr(&refused).contains(name), "{}", stderr(&refused));
+        assert_eq!(
+            std::fs::read(&path).unwrap(),
+            foreign,
+            "{name} was rewritten"
+        );
+        std::fs::write(&path, own).unwrap();
+    }
 }
 
 #[test]
@@ -615,6 +648,16 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     generate_and_verify_with_a_run(dir.path(), out_s);
     evaluate_a_run(dir.path(), out_s);
     score_a_run_as_one_seed(dir.path(), out_s);
+    // Another game's Generator metrics (racing names other piece features) are refused.
+    let metrics = out.join("generator-metrics.csv");
+    let own = std::fs::read_to_string(&metrics).unwrap();
+    std::fs::write(&metrics, own.replacen("distance_easy", "curve_easy", 1)).unwrap();
+    let refused = arlpcg(&["train", "--steps", "2048", "--out", out_s, "--resume"]);
+    fails_with(
+        &refused,
+        1,
+        "generator-metrics.csv: its columns are not those",
+    );
 }
 
 /// A staged run with a finish, resumed with a larger budget (through its last stage and a

@@ -10,8 +10,8 @@ use super::cards::{
 };
 use super::config::TrainConfig;
 use super::metrics::{
-    generator_metrics_header, generator_row, open_append, scripted_columns, time_columns,
-    truncate_metrics, update_columns,
+    check_metrics_header, generator_metrics_header, generator_row, open_append, scripted_columns,
+    time_columns, truncate_metrics, update_columns,
 };
 use super::population::{PopulationRecord, Snapshot, population_from, population_record};
 use super::solver_run::SolverRun;
@@ -101,6 +101,11 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             read_checkpoint(&out.join(CHECKPOINT), G::GAME, Role::Solver, mode)?;
         }
         let (loaded, generator_state) = read_checkpoint(&path, G::GAME, Role::Generator, mode)?;
+        check_metrics_header(
+            &out.join(GENERATOR_METRICS),
+            &generator_metrics_header::<G>(),
+            &path,
+        )?;
         let generator_iteration = generator_state.iteration;
         let record: PopulationRecord = match &generator_state.source {
             serde_json::Value::Null => PopulationRecord::default(),

@@ -153,6 +153,29 @@ pub(super) fn time_columns(time: &TimeSplit) -> String {
         .join(",")
 }
 
+/// Refuses a metrics file whose columns are not `header`'s (or its first columns, from before
+/// later ones were added): a run folder that holds another run's metrics (another game's, or a
+/// Solver-only run's) is named before anything is written in it.
+pub(super) fn check_metrics_header(path: &Path, header: &str, checkpoint: &Path) -> Result<()> {
+    let Some(text) = read_text(path) else {
+        return Ok(()); // missing: the resume writes it afresh
+    };
+    let written = text.lines().next().unwrap_or_default();
+    let extends = header
+        .strip_prefix(written)
+        .is_some_and(|rest| rest.is_empty() || rest.starts_with(','));
+    if !extends {
+        anyhow::bail!(
+            "{}: its columns are not those of the run in {} (it begins \"{}\"): the folder \
+             holds files of two different runs; resume a folder that one run wrote",
+            path.display(),
+            checkpoint.display(),
+            written.chars().take(60).collect::<String>()
+        );
+    }
+    Ok(())
+}
+
 /// Drops metric rows written after the checkpoint a run resumes from, so the curve continues
 /// without a gap or a repeat.
 /// A file written before columns were appended to `header` gains them, empty in its rows.
@@ -204,11 +227,29 @@ mod tests {
             std::fs::read_to_string(&path).unwrap(),
             "iteration,a,b,c\n1,0.5,,\n"
         );
-        // A header that is not an extension of the file's is left alone.
-        truncate_metrics(&path, "iteration,z", 1).unwrap();
-        assert_eq!(
-            std::fs::read_to_string(&path).unwrap(),
-            "iteration,a,b,c\n1,0.5,,\n"
-        );
+    }
+
+    /// A resume accepts a metrics file of its own columns, or of their first ones, and refuses
+    /// another run's by name.
+    #[test]
+    fn a_metrics_file_of_other_columns_is_refused_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("generator-metrics.csv");
+        let checkpoint = dir.path().join("checkpoint.safetensors");
+        check_metrics_header(&path, "iteration,a,b", &checkpoint).unwrap();
+        for own in ["iteration,a,b", "iteration,a"] {
+            std::fs::write(&path, format!("{own}\n1,0.5\n")).unwrap();
+            check_metrics_header(&path, "iteration,a,b", &checkpoint).unwrap();
+        }
+        for other in ["iteration,z", "iteration,a,bb", "iteration,a,b,c", ""] {
+            std::fs::write(&path, format!("{other}\n")).unwrap();
+            let err = check_metrics_header(&path, "iteration,a,b", &checkpoint)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("generator-metrics.csv") && err.contains("two different runs"),
+                "{other}: {err}"
+            );
+        }
     }
 }

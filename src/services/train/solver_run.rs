@@ -9,7 +9,9 @@ use super::cards::{
     card, read_checkpoint, record_commands, recorded_commands, save_policy_files, solver_shape,
 };
 use super::config::{TrainConfig, check_config, check_resumable_change};
-use super::metrics::{open_append, time_columns, truncate_metrics, update_columns};
+use super::metrics::{
+    check_metrics_header, open_append, time_columns, truncate_metrics, update_columns,
+};
 use super::solver_envs::SolverEnvs;
 use super::{CHECKPOINT, ConfigChange, METRICS, METRICS_HEADER, Training, UNDER_WAY};
 use crate::services::fsio;
@@ -120,6 +122,8 @@ impl<E: Resumable> SolverRun<E> {
         check_config(&stored, E::GAME).map_err(|problem| {
             anyhow::anyhow!("{}: stored configuration: {problem}", path.display())
         })?;
+        check_folder_config(out, &stored, state.global_step, &path)?;
+        check_metrics_header(&out.join(METRICS), METRICS_HEADER, &path)?;
         let config = change.apply(&stored);
         check_resumable_change(&stored, &config).map_err(|problem| {
             anyhow::anyhow!(
@@ -338,5 +342,45 @@ impl<G: GameSpec> Training for SolverRun<SolverEnvs<G>> {
 
     fn out(&self) -> &Path {
         &self.out
+    }
+}
+
+/// Refuses a run folder whose `config.yaml` is not its checkpoint's configuration (the files of
+/// two runs, say another game's config beside this checkpoint), before anything is written. A
+/// session stopped between a `--config` change and its first checkpoint leaves the new file
+/// beside `config-until-step-N.yaml` of the checkpoint's step, which holds the checkpoint's.
+fn check_folder_config(
+    out: &Path,
+    stored: &TrainConfig,
+    step: u64,
+    checkpoint: &Path,
+) -> Result<()> {
+    let read = |name: &str| -> Option<std::result::Result<TrainConfig, String>> {
+        let path = out.join(name);
+        let text = std::fs::read_to_string(&path).ok()?;
+        Some(serde_yaml::from_str(&text).map_err(|e| format!("{}: {e}", path.display())))
+    };
+    let config = out.join("config.yaml");
+    match read("config.yaml") {
+        None => Ok(()), // missing: the checkpoint's own is the run's configuration
+        Some(Ok(own)) if own == *stored => Ok(()),
+        Some(own) => {
+            let before_change = read(&format!("config-until-step-{step}.yaml"));
+            if matches!(before_change, Some(Ok(before)) if before == *stored) {
+                return Ok(());
+            }
+            let why = match own {
+                Err(e) => format!("it does not read as a configuration ({e})"),
+                Ok(_) => format!(
+                    "it is not the configuration stored in {}",
+                    checkpoint.display()
+                ),
+            };
+            bail!(
+                "{}: {why}: the folder holds files of two different runs; resume a folder that \
+                 one run wrote",
+                config.display()
+            )
+        }
     }
 }

@@ -281,6 +281,13 @@ fn write_batch(
     levels: &[Level],
     plans: &[(u64, LevelFiles)],
 ) -> Result<(usize, usize)> {
+    // One batch into a folder at a time: another's check, staging and rollback wait for ours.
+    let _held = fsio::lock_folder(&args.out, || {
+        crate::warn!(
+            "waiting for another arlpcg run that is writing into {}",
+            args.out.display()
+        )
+    })?;
     fsio::remove_stale_temps(&args.out, std::time::SystemTime::now())?;
     let mut batch = fsio::FileBatch::new();
     let mut kept = 0;

@@ -2,8 +2,9 @@
 //! ([`TrackBuild`]: what the Generator sees, what its action places), its rewards, and a
 //! [`Match`]: one Generator building a level while one Solver plays it, written once for both
 //! games. The platform Generator places the next block when the Solver stands on the newest one;
-//! the racing Generator places the next segment when the car comes within 15 m of the road's
-//! end. The Generator's episode ends with the Solver's.
+//! the racing Generator places the next segment when the car comes within
+//! [`super::racing::generator::REQUEST_DISTANCE`] (65 m) of the road's end. The Generator's
+//! episode ends with the Solver's.
 //!
 //! Rewards follow the paper's eq. 1 with a vector of aux inputs λᵢ, each with weights αᵢ (on the
 //! Generator's own, internal reward) and βᵢ (on the reward from the Solver's behaviour):

@@ -762,6 +762,16 @@ fn a_run_paused_mid_stage_resumes_to_the_bytes_of_one_never_paused() {
     let paused = train("arlpcg", TINY_ADVERSARIAL, "1024", Some("800"));
     assert_same_training(&whole, &paused, &[SOLVER, GENERATOR]);
     assert_eq!(curve(&paused).last().unwrap().1, 1024 + 128);
+    // With retries a failed Solver starts again on the piece it failed, and the match goes on.
+    let retries =
+        TINY_ADVERSARIAL.replace("generator:\n", "generator:\n  rewards:\n    retries: 2\n");
+    assert_ne!(retries, TINY_ADVERSARIAL);
+    for run in [&whole, &paused] {
+        std::fs::remove_dir_all(run).unwrap();
+    }
+    let whole = train("arlpcg", &retries, "1024", None);
+    let paused = train("arlpcg", &retries, "1024", Some("800"));
+    assert_same_training(&whole, &paused, &[SOLVER, GENERATOR]);
     let whole = train("rule-pcg", TINY, "640", None);
     let paused = train("rule-pcg", TINY, "640", Some("300"));
     assert_same_training(&whole, &paused, &[SOLVER]);

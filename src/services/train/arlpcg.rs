@@ -568,10 +568,11 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
                 ended: step.outcome.is_some(),
                 success: step.outcome.map(|o| o == Outcome::Success),
             };
-            match step.outcome {
-                Some(outcome) => finished.push((i, Some(outcome))),
-                None if self.matches[i].needs_piece() => turns.push(i),
-                None => {}
+            // A Solver run that failed with a retry left starts again: its match goes on.
+            if self.matches[i].over() {
+                finished.push((i, Some(self.matches[i].solver_outcome())));
+            } else if step.outcome.is_none() && self.matches[i].needs_piece() {
+                turns.push(i);
             }
         }
         // A failed placement ends the match: the Solver's run is cut, not failed.

@@ -54,6 +54,18 @@ pub struct GeneratorRewards {
     pub air_step: f32,
     /// An invalid piece, or no goal within the piece budget: the match ends.
     pub invalid: f32,
+    /// Tries the Solver has again on a piece it failed, from that piece's start, before the
+    /// match ends (0: it ends at the first failure, the paper's match). With retries every
+    /// failure is paid where it happens ([`GeneratorRewards::on_piece_failure`]), so a late
+    /// failure is worth no more than an early one, and a piece that fails again and again (a
+    /// wall) costs more than it pays.
+    pub retries: u32,
+    /// With retries: the hazard per piece (the Solver's chance to fail a piece) that pays best at
+    /// λ = -1, falling linearly to 0 at λ = 0.
+    pub hazard_at_hardest: f32,
+    /// With retries: the weight of a piece's first failure at λ < 0, times its share of the way
+    /// to the goal (so the term does not grow with the number of pieces).
+    pub piece_failure_weight: f32,
     /// The weights of each aux input (both games use one).
     pub aux: Vec<AuxWeights>,
 }
@@ -66,6 +78,9 @@ impl Default for GeneratorRewards {
             step_penalty: 0.1,
             air_step: 0.0,
             invalid: -10.0,
+            retries: 0,
+            hazard_at_hardest: 0.05,
+            piece_failure_weight: 10.0,
             aux: vec![AuxWeights {
                 alpha: 1.0,
                 beta: 1.0,
@@ -78,6 +93,27 @@ impl GeneratorRewards {
     /// The reward when the Solver fails, at aux inputs `aux`.
     pub fn on_failure(&self, aux: &[f32]) -> f32 {
         self.failure * self.weighted(aux, |w, l| w.beta * l)
+    }
+
+    /// With retries, the reward for the Solver's failure on a piece that takes `share` of the way
+    /// to the goal, at aux inputs `aux`; `repeat`: it has failed this piece before. At λ ≥ 0
+    /// every failure is charged [`GeneratorRewards::on_failure`]. At λ < 0 the first failure
+    /// pays `on_failure · piece_failure_weight · share` and each repeat costs that times
+    /// `c = (1 - h)² / (1 - (1 - h)²)`, with `h` the hazard λ asks for: a piece the Solver fails
+    /// with chance `p` (and retries) earns `p - c·p²/(1 - p)` in expectation, most at `p = h`.
+    pub fn on_piece_failure(&self, aux: &[f32], share: f64, repeat: bool) -> f32 {
+        let charge = self.on_failure(aux);
+        if charge <= 0.0 {
+            return charge;
+        }
+        let pay = charge * self.piece_failure_weight * share as f32;
+        if !repeat {
+            return pay;
+        }
+        let hardness = (-aux.first().copied().unwrap_or(0.0)).clamp(0.0, 1.0);
+        let hazard = (self.hazard_at_hardest * hardness).clamp(1e-3, 0.99);
+        let kept = (1.0 - hazard).powi(2);
+        -pay * kept / (1.0 - kept)
     }
 
     /// The reward for placing a piece, at aux inputs `aux`.
@@ -180,6 +216,9 @@ pub trait GeneratorGame: GameSpec {
     fn furthest_piece(env: &Self::Env) -> usize;
     /// Steps the Solver has spent in the air in this run.
     fn air_steps(env: &Self::Env) -> u32;
+    /// Starts the Solver again (seeded `seed`) at the start of the piece after `piece`, the
+    /// furthest it had left behind ([`GeneratorGame::furthest_piece`]), as after a reset.
+    fn respawn(env: &mut Self::Env, piece: usize, seed: u64);
 }
 
 /// How far, in degrees, the racing Generator's curve action may ask to turn from the goal's
@@ -258,6 +297,13 @@ pub struct Match<G: GeneratorGame> {
     /// The furthest piece the Solver had left behind when the Generator was last paid.
     paid_up_to: usize,
     air_paid: u32,
+    /// With retries: the piece after which the Solver last failed, and how often in a row.
+    failed_after: usize,
+    failures_here: u32,
+    /// How the Solver's first failed run of the match ended (none: no run failed).
+    first_failure: Option<Outcome>,
+    /// The match has ended: the Solver completed the track, or failed with no retry left.
+    over: bool,
 }
 
 impl<G: GeneratorGame> Match<G> {
@@ -274,7 +320,30 @@ impl<G: GeneratorGame> Match<G> {
             complete: false,
             paid_up_to: 0,
             air_paid: 0,
+            failed_after: 0,
+            failures_here: 0,
+            first_failure: None,
+            over: false,
         }
+    }
+
+    /// Whether the match has ended (the Solver completed the track, or failed with no retry
+    /// left); a Solver run that fails with a retry left starts again and the match goes on.
+    pub fn over(&self) -> bool {
+        self.over
+    }
+
+    /// How the match ended for the Solver: success only if no run of it failed.
+    pub fn solver_outcome(&self) -> Outcome {
+        self.first_failure.unwrap_or(Outcome::Success)
+    }
+
+    /// The share of the way to the goal that the piece after `piece` covers (0 for one that
+    /// leads away from it).
+    fn share_after(build: &G::Build, piece: usize) -> f64 {
+        let whole = build.distance_to_goal(0).max(1e-9);
+        let next = (piece + 1).min(build.piece_count());
+        ((build.distance_to_goal(piece) - build.distance_to_goal(next)) / whole).max(0.0)
     }
 
     /// The same match with λ changing along the track (one aux input).
@@ -395,14 +464,40 @@ impl<G: GeneratorGame> Match<G> {
         }
         let air = G::air_steps(env);
         // λ of the piece the Solver is on: the one after those it has left behind.
-        let aux = self.piece_aux(furthest);
+        let aux = self.piece_aux(furthest).to_vec();
+        let aux = &aux[..];
         if air > self.air_paid {
             generator += rewards.per_air_step(aux) * (air - self.air_paid) as f32;
         }
-        if step.outcome.is_some_and(|o| o != Outcome::Success) {
-            generator += rewards.on_failure(aux);
-        }
         self.air_paid = self.air_paid.max(air);
+        match step.outcome {
+            None => {}
+            Some(Outcome::Success) => self.over = true,
+            Some(_) if rewards.retries == 0 => {
+                generator += rewards.on_failure(aux);
+                self.first_failure
+                    .get_or_insert(step.outcome.expect("failed"));
+                self.over = true;
+            }
+            Some(outcome) => {
+                if furthest != self.failed_after || self.failures_here == 0 {
+                    self.failed_after = furthest;
+                    self.failures_here = 0;
+                }
+                let share = Self::share_after(&self.build, furthest);
+                generator += rewards.on_piece_failure(aux, share, self.failures_here > 0);
+                self.failures_here += 1;
+                self.first_failure.get_or_insert(outcome);
+                if self.failures_here > rewards.retries {
+                    self.over = true;
+                } else {
+                    let seed = self.solver_seed.wrapping_add(u64::from(self.failures_here));
+                    let env = self.env.as_mut().expect("the Solver is playing");
+                    G::respawn(env, furthest, seed);
+                    self.air_paid = 0;
+                }
+            }
+        }
         (step, generator)
     }
 }

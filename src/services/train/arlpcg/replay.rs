@@ -188,7 +188,8 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
                     ));
                 }
             };
-            if game.step_solver(action, rewards).0.outcome.is_some() {
+            game.step_solver(action, rewards);
+            if game.over() {
                 return Err(format!("match {}: it ends before its last step", log.seed));
             }
         }

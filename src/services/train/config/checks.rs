@@ -17,6 +17,8 @@ const MAX_POPULATION: usize = 16;
 const MAX_PHASE_STEPS: u64 = 1_000_000_000_000;
 /// Hard matches in a finish's block (a Generator phase plays a few hundred a minute).
 const MAX_HARD_MATCH_BLOCK: u32 = 100_000;
+/// The most retries a Solver gets on one piece of a match.
+const MAX_RETRIES: u32 = 10;
 
 /// Checks that `new` may replace `old` in a resumed run: the fields that fix the networks'
 /// shapes, the number of matches and the seed stream stay; learning rates, coefficients,
@@ -191,12 +193,19 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
         r.step_penalty,
         r.air_step,
         r.invalid,
+        r.piece_failure_weight,
     ]
     .into_iter()
     .chain(weights)
     .all(f32::is_finite)
     {
         return Err("rewards: every weight must be a finite number".into());
+    }
+    if r.retries > MAX_RETRIES {
+        return Err(format!("rewards.retries must be within [0, {MAX_RETRIES}]"));
+    }
+    if !(r.hazard_at_hardest > 0.0 && r.hazard_at_hardest < 1.0) {
+        return Err("rewards.hazard_at_hardest must be a number in (0, 1)".into());
     }
     if g.snapshot_share.is_some_and(|p| !(0.0..=1.0).contains(&p)) {
         return Err("snapshot_share must be a number in [0, 1]".into());

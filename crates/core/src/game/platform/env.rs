@@ -160,8 +160,15 @@ impl PlatformEnv {
     /// Starts a new run: the character stands on the start block, placed and turned at random
     /// (seeded) within a metre of its centre and 90 degrees of the track's direction.
     pub fn reset(&mut self, seed: u64) {
+        self.reset_on(0, seed);
+    }
+
+    /// Starts a new run on block `block` (0: the start block), as [`PlatformEnv::reset`] does on
+    /// the start block; the blocks before it count as left behind.
+    pub fn reset_on(&mut self, block: usize, seed: u64) {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let start = self.world.platforms()[0];
+        let block = block.min(self.world.platforms().len() - 1);
+        let start = self.world.platforms()[block];
         let reach = (0.5 * start.size - RADIUS - 0.5).clamp(0.0, 1.0);
         let local = Vector::new(
             rng.random_range(-reach..=reach),
@@ -171,7 +178,7 @@ impl PlatformEnv {
         let offset = rapier3d::math::Rotation::from_rotation_y(start.heading) * local;
         let yaw = start.heading + rng.random_range(-90.0f32..=90.0).to_radians();
         self.character = Character::new(start.top + offset, yaw);
-        self.furthest = 0;
+        self.furthest = block;
         self.steps = 0;
         self.outcome = None;
         self.remaining = self.path_remaining();

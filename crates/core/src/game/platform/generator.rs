@@ -269,6 +269,10 @@ impl GeneratorGame for PlatformGame {
     fn air_steps(_: &PlatformEnv) -> u32 {
         0
     }
+
+    fn respawn(env: &mut PlatformEnv, piece: usize, seed: u64) {
+        env.reset_on(piece, seed);
+    }
 }
 
 #[cfg(test)]
@@ -431,6 +435,80 @@ mod tests {
         let (_, reversed, early) = paced_match(-1.0, 1.0, 1);
         assert_eq!(reversed[0], -1.0);
         assert_eq!(early, 10.0, "failing in the hard first half pays");
+    }
+
+    /// A hard match (λ = -1) with a retry: the scripted controller plays until `stop_after`
+    /// blocks are behind it, then stands still, twice. Returns the Generator's reward at each
+    /// failure, the share of the way of the block it failed to reach, and the match.
+    fn retried_match(stop_after: usize) -> (Vec<f32>, f64, Match<PlatformGame>) {
+        let goal = [40.0, 0.0, 0.0];
+        let build = PlatformBuild {
+            track: PlatformTrack::new(Start::default()),
+            goal,
+            max_blocks: 30,
+        };
+        let mut game = Match::<PlatformGame>::new(build, vec![-1.0], 7);
+        let rewards = GeneratorRewards {
+            retries: 1,
+            ..GeneratorRewards::default()
+        };
+        let mut controller = crate::game::platform::ScriptedController::new(7, 0.0);
+        let mut paid = Vec::new();
+        for _ in 0..20_000 {
+            if game.needs_piece() {
+                let row = aimed(&game.build().track, goal);
+                assert!(!game.place(&row).is_invalid());
+            }
+            let action = if PlatformGame::furthest_piece(game.env()) >= stop_after {
+                crate::game::platform::PlatformAction::default()
+            } else {
+                controller.act(game.env())
+            };
+            let (step, reward) = game.step_solver(action, &rewards);
+            if step.outcome.is_some() {
+                assert_ne!(step.outcome, Some(Outcome::Success), "it stood still");
+                paid.push(reward);
+                if game.over() {
+                    let build = game.build();
+                    let share = (build.distance_to_goal(stop_after)
+                        - build.distance_to_goal(stop_after + 1))
+                        / build.distance_to_goal(0);
+                    return (paid, share, game);
+                }
+                // Started again where it failed: on the block it stood on, the run going on.
+                assert_eq!(PlatformGame::furthest_piece(game.env()), stop_after);
+                assert_eq!(game.env().outcome(), None);
+            }
+        }
+        panic!("the match did not end");
+    }
+
+    /// With retries, a failure is paid at the piece where it happens, by that piece's share of
+    /// the way and not by being last; failing the same piece again costs more than the first
+    /// failure paid (a wall does not pay), and the match ends when no retry is left.
+    #[test]
+    fn a_failure_is_charged_to_the_piece_it_happens_on() {
+        let rewards = GeneratorRewards::default();
+        for stop_after in [1, 3] {
+            let (paid, share, game) = retried_match(stop_after);
+            assert_eq!(paid.len(), 2, "one retry: two failures end the match");
+            assert!(share > 0.05, "{share}");
+            // The first failure: -10·λ × the weight × the share of the block not reached.
+            let first = 10.0 * rewards.piece_failure_weight * share as f32;
+            assert!((paid[0] - first).abs() < 1e-3, "{paid:?} vs {first}");
+            // The repeat: that times (1 - h)² / (1 - (1 - h)²), h = 0.05 at λ = -1.
+            assert!((paid[1] + first * 0.9025 / 0.0975).abs() < 1e-2, "{paid:?}");
+            assert!(paid[0] + paid[1] < 0.0, "a piece failed twice costs");
+            assert!(game.over());
+            assert_eq!(game.solver_outcome(), Outcome::TimedOut);
+        }
+        // No retries (the paper's match): the first failure ends it, paid -10·λ wherever it is.
+        let mut rewards = GeneratorRewards::default();
+        assert_eq!(rewards.retries, 0);
+        rewards.retries = 1;
+        assert_eq!(rewards.on_piece_failure(&[1.0], 0.2, false), -10.0);
+        assert_eq!(rewards.on_piece_failure(&[1.0], 0.2, true), -10.0);
+        assert_eq!(rewards.on_piece_failure(&[0.0], 0.2, true), 0.0);
     }
 
     #[test]

@@ -187,8 +187,17 @@ impl RacingEnv {
     /// Starts a new run: the car at rest [`START_S`] m along the road, shifted and turned at
     /// random (seeded) within a metre and a few degrees.
     pub fn reset(&mut self, seed: u64) {
+        self.reset_on(0, seed);
+    }
+
+    /// Starts a new run [`START_S`] m into segment `segment`, as [`RacingEnv::reset`] does at
+    /// the road's start.
+    pub fn reset_on(&mut self, segment: usize, seed: u64) {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let start = self.road.nearest_along(START_S);
+        let segment = segment.min(self.road.segment_count() - 1);
+        let start = self
+            .road
+            .nearest_along(self.road.segment_start(segment) + START_S);
         let sample = self.road.samples()[start];
         let offset = rng.random_range(-START_JITTER_M..=START_JITTER_M);
         let turn = rng

@@ -341,6 +341,10 @@ impl GeneratorGame for RacingGame {
     fn air_steps(env: &RacingEnv) -> u32 {
         env.air_steps()
     }
+
+    fn respawn(env: &mut RacingEnv, piece: usize, seed: u64) {
+        env.reset_on(piece, seed);
+    }
 }
 
 #[cfg(test)]

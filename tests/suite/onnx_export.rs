@@ -206,3 +206,93 @@ fn export_policy_writes_the_graph_and_its_sidecar_once() {
     );
     assert!(!other.exists() && !Path::new("model.pt").exists());
 }
+
+/// A Solver's export has its golden episode beside it: a real run on the level it carries,
+/// which plays again to the same observations from the recorded actions (so a port checks
+/// itself against a run the game really has), each frame's state holding every group a port
+/// reads. A Generator's export has none.
+#[test]
+fn a_solvers_golden_episode_replays_from_its_level_and_actions() {
+    use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
+    fn replay<G: GameSpec>(episode: &serde_json::Value, state_names: &[&str]) {
+        let level = arlpcg_core::level::yaml::parse(episode["level"].as_str().unwrap()).unwrap();
+        let mut env = G::solver_env(&level).unwrap();
+        env.reset(episode["run_seed"].as_u64().unwrap());
+        let frames = episode["frames"].as_array().unwrap();
+        assert!(frames.len() > 50, "{} frames", frames.len());
+        for frame in frames {
+            let mut observation = vec![0.0f32; G::Env::OBSERVATION_SIZE];
+            env.observe(&mut observation);
+            let recorded: Vec<f32> = serde_json::from_value(frame["observation"].clone()).unwrap();
+            assert_eq!(observation, recorded);
+            let names: Vec<&str> = frame["state"]
+                .as_object()
+                .unwrap()
+                .keys()
+                .map(String::as_str)
+                .collect();
+            assert_eq!(names, state_names);
+            let action: Vec<f32> = serde_json::from_value(frame["action"].clone()).unwrap();
+            assert!(action.iter().all(|a| (-1.0..=1.0).contains(a)));
+            env.step(G::Env::action_from_policy_row(&action));
+        }
+        assert_eq!(
+            episode["outcome"], "Success",
+            "the shipped Solver completes its level"
+        );
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for (game, names) in [
+        (
+            "platform",
+            &[
+                "feet",
+                "goal",
+                "grounded",
+                "height_map_hits",
+                "max_steps",
+                "next_block_size",
+                "next_block_top",
+                "steps",
+                "velocity",
+                "yaw",
+            ][..],
+        ),
+        (
+            "racing",
+            &[
+                "angular_velocity",
+                "centre_line_ahead",
+                "fan_hits",
+                "goal",
+                "position",
+                "road_heading",
+                "road_point",
+                "rotation_xyzw",
+                "velocity",
+            ][..],
+        ),
+    ] {
+        let out = dir.path().join(format!("{game}.onnx"));
+        let policy = format!(
+            "{}/policies/{game}/solver.safetensors",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        arlpcg_ok(&["export-policy", &policy, "--out", out.to_str().unwrap()]);
+        let golden = dir.path().join(format!("{game}.onnx.golden.json"));
+        let episode: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&golden).unwrap()).unwrap();
+        assert_eq!(episode["format"], "arlpcg-golden-episode");
+        match game {
+            "platform" => replay::<PlatformGame>(&episode, names),
+            _ => replay::<RacingGame>(&episode, names),
+        }
+    }
+    let generator = format!(
+        "{}/policies/racing/generator.safetensors",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = dir.path().join("generator.onnx");
+    arlpcg_ok(&["export-policy", &generator, "--out", out.to_str().unwrap()]);
+    assert!(!dir.path().join("generator.onnx.golden.json").exists());
+}

@@ -22,6 +22,7 @@
 //! so an integration can check itself.
 
 mod builder;
+pub mod golden;
 pub mod proto;
 
 use prost::Message;

@@ -2,7 +2,12 @@
 
 use anyhow::{Context, Result};
 
+use arlpcg_core::game::{PlatformGame, RacingGame};
+use arlpcg_core::level::Game;
+use arlpcg_core::rl::checkpoint::Role;
+
 use crate::services::fsio::{FileBatch, Overwrite};
+use crate::services::onnx::golden::golden_episode;
 use crate::shells::cli::ExportPolicyArgs;
 
 pub fn run(args: &ExportPolicyArgs) -> Result<()> {
@@ -14,12 +19,13 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
         .into());
     }
     let sidecar_path = crate::services::onnx::sidecar_path(&args.out);
+    let golden_path = crate::services::onnx::golden::golden_path(&args.out);
     let overwrite = if args.force {
         Overwrite::Allowed
     } else {
         Overwrite::Never
     };
-    for path in [&args.out, &sidecar_path] {
+    for path in [&args.out, &sidecar_path, &golden_path] {
         crate::services::fsio::check_writable(path, overwrite)?;
     }
     // Loaded through the game's own loader: game, role, shape and normalizer all checked.
@@ -27,12 +33,32 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
     let exported = crate::services::onnx::export(&policy, &card, reference, args.profile)
         .with_context(|| format!("{}: exporting the actor", args.policy.display()))?;
     let sidecar = serde_json::to_string_pretty(&exported.sidecar)? + "\n";
+    // A Solver's golden episode, for a port of its observation (docs/engines.md).
+    let golden = match card.role {
+        Role::Solver => {
+            let reference = exported.sidecar.policy.clone();
+            let episode = match card.game {
+                Game::Platform => golden_episode::<PlatformGame>(&policy, &card, reference),
+                Game::Racing => golden_episode::<RacingGame>(&policy, &card, reference),
+            }
+            .with_context(|| format!("{}: playing its golden episode", args.policy.display()))?;
+            Some(serde_json::to_string(&episode)? + "\n")
+        }
+        Role::Generator => None,
+    };
     let mut batch = FileBatch::new();
     batch.stage(&args.out, &exported.onnx, overwrite)?;
     batch.stage(&sidecar_path, sidecar.as_bytes(), overwrite)?;
+    if let Some(golden) = &golden {
+        batch.stage(&golden_path, golden.as_bytes(), overwrite)?;
+    }
     batch.commit()?;
+    let golden = match golden {
+        Some(_) => format!(" and its golden episode {}", golden_path.display()),
+        None => String::new(),
+    };
     crate::say!(
-        "wrote {} ({} {}, profile {}, opset {}) and {}",
+        "wrote {} ({} {}, profile {}, opset {}), {}{golden}",
         args.out.display(),
         card.game,
         card.role,

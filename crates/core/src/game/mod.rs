@@ -56,6 +56,19 @@ pub trait SolverEnv: Send + Sync + Sized {
     fn trial_result(&self, outcome: Outcome) -> crate::level::stats::TrialResult;
     /// Where the player is (a recorded run's path).
     fn marker(&self) -> [f32; 3];
+    /// The game state the observation is computed from, by name, in world coordinates (the
+    /// golden episodes an engine's port of the observation is checked against; docs/engines.md):
+    /// what the port cannot compute itself (positions, rotations, the distance each ray travels
+    /// before it hits) and nothing it can.
+    fn port_state(&self) -> PortState;
+}
+
+/// Named groups of numbers: a Solver's state as a port of its observation starts from.
+pub type PortState = Vec<(&'static str, Vec<f64>)>;
+
+/// A vector's three coordinates as f64.
+fn coords(v: rapier3d::math::Vector) -> Vec<f64> {
+    v.to_array().map(f64::from).to_vec()
 }
 
 /// A scripted player of environment `E`.

@@ -287,15 +287,27 @@ impl PlatformEnv {
         for (slot, value) in state_out.iter_mut().zip(state) {
             *slot = value;
         }
+        for (slot, depth) in map.iter_mut().zip(self.height_map_hits()) {
+            *slot = (RAY_START_HEIGHT - depth) / 4.0;
+        }
+    }
+
+    /// How far each height-map ray travels down before it hits something ([`RAY_LENGTH`] where
+    /// nothing is below), forward-major: from [`HEIGHT_MAP_FORWARD`]'s first row (behind), each
+    /// row from right to left ([`HEIGHT_MAP_LEFT`]), every ray from [`RAY_START_HEIGHT`] above
+    /// the feet.
+    fn height_map_hits(&self) -> [f32; HEIGHT_MAP_SIDE * HEIGHT_MAP_SIDE] {
+        let c = &self.character;
+        let forward = c.facing();
+        let left = Vector::new(forward.z, 0.0, -forward.x);
         let origins = HEIGHT_MAP_FORWARD.iter().flat_map(|&f| {
             HEIGHT_MAP_LEFT
                 .iter()
                 .map(move |&l| c.feet + forward * f + left * l + Vector::Y * RAY_START_HEIGHT)
         });
-        self.world.cast_down(origins, RAY_LENGTH, map);
-        for depth in map.iter_mut() {
-            *depth = (RAY_START_HEIGHT - *depth) / 4.0;
-        }
+        let mut hits = [0.0; HEIGHT_MAP_SIDE * HEIGHT_MAP_SIDE];
+        self.world.cast_down(origins, RAY_LENGTH, &mut hits);
+        hits
     }
 
     /// The observation as a new vector.
@@ -373,5 +385,25 @@ impl crate::game::SolverEnv for PlatformEnv {
     fn marker(&self) -> [f32; 3] {
         let f = self.character().feet;
         [f.x, f.y, f.z]
+    }
+
+    fn port_state(&self) -> crate::game::PortState {
+        let c = &self.character;
+        let next = self.world.platforms()[self.next_index()];
+        vec![
+            ("feet", super::super::coords(c.feet)),
+            ("yaw", vec![f64::from(c.yaw)]),
+            ("velocity", super::super::coords(c.velocity)),
+            ("grounded", vec![f64::from(u8::from(c.grounded))]),
+            ("steps", vec![f64::from(self.steps)]),
+            ("max_steps", vec![f64::from(self.max_steps)]),
+            ("goal", super::super::coords(self.goal)),
+            ("next_block_top", super::super::coords(next.top)),
+            ("next_block_size", vec![f64::from(next.size)]),
+            (
+                "height_map_hits",
+                self.height_map_hits().map(f64::from).to_vec(),
+            ),
+        ]
     }
 }

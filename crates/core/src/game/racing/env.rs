@@ -323,8 +323,7 @@ impl RacingEnv {
         let position = self.world.position();
         let rotation = self.world.rotation();
         let into_car = rotation.inverse();
-        let forward = rotation * Vector::X;
-        let yaw = (-forward.z).atan2(forward.x);
+        let yaw = self.yaw();
         let level = Rotation::from_rotation_y(yaw);
         let into_level = level.inverse();
         let goal = Vector::new(
@@ -339,8 +338,7 @@ impl RacingEnv {
         let velocity = into_car * self.world.velocity();
         let spin = into_car * self.world.angular_velocity();
         let up = into_car * Vector::Y;
-        let ahead = LOOK_AHEAD.map(|ahead| {
-            let point = self.road.samples()[self.road.nearest_along(self.along + ahead)].centre;
+        let ahead = self.centre_line_ahead().map(|point| {
             let local = into_level * (to_f32(point) - position);
             [local.x / 60.0, local.z / 20.0]
         });
@@ -359,16 +357,39 @@ impl RacingEnv {
             *slot = value;
         }
         let fan = &mut out[OBSERVATION_SIZE - FAN_SIZE..];
+        for (slot, depth) in fan.iter_mut().zip(self.fan_hits()) {
+            // Height of what the ray hit relative to the chassis; nothing hit reads -12 m.
+            *slot = (FAN_START_HEIGHT - depth) / 6.0;
+        }
+    }
+
+    /// The car's heading in the level (radians about +Y, 0 along +X), from its forward axis.
+    fn yaw(&self) -> f32 {
+        let forward = self.world.rotation() * Vector::X;
+        (-forward.z).atan2(forward.x)
+    }
+
+    /// The centre line's points [`LOOK_AHEAD`] metres further along the road than the car.
+    fn centre_line_ahead(&self) -> [[f64; 3]; LOOK_AHEAD.len()] {
+        LOOK_AHEAD
+            .map(|ahead| self.road.samples()[self.road.nearest_along(self.along + ahead)].centre)
+    }
+
+    /// How far each fan ray travels down before it hits road or obstacle ([`FAN_LENGTH`] where
+    /// nothing is below), forward-major: from [`FAN_FORWARD`]'s nearest row, each row from right
+    /// to left ([`FAN_LEFT`]), every ray from [`FAN_START_HEIGHT`] above the chassis's centre,
+    /// in the car's level heading frame.
+    fn fan_hits(&self) -> [f32; FAN_SIZE] {
+        let position = self.world.position();
+        let level = Rotation::from_rotation_y(self.yaw());
         let origins = FAN_FORWARD.iter().flat_map(|&f| {
             FAN_LEFT
                 .iter()
                 .map(move |&l| position + level * Vector::new(f, FAN_START_HEIGHT, -l))
         });
-        self.world.cast_down(origins, FAN_LENGTH, fan);
-        for depth in fan.iter_mut() {
-            // Height of what the ray hit relative to the chassis; nothing hit reads -12 m.
-            *depth = (FAN_START_HEIGHT - *depth) / 6.0;
-        }
+        let mut hits = [0.0; FAN_SIZE];
+        self.world.cast_down(origins, FAN_LENGTH, &mut hits);
+        hits
     }
 
     pub fn road(&self) -> &Road {
@@ -473,5 +494,29 @@ impl crate::game::SolverEnv for RacingEnv {
 
     fn marker(&self) -> [f32; 3] {
         self.world.position().to_array()
+    }
+
+    fn port_state(&self) -> crate::game::PortState {
+        let rotation = self.world.rotation();
+        let sample = self.road.samples()[self.nearest];
+        vec![
+            ("position", super::super::coords(self.world.position())),
+            (
+                "rotation_xyzw",
+                [rotation.x, rotation.y, rotation.z, rotation.w]
+                    .map(f64::from)
+                    .to_vec(),
+            ),
+            ("velocity", super::super::coords(self.world.velocity())),
+            (
+                "angular_velocity",
+                super::super::coords(self.world.angular_velocity()),
+            ),
+            ("goal", self.goal.to_vec()),
+            ("road_point", sample.centre.to_vec()),
+            ("road_heading", vec![sample.heading]),
+            ("centre_line_ahead", self.centre_line_ahead().concat()),
+            ("fan_hits", self.fan_hits().map(f64::from).to_vec()),
+        ]
     }
 }

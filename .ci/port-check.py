@@ -1,10 +1,10 @@
-"""An independent port of the Solvers' observations, written from docs/engines.md ("Porting a
-Solver") alone, checked against the golden episodes `arlpcg export-policy` writes beside each
-Solver's graph: every frame's observation recomputed from its recorded state within 1e-4, and
+"""An independent port of the Solvers' and Generators' observations, written from
+docs/engines.md ("Porting a policy") alone, checked against the golden episodes `arlpcg
+export-policy` writes beside each graph: every frame's observation recomputed from its recorded state within 1e-4, and
 the graph (run by onnxruntime on the recorded observations) choosing the recorded actions
 (continuous within 1e-5, binary equal). It imports nothing of arlpcg.
 
-    python .ci/port-check.py FILE.onnx...   (plain-profile Solver graphs; others are skipped)
+    python .ci/port-check.py FILE.onnx...   (plain-profile graphs; others are skipped)
 """
 import json
 import math
@@ -86,17 +86,63 @@ def racing_observation(s):
     return obs
 
 
-PORTS = {"platform": platform_observation, "racing": racing_observation}
+def plan_local(d, heading_degrees):
+    """`d` in the frame of a heading: forward, up, left (a positive turn)."""
+    h = math.radians(heading_degrees)
+    fx, fz = math.cos(h), -math.sin(h)
+    return [d[0] * fx + d[2] * fz, d[1], d[0] * fz - d[2] * fx]
+
+
+def platform_generator_observation(s, aux):
+    p = s["last_position"]
+    heading = s["last_heading_degrees"][0]
+
+    def local(point):
+        return plan_local([point[k] - p[k] for k in range(3)], heading)
+
+    g = local(s["goal"])
+    bearing = math.atan2(g[2], g[0])
+    obs = [x / 50 for x in g] + [math.sin(bearing), math.cos(bearing), math.hypot(g[0], g[2]) / 50]
+    obs.append(s["last_size"][0] / 6)
+    previous = s["previous_position_size"]
+    obs += [x / 10 for x in local(previous[:3])] if previous else [0.0] * 3
+    obs.append(previous[3] / 6 if previous else 0.0)
+    turn = math.radians(s["last_turn_degrees"][0]) if s["last_turn_degrees"] else 0.0
+    obs += [math.sin(turn), math.cos(turn)]
+    obs.append(1 - s["blocks"][0] / s["max_blocks"][0])
+    return obs + [aux]
+
+
+def racing_generator_observation(s, aux):
+    end = s["road_end"]
+    heading = s["road_end_heading_degrees"][0]
+    g = plan_local([s["goal"][k] - end[k] for k in range(3)], heading)
+    bearing = math.atan2(g[2], g[0])
+    obs = [x / 100 for x in g] + [math.sin(bearing), math.cos(bearing), math.hypot(g[0], g[2]) / 300]
+    obs += [math.sin(math.radians(heading)), math.cos(math.radians(heading))]
+    last = s["last_segment"]
+    obs += [(last[0] - 20) / 10 * 2 - 1, last[1] / 30, last[2] / 5] if last else [0.0] * 3
+    obs.append(1 - s["segments"][0] / s["max_segments"][0])
+    return obs + s["obstacle_rays"] + s["road_rays"] + [aux]
+
+
+PORTS = {
+    ("platform", "solver"): lambda s, aux: platform_observation(s),
+    ("racing", "solver"): lambda s, aux: racing_observation(s),
+    ("platform", "generator"): platform_generator_observation,
+    ("racing", "generator"): racing_generator_observation,
+}
 
 
 def check(onnx_path):
     sidecar = json.load(open(onnx_path + ".json"))
-    if sidecar["role"] != "solver" or sidecar["profile"] != "plain":
+    if sidecar["profile"] != "plain":
         return None
     episode = json.load(open(onnx_path + ".golden.json"))
-    port = PORTS[episode["game"]]
+    port = PORTS[(episode["game"], episode["role"])]
+    aux = episode.get("aux")
     recorded = np.array([f["observation"] for f in episode["frames"]], dtype=np.float64)
-    ported = np.array([port(f["state"]) for f in episode["frames"]], dtype=np.float64)
+    ported = np.array([port(f["state"], aux) for f in episode["frames"]], dtype=np.float64)
     if ported.shape != recorded.shape:
         raise SystemExit(f"{onnx_path}: ported {ported.shape}, recorded {recorded.shape}")
     observation_error = float(np.abs(ported - recorded).max())
@@ -121,7 +167,7 @@ def check(onnx_path):
 def main(paths):
     results = [r for r in (check(p) for p in paths) if r is not None]
     if not results:
-        raise SystemExit("no plain-profile Solver graph among the files given")
+        raise SystemExit("no plain-profile graph among the files given")
     if not all(results):
         raise SystemExit("the port does not reproduce every golden episode")
     print(f"the port reproduces {len(results)} golden episodes")

@@ -207,12 +207,12 @@ fn export_policy_writes_the_graph_and_its_sidecar_once() {
     assert!(!other.exists() && !Path::new("model.pt").exists());
 }
 
-/// A Solver's export has its golden episode beside it: a real run on the level it carries,
-/// which plays again to the same observations from the recorded actions (so a port checks
-/// itself against a run the game really has), each frame's state holding every group a port
-/// reads. A Generator's export has none.
+/// A policy's export has its golden episode beside it. A Solver's is a real run on the level
+/// it carries, which plays again to the same observations from the recorded actions (so a port
+/// checks itself against a run the game really has), each frame's state holding every group a
+/// port reads; a Generator's has one frame per piece of the level it built.
 #[test]
-fn a_solvers_golden_episode_replays_from_its_level_and_actions() {
+fn a_policys_golden_episode_replays_from_its_level_and_actions() {
     use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
     fn replay<G: GameSpec>(episode: &serde_json::Value, state_names: &[&str]) {
         let level = arlpcg_core::level::yaml::parse(episode["level"].as_str().unwrap()).unwrap();
@@ -288,11 +288,27 @@ fn a_solvers_golden_episode_replays_from_its_level_and_actions() {
             _ => replay::<RacingGame>(&episode, names),
         }
     }
-    let generator = format!(
-        "{}/policies/racing/generator.safetensors",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let out = dir.path().join("generator.onnx");
-    arlpcg_ok(&["export-policy", &generator, "--out", out.to_str().unwrap()]);
-    assert!(!dir.path().join("generator.onnx.golden.json").exists());
+    // A Generator's: each piece it placed at λ = -1, the level it built loading as a level.
+    for game in ["platform", "racing"] {
+        let generator = format!(
+            "{}/policies/{game}/generator.safetensors",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let out = dir.path().join(format!("{game}-generator.onnx"));
+        arlpcg_ok(&["export-policy", &generator, "--out", out.to_str().unwrap()]);
+        let golden = dir
+            .path()
+            .join(format!("{game}-generator.onnx.golden.json"));
+        let episode: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&golden).unwrap()).unwrap();
+        assert_eq!(episode["aux"], -1.0);
+        assert_eq!(episode["outcome"], "Completed");
+        let level = arlpcg_core::level::yaml::parse(episode["level"].as_str().unwrap()).unwrap();
+        let frames = episode["frames"].as_array().unwrap();
+        assert_eq!(
+            frames.len(),
+            level.piece_count(),
+            "one frame per piece placed"
+        );
+    }
 }

@@ -1,8 +1,9 @@
-//! Golden episodes: a real run of a Solver policy on a rule level of its game, each decision's
-//! game state ([`SolverEnv::port_state`]), the raw observation the game computed from it and the
-//! deterministic action the policy (and so its ONNX graph) chose. An engine's port of the
-//! observation recomputes each frame's observation from its state and runs the graph on it;
-//! `.ci/port-check.py` is such a port, written from docs/engines.md alone.
+//! Golden episodes: a real run of a policy, each decision's state ([`SolverEnv::port_state`],
+//! [`TrackBuild::port_state`]), the raw observation computed from it and the deterministic
+//! action the policy (and so its ONNX graph) chose. A Solver plays a rule level of its game; a
+//! Generator builds a level at λ = [`GOLDEN_AUX`] toward the goal of a seed. An engine's port
+//! of the observation recomputes each frame's observation from its state and runs the graph on
+//! it; `.ci/port-check.py` is such a port, written from docs/engines.md alone.
 
 use std::collections::BTreeMap;
 
@@ -10,15 +11,20 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use arlpcg_core::game::{GameSpec, SolverEnv};
+use arlpcg_core::game::generator::{
+    BuildLimits, GeneratorGame, Placement, TrackBuild, observation_size,
+};
+use arlpcg_core::game::{GameSpec, PortState, SolverEnv};
 use arlpcg_core::level::PolicyRef;
 use arlpcg_core::rl::checkpoint::PolicyCard;
 use arlpcg_core::rl::policy::{ActMode, ActorCritic};
 
 /// The rule level a golden episode plays: the first seed from here whose rules find a level.
 const GOLDEN_LEVEL_SEED: u64 = 1;
-/// The run's reset seed (the start's jitter).
+/// The run's reset seed (the start's jitter); a Generator's scene (goal, start, obstacles).
 const GOLDEN_RUN_SEED: u64 = 0;
+/// λ of a Generator's golden episode.
+const GOLDEN_AUX: f32 = -1.0;
 
 /// A Solver's run, decision by decision.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -28,8 +34,11 @@ pub struct GoldenEpisode {
     pub game: String,
     pub role: String,
     pub policy: PolicyRef,
-    /// The level played, as its YAML file.
+    /// The level played (a Generator's: the level it built), as its YAML file.
     pub level: String,
+    /// λ a Generator built at (none: a Solver's episode).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aux: Option<f32>,
     /// The run's reset seed.
     pub run_seed: u64,
     /// How the run ended.
@@ -59,29 +68,14 @@ pub fn golden_episode<G: GameSpec>(
         .expect("the rules find a level within a few seeds");
     let mut env = G::solver_env(&level).expect("a rule level of the game itself");
     env.reset(GOLDEN_RUN_SEED);
-    let continuous = policy.shape().continuous;
-    // Deterministic play draws nothing; the stream is only what `choose` asks for.
-    let mut rng = ChaCha8Rng::seed_from_u64(0);
     let mut frames = Vec::new();
     let outcome = loop {
         let mut observation = vec![0.0; G::Env::OBSERVATION_SIZE];
         env.observe(&mut observation);
-        let mut normalized = observation.clone();
-        card.normalizer.normalize(&mut normalized);
-        let mut action = policy.choose(&normalized, ActMode::Deterministic, &mut rng)?;
-        for value in &mut action[..continuous] {
-            *value = value.clamp(-1.0, 1.0);
-        }
-        frames.push(GoldenFrame {
-            state: env
-                .port_state()
-                .into_iter()
-                .map(|(name, values)| (name.to_string(), values))
-                .collect(),
-            observation,
-            action: action.clone(),
-        });
-        if let Some(outcome) = env.step(G::Env::action_from_policy_row(&action)).outcome {
+        let frame = frame(policy, card, env.port_state(), observation)?;
+        let action = G::Env::action_from_policy_row(&frame.action);
+        frames.push(frame);
+        if let Some(outcome) = env.step(action).outcome {
             break outcome;
         }
     };
@@ -92,9 +86,82 @@ pub fn golden_episode<G: GameSpec>(
         role: card.role.to_string(),
         policy: reference,
         level: arlpcg_core::level::yaml::to_string(&level),
+        aux: None,
         run_seed: GOLDEN_RUN_SEED,
         outcome: format!("{outcome:?}"),
         frames,
+    })
+}
+
+/// The golden episode of Generator `policy` (with its `card` and `limits`) of game `G`: each
+/// piece it places, until the track reaches its goal or ends.
+pub fn generator_golden_episode<G: GeneratorGame>(
+    policy: &ActorCritic,
+    card: &PolicyCard,
+    reference: PolicyRef,
+    limits: BuildLimits,
+) -> candle_core::Result<GoldenEpisode> {
+    let obstacles = arlpcg_core::game::facts::facts(G::GAME).scene_obstacles;
+    let (mut build, _) = G::new_build(GOLDEN_RUN_SEED, None, limits, obstacles);
+    let mut frames = Vec::new();
+    let outcome = loop {
+        let mut observation = vec![0.0; observation_size::<G>()];
+        build.observe(&[GOLDEN_AUX], &mut observation);
+        let frame = frame(policy, card, build.port_state(), observation)?;
+        let placement = build.place(&frame.action);
+        frames.push(frame);
+        if placement != Placement::Placed {
+            break placement;
+        }
+    };
+    let level = arlpcg_core::level::Level {
+        seed: Some(GOLDEN_RUN_SEED),
+        aux: Some(f64::from(GOLDEN_AUX)),
+        goal: build.goal(),
+        track: build.into_track(),
+        source: arlpcg_core::level::Source::Policy {
+            generator: reference.clone(),
+        },
+        stats: None,
+        pacing: None,
+    };
+    Ok(GoldenEpisode {
+        format: "arlpcg-golden-episode".into(),
+        version: 1,
+        game: card.game.to_string(),
+        role: card.role.to_string(),
+        policy: reference,
+        level: arlpcg_core::level::yaml::to_string(&level),
+        aux: Some(GOLDEN_AUX),
+        run_seed: GOLDEN_RUN_SEED,
+        outcome: format!("{outcome:?}"),
+        frames,
+    })
+}
+
+/// One decision: the policy's deterministic action on `observation` (normalized by the card's
+/// normalizer), continuous actions clipped to [-1, 1] as the games clip them.
+fn frame(
+    policy: &ActorCritic,
+    card: &PolicyCard,
+    state: PortState,
+    observation: Vec<f32>,
+) -> candle_core::Result<GoldenFrame> {
+    let mut normalized = observation.clone();
+    card.normalizer.normalize(&mut normalized);
+    // Deterministic play draws nothing from the stream.
+    let mut unused = ChaCha8Rng::seed_from_u64(0);
+    let mut action = policy.choose(&normalized, ActMode::Deterministic, &mut unused)?;
+    for value in &mut action[..policy.shape().continuous] {
+        *value = value.clamp(-1.0, 1.0);
+    }
+    Ok(GoldenFrame {
+        state: state
+            .into_iter()
+            .map(|(name, values)| (name.to_string(), values))
+            .collect(),
+        observation,
+        action,
     })
 }
 

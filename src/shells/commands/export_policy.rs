@@ -7,7 +7,7 @@ use arlpcg_core::level::Game;
 use arlpcg_core::rl::checkpoint::Role;
 
 use crate::services::fsio::{FileBatch, Overwrite};
-use crate::services::onnx::golden::golden_episode;
+use crate::services::onnx::golden::{generator_golden_episode, golden_episode};
 use crate::shells::cli::ExportPolicyArgs;
 
 pub fn run(args: &ExportPolicyArgs) -> Result<()> {
@@ -33,7 +33,7 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
     let exported = crate::services::onnx::export(&policy, &card, reference, args.profile)
         .with_context(|| format!("{}: exporting the actor", args.policy.display()))?;
     let sidecar = serde_json::to_string_pretty(&exported.sidecar)? + "\n";
-    // A Solver's golden episode, for a port of its observation (docs/engines.md).
+    // The policy's golden episode, for a port of its observation (docs/engines.md).
     let golden = match card.role {
         Role::Solver => {
             let reference = exported.sidecar.policy.clone();
@@ -44,7 +44,23 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
             .with_context(|| format!("{}: playing its golden episode", args.policy.display()))?;
             Some(serde_json::to_string(&episode)? + "\n")
         }
-        Role::Generator => None,
+        Role::Generator => {
+            let reference = exported.sidecar.policy.clone();
+            // The card's piece budget and curve offset, checked as generation reads them.
+            let limits = crate::services::policies::load_generator(&args.policy, card.game)?
+                .0
+                .limits;
+            let episode = match card.game {
+                Game::Platform => {
+                    generator_golden_episode::<PlatformGame>(&policy, &card, reference, limits)
+                }
+                Game::Racing => {
+                    generator_golden_episode::<RacingGame>(&policy, &card, reference, limits)
+                }
+            }
+            .with_context(|| format!("{}: building its golden episode", args.policy.display()))?;
+            Some(serde_json::to_string(&episode)? + "\n")
+        }
     };
     let mut batch = FileBatch::new();
     batch.stage(&args.out, &exported.onnx, overwrite)?;

@@ -167,6 +167,9 @@ pub trait TrackBuild: Clone + Send + Sync {
     fn piece_features(&self) -> Vec<[f64; 2]>;
     /// The finished track.
     fn into_track(self) -> Track;
+    /// The state the Generator's observation is computed from, by name (the golden episodes of
+    /// docs/engines.md): positions and headings in the world, and what each plan-view ray found.
+    fn port_state(&self) -> super::PortState;
 }
 
 /// A game whose levels a Generator builds: its track under construction, the Generator's

@@ -162,6 +162,29 @@ impl TrackBuild for PlatformBuild {
         observe(&self.track, self.goal, aux, self.max_blocks, out);
     }
 
+    fn port_state(&self) -> crate::game::PortState {
+        let platforms = self.track.platforms();
+        let last = self.track.last();
+        let n = platforms.len();
+        // The block before the last, and the turn the last was placed with (none: the last is
+        // the start block).
+        let previous = (n > 1).then(|| {
+            let p = platforms[n - 2];
+            [p.position.to_vec(), vec![p.size]].concat()
+        });
+        let turn = (n > 1).then(|| vec![self.track.block_params()[n - 2].angle]);
+        vec![
+            ("goal", self.goal.to_vec()),
+            ("last_position", last.position.to_vec()),
+            ("last_heading_degrees", vec![last.heading]),
+            ("last_size", vec![last.size]),
+            ("last_turn_degrees", turn.unwrap_or_default()),
+            ("previous_position_size", previous.unwrap_or_default()),
+            ("blocks", vec![self.track.block_count() as f64]),
+            ("max_blocks", vec![self.max_blocks as f64]),
+        ]
+    }
+
     fn place(&mut self, row: &[f32]) -> Placement {
         if self.track.block_count() >= self.max_blocks {
             return Placement::OutOfPieces;

@@ -127,6 +127,35 @@ impl RacingBuild {
         }
     }
 
+    /// The two fans of plan-view rays from the road's end: to the first point too near an
+    /// obstacle, and to the first too near an earlier part of the road (beyond the arc near its
+    /// end that a new segment joins).
+    fn plan_rays(&self) -> ([f32; RAYS], [f32; RAYS]) {
+        let mut obstacle_rays = [0.0; RAYS];
+        let obstacles = &self.track.obstacles;
+        self.rays(&mut obstacle_rays, |x, z| {
+            obstacles
+                .iter()
+                .any(|o| o.plan_distance(x, z) < MIN_OBSTACLE_DISTANCE)
+        });
+        let reach = self.road.length() - CROSSING_ARC;
+        let earlier: Vec<[f64; 2]> = self
+            .road
+            .samples()
+            .iter()
+            .step_by(3)
+            .take_while(|p| p.s < reach)
+            .map(|p| [p.centre[0], p.centre[2]])
+            .collect();
+        let mut road_rays = [0.0; RAYS];
+        self.rays(&mut road_rays, |x, z| {
+            earlier.iter().any(|c| {
+                (c[0] - x).powi(2) + (c[1] - z).powi(2) < MIN_SELF_DISTANCE * MIN_SELF_DISTANCE
+            })
+        });
+        (obstacle_rays, road_rays)
+    }
+
     /// Distance along each ray from the road's end to the first point within `too_near` of
     /// something `near` tells the distance to, over [`RAY_LENGTH`] (1: nothing).
     fn rays(&self, out: &mut [f32], near: impl Fn(f64, f64) -> bool) {
@@ -185,31 +214,32 @@ impl TrackBuild for RacingBuild {
             *slot = value;
             written += 1;
         }
-        let (obstacle_rays, rest) = out[written..].split_at_mut(RAYS);
-        let (road_rays, aux_out) = rest.split_at_mut(RAYS);
-        let obstacles = &self.track.obstacles;
-        self.rays(obstacle_rays, |x, z| {
-            obstacles
-                .iter()
-                .any(|o| o.plan_distance(x, z) < MIN_OBSTACLE_DISTANCE)
-        });
-        // The road's own earlier parts, beyond the arc near its end that a new segment joins.
-        let reach = self.road.length() - CROSSING_ARC;
-        let earlier: Vec<[f64; 2]> = self
-            .road
-            .samples()
-            .iter()
-            .step_by(3)
-            .take_while(|p| p.s < reach)
-            .map(|p| [p.centre[0], p.centre[2]])
-            .collect();
-        self.rays(road_rays, |x, z| {
-            earlier.iter().any(|c| {
-                (c[0] - x).powi(2) + (c[1] - z).powi(2) < MIN_SELF_DISTANCE * MIN_SELF_DISTANCE
-            })
-        });
+        let (obstacle_out, rest) = out[written..].split_at_mut(RAYS);
+        let (road_out, aux_out) = rest.split_at_mut(RAYS);
+        let (obstacle_rays, road_rays) = self.plan_rays();
+        obstacle_out.copy_from_slice(&obstacle_rays);
+        road_out.copy_from_slice(&road_rays);
         assert_eq!(aux_out.len(), aux.len(), "one value per aux input");
         aux_out.copy_from_slice(aux);
+    }
+
+    fn port_state(&self) -> crate::game::PortState {
+        let (end, heading) = self.road.end();
+        let (obstacle_rays, road_rays) = self.plan_rays();
+        let last = self.track.segments.last();
+        vec![
+            ("goal", self.goal.to_vec()),
+            ("road_end", end.to_vec()),
+            ("road_end_heading_degrees", vec![heading]),
+            (
+                "last_segment",
+                last.map_or(Vec::new(), |s| vec![s.length, s.curve, s.height]),
+            ),
+            ("segments", vec![self.track.segments.len() as f64]),
+            ("max_segments", vec![self.max_segments as f64]),
+            ("obstacle_rays", obstacle_rays.map(f64::from).to_vec()),
+            ("road_rays", road_rays.map(f64::from).to_vec()),
+        ]
     }
 
     fn place(&mut self, row: &[f32]) -> Placement {

@@ -279,6 +279,7 @@ fn a_policys_golden_episode_replays_from_its_level_and_actions() {
             env!("CARGO_MANIFEST_DIR")
         );
         arlpcg_ok(&["export-policy", &policy, "--out", out.to_str().unwrap()]);
+        every_observation_part_says_what_it_holds(&dir.path().join(format!("{game}.onnx.json")));
         let golden = dir.path().join(format!("{game}.onnx.golden.json"));
         let episode: serde_json::Value =
             serde_json::from_slice(&std::fs::read(&golden).unwrap()).unwrap();
@@ -296,6 +297,9 @@ fn a_policys_golden_episode_replays_from_its_level_and_actions() {
         );
         let out = dir.path().join(format!("{game}-generator.onnx"));
         arlpcg_ok(&["export-policy", &generator, "--out", out.to_str().unwrap()]);
+        every_observation_part_says_what_it_holds(
+            &dir.path().join(format!("{game}-generator.onnx.json")),
+        );
         let golden = dir
             .path()
             .join(format!("{game}-generator.onnx.golden.json"));
@@ -310,5 +314,14 @@ fn a_policys_golden_episode_replays_from_its_level_and_actions() {
             level.piece_count(),
             "one frame per piece placed"
         );
+    }
+}
+
+/// The sidecar at `path` says, for every part of the observation, how it is computed.
+fn every_observation_part_says_what_it_holds(path: &Path) {
+    let sidecar: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    for column in sidecar["inputs"][0]["columns"].as_array().unwrap() {
+        let meaning = column["meaning"].as_str().unwrap_or_default();
+        assert!(meaning.len() > 10, "{}: {column}", path.display());
     }
 }

@@ -123,6 +123,9 @@ pub struct Columns {
     pub name: String,
     pub offset: usize,
     pub width: usize,
+    /// How an observation part is computed (frame, scale, sign, order), for a port of it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub meaning: Option<String>,
 }
 
 /// Named runs of columns laid end to end.
@@ -136,6 +139,7 @@ fn columns(named: impl IntoIterator<Item = (String, usize)>) -> Vec<Columns> {
                 name,
                 offset: offset - width,
                 width,
+                meaning: None,
             }
         })
         .collect()
@@ -171,6 +175,41 @@ struct Output {
 
 const CONTINUOUS_MEANING: &str =
     "the deterministic continuous actions (the Gaussian's mean clipped to [-1, 1])";
+
+/// The observation's columns, each part with what it holds (the game's own words, by name).
+fn observation_columns(card: &PolicyCard) -> Vec<Columns> {
+    use arlpcg_core::game::generator::GeneratorGame;
+    use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame};
+    use arlpcg_core::level::Game;
+    use arlpcg_core::rl::checkpoint::Role;
+    let (layout, meanings) = match (card.game, card.role) {
+        (Game::Platform, Role::Solver) => (
+            PlatformGame::OBSERVATION_LAYOUT,
+            PlatformGame::OBSERVATION_MEANINGS,
+        ),
+        (Game::Racing, Role::Solver) => (
+            RacingGame::OBSERVATION_LAYOUT,
+            RacingGame::OBSERVATION_MEANINGS,
+        ),
+        (Game::Platform, Role::Generator) => (
+            PlatformGame::GENERATOR_OBSERVATION_LAYOUT,
+            PlatformGame::GENERATOR_OBSERVATION_MEANINGS,
+        ),
+        (Game::Racing, Role::Generator) => (
+            RacingGame::GENERATOR_OBSERVATION_LAYOUT,
+            RacingGame::GENERATOR_OBSERVATION_MEANINGS,
+        ),
+    };
+    let mut columns = columns(card.observation.clone());
+    for column in &mut columns {
+        column.meaning = layout
+            .iter()
+            .zip(meanings)
+            .find(|((name, width), _)| *name == column.name && *width == column.width)
+            .map(|(_, meaning)| meaning.to_string());
+    }
+    columns
+}
 
 /// One column per action name.
 fn action_columns(names: &[String]) -> Vec<Columns> {
@@ -244,7 +283,7 @@ pub fn export(
         shape: dims_json(&[None, Some(observation)]),
         meaning: "raw observations, as the game produces them (normalized inside the graph)".into(),
         element_type: None,
-        columns: columns(card.observation.clone()),
+        columns: observation_columns(card),
     }];
     if profile == Profile::Mlagents && binary > 0 {
         inputs.push(Port {

@@ -179,6 +179,8 @@ pub trait GeneratorGame: GameSpec {
     type Build: TrackBuild;
     /// The Generator's observation, named parts in order.
     const GENERATOR_OBSERVATION_LAYOUT: &'static [(&'static str, usize)];
+    /// What each part of the Generator's observation holds, in the layout's order.
+    const GENERATOR_OBSERVATION_MEANINGS: &'static [&'static str];
     /// The Generator's actions, in the policy's order.
     const GENERATOR_ACTIONS: &'static [&'static str];
     /// The piece budget of a Generator's track by default.

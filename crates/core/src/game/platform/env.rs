@@ -42,6 +42,19 @@ pub const OBSERVATION_LAYOUT: [(&str, usize); 9] = [
     ("height_map", HEIGHT_MAP_SIDE * HEIGHT_MAP_SIDE),
 ];
 
+/// What each part of [`OBSERVATION_LAYOUT`] holds, for a port of it (an export's sidecar).
+pub const OBSERVATION_MEANINGS: [&str; 9] = [
+    "goal - feet in the character's frame (forward f = (cos yaw, 0, -sin yaw), up, left l = (f.z, 0, -f.x)), / 50 m",
+    "|goal - feet| / 50 m",
+    "top centre of the block after the furthest one stood on, minus the feet, character frame, / 10 m",
+    "that block's side / 6 m",
+    "velocity in the character's frame / 10 m/s",
+    "sin, cos of the next block's bearing, atan2(left, forward) of its relative position (+ left)",
+    "1 on the ground, else 0",
+    "1 - decisions taken / decisions allowed (10 s + 4 s per block, 30 decisions per s)",
+    "(2.2 - d) / 4 for 25 rays straight down from 2.2 m above the feet, d the distance to a hit (8 m: none); forward-major: rows 1.5 m behind to 4.5 m ahead in 1.5 m steps, each from 3 m right to 3 m left in 1.5 m steps",
+];
+
 /// Length of the state part (everything before the height map).
 const STATE_SIZE: usize = OBSERVATION_SIZE - HEIGHT_MAP_SIDE * HEIGHT_MAP_SIDE;
 

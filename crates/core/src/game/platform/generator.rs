@@ -29,6 +29,19 @@ pub const GENERATOR_OBSERVATION_LAYOUT: [(&str, usize); 9] = [
     ("aux", 1),
 ];
 
+/// What each part of [`GENERATOR_OBSERVATION_LAYOUT`] holds, for a port of it.
+pub const GENERATOR_OBSERVATION_MEANINGS: [&str; 9] = [
+    "goal - the last block's top centre in its frame (forward f = (cos H, 0, -sin H) for its heading H, up, left l = (f.z, 0, -f.x)) / 50 m",
+    "sin, cos of atan2(left, forward) of that vector (+ left)",
+    "its horizontal length / 50 m",
+    "the last block's side / 6 m",
+    "the block before the last, minus the last's top centre, same frame, / 10 m (0 when the last is the start)",
+    "its side / 6 m (0 at the start)",
+    "sin, cos of the turn the last block was placed with (0 at the start)",
+    "1 - blocks placed / the piece budget",
+    "λ: +1 easy, -1 hard",
+];
+
 /// Length of the Generator's observation vector.
 pub const GENERATOR_OBSERVATION_SIZE: usize = {
     let mut total = 0;
@@ -222,6 +235,7 @@ impl GeneratorGame for PlatformGame {
     type Build = PlatformBuild;
     const GENERATOR_OBSERVATION_LAYOUT: &'static [(&'static str, usize)] =
         &GENERATOR_OBSERVATION_LAYOUT;
+    const GENERATOR_OBSERVATION_MEANINGS: &'static [&'static str] = &GENERATOR_OBSERVATION_MEANINGS;
     const GENERATOR_ACTIONS: &'static [&'static str] = &GENERATOR_ACTIONS;
     const DEFAULT_MAX_PIECES: usize = DEFAULT_MAX_BLOCKS;
     const MAX_PIECES: usize = crate::level::platform::MAX_BLOCKS;

@@ -63,6 +63,19 @@ pub const OBSERVATION_LAYOUT: [(&str, usize); 9] = [
     ("ray_fan", FAN_FORWARD.len() * FAN_LEFT.len()),
 ];
 
+/// What each part of [`OBSERVATION_LAYOUT`] holds, for a port of it (an export's sidecar).
+pub const OBSERVATION_MEANINGS: [&str; 9] = [
+    "goal - chassis centre in the car's level heading frame (x ahead, y up, z right; heading = atan2(-F.z, F.x) of the body's forward axis F), / 100 m",
+    "sin, cos of atan2(-z, x) of that vector (+ left)",
+    "linear velocity in the body frame (x forward, y up, z right) / 20 m/s",
+    "angular velocity in the body frame, rad/s",
+    "world +Y in the body frame",
+    "the chassis centre's signed distance from the nearest centre-line point across the road's heading there (+ left) / 4.5 m (±1 at the edges)",
+    "sin, cos of (the road's heading at the nearest centre-line point - the car's heading)",
+    "the centre line 8, 16, 26, 40, 60 m further along than the car, each in the level heading frame as x / 60 m then z / 20 m",
+    "(6 - d) / 6 for 20 rays straight down from 6 m above the chassis centre, d the distance to road or obstacle (18 m: none); forward-major: rows 5, 11, 19, 30 m ahead, each from 7 m right to 7 m left in 3.5 m steps, in the level heading frame",
+];
+
 /// Length of the observation vector.
 pub const OBSERVATION_SIZE: usize = {
     let mut total = 0;

@@ -51,6 +51,19 @@ pub const GENERATOR_OBSERVATION_LAYOUT: [(&str, usize); 9] = [
     ("aux", 1),
 ];
 
+/// What each part of [`GENERATOR_OBSERVATION_LAYOUT`] holds, for a port of it.
+pub const GENERATOR_OBSERVATION_MEANINGS: [&str; 9] = [
+    "goal - the road's end in its frame (forward f = (cos H, 0, -sin H) for the end's heading H, up, left l = (f.z, 0, -f.x)) / 100 m",
+    "sin, cos of atan2(left, forward) of that vector (+ left)",
+    "its horizontal length / 300 m",
+    "sin, cos of the end's heading H (0 along +X, + turns left)",
+    "the last segment: (length - 20) / 5 - 1, curve / 30 degrees, height / 5 m (0 before the first)",
+    "1 - segments placed / the piece budget",
+    "9 plan-view rays from the road's end at H - 80 to H + 80 degrees (right to left) in 4 m steps: the first distance within 6 m of an obstacle's footprint / 80 m (1: none within 80 m)",
+    "the same rays to the first point within 12 m of the centre line before the road's last 36 m (every third sample)",
+    "λ: +1 easy, -1 hard",
+];
+
 /// The Generator's action names, in the policy's order, each a value in [-1, 1] mapped onto its
 /// range of docs/spec.md §1.2. The curve is taken relative to the bearing of the goal from the
 /// road's end (0 turns toward it, as far as a segment may) and the height change relative to the
@@ -290,6 +303,7 @@ impl GeneratorGame for RacingGame {
     type Build = RacingBuild;
     const GENERATOR_OBSERVATION_LAYOUT: &'static [(&'static str, usize)] =
         &GENERATOR_OBSERVATION_LAYOUT;
+    const GENERATOR_OBSERVATION_MEANINGS: &'static [&'static str] = &GENERATOR_OBSERVATION_MEANINGS;
     const GENERATOR_ACTIONS: &'static [&'static str] = &GENERATOR_ACTIONS;
     const DEFAULT_MAX_PIECES: usize = DEFAULT_MAX_SEGMENTS;
     const MAX_PIECES: usize = racing::MAX_SEGMENTS;

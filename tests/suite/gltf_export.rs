@@ -489,7 +489,18 @@ fn finish_zone_is_where_the_game_counts_success(
                 assert!(inside(at(0.1, across)), "the road's end, {across} m across");
                 assert!(inside(at(FINISH_LENGTH - 0.1, across)), "3 m before it");
                 assert!(!inside(at(FINISH_LENGTH + 0.5, across)), "3.5 m before it");
-                assert!(!inside(at(0.0, across + ROAD_WIDTH)), "beside the road");
+            }
+            // Half a metre beyond either edge, measured level, as the game measures the car's
+            // distance from the centre line (a banked end tilts the surface, not the rule).
+            let (s, c) = end.heading.sin_cos();
+            for side in [-1.0, 1.0] {
+                let off = side * (0.5 * ROAD_WIDTH + 0.5);
+                let p = [
+                    end.centre[0] - off * s,
+                    end.centre[1],
+                    end.centre[2] - off * c,
+                ];
+                assert!(!inside(p), "beside the road");
             }
         }
     }

@@ -426,6 +426,41 @@ impl HalfwaySplit {
     }
 }
 
+/// Where a batch's failures gather: the share of all failures on each level's last piece and on
+/// each level's most-failed piece (so weighted by failures), and the pieces per level. A knob
+/// that builds a wall before the goal shows as a last-piece share near 1; one that makes every
+/// stretch harder, as small shares of both.
+#[derive(Debug, Default, Clone, Copy, PartialEq)]
+pub struct FailureConcentration {
+    pub failures: u64,
+    pub on_last_piece: u64,
+    pub on_worst_piece: u64,
+    pub levels: u64,
+    pub pieces: u64,
+}
+
+impl FailureConcentration {
+    pub fn add(&mut self, stats: &SolverStats) {
+        let by_piece = &stats.failures_by_piece;
+        self.failures += by_piece.iter().map(|&f| u64::from(f)).sum::<u64>();
+        self.on_last_piece += by_piece.last().map_or(0, |&f| u64::from(f));
+        self.on_worst_piece += by_piece.iter().max().map_or(0, |&f| u64::from(f));
+        self.levels += 1;
+        self.pieces += by_piece.len() as u64;
+    }
+
+    /// The shares on the last and on the most-failed piece (none without failures).
+    pub fn shares(&self) -> Option<[f64; 2]> {
+        (self.failures > 0).then(|| {
+            [self.on_last_piece, self.on_worst_piece].map(|n| n as f64 / self.failures as f64)
+        })
+    }
+
+    pub fn pieces_per_level(&self) -> f64 {
+        self.pieces as f64 / self.levels.max(1) as f64
+    }
+}
+
 /// The difficulty along a level: the share of runs past each piece, piece by piece from the
 /// start, and, on a paced level, the difficulty its λ asked for (`(1 - λ) / 2`: 0 easy, 1 hard).
 /// Pieces are counted, not placed by the fraction of the way where they begin: a level that
@@ -476,6 +511,27 @@ pub fn passed_by_piece(stats: &SolverStats) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A wall before the goal shows as all failures on the last piece; failures spread over a
+    /// level, as small shares of both.
+    #[test]
+    fn failure_concentration_weighs_each_levels_last_and_worst_piece_by_failures() {
+        let stats = |by_piece: Vec<u32>| {
+            let mut s = SolverStats::from_trials(SolverRef::Random, 0, by_piece.len(), &[]);
+            s.failures_by_piece = by_piece;
+            s
+        };
+        let mut wall = FailureConcentration::default();
+        wall.add(&stats(vec![0, 0, 0, 9]));
+        wall.add(&stats(vec![0, 0, 1]));
+        assert_eq!(wall.shares(), Some([1.0, 1.0]));
+        assert_eq!(wall.pieces_per_level(), 3.5);
+        let mut spread = FailureConcentration::default();
+        spread.add(&stats(vec![2, 1, 2, 1, 0]));
+        spread.add(&stats(vec![0, 0, 0]));
+        assert_eq!(spread.shares(), Some([0.0, 2.0 / 6.0]));
+        assert_eq!(FailureConcentration::default().shares(), None);
+    }
 
     /// The shipped easy-then-hard level winds back and forth near halfway, so its pieces'
     /// fractions of the way are not in order; the chart still reads left to right.

@@ -11,7 +11,8 @@ use serde_json::json;
 use crate::services::panel::{JudgePanel, rate};
 use crate::services::policies::{load_panel, load_solver};
 use crate::services::verify::{
-    HalfwaySplit, Solver, SolverPolicy, Summary, Watch, passed_by_piece, verify,
+    FailureConcentration, HalfwaySplit, Solver, SolverPolicy, Summary, Watch, passed_by_piece,
+    verify,
 };
 use crate::shells::cli::{Judges, SolverChoice, VerifyArgs, default_solver};
 use arlpcg_core::game::Skill;
@@ -53,6 +54,7 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
     let mut failed = 0;
     let mut all = Vec::new();
     let mut halfway = HalfwaySplit::default();
+    let mut concentration = FailureConcentration::default();
     for path in &args.levels {
         if crate::shells::common::stdout_closed() {
             break; // nobody reads the rest
@@ -79,6 +81,7 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
                     crate::say!("{}", describe(path, &level, &stats));
                 }
                 halfway.add(&level, &stats);
+                concentration.add(&stats);
                 if let Some(chart) = &args.chart {
                     let name = path.file_stem().unwrap_or_default().to_string_lossy();
                     let png = crate::services::verify::pacing_chart(&name, &level, &stats).to_png();
@@ -111,6 +114,13 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
             s.completed_by_any,
             s.mean_progress
         );
+        if let Some([last, worst]) = concentration.shares() {
+            crate::say!(
+                "of the {} failures, {last:.2} on each level's last piece and {worst:.2} on its most-failed piece; {:.1} pieces per level",
+                concentration.failures,
+                concentration.pieces_per_level()
+            );
+        }
         let [before, past] = halfway.per_piece();
         if halfway.failures.iter().sum::<u64>() > 0 {
             crate::say!(

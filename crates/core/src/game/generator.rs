@@ -4,7 +4,8 @@
 //! games. The platform Generator places the next block when the Solver stands on the newest one;
 //! the racing Generator places the next segment when the car comes within
 //! [`super::racing::generator::REQUEST_DISTANCE`] (65 m) of the road's end. The Generator's
-//! episode ends with the Solver's.
+//! episode ends with the Solver's run, or, with [`GeneratorRewards::retries`], with its last
+//! try on a piece it keeps failing (a failed run starts again on that piece).
 //!
 //! Rewards follow the paper's eq. 1 with a vector of aux inputs λᵢ, each with weights αᵢ (on the
 //! Generator's own, internal reward) and βᵢ (on the reward from the Solver's behaviour):
@@ -17,7 +18,9 @@
 //! - racing: each Solver step with the car in the air, `air_step · Σ βᵢ max(-λᵢ, 0)` (only when
 //!   λ < 0);
 //! - an invalid placement (overlap, crossing, obstacle) or a track that runs out of pieces before
-//!   the goal: `invalid`, and the match ends.
+//!   the goal: `invalid`, and the match ends;
+//! - with retries, the failure term instead: [`GeneratorRewards::on_piece_failure`] at the
+//!   piece where each failure happens.
 //!
 //! A paced match ([`MatchPacing`]) changes λ along the track: each piece is built, and each of
 //! the terms above paid, at the λ of the piece it belongs to (the failure and air terms at the

@@ -84,23 +84,39 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
 
 /// Loads a Generator policy of `game`.
 pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, PolicyCard)> {
-    let (observation, actions, default_max_pieces, most_pieces) = match game {
+    let (observation, actions) = match game {
         Game::Platform => (
             observation_size::<PlatformGame>(),
             PlatformGame::GENERATOR_ACTIONS,
-            PlatformGame::DEFAULT_MAX_PIECES,
-            PlatformGame::MAX_PIECES,
         ),
         Game::Racing => (
             observation_size::<RacingGame>(),
             RacingGame::GENERATOR_ACTIONS,
-            RacingGame::DEFAULT_MAX_PIECES,
-            RacingGame::MAX_PIECES,
         ),
     };
     let (loaded, reference) =
         load_pinned(path, (game, Role::Generator), observation, (actions, &[]))?;
     let card = loaded.card.clone();
+    let limits = generator_limits(path, &card)?;
+    Ok((
+        GeneratorPolicy {
+            game,
+            policy: loaded.policy,
+            limits,
+            normalizer: loaded.card.normalizer,
+            reference,
+        },
+        card,
+    ))
+}
+
+/// The piece budget and curve offset a Generator's card (of the file at `path`) records, each
+/// checked against its game's range, or the game's defaults where the card has none.
+pub fn generator_limits(path: &Path, card: &PolicyCard) -> Result<BuildLimits> {
+    let (default_max_pieces, most_pieces) = match card.game {
+        Game::Platform => (PlatformGame::DEFAULT_MAX_PIECES, PlatformGame::MAX_PIECES),
+        Game::Racing => (RacingGame::DEFAULT_MAX_PIECES, RacingGame::MAX_PIECES),
+    };
     let limits = BuildLimits {
         max_pieces: card.max_pieces.unwrap_or(default_max_pieces),
         curve_offset: card.curve_offset.unwrap_or(DEFAULT_CURVE_OFFSET),
@@ -119,16 +135,7 @@ pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, Polic
             limits.curve_offset
         );
     }
-    Ok((
-        GeneratorPolicy {
-            game,
-            policy: loaded.policy,
-            limits,
-            normalizer: loaded.card.normalizer,
-            reference,
-        },
-        card,
-    ))
+    Ok(limits)
 }
 
 /// The file beside a policies folder's Generator that holds its λ→success curve with the

@@ -46,6 +46,30 @@ pub struct GoldenEpisode {
     pub frames: Vec<GoldenFrame>,
 }
 
+impl GoldenEpisode {
+    fn new(
+        card: &PolicyCard,
+        policy: PolicyRef,
+        level: &arlpcg_core::level::Level,
+        aux: Option<f32>,
+        outcome: String,
+        frames: Vec<GoldenFrame>,
+    ) -> Self {
+        Self {
+            format: "arlpcg-golden-episode".into(),
+            version: 1,
+            game: card.game.to_string(),
+            role: card.role.to_string(),
+            policy,
+            level: arlpcg_core::level::yaml::to_string(level),
+            aux,
+            run_seed: GOLDEN_RUN_SEED,
+            outcome,
+            frames,
+        }
+    }
+}
+
 /// One decision.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GoldenFrame {
@@ -79,18 +103,14 @@ pub fn golden_episode<G: GameSpec>(
             break outcome;
         }
     };
-    Ok(GoldenEpisode {
-        format: "arlpcg-golden-episode".into(),
-        version: 1,
-        game: card.game.to_string(),
-        role: card.role.to_string(),
-        policy: reference,
-        level: arlpcg_core::level::yaml::to_string(&level),
-        aux: None,
-        run_seed: GOLDEN_RUN_SEED,
-        outcome: format!("{outcome:?}"),
+    Ok(GoldenEpisode::new(
+        card,
+        reference,
+        &level,
+        None,
+        format!("{outcome:?}"),
         frames,
-    })
+    ))
 }
 
 /// The golden episode of Generator `policy` (with its `card` and `limits`) of game `G`: each
@@ -125,18 +145,15 @@ pub fn generator_golden_episode<G: GeneratorGame>(
         stats: None,
         pacing: None,
     };
-    Ok(GoldenEpisode {
-        format: "arlpcg-golden-episode".into(),
-        version: 1,
-        game: card.game.to_string(),
-        role: card.role.to_string(),
-        policy: reference,
-        level: arlpcg_core::level::yaml::to_string(&level),
-        aux: Some(GOLDEN_AUX),
-        run_seed: GOLDEN_RUN_SEED,
-        outcome: format!("{outcome:?}"),
+    let outcome = format!("{outcome:?}");
+    Ok(GoldenEpisode::new(
+        card,
+        reference,
+        &level,
+        Some(GOLDEN_AUX),
+        outcome,
         frames,
-    })
+    ))
 }
 
 /// One decision: the policy's deterministic action on `observation` (normalized by the card's

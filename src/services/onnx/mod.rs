@@ -178,33 +178,17 @@ const CONTINUOUS_MEANING: &str =
 
 /// The observation's columns, each part with what it holds (the game's own words, by name).
 fn observation_columns(card: &PolicyCard) -> Vec<Columns> {
-    use arlpcg_core::game::generator::GeneratorGame;
-    use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame};
-    use arlpcg_core::level::Game;
-    use arlpcg_core::rl::checkpoint::Role;
-    let (layout, meanings) = match (card.game, card.role) {
-        (Game::Platform, Role::Solver) => (
-            PlatformGame::OBSERVATION_LAYOUT,
-            PlatformGame::OBSERVATION_MEANINGS,
-        ),
-        (Game::Racing, Role::Solver) => (
-            RacingGame::OBSERVATION_LAYOUT,
-            RacingGame::OBSERVATION_MEANINGS,
-        ),
-        (Game::Platform, Role::Generator) => (
-            PlatformGame::GENERATOR_OBSERVATION_LAYOUT,
-            PlatformGame::GENERATOR_OBSERVATION_MEANINGS,
-        ),
-        (Game::Racing, Role::Generator) => (
-            RacingGame::GENERATOR_OBSERVATION_LAYOUT,
-            RacingGame::GENERATOR_OBSERVATION_MEANINGS,
-        ),
+    let facts = arlpcg_core::game::facts::facts(card.game);
+    let observation = match card.role {
+        arlpcg_core::rl::checkpoint::Role::Solver => &facts.solver_observation,
+        arlpcg_core::rl::checkpoint::Role::Generator => &facts.generator_observation,
     };
     let mut columns = columns(card.observation.clone());
     for column in &mut columns {
-        column.meaning = layout
+        column.meaning = observation
+            .layout
             .iter()
-            .zip(meanings)
+            .zip(observation.meanings)
             .find(|((name, width), _)| *name == column.name && *width == column.width)
             .map(|(_, meaning)| meaning.to_string());
     }

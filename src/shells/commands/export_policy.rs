@@ -46,10 +46,7 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
         }
         Role::Generator => {
             let reference = exported.sidecar.policy.clone();
-            // The card's piece budget and curve offset, checked as generation reads them.
-            let limits = crate::services::policies::load_generator(&args.policy, card.game)?
-                .0
-                .limits;
+            let limits = crate::services::policies::generator_limits(&args.policy, &card)?;
             let episode = match card.game {
                 Game::Platform => {
                     generator_golden_episode::<PlatformGame>(&policy, &card, reference, limits)

@@ -33,6 +33,17 @@ pub struct GameFacts {
     pub controllability_header: &'static str,
     /// The paper's generalization figure per training mode (docs/spec.md §4).
     pub paper_generalization: [(&'static str, &'static str); 4],
+    /// The Solver's and the Generator's observations: each part's name and width, and what it
+    /// holds (frame, scale, sign, order), for a port of it (an export's sidecar).
+    pub solver_observation: ObservationFacts,
+    pub generator_observation: ObservationFacts,
+}
+
+/// An observation's parts in order, and what each holds.
+#[derive(Debug)]
+pub struct ObservationFacts {
+    pub layout: &'static [(&'static str, usize)],
+    pub meanings: &'static [&'static str],
 }
 
 impl GameFacts {
@@ -76,6 +87,14 @@ pub const PLATFORM: GameFacts = GameFacts {
         ("fixed-aux", "0.173 ± 0.195, 0.90 (442 steps)"),
         ("arlpcg", "0.457 ± 0.211, 1.00 (467 steps)"),
     ],
+    solver_observation: ObservationFacts {
+        layout: &super::platform::env::OBSERVATION_LAYOUT,
+        meanings: &super::platform::env::OBSERVATION_MEANINGS,
+    },
+    generator_observation: ObservationFacts {
+        layout: &super::platform::generator::GENERATOR_OBSERVATION_LAYOUT,
+        meanings: &super::platform::generator::GENERATOR_OBSERVATION_MEANINGS,
+    },
 };
 
 /// The racing game's facts.
@@ -108,6 +127,14 @@ pub const RACING: GameFacts = GameFacts {
         ("fixed-aux", "0.163 ± 0.138, 0.8 (382 m)"),
         ("arlpcg", "0.331 ± 0.225, 1.0 (507 m)"),
     ],
+    solver_observation: ObservationFacts {
+        layout: &super::racing::env::OBSERVATION_LAYOUT,
+        meanings: &super::racing::env::OBSERVATION_MEANINGS,
+    },
+    generator_observation: ObservationFacts {
+        layout: &super::racing::generator::GENERATOR_OBSERVATION_LAYOUT,
+        meanings: &super::racing::generator::GENERATOR_OBSERVATION_MEANINGS,
+    },
 };
 
 /// The facts of `game`.

@@ -182,8 +182,6 @@ pub trait GeneratorGame: GameSpec {
     type Build: TrackBuild;
     /// The Generator's observation, named parts in order.
     const GENERATOR_OBSERVATION_LAYOUT: &'static [(&'static str, usize)];
-    /// What each part of the Generator's observation holds, in the layout's order.
-    const GENERATOR_OBSERVATION_MEANINGS: &'static [&'static str];
     /// The Generator's actions, in the policy's order.
     const GENERATOR_ACTIONS: &'static [&'static str];
     /// The piece budget of a Generator's track by default.
@@ -471,31 +469,30 @@ impl<G: GeneratorGame> Match<G> {
             self.paid_up_to = furthest;
         }
         let air = G::air_steps(env);
-        // λ of the piece the Solver is on: the one after those it has left behind.
-        let aux = self.piece_aux(furthest).to_vec();
-        let aux = &aux[..];
-        if air > self.air_paid {
-            generator += rewards.per_air_step(aux) * (air - self.air_paid) as f32;
+        let failed = step.outcome.is_some_and(|o| o != Outcome::Success);
+        // With retries, a repeat: the Solver failed after this same piece the time before.
+        let repeat = self.failures_here > 0 && furthest == self.failed_after;
+        {
+            // λ of the piece the Solver is on: the one after those it has left behind.
+            let aux = self.piece_aux(furthest);
+            if air > self.air_paid {
+                generator += rewards.per_air_step(aux) * (air - self.air_paid) as f32;
+            }
+            if failed && rewards.retries == 0 {
+                generator += rewards.on_failure(aux);
+            } else if failed {
+                let share = Self::share_after(&self.build, furthest);
+                generator += rewards.on_piece_failure(aux, share, repeat);
+            }
         }
         self.air_paid = self.air_paid.max(air);
         match step.outcome {
             None => {}
             Some(Outcome::Success) => self.over = true,
-            Some(_) if rewards.retries == 0 => {
-                generator += rewards.on_failure(aux);
-                self.first_failure
-                    .get_or_insert(step.outcome.expect("failed"));
-                self.over = true;
-            }
             Some(outcome) => {
-                if furthest != self.failed_after || self.failures_here == 0 {
-                    self.failed_after = furthest;
-                    self.failures_here = 0;
-                }
-                let share = Self::share_after(&self.build, furthest);
-                generator += rewards.on_piece_failure(aux, share, self.failures_here > 0);
-                self.failures_here += 1;
                 self.first_failure.get_or_insert(outcome);
+                self.failed_after = furthest;
+                self.failures_here = if repeat { self.failures_here + 1 } else { 1 };
                 if self.failures_here > rewards.retries {
                     self.over = true;
                 } else {

@@ -87,8 +87,6 @@ pub trait GameSpec: Send + Sync + 'static {
     type Scripted: Scripted<Self::Env> + Send + Sync;
     /// The Solver's observation, named parts in order.
     const OBSERVATION_LAYOUT: &'static [(&'static str, usize)];
-    /// What each part of the observation holds, in the layout's order (a port's contract).
-    const OBSERVATION_MEANINGS: &'static [&'static str];
     /// The Solver's continuous actions, in the policy's order...
     const CONTINUOUS_ACTIONS: &'static [&'static str];
     /// ...and its binary ones, after them.
@@ -113,7 +111,6 @@ impl GameSpec for PlatformGame {
     type Env = platform::PlatformEnv;
     type Scripted = platform::ScriptedController;
     const OBSERVATION_LAYOUT: &'static [(&'static str, usize)] = &platform::env::OBSERVATION_LAYOUT;
-    const OBSERVATION_MEANINGS: &'static [&'static str] = &platform::env::OBSERVATION_MEANINGS;
     const CONTINUOUS_ACTIONS: &'static [&'static str] = &["forward", "turn"];
     const BINARY_ACTIONS: &'static [&'static str] = &["jump"];
 
@@ -147,7 +144,6 @@ impl GameSpec for RacingGame {
     type Env = racing::RacingEnv;
     type Scripted = racing::ScriptedDriver;
     const OBSERVATION_LAYOUT: &'static [(&'static str, usize)] = &racing::env::OBSERVATION_LAYOUT;
-    const OBSERVATION_MEANINGS: &'static [&'static str] = &racing::env::OBSERVATION_MEANINGS;
     const CONTINUOUS_ACTIONS: &'static [&'static str] = &["throttle", "steer"];
     const BINARY_ACTIONS: &'static [&'static str] = &[];
 

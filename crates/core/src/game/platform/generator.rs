@@ -235,7 +235,6 @@ impl GeneratorGame for PlatformGame {
     type Build = PlatformBuild;
     const GENERATOR_OBSERVATION_LAYOUT: &'static [(&'static str, usize)] =
         &GENERATOR_OBSERVATION_LAYOUT;
-    const GENERATOR_OBSERVATION_MEANINGS: &'static [&'static str] = &GENERATOR_OBSERVATION_MEANINGS;
     const GENERATOR_ACTIONS: &'static [&'static str] = &GENERATOR_ACTIONS;
     const DEFAULT_MAX_PIECES: usize = DEFAULT_MAX_BLOCKS;
     const MAX_PIECES: usize = crate::level::platform::MAX_BLOCKS;

@@ -303,7 +303,6 @@ impl GeneratorGame for RacingGame {
     type Build = RacingBuild;
     const GENERATOR_OBSERVATION_LAYOUT: &'static [(&'static str, usize)] =
         &GENERATOR_OBSERVATION_LAYOUT;
-    const GENERATOR_OBSERVATION_MEANINGS: &'static [&'static str] = &GENERATOR_OBSERVATION_MEANINGS;
     const GENERATOR_ACTIONS: &'static [&'static str] = &GENERATOR_ACTIONS;
     const DEFAULT_MAX_PIECES: usize = DEFAULT_MAX_SEGMENTS;
     const MAX_PIECES: usize = racing::MAX_SEGMENTS;

@@ -248,6 +248,49 @@ pub fn lock_folder(dir: &Path, on_wait: impl FnOnce()) -> Result<Option<std::fs:
     Ok(Some(handle))
 }
 
+/// Writes `files` into folder `dir`, all or none, one batch into a folder at a time
+/// ([`lock_folder`]; `on_wait` if another run holds it): each file is staged beside its target
+/// as the iterator makes it (memory stays bounded), then all are renamed into place. A file
+/// that exists already with the same bytes is left alone (a re-run finishes a batch); one with
+/// other bytes is replaced only when `replace(path)`, else the batch is refused, the message
+/// ending with `refusal` (how to allow it). Returns (files written, files left as they were).
+pub fn write_batch(
+    dir: &Path,
+    files: impl IntoIterator<Item = (PathBuf, Vec<u8>)>,
+    replace: &dyn Fn(&Path) -> bool,
+    refusal: &str,
+    on_wait: impl FnOnce(),
+) -> Result<(usize, usize)> {
+    let _held = lock_folder(dir, on_wait)?;
+    remove_stale_temps(dir, std::time::SystemTime::now())?;
+    let mut batch = FileBatch::new();
+    let mut kept = 0;
+    let nothing = "nothing was written";
+    for (path, bytes) in files {
+        check_not_in_the_way(&path).with_context(|| nothing.to_string())?;
+        let overwrite = match std::fs::read(&path) {
+            Ok(existing) if existing == bytes => {
+                kept += 1;
+                continue;
+            }
+            Ok(_) if !replace(&path) => bail!(
+                "{} already exists with other contents ({refusal}); {nothing}",
+                path.display()
+            ),
+            Ok(_) => Overwrite::Allowed,
+            // Absent when checked: written only if still absent (another run may get there
+            // first, and its file is not replaced).
+            Err(_) => Overwrite::Never,
+        };
+        batch
+            .stage(&path, &bytes, overwrite)
+            .with_context(|| nothing.to_string())?;
+    }
+    let staged = batch.len();
+    batch.commit()?;
+    Ok((staged, kept))
+}
+
 /// Removes the temporary files a killed run left in `dir` (older than [`STALE_TEMP_AGE`],
 /// so another run's file being written is never touched); returns how many went. `now` is the
 /// caller's clock.

@@ -1,7 +1,9 @@
 //! What the shells run, on top of `arlpcg_core`: each service is pure and seeded but for the
 //! files it is told to read or write.
 
+pub mod campaign;
 pub mod chart;
+pub mod checks;
 pub mod difficulty;
 pub mod eval;
 pub mod fsio;

@@ -123,6 +123,36 @@ pub fn play(
     Ok(Some(panel_stats(panel, seed, trials, &played)))
 }
 
+/// Plays every level of `levels` with every judge of `panel` (each from its verification's
+/// seed), several levels at once, and rates them together into their statistics; returns the
+/// judges' θ. Levels that `watch.stop` left unplayed are dropped from the end.
+pub fn play_and_rate(
+    panel: &JudgePanel,
+    levels: &mut Vec<Level>,
+    trials: u32,
+    watch: &Watch,
+) -> Vec<(String, f64)> {
+    use rayon::prelude::*;
+    let played: Vec<Option<PanelStats>> = levels
+        .par_iter()
+        .map(|level| {
+            let seed = level.stats.as_ref().map_or(0, |s| s.seed);
+            play(panel, level, trials, seed, watch, &|_, _| {})
+                .expect("judges are loaded for the levels' game")
+        })
+        .collect();
+    let done = played.iter().take_while(|p| p.is_some()).count();
+    levels.truncate(done);
+    let mut panels: Vec<PanelStats> = played.into_iter().flatten().take(done).collect();
+    let abilities = rate(&mut panels.iter_mut().collect::<Vec<_>>());
+    for (level, panel) in levels.iter_mut().zip(panels) {
+        if let Some(stats) = level.stats.as_mut() {
+            stats.panel = Some(panel);
+        }
+    }
+    abilities
+}
+
 /// Rates every level of `panels` together: fits the Rasch model over their judges × levels (a
 /// judge is matched by name; one a level was not played by says nothing about it) and records
 /// each level's b with its interval. Returns each judge's ability θ, by name.

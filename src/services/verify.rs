@@ -45,7 +45,8 @@ pub enum Solver<'a> {
 }
 
 impl Solver<'_> {
-    fn reference(&self) -> SolverRef {
+    /// How a level's statistics name this Solver.
+    pub fn reference(&self) -> SolverRef {
         match self {
             Solver::Scripted(skill) => SolverRef::Scripted { skill: *skill },
             Solver::Random => SolverRef::Random,
@@ -251,6 +252,21 @@ pub fn certify(
         }
     }
     Ok(None)
+}
+
+/// `level` with a certificate in its statistics: single runs from the trials' seeds on, so a
+/// level some trial completed is certified within a few runs unless its success ratio is tiny.
+pub fn certified(mut level: Level, solver: &Solver, seed: u64) -> Result<Level, WrongGame> {
+    if let Some(stats) = &level.stats
+        && stats.successes > 0
+    {
+        let seeds = (0..2 * stats.trials as u64).map(|k| seed.wrapping_add(k));
+        let certificate = certify(&level, solver, seeds)?;
+        if let Some(stats) = &mut level.stats {
+            stats.certificate = certificate;
+        }
+    }
+    Ok(level)
 }
 
 /// Plays one run with the game's scripted player of `skill`, seeded by `seed`.

@@ -16,6 +16,12 @@ pub struct UsageError(pub String);
 #[error("{0}")]
 pub struct Interrupted(pub String);
 
+/// Levels that failed their acceptance checks (`--check`; exit code 3, so that CI can tell a
+/// batch that missed its spec from a run that failed). The files were written all the same.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct ChecksFailed(pub String);
+
 /// Whether a write to standard output has failed (a closed pipe, `| head`): what is left to
 /// say is dropped, commands that stream lines stop early, and the process exits
 /// [`BROKEN_PIPE_EXIT`].
@@ -91,10 +97,13 @@ macro_rules! warn {
     };
 }
 
-/// The exit code for an error: 2 for a [`UsageError`], 130 for [`Interrupted`], 1 for the rest.
+/// The exit code for an error: 2 for a [`UsageError`], 3 for [`ChecksFailed`], 130 for
+/// [`Interrupted`], 1 for the rest.
 pub fn exit_code(err: &anyhow::Error) -> u8 {
     if err.downcast_ref::<UsageError>().is_some() {
         2
+    } else if err.downcast_ref::<ChecksFailed>().is_some() {
+        3
     } else if err.downcast_ref::<Interrupted>().is_some() {
         130
     } else {

@@ -4,6 +4,7 @@
 mod common;
 
 mod architecture;
+mod campaign;
 mod cli;
 mod designer;
 mod determinism;

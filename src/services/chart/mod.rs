@@ -154,20 +154,31 @@ impl Canvas {
     }
 
     fn png(&self) -> Vec<u8> {
-        let mut bytes = Vec::new();
-        {
-            let mut encoder = png::Encoder::new(&mut bytes, WIDTH as u32, HEIGHT as u32);
-            encoder.set_color(png::ColorType::Rgb);
-            encoder.set_depth(png::BitDepth::Eight);
-            let mut writer = encoder
-                .write_header()
-                .expect("writing to memory cannot fail");
-            writer
-                .write_image_data(&self.pixels)
-                .expect("the buffer matches the header");
-        }
-        bytes
+        encode(&self.pixels, HEIGHT)
     }
+}
+
+/// RGB rows of [`WIDTH`] pixels, `height` of them, as PNG bytes.
+fn encode(pixels: &[u8], height: usize) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut bytes, WIDTH as u32, height as u32);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder
+            .write_header()
+            .expect("writing to memory cannot fail");
+        writer
+            .write_image_data(pixels)
+            .expect("the buffer matches the header");
+    }
+    bytes
+}
+
+/// Charts one above the other in one PNG, each as [`LineChart::to_png`] draws it alone.
+pub fn stacked_png(charts: &[LineChart]) -> Vec<u8> {
+    let pixels: Vec<u8> = charts.iter().flat_map(|c| c.draw().pixels).collect();
+    encode(&pixels, HEIGHT * charts.len())
 }
 
 /// About five round tick values covering [lo, hi].
@@ -202,6 +213,10 @@ fn label(value: f64) -> String {
 impl LineChart {
     /// The chart as PNG bytes.
     pub fn to_png(&self) -> Vec<u8> {
+        self.draw().png()
+    }
+
+    fn draw(&self) -> Canvas {
         let finite = |v: &f64| v.is_finite();
         let points = || self.series.iter().flat_map(|s| s.points.iter());
         let xs: Vec<f64> = points().map(|p| p.0).filter(finite).collect();
@@ -294,7 +309,7 @@ impl LineChart {
         let tw = canvas.text_width(&self.y_label, 14.0);
         let y_label_at = top as f64 + (h + tw) / 2.0;
         canvas.text(&self.y_label, 22.0, y_label_at, 14.0, INK, true);
-        canvas.png()
+        canvas
     }
 }
 

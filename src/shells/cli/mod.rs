@@ -8,10 +8,12 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 mod values;
 pub use values::{Judges, KeepArg, Shard};
 use values::{
-    parse_aux, parse_game, parse_judges, parse_keep, parse_minutes, parse_point, parse_profile,
-    parse_shard, parse_target,
+    parse_aux, parse_game, parse_judges, parse_keep, parse_minutes, parse_point, parse_population,
+    parse_profile, parse_retry, parse_shard, parse_target,
 };
 
+use crate::services::campaign::Ramp;
+use crate::services::checks::Check;
 use crate::services::generation::Ask;
 use crate::services::panel::Judge;
 use arlpcg_core::game::Skill;
@@ -57,6 +59,9 @@ pub enum Command {
     ExportPolicy(ExportPolicyArgs),
     /// Play levels many times and report how often the Solver gets through.
     Verify(VerifyArgs),
+    /// Generate a sequence of levels on a difficulty ramp, rate them with the panel of judges,
+    /// and report the players it keeps and loses (campaign.yaml, campaign.md, campaign.png).
+    Campaign(CampaignArgs),
     /// Reproduce the paper's tables (controllability, generalization, each Solver at each λ)
     /// for trained policies: markdown, CSV, a PNG chart and results.json.
     Eval(EvalArgs),
@@ -273,6 +278,12 @@ pub struct GenerateArgs {
     /// seed as its certificate (`verify --replay` re-runs it).
     #[arg(long, requires = "verify")]
     pub allow_unsolved: bool,
+    /// Acceptance check on every level (repeatable): `success LO..HI` (the success ratio),
+    /// `b LO..HI` (the panel's difficulty, with --panel) or `completed`. A level fails a range
+    /// only when its 95% interval lies wholly outside it; any failure ends the run with exit
+    /// code 3 and names each level and check (the files are written all the same).
+    #[arg(long = "check", value_name = "CHECK", value_parser = Check::parse)]
+    pub checks: Vec<Check>,
     /// Make only shard I of K of the batch (0 <= I < K): level i of the batch when i mod K = I.
     /// K machines with I = 0..K-1 together write exactly the files of the whole batch.
     #[arg(long, value_name = "I/K", value_parser = parse_shard)]
@@ -405,7 +416,7 @@ pub fn default_solver(game: Game) -> PathBuf {
 #[derive(Debug, Args)]
 pub struct VerifyArgs {
     /// Level files (.yaml).
-    #[arg(required = true)]
+    #[arg(required_unless_present = "campaign")]
     pub levels: Vec<PathBuf>,
     /// Runs per level.
     #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
@@ -439,9 +450,82 @@ pub struct VerifyArgs {
     #[arg(long, value_name = "JUDGES", num_args = 0..=1, default_missing_value = "",
           value_parser = parse_judges, conflicts_with_all = ["solver", "policy", "replay", "chart"])]
     pub panel: Option<Judges>,
-    /// The policies folder the panel's Solvers come from (default: policies/<game>).
-    #[arg(long, requires = "panel")]
+    /// The policies folder the panel's Solvers (and a campaign's judge) come from (default:
+    /// policies/<game>).
+    #[arg(long)]
     pub policies: Option<PathBuf>,
+    /// Acceptance check on every level (repeatable): `success LO..HI` (the success ratio),
+    /// `b LO..HI` (the panel's difficulty, with --panel) or `completed`. A level fails a range
+    /// only when its 95% interval lies wholly outside it; any failure ends the run with exit
+    /// code 3 and names each level and check .
+    #[arg(long = "check", value_name = "CHECK", value_parser = Check::parse)]
+    pub checks: Vec<Check>,
+    /// Re-play and re-report a campaign (its campaign.yaml, e.g. after editing its levels or
+    /// checks): the judge and the panel play every level again, the population goes through,
+    /// the report goes to standard output and its checks (and --check) are applied. Writes
+    /// nothing.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["solver", "policy", "replay", "chart", "panel", "json", "levels"])]
+    pub campaign: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+#[command(after_help = "Examples:\n  \
+    arlpcg campaign --game platform --levels 10 --ramp \"0:0.95, 1:0.5\" --judge scripted-median --out campaigns/first\n  \
+    arlpcg campaign --game racing --levels 8 --ramp \"0:0.9, 0.5:0.9, 0.5:0.6, 1:0.6\" --check \"success 0.4..1\" --out campaigns/racing\n  \
+    arlpcg campaign --game platform --levels 10 --ramp \"0:0.95, 1:0.5\" --out campaigns/first --resume\n  \
+    arlpcg verify --campaign campaigns/first/campaign.yaml --check \"b -3..3\"\n\n\
+    Exit codes: 0 done, 1 an error (a file, a policy), 2 arguments that do not fit, 3 a level \
+    failed a --check (the files are written), 130 interrupted (--resume finishes).")]
+pub struct CampaignArgs {
+    /// Which game.
+    #[arg(long, default_value = "platform", value_parser = parse_game)]
+    pub game: Game,
+    /// The Generator, the judge and the panel's Solvers (default: the shipped policies/<game>).
+    #[arg(long, value_name = "DIR")]
+    pub policies: Option<PathBuf>,
+    /// How many levels.
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub levels: u32,
+    /// The success asked for along the campaign: control points `position:success`, position 0
+    /// the first level and 1 the last, linear between them ("0:0.95, 1:0.5"; two points at one
+    /// position are a step). Each level is searched (λ and draws) until the judge's success is
+    /// within ±0.1 of its point.
+    #[arg(long, value_name = "CURVE", value_parser = Ramp::parse)]
+    pub ramp: Ramp,
+    /// Whose success the ramp asks for: a Solver of --policies named by its training mode
+    /// (arlpcg, rule-pcg, fixed-track, fixed-aux) or the scripted player (scripted-novice,
+    /// scripted-median, scripted-expert). Default: arlpcg.
+    #[arg(long, value_name = "NAME", value_parser = Judge::parse)]
+    pub judge: Option<Judge>,
+    /// Runs per level, for the judge's search and for each judge of the panel.
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(10..=100_000))]
+    pub trials: u32,
+    /// Level k is searched from seed SEED + k: the same seed gives the same campaign, byte for
+    /// byte.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// The players' ability θ ~ Normal(MEAN, SD) on the panel's logit scale. Default: fitted
+    /// so that the scripted novice, median and expert are its 10th, 50th and 90th percentiles.
+    #[arg(long, value_name = "MEAN,SD", allow_hyphen_values = true, value_parser = parse_population)]
+    pub population: Option<(f64, f64)>,
+    /// The chance that a player tries a level again after failing it (else quits).
+    #[arg(long, value_name = "P", default_value_t = arlpcg_core::statistics::population::DEFAULT_RETRY, value_parser = parse_retry)]
+    pub retry: f64,
+    /// Acceptance check on every level (repeatable): `success LO..HI` (the success ratio),
+    /// `b LO..HI` (the panel's difficulty) or `completed`. A level fails a range
+    /// only when its 95% interval lies wholly outside it; any failure ends the run with exit
+    /// code 3 and names each level and check (the files are written all the same).
+    #[arg(long = "check", value_name = "CHECK", value_parser = Check::parse)]
+    pub checks: Vec<Check>,
+    /// Level file formats, comma-separated.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "yaml,glb")]
+    pub format: Vec<FormatArg>,
+    /// Folder to write into (created if missing).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Finish an interrupted campaign in --out: its level files are kept and the rest made.
+    #[arg(long)]
+    pub resume: bool,
 }
 
 #[derive(Debug, Args)]

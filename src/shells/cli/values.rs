@@ -125,3 +125,27 @@ pub(super) fn parse_point(s: &str) -> Result<[f64; 3], String> {
     }
     Ok(point)
 }
+
+/// `--population MEAN,SD`: the players' ability θ, logits.
+pub(super) fn parse_population(s: &str) -> Result<(f64, f64), String> {
+    let bad = || format!("`{s}` is not MEAN,SD (two numbers, SD ≥ 0: e.g. 0.5,1.2)");
+    let (mean, sd) = s.split_once(',').ok_or_else(bad)?;
+    let (mean, sd): (f64, f64) = (
+        mean.trim().parse().map_err(|_| bad())?,
+        sd.trim().parse().map_err(|_| bad())?,
+    );
+    match mean.is_finite() && sd.is_finite() && sd >= 0.0 {
+        true => Ok((mean, sd)),
+        false => Err(bad()),
+    }
+}
+
+/// `--retry P`: a chance within [0, 1).
+pub(super) fn parse_retry(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(p) if (0.0..1.0).contains(&p) => Ok(p),
+        _ => Err(format!(
+            "`{s}` is not a chance within [0, 1) (1 would retry forever)"
+        )),
+    }
+}

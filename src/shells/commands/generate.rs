@@ -8,18 +8,18 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 
+use crate::services::checks;
 use crate::services::difficulty;
-use crate::services::fsio::{self, Overwrite};
+use crate::services::fsio;
 use crate::services::generation::{self, Ask, GeneratorPolicy, KeptPrefix, LevelRequest};
 use crate::services::level_files::{Format, LevelFiles, file_stem, render};
-use crate::services::panel::{Judge, JudgePanel, rate};
+use crate::services::panel::Judge;
 use crate::services::policies::{
     load_generator, load_judge, load_panel, load_solver, policy_paths,
 };
 use crate::services::verify::{self, Solver, SolverPolicy};
 use crate::shells::cli::{GenerateArgs, KeepArg, default_solver};
 use arlpcg_core::game::Skill;
-use arlpcg_core::level::stats::PanelStats;
 use arlpcg_core::level::{Game, Level};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
@@ -82,12 +82,15 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         &stop,
     )?;
     if let Some(panel) = &panel {
-        play_panel(
-            panel,
-            &mut levels,
-            verify_trials.unwrap_or(TARGET_TRIALS),
-            &stop,
-        );
+        let trials = verify_trials.unwrap_or(TARGET_TRIALS);
+        let runs = (levels.len() * panel.judges.len()) as u64 * trials as u64;
+        let bar = crate::shells::common::progress_bar(runs, "panel runs");
+        let watch = verify::Watch {
+            on_trial: &|_| bar.inc(1),
+            stop: &|| stop.load(Ordering::SeqCst),
+        };
+        crate::services::panel::play_and_rate(panel, &mut levels, trials, &watch);
+        bar.finish_and_clear();
     }
     // The folder is made only now, and removed again if the batch fails.
     let made_folder = !args.out.exists();
@@ -122,7 +125,16 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         args.out.display()
     );
     report_verification(&levels);
-    Ok(())
+    let named = levels.iter().zip(&plans).map(|(level, (seed, _))| {
+        let (stats, rating) = checks::evidence(level);
+        (
+            format!("{} (seed {seed})", stem(args, *seed)),
+            stats,
+            rating,
+        )
+    });
+    let failed = checks::failures(&args.checks, named);
+    super::campaign::report_checks(&args.checks, failed, levels.len())
 }
 
 /// What verification did across the batch: redrawn, unsolved and uncertified levels.
@@ -158,35 +170,6 @@ fn policies_dir(args: &GenerateArgs) -> PathBuf {
     args.policies
         .clone()
         .unwrap_or_else(|| crate::services::policies::shipped_dir(args.game))
-}
-
-/// Plays every level with every judge of `panel` (seeds as --verify's) and rates them together.
-/// Levels a Ctrl-C left unplayed are dropped from the end, as unbuilt ones are.
-fn play_panel(panel: &JudgePanel, levels: &mut Vec<Level>, trials: u32, stop: &AtomicBool) {
-    let runs = (levels.len() * panel.judges.len()) as u64 * trials as u64;
-    let bar = crate::shells::common::progress_bar(runs, "panel runs");
-    let played: Vec<Option<PanelStats>> = levels
-        .par_iter()
-        .map(|level| {
-            let seed = level.stats.as_ref().map_or(0, |s| s.seed);
-            let watch = verify::Watch {
-                on_trial: &|_| bar.inc(1),
-                stop: &|| stop.load(Ordering::SeqCst),
-            };
-            crate::services::panel::play(panel, level, trials, seed, &watch, &|_, _| {})
-                .expect("judges are loaded for the batch's game")
-        })
-        .collect();
-    bar.finish_and_clear();
-    let done = played.iter().take_while(|p| p.is_some()).count();
-    levels.truncate(done);
-    let mut panels: Vec<PanelStats> = played.into_iter().flatten().take(done).collect();
-    rate(&mut panels.iter_mut().collect::<Vec<_>>());
-    for (level, panel) in levels.iter_mut().zip(panels) {
-        if let Some(stats) = level.stats.as_mut() {
-            stats.panel = Some(panel);
-        }
-    }
 }
 
 fn target_curve(
@@ -250,6 +233,14 @@ fn check_arguments(args: &GenerateArgs) -> Result<Vec<u64>> {
     if args.solver_policy.is_some() && args.verify.is_none() && success.is_none() {
         return usage("--solver-policy plays --verify N or --target-success P; give one of them");
     }
+    if !args.checks.is_empty() && args.verify.is_none() && success.is_none() {
+        return usage(
+            "--check reads the levels' statistics: give --verify N or --target-success P",
+        );
+    }
+    if args.checks.iter().any(|c| c.needs_panel()) && !args.panel {
+        return usage("--check b reads the panel's rating: give --panel too");
+    }
     if args.judge.is_some() && args.verify.is_none() && success.is_none() {
         return usage("--judge plays --verify N or --target-success P; give one of them");
     }
@@ -272,71 +263,34 @@ fn check_arguments(args: &GenerateArgs) -> Result<Vec<u64>> {
         })
 }
 
-/// Writes the files of `levels`, all or none: each level is rendered and staged beside its
-/// target one at a time (memory stays bounded), then all are renamed into place. Files that
-/// exist already and are identical are left alone (a re-run finishes a batch); others are
-/// refused unless --force. Returns (files written, files left as they were).
+/// Writes the files of `levels`, all or none ([`fsio::write_batch`]); files of other contents
+/// are replaced only with --force. Returns (files written, files left as they were).
 fn write_batch(
     args: &GenerateArgs,
     levels: &[Level],
     plans: &[(u64, LevelFiles)],
 ) -> Result<(usize, usize)> {
-    // One batch into a folder at a time: another's check, staging and rollback wait for ours.
-    let _held = fsio::lock_folder(&args.out, || {
-        crate::warn!(
-            "waiting for another arlpcg run that is writing into {}",
-            args.out.display()
-        )
-    })?;
-    fsio::remove_stale_temps(&args.out, std::time::SystemTime::now())?;
-    let mut batch = fsio::FileBatch::new();
-    let mut kept = 0;
-    let nothing = "nothing was written";
-    for (level, (_, files)) in levels.iter().zip(plans) {
-        // A .gltf after the .bin it names.
-        for (path, bytes) in render(level, files).into_iter().rev() {
-            fsio::check_not_in_the_way(&path).with_context(|| nothing.to_string())?;
-            let overwrite = match std::fs::read(&path) {
-                Ok(existing) if existing == bytes => {
-                    kept += 1;
-                    continue;
-                }
-                Ok(_) if !args.force => bail!(
-                    "{} already exists with other contents (use --force to overwrite it); {nothing}",
-                    path.display()
-                ),
-                Ok(_) => Overwrite::Allowed,
-                // Absent when checked: written only if still absent (another run may get there
-                // first, and its file is not replaced).
-                Err(_) => Overwrite::Never,
-            };
-            batch
-                .stage(&path, &bytes, overwrite)
-                .with_context(|| nothing.to_string())?;
-        }
-    }
-    let staged = batch.len();
-    batch.commit()?;
-    Ok((staged, kept))
+    // A .gltf after the .bin it names.
+    let files = levels
+        .iter()
+        .zip(plans)
+        .flat_map(|(level, (_, files))| render(level, files).into_iter().rev());
+    fsio::write_batch(
+        &args.out,
+        files,
+        &|_| args.force,
+        "use --force to overwrite it",
+        || {
+            crate::warn!(
+                "waiting for another arlpcg run that is writing into {}",
+                args.out.display()
+            )
+        },
+    )
 }
 
 /// Runs per candidate of `--target-success` without `--verify`.
 const TARGET_TRIALS: u32 = 100;
-
-/// The level with a certificate in its statistics: single runs from the trials' seeds on, so a
-/// level some trial completed is certified within a few runs unless its success ratio is tiny.
-fn certified(mut level: Level, solver: &Solver, seed: u64) -> Result<Level> {
-    if let Some(stats) = &level.stats
-        && stats.successes > 0
-    {
-        let seeds = (0..2 * stats.trials as u64).map(|k| seed.wrapping_add(k));
-        let certificate = verify::certify(&level, solver, seeds)?;
-        if let Some(stats) = &mut level.stats {
-            stats.certificate = certificate;
-        }
-    }
-    Ok(level)
-}
 
 /// The level `--keep` names, read and checked, and the pieces to keep of it.
 fn kept_prefix(keep: &KeepArg, game: Game) -> Result<KeptPrefix> {
@@ -442,7 +396,7 @@ fn build_verified(
         }
         stats.redraws = draw;
         level.stats = Some(stats);
-        return certified(level, solver, seed).map(Some);
+        return Ok(Some(verify::certified(level, solver, seed)?));
     }
     bail!(
         "none of the {MAX_DRAWS} levels drawn for this seed was completed by any of {trials} runs (--allow-unsolved keeps the first anyway)"
@@ -500,7 +454,7 @@ fn build_levels(
                     verify_trials.unwrap_or(TARGET_TRIALS),
                 )
                 .map_err(anyhow::Error::from)
-                .and_then(|level| certified(level, who, *seed))
+                .and_then(|level| verify::certified(level, who, *seed).map_err(anyhow::Error::from))
                 .map(Some),
                 _ => build_verified(args, keep, generator, who, *seed, stop),
             };

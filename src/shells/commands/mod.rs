@@ -2,6 +2,7 @@
 //! Errors come back as `anyhow` errors with the file and field named; `main` turns them into
 //! one line and a non-zero exit code.
 
+pub(crate) mod campaign;
 mod eval;
 mod export;
 mod export_policy;
@@ -10,7 +11,7 @@ mod report;
 mod train;
 mod verify;
 
-pub use crate::shells::common::{Interrupted, UsageError, exit_code};
+pub use crate::shells::common::{ChecksFailed, Interrupted, UsageError, exit_code};
 pub use verify::one_line;
 
 use anyhow::Result;
@@ -24,6 +25,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Export(args)) => export::run(&args),
         Some(Command::ExportPolicy(args)) => export_policy::run(&args),
         Some(Command::Verify(args)) => verify::run(&args),
+        Some(Command::Campaign(args)) => campaign::run(&args),
         Some(Command::Eval(args)) => eval::run(&args),
         Some(Command::Report(args)) => report::run(&args),
         Some(Command::Train(args)) => train::run(&args),

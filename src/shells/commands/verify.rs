@@ -8,6 +8,8 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use serde_json::json;
 
+use super::campaign::report_checks;
+use crate::services::checks::{Check, failures};
 use crate::services::panel::{JudgePanel, rate};
 use crate::services::policies::{load_panel, load_solver};
 use crate::services::verify::{
@@ -22,6 +24,24 @@ use arlpcg_core::level::yaml;
 use arlpcg_core::level::{Game, Level};
 
 pub fn run(args: &VerifyArgs) -> Result<()> {
+    let usage = |message: &str| Err(crate::shells::common::UsageError(message.into()).into());
+    if let Some(file) = &args.campaign {
+        return super::campaign::replay(args, file);
+    }
+    if args.policies.is_some() && args.panel.is_none() {
+        return usage("--policies names where the panel's Solvers come from: give --panel too");
+    }
+    if args.replay && !args.checks.is_empty() {
+        return usage("--check reads new trials; --replay plays none");
+    }
+    if args.panel.is_some() && args.checks.iter().any(|c| !c.needs_panel()) {
+        return usage(
+            "with --panel, a check is `b LO..HI`; `success` and `completed` read one Solver's runs (verify without --panel)",
+        );
+    }
+    if args.panel.is_none() && args.checks.iter().any(Check::needs_panel) {
+        return usage("--check b reads the panel's rating: give --panel too");
+    }
     if args.replay {
         return replay(args);
     }
@@ -51,6 +71,7 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
         );
     }
     let mut solvers = Solvers::default();
+    let mut checked = Vec::new();
     let mut failed = 0;
     let mut all = Vec::new();
     let mut halfway = HalfwaySplit::default();
@@ -82,6 +103,10 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
                 }
                 halfway.add(&level, &stats);
                 concentration.add(&stats);
+                checked.extend(failures(
+                    &args.checks,
+                    [(path.display().to_string(), Some(&stats), None)],
+                ));
                 if let Some(chart) = &args.chart {
                     let name = path.file_stem().unwrap_or_default().to_string_lossy();
                     let png = crate::services::verify::pacing_chart(&name, &level, &stats).to_png();
@@ -138,7 +163,7 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
             args.levels.len()
         );
     }
-    Ok(())
+    report_checks(&args.checks, checked, args.levels.len())
 }
 
 /// `verify --replay`: each level's certificate run, again, with the Solver that recorded it.
@@ -279,6 +304,12 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
             crate::say!("{game} judges' ability θ (logits): {}", shown.join(", "));
         }
     }
+    let checked = failures(
+        &args.checks,
+        rated
+            .iter()
+            .map(|(path, _, stats)| (path.display().to_string(), None, stats.rating)),
+    );
     for (path, _, stats) in &rated {
         let rating = stats.rating.expect("rated above");
         if args.json {
@@ -320,7 +351,7 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
             args.levels.len()
         );
     }
-    Ok(())
+    report_checks(&args.checks, checked, args.levels.len())
 }
 
 /// The Solver of each game met so far, resolved from the arguments once per game.

@@ -24,95 +24,150 @@ pub struct AuxCurve {
     points: Vec<(f64, f64)>,
 }
 
+/// The words a curve's messages use: what the curve is, its x and y, and examples of a whole
+/// curve, of one point and of a step.
+pub struct CurveWords {
+    pub curve: &'static str,
+    pub x: &'static str,
+    /// What x is, for the range message: "the fraction of the way to the goal".
+    pub x_meaning: &'static str,
+    pub y: &'static str,
+    pub examples: [&'static str; 3],
+}
+
+const AUX_CURVE_WORDS: CurveWords = CurveWords {
+    curve: "an aux curve",
+    x: "fraction",
+    x_meaning: "the fraction of the way to the goal",
+    y: "λ",
+    examples: ["0:1, 1:-1", "0.5:-1", "0.5:1, 0.5:-1"],
+};
+
+/// Parses control points `x:y, x:y, ...` and checks them ([`check_points`], each y by
+/// `check_y`); the error says which point is wrong and why.
+pub fn parse_points(
+    text: &str,
+    words: &CurveWords,
+    check_y: impl Fn(f64) -> Result<(), String>,
+) -> Result<Vec<(f64, f64)>, String> {
+    let text = text.trim();
+    if text.is_empty() {
+        return Err(format!(
+            "{} needs at least one point `{}:{}`, e.g. `{}`",
+            words.curve, words.x, words.y, words.examples[0]
+        ));
+    }
+    let mut points = Vec::new();
+    for (i, item) in text.split(',').enumerate() {
+        let item = item.trim();
+        let number = |s: &str, what: &str| {
+            s.trim().parse::<f64>().map_err(|_| {
+                format!(
+                    "point {} (`{item}`): its {what} `{}` is not a number",
+                    i + 1,
+                    s.trim()
+                )
+            })
+        };
+        let Some((x, y)) = item.split_once(':') else {
+            return Err(format!(
+                "point {} (`{item}`) is not `{}:{}` (e.g. `{}`)",
+                i + 1,
+                words.x,
+                words.y,
+                words.examples[1]
+            ));
+        };
+        points.push((number(x, words.x)?, number(y, words.y)?));
+    }
+    check_points(&points, words, check_y)?;
+    Ok(points)
+}
+
+/// Checks control points: 1 to [`MAX_POINTS`], x increasing within [0, 1] (at most two points
+/// at one x: a step), each y by `check_y` (NaN fails).
+pub fn check_points(
+    points: &[(f64, f64)],
+    words: &CurveWords,
+    check_y: impl Fn(f64) -> Result<(), String>,
+) -> Result<(), String> {
+    if points.is_empty() || points.len() > MAX_POINTS {
+        return Err(format!(
+            "{} has 1 to {MAX_POINTS} points, not {}",
+            words.curve,
+            points.len()
+        ));
+    }
+    for (i, &(x, y)) in points.iter().enumerate() {
+        let at = format!("point {} ({}:{})", i + 1, show_number(x), show_number(y));
+        if !(0.0..=1.0).contains(&x) {
+            return Err(format!("{at}: {} must be within [0, 1]", words.x_meaning));
+        }
+        check_y(y).map_err(|e| format!("{at}: {e}"))?;
+        if i > 0 && x < points[i - 1].0 {
+            return Err(format!(
+                "{at}: {}s must increase from point to point (the previous is {})",
+                words.x,
+                show_number(points[i - 1].0)
+            ));
+        }
+        if i > 1 && x == points[i - 2].0 {
+            return Err(format!(
+                "{at}: three points at one {}; a step takes two (`{}`)",
+                words.x, words.examples[2]
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The piecewise-linear value of control points at `x` (clamped to [0, 1]; NaN reads 0): the
+/// first point's y before it, the last's after it, and at a step the first of its two.
+pub fn value_at(points: &[(f64, f64)], x: f64) -> f64 {
+    let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+    let first = points[0];
+    if x <= first.0 {
+        return first.1;
+    }
+    for pair in points.windows(2) {
+        let ((x0, y0), (x1, y1)) = (pair[0], pair[1]);
+        if x <= x1 && x1 > x0 {
+            return y0 + (y1 - y0) * (x - x0) / (x1 - x0);
+        }
+    }
+    points[points.len() - 1].1
+}
+
+/// Control points in the form [`parse_points`] reads: `0:1, 0.5:1, 0.6:-1, 1:-1`.
+pub fn show_points(points: &[(f64, f64)]) -> String {
+    points
+        .iter()
+        .map(|(x, y)| format!("{}:{}", show_number(*x), show_number(*y)))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn check_aux(aux: f64) -> Result<(), String> {
+    AUX.check(aux).map(|_| ()).map_err(|e| e.to_string())
+}
+
 impl AuxCurve {
     /// Parses `fraction:λ, fraction:λ, ...`; the error says which point is wrong and why.
     pub fn parse(text: &str) -> Result<Self, String> {
-        let text = text.trim();
-        if text.is_empty() {
-            return Err(
-                "an aux curve needs at least one point `fraction:λ`, e.g. `0:1, 1:-1`".into(),
-            );
-        }
-        let mut points = Vec::new();
-        for (i, item) in text.split(',').enumerate() {
-            let item = item.trim();
-            let number = |s: &str, what: &str| {
-                s.trim().parse::<f64>().map_err(|_| {
-                    format!(
-                        "point {} (`{item}`): its {what} `{}` is not a number",
-                        i + 1,
-                        s.trim()
-                    )
-                })
-            };
-            let Some((fraction, aux)) = item.split_once(':') else {
-                return Err(format!(
-                    "point {} (`{item}`) is not `fraction:λ` (e.g. `0.5:-1`)",
-                    i + 1
-                ));
-            };
-            let (fraction, aux) = (number(fraction, "fraction")?, number(aux, "λ")?);
-            points.push((fraction, aux));
-        }
-        Self::new(points)
+        parse_points(text, &AUX_CURVE_WORDS, check_aux).map(|points| Self { points })
     }
 
     /// A curve through `points`, checked: 1 to [`MAX_POINTS`] points, fractions increasing
     /// within [0, 1] (at most two points at one fraction: a step), every λ within [-1, 1] (NaN
     /// fails).
     pub fn new(points: Vec<(f64, f64)>) -> Result<Self, String> {
-        if points.is_empty() || points.len() > MAX_POINTS {
-            return Err(format!(
-                "an aux curve has 1 to {MAX_POINTS} points, not {}",
-                points.len()
-            ));
-        }
-        for (i, &(fraction, aux)) in points.iter().enumerate() {
-            let at = format!(
-                "point {} ({}:{})",
-                i + 1,
-                show_number(fraction),
-                show_number(aux)
-            );
-            if !(0.0..=1.0).contains(&fraction) {
-                return Err(format!(
-                    "{at}: the fraction of the way to the goal must be within [0, 1]"
-                ));
-            }
-            AUX.check(aux).map_err(|e| format!("{at}: {e}"))?;
-            if i > 0 && fraction < points[i - 1].0 {
-                return Err(format!(
-                    "{at}: fractions must increase from point to point (the previous is {})",
-                    show_number(points[i - 1].0)
-                ));
-            }
-            if i > 1 && fraction == points[i - 2].0 {
-                return Err(format!(
-                    "{at}: three points at one fraction; a step takes two (`0.5:1, 0.5:-1`)"
-                ));
-            }
-        }
+        check_points(&points, &AUX_CURVE_WORDS, check_aux)?;
         Ok(Self { points })
     }
 
     /// λ at `fraction` of the way to the goal (clamped to [0, 1]).
     pub fn at(&self, fraction: f64) -> f64 {
-        let fraction = if fraction.is_nan() {
-            0.0
-        } else {
-            fraction.clamp(0.0, 1.0)
-        };
-        let first = self.points[0];
-        if fraction <= first.0 {
-            return first.1;
-        }
-        for pair in self.points.windows(2) {
-            let ((x0, y0), (x1, y1)) = (pair[0], pair[1]);
-            if fraction <= x1 && x1 > x0 {
-                return y0 + (y1 - y0) * (fraction - x0) / (x1 - x0);
-            }
-        }
-        self.points[self.points.len() - 1].1
+        value_at(&self.points, fraction)
     }
 
     /// The control points, `(fraction, λ)`.
@@ -124,13 +179,7 @@ impl AuxCurve {
 impl fmt::Display for AuxCurve {
     /// The form [`AuxCurve::parse`] reads: `0:1, 0.5:1, 0.6:-1, 1:-1`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, (fraction, aux)) in self.points.iter().enumerate() {
-            if i > 0 {
-                f.write_str(", ")?;
-            }
-            write!(f, "{}:{}", show_number(*fraction), show_number(*aux))?;
-        }
-        Ok(())
+        f.write_str(&show_points(&self.points))
     }
 }
 

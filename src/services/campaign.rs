@@ -1,0 +1,460 @@
+//! Campaigns (`arlpcg campaign`): a sequence of levels on a difficulty ramp, each searched to
+//! its ramp point ([`crate::services::difficulty::level_for`]) and verified, rated together by
+//! the panel of judges, and a player population ([`Population`]) sent through them: who reaches
+//! each level, who quits on it, how many attempts a success takes. The campaign's record is
+//! `campaign.yaml`; `campaign.md` and `campaign.png` report it.
+//!
+//! A ramp asks a success ratio per position in the campaign, written like an aux curve:
+//! `position:success` points, position 0 the first level and 1 the last, linear between them
+//! (`0:0.95, 1:0.5`).
+
+use std::fmt;
+
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use crate::services::chart::{LineChart, Series};
+use crate::services::checks::Check;
+use arlpcg_core::level::pacing::{CurveWords, parse_points, show_points, value_at};
+use arlpcg_core::level::{Game, Level};
+use arlpcg_core::statistics::population::{LevelFlow, Population};
+
+/// The `format:` of a campaign file.
+pub const FORMAT: &str = "arlpcg-campaign";
+/// The campaign file's version.
+pub const VERSION: u32 = 1;
+
+const RAMP_WORDS: CurveWords = CurveWords {
+    curve: "a ramp",
+    x: "position",
+    x_meaning: "the position in the campaign (0 the first level, 1 the last)",
+    y: "success",
+    examples: ["0:0.95, 1:0.5", "0.5:0.7", "0.5:0.9, 0.5:0.6"],
+};
+
+/// The success ratio asked for along a campaign.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ramp {
+    points: Vec<(f64, f64)>,
+}
+
+impl Ramp {
+    /// Parses `position:success, ...`; each success strictly between 0 and 1 (a level that no
+    /// run completes is never kept, and 1 cannot be measured within a band).
+    pub fn parse(text: &str) -> Result<Self, String> {
+        parse_points(text, &RAMP_WORDS, |success| {
+            match success > 0.0 && success < 1.0 {
+                true => Ok(()),
+                false => Err("a success ratio strictly between 0 and 1".into()),
+            }
+        })
+        .map(|points| Self { points })
+    }
+
+    /// The success asked for at `position` (0 first level, 1 last).
+    pub fn at(&self, position: f64) -> f64 {
+        value_at(&self.points, position)
+    }
+}
+
+impl fmt::Display for Ramp {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&show_points(&self.points))
+    }
+}
+
+impl std::str::FromStr for Ramp {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Ramp::parse(s)
+    }
+}
+
+impl Serialize for Ramp {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
+}
+
+impl<'de> Deserialize<'de> for Ramp {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let text = String::deserialize(deserializer)?;
+        Ramp::parse(&text).map_err(serde::de::Error::custom)
+    }
+}
+
+/// Level `k`'s position in a campaign of `n` levels: 0 for the first, 1 for the last.
+pub fn position(k: usize, n: usize) -> f64 {
+    match n {
+        0 | 1 => 0.0,
+        _ => k as f64 / (n - 1) as f64,
+    }
+}
+
+/// The name of level `k` (from 0) of a campaign of `n` levels: `level01`, wide enough that
+/// the names sort in order.
+pub fn level_stem(k: usize, n: usize) -> String {
+    let width = n.to_string().len().max(2);
+    format!("level{:0width$}", k + 1)
+}
+
+/// A campaign's record (`campaign.yaml`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Campaign {
+    pub format: String,
+    pub version: u32,
+    pub game: Game,
+    /// Level `k` is searched from seed `seed + k`.
+    pub seed: u64,
+    /// The judge whose success the ramp asks for.
+    pub judge: String,
+    /// Runs per level, for the judge and for each judge of the panel.
+    pub trials: u32,
+    pub ramp: Ramp,
+    /// Acceptance checks every level must pass (`verify --campaign` applies them).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub checks: Vec<Check>,
+    pub population: Population,
+    /// `scripted judges`: the population's 10th, 50th and 90th percentiles of θ are the
+    /// scripted novice's, median's and expert's; `given`: as asked for.
+    pub population_from: String,
+    /// Each judge's ability θ from the panel's rating of these levels, logits.
+    pub judges_theta: Vec<JudgeTheta>,
+    pub levels: Vec<CampaignLevel>,
+}
+
+/// A judge's ability on the campaign's levels.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JudgeTheta {
+    pub judge: String,
+    pub theta: f64,
+}
+
+/// One level of a campaign: what was asked, what was measured, and how the population fares.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CampaignLevel {
+    /// The level file, beside campaign.yaml.
+    pub file: String,
+    pub position: f64,
+    /// The judge's success asked for by the ramp.
+    pub asked: f64,
+    /// The judge's success measured, with its 95% interval.
+    pub measured: f64,
+    pub ci95: [f64; 2],
+    /// The λ the level was built at.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aux: Option<f64>,
+    /// Difficulty on the panel's scale, logits, with its 95% interval.
+    pub b: f64,
+    pub b_ci95: [f64; 2],
+    /// How the population fares on it.
+    pub players: LevelFlow,
+}
+
+/// How the population is chosen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PopulationAsk {
+    /// From the scripted judges' θ (10th, 50th, 90th percentiles), with this retry chance.
+    ScriptedJudges { retry: f64 },
+    /// As given.
+    Given(Population),
+}
+
+/// What a campaign was asked for.
+#[derive(Debug, Clone)]
+pub struct CampaignAsk {
+    pub game: Game,
+    pub seed: u64,
+    pub judge: String,
+    pub trials: u32,
+    pub ramp: Ramp,
+    pub checks: Vec<Check>,
+    pub population: PopulationAsk,
+}
+
+impl CampaignAsk {
+    /// The success asked of level `k` of `n`.
+    pub fn target(&self, k: usize, n: usize) -> f64 {
+        self.ramp.at(position(k, n))
+    }
+
+    /// The campaign record of `levels` (named by file, in order), each verified by the judge
+    /// and played by the panel, rated together into `judges_theta`. `Err` when the population
+    /// is fitted but a scripted judge is missing from the panel.
+    pub fn record(
+        &self,
+        levels: &[(String, &Level)],
+        judges_theta: &[(String, f64)],
+    ) -> Result<Campaign, String> {
+        let population = match self.population {
+            PopulationAsk::Given(population) => population,
+            PopulationAsk::ScriptedJudges { retry } => {
+                let theta = |name: &str| {
+                    judges_theta
+                        .iter()
+                        .find(|(n, _)| n == name)
+                        .map(|(_, t)| *t)
+                        .ok_or_else(|| {
+                            format!("the panel has no {name}, whose θ the population is fitted to")
+                        })
+                };
+                Population::from_percentiles(
+                    theta("scripted-novice")?,
+                    theta("scripted-median")?,
+                    theta("scripted-expert")?,
+                    retry,
+                )
+            }
+        };
+        let rating = |level: &Level| {
+            level
+                .stats
+                .as_ref()
+                .and_then(|s| s.panel.as_ref())
+                .and_then(|p| p.rating)
+        };
+        let b: Vec<f64> = levels
+            .iter()
+            .map(|(_, l)| rating(l).map_or(f64::NAN, |r| r.b))
+            .collect();
+        let flows = population.funnel(&b);
+        let n = levels.len();
+        let records = levels
+            .iter()
+            .zip(flows)
+            .enumerate()
+            .map(|(k, ((file, level), flow))| {
+                let stats = level.stats.as_ref();
+                let rating = rating(level);
+                CampaignLevel {
+                    file: file.clone(),
+                    position: round4(position(k, n)),
+                    asked: round4(self.target(k, n)),
+                    measured: stats.map_or(f64::NAN, |s| s.success_ratio),
+                    ci95: stats.map_or([f64::NAN; 2], |s| s.ci95),
+                    aux: level.aux,
+                    b: rating.map_or(f64::NAN, |r| r.b),
+                    b_ci95: rating.map_or([f64::NAN; 2], |r| r.ci95),
+                    players: LevelFlow {
+                        reach: round4(flow.reach),
+                        quit: round4(flow.quit),
+                        pass: round4(flow.pass),
+                        attempts_per_success: round4(flow.attempts_per_success),
+                    },
+                }
+            })
+            .collect();
+        Ok(Campaign {
+            format: FORMAT.into(),
+            version: VERSION,
+            game: self.game,
+            seed: self.seed,
+            judge: self.judge.clone(),
+            trials: self.trials,
+            ramp: self.ramp.clone(),
+            checks: self.checks.clone(),
+            population: Population {
+                theta_mean: round4(population.theta_mean),
+                theta_sd: round4(population.theta_sd),
+                retry: population.retry,
+            },
+            population_from: match self.population {
+                PopulationAsk::Given(_) => "given".into(),
+                PopulationAsk::ScriptedJudges { .. } => "scripted judges".into(),
+            },
+            judges_theta: judges_theta
+                .iter()
+                .map(|(judge, theta)| JudgeTheta {
+                    judge: judge.clone(),
+                    theta: round4(*theta),
+                })
+                .collect(),
+            levels: records,
+        })
+    }
+}
+
+impl Campaign {
+    /// Checks a campaign read back from a file; `Err` names the field.
+    pub fn check(&self) -> Result<(), String> {
+        if self.format != FORMAT {
+            return Err(format!("format: `{}`, not `{FORMAT}`", self.format));
+        }
+        if self.version != VERSION {
+            return Err(format!(
+                "version: {} is not a version this tool reads ({VERSION})",
+                self.version
+            ));
+        }
+        if self.trials == 0 {
+            return Err("trials: at least 1".into());
+        }
+        self.population
+            .check()
+            .map_err(|e| format!("population.{e}"))?;
+        if self.levels.is_empty() {
+            return Err("levels: none; a campaign has at least one level".into());
+        }
+        for (k, level) in self.levels.iter().enumerate() {
+            let plain = std::path::Path::new(&level.file)
+                .file_name()
+                .is_some_and(|name| name == level.file.as_str());
+            if !plain || !level.file.ends_with(".yaml") {
+                return Err(format!(
+                    "levels[{k}].file: `{}` must be a .yaml file name beside campaign.yaml",
+                    level.file
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The share of the population that finishes the campaign.
+    pub fn finishers(&self) -> f64 {
+        self.levels
+            .last()
+            .map_or(1.0, |l| l.players.reach - l.players.quit)
+    }
+
+    /// The campaign as a Markdown page: what was asked, a table per level, the funnel.
+    pub fn to_markdown(&self) -> String {
+        let p = &self.population;
+        let mut page = format!(
+            "# Campaign: {} {} levels, seed {}\n\n\
+             Ramp asked for `{}` (success of `{}`, {} runs per level). Population: θ ~ \
+             Normal({:+.2}, {:.2}) logits ({}), retries after a failure with chance {:.2}; \
+             {:.1}% of players finish the campaign.\n\n\
+             | level | file | asked | measured (95% CI) | λ | b (95% CI) | reach | quit here | attempts per success |\n\
+             |---|---|---|---|---|---|---|---|---|\n",
+            self.levels.len(),
+            self.game,
+            self.seed,
+            self.ramp,
+            self.judge,
+            self.trials,
+            p.theta_mean,
+            p.theta_sd,
+            self.population_from,
+            p.retry,
+            100.0 * self.finishers(),
+        );
+        for (k, l) in self.levels.iter().enumerate() {
+            let aux = l.aux.map_or("".into(), |a| format!("{a:+.2}"));
+            page += &format!(
+                "| {} | {} | {:.2} | {:.2} ({:.2}–{:.2}) | {aux} | {:+.2} ({:+.2} to {:+.2}) | {:.3} | {:.3} | {:.2} |\n",
+                k + 1,
+                l.file,
+                l.asked,
+                l.measured,
+                l.ci95[0],
+                l.ci95[1],
+                l.b,
+                l.b_ci95[0],
+                l.b_ci95[1],
+                l.players.reach,
+                l.players.quit,
+                l.players.attempts_per_success,
+            );
+        }
+        let thetas: Vec<String> = self
+            .judges_theta
+            .iter()
+            .map(|j| format!("{} {:+.2}", j.judge, j.theta))
+            .collect();
+        page += &format!("\nJudges' ability θ (logits): {}.\n", thetas.join(", "));
+        if !self.checks.is_empty() {
+            let checks: Vec<String> = self.checks.iter().map(|c| format!("`{c}`")).collect();
+            page += &format!("\nChecks every level must pass: {}.\n", checks.join(", "));
+        }
+        page
+    }
+
+    /// The campaign's charts, one above the other: success asked and measured with the share
+    /// of players who reach each level; and b per level with its interval.
+    pub fn charts(&self) -> Vec<LineChart> {
+        let per_level = |f: &dyn Fn(&CampaignLevel) -> f64| -> Vec<(f64, f64)> {
+            self.levels
+                .iter()
+                .enumerate()
+                .map(|(k, l)| ((k + 1) as f64, f(l)))
+                .collect()
+        };
+        let series = |name: &str, f: &dyn Fn(&CampaignLevel) -> f64| Series {
+            name: name.into(),
+            points: per_level(f),
+        };
+        vec![
+            LineChart {
+                title: format!(
+                    "{} campaign: success of {} and players who reach each level",
+                    self.game, self.judge
+                ),
+                x_label: "level".into(),
+                y_label: "share".into(),
+                series: vec![
+                    series("asked", &|l| l.asked),
+                    series("measured", &|l| l.measured),
+                    series("players reaching", &|l| l.players.reach),
+                ],
+                y_range: Some((0.0, 1.0)),
+            },
+            LineChart {
+                title: "difficulty b on the panel's scale (95% interval)".into(),
+                x_label: "level".into(),
+                y_label: "b (logits)".into(),
+                series: vec![
+                    series("b", &|l| l.b),
+                    series("low", &|l| l.b_ci95[0]),
+                    series("high", &|l| l.b_ci95[1]),
+                ],
+                y_range: None,
+            },
+        ]
+    }
+}
+
+fn round4(x: f64) -> f64 {
+    (x * 1e4).round() / 1e4
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_ramp_reads_back_what_it_writes_and_names_a_bad_point() {
+        let ramp = Ramp::parse("0:0.95, 1:0.5").unwrap();
+        assert_eq!(ramp.to_string(), "0:0.95, 1:0.5");
+        assert!((ramp.at(position(5, 11)) - 0.725).abs() < 1e-12);
+        assert_eq!(ramp.at(position(0, 1)), 0.95);
+        let step = Ramp::parse("0:0.9, 0.5:0.9, 0.5:0.6, 1:0.6").unwrap();
+        assert_eq!(step.at(0.75), 0.6);
+        for (text, expected) in [
+            ("", "a ramp needs at least one point `position:success`"),
+            (
+                "0:1",
+                "point 1 (0:1): a success ratio strictly between 0 and 1",
+            ),
+            (
+                "0:0.9, 1.5:0.5",
+                "point 2 (1.5:0.5): the position in the campaign",
+            ),
+            ("0.5:0.9, 0:0.5", "positions must increase"),
+            ("0:x", "its success `x` is not a number"),
+        ] {
+            let err = Ramp::parse(text).unwrap_err();
+            assert!(err.contains(expected), "{text}: {err}");
+        }
+    }
+
+    #[test]
+    fn level_names_sort_in_order() {
+        assert_eq!(level_stem(0, 10), "level01");
+        assert_eq!(level_stem(9, 10), "level10");
+        assert_eq!(level_stem(99, 120), "level100");
+        assert_eq!(level_stem(4, 120), "level005");
+    }
+}

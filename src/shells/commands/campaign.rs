@@ -1,0 +1,449 @@
+//! `arlpcg campaign`: levels on a difficulty ramp, searched and verified, rated by the panel,
+//! with a player population through them; and `verify --campaign`, which plays an existing
+//! campaign again. The record and its report are [`crate::services::campaign`]'s.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use anyhow::{Context, Result};
+use rayon::prelude::*;
+
+use crate::services::campaign::{Campaign, CampaignAsk, PopulationAsk, level_stem};
+use crate::services::chart::stacked_png;
+use crate::services::checks::{Check, evidence, failures};
+use crate::services::difficulty;
+use crate::services::fsio;
+use crate::services::level_files::{Format, LevelFiles, render};
+use crate::services::panel::{Judge, play_and_rate};
+use crate::services::policies::{
+    difficulty_curve, load_generator, load_judge, load_panel, policy_paths, shipped_dir,
+};
+use crate::services::verify::{self, Solver, SolverPolicy, Watch};
+use crate::shells::cli::{CampaignArgs, VerifyArgs};
+use crate::shells::common::{ChecksFailed, Interrupted, progress_bar};
+use arlpcg_core::level::{Game, Level, yaml};
+use arlpcg_core::rl::checkpoint::TrainMode;
+use arlpcg_core::statistics::population::Population;
+
+/// The record's file name, beside the levels.
+pub const CAMPAIGN_FILE: &str = "campaign.yaml";
+
+pub fn run(args: &CampaignArgs) -> Result<()> {
+    if args.out.exists() && !args.out.is_dir() {
+        anyhow::bail!("--out {} is not a folder", args.out.display());
+    }
+    let dir = args
+        .policies
+        .clone()
+        .unwrap_or_else(|| shipped_dir(args.game));
+    let judge = args.judge.unwrap_or(Judge::Solver(TrainMode::Arlpcg));
+    let ask = CampaignAsk {
+        game: args.game,
+        seed: args.seed,
+        judge: judge.name(),
+        trials: args.trials,
+        ramp: args.ramp.clone(),
+        checks: args.checks.clone(),
+        population: match args.population {
+            Some((theta_mean, theta_sd)) => PopulationAsk::Given(Population {
+                theta_mean,
+                theta_sd,
+                retry: args.retry,
+            }),
+            None => PopulationAsk::ScriptedJudges { retry: args.retry },
+        },
+    };
+    let n = args.levels as usize;
+    let generator = load_generator(&policy_paths(&dir).0, args.game)?.0;
+    let judge_policy = judge_policy(&dir, args.game, judge)?;
+    let solver = judge_policy
+        .as_ref()
+        .map_or_else(|| scripted(judge), Solver::Policy);
+    let panel = load_panel(&dir, args.game, None)?;
+    let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
+    if !formats.contains(&Format::Yaml) {
+        return Err(crate::shells::common::UsageError(
+            "--format must include yaml: the campaign's record names its level files".into(),
+        )
+        .into());
+    }
+    let files: Vec<LevelFiles> = (0..n)
+        .map(|k| LevelFiles::new(&args.out, &level_stem(k, n), &formats))
+        .collect();
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    let resumed = match args.resume {
+        true => resumed_levels(args, &files, &solver)?,
+        false => vec![None; n],
+    };
+    let curve = difficulty_curve(
+        &dir,
+        &generator,
+        &solver,
+        || {
+            crate::warn!(
+                "measuring the policies' λ→success curve for {} ({} λ values × {} levels × {} runs), once",
+                judge.name(),
+                difficulty::CURVE_AUX.len(),
+                difficulty::CURVE_LEVELS,
+                difficulty::CURVE_TRIALS
+            )
+        },
+        &|| stop.load(Ordering::SeqCst),
+    )?;
+    let bar = progress_bar(n as u64, "campaign levels searched");
+    bar.inc(resumed.iter().flatten().count() as u64);
+    let built: Vec<Option<Level>> = resumed
+        .into_par_iter()
+        .enumerate()
+        .map(|(k, kept)| -> Result<Option<Level>> {
+            if let Some(level) = kept {
+                return Ok(Some(level));
+            }
+            if stop.load(Ordering::SeqCst) {
+                return Ok(None);
+            }
+            let seed = level_seed(args.seed, k)?;
+            let level = difficulty::level_for(
+                &generator,
+                &solver,
+                &curve,
+                seed,
+                None,
+                ask.target(k, n),
+                args.trials,
+            )
+            .map_err(anyhow::Error::from)
+            .and_then(|level| Ok(verify::certified(level, &solver, seed)?))
+            .with_context(|| {
+                format!(
+                    "level {} of {n} (seed {seed}, success {:.2} asked); nothing was written",
+                    k + 1,
+                    ask.target(k, n)
+                )
+            })?;
+            bar.inc(1);
+            Ok(Some(level))
+        })
+        .collect::<Result<_>>()?;
+    bar.finish_and_clear();
+    if built.iter().any(Option::is_none) {
+        return interrupted(args, &built, &files);
+    }
+    let mut levels: Vec<Level> = built.into_iter().flatten().collect();
+    let searched = levels.clone();
+    let thetas = play_panel(&panel, &mut levels, args.trials, &stop);
+    if levels.len() < n {
+        let searched: Vec<Option<Level>> = searched.into_iter().map(Some).collect();
+        return interrupted(args, &searched, &files);
+    }
+    let named: Vec<(String, &Level)> = levels
+        .iter()
+        .enumerate()
+        .map(|(k, l)| (format!("{}.yaml", level_stem(k, n)), l))
+        .collect();
+    let campaign = ask.record(&named, &thetas).map_err(anyhow::Error::msg)?;
+    let record = serde_yaml::to_string(&campaign).context("the campaign record")?;
+    let level_files = levels
+        .iter()
+        .zip(&files)
+        .flat_map(|(level, files)| render(level, files).into_iter().rev());
+    let reports = [
+        (args.out.join(CAMPAIGN_FILE), record.into_bytes()),
+        (
+            args.out.join("campaign.md"),
+            campaign.to_markdown().into_bytes(),
+        ),
+        (
+            args.out.join("campaign.png"),
+            stacked_png(&campaign.charts()),
+        ),
+    ];
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    // A resumed campaign's own files (its levels, verified without the panel, and its
+    // reports) are replaced; anything else of other contents is refused.
+    let ours = |path: &Path| args.resume && is_campaign_file(path, n);
+    let (written, kept) = fsio::write_batch(
+        &args.out,
+        level_files.chain(reports),
+        &ours,
+        "choose another --out, or remove it",
+        || {
+            crate::warn!(
+                "waiting for another arlpcg run that is writing into {}",
+                args.out.display()
+            )
+        },
+    )?;
+    let unchanged = match kept {
+        0 => String::new(),
+        k => format!(", {k} of them already there and identical"),
+    };
+    crate::say!(
+        "wrote a campaign of {n} levels ({} files{unchanged}) to {}",
+        written + kept,
+        args.out.display()
+    );
+    report(&campaign);
+    apply_checks(&campaign.checks, &named)
+}
+
+/// The seed level `k` is searched from.
+fn level_seed(seed: u64, k: usize) -> Result<u64> {
+    seed.checked_add(k as u64).ok_or_else(|| {
+        crate::shells::common::UsageError(format!(
+            "--seed {seed} plus the levels overflows a 64-bit seed"
+        ))
+        .into()
+    })
+}
+
+fn scripted(judge: Judge) -> Solver<'static> {
+    match judge {
+        Judge::Scripted(skill) => Solver::Scripted(skill),
+        Judge::Solver(_) => unreachable!("a Solver judge is loaded with its policy"),
+    }
+}
+
+/// The judge's Solver policy from `dir`; none for the scripted player.
+fn judge_policy(dir: &Path, game: Game, judge: Judge) -> Result<Option<SolverPolicy>> {
+    Ok(load_judge(dir, game, judge)?.map(|(policy, _)| policy))
+}
+
+/// Whether `path` is one of the files a campaign of `n` levels writes.
+fn is_campaign_file(path: &Path, n: usize) -> bool {
+    let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
+        return false;
+    };
+    let stem = name.split('.').next().unwrap_or_default();
+    ["campaign.yaml", "campaign.md", "campaign.png"].contains(&name)
+        || (0..n).any(|k| level_stem(k, n) == stem)
+}
+
+/// With --resume, the levels an interrupted run of this campaign left in --out (by file name),
+/// each checked to be this campaign's: its game, verified by the judge from its seed.
+fn resumed_levels(
+    args: &CampaignArgs,
+    files: &[LevelFiles],
+    solver: &Solver,
+) -> Result<Vec<Option<Level>>> {
+    let mut levels = Vec::with_capacity(files.len());
+    for (k, files) in files.iter().enumerate() {
+        let path = files
+            .paths()
+            .into_iter()
+            .find(|p| p.extension().is_some_and(|e| e == "yaml"))
+            .expect("a campaign writes YAML");
+        if !path.exists() {
+            levels.push(None);
+            continue;
+        }
+        let mut level = yaml::load(&path)?;
+        let seed = level_seed(args.seed, k)?;
+        let ours = level.game() == args.game
+            && level
+                .stats
+                .as_ref()
+                .is_some_and(|s| s.seed == seed && s.solver == solver.reference());
+        if !ours {
+            anyhow::bail!(
+                "{}: not level {} of this campaign (a {} level verified from seed {seed} by {}); remove it or choose another --out",
+                path.display(),
+                k + 1,
+                args.game,
+                solver.reference().describe()
+            );
+        }
+        // The panel plays the whole campaign again: its rating is of all the levels together.
+        if let Some(stats) = &mut level.stats {
+            stats.panel = None;
+        }
+        levels.push(Some(level));
+    }
+    Ok(levels)
+}
+
+/// After a Ctrl-C: writes the levels finished so far (without the panel's rating, which is of
+/// the whole campaign) for `--resume` to keep, and says so (exit 130).
+fn interrupted(args: &CampaignArgs, built: &[Option<Level>], files: &[LevelFiles]) -> Result<()> {
+    let finished: Vec<(&Level, &LevelFiles)> = built
+        .iter()
+        .zip(files)
+        .filter_map(|(level, files)| level.as_ref().map(|l| (l, files)))
+        .collect();
+    if !finished.is_empty() {
+        std::fs::create_dir_all(&args.out)
+            .with_context(|| format!("cannot create {}", args.out.display()))?;
+        let level_files = finished
+            .iter()
+            .flat_map(|(level, files)| render(level, files).into_iter().rev());
+        fsio::write_batch(
+            &args.out,
+            level_files,
+            &|path| args.resume && is_campaign_file(path, files.len()),
+            "choose another --out, or remove it",
+            || {},
+        )?;
+    }
+    Err(Interrupted(format!(
+        "interrupted (Ctrl-C): {} of {} levels were finished and written to {}; the same command with --resume finishes the campaign",
+        finished.len(),
+        files.len(),
+        args.out.display()
+    ))
+    .into())
+}
+
+/// The panel plays every level; the levels are rated together. Returns the judges' θ.
+fn play_panel(
+    panel: &crate::services::panel::JudgePanel,
+    levels: &mut Vec<Level>,
+    trials: u32,
+    stop: &AtomicBool,
+) -> Vec<(String, f64)> {
+    let runs = (levels.len() * panel.judges.len()) as u64 * trials as u64;
+    let bar = progress_bar(runs, "panel runs");
+    let watch = Watch {
+        on_trial: &|_| bar.inc(1),
+        stop: &|| stop.load(Ordering::SeqCst),
+    };
+    let thetas = play_and_rate(panel, levels, trials, &watch);
+    bar.finish_and_clear();
+    thetas
+}
+
+/// One line per level, then the funnel's end.
+fn report(campaign: &Campaign) {
+    for level in &campaign.levels {
+        crate::say!(
+            "{}: asked {:.2}, measured {:.2} ({:.2} to {:.2}), b {:+.2}; {:.1}% of players reach it, {:.1}% quit on it",
+            level.file,
+            level.asked,
+            level.measured,
+            level.ci95[0],
+            level.ci95[1],
+            level.b,
+            100.0 * level.players.reach,
+            100.0 * level.players.quit
+        );
+    }
+    crate::say!(
+        "{:.1}% of players finish the campaign (θ ~ Normal({:+.2}, {:.2}), retry {:.2})",
+        100.0 * campaign.finishers(),
+        campaign.population.theta_mean,
+        campaign.population.theta_sd,
+        campaign.population.retry
+    );
+}
+
+fn apply_checks(checks: &[Check], levels: &[(String, &Level)]) -> Result<()> {
+    let evidence = levels.iter().map(|(name, level)| {
+        let (stats, rating) = evidence(level);
+        (name.clone(), stats, rating)
+    });
+    report_checks(checks, failures(checks, evidence), levels.len())
+}
+
+/// Exit code 3, naming each level and check that failed, when any did.
+pub fn report_checks(checks: &[Check], failed: Vec<(String, String)>, levels: usize) -> Result<()> {
+    if failed.is_empty() {
+        if !checks.is_empty() {
+            crate::say!("every level passed its checks ({})", checks.len());
+        }
+        return Ok(());
+    }
+    for (level, why) in &failed {
+        crate::say!("check failed: {level}: {why}");
+    }
+    let levels_failed = {
+        let mut names: Vec<&String> = failed.iter().map(|(n, _)| n).collect();
+        names.dedup();
+        names.len()
+    };
+    Err(ChecksFailed(format!(
+        "{levels_failed} of {levels} levels failed their checks ({} failures)",
+        failed.len()
+    ))
+    .into())
+}
+
+/// `verify --campaign FILE`: the judge and the panel play every level of the campaign again
+/// (the levels as they are now, from the seeds the campaign gives them); the report goes to
+/// standard output; the campaign's checks and --check are applied.
+pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
+    let bytes = fsio::read_limited(file, 1 << 22, "campaign file")?;
+    let campaign: Campaign =
+        serde_yaml::from_slice(&bytes).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    campaign
+        .check()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    let folder = file.parent().unwrap_or(Path::new("."));
+    let judge = Judge::parse(&campaign.judge)
+        .map_err(|e| anyhow::anyhow!("{}: judge: {e}", file.display()))?;
+    let dir: PathBuf = args
+        .policies
+        .clone()
+        .unwrap_or_else(|| shipped_dir(campaign.game));
+    let judge_policy = judge_policy(&dir, campaign.game, judge)?;
+    let solver = judge_policy
+        .as_ref()
+        .map_or_else(|| scripted(judge), Solver::Policy);
+    let panel = load_panel(&dir, campaign.game, None)?;
+    let mut levels = Vec::with_capacity(campaign.levels.len());
+    for (k, entry) in campaign.levels.iter().enumerate() {
+        let path = folder.join(&entry.file);
+        let mut level = yaml::load(&path)?;
+        if level.game() != campaign.game {
+            anyhow::bail!(
+                "{}: a {} level in a {} campaign",
+                path.display(),
+                level.game(),
+                campaign.game
+            );
+        }
+        let seed = level_seed(campaign.seed, k)?;
+        level.stats = Some(verify::verify(
+            &level,
+            &solver,
+            campaign.trials,
+            seed,
+            &|| {},
+        )?);
+        levels.push(level);
+    }
+    let stop = AtomicBool::new(false);
+    let thetas = play_panel(&panel, &mut levels, campaign.trials, &stop);
+    let ask = CampaignAsk {
+        game: campaign.game,
+        seed: campaign.seed,
+        judge: campaign.judge.clone(),
+        trials: campaign.trials,
+        ramp: campaign.ramp.clone(),
+        checks: campaign
+            .checks
+            .iter()
+            .chain(&args.checks)
+            .copied()
+            .collect(),
+        population: match campaign.population_from.as_str() {
+            "given" => PopulationAsk::Given(campaign.population),
+            _ => PopulationAsk::ScriptedJudges {
+                retry: campaign.population.retry,
+            },
+        },
+    };
+    let named: Vec<(String, &Level)> = campaign
+        .levels
+        .iter()
+        .zip(&levels)
+        .map(|(entry, level)| (entry.file.clone(), level))
+        .collect();
+    let replayed = ask.record(&named, &thetas).map_err(anyhow::Error::msg)?;
+    crate::say!("{}", replayed.to_markdown());
+    apply_checks(&replayed.checks, &named)
+}

@@ -14,6 +14,7 @@ use crate::services::chart::stacked_png;
 use crate::services::checks::{Check, evidence, failures};
 use crate::services::difficulty;
 use crate::services::fsio;
+use crate::services::generation::GeneratorPolicy;
 use crate::services::level_files::{Format, LevelFiles, render};
 use crate::services::panel::{Judge, play_and_rate};
 use crate::services::policies::{
@@ -32,6 +33,13 @@ pub const CAMPAIGN_FILE: &str = "campaign.yaml";
 pub fn run(args: &CampaignArgs) -> Result<()> {
     if args.out.exists() && !args.out.is_dir() {
         anyhow::bail!("--out {} is not a folder", args.out.display());
+    }
+    let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
+    if !formats.contains(&Format::Yaml) {
+        return Err(crate::shells::common::UsageError(
+            "--format must include yaml: the campaign's record names its level files".into(),
+        )
+        .into());
     }
     let dir = args
         .policies
@@ -61,13 +69,6 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         .as_ref()
         .map_or_else(|| scripted(judge), Solver::Policy);
     let panel = load_panel(&dir, args.game, None)?;
-    let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
-    if !formats.contains(&Format::Yaml) {
-        return Err(crate::shells::common::UsageError(
-            "--format must include yaml: the campaign's record names its level files".into(),
-        )
-        .into());
-    }
     let files: Vec<LevelFiles> = (0..n)
         .map(|k| LevelFiles::new(&args.out, &level_stem(k, n), &formats))
         .collect();
@@ -95,42 +96,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         },
         &|| stop.load(Ordering::SeqCst),
     )?;
-    let bar = progress_bar(n as u64, "campaign levels searched");
-    bar.inc(resumed.iter().flatten().count() as u64);
-    let built: Vec<Option<Level>> = resumed
-        .into_par_iter()
-        .enumerate()
-        .map(|(k, kept)| -> Result<Option<Level>> {
-            if let Some(level) = kept {
-                return Ok(Some(level));
-            }
-            if stop.load(Ordering::SeqCst) {
-                return Ok(None);
-            }
-            let seed = level_seed(args.seed, k)?;
-            let level = difficulty::level_for(
-                &generator,
-                &solver,
-                &curve,
-                seed,
-                None,
-                ask.target(k, n),
-                args.trials,
-            )
-            .map_err(anyhow::Error::from)
-            .and_then(|level| Ok(verify::certified(level, &solver, seed)?))
-            .with_context(|| {
-                format!(
-                    "level {} of {n} (seed {seed}, success {:.2} asked); nothing was written",
-                    k + 1,
-                    ask.target(k, n)
-                )
-            })?;
-            bar.inc(1);
-            Ok(Some(level))
-        })
-        .collect::<Result<_>>()?;
-    bar.finish_and_clear();
+    let built = search_levels(args, &ask, &generator, &solver, &curve, resumed, &stop)?;
     if built.iter().any(Option::is_none) {
         return interrupted(args, &built, &files);
     }
@@ -147,10 +113,75 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         .map(|(k, l)| (format!("{}.yaml", level_stem(k, n)), l))
         .collect();
     let campaign = ask.record(&named, &thetas).map_err(anyhow::Error::msg)?;
+    write_campaign(args, &campaign, &levels, &files)?;
+    report(&campaign);
+    apply_checks(&campaign.checks, &named)
+}
+
+/// Searches each level not resumed for its ramp point, several at once; `None` for those a
+/// Ctrl-C left unsearched.
+#[allow(clippy::too_many_arguments)]
+fn search_levels(
+    args: &CampaignArgs,
+    ask: &CampaignAsk,
+    generator: &GeneratorPolicy,
+    solver: &Solver,
+    curve: &difficulty::Curve,
+    resumed: Vec<Option<Level>>,
+    stop: &AtomicBool,
+) -> Result<Vec<Option<Level>>> {
+    let n = resumed.len();
+    let bar = progress_bar(n as u64, "campaign levels searched");
+    bar.inc(resumed.iter().flatten().count() as u64);
+    let built: Vec<Option<Level>> = resumed
+        .into_par_iter()
+        .enumerate()
+        .map(|(k, kept)| -> Result<Option<Level>> {
+            if let Some(level) = kept {
+                return Ok(Some(level));
+            }
+            if stop.load(Ordering::SeqCst) {
+                return Ok(None);
+            }
+            let seed = level_seed(args.seed, k)?;
+            let level = difficulty::level_for(
+                generator,
+                solver,
+                curve,
+                seed,
+                None,
+                ask.target(k, n),
+                args.trials,
+            )
+            .map_err(anyhow::Error::from)
+            .and_then(|level| Ok(verify::certified(level, solver, seed)?))
+            .with_context(|| {
+                format!(
+                    "level {} of {n} (seed {seed}, success {:.2} asked); nothing was written",
+                    k + 1,
+                    ask.target(k, n)
+                )
+            })?;
+            bar.inc(1);
+            Ok(Some(level))
+        })
+        .collect::<Result<_>>()?;
+    bar.finish_and_clear();
+    Ok(built)
+}
+
+/// Writes the levels, campaign.yaml, campaign.md and campaign.png, all or none, and says so.
+fn write_campaign(
+    args: &CampaignArgs,
+    campaign: &Campaign,
+    levels: &[Level],
+    files: &[LevelFiles],
+) -> Result<()> {
+    let n = levels.len();
     let record = serde_yaml::to_string(&campaign).context("the campaign record")?;
     let level_files = levels
         .iter()
-        .zip(&files)
+        .zip(files)
         .flat_map(|(level, files)| render(level, files).into_iter().rev());
     let reports = [
         (args.out.join(CAMPAIGN_FILE), record.into_bytes()),
@@ -189,8 +220,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         written + kept,
         args.out.display()
     );
-    report(&campaign);
-    apply_checks(&campaign.checks, &named)
+    Ok(())
 }
 
 /// The seed level `k` is searched from.

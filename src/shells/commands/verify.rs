@@ -24,44 +24,15 @@ use arlpcg_core::level::yaml;
 use arlpcg_core::level::{Game, Level};
 
 pub fn run(args: &VerifyArgs) -> Result<()> {
-    let usage = |message: &str| Err(crate::shells::common::UsageError(message.into()).into());
     if let Some(file) = &args.campaign {
         return super::campaign::replay(args, file);
     }
-    if args.policies.is_some() && args.panel.is_none() {
-        return usage("--policies names where the panel's Solvers come from: give --panel too");
-    }
-    if args.replay && !args.checks.is_empty() {
-        return usage("--check reads new trials; --replay plays none");
-    }
-    if args.panel.is_some() && args.checks.iter().any(|c| !c.needs_panel()) {
-        return usage(
-            "with --panel, a check is `b LO..HI`; `success` and `completed` read one Solver's runs (verify without --panel)",
-        );
-    }
-    if args.panel.is_none() && args.checks.iter().any(Check::needs_panel) {
-        return usage("--check b reads the panel's rating: give --panel too");
-    }
+    check_arguments(args)?;
     if args.replay {
         return replay(args);
     }
     if let Some(judges) = &args.panel {
         return panel(args, judges);
-    }
-    if args.chart.is_some() && args.levels.len() != 1 {
-        return Err(crate::shells::common::UsageError(
-            "--chart draws one level: give one level file".into(),
-        )
-        .into());
-    }
-    if let Some(chart) = &args.chart
-        && chart.extension().is_none_or(|e| e != "png")
-    {
-        return Err(crate::shells::common::UsageError(format!(
-            "--chart {}: the file name must end in .png",
-            chart.display()
-        ))
-        .into());
     }
     if let Some(chart) = args.chart.as_ref().filter(|c| c.exists()) {
         anyhow::bail!(
@@ -164,6 +135,37 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
         );
     }
     report_checks(&args.checks, checked, args.levels.len())
+}
+
+/// The checks on the arguments alone (exit 2 on a misfit).
+fn check_arguments(args: &VerifyArgs) -> Result<()> {
+    let usage = |message: &str| Err(crate::shells::common::UsageError(message.into()).into());
+    if args.policies.is_some() && args.panel.is_none() {
+        return usage("--policies names where the panel's Solvers come from: give --panel too");
+    }
+    if args.replay && !args.checks.is_empty() {
+        return usage("--check reads new trials; --replay plays none");
+    }
+    if args.panel.is_some() && args.checks.iter().any(|c| !c.needs_panel()) {
+        return usage(
+            "with --panel, a check is `b LO..HI`; `success` and `completed` read one Solver's runs (verify without --panel)",
+        );
+    }
+    if args.panel.is_none() && args.checks.iter().any(Check::needs_panel) {
+        return usage("--check b reads the panel's rating: give --panel too");
+    }
+    if args.chart.is_some() && args.levels.len() != 1 {
+        return usage("--chart draws one level: give one level file");
+    }
+    if let Some(chart) = &args.chart
+        && chart.extension().is_none_or(|e| e != "png")
+    {
+        return usage(&format!(
+            "--chart {}: the file name must end in .png",
+            chart.display()
+        ));
+    }
+    Ok(())
 }
 
 /// `verify --replay`: each level's certificate run, again, with the Solver that recorded it.

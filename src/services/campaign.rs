@@ -138,6 +138,9 @@ pub struct JudgeTheta {
 pub struct CampaignLevel {
     /// The level file, beside campaign.yaml.
     pub file: String,
+    /// The seed its search and its runs started from (campaign seed + the level's place in the
+    /// search, before [`order_by_difficulty`]).
+    pub seed: u64,
     pub position: f64,
     /// The judge's success asked for by the ramp.
     pub asked: f64,
@@ -231,6 +234,7 @@ impl CampaignAsk {
                 let rating = rating(level);
                 CampaignLevel {
                     file: file.clone(),
+                    seed: stats.map_or(0, |s| s.seed),
                     position: round4(position(k, n)),
                     asked: round4(self.target(k, n)),
                     measured: stats.map_or(f64::NAN, |s| s.success_ratio),
@@ -365,6 +369,16 @@ impl Campaign {
             .map(|j| format!("{} {:+.2}", j.judge, j.theta))
             .collect();
         page += &format!("\nJudges' ability θ (logits): {}.\n", thetas.join(", "));
+        page += &match self.steps_down()[..] {
+            [] => "\nb rises from level to level, within its intervals.\n".to_string(),
+            ref down => format!(
+                "\nb steps down beyond its intervals at level {}.\n",
+                down.iter()
+                    .map(|k| k.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        };
         if !self.checks.is_empty() {
             let checks: Vec<String> = self.checks.iter().map(|c| format!("`{c}`")).collect();
             page += &format!("\nChecks every level must pass: {}.\n", checks.join(", "));
@@ -416,6 +430,46 @@ impl Campaign {
     }
 }
 
+/// Puts the levels in order of the panel's difficulty b wherever the ramp allows it: two
+/// neighbours trade places when the later is rated easier and each still measures within
+/// `band` of the other's ramp point, until no such pair is left. The judge's ramp holds; the
+/// other judges, whom b also counts, see fewer steps down.
+pub fn order_by_difficulty(levels: &mut [Level], targets: &[f64], band: f64) {
+    let measured = |l: &Level| l.stats.as_ref().map_or(f64::NAN, |s| s.success_ratio);
+    let b = |l: &Level| {
+        l.stats
+            .as_ref()
+            .and_then(|s| s.panel.as_ref())
+            .and_then(|p| p.rating)
+            .map_or(f64::NAN, |r| r.b)
+    };
+    let fits = |l: &Level, k: usize| (measured(l) - targets[k]).abs() <= band + 1e-9;
+    let mut swapped = true;
+    while swapped {
+        swapped = false;
+        for k in 0..levels.len().saturating_sub(1) {
+            let (earlier, later) = (&levels[k], &levels[k + 1]);
+            if b(earlier) > b(later) && fits(later, k) && fits(earlier, k + 1) {
+                levels.swap(k, k + 1);
+                swapped = true;
+            }
+        }
+    }
+}
+
+impl Campaign {
+    /// The levels (numbered from 1) whose b falls below the one before it beyond both
+    /// intervals: where the campaign steps down for the panel.
+    pub fn steps_down(&self) -> Vec<usize> {
+        self.levels
+            .windows(2)
+            .enumerate()
+            .filter(|(_, pair)| pair[1].b_ci95[1] < pair[0].b_ci95[0])
+            .map(|(k, _)| k + 2)
+            .collect()
+    }
+}
+
 fn round4(x: f64) -> f64 {
     (x * 1e4).round() / 1e4
 }
@@ -448,6 +502,58 @@ mod tests {
             let err = Ramp::parse(text).unwrap_err();
             assert!(err.contains(expected), "{text}: {err}");
         }
+    }
+
+    /// Neighbours trade places when the later is rated easier and both still fit the other's
+    /// ramp point; a pair that does not fit stays as it is.
+    #[test]
+    fn levels_go_in_order_of_difficulty_where_the_ramp_allows() {
+        let shipped = arlpcg_core::level::yaml::parse(include_str!(
+            "../../levels/platform/platform_seed7_aux+1.00.yaml"
+        ))
+        .unwrap();
+        let level = |success: f64, b: f64| {
+            let mut level = shipped.clone();
+            let stats = level.stats.as_mut().unwrap();
+            stats.success_ratio = success;
+            stats.panel = Some(arlpcg_core::level::stats::PanelStats {
+                seed: 0,
+                trials: 10,
+                judges: Vec::new(),
+                rating: Some(arlpcg_core::level::stats::Rating {
+                    b,
+                    ci95: [b - 0.1, b + 0.1],
+                    levels: 4,
+                }),
+            });
+            level
+        };
+        let b_of = |levels: &[Level]| -> Vec<f64> {
+            levels
+                .iter()
+                .map(|l| {
+                    l.stats
+                        .as_ref()
+                        .unwrap()
+                        .panel
+                        .as_ref()
+                        .unwrap()
+                        .rating
+                        .unwrap()
+                        .b
+                })
+                .collect()
+        };
+        let targets = [0.9, 0.8, 0.7, 0.2];
+        let mut levels = vec![
+            level(0.85, 1.0),
+            level(0.85, -1.0),
+            level(0.7, 2.0),
+            level(0.2, 0.5),
+        ];
+        order_by_difficulty(&mut levels, &targets, 0.1);
+        // 1 and 2 trade places; 3 and 4 do not (0.2 is not within 0.1 of 0.7).
+        assert_eq!(b_of(&levels), [-1.0, 1.0, 2.0, 0.5]);
     }
 
     #[test]

@@ -98,7 +98,7 @@ fn a_campaign_follows_its_ramp_and_resumes_to_the_same_bytes() {
     fails_with(
         &campaign(&other, &["--resume"]),
         1,
-        "level02.yaml: not level 2 of this campaign",
+        "level02.yaml: not a level of this campaign",
     );
     // Without --resume it is not replaced.
     fails_with(

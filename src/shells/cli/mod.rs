@@ -489,7 +489,8 @@ pub struct CampaignArgs {
     /// The success asked for along the campaign: control points `position:success`, position 0
     /// the first level and 1 the last, linear between them ("0:0.95, 1:0.5"; two points at one
     /// position are a step). Each level is searched (λ and draws) until the judge's success is
-    /// within ±0.1 of its point.
+    /// within ±0.1 of its point; then neighbours trade places where both still fit, so that
+    /// the panel's difficulty b rises along the campaign.
     #[arg(long, value_name = "CURVE", value_parser = Ramp::parse)]
     pub ramp: Ramp,
     /// Whose success the ramp asks for: a Solver of --policies named by its training mode

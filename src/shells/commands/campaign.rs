@@ -9,7 +9,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Context, Result};
 use rayon::prelude::*;
 
-use crate::services::campaign::{Campaign, CampaignAsk, PopulationAsk, level_stem};
+use crate::services::campaign::{
+    Campaign, CampaignAsk, PopulationAsk, level_stem, order_by_difficulty,
+};
 use crate::services::chart::stacked_png;
 use crate::services::checks::{Check, evidence, failures};
 use crate::services::difficulty;
@@ -107,6 +109,8 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         let searched: Vec<Option<Level>> = searched.into_iter().map(Some).collect();
         return interrupted(args, &searched, &files);
     }
+    let targets: Vec<f64> = (0..n).map(|k| ask.target(k, n)).collect();
+    order_by_difficulty(&mut levels, &targets, difficulty::BAND);
     let named: Vec<(String, &Level)> = levels
         .iter()
         .enumerate()
@@ -255,45 +259,48 @@ fn is_campaign_file(path: &Path, n: usize) -> bool {
         || (0..n).any(|k| level_stem(k, n) == stem)
 }
 
-/// With --resume, the levels an interrupted run of this campaign left in --out (by file name),
-/// each checked to be this campaign's: its game, verified by the judge from its seed.
+/// With --resume, the levels an earlier run of this campaign left in --out, each in the slot of
+/// the seed it was searched from (a finished campaign's files are in the panel's order): each
+/// checked to be this campaign's, its game, verified by the judge from one of its seeds.
 fn resumed_levels(
     args: &CampaignArgs,
     files: &[LevelFiles],
     solver: &Solver,
 ) -> Result<Vec<Option<Level>>> {
-    let mut levels = Vec::with_capacity(files.len());
-    for (k, files) in files.iter().enumerate() {
+    let n = files.len();
+    let mut levels: Vec<Option<Level>> = vec![None; n];
+    for files in files {
         let path = files
             .paths()
             .into_iter()
             .find(|p| p.extension().is_some_and(|e| e == "yaml"))
             .expect("a campaign writes YAML");
         if !path.exists() {
-            levels.push(None);
             continue;
         }
         let mut level = yaml::load(&path)?;
-        let seed = level_seed(args.seed, k)?;
-        let ours = level.game() == args.game
-            && level
-                .stats
-                .as_ref()
-                .is_some_and(|s| s.seed == seed && s.solver == solver.reference());
-        if !ours {
+        let slot = level
+            .stats
+            .as_ref()
+            .filter(|s| level.game() == args.game && s.solver == solver.reference())
+            .and_then(|s| s.seed.checked_sub(args.seed))
+            .filter(|&j| j < n as u64)
+            .map(|j| j as usize);
+        let Some(slot) = slot.filter(|&j| levels[j].is_none()) else {
             anyhow::bail!(
-                "{}: not level {} of this campaign (a {} level verified from seed {seed} by {}); remove it or choose another --out",
+                "{}: not a level of this campaign (a {} level verified by {} from one of seeds {}..{}, each once); remove it or choose another --out",
                 path.display(),
-                k + 1,
                 args.game,
-                solver.reference().describe()
+                solver.reference().describe(),
+                args.seed,
+                args.seed.saturating_add(n as u64 - 1),
             );
-        }
+        };
         // The panel plays the whole campaign again: its rating is of all the levels together.
         if let Some(stats) = &mut level.stats {
             stats.panel = None;
         }
-        levels.push(Some(level));
+        levels[slot] = Some(level);
     }
     Ok(levels)
 }
@@ -362,6 +369,13 @@ fn report(campaign: &Campaign) {
             100.0 * level.players.quit
         );
     }
+    if let down @ [_, ..] = &campaign.steps_down()[..] {
+        let down: Vec<String> = down.iter().map(|k| k.to_string()).collect();
+        crate::say!(
+            "the panel's b steps down beyond its intervals at level {}",
+            down.join(", ")
+        );
+    }
     crate::say!(
         "{:.1}% of players finish the campaign (θ ~ Normal({:+.2}, {:.2}), retry {:.2})",
         100.0 * campaign.finishers(),
@@ -425,7 +439,7 @@ pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
         .map_or_else(|| scripted(judge), Solver::Policy);
     let panel = load_panel(&dir, campaign.game, None)?;
     let mut levels = Vec::with_capacity(campaign.levels.len());
-    for (k, entry) in campaign.levels.iter().enumerate() {
+    for entry in &campaign.levels {
         let path = folder.join(&entry.file);
         let mut level = yaml::load(&path)?;
         if level.game() != campaign.game {
@@ -436,7 +450,7 @@ pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
                 campaign.game
             );
         }
-        let seed = level_seed(campaign.seed, k)?;
+        let seed = entry.seed;
         level.stats = Some(verify::verify(
             &level,
             &solver,

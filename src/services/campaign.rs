@@ -18,6 +18,9 @@ use arlpcg_core::level::pacing::{CurveWords, parse_points, show_points, value_at
 use arlpcg_core::level::{Game, Level};
 use arlpcg_core::statistics::population::{LevelFlow, Population};
 
+/// The record's file name, beside the levels.
+pub const CAMPAIGN_FILE: &str = "campaign.yaml";
+
 /// The `format:` of a campaign file.
 pub const FORMAT: &str = "arlpcg-campaign";
 /// The campaign file's version.
@@ -468,6 +471,41 @@ impl Campaign {
             .map(|(k, _)| k + 2)
             .collect()
     }
+}
+
+/// A campaign read back: its folder, its record (checked), and its levels in order, each of
+/// the campaign's game. `path` is the folder or its campaign.yaml.
+pub fn open(path: &std::path::Path) -> anyhow::Result<(std::path::PathBuf, Campaign, Vec<Level>)> {
+    let file = match path.is_dir() {
+        true => path.join(CAMPAIGN_FILE),
+        false => path.to_path_buf(),
+    };
+    let folder = file
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."))
+        .to_path_buf();
+    let bytes = crate::services::fsio::read_limited(&file, 1 << 22, "campaign file")?;
+    let campaign: Campaign =
+        serde_yaml::from_slice(&bytes).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    campaign
+        .check()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    let mut levels = Vec::with_capacity(campaign.levels.len());
+    for entry in &campaign.levels {
+        let level_path = folder.join(&entry.file);
+        let level = arlpcg_core::level::yaml::load(&level_path)?;
+        if level.game() != campaign.game {
+            anyhow::bail!(
+                "{}: a {} level in a {} campaign",
+                level_path.display(),
+                level.game(),
+                campaign.game
+            );
+        }
+        levels.push(level);
+    }
+    Ok((folder, campaign, levels))
 }
 
 fn round4(x: f64) -> f64 {

@@ -834,3 +834,56 @@ fn no_color_draws_the_same_screen_without_colours() {
     assert!(cells(&h).iter().all(plain_colour));
     assert_eq!(h.screen(120, 36), text, "the same text");
 }
+
+/// `o`: a campaign folder opens on its view (one column per level under the ramp's bars, the
+/// funnel's end); `→` and `Enter` open level 2 on the screen, with its trials; `o` comes back.
+#[test]
+fn the_campaign_view_opens_a_campaign_and_its_levels() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("campaign");
+    crate::common::arlpcg_ok(&[
+        "campaign",
+        "--levels",
+        "3",
+        "--ramp",
+        "0:0.9, 1:0.5",
+        "--judge",
+        "scripted-median",
+        "--trials",
+        "20",
+        "--seed",
+        "40",
+        "--format",
+        "yaml",
+        "--out",
+        folder.to_str().unwrap(),
+    ]);
+    let mut h = Harness::rules(dir.path());
+    h.settle();
+    h.key(KeyCode::Char('o'));
+    h.keys(folder.to_str().unwrap());
+    h.key(KeyCode::Enter);
+    h.settle();
+    assert_eq!(h.app.overlay, Overlay::Campaign);
+    h.key(KeyCode::Right);
+    insta::assert_snapshot!("campaign_view_120x36", h.screen(120, 36));
+    h.key(KeyCode::Enter);
+    h.settle();
+    assert_eq!(h.app.overlay, Overlay::None);
+    let expected = yaml::load(&folder.join("level02.yaml")).unwrap();
+    let shown = h.app.level.as_ref().expect("level 2 on screen");
+    assert_eq!(shown.track, expected.track);
+    assert!(h.app.trials.as_ref().unwrap().stats.is_some());
+    h.key(KeyCode::Char('o'));
+    assert_eq!(h.app.overlay, Overlay::Campaign);
+    h.key(KeyCode::Esc);
+    assert_eq!(h.app.overlay, Overlay::None);
+    // A folder without a campaign is a message.
+    h.key(KeyCode::Char('o'));
+    h.key(KeyCode::Char('o'));
+    h.keys("/nonexistent");
+    h.key(KeyCode::Enter);
+    h.settle();
+    let (status, problem) = h.app.status.clone().unwrap();
+    assert!(problem && status.contains("no campaign opened"), "{status}");
+}

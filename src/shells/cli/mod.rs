@@ -118,6 +118,9 @@ pub struct DesignArgs {
     /// The seed of the first level.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Open on the campaign view of this folder (what `arlpcg campaign` wrote; its game).
+    #[arg(long, value_name = "DIR")]
+    pub campaign: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]

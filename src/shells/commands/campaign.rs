@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 
 use crate::services::campaign::{
-    Campaign, CampaignAsk, PopulationAsk, level_stem, order_by_difficulty,
+    CAMPAIGN_FILE, Campaign, CampaignAsk, PopulationAsk, level_stem, order_by_difficulty,
 };
 use crate::services::chart::stacked_png;
 use crate::services::checks::{Check, evidence, failures};
@@ -28,9 +28,6 @@ use crate::shells::common::{ChecksFailed, Interrupted, progress_bar};
 use arlpcg_core::level::{Game, Level, yaml};
 use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::statistics::population::Population;
-
-/// The record's file name, beside the levels.
-pub const CAMPAIGN_FILE: &str = "campaign.yaml";
 
 pub fn run(args: &CampaignArgs) -> Result<()> {
     if args.out.exists() && !args.out.is_dir() {
@@ -420,13 +417,7 @@ pub fn report_checks(checks: &[Check], failed: Vec<(String, String)>, levels: us
 /// (the levels as they are now, from the seeds the campaign gives them); the report goes to
 /// standard output; the campaign's checks and --check are applied.
 pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
-    let bytes = fsio::read_limited(file, 1 << 22, "campaign file")?;
-    let campaign: Campaign =
-        serde_yaml::from_slice(&bytes).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
-    campaign
-        .check()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
-    let folder = file.parent().unwrap_or(Path::new("."));
+    let (_, campaign, mut levels) = crate::services::campaign::open(file)?;
     let judge = Judge::parse(&campaign.judge)
         .map_err(|e| anyhow::anyhow!("{}: judge: {e}", file.display()))?;
     let dir: PathBuf = args
@@ -438,27 +429,14 @@ pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
         .as_ref()
         .map_or_else(|| scripted(judge), Solver::Policy);
     let panel = load_panel(&dir, campaign.game, None)?;
-    let mut levels = Vec::with_capacity(campaign.levels.len());
-    for entry in &campaign.levels {
-        let path = folder.join(&entry.file);
-        let mut level = yaml::load(&path)?;
-        if level.game() != campaign.game {
-            anyhow::bail!(
-                "{}: a {} level in a {} campaign",
-                path.display(),
-                level.game(),
-                campaign.game
-            );
-        }
-        let seed = entry.seed;
+    for (level, entry) in levels.iter_mut().zip(&campaign.levels) {
         level.stats = Some(verify::verify(
-            &level,
+            level,
             &solver,
             campaign.trials,
-            seed,
+            entry.seed,
             &|| {},
         )?);
-        levels.push(level);
     }
     let stop = AtomicBool::new(false);
     let thetas = play_panel(&panel, &mut levels, campaign.trials, &stop);

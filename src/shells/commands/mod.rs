@@ -38,6 +38,7 @@ pub fn run(cli: Cli) -> Result<()> {
                     policies: None,
                     out: "levels".into(),
                     seed: 1,
+                    campaign: None,
                 })
             } else {
                 use clap::CommandFactory;
@@ -54,5 +55,6 @@ fn design(args: crate::shells::cli::DesignArgs) -> Result<()> {
         policies: args.policies,
         out: args.out,
         seed: args.seed,
+        campaign: args.campaign,
     })
 }

@@ -17,6 +17,7 @@ use arlpcg_core::level::{Game, Level};
 
 use super::layout::Areas;
 
+pub mod campaign;
 mod input;
 pub mod judges;
 mod loaded;
@@ -80,6 +81,7 @@ pub enum PromptKind {
     Policies,
     Target,
     Curve,
+    Campaign,
 }
 
 impl PromptKind {
@@ -90,6 +92,7 @@ impl PromptKind {
             PromptKind::Target => "target success rate, 0.05-0.95 (empty: back to the λ slider)",
             PromptKind::Policies => "policies folder, or a Generator/Solver .safetensors file",
             PromptKind::Curve => "aux curve, fraction:λ, ... (e.g. 0:1, 0.5:1, 0.6:-1, 1:-1)",
+            PromptKind::Campaign => "campaign folder (what `arlpcg campaign` wrote)",
         }
     }
 }
@@ -109,6 +112,8 @@ pub enum Overlay {
     ConfirmOverwrite {
         paths: Vec<PathBuf>,
     },
+    /// The campaign open in [`App::campaign`].
+    Campaign,
 }
 
 /// What the bottom-right panel shows.
@@ -160,6 +165,8 @@ pub struct App {
     replays: u64,
     pub sweep: Option<Sweep>,
     pub judging: Option<judges::Judging>,
+    /// The campaign opened last (`o`).
+    pub campaign: Option<campaign::CampaignView>,
     pub panel: SidePane,
     /// Selected block (index into the level's blocks).
     pub selected: Option<usize>,
@@ -199,6 +206,7 @@ impl App {
             replays: 0,
             sweep: None,
             judging: None,
+            campaign: None,
             panel: SidePane::Failures,
             selected: None,
             overlay: Overlay::None,

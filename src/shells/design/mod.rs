@@ -34,6 +34,8 @@ pub struct DesignOptions {
     pub policies: Option<PathBuf>,
     pub out: PathBuf,
     pub seed: u64,
+    /// A campaign folder to open the campaign view on (its game is the one shown).
+    pub campaign: Option<PathBuf>,
 }
 
 /// The policies the designer starts on for `game`, and a note when it falls back to rules and
@@ -66,7 +68,11 @@ fn starting_policies(
 }
 
 /// Runs the designer until the user quits.
-pub fn run(options: DesignOptions) -> Result<()> {
+pub fn run(mut options: DesignOptions) -> Result<()> {
+    // A campaign that cannot be read is an error before the terminal opens.
+    if let Some(folder) = &options.campaign {
+        options.game = crate::services::campaign::open(folder)?.1.game;
+    }
     let (policies, info, note) = starting_policies(&options, options.game)?;
     let other_game = match options.game {
         Game::Platform => Game::Racing,
@@ -79,6 +85,7 @@ pub fn run(options: DesignOptions) -> Result<()> {
     let (answers, responses) = channel();
     let workers = Workers::start(shelf, answers);
     let mut app = App::new(options.game, info, options.seed, options.out);
+    let opening = options.campaign.map(|folder| app.open_campaign(folder));
     // https://no-color.org: present and not empty.
     app.colour = std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty());
     app.other_policies = other_info;
@@ -94,7 +101,12 @@ pub fn run(options: DesignOptions) -> Result<()> {
     let mut terminal = ratatui::try_init().context("cannot open the terminal for the designer")?;
     let result = execute!(std::io::stdout(), EnableMouseCapture)
         .context("cannot enable the mouse")
-        .and_then(|()| event_loop(&mut terminal, &mut app, &workers, &responses));
+        .and_then(|()| {
+            for effect in opening.into_iter().flatten() {
+                workers.submit(effect);
+            }
+            event_loop(&mut terminal, &mut app, &workers, &responses)
+        });
     let _ = execute!(std::io::stdout(), DisableMouseCapture);
     ratatui::restore();
     result

@@ -10,6 +10,7 @@ use std::sync::{Arc, Mutex};
 
 use anyhow::Result;
 
+use super::app::campaign::OpenedCampaign;
 use super::app::judges::{PANEL_SEED, PanelUpdate};
 use super::app::{
     Effect, ExportOutcome, JudgeSwitch, LoadedInfo, PolicyInfo, Response, SweepPoint,
@@ -145,7 +146,10 @@ fn slot(effect: &Effect) -> (Slot, u64) {
         Effect::Record { id, .. } => (Slot::Record, *id),
         Effect::Sweep { id, .. } => (Slot::Sweep, *id),
         Effect::Panel { id, .. } => (Slot::Panel, *id),
-        Effect::Export { .. } | Effect::Load { .. } | Effect::NextJudge { .. } => (Slot::Always, 0),
+        Effect::Export { .. }
+        | Effect::Load { .. }
+        | Effect::NextJudge { .. }
+        | Effect::OpenCampaign { .. } => (Slot::Always, 0),
     }
 }
 
@@ -314,6 +318,7 @@ pub fn perform(
             next_judge(policies, game, after, &folder).map(Box::new),
         )),
         Effect::Load { path, game } => send(Response::Loaded(load_into(policies, &path, game))),
+        Effect::OpenCampaign { folder } => send(Response::Campaign(open_campaign(&folder))),
         Effect::Panel {
             id,
             level,
@@ -323,6 +328,17 @@ pub fn perform(
             send(Response::Panel { id, update })
         }),
     }
+}
+
+/// The campaign in `folder`, read back for the designer's view.
+fn open_campaign(folder: &Path) -> Result<Box<OpenedCampaign>, String> {
+    let (folder, record, levels) =
+        crate::services::campaign::open(folder).map_err(|e| format!("{e:#}"))?;
+    Ok(Box::new(OpenedCampaign {
+        folder,
+        record,
+        levels: levels.into_iter().map(Arc::new).collect(),
+    }))
 }
 
 /// Every judge of the panel in `folder` plays `level` `trials` times, each reported as it

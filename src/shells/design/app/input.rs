@@ -25,6 +25,7 @@ impl App {
                 }
             }
             Overlay::Prompt { kind, text } => return self.prompt_key(kind, text, key),
+            Overlay::Campaign => return self.campaign_view_key(key),
             Overlay::ConfirmOverwrite { .. } => {
                 if matches!(key.code, KeyCode::Char('y' | 'Y')) {
                     return self.export(true);
@@ -98,6 +99,7 @@ impl App {
             KeyCode::Char('x') => self.export(false),
             KeyCode::Char('P') => self.next_pacing(),
             KeyCode::Char('C') => self.open_prompt(PromptKind::Curve),
+            KeyCode::Char('o') => self.campaign_key_o(),
             KeyCode::Char('k') => self.keep_prefix(),
             KeyCode::Char('K') => self.release_prefix(),
             _ => Vec::new(),
@@ -111,6 +113,7 @@ impl App {
             PromptKind::Target => self.ask.success().map_or(String::new(), |t| format!("{t}")),
             PromptKind::Policies => String::new(),
             PromptKind::Curve => self.ask.curve().map_or(String::new(), ToString::to_string),
+            PromptKind::Campaign => String::new(),
         };
         self.overlay = Overlay::Prompt { kind, text };
         Vec::new()
@@ -132,6 +135,8 @@ impl App {
 
     fn submit(&mut self, kind: PromptKind, text: &str) -> Vec<Effect> {
         match kind {
+            PromptKind::Campaign if text.is_empty() => Vec::new(),
+            PromptKind::Campaign => self.open_campaign(PathBuf::from(text)),
             PromptKind::Seed => match text.parse::<u64>() {
                 Ok(seed) => {
                     self.seed = seed;

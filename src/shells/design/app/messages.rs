@@ -64,6 +64,8 @@ pub enum Response {
         id: u64,
         update: judges::PanelUpdate,
     },
+    /// A campaign folder read back (or why not).
+    Campaign(Result<Box<super::campaign::OpenedCampaign>, String>),
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -121,6 +123,8 @@ pub enum Effect {
         after: Judge,
         folder: PathBuf,
     },
+    /// Read the campaign in `folder` (its campaign.yaml and levels).
+    OpenCampaign { folder: PathBuf },
     /// Every judge whose Solver is in `folder`, and the scripted skills, play `level`.
     Panel {
         id: u64,

@@ -57,6 +57,10 @@ impl App {
                 self.panel_update(id, update);
                 Vec::new()
             }
+            Response::Campaign(result) => {
+                self.campaign_opened(result);
+                Vec::new()
+            }
             Response::Loaded(result) => match result {
                 Ok(info) => self.loaded(*info),
                 Err(problem) => {

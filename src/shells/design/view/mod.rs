@@ -42,7 +42,7 @@ pub const KEYS: [(&str, &str); 22] = [
     ("P C", "pacing: next preset / type a curve fraction:λ, ..."),
     ("k K", "keep pieces up to the selected one / let go"),
     ("x", "export YAML (with the Solver statistics) + .glb"),
-    ("p", "load policies (a folder or one .safetensors file)"),
+    ("p o", "load policies / open a campaign folder (its view)"),
     ("c j J", "cards / next judge plays trials / all judges play"),
     ("Tab", "game: platform / racing"),
     ("?", "this help (any key closes it)"),

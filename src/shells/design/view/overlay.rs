@@ -23,6 +23,7 @@ fn centred(screen: Rect, width: u16, height: u16) -> Rect {
 pub(super) fn overlay(app: &App, frame: &mut Frame, screen: Rect) {
     match &app.overlay {
         Overlay::None => {}
+        Overlay::Campaign => crate::shells::design::app::campaign::draw(app, frame, screen),
         Overlay::Help => {
             let lines: Vec<Line> = KEYS
                 .iter()

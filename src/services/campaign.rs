@@ -10,7 +10,7 @@
 
 use std::fmt;
 
-use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use serde::{Deserialize, Serialize};
 
 use crate::services::chart::{LineChart, Series};
 use crate::services::checks::Check;
@@ -65,26 +65,7 @@ impl fmt::Display for Ramp {
     }
 }
 
-impl std::str::FromStr for Ramp {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Ramp::parse(s)
-    }
-}
-
-impl Serialize for Ramp {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_str(self)
-    }
-}
-
-impl<'de> Deserialize<'de> for Ramp {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let text = String::deserialize(deserializer)?;
-        Ramp::parse(&text).map_err(serde::de::Error::custom)
-    }
-}
+arlpcg_core::as_text!(Ramp);
 
 /// Level `k`'s position in a campaign of `n` levels: 0 for the first, 1 for the last.
 pub fn position(k: usize, n: usize) -> f64 {

@@ -8,8 +8,6 @@
 
 use std::fmt;
 
-use serde::{Deserialize, Deserializer, Serialize, Serializer};
-
 use arlpcg_core::level::Level;
 use arlpcg_core::level::params::show_number;
 use arlpcg_core::level::stats::{Rating, SolverStats};
@@ -123,26 +121,7 @@ impl fmt::Display for Check {
     }
 }
 
-impl std::str::FromStr for Check {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Check::parse(s)
-    }
-}
-
-impl Serialize for Check {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_str(self)
-    }
-}
-
-impl<'de> Deserialize<'de> for Check {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let text = String::deserialize(deserializer)?;
-        Check::parse(&text).map_err(serde::de::Error::custom)
-    }
-}
+arlpcg_core::as_text!(Check);
 
 /// Every failure of `checks` over named levels' evidence ([`evidence`]): (level name, why),
 /// in order.

@@ -2,56 +2,16 @@
 //! refuses a folder of other files; `verify --campaign` re-reports; `--check` fails a batch
 //! with exit code 3 and bad checks are usage errors.
 
-use std::path::Path;
 
-use crate::common::{arlpcg, arlpcg_ok, fails_with, stderr};
+use crate::common::{arlpcg, arlpcg_ok, fails_with, files_of, small_campaign, stderr};
 
 const LEVEL: &str = "levels/platform/platform_seed7_aux-1.00.yaml";
-
-fn campaign(out: &Path, extra: &[&str]) -> std::process::Output {
-    let mut args = vec![
-        "campaign",
-        "--game",
-        "platform",
-        "--levels",
-        "3",
-        "--ramp",
-        "0:0.9, 1:0.5",
-        "--judge",
-        "scripted-median",
-        "--trials",
-        "20",
-        "--seed",
-        "40",
-        "--format",
-        "yaml",
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    arlpcg(&args)
-}
-
-fn files_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let e = e.unwrap();
-            (
-                e.file_name().to_string_lossy().into_owned(),
-                std::fs::read(e.path()).unwrap(),
-            )
-        })
-        .collect();
-    files.sort();
-    files
-}
 
 #[test]
 fn a_campaign_follows_its_ramp_and_resumes_to_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("first");
-    let done = campaign(&out, &["--check", "completed"]);
+    let done = small_campaign(&out, &["--check", "completed"]);
     assert!(done.status.success(), "{}", stderr(&done));
     let record: serde_yaml::Value =
         serde_yaml::from_slice(&std::fs::read(out.join("campaign.yaml")).unwrap()).unwrap();
@@ -78,7 +38,7 @@ fn a_campaign_follows_its_ramp_and_resumes_to_the_same_bytes() {
     let first = files_of(&out);
 
     // The same command again finds every file identical.
-    let again = campaign(&out, &["--check", "completed"]);
+    let again = small_campaign(&out, &["--check", "completed"]);
     assert!(String::from_utf8_lossy(&again.stdout).contains("already there and identical"));
 
     // Interrupted after two levels (as a Ctrl-C leaves it): --resume finishes it, the same bytes.
@@ -87,7 +47,7 @@ fn a_campaign_follows_its_ramp_and_resumes_to_the_same_bytes() {
     for name in ["level01.yaml", "level03.yaml"] {
         std::fs::copy(out.join(name), resumed.join(name)).unwrap();
     }
-    let done = campaign(&resumed, &["--check", "completed", "--resume"]);
+    let done = small_campaign(&resumed, &["--check", "completed", "--resume"]);
     assert!(done.status.success(), "{}", stderr(&done));
     assert_eq!(files_of(&resumed), first);
 
@@ -96,13 +56,13 @@ fn a_campaign_follows_its_ramp_and_resumes_to_the_same_bytes() {
     std::fs::create_dir(&other).unwrap();
     std::fs::copy(LEVEL, other.join("level02.yaml")).unwrap();
     fails_with(
-        &campaign(&other, &["--resume"]),
+        &small_campaign(&other, &["--resume"]),
         1,
         "level02.yaml: not a level of this campaign",
     );
     // Without --resume it is not replaced.
     fails_with(
-        &campaign(&other, &[]),
+        &small_campaign(&other, &[]),
         1,
         "level02.yaml already exists with other contents",
     );

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use crate::common::{arlpcg, arlpcg_ok, fails_with, stderr};
+use crate::common::{arlpcg, arlpcg_ok, fails_with, files_of, stderr};
 
 fn generate(dir: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
@@ -17,21 +17,6 @@ fn generate(dir: &Path, extra: &[&str]) -> Output {
     ];
     args.extend_from_slice(extra);
     arlpcg(&args)
-}
-
-fn files_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut files: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let path = e.unwrap().path();
-            (
-                path.file_name().unwrap().to_string_lossy().into_owned(),
-                std::fs::read(&path).unwrap(),
-            )
-        })
-        .collect();
-    files.sort();
-    files
 }
 
 #[test]

@@ -841,23 +841,8 @@ fn no_color_draws_the_same_screen_without_colours() {
 fn the_campaign_view_opens_a_campaign_and_its_levels() {
     let dir = tempfile::tempdir().unwrap();
     let folder = dir.path().join("campaign");
-    crate::common::arlpcg_ok(&[
-        "campaign",
-        "--levels",
-        "3",
-        "--ramp",
-        "0:0.9, 1:0.5",
-        "--judge",
-        "scripted-median",
-        "--trials",
-        "20",
-        "--seed",
-        "40",
-        "--format",
-        "yaml",
-        "--out",
-        folder.to_str().unwrap(),
-    ]);
+    let made = crate::common::small_campaign(&folder, &[]);
+    assert!(made.status.success(), "{}", crate::common::stderr(&made));
     let mut h = Harness::rules(dir.path());
     h.settle();
     h.key(KeyCode::Char('o'));

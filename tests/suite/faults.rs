@@ -2,7 +2,7 @@
 //! level, a policy, a configuration or an output file should be is refused at once (opening it
 //! would block forever), and nothing is overwritten without `--force`.
 
-use crate::common::stderr;
+use crate::common::{files_of, stderr};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -273,21 +273,6 @@ fn arlpcg_with_file_limit(kib: u32, args: &[&str]) -> Option<Output> {
     Some(output)
 }
 
-fn folder(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut files: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let e = e.unwrap();
-            (
-                e.file_name().into_string().unwrap(),
-                std::fs::read(e.path()).unwrap(),
-            )
-        })
-        .collect();
-    files.sort();
-    files
-}
-
 /// A batch whose glTF files do not fit (a full disk) leaves every folder as it was: a new folder
 /// is not made, an old batch replaced with --force stays whole, no temporary file stays behind.
 #[test]
@@ -333,14 +318,14 @@ fn a_batch_that_cannot_be_written_whole_leaves_the_folder_as_it_was() {
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let output = crate::common::arlpcg(&args);
     assert!(output.status.success());
-    let before = folder(&old);
+    let before = files_of(&old);
     assert_eq!(before.len(), 12);
     let args = batch(&old, "-1", &["--force"]);
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let output = arlpcg_with_file_limit(4, &args).unwrap();
     assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
     assert_eq!(
-        folder(&old),
+        files_of(&old),
         before,
         "the old batch, whole, and nothing else"
     );

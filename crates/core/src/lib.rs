@@ -11,6 +11,37 @@
 //! This crate depends on no other crate of the workspace, so the compiler refuses an import
 //! from the layers above.
 
+/// A type written as text (`Display`) and read back by its checking parser
+/// (`fn parse(&str) -> Result<Self, String>`): `FromStr` (clap's value parser) and serde as that
+/// text, so a file holds what a user types and a bad value is refused with the parser's words.
+#[macro_export]
+macro_rules! as_text {
+    ($type:ty) => {
+        impl ::std::str::FromStr for $type {
+            type Err = String;
+
+            fn from_str(s: &str) -> Result<Self, Self::Err> {
+                <$type>::parse(s)
+            }
+        }
+
+        impl ::serde::Serialize for $type {
+            fn serialize<S: ::serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+                serializer.collect_str(self)
+            }
+        }
+
+        impl<'de> ::serde::Deserialize<'de> for $type {
+            fn deserialize<D: ::serde::Deserializer<'de>>(
+                deserializer: D,
+            ) -> Result<Self, D::Error> {
+                let text = <String as ::serde::Deserialize>::deserialize(deserializer)?;
+                <$type>::parse(&text).map_err(::serde::de::Error::custom)
+            }
+        }
+    };
+}
+
 pub mod game;
 pub mod level;
 pub mod rl;

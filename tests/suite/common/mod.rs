@@ -28,6 +28,48 @@ pub fn arlpcg_ok(args: &[&str]) -> Output {
     output
 }
 
+/// Every file of folder `dir` (not below it): name and bytes, sorted by name.
+pub fn files_of(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                std::fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+/// A small platform campaign into `out` (3 levels on the ramp `0:0.9, 1:0.5` for the scripted
+/// median player, 20 runs each, seed 40, YAML only), with `extra` arguments.
+pub fn small_campaign(out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "campaign",
+        "--game",
+        "platform",
+        "--levels",
+        "3",
+        "--ramp",
+        "0:0.9, 1:0.5",
+        "--judge",
+        "scripted-median",
+        "--trials",
+        "20",
+        "--seed",
+        "40",
+        "--format",
+        "yaml",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    arlpcg(&args)
+}
+
 /// The `results.json` an `eval` wrote into `dir`.
 pub fn results_json(dir: &Path) -> serde_json::Value {
     let path = dir.join("results.json");

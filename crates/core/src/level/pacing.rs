@@ -9,8 +9,6 @@
 
 use std::fmt;
 
-use serde::{Deserialize, Deserializer, Serialize, Serializer};
-
 use super::params::{AUX, show_number};
 
 /// Control points of a curve, at most (a designer's curve has a handful).
@@ -183,26 +181,7 @@ impl fmt::Display for AuxCurve {
     }
 }
 
-impl std::str::FromStr for AuxCurve {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::parse(s)
-    }
-}
-
-impl Serialize for AuxCurve {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_str(self)
-    }
-}
-
-impl<'de> Deserialize<'de> for AuxCurve {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let text = String::deserialize(deserializer)?;
-        Self::parse(&text).map_err(serde::de::Error::custom)
-    }
-}
+crate::as_text!(AuxCurve);
 
 /// λ along a built level: the curve it was built with and the λ each piece was built at.
 #[derive(Debug, Clone, PartialEq)]

@@ -378,10 +378,7 @@ mod tests {
     fn only_old_temporary_files_of_ours_count_as_stale() {
         let dir = tempfile::tempdir().unwrap();
         for name in [
-            ".arlpcg-old.tmp",
-            ".arlpcg-new.tmp",
-            "old.tmp",
-            "level.yaml",
+            ".arlpcg-old.tmp", ".arlpcg-new.tmp", "old.tmp", "level.yaml",
         ] {
             std::fs::write(dir.path().join(name), b"x").unwrap();
         }

@@ -239,20 +239,14 @@ fn build_level<G: GeneratorGame>(
     request: &LevelRequest,
 ) -> Result<Level, GenerationError> {
     let (empty, mut rng) = G::new_build(
-        request.seed,
-        request.goal,
-        generator.limits,
-        request.obstacles,
+        request.seed, request.goal, generator.limits, request.obstacles,
     );
     // A kept prefix replaces the seed's scene; the seed still drives the Generator's samples.
     let (empty, kept_aux) = match &request.keep {
         None => (empty, Vec::new()),
         Some(keep) => {
             let build = G::kept_build(
-                &keep.level.track,
-                keep.level.goal,
-                keep.pieces,
-                generator.limits,
+                &keep.level.track, keep.level.goal, keep.pieces, generator.limits,
             )
             .map_err(|problem| GenerationError::Keep { problem })?;
             let aux = (0..keep.pieces)

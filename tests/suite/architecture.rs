@@ -15,13 +15,8 @@ fn root() -> &'static Path {
 
 /// The pure parts, from the repository's root: the core crate and the services that compute.
 const PURE: &[&str] = &[
-    "crates/core/src",
-    "src/services/train",
-    "src/services/eval",
-    "src/services/onnx",
-    "src/services/verify.rs",
-    "src/services/generation.rs",
-    "src/services/difficulty.rs",
+    "crates/core/src", "src/services/train", "src/services/eval", "src/services/onnx",
+    "src/services/verify.rs", "src/services/generation.rs", "src/services/difficulty.rs",
     "src/services/panel.rs",
 ];
 
@@ -83,9 +78,7 @@ const NEVER: &[Never] = &[
         why: "training is driven by the `train` command alone (the card's types live in `rl`; \
               `report` draws a run's curve from its metrics)",
         except: &[
-            "src/services/train",
-            "src/shells/commands/train.rs",
-            "src/shells/commands/report.rs",
+            "src/services/train", "src/shells/commands/train.rs", "src/shells/commands/report.rs",
         ],
     },
     Never {
@@ -281,12 +274,7 @@ fn function_lengths(text: &str) -> Vec<(usize, usize)> {
     let is_fn = |line: &str| {
         let mut rest = line.trim_start();
         for prefix in [
-            "pub(crate) ",
-            "pub(super) ",
-            "pub ",
-            "const ",
-            "async ",
-            "unsafe ",
+            "pub(crate) ", "pub(super) ", "pub ", "const ", "async ", "unsafe ",
         ] {
             rest = rest.strip_prefix(prefix).unwrap_or(rest);
         }

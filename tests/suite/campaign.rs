@@ -2,7 +2,6 @@
 //! refuses a folder of other files; `verify --campaign` re-reports; `--check` fails a batch
 //! with exit code 3 and bad checks are usage errors.
 
-
 use crate::common::{arlpcg, arlpcg_ok, fails_with, files_of, small_campaign, stderr};
 
 const LEVEL: &str = "levels/platform/platform_seed7_aux-1.00.yaml";
@@ -92,12 +91,7 @@ fn a_campaign_follows_its_ramp_and_resumes_to_the_same_bytes() {
 fn checks_fail_a_batch_with_exit_code_3_and_bad_checks_are_usage_errors() {
     let verify = |checks: &[&str]| {
         let mut args = vec![
-            "verify",
-            LEVEL,
-            "--trials",
-            "10",
-            "--solver",
-            "scripted-expert",
+            "verify", LEVEL, "--trials", "10", "--solver", "scripted-expert",
         ];
         for check in checks {
             args.extend_from_slice(&["--check", check]);
@@ -127,20 +121,8 @@ fn checks_fail_a_batch_with_exit_code_3_and_bad_checks_are_usage_errors() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
     let generated = arlpcg(&[
-        "generate",
-        "--rules",
-        "--count",
-        "2",
-        "--verify",
-        "10",
-        "--judge",
-        "scripted-expert",
-        "--format",
-        "yaml",
-        "--check",
-        "success 0..0.05",
-        "--out",
-        out,
+        "generate", "--rules", "--count", "2", "--verify", "10", "--judge", "scripted-expert",
+        "--format", "yaml", "--check", "success 0..0.05", "--out", out,
     ]);
     fails_with(&generated, 3, "2 of 2 levels failed their checks");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);

@@ -108,8 +108,7 @@ fn generate_names_files_by_game_seed_and_aux_and_never_overwrites() {
     assert_eq!(
         names,
         [
-            "platform_seed5_aux-0.50.yaml",
-            "platform_seed6_aux-0.50.yaml"
+            "platform_seed5_aux-0.50.yaml", "platform_seed6_aux-0.50.yaml"
         ]
     );
     let before = files_of(dir.path());
@@ -205,9 +204,7 @@ fn export_writes_glb_and_gltf_with_bin() {
     assert_eq!(
         names,
         [
-            "platform_seed3.bin",
-            "platform_seed3.glb",
-            "platform_seed3.gltf",
+            "platform_seed3.bin", "platform_seed3.glb", "platform_seed3.gltf",
             "platform_seed3.yaml"
         ]
     );
@@ -266,11 +263,7 @@ fn verify_reports_json_with_the_documented_keys() {
     let line = String::from_utf8(out.stdout).unwrap();
     let report: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
     for key in [
-        "level",
-        "trials",
-        "successes",
-        "success_ratio",
-        "mean_progress",
+        "level", "trials", "successes", "success_ratio", "mean_progress",
     ] {
         assert!(report.get(key).is_some(), "missing {key} in {report}");
     }
@@ -433,14 +426,7 @@ fn a_missing_level_file_is_named() {
 #[test]
 fn a_generator_of_the_other_game_is_refused_by_name() {
     let out = arlpcg(&[
-        "generate",
-        "--game",
-        "racing",
-        "--policies",
-        "policies/platform",
-        "--aux",
-        "0",
-        "--out",
+        "generate", "--game", "racing", "--policies", "policies/platform", "--aux", "0", "--out",
         "x",
     ]);
     assert_eq!(out.status.code(), Some(1));
@@ -472,12 +458,7 @@ fn arguments_that_do_not_fit_together_exit_2() {
         (vec!["train", "--steps", "10"], "--out <OUT>"),
         (
             vec![
-                "generate",
-                "--rules",
-                "--seed",
-                "99999999999999999999999",
-                "--out",
-                "x",
+                "generate", "--rules", "--seed", "99999999999999999999999", "--out", "x",
             ],
             "number too large",
         ),
@@ -652,13 +633,7 @@ fn sharded_eval_merges_into_the_unsharded_results() {
     let dir = tempfile::tempdir().unwrap();
     let at = |name: &str| dir.path().join(name).display().to_string();
     let budget = [
-        "--policies",
-        "policies/platform",
-        "--tracks",
-        "2",
-        "--trials",
-        "3",
-        "--validation-tracks",
+        "--policies", "policies/platform", "--tracks", "2", "--trials", "3", "--validation-tracks",
         "4",
     ];
     let run = |extra: &[&str]| {
@@ -686,10 +661,7 @@ fn sharded_eval_merges_into_the_unsharded_results() {
     let out = merge(&["part2", "part0", "part1"], "merged");
     assert!(out.status.success(), "{}", stderr(&out));
     for file in [
-        "results.json",
-        "results.md",
-        "controllability.csv",
-        "cross.csv",
+        "results.json", "results.md", "controllability.csv", "cross.csv",
     ] {
         assert_eq!(
             std::fs::read(dir.path().join("whole").join(file)).unwrap(),
@@ -701,19 +673,8 @@ fn sharded_eval_merges_into_the_unsharded_results() {
     fails_with(&out, 1, "shard 1/3 is missing");
     let other_dir = at("other");
     arlpcg_ok(&[
-        "eval",
-        "--policies",
-        "policies/platform",
-        "--tracks",
-        "2",
-        "--trials",
-        "2",
-        "--validation-tracks",
-        "4",
-        "--shard",
-        "1/3",
-        "--out",
-        &other_dir,
+        "eval", "--policies", "policies/platform", "--tracks", "2", "--trials", "2",
+        "--validation-tracks", "4", "--shard", "1/3", "--out", &other_dir,
     ]);
     let out = merge(&["part0", "other", "part2"], "mixed");
     fails_with(&out, 1, "their budget differ");
@@ -888,23 +849,12 @@ fn target_success_levels_measure_within_the_band() {
     assert!(auxes.iter().sum::<f64>() / 3.0 < 0.25, "{auxes:?}");
     for bad in ["0", "1", "1.5", "nan"] {
         let out = arlpcg(&[
-            "generate",
-            "--policies",
-            "policies/platform",
-            "--target-success",
-            bad,
-            "--out",
-            "x",
+            "generate", "--policies", "policies/platform", "--target-success", bad, "--out", "x",
         ]);
         assert_eq!(out.status.code(), Some(2), "{bad}");
     }
     let out = arlpcg(&[
-        "generate",
-        "--rules",
-        "--target-success",
-        "0.5",
-        "--out",
-        "x",
+        "generate", "--rules", "--target-success", "0.5", "--out", "x",
     ]);
     assert_eq!(
         out.status.code(),
@@ -979,47 +929,28 @@ fn options_that_would_do_nothing_or_count_twice_are_refused_by_name() {
         ),
         (
             vec![
-                "generate",
-                "--rules",
-                "--judge",
-                "scripted-median",
-                "--out",
-                out,
+                "generate", "--rules", "--judge", "scripted-median", "--out", out,
             ],
             2,
             "--judge plays --verify",
         ),
         (
             vec![
-                "verify",
-                "--panel",
-                "scripted-median,scripted-median",
-                level,
+                "verify", "--panel", "scripted-median,scripted-median", level,
             ],
             2,
             "scripted-median is named twice",
         ),
         (
             vec![
-                "verify",
-                "--panel",
-                "--policies",
-                nowhere,
-                "--trials",
-                "1",
-                level,
+                "verify", "--panel", "--policies", nowhere, "--trials", "1", level,
             ],
             1,
             "no such policies folder",
         ),
         (
             vec![
-                "generate",
-                "--policies",
-                "policies/platform",
-                "--target-success",
-                "-0.5",
-                "--out",
+                "generate", "--policies", "policies/platform", "--target-success", "-0.5", "--out",
                 out,
             ],
             2,
@@ -1046,12 +977,7 @@ fn options_that_would_do_nothing_or_count_twice_are_refused_by_name() {
 fn a_huge_refused_argument_is_not_echoed_whole() {
     let curve = vec!["0:0"; 25_000].join(", ");
     let output = arlpcg(&[
-        "generate",
-        "--policies",
-        "policies/platform",
-        "--aux-curve",
-        &curve,
-        "--out",
+        "generate", "--policies", "policies/platform", "--aux-curve", &curve, "--out",
         "never-written",
     ]);
     fails_with(&output, 2, "an aux curve has 1 to 32 points, not 25000");

@@ -381,14 +381,8 @@ fn racing_tracks_are_designed_like_platform_levels() {
     assert_eq!(trials.stats.as_ref().unwrap().trials, app::DEFAULT_TRIALS);
     let screen = h.screen(100, 32);
     for part in [
-        "top-down: ",
-        " segments, ",
-        "elevation: ",
-        "off road ",
-        "flipped ",
-        "air time ",
-        "Solver: scripted-expert",
-        "failures per segment",
+        "top-down: ", " segments, ", "elevation: ", "off road ", "flipped ", "air time ",
+        "Solver: scripted-expert", "failures per segment",
     ] {
         assert!(screen.contains(part), "{part} missing from\n{screen}");
     }
@@ -728,13 +722,8 @@ fn the_judge_key_cycles_through_the_panel() {
     assert_eq!(
         seen,
         [
-            "rule-pcg",
-            "fixed-track",
-            "fixed-aux",
-            "scripted-novice",
-            "scripted-median",
-            "scripted-expert",
-            "arlpcg"
+            "rule-pcg", "fixed-track", "fixed-aux", "scripted-novice", "scripted-median",
+            "scripted-expert", "arlpcg"
         ]
     );
 }
@@ -755,12 +744,7 @@ fn the_whole_panel_plays_the_level_on_screen_and_the_export_records_it() {
     assert_eq!(
         names,
         [
-            "arlpcg",
-            "rule-pcg",
-            "fixed-track",
-            "fixed-aux",
-            "scripted-novice",
-            "scripted-median",
+            "arlpcg", "rule-pcg", "fixed-track", "fixed-aux", "scripted-novice", "scripted-median",
             "scripted-expert"
         ]
     );

@@ -219,13 +219,7 @@ fn messages_name_the_field_and_exit_codes_tell_arguments_from_input() {
         ),
         (
             vec![
-                "generate",
-                "--rules",
-                "--seed",
-                "18446744073709551610",
-                "--count",
-                "10",
-                "--out",
+                "generate", "--rules", "--seed", "18446744073709551610", "--count", "10", "--out",
                 out_s,
             ],
             2,
@@ -341,10 +335,7 @@ fn ctrl_c_stops_the_difficulty_curve_measurement_at_once() {
     std::fs::create_dir(&policies).unwrap();
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
     for name in [
-        "generator.safetensors",
-        "generator.yaml",
-        "solver.safetensors",
-        "solver.yaml",
+        "generator.safetensors", "generator.yaml", "solver.safetensors", "solver.yaml",
     ] {
         std::fs::copy(shipped.join(name), policies.join(name)).unwrap();
     }

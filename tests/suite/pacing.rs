@@ -290,13 +290,7 @@ fn a_prefix_that_cannot_be_kept_is_refused_with_the_reason() {
     ];
     for (args, code, expected) in cases {
         let mut all = vec![
-            "generate",
-            "--policies",
-            policies,
-            "--aux",
-            "1",
-            "--out",
-            out,
+            "generate", "--policies", policies, "--aux", "1", "--out", out,
         ];
         all.extend_from_slice(args);
         if !args.contains(&"--game") {

@@ -89,13 +89,7 @@ fn verify_panel_reports_every_judge_and_rates_the_levels_together() {
     );
 
     let some = arlpcg_ok(&[
-        "verify",
-        levels[0],
-        "--panel",
-        "scripted-median,arlpcg",
-        "--trials",
-        "4",
-        "--json",
+        "verify", levels[0], "--panel", "scripted-median,arlpcg", "--trials", "4", "--json",
     ]);
     let row: serde_json::Value = serde_json::from_slice(&some.stdout).unwrap();
     let names: Vec<&String> = row["panel"].as_object().unwrap().keys().collect();

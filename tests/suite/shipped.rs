@@ -253,10 +253,7 @@ fn the_shipped_policies_were_trained_by_the_recipe() {
     for game in [Game::Platform, Game::Racing] {
         let dir = root.join("policies").join(game.name());
         for file in [
-            "generator.yaml",
-            "solver.yaml",
-            "solver-rule-pcg.yaml",
-            "solver-fixed-track.yaml",
+            "generator.yaml", "solver.yaml", "solver-rule-pcg.yaml", "solver-fixed-track.yaml",
             "solver-fixed-aux.yaml",
         ] {
             let card: arlpcg_core::rl::checkpoint::PolicyCard =

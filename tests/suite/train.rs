@@ -27,17 +27,8 @@ ppo:
 /// The columns the clock writes into a metrics file (two runs of the same bytes differ there):
 /// wall time, steps/s, rollout and update seconds, and the time split.
 const CLOCK_COLUMNS: [&str; 11] = [
-    "wall_time_s",
-    "steps_per_s",
-    "rollout_s",
-    "update_s",
-    "env_s",
-    "forward_s",
-    "generator_s",
-    "gae_s",
-    "copies_s",
-    "iteration_s",
-    "update_mfu",
+    "wall_time_s", "steps_per_s", "rollout_s", "update_s", "env_s", "forward_s", "generator_s",
+    "gae_s", "copies_s", "iteration_s", "update_mfu",
 ];
 
 /// The rows of a metrics file (header included) without the clock's columns; none without
@@ -176,14 +167,7 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
     // The budget is stored with the run: the first command plus --resume (no --steps) stops
     // at it at once.
     arlpcg_ok(&[
-        "train",
-        "--mode",
-        "fixed-track",
-        "--seed",
-        "3",
-        "--out",
-        out_s,
-        "--resume",
+        "train", "--mode", "fixed-track", "--seed", "3", "--out", out_s, "--resume",
     ]);
     assert_eq!(curve(&out), after);
     the_card_records_the_whole_run(&out, target);
@@ -232,14 +216,7 @@ fn a_live_lock_refuses_a_second_session(out: &Path) {
         .unwrap();
     std::thread::sleep(Duration::from_millis(300));
     let busy = arlpcg(&[
-        "train",
-        "--mode",
-        "fixed-track",
-        "--steps",
-        "100000",
-        "--out",
-        out_s,
-        "--resume",
+        "train", "--mode", "fixed-track", "--steps", "100000", "--out", out_s, "--resume",
     ]);
     holder.kill().unwrap();
     holder.wait().unwrap();
@@ -251,13 +228,7 @@ fn a_live_lock_refuses_a_second_session(out: &Path) {
 /// Resuming without --resume, or with another mode or seed, is refused.
 fn wrong_resumes_are_refused(out_s: &str) {
     let refused = arlpcg(&[
-        "train",
-        "--mode",
-        "fixed-track",
-        "--steps",
-        "100",
-        "--out",
-        out_s,
+        "train", "--mode", "fixed-track", "--steps", "100", "--out", out_s,
     ]);
     fails_with(&refused, 1, "add --resume");
     // A resume with another mode or game is refused, naming the run's own.
@@ -269,14 +240,7 @@ fn wrong_resumes_are_refused(out_s: &str) {
     }
     // A resume with another seed is refused by name; the run's own seed may be given again.
     let refused = arlpcg(&[
-        "train",
-        "--mode",
-        "fixed-track",
-        "--seed",
-        "5",
-        "--out",
-        out_s,
-        "--resume",
+        "train", "--mode", "fixed-track", "--seed", "5", "--out", out_s, "--resume",
     ]);
     fails_with(&refused, 1, "seed cannot change");
     files_of_another_run_are_refused(Path::new(out_s));
@@ -360,12 +324,10 @@ fn out_of_range_training_configs_are_refused_before_anything_is_written() {
             "solver.num_minibatches",
         ),
         (
-            "generator:\n  ppo:\n    gamma: 1.5\n",
-            "generator.ppo.gamma",
+            "generator:\n  ppo:\n    gamma: 1.5\n", "generator.ppo.gamma",
         ),
         (
-            "generator:\n  solver_phase_steps: 0\n",
-            "solver_phase_steps",
+            "generator:\n  solver_phase_steps: 0\n", "solver_phase_steps",
         ),
     ];
     let deep = format!("seed: {}1{}\n", "[".repeat(100_000), "]".repeat(100_000));
@@ -415,12 +377,7 @@ fn out_of_range_training_configs_are_refused_before_anything_is_written() {
 fn a_fixed_aux_run_refuses_a_finish_that_waits_for_hard_matches() {
     let dir = tempfile::tempdir().unwrap();
     let recipe = arlpcg(&[
-        "train",
-        "--game",
-        "racing",
-        "--mode",
-        "arlpcg",
-        "--print-config",
+        "train", "--game", "racing", "--mode", "arlpcg", "--print-config",
     ]);
     let config = dir.path().join("racing-arlpcg.yaml");
     std::fs::write(&config, &recipe.stdout).unwrap();
@@ -444,12 +401,7 @@ fn a_fixed_aux_run_refuses_a_finish_that_waits_for_hard_matches() {
     );
     assert!(!run.exists(), "a refused run left {}", run.display());
     let defaults = arlpcg(&[
-        "train",
-        "--game",
-        "racing",
-        "--mode",
-        "fixed-aux",
-        "--print-config",
+        "train", "--game", "racing", "--mode", "fixed-aux", "--print-config",
     ]);
     // What --print-config prints for fixed-aux reads back as fixed-aux's defaults: the
     // racing finish's stop is not filled in from the game's defaults.
@@ -679,16 +631,8 @@ fn a_staged_run_with_a_finish_resumes_to_the_same_bytes_on_any_thread_count() {
         arlpcg_ok(&[&first[..], &["--steps", "640", "--threads", threads]].concat());
         // ...then resumed to a budget of 1024, inside the stage, and the finish after it.
         arlpcg_ok(&[
-            "train",
-            "--mode",
-            "arlpcg",
-            "--steps",
-            "1024",
-            "--out",
-            out_s,
-            "--resume",
-            "--threads",
-            threads,
+            "train", "--mode", "arlpcg", "--steps", "1024", "--out", out_s, "--resume",
+            "--threads", threads,
         ]);
         out
     };
@@ -1123,21 +1067,8 @@ fn generate_and_verify_with_a_run(dir: &Path, run: &str) {
     let levels_s = levels.to_str().unwrap();
     let generate = |goal: &str| {
         arlpcg(&[
-            "generate",
-            "--policies",
-            run,
-            "--aux",
-            "-0.5",
-            "--seed",
-            "3",
-            "--verify",
-            "4",
-            "--goal",
-            goal,
-            "--format",
-            "yaml",
-            "--out",
-            levels_s,
+            "generate", "--policies", run, "--aux", "-0.5", "--seed", "3", "--verify", "4",
+            "--goal", goal, "--format", "yaml", "--out", levels_s,
         ])
     };
     // An untrained Generator may find no way to an arbitrary goal; a goal on the start block's
@@ -1183,27 +1114,14 @@ fn evaluate_a_run(dir: &Path, run: &str) {
     let results = dir.join("results");
     let results_s = results.to_str().unwrap();
     arlpcg_ok(&[
-        "eval",
-        "--policies",
-        run,
-        "--tracks",
-        "2",
-        "--trials",
-        "2",
-        "--validation-tracks",
-        "4",
-        "--out",
-        results_s,
+        "eval", "--policies", run, "--tracks", "2", "--trials", "2", "--validation-tracks", "4",
+        "--out", results_s,
     ]);
     let json: serde_json::Value = crate::common::results_json(&results);
     let rows = json["controllability"].as_array().unwrap();
     assert_eq!(rows.len(), 5);
     for key in [
-        "aux",
-        "success_ratio",
-        "completed_by_any",
-        "avg_block_distance",
-        "avg_block_size",
+        "aux", "success_ratio", "completed_by_any", "avg_block_distance", "avg_block_size",
     ] {
         assert!(rows[0].get(key).is_some(), "controllability.{key}");
     }
@@ -1215,10 +1133,7 @@ fn evaluate_a_run(dir: &Path, run: &str) {
     assert_eq!(
         judges,
         [
-            "arlpcg",
-            "scripted-expert",
-            "scripted-median",
-            "scripted-novice"
+            "arlpcg", "scripted-expert", "scripted-median", "scripted-novice"
         ]
         .into(),
         "the run's Solver and the scripted player's skills"
@@ -1235,11 +1150,7 @@ fn evaluate_a_run(dir: &Path, run: &str) {
     // Half the validation set is rule levels, so the Solver has something to play.
     assert!(generalization[0]["success_ratio"].is_number());
     for name in [
-        "results.md",
-        "results.png",
-        "controllability.csv",
-        "generalization.csv",
-        "cross.csv",
+        "results.md", "results.png", "controllability.csv", "generalization.csv", "cross.csv",
     ] {
         assert!(results.join(name).exists(), "{name}");
     }
@@ -1525,9 +1436,7 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
     assert_eq!(
         loaded.card.continuous_actions,
         [
-            "length",
-            "curve_from_goal_bearing",
-            "height_from_goal_slope"
+            "length", "curve_from_goal_bearing", "height_from_goal_slope"
         ]
     );
     assert_eq!(loaded.card.max_pieces, Some(30));
@@ -1594,10 +1503,7 @@ fn evaluate_a_racing_run(dir: &Path, run: &str) {
     let rows = json["controllability"].as_array().unwrap();
     assert_eq!(rows.len(), 5);
     for key in [
-        "air_time",
-        "avg_segment_curve",
-        "avg_segment_length",
-        "avg_segment_height",
+        "air_time", "avg_segment_curve", "avg_segment_length", "avg_segment_height",
     ] {
         assert!(
             rows[0].get(key).is_some(),
@@ -1656,14 +1562,7 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
     let original = std::fs::read(&checkpoint).unwrap();
     let resume = || {
         arlpcg(&[
-            "train",
-            "--mode",
-            "fixed-track",
-            "--steps",
-            "512",
-            "--out",
-            out_s,
-            "--resume",
+            "train", "--mode", "fixed-track", "--steps", "512", "--out", out_s, "--resume",
         ])
     };
     for (field, value, expected) in cases {
@@ -1730,12 +1629,7 @@ fn the_time_buckets_add_up_to_each_iteration_and_reach_the_cards() {
         "{said}"
     );
     let buckets = [
-        "env_s",
-        "forward_s",
-        "generator_s",
-        "gae_s",
-        "update_s",
-        "copies_s",
+        "env_s", "forward_s", "generator_s", "gae_s", "update_s", "copies_s",
     ];
     let mut run_total = 0.0;
     for file in ["metrics.csv", "generator-metrics.csv"] {

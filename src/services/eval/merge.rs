@@ -222,10 +222,7 @@ pub fn merge(parts: Vec<(PathBuf, Part)>) -> Result<Results> {
         .map(|(i, s)| s.ok_or_else(|| anyhow::anyhow!("play {i} is missing from its shard's part")))
         .collect::<Result<_>>()?;
     Ok(assemble(
-        first.budget,
-        &first.generator.path,
-        &first.layout,
-        &stats,
+        first.budget, &first.generator.path, &first.layout, &stats,
     ))
 }
 

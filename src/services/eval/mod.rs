@@ -87,10 +87,7 @@ pub fn evaluate(
     let all: Vec<usize> = (0..levels.layout.plays().len()).collect();
     let stats = play(&levels, solvers, budget, &all, on_level);
     Ok(assemble(
-        budget,
-        &generator.reference.path,
-        &levels.layout,
-        &stats,
+        budget, &generator.reference.path, &levels.layout, &stats,
     ))
 }
 

@@ -330,9 +330,9 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         self.envs().rules.scripted_opponent = schedule.scripted_opponent;
         match self.envs().state.phase {
             Phase::Solver => {
-                let rollout =
-                    self.solver
-                        .solver_iteration(lr_scale, schedule.solver_learning_rate, wall)?;
+                let rollout = self
+                    .solver
+                    .solver_iteration(lr_scale, schedule.solver_learning_rate, wall)?;
                 let phase_began = steps.saturating_sub(self.envs().state.phase_steps);
                 let catching_up = self.solver.config.in_finish(phase_began);
                 // A Solver phase under way when the finish begins ends with the finish's first

@@ -56,11 +56,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         return write_shard(args, shard, &pool, &generator, &named, budget, overwrite);
     }
     let names = [
-        "results.md",
-        "results.json",
-        "results.png",
-        "controllability.csv",
-        "generalization.csv",
+        "results.md", "results.json", "results.png", "controllability.csv", "generalization.csv",
         "cross.csv",
     ];
     if overwrite == Overwrite::Never {

@@ -19,11 +19,7 @@ const MAX_FILE_BYTES: u64 = 64 * 1024 * 1024;
 
 /// The shipped policies a game's table lists, in its order.
 const POLICIES: [&str; 5] = [
-    "generator",
-    "solver",
-    "solver-rule-pcg",
-    "solver-fixed-track",
-    "solver-fixed-aux",
+    "generator", "solver", "solver-rule-pcg", "solver-fixed-track", "solver-fixed-aux",
 ];
 
 pub fn run(args: &ReportArgs) -> Result<()> {

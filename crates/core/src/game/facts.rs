@@ -74,11 +74,8 @@ pub const PLATFORM: GameFacts = GameFacts {
     goal_height: super::platform::rules::GOAL_HEIGHT,
     goal_distance_step: 5.0,
     paper_controllability: [
-        "0.97, 6.73 m, 5.95 m",
-        "0.92, 6.98 m, 5.77 m",
-        "0.88, 7.15 m, 5.42 m",
-        "0.74, 7.11 m, 4.52 m",
-        "0.69, 7.46 m, 4.01 m",
+        "0.97, 6.73 m, 5.95 m", "0.92, 6.98 m, 5.77 m", "0.88, 7.15 m, 5.42 m",
+        "0.74, 7.11 m, 4.52 m", "0.69, 7.46 m, 4.01 m",
     ],
     controllability_header: "| λ | success ratio | completed by any | avg block distance | avg block size | levels | paper: success, distance, size |\n|---|---|---|---|---|---|---|\n",
     paper_generalization: [
@@ -114,11 +111,8 @@ pub const RACING: GameFacts = GameFacts {
     goal_height: super::racing::rules::GOAL_HEIGHT,
     goal_distance_step: 20.0,
     paper_controllability: [
-        "0.99, 14.4°, 28.4 m, 1.5 m",
-        "0.89, 14.7°, 27.1 m, 2.0 m",
-        "0.77, 15.1°, 25.1 m, 2.5 m",
-        "0.64, 15.3°, 23.0 m, 3.1 m",
-        "0.61, 16.8°, 21.8 m, 3.9 m",
+        "0.99, 14.4°, 28.4 m, 1.5 m", "0.89, 14.7°, 27.1 m, 2.0 m", "0.77, 15.1°, 25.1 m, 2.5 m",
+        "0.64, 15.3°, 23.0 m, 3.1 m", "0.61, 16.8°, 21.8 m, 3.9 m",
     ],
     controllability_header: "| λ | success ratio | completed by any | air time per run | avg segment curve | avg segment length | avg segment height change | tracks | paper: success, angle, length, height |\n|---|---|---|---|---|---|---|---|---|\n",
     paper_generalization: [

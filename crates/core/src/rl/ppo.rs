@@ -298,10 +298,7 @@ impl Ppo {
                 self.adam
                     .apply(&mut params, &workspace.gradients, learning_rate, scale);
                 for (sum, value) in sums.iter_mut().zip([
-                    terms.policy_loss,
-                    terms.value_loss,
-                    terms.entropy,
-                    terms.approx_kl,
+                    terms.policy_loss, terms.value_loss, terms.entropy, terms.approx_kl,
                     terms.clip_fraction,
                 ]) {
                     *sum += value;

@@ -131,11 +131,7 @@ impl<E: VecEnv> Trainer<E> {
         let last_values = self.ppo.policy.values(&self.normalized())?;
         time.forward_s += watch.lap();
         let (advantages, returns) = gae(
-            &rewards,
-            &batch.values,
-            &ended,
-            &last_values,
-            self.ppo.config.gamma,
+            &rewards, &batch.values, &ended, &last_values, self.ppo.config.gamma,
             self.ppo.config.gae_lambda,
         );
         batch.advantages = advantages;

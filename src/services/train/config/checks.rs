@@ -93,8 +93,7 @@ fn check_schedule(g: &GeneratorConfig) -> Result<(), String> {
         }
         for (name, ratio) in [
             (
-                "generator_until_hard_success",
-                g.finish.generator_until_hard_success,
+                "generator_until_hard_success", g.finish.generator_until_hard_success,
             ),
             ("until_hard_success", g.finish.until_hard_success),
         ] {
@@ -188,11 +187,7 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
     let r = &g.rewards;
     let weights = r.aux.iter().flat_map(|w| [w.alpha, w.beta]);
     if ![
-        r.progress_per_metre,
-        r.failure,
-        r.step_penalty,
-        r.air_step,
-        r.invalid,
+        r.progress_per_metre, r.failure, r.step_penalty, r.air_step, r.invalid,
         r.piece_failure_weight,
     ]
     .into_iter()

@@ -45,9 +45,7 @@ fn the_platform_finish_follows_the_budget_and_stages_apply_from_their_step() {
     let finish = learning.schedule_at(learning.steps);
     assert_eq!(
         (
-            finish.solver_learning_rate,
-            finish.solver_phase_steps,
-            finish.generator_phase_steps
+            finish.solver_learning_rate, finish.solver_phase_steps, finish.generator_phase_steps
         ),
         (Some(1.0e-4), 16, 9)
     );
@@ -59,9 +57,7 @@ fn the_platform_finish_follows_the_budget_and_stages_apply_from_their_step() {
     let last = staged.schedule_at(100);
     assert_eq!(
         (
-            last.solver_learning_rate,
-            last.solver_phase_steps,
-            last.generator_phase_steps
+            last.solver_learning_rate, last.solver_phase_steps, last.generator_phase_steps
         ),
         (Some(0.0), 8, 9)
     );

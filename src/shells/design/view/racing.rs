@@ -181,11 +181,7 @@ pub(super) fn profile(app: &App, level: &Level, road: &Road, frame: &mut Frame, 
             for w in samples.windows(2) {
                 let colour = colours.get(w[1].segment).copied().unwrap_or(Color::White);
                 ctx.draw(&CanvasLine::new(
-                    w[0].s,
-                    w[0].centre[1],
-                    w[1].s,
-                    w[1].centre[1],
-                    colour,
+                    w[0].s, w[0].centre[1], w[1].s, w[1].centre[1], colour,
                 ));
             }
             draw_replay(app, ctx, |f| {

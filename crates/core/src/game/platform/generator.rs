@@ -62,10 +62,7 @@ pub const GENERATOR_OBSERVATION_SIZE: usize = {
 /// themselves or ran out of blocks and none reached its goal in a million Solver steps, so the
 /// Solver never saw a success.
 pub const GENERATOR_ACTIONS: [&str; 4] = [
-    "distance",
-    "turn_from_goal_bearing",
-    "size",
-    "height_from_goal_slope",
+    "distance", "turn_from_goal_bearing", "size", "height_from_goal_slope",
 ];
 
 /// The block budget of a Generator's track by default: a track that has not reached its goal

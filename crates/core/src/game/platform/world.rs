@@ -35,9 +35,7 @@ impl PlatformBox {
     fn from_platform(p: &Platform) -> Self {
         Self {
             top: Vector::new(
-                p.position[0] as f32,
-                p.position[1] as f32,
-                p.position[2] as f32,
+                p.position[0] as f32, p.position[1] as f32, p.position[2] as f32,
             ),
             heading: p.heading.to_radians() as f32,
             size: p.size as f32,

@@ -340,9 +340,7 @@ impl RacingEnv {
         let level = Rotation::from_rotation_y(yaw);
         let into_level = level.inverse();
         let goal = Vector::new(
-            self.goal[0] as f32,
-            self.goal[1] as f32,
-            self.goal[2] as f32,
+            self.goal[0] as f32, self.goal[1] as f32, self.goal[2] as f32,
         );
         let to_goal = into_level * (goal - position);
         let bearing = (-to_goal.z).atan2(to_goal.x);

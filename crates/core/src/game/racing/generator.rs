@@ -71,9 +71,7 @@ pub const GENERATOR_OBSERVATION_MEANINGS: [&str; 9] = [
 /// §1.2 defines them. As with the platform Generator, this lets an untrained Generator reach its
 /// goal.
 pub const GENERATOR_ACTIONS: [&str; 3] = [
-    "length",
-    "curve_from_goal_bearing",
-    "height_from_goal_slope",
+    "length", "curve_from_goal_bearing", "height_from_goal_slope",
 ];
 
 /// A policy's action row (unbounded Gaussian samples) as the next segment of `road` toward

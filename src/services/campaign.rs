@@ -454,6 +454,17 @@ impl Campaign {
     }
 }
 
+/// A campaign's record alone (`campaign.yaml`), read and checked.
+pub fn read_record(file: &std::path::Path) -> anyhow::Result<Campaign> {
+    let bytes = crate::services::fsio::read_limited(file, 1 << 22, "campaign file")?;
+    let campaign: Campaign =
+        serde_yaml::from_slice(&bytes).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    campaign
+        .check()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    Ok(campaign)
+}
+
 /// A campaign read back: its folder, its record (checked), and its levels in order, each of
 /// the campaign's game. `path` is the folder or its campaign.yaml.
 pub fn open(path: &std::path::Path) -> anyhow::Result<(std::path::PathBuf, Campaign, Vec<Level>)> {
@@ -466,12 +477,7 @@ pub fn open(path: &std::path::Path) -> anyhow::Result<(std::path::PathBuf, Campa
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(std::path::Path::new("."))
         .to_path_buf();
-    let bytes = crate::services::fsio::read_limited(&file, 1 << 22, "campaign file")?;
-    let campaign: Campaign =
-        serde_yaml::from_slice(&bytes).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
-    campaign
-        .check()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    let campaign = read_record(&file)?;
     let mut levels = Vec::with_capacity(campaign.levels.len());
     for entry in &campaign.levels {
         let level_path = folder.join(&entry.file);

@@ -4,7 +4,6 @@
 mod common;
 
 mod architecture;
-mod campaign;
 mod cli;
 mod designer;
 mod determinism;

@@ -92,12 +92,20 @@ fn read_game(game: Game, results: &Path, policies: &Path) -> Result<GamePage> {
             Ok((format!("{name}.safetensors"), card))
         })
         .collect::<Result<Vec<_>>>()?;
+    let campaign_file = dir
+        .join("campaign")
+        .join(crate::services::campaign::CAMPAIGN_FILE);
+    let campaign = match campaign_file.is_file() {
+        true => Some(crate::services::campaign::read_record(&campaign_file)?),
+        false => None,
+    };
     Ok(GamePage {
         game,
         cards,
         results,
         seeds,
         more_seeds,
+        campaign,
     })
 }
 

@@ -12,8 +12,15 @@ use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
-use crate::services::chart::{LineChart, Series};
+use std::path::{Path, PathBuf};
+
+use crate::services::chart::{LineChart, Series, stacked_png};
 use crate::services::checks::Check;
+use crate::services::difficulty;
+use crate::services::generation::GeneratorPolicy;
+use crate::services::level_files::{Format, LevelFiles, render};
+use crate::services::panel::{JudgePanel, play_and_rate};
+use crate::services::verify::{self, Solver, Watch};
 use arlpcg_core::level::pacing::{CurveWords, parse_points, show_points, value_at};
 use arlpcg_core::level::{Game, Level};
 use arlpcg_core::statistics::population::{LevelFlow, Population};
@@ -266,6 +273,24 @@ impl CampaignAsk {
 }
 
 impl Campaign {
+    /// What the campaign was asked for, as its record says (to play or extend it again).
+    pub fn ask(&self) -> CampaignAsk {
+        CampaignAsk {
+            game: self.game,
+            seed: self.seed,
+            judge: self.judge.clone(),
+            trials: self.trials,
+            ramp: self.ramp.clone(),
+            checks: self.checks.clone(),
+            population: match self.population_from.as_str() {
+                "given" => PopulationAsk::Given(self.population),
+                _ => PopulationAsk::ScriptedJudges {
+                    retry: self.population.retry,
+                },
+            },
+        }
+    }
+
     /// Checks a campaign read back from a file; `Err` names the field.
     pub fn check(&self) -> Result<(), String> {
         if self.format != FORMAT {
@@ -287,7 +312,7 @@ impl Campaign {
             return Err("levels: none; a campaign has at least one level".into());
         }
         for (k, level) in self.levels.iter().enumerate() {
-            let plain = std::path::Path::new(&level.file)
+            let plain = Path::new(&level.file)
                 .file_name()
                 .is_some_and(|name| name == level.file.as_str());
             if !plain || !level.file.ends_with(".yaml") {
@@ -454,8 +479,78 @@ impl Campaign {
     }
 }
 
+/// Level `seed`'s search: a level whose success for `solver`, over `trials` runs, is within
+/// [`difficulty::BAND`] of `target` ([`difficulty::level_for`]), with its certificate.
+pub fn search_level(
+    generator: &GeneratorPolicy,
+    solver: &Solver,
+    curve: &difficulty::Curve,
+    seed: u64,
+    target: f64,
+    trials: u32,
+) -> anyhow::Result<Level> {
+    let level = difficulty::level_for(generator, solver, curve, seed, None, target, trials)?;
+    Ok(verify::certified(level, solver, seed)?)
+}
+
+/// The panel plays `levels` (each verified by the judge), rates them together and, with
+/// `reorder`, puts them in order of b where the ramp allows ([`order_by_difficulty`]); then the
+/// record, the levels named `levelNN.yaml` in their order. `Ok(None)` when `watch.stop` cut the
+/// panel short (the levels are then as they came).
+pub fn rate(
+    ask: &CampaignAsk,
+    panel: &JudgePanel,
+    levels: &mut Vec<Level>,
+    watch: &Watch,
+    reorder: bool,
+) -> anyhow::Result<Option<Campaign>> {
+    let n = levels.len();
+    let searched = levels.clone();
+    let thetas = play_and_rate(panel, levels, ask.trials, watch);
+    if levels.len() < n {
+        *levels = searched;
+        return Ok(None);
+    }
+    if reorder {
+        let targets: Vec<f64> = (0..n).map(|k| ask.target(k, n)).collect();
+        order_by_difficulty(levels, &targets, difficulty::BAND);
+    }
+    let named: Vec<(String, &Level)> = levels
+        .iter()
+        .enumerate()
+        .map(|(k, l)| (format!("{}.yaml", level_stem(k, n)), l))
+        .collect();
+    ask.record(&named, &thetas)
+        .map(Some)
+        .map_err(anyhow::Error::msg)
+}
+
+/// The files of a campaign in folder `dir`: each level's (`levelNN` in `formats`, a .gltf after
+/// the .bin it names), then campaign.yaml, campaign.md and campaign.png.
+pub fn campaign_files(
+    dir: &Path,
+    campaign: &Campaign,
+    levels: &[Level],
+    formats: &[Format],
+) -> anyhow::Result<Vec<(PathBuf, Vec<u8>)>> {
+    let n = levels.len();
+    let mut files: Vec<(PathBuf, Vec<u8>)> = levels
+        .iter()
+        .enumerate()
+        .flat_map(|(k, level)| {
+            let names = LevelFiles::new(dir, &level_stem(k, n), formats);
+            render(level, &names).into_iter().rev()
+        })
+        .collect();
+    let record = serde_yaml::to_string(campaign)?;
+    files.push((dir.join(CAMPAIGN_FILE), record.into_bytes()));
+    files.push((dir.join("campaign.md"), campaign.to_markdown().into_bytes()));
+    files.push((dir.join("campaign.png"), stacked_png(&campaign.charts())));
+    Ok(files)
+}
+
 /// A campaign's record alone (`campaign.yaml`), read and checked.
-pub fn read_record(file: &std::path::Path) -> anyhow::Result<Campaign> {
+pub fn read_record(file: &Path) -> anyhow::Result<Campaign> {
     let bytes = crate::services::fsio::read_limited(file, 1 << 22, "campaign file")?;
     let campaign: Campaign =
         serde_yaml::from_slice(&bytes).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
@@ -467,7 +562,7 @@ pub fn read_record(file: &std::path::Path) -> anyhow::Result<Campaign> {
 
 /// A campaign read back: its folder, its record (checked), and its levels in order, each of
 /// the campaign's game. `path` is the folder or its campaign.yaml.
-pub fn open(path: &std::path::Path) -> anyhow::Result<(std::path::PathBuf, Campaign, Vec<Level>)> {
+pub fn open(path: &Path) -> anyhow::Result<(PathBuf, Campaign, Vec<Level>)> {
     let file = match path.is_dir() {
         true => path.join(CAMPAIGN_FILE),
         false => path.to_path_buf(),
@@ -475,7 +570,7 @@ pub fn open(path: &std::path::Path) -> anyhow::Result<(std::path::PathBuf, Campa
     let folder = file
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."))
+        .unwrap_or(Path::new("."))
         .to_path_buf();
     let campaign = read_record(&file)?;
     let mut levels = Vec::with_capacity(campaign.levels.len());

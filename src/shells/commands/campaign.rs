@@ -10,15 +10,14 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 
 use crate::services::campaign::{
-    CAMPAIGN_FILE, Campaign, CampaignAsk, PopulationAsk, level_stem, order_by_difficulty,
+    Campaign, CampaignAsk, PopulationAsk, campaign_files, level_stem, rate, search_level,
 };
-use crate::services::chart::stacked_png;
 use crate::services::checks::{Check, evidence, failures};
 use crate::services::difficulty;
 use crate::services::fsio;
 use crate::services::generation::GeneratorPolicy;
 use crate::services::level_files::{Format, LevelFiles, render};
-use crate::services::panel::{Judge, play_and_rate};
+use crate::services::panel::Judge;
 use crate::services::policies::{
     difficulty_curve, load_generator, load_judge, load_panel, policy_paths, shipped_dir,
 };
@@ -100,21 +99,17 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         return interrupted(args, &built, &files);
     }
     let mut levels: Vec<Level> = built.into_iter().flatten().collect();
-    let searched = levels.clone();
-    let thetas = play_panel(&panel, &mut levels, args.trials, &stop);
-    if levels.len() < n {
-        let searched: Vec<Option<Level>> = searched.into_iter().map(Some).collect();
+    let Some(campaign) = rate_levels(&ask, &panel, &mut levels, &stop, true)? else {
+        let searched: Vec<Option<Level>> = levels.into_iter().map(Some).collect();
         return interrupted(args, &searched, &files);
-    }
-    let targets: Vec<f64> = (0..n).map(|k| ask.target(k, n)).collect();
-    order_by_difficulty(&mut levels, &targets, difficulty::BAND);
-    let named: Vec<(String, &Level)> = levels
+    };
+    write_campaign(args, &campaign, &levels)?;
+    let named: Vec<(String, &Level)> = campaign
+        .levels
         .iter()
-        .enumerate()
-        .map(|(k, l)| (format!("{}.yaml", level_stem(k, n)), l))
+        .zip(&levels)
+        .map(|(entry, level)| (entry.file.clone(), level))
         .collect();
-    let campaign = ask.record(&named, &thetas).map_err(anyhow::Error::msg)?;
-    write_campaign(args, &campaign, &levels, &files)?;
     report(&campaign);
     apply_checks(&campaign.checks, &named)
 }
@@ -145,17 +140,14 @@ fn search_levels(
                 return Ok(None);
             }
             let seed = level_seed(args.seed, k)?;
-            let level = difficulty::level_for(
+            let level = search_level(
                 generator,
                 solver,
                 curve,
                 seed,
-                None,
                 ask.target(k, n),
                 args.trials,
             )
-            .map_err(anyhow::Error::from)
-            .and_then(|level| Ok(verify::certified(level, solver, seed)?))
             .with_context(|| {
                 format!(
                     "level {} of {n} (seed {seed}, success {:.2} asked); nothing was written",
@@ -172,29 +164,10 @@ fn search_levels(
 }
 
 /// Writes the levels, campaign.yaml, campaign.md and campaign.png, all or none, and says so.
-fn write_campaign(
-    args: &CampaignArgs,
-    campaign: &Campaign,
-    levels: &[Level],
-    files: &[LevelFiles],
-) -> Result<()> {
+fn write_campaign(args: &CampaignArgs, campaign: &Campaign, levels: &[Level]) -> Result<()> {
     let n = levels.len();
-    let record = serde_yaml::to_string(&campaign).context("the campaign record")?;
-    let level_files = levels
-        .iter()
-        .zip(files)
-        .flat_map(|(level, files)| render(level, files).into_iter().rev());
-    let reports = [
-        (args.out.join(CAMPAIGN_FILE), record.into_bytes()),
-        (
-            args.out.join("campaign.md"),
-            campaign.to_markdown().into_bytes(),
-        ),
-        (
-            args.out.join("campaign.png"),
-            stacked_png(&campaign.charts()),
-        ),
-    ];
+    let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
+    let files = campaign_files(&args.out, campaign, levels, &formats)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     // A resumed campaign's own files (its levels, verified without the panel, and its
@@ -202,7 +175,7 @@ fn write_campaign(
     let ours = |path: &Path| args.resume && is_campaign_file(path, n);
     let (written, kept) = fsio::write_batch(
         &args.out,
-        level_files.chain(reports),
+        files,
         &ours,
         "choose another --out, or remove it",
         || {
@@ -333,22 +306,24 @@ fn interrupted(args: &CampaignArgs, built: &[Option<Level>], files: &[LevelFiles
     .into())
 }
 
-/// The panel plays every level; the levels are rated together. Returns the judges' θ.
-fn play_panel(
+/// The panel plays every level (a progress bar), the levels are rated together and recorded;
+/// `None` after a Ctrl-C.
+fn rate_levels(
+    ask: &CampaignAsk,
     panel: &crate::services::panel::JudgePanel,
     levels: &mut Vec<Level>,
-    trials: u32,
     stop: &AtomicBool,
-) -> Vec<(String, f64)> {
-    let runs = (levels.len() * panel.judges.len()) as u64 * trials as u64;
+    reorder: bool,
+) -> Result<Option<Campaign>> {
+    let runs = (levels.len() * panel.judges.len()) as u64 * ask.trials as u64;
     let bar = progress_bar(runs, "panel runs");
     let watch = Watch {
         on_trial: &|_| bar.inc(1),
         stop: &|| stop.load(Ordering::SeqCst),
     };
-    let thetas = play_and_rate(panel, levels, trials, &watch);
+    let campaign = rate(ask, panel, levels, &watch, reorder);
     bar.finish_and_clear();
-    thetas
+    campaign
 }
 
 /// One line per level, then the funnel's end.
@@ -438,34 +413,17 @@ pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
             &|| {},
         )?);
     }
-    let stop = AtomicBool::new(false);
-    let thetas = play_panel(&panel, &mut levels, campaign.trials, &stop);
-    let ask = CampaignAsk {
-        game: campaign.game,
-        seed: campaign.seed,
-        judge: campaign.judge.clone(),
-        trials: campaign.trials,
-        ramp: campaign.ramp.clone(),
-        checks: campaign
-            .checks
-            .iter()
-            .chain(&args.checks)
-            .copied()
-            .collect(),
-        population: match campaign.population_from.as_str() {
-            "given" => PopulationAsk::Given(campaign.population),
-            _ => PopulationAsk::ScriptedJudges {
-                retry: campaign.population.retry,
-            },
-        },
-    };
+    let mut ask = campaign.ask();
+    ask.checks.extend(args.checks.iter().copied());
+    let replayed = rate_levels(&ask, &panel, &mut levels, &AtomicBool::new(false), false)?
+        .expect("a panel without a stop condition plays to the end");
+    // The levels keep the files the campaign gives them.
     let named: Vec<(String, &Level)> = campaign
         .levels
         .iter()
         .zip(&levels)
         .map(|(entry, level)| (entry.file.clone(), level))
         .collect();
-    let replayed = ask.record(&named, &thetas).map_err(anyhow::Error::msg)?;
     crate::say!("{}", replayed.to_markdown());
     apply_checks(&replayed.checks, &named)
 }

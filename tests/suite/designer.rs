@@ -820,14 +820,15 @@ fn no_color_draws_the_same_screen_without_colours() {
 }
 
 /// `o`: a campaign folder opens on its view (one column per level under the ramp's bars, the
-/// funnel's end); `→` and `Enter` open level 2 on the screen, with its trials; `o` comes back.
+/// funnel's end); `→` and `Enter` open level 2 on the screen, with its trials; `o` comes back,
+/// and `R` searches level 2 anew and rewrites the campaign.
 #[test]
 fn the_campaign_view_opens_a_campaign_and_its_levels() {
     let dir = tempfile::tempdir().unwrap();
     let folder = dir.path().join("campaign");
     let made = crate::common::small_campaign(&folder, &[]);
     assert!(made.status.success(), "{}", crate::common::stderr(&made));
-    let mut h = Harness::rules(dir.path());
+    let mut h = Harness::shipped(dir.path());
     h.settle();
     h.key(KeyCode::Char('o'));
     h.keys(folder.to_str().unwrap());
@@ -845,6 +846,27 @@ fn the_campaign_view_opens_a_campaign_and_its_levels() {
     assert!(h.app.trials.as_ref().unwrap().stats.is_some());
     h.key(KeyCode::Char('o'));
     assert_eq!(h.app.overlay, Overlay::Campaign);
+    // R: level 2 searched anew from an unused seed, the campaign rated again and rewritten.
+    h.key(KeyCode::Char('R'));
+    h.settle();
+    let (status, problem) = h.app.status.clone().unwrap();
+    assert!(
+        !problem && status.starts_with("level 2 searched anew"),
+        "{status}"
+    );
+    let record: serde_yaml::Value =
+        serde_yaml::from_slice(&std::fs::read(folder.join("campaign.yaml")).unwrap()).unwrap();
+    let level = &record["levels"][1];
+    assert_eq!(level["seed"].as_u64(), Some(43));
+    let (asked, measured) = (
+        level["asked"].as_f64().unwrap(),
+        level["measured"].as_f64().unwrap(),
+    );
+    assert!((asked - measured).abs() <= 0.1 + 1e-9, "{asked} {measured}");
+    assert_ne!(
+        yaml::load(&folder.join("level02.yaml")).unwrap().track,
+        expected.track
+    );
     h.key(KeyCode::Esc);
     assert_eq!(h.app.overlay, Overlay::None);
     // A folder without a campaign is a message.

@@ -2,7 +2,10 @@
 //! campaign` wrote, as one column per level (the success asked and measured, the panel's b,
 //! the share of players who reach it and who quit on it) under the ramp drawn as bars, and
 //! the funnel's end. `← →` select a level, `Enter` opens it on the designer's screen (its
-//! Solver trials run as for any level), `o` types another folder, `Esc` closes the view.
+//! Solver trials run as for any level), `R` searches the selected level anew (from a seed the
+//! campaign has not used, with the designer's Generator, to its ramp point for the campaign's
+//! judge), the panel rates the campaign again and its files are rewritten; `o` types another
+//! folder, `Esc` closes the view.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -24,6 +27,8 @@ pub struct OpenedCampaign {
     pub folder: PathBuf,
     pub record: Campaign,
     pub levels: Vec<Arc<Level>>,
+    /// The level just searched anew (`R`), if that is why it was read.
+    pub regenerated: Option<usize>,
 }
 
 /// The campaign on view, and the level selected in it.
@@ -65,15 +70,30 @@ impl App {
     pub(super) fn campaign_opened(&mut self, result: Result<Box<OpenedCampaign>, String>) {
         match result {
             Ok(opened) => {
-                self.say(format!(
-                    "campaign: {} {} levels from {}",
-                    opened.levels.len(),
-                    opened.record.game,
-                    opened.folder.display()
-                ));
+                let selected = match opened.regenerated {
+                    Some(k) => {
+                        let entry = &opened.record.levels[k];
+                        self.say(format!(
+                            "level {} searched anew: {:.2} measured for {:.2} asked; the panel rated the campaign again and its files were rewritten",
+                            k + 1,
+                            entry.measured,
+                            entry.asked
+                        ));
+                        k
+                    }
+                    None => {
+                        self.say(format!(
+                            "campaign: {} {} levels from {}",
+                            opened.levels.len(),
+                            opened.record.game,
+                            opened.folder.display()
+                        ));
+                        0
+                    }
+                };
                 self.campaign = Some(CampaignView {
                     opened: *opened,
-                    selected: 0,
+                    selected,
                 });
                 self.overlay = Overlay::Campaign;
             }
@@ -94,6 +114,23 @@ impl App {
             KeyCode::Home => view.selected = 0,
             KeyCode::End => view.selected = count.saturating_sub(1),
             KeyCode::Enter => return self.open_selected_level(),
+            KeyCode::Char('R') => {
+                let (folder, level) = (view.opened.folder.clone(), view.selected);
+                let game = view.opened.record.game;
+                if game != self.game {
+                    self.complain(format!("a {game} campaign: Tab to {game} first"));
+                    return Vec::new();
+                }
+                self.say(format!(
+                    "searching level {} anew, then the panel rates the campaign again…",
+                    level + 1
+                ));
+                return vec![Effect::RegenerateCampaignLevel {
+                    folder,
+                    level,
+                    policies: self.policies.folder(game),
+                }];
+            }
             KeyCode::Char('o') => {
                 self.overlay = Overlay::Prompt {
                     kind: PromptKind::Campaign,
@@ -150,7 +187,7 @@ pub(crate) fn draw(app: &App, frame: &mut Frame, screen: Rect) {
     let record = &view.opened.record;
     frame.render_widget(Clear, screen);
     let block = Block::bordered().title(format!(
-        " campaign: {} {} levels, ramp {} for {} (← → select, ⏎ open, o folder, Esc close) ",
+        " campaign: {} {} levels, ramp {} for {} (← → select, ⏎ open, R search anew, o folder, Esc close) ",
         record.levels.len(),
         record.game,
         record.ramp,

@@ -125,6 +125,13 @@ pub enum Effect {
     },
     /// Read the campaign in `folder` (its campaign.yaml and levels).
     OpenCampaign { folder: PathBuf },
+    /// Search level `level` of the campaign in `folder` anew (the Generator on the shelf, the
+    /// judge and the panel from `policies`), rate the campaign again and rewrite its files.
+    RegenerateCampaignLevel {
+        folder: PathBuf,
+        level: usize,
+        policies: PathBuf,
+    },
     /// Every judge whose Solver is in `folder`, and the scripted skills, play `level`.
     Panel {
         id: u64,

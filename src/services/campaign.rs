@@ -9,10 +9,9 @@
 //! (`0:0.95, 1:0.5`).
 
 use std::fmt;
+use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
-
-use std::path::{Path, PathBuf};
 
 use crate::services::chart::{LineChart, Series, stacked_png};
 use crate::services::checks::Check;

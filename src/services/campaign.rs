@@ -377,16 +377,7 @@ impl Campaign {
             .map(|j| format!("{} {:+.2}", j.judge, j.theta))
             .collect();
         page += &format!("\nJudges' ability θ (logits): {}.\n", thetas.join(", "));
-        page += &match self.steps_down()[..] {
-            [] => "\nb rises from level to level, within its intervals.\n".to_string(),
-            ref down => format!(
-                "\nb steps down beyond its intervals at level {}.\n",
-                down.iter()
-                    .map(|k| k.to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        };
+        page += &format!("\n{}.\n", self.b_trend());
         if !self.checks.is_empty() {
             let checks: Vec<String> = self.checks.iter().map(|c| format!("`{c}`")).collect();
             page += &format!("\nChecks every level must pass: {}.\n", checks.join(", "));
@@ -466,6 +457,21 @@ pub fn order_by_difficulty(levels: &mut [Level], targets: &[f64], band: f64) {
 }
 
 impl Campaign {
+    /// Whether b rises along the campaign, in words: `b rises level to level within its
+    /// intervals`, or where it steps down.
+    pub fn b_trend(&self) -> String {
+        match self.steps_down()[..] {
+            [] => "b rises level to level within its intervals".into(),
+            ref down => format!(
+                "b steps down beyond its intervals at level {}",
+                down.iter()
+                    .map(|k| k.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        }
+    }
+
     /// The levels (numbered from 1) whose b falls below the one before it beyond both
     /// intervals: where the campaign steps down for the panel.
     pub fn steps_down(&self) -> Vec<usize> {

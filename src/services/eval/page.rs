@@ -88,16 +88,7 @@ fn campaign_line(c: &Campaign) -> String {
         .iter()
         .map(|l| (l.measured - l.asked).abs())
         .fold(0.0, f64::max);
-    let b = match c.steps_down()[..] {
-        [] => "b rises level to level within its intervals".to_string(),
-        ref down => format!(
-            "b steps down beyond its intervals at level {}",
-            down.iter()
-                .map(|k| k.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-    };
+    let b = c.b_trend();
     format!(
         "arlpcg campaign --game {} --levels {} --ramp \"{}\" --judge {} --trials {} --seed {} --out results/{}/campaign  # each level within {miss:.2} of its point; {b}; {:.1}% of players finish\n",
         c.game,

@@ -10,7 +10,8 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 
 use crate::services::campaign::{
-    Campaign, CampaignAsk, PopulationAsk, campaign_files, level_stem, rate, search_level,
+    Campaign, CampaignAsk, CampaignLevel, PopulationAsk, campaign_files, level_stem, rate,
+    search_level,
 };
 use crate::services::checks::{Check, evidence, failures};
 use crate::services::difficulty;
@@ -104,14 +105,8 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         return interrupted(args, &searched, &files);
     };
     write_campaign(args, &campaign, &levels)?;
-    let named: Vec<(String, &Level)> = campaign
-        .levels
-        .iter()
-        .zip(&levels)
-        .map(|(entry, level)| (entry.file.clone(), level))
-        .collect();
     report(&campaign);
-    apply_checks(&campaign.checks, &named)
+    apply_checks(&campaign, &levels)
 }
 
 /// Searches each level not resumed for its ramp point, several at once; `None` for those a
@@ -341,12 +336,8 @@ fn report(campaign: &Campaign) {
             100.0 * level.players.quit
         );
     }
-    if let down @ [_, ..] = &campaign.steps_down()[..] {
-        let down: Vec<String> = down.iter().map(|k| k.to_string()).collect();
-        crate::say!(
-            "the panel's b steps down beyond its intervals at level {}",
-            down.join(", ")
-        );
+    if !campaign.steps_down().is_empty() {
+        crate::say!("the panel's {}", campaign.b_trend());
     }
     crate::say!(
         "{:.1}% of players finish the campaign (θ ~ Normal({:+.2}, {:.2}), retry {:.2})",
@@ -357,12 +348,14 @@ fn report(campaign: &Campaign) {
     );
 }
 
-fn apply_checks(checks: &[Check], levels: &[(String, &Level)]) -> Result<()> {
-    let evidence = levels.iter().map(|(name, level)| {
+/// The campaign's checks on its levels (named by their files), exit code 3 on a failure.
+fn apply_checks(campaign: &Campaign, levels: &[Level]) -> Result<()> {
+    let evidence = campaign.levels.iter().zip(levels).map(|(entry, level)| {
         let (stats, rating) = evidence(level);
-        (name.clone(), stats, rating)
+        (entry.file.clone(), stats, rating)
     });
-    report_checks(checks, failures(checks, evidence), levels.len())
+    let failed = failures(&campaign.checks, evidence);
+    report_checks(&campaign.checks, failed, levels.len())
 }
 
 /// Exit code 3, naming each level and check that failed, when any did.
@@ -418,12 +411,18 @@ pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
     let replayed = rate_levels(&ask, &panel, &mut levels, &AtomicBool::new(false), false)?
         .expect("a panel without a stop condition plays to the end");
     // The levels keep the files the campaign gives them.
-    let named: Vec<(String, &Level)> = campaign
-        .levels
-        .iter()
-        .zip(&levels)
-        .map(|(entry, level)| (entry.file.clone(), level))
-        .collect();
+    let replayed = Campaign {
+        levels: campaign
+            .levels
+            .iter()
+            .zip(replayed.levels)
+            .map(|(entry, again)| CampaignLevel {
+                file: entry.file.clone(),
+                ..again
+            })
+            .collect(),
+        ..replayed
+    };
     crate::say!("{}", replayed.to_markdown());
-    apply_checks(&replayed.checks, &named)
+    apply_checks(&replayed, &levels)
 }

@@ -263,24 +263,13 @@ pub(crate) fn draw(app: &App, frame: &mut Frame, screen: Rect) {
         selected.b_ci95[1],
         selected.players.attempts_per_success
     )));
-    let steps_down = record.steps_down();
     lines.push(Line::from(format!(
-        "{:.1}% of players finish (θ ~ Normal({:+.2}, {:.2}), retry {:.2}); b {}",
+        "{:.1}% of players finish (θ ~ Normal({:+.2}, {:.2}), retry {:.2}); {}",
         100.0 * record.finishers(),
         record.population.theta_mean,
         record.population.theta_sd,
         record.population.retry,
-        match steps_down.is_empty() {
-            true => "rises level to level".to_string(),
-            false => format!(
-                "steps down at level {}",
-                steps_down
-                    .iter()
-                    .map(|k| k.to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        }
+        record.b_trend()
     )));
     lines.push(Line::from(vec![
         Span::raw("░░ asked  ").dim(),

@@ -314,99 +314,110 @@ const GOOD: &str = "format: arlpcg-level\nversion: 1\ngame: platform\nstart: {po
 
 #[test]
 fn hand_broken_level_files_get_one_clear_line_and_a_non_zero_exit() {
-    assert_rejected("empty.yaml", b"", "the file is empty");
-    assert_rejected(
-        "truncated.yaml",
-        &GOOD.as_bytes()[..GOOD.len() - 20],
-        "invalid YAML: did not find expected node content at line 7",
-    );
-    assert_rejected(
-        "cut.yaml",
-        &GOOD.as_bytes()[..GOOD.len() - 46],
-        "blocks: missing: a platform level needs its blocks",
-    );
-    assert_rejected(
-        "version.yaml",
-        GOOD.replace("version: 1", "version: 7").as_bytes(),
-        "format version 7 is not supported",
-    );
-    assert_rejected(
-        "range.yaml",
-        GOOD.replace("size: 5", "size: 12").as_bytes(),
-        "size 12 is out of range [4, 6] m",
-    );
-    assert_rejected(
-        "nan.yaml",
-        GOOD.replace("height: 1", "height: .nan").as_bytes(),
-        "height must be a number, not NaN",
-    );
-    assert_rejected(
-        "game.yaml",
-        GOOD.replace("game: platform", "game: tetris").as_bytes(),
-        "unknown variant `tetris`",
-    );
-    assert_rejected(
-        "racing.yaml",
-        GOOD.replace("game: platform", "game: racing").as_bytes(),
-        "a racing level has `segments`, not `blocks`",
-    );
-    let random: Vec<u8> = (0..4096u32)
-        .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
-        .collect();
-    assert_rejected("random.yaml", &random, "not a text file");
-    let large = format!("{GOOD}# {}\n", "x".repeat(5 << 20));
-    assert_rejected("large.yaml", large.as_bytes(), "larger than 4 MiB");
-    assert_rejected(
-        "unknown.yaml",
-        format!("{GOOD}colour: red\n").as_bytes(),
-        "unknown field `colour`",
-    );
+    let edited = |from: &str, to: &str| GOOD.replace(from, to).into_bytes();
     // Statistics and the source are checked like the track: NaN and absurd values were accepted.
     let rules = |spread: &str, margin: &str, max: &str| {
         format!(
             "{GOOD}source: {{kind: rules, rules: {{max_blocks: {max}, angle_spread: {spread}, reach_margin: {margin}}}}}\n"
         )
+        .into_bytes()
     };
-    assert_rejected(
-        "spread.yaml",
-        rules(".nan", "0.5", "40").as_bytes(),
-        "source: rules.angle_spread NaN must be a number of degrees within [0, 180] (line 7)",
-    );
-    assert_rejected(
-        "margin.yaml",
-        rules("60", "-4", "40").as_bytes(),
-        "source: rules.reach_margin -4 must be",
-    );
-    assert_rejected(
-        "max.yaml",
-        rules("60", "0.5", "0").as_bytes(),
-        "source: rules.max_blocks 0 must be within [1, 400]",
-    );
     let stats = |ratio: &str, ci: &str| {
         format!(
             "{GOOD}stats: {{solver: {{kind: scripted}}, seed: 3, trials: 3, successes: 3, fell: 0, timed_out: 0, \
              success_ratio: {ratio}, ci95: [0.4385, {ci}], mean_progress: 1.0, mean_success_steps: 297.3, \
              failures_by_piece: [0]}}\n"
         )
+        .into_bytes()
     };
-    let good = dir_with_level(stats("1.0", "1.0").as_bytes());
+    let good = dir_with_level(&stats("1.0", "1.0"));
     arlpcg_ok(&["verify", good.1.to_str().unwrap(), "--solver", "scripted"]);
     good.0.close().unwrap();
-    assert_rejected(
-        "ratio.yaml",
-        stats(".nan", "1.0").as_bytes(),
-        "stats: success_ratio NaN does not match successes / trials = 1 (line 7)",
-    );
-    assert_rejected(
-        "huge.yaml",
-        GOOD.replace("distance: 7", "distance: 1e308").as_bytes(),
-        "distance 1e308 is out of range [5, 10] m",
-    );
-    assert_rejected(
-        "ci.yaml",
-        stats("1.0", ".inf").as_bytes(),
-        "stats: ci95 [0.4385, inf] does not match",
-    );
+    let random: Vec<u8> = (0..4096u32)
+        .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
+        .collect();
+    let cases: [(&str, Vec<u8>, &str); 17] = [
+        ("empty.yaml", Vec::new(), "the file is empty"),
+        (
+            "truncated.yaml",
+            GOOD.as_bytes()[..GOOD.len() - 20].to_vec(),
+            "invalid YAML: did not find expected node content at line 7",
+        ),
+        (
+            "cut.yaml",
+            GOOD.as_bytes()[..GOOD.len() - 46].to_vec(),
+            "blocks: missing: a platform level needs its blocks",
+        ),
+        (
+            "version.yaml",
+            edited("version: 1", "version: 7"),
+            "format version 7 is not supported",
+        ),
+        (
+            "range.yaml",
+            edited("size: 5", "size: 12"),
+            "size 12 is out of range [4, 6] m",
+        ),
+        (
+            "nan.yaml",
+            edited("height: 1", "height: .nan"),
+            "height must be a number, not NaN",
+        ),
+        (
+            "game.yaml",
+            edited("game: platform", "game: tetris"),
+            "unknown variant `tetris`",
+        ),
+        (
+            "racing.yaml",
+            edited("game: platform", "game: racing"),
+            "a racing level has `segments`, not `blocks`",
+        ),
+        ("random.yaml", random, "not a text file"),
+        (
+            "large.yaml",
+            format!("{GOOD}# {}\n", "x".repeat(5 << 20)).into_bytes(),
+            "larger than 4 MiB",
+        ),
+        (
+            "unknown.yaml",
+            format!("{GOOD}colour: red\n").into_bytes(),
+            "unknown field `colour`",
+        ),
+        (
+            "spread.yaml",
+            rules(".nan", "0.5", "40"),
+            "source: rules.angle_spread NaN must be a number of degrees within [0, 180] (line 7)",
+        ),
+        (
+            "margin.yaml",
+            rules("60", "-4", "40"),
+            "source: rules.reach_margin -4 must be",
+        ),
+        (
+            "max.yaml",
+            rules("60", "0.5", "0"),
+            "source: rules.max_blocks 0 must be within [1, 400]",
+        ),
+        (
+            "ratio.yaml",
+            stats(".nan", "1.0"),
+            "stats: success_ratio NaN does not match successes / trials = 1 (line 7)",
+        ),
+        (
+            "huge.yaml",
+            edited("distance: 7", "distance: 1e308"),
+            "distance 1e308 is out of range [5, 10] m",
+        ),
+        (
+            "ci.yaml",
+            stats("1.0", ".inf"),
+            "stats: ci95 [0.4385, inf] does not match",
+        ),
+    ];
+    for (name, contents, expected) in &cases {
+        assert_rejected(name, contents, expected);
+    }
 }
 
 /// A temporary folder holding `level.yaml` with these bytes.

@@ -18,7 +18,7 @@ use crate::services::checks::Check;
 use crate::services::difficulty;
 use crate::services::generation::GeneratorPolicy;
 use crate::services::level_files::{Format, LevelFiles, render};
-use crate::services::panel::{JudgePanel, play_and_rate};
+use crate::services::panel::{Judge, JudgePanel, play_and_rate};
 use crate::services::verify::{self, Solver, Watch};
 use arlpcg_core::level::pacing::{CurveWords, parse_points, show_points, value_at};
 use arlpcg_core::level::{Game, Level};
@@ -552,6 +552,59 @@ pub fn campaign_files(
     files.push((dir.join("campaign.md"), campaign.to_markdown().into_bytes()));
     files.push((dir.join("campaign.png"), stacked_png(&campaign.charts())));
     Ok(files)
+}
+
+/// Level `k` of the campaign in `folder` searched anew from a seed the campaign has not used
+/// (one past its largest), with `generator` and the campaign's judge from the policies folder
+/// `dir`, to its ramp point; then the panel of `dir` rates the campaign again (the levels stay
+/// in their places) and every file of the campaign is rewritten in the formats it has. Returns
+/// the campaign as [`open`] would read it now.
+pub fn regenerate_level(
+    folder: &Path,
+    k: usize,
+    generator: &GeneratorPolicy,
+    dir: &Path,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> anyhow::Result<(PathBuf, Campaign, Vec<Level>)> {
+    let (folder, record, mut levels) = open(folder)?;
+    let judge = Judge::parse(&record.judge).map_err(anyhow::Error::msg)?;
+    let judged = crate::services::policies::load_panel(dir, record.game, Some(&[judge]))?;
+    let solver = judged.solver(0);
+    let curve = crate::services::policies::difficulty_curve(dir, generator, &solver, || {}, stop)?;
+    let seed = record
+        .levels
+        .iter()
+        .map(|l| l.seed)
+        .max()
+        .unwrap_or(record.seed)
+        + 1;
+    let target = record.levels[k].asked;
+    levels[k] = search_level(generator, &solver, &curve, seed, target, record.trials)?;
+    for level in &mut levels {
+        if let Some(stats) = &mut level.stats {
+            stats.panel = None;
+        }
+    }
+    let panel = crate::services::policies::load_panel(dir, record.game, None)?;
+    let watch = Watch {
+        on_trial: &|_| {},
+        stop,
+    };
+    let rated = rate(&record.ask(), &panel, &mut levels, &watch, false)?
+        .ok_or_else(|| anyhow::anyhow!("stopped"))?;
+    let n = levels.len();
+    let formats: Vec<Format> = [
+        (Format::Yaml, "yaml"),
+        (Format::Glb, "glb"),
+        (Format::Gltf, "gltf"),
+    ]
+    .into_iter()
+    .filter(|(_, ext)| folder.join(format!("{}.{ext}", level_stem(0, n))).exists())
+    .map(|(format, _)| format)
+    .collect();
+    let files = campaign_files(&folder, &rated, &levels, &formats)?;
+    crate::services::fsio::write_batch(&folder, files, &|_| true, "", || {})?;
+    Ok((folder, rated, levels))
 }
 
 /// A campaign's record alone (`campaign.yaml`), read and checked.

@@ -20,12 +20,12 @@ use crate::services::generation::GeneratorPolicy;
 use crate::services::level_files::{Format, LevelFiles, render};
 use crate::services::panel::Judge;
 use crate::services::policies::{
-    difficulty_curve, load_generator, load_judge, load_panel, policy_paths, shipped_dir,
+    difficulty_curve, load_generator, load_panel, policy_paths, shipped_dir,
 };
-use crate::services::verify::{self, Solver, SolverPolicy, Watch};
+use crate::services::verify::{self, Solver, Watch};
 use crate::shells::cli::{CampaignArgs, VerifyArgs};
 use crate::shells::common::{ChecksFailed, Interrupted, progress_bar};
-use arlpcg_core::level::{Game, Level, yaml};
+use arlpcg_core::level::{Level, yaml};
 use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::statistics::population::Population;
 
@@ -63,10 +63,8 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     };
     let n = args.levels as usize;
     let generator = load_generator(&policy_paths(&dir).0, args.game)?.0;
-    let judge_policy = judge_policy(&dir, args.game, judge)?;
-    let solver = judge_policy
-        .as_ref()
-        .map_or_else(|| scripted(judge), Solver::Policy);
+    let judged = load_panel(&dir, args.game, Some(&[judge]))?;
+    let solver = judged.solver(0);
     let panel = load_panel(&dir, args.game, None)?;
     let files: Vec<LevelFiles> = (0..n)
         .map(|k| LevelFiles::new(&args.out, &level_stem(k, n), &formats))
@@ -200,18 +198,6 @@ fn level_seed(seed: u64, k: usize) -> Result<u64> {
         ))
         .into()
     })
-}
-
-fn scripted(judge: Judge) -> Solver<'static> {
-    match judge {
-        Judge::Scripted(skill) => Solver::Scripted(skill),
-        Judge::Solver(_) => unreachable!("a Solver judge is loaded with its policy"),
-    }
-}
-
-/// The judge's Solver policy from `dir`; none for the scripted player.
-fn judge_policy(dir: &Path, game: Game, judge: Judge) -> Result<Option<SolverPolicy>> {
-    Ok(load_judge(dir, game, judge)?.map(|(policy, _)| policy))
 }
 
 /// Whether `path` is one of the files a campaign of `n` levels writes.
@@ -392,10 +378,8 @@ pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
         .policies
         .clone()
         .unwrap_or_else(|| shipped_dir(campaign.game));
-    let judge_policy = judge_policy(&dir, campaign.game, judge)?;
-    let solver = judge_policy
-        .as_ref()
-        .map_or_else(|| scripted(judge), Solver::Policy);
+    let judged = load_panel(&dir, campaign.game, Some(&[judge]))?;
+    let solver = judged.solver(0);
     let panel = load_panel(&dir, campaign.game, None)?;
     for (level, entry) in levels.iter_mut().zip(&campaign.levels) {
         level.stats = Some(verify::verify(

@@ -322,10 +322,11 @@ pub fn perform(
         Effect::OpenCampaign { folder } => send(Response::Campaign(open_campaign(&folder))),
         Effect::RegenerateCampaignLevel {
             folder,
+            game,
             level,
             policies: dir,
         } => send(Response::Campaign(
-            regenerate_campaign_level(policies, &folder, level, &dir, stop)
+            regenerate_campaign_level(policies, &folder, game, level, &dir, stop)
                 .map_err(|e| format!("level {} was not searched anew: {e:#}", level + 1)),
         )),
         Effect::Panel {
@@ -351,69 +352,26 @@ fn open_campaign(folder: &Path) -> Result<Box<OpenedCampaign>, String> {
     }))
 }
 
-/// Level `k` of the campaign in `folder` searched anew from a seed the campaign has not used
-/// (one past its largest), with the Generator on the shelf and the campaign's judge from
-/// `dir`, to its ramp point; then the panel of `dir` rates the campaign again (the levels stay
-/// in their places) and every file of the campaign is rewritten in the formats it has.
+/// Level `k` of the campaign in `folder` searched anew with the Generator on the shelf
+/// ([`crate::services::campaign::regenerate_level`]), read back for the view.
 fn regenerate_campaign_level(
     policies: &Mutex<GamePolicies>,
     folder: &Path,
+    game: Game,
     k: usize,
     dir: &Path,
     stop: &(dyn Fn() -> bool + Sync),
 ) -> anyhow::Result<Box<OpenedCampaign>> {
-    use crate::services::campaign::{self, level_stem};
-    let (folder, record, mut levels) = campaign::open(folder)?;
-    let game = record.game;
     let generator = policies
         .lock()
         .ok()
         .and_then(|shelf| shelf.of(game).generator.clone())
         .ok_or_else(|| anyhow::anyhow!("no {game} Generator is loaded (p loads one)"))?;
-    let judge = Judge::parse(&record.judge).map_err(anyhow::Error::msg)?;
-    let judge_policy = crate::services::policies::load_judge(dir, game, judge)?;
-    let solver = match (&judge_policy, judge) {
-        (Some((policy, _)), _) => Solver::Policy(policy),
-        (None, Judge::Scripted(skill)) => Solver::Scripted(skill),
-        (None, Judge::Solver(_)) => unreachable!("a Solver judge is loaded with its policy"),
-    };
-    let curve = crate::services::policies::difficulty_curve(dir, &generator, &solver, || {}, stop)?;
-    let seed = record
-        .levels
-        .iter()
-        .map(|l| l.seed)
-        .max()
-        .unwrap_or(record.seed)
-        + 1;
-    let target = record.levels[k].asked;
-    levels[k] = campaign::search_level(&generator, &solver, &curve, seed, target, record.trials)?;
-    for level in &mut levels {
-        if let Some(stats) = &mut level.stats {
-            stats.panel = None;
-        }
-    }
-    let panel = crate::services::policies::load_panel(dir, game, None)?;
-    let watch = Watch {
-        on_trial: &|_| {},
-        stop,
-    };
-    let rated = campaign::rate(&record.ask(), &panel, &mut levels, &watch, false)?
-        .ok_or_else(|| anyhow::anyhow!("stopped"))?;
-    let n = levels.len();
-    let formats: Vec<Format> = [
-        (Format::Yaml, "yaml"),
-        (Format::Glb, "glb"),
-        (Format::Gltf, "gltf"),
-    ]
-    .into_iter()
-    .filter(|(_, ext)| folder.join(format!("{}.{ext}", level_stem(0, n))).exists())
-    .map(|(format, _)| format)
-    .collect();
-    let files = campaign::campaign_files(&folder, &rated, &levels, &formats)?;
-    crate::services::fsio::write_batch(&folder, files, &|_| true, "", || {})?;
+    let (folder, record, levels) =
+        crate::services::campaign::regenerate_level(folder, k, &generator, dir, stop)?;
     Ok(Box::new(OpenedCampaign {
         folder,
-        record: rated,
+        record,
         levels: levels.into_iter().map(Arc::new).collect(),
         regenerated: Some(k),
     }))

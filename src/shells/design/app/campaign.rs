@@ -127,6 +127,7 @@ impl App {
                 ));
                 return vec![Effect::RegenerateCampaignLevel {
                     folder,
+                    game,
                     level,
                     policies: self.policies.folder(game),
                 }];

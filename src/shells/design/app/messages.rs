@@ -129,6 +129,7 @@ pub enum Effect {
     /// judge and the panel from `policies`), rate the campaign again and rewrite its files.
     RegenerateCampaignLevel {
         folder: PathBuf,
+        game: Game,
         level: usize,
         policies: PathBuf,
     },

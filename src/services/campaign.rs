@@ -16,11 +16,12 @@ use serde::{Deserialize, Serialize};
 use crate::services::chart::{LineChart, Series, stacked_png};
 use crate::services::checks::Check;
 use crate::services::difficulty;
-use crate::services::generation::GeneratorPolicy;
+use crate::services::generation::{AuxAsk, GeneratorPolicy, LevelRequest};
 use crate::services::level_files::{Format, LevelFiles, render};
 use crate::services::panel::{Judge, JudgePanel, play_and_rate};
 use crate::services::verify::{self, Solver, Watch};
-use arlpcg_core::level::pacing::{CurveWords, parse_points, show_points, value_at};
+use arlpcg_core::level::pacing::{AuxCurve, CurveWords, parse_points, show_points, value_at};
+use arlpcg_core::level::stats::Rating;
 use arlpcg_core::level::{Game, Level};
 use arlpcg_core::statistics::population::{LevelFlow, Population};
 
@@ -102,6 +103,9 @@ pub struct Campaign {
     /// Runs per level, for the judge and for each judge of the panel.
     pub trials: u32,
     pub ramp: Ramp,
+    /// The shape of λ along each level (pacing), moved as a whole by each level's search.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pacing: Option<AuxCurve>,
     /// Acceptance checks every level must pass (`verify --campaign` applies them).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub checks: Vec<Check>,
@@ -129,7 +133,7 @@ pub struct CampaignLevel {
     /// The level file, beside campaign.yaml.
     pub file: String,
     /// The seed its search and its runs started from (campaign seed + the level's place in the
-    /// search, before [`order_by_difficulty`]).
+    /// search, before [`order_by_difficulty`]; seed + n + d for the d-th level drawn anew).
     pub seed: u64,
     pub position: f64,
     /// The judge's success asked for by the ramp.
@@ -137,9 +141,11 @@ pub struct CampaignLevel {
     /// The judge's success measured, with its 95% interval.
     pub measured: f64,
     pub ci95: [f64; 2],
-    /// The λ the level was built at.
+    /// The λ the level was built at, or its curve of λ (with `pacing`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub aux: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aux_curve: Option<AuxCurve>,
     /// Difficulty on the panel's scale, logits, with its 95% interval.
     pub b: f64,
     pub b_ci95: [f64; 2],
@@ -164,6 +170,7 @@ pub struct CampaignAsk {
     pub judge: String,
     pub trials: u32,
     pub ramp: Ramp,
+    pub pacing: Option<AuxCurve>,
     pub checks: Vec<Check>,
     pub population: PopulationAsk,
 }
@@ -172,6 +179,22 @@ impl CampaignAsk {
     /// The success asked of level `k` of `n`.
     pub fn target(&self, k: usize, n: usize) -> f64 {
         self.ramp.at(position(k, n))
+    }
+
+    /// [`Self::record`] of `levels` in their order, named `levelNN.yaml`.
+    pub fn named_record(
+        &self,
+        levels: &[Level],
+        judges_theta: &[(String, f64)],
+    ) -> anyhow::Result<Campaign> {
+        let n = levels.len();
+        let named: Vec<(String, &Level)> = levels
+            .iter()
+            .enumerate()
+            .map(|(k, l)| (format!("{}.yaml", level_stem(k, n)), l))
+            .collect();
+        self.record(&named, judges_theta)
+            .map_err(anyhow::Error::msg)
     }
 
     /// The campaign record of `levels` (named by file, in order), each verified by the judge
@@ -202,13 +225,6 @@ impl CampaignAsk {
                 )
             }
         };
-        let rating = |level: &Level| {
-            level
-                .stats
-                .as_ref()
-                .and_then(|s| s.panel.as_ref())
-                .and_then(|p| p.rating)
-        };
         let b: Vec<f64> = levels
             .iter()
             .map(|(_, l)| rating(l).map_or(f64::NAN, |r| r.b))
@@ -230,6 +246,7 @@ impl CampaignAsk {
                     measured: stats.map_or(f64::NAN, |s| s.success_ratio),
                     ci95: stats.map_or([f64::NAN; 2], |s| s.ci95),
                     aux: level.aux,
+                    aux_curve: level.pacing.as_ref().map(|p| p.curve.clone()),
                     b: rating.map_or(f64::NAN, |r| r.b),
                     b_ci95: rating.map_or([f64::NAN; 2], |r| r.ci95),
                     players: LevelFlow {
@@ -249,6 +266,7 @@ impl CampaignAsk {
             judge: self.judge.clone(),
             trials: self.trials,
             ramp: self.ramp.clone(),
+            pacing: self.pacing.clone(),
             checks: self.checks.clone(),
             population: Population {
                 theta_mean: round4(population.theta_mean),
@@ -280,6 +298,7 @@ impl Campaign {
             judge: self.judge.clone(),
             trials: self.trials,
             ramp: self.ramp.clone(),
+            pacing: self.pacing.clone(),
             checks: self.checks.clone(),
             population: match self.population_from.as_str() {
                 "given" => PopulationAsk::Given(self.population),
@@ -336,7 +355,7 @@ impl Campaign {
         let p = &self.population;
         let mut page = format!(
             "# Campaign: {} {} levels, seed {}\n\n\
-             Ramp asked for `{}` (success of `{}`, {} runs per level). Population: θ ~ \
+             Ramp asked for `{}` (success of `{}`, {} runs per level){}. Population: θ ~ \
              Normal({:+.2}, {:.2}) logits ({}), retries after a failure with chance {:.2}; \
              {:.1}% of players finish the campaign.\n\n\
              | level | file | asked | measured (95% CI) | λ | b (95% CI) | reach | quit here | attempts per success |\n\
@@ -347,6 +366,9 @@ impl Campaign {
             self.ramp,
             self.judge,
             self.trials,
+            self.pacing.as_ref().map_or(String::new(), |c| format!(
+                ", each level paced by `{c}` moved as a whole"
+            )),
             p.theta_mean,
             p.theta_sd,
             self.population_from,
@@ -354,7 +376,11 @@ impl Campaign {
             100.0 * self.finishers(),
         );
         for (k, l) in self.levels.iter().enumerate() {
-            let aux = l.aux.map_or("".into(), |a| format!("{a:+.2}"));
+            let aux = match (l.aux, &l.aux_curve) {
+                (Some(aux), _) => format!("{aux:+.2}"),
+                (None, Some(curve)) => format!("`{curve}`"),
+                (None, None) => String::new(),
+            };
             page += &format!(
                 "| {} | {} | {:.2} | {:.2} ({:.2}–{:.2}) | {aux} | {:+.2} ({:+.2} to {:+.2}) | {:.3} | {:.3} | {:.2} |\n",
                 k + 1,
@@ -435,13 +461,7 @@ impl Campaign {
 /// other judges, whom b also counts, see fewer steps down.
 pub fn order_by_difficulty(levels: &mut [Level], targets: &[f64], band: f64) {
     let measured = |l: &Level| l.stats.as_ref().map_or(f64::NAN, |s| s.success_ratio);
-    let b = |l: &Level| {
-        l.stats
-            .as_ref()
-            .and_then(|s| s.panel.as_ref())
-            .and_then(|p| p.rating)
-            .map_or(f64::NAN, |r| r.b)
-    };
+    let b = |l: &Level| rating(l).map_or(f64::NAN, |r| r.b);
     let fits = |l: &Level, k: usize| (measured(l) - targets[k]).abs() <= band + 1e-9;
     let mut swapped = true;
     while swapped {
@@ -485,49 +505,145 @@ impl Campaign {
 }
 
 /// Level `seed`'s search: a level whose success for `solver`, over `trials` runs, is within
-/// [`difficulty::BAND`] of `target` ([`difficulty::level_for`]), with its certificate.
+/// [`difficulty::BAND`] of `target` ([`difficulty::level_for`]; with `pacing`, that curve of λ
+/// moved as a whole), with its certificate.
 pub fn search_level(
     generator: &GeneratorPolicy,
     solver: &Solver,
     curve: &difficulty::Curve,
     seed: u64,
+    pacing: Option<&AuxCurve>,
     target: f64,
     trials: u32,
 ) -> anyhow::Result<Level> {
-    let level = difficulty::level_for(generator, solver, curve, seed, None, target, trials)?;
+    let asked = LevelRequest::new(seed, None);
+    let asked = match pacing {
+        Some(shape) => asked.aux(AuxAsk::Curve(shape.clone())),
+        None => asked,
+    };
+    let level = difficulty::level_for(generator, solver, curve, &asked, target, trials)?;
     Ok(verify::certified(level, solver, seed)?)
 }
 
-/// The panel plays `levels` (each verified by the judge), rates them together and, with
-/// `reorder`, puts them in order of b where the ramp allows ([`order_by_difficulty`]); then the
-/// record, the levels named `levelNN.yaml` in their order. `Ok(None)` when `watch.stop` cut the
-/// panel short (the levels are then as they came).
+/// The panel plays `levels` (each verified by the judge; those it has played keep their plays)
+/// and rates them together; then the record, the levels named `levelNN.yaml` in their order.
+/// `Ok(None)` when `watch.stop` cut the panel short (the levels are then as they came).
 pub fn rate(
     ask: &CampaignAsk,
     panel: &JudgePanel,
     levels: &mut Vec<Level>,
     watch: &Watch,
-    reorder: bool,
 ) -> anyhow::Result<Option<Campaign>> {
-    let n = levels.len();
     let searched = levels.clone();
     let thetas = play_and_rate(panel, levels, ask.trials, watch);
-    if levels.len() < n {
+    if levels.len() < searched.len() {
         *levels = searched;
         return Ok(None);
     }
-    if reorder {
-        let targets: Vec<f64> = (0..n).map(|k| ask.target(k, n)).collect();
-        order_by_difficulty(levels, &targets, difficulty::BAND);
-    }
-    let named: Vec<(String, &Level)> = levels
+    ask.named_record(levels, &thetas).map(Some)
+}
+
+/// How many levels a campaign may draw anew where the panel's b steps down.
+pub const REDRAWS: usize = 4;
+
+/// How far b steps down along `levels`: over neighbours, the sum of the gaps by which a level's
+/// 95% interval of b lies wholly below the one before it (0 when b rises within its intervals).
+pub fn descent(levels: &[Level]) -> f64 {
+    let intervals: Vec<[f64; 2]> = levels
+        .iter()
+        .map(|l| rating(l).map_or([f64::NAN; 2], |r| r.ci95))
+        .collect();
+    intervals
+        .windows(2)
+        .map(|pair| (pair[0][0] - pair[1][1]).max(0.0))
+        .sum()
+}
+
+/// Of the neighbours `k - 1` and `k`, the one whose b lies farther from the campaign's trend
+/// (the least-squares line of b over position): the one to draw anew.
+fn off_trend(levels: &[Level], k: usize) -> usize {
+    let b: Vec<f64> = levels
+        .iter()
+        .map(|l| rating(l).map_or(f64::NAN, |r| r.b))
+        .collect();
+    let n = b.len() as f64;
+    let x_mean = (n - 1.0) / 2.0;
+    let b_mean = b.iter().sum::<f64>() / n;
+    let (sxy, sxx) = b
         .iter()
         .enumerate()
-        .map(|(k, l)| (format!("{}.yaml", level_stem(k, n)), l))
-        .collect();
-    ask.record(&named, &thetas)
-        .map(Some)
-        .map_err(anyhow::Error::msg)
+        .fold((0.0, 0.0), |(sxy, sxx), (i, bi)| {
+            let dx = i as f64 - x_mean;
+            (sxy + dx * (bi - b_mean), sxx + dx * dx)
+        });
+    let slope = if sxx > 0.0 { sxy / sxx } else { 0.0 };
+    let residual = |i: usize| (b[i] - (b_mean + slope * (i as f64 - x_mean))).abs();
+    if residual(k - 1) > residual(k) {
+        k - 1
+    } else {
+        k
+    }
+}
+
+/// [`rate`] with the levels reordered, then mended where b still steps down: up to [`REDRAWS`]
+/// times, the level of the first step down that lies off the trend is drawn anew by `draw`
+/// (from seed `ask.seed + n + d` for the d-th draw, at its ramp point), the panel plays it and
+/// the campaign is rated again; the new draw is kept when the campaign then steps down less
+/// ([`descent`]). Returns the campaign and the seeds of the draws kept; `Ok(None)` after a stop.
+pub fn rate_and_mend(
+    ask: &CampaignAsk,
+    panel: &JudgePanel,
+    levels: &mut Vec<Level>,
+    watch: &Watch,
+    draw: &dyn Fn(u64, f64) -> anyhow::Result<Level>,
+) -> anyhow::Result<Option<(Campaign, Vec<u64>)>> {
+    let n = levels.len();
+    let targets: Vec<f64> = (0..n).map(|k| ask.target(k, n)).collect();
+    let Some(mut thetas) = rate_in_order(panel, levels, ask.trials, watch, &targets) else {
+        return Ok(None);
+    };
+    let mut kept = Vec::new();
+    for d in 0..REDRAWS {
+        let Some(k) = (1..n).find(|&k| descent(&levels[k - 1..=k]) > 0.0) else {
+            break;
+        };
+        let k = off_trend(levels, k);
+        let seed = ask.seed.checked_add((n + d) as u64).ok_or_else(|| {
+            anyhow::anyhow!("the campaign's seed plus its redraws overflows a 64-bit seed")
+        })?;
+        let mut candidate = levels.clone();
+        candidate[k] = draw(seed, targets[k])?;
+        let Some(candidate_thetas) =
+            rate_in_order(panel, &mut candidate, ask.trials, watch, &targets)
+        else {
+            return Ok(None);
+        };
+        if descent(&candidate) < descent(levels) {
+            *levels = candidate;
+            thetas = candidate_thetas;
+            kept.push(seed);
+        }
+    }
+    Ok(Some((ask.named_record(levels, &thetas)?, kept)))
+}
+
+/// The panel plays the levels not yet played, all are rated together and put in order of b
+/// where `targets` allow; the judges' θ, or `None` after a stop (the levels then as they came).
+fn rate_in_order(
+    panel: &JudgePanel,
+    levels: &mut Vec<Level>,
+    trials: u32,
+    watch: &Watch,
+    targets: &[f64],
+) -> Option<Vec<(String, f64)>> {
+    let before = levels.clone();
+    let thetas = play_and_rate(panel, levels, trials, watch);
+    if levels.len() < before.len() {
+        *levels = before;
+        return None;
+    }
+    order_by_difficulty(levels, targets, difficulty::BAND);
+    Some(thetas)
 }
 
 /// The files of a campaign in folder `dir`: each level's (`levelNN` in `formats`, a .gltf after
@@ -579,7 +695,10 @@ pub fn regenerate_level(
         .unwrap_or(record.seed)
         + 1;
     let target = record.levels[k].asked;
-    levels[k] = search_level(generator, &solver, &curve, seed, target, record.trials)?;
+    let pacing = record.pacing.as_ref();
+    levels[k] = search_level(
+        generator, &solver, &curve, seed, pacing, target, record.trials,
+    )?;
     for level in &mut levels {
         if let Some(stats) = &mut level.stats {
             stats.panel = None;
@@ -590,7 +709,7 @@ pub fn regenerate_level(
         on_trial: &|_| {},
         stop,
     };
-    let rated = rate(&record.ask(), &panel, &mut levels, &watch, false)?
+    let rated = rate(&record.ask(), &panel, &mut levels, &watch)?
         .ok_or_else(|| anyhow::anyhow!("stopped"))?;
     let n = levels.len();
     let formats: Vec<Format> = [
@@ -648,6 +767,15 @@ pub fn open(path: &Path) -> anyhow::Result<(PathBuf, Campaign, Vec<Level>)> {
     Ok((folder, campaign, levels))
 }
 
+/// The panel's rating of `level`, when it has one.
+fn rating(level: &Level) -> Option<Rating> {
+    level
+        .stats
+        .as_ref()
+        .and_then(|s| s.panel.as_ref())
+        .and_then(|p| p.rating)
+}
+
 fn round4(x: f64) -> f64 {
     (x * 1e4).round() / 1e4
 }
@@ -682,56 +810,63 @@ mod tests {
         }
     }
 
+    /// A shipped level measuring `success` for the judge, rated `b` ± 0.1 by the panel.
+    fn rated(success: f64, b: f64) -> Level {
+        let mut level = arlpcg_core::level::yaml::parse(include_str!(
+            "../../levels/platform/platform_seed7_aux+1.00.yaml"
+        ))
+        .unwrap();
+        let stats = level.stats.as_mut().unwrap();
+        stats.success_ratio = success;
+        stats.panel = Some(arlpcg_core::level::stats::PanelStats {
+            seed: 0,
+            trials: 10,
+            judges: Vec::new(),
+            rating: Some(Rating {
+                b,
+                ci95: [b - 0.1, b + 0.1],
+                levels: 4,
+            }),
+        });
+        level
+    }
+
+    fn b_of(levels: &[Level]) -> Vec<f64> {
+        levels.iter().map(|l| rating(l).unwrap().b).collect()
+    }
+
     /// Neighbours trade places when the later is rated easier and both still fit the other's
     /// ramp point; a pair that does not fit stays as it is.
     #[test]
     fn levels_go_in_order_of_difficulty_where_the_ramp_allows() {
-        let shipped = arlpcg_core::level::yaml::parse(include_str!(
-            "../../levels/platform/platform_seed7_aux+1.00.yaml"
-        ))
-        .unwrap();
-        let level = |success: f64, b: f64| {
-            let mut level = shipped.clone();
-            let stats = level.stats.as_mut().unwrap();
-            stats.success_ratio = success;
-            stats.panel = Some(arlpcg_core::level::stats::PanelStats {
-                seed: 0,
-                trials: 10,
-                judges: Vec::new(),
-                rating: Some(arlpcg_core::level::stats::Rating {
-                    b,
-                    ci95: [b - 0.1, b + 0.1],
-                    levels: 4,
-                }),
-            });
-            level
-        };
-        let b_of = |levels: &[Level]| -> Vec<f64> {
-            levels
-                .iter()
-                .map(|l| {
-                    l.stats
-                        .as_ref()
-                        .unwrap()
-                        .panel
-                        .as_ref()
-                        .unwrap()
-                        .rating
-                        .unwrap()
-                        .b
-                })
-                .collect()
-        };
         let targets = [0.9, 0.8, 0.7, 0.2];
         let mut levels = vec![
-            level(0.85, 1.0),
-            level(0.85, -1.0),
-            level(0.7, 2.0),
-            level(0.2, 0.5),
+            rated(0.85, 1.0),
+            rated(0.85, -1.0),
+            rated(0.7, 2.0),
+            rated(0.2, 0.5),
         ];
         order_by_difficulty(&mut levels, &targets, 0.1);
         // 1 and 2 trade places; 3 and 4 do not (0.2 is not within 0.1 of 0.7).
         assert_eq!(b_of(&levels), [-1.0, 1.0, 2.0, 0.5]);
+    }
+
+    /// Descent adds the gaps between intervals that step down; overlapping intervals are no
+    /// step. Of a pair that steps down, the level off the campaign's trend is drawn anew.
+    #[test]
+    fn descent_counts_steps_beyond_the_intervals_and_the_outlier_is_redrawn() {
+        let levels: Vec<Level> = [-2.0, -1.0, 1.5, 0.0, 1.0, 0.9]
+            .into_iter()
+            .map(|b| rated(0.5, b))
+            .collect();
+        // 1.5 → 0.0: [1.4, 1.6] over [-0.1, 0.1], a gap of 1.3; 1.0 → 0.9 overlaps.
+        assert!((descent(&levels) - 1.3).abs() < 1e-9);
+        assert_eq!(descent(&levels[..3]), 0.0);
+        assert_eq!(off_trend(&levels, 3), 2, "1.5 lies above the rising trend");
+        let mut low = levels.clone();
+        low[2] = rated(0.5, 0.5);
+        low[3] = rated(0.5, -2.0);
+        assert_eq!(off_trend(&low, 3), 3, "-2.0 lies below it");
     }
 
     #[test]

@@ -13,9 +13,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::services::generation::{self, GenerationError, GeneratorPolicy, LevelRequest};
+use crate::services::generation::{self, AuxAsk, GenerationError, GeneratorPolicy, LevelRequest};
 use crate::services::verify::{Solver, Watch, WrongGame, stats_of, trial_results, verify};
 use arlpcg_core::level::Level;
+#[cfg(doc)]
+use arlpcg_core::level::pacing::AuxCurve;
 use arlpcg_core::level::stats::{Outcome, wilson_interval};
 
 /// A kept level measures within this of the wanted success ratio.
@@ -186,19 +188,25 @@ impl Curve {
     }
 }
 
-/// A level of `seed` whose success, verified with `trials` runs, is within [`BAND`] of
+/// A level of `asked.seed` whose success, verified with `trials` runs, is within [`BAND`] of
 /// `target`: the search starts at the curve's λ and moves λ against each miss, each candidate
-/// a new draw of the seed, or of another seed after [`OWN_SCENE_CANDIDATES`] (unless `goal`
-/// is given). A candidate that no run completed is never kept.
+/// a new draw of the seed, or of another seed after [`OWN_SCENE_CANDIDATES`] (unless
+/// `asked.goal` is given). When `asked` has a curve of λ (pacing), the search moves the whole
+/// curve, its mean at the λ searched ([`AuxCurve::shifted`]). A candidate that no run completed
+/// is never kept.
 pub fn level_for(
     generator: &GeneratorPolicy,
     solver: &Solver,
     curve: &Curve,
-    seed: u64,
-    goal: Option<[f64; 3]>,
+    asked: &LevelRequest,
     target: f64,
     trials: u32,
 ) -> Result<Level, TargetError> {
+    let (seed, goal) = (asked.seed, asked.goal);
+    let shape = match &asked.aux {
+        Some(AuxAsk::Curve(shape)) => Some(shape),
+        _ => None,
+    };
     let mut aux = curve.aux_for(target);
     let mut closest = (f64::INFINITY, f64::NAN, aux);
     let (mut uncompleted, mut unbuilt) = (0, 0);
@@ -216,6 +224,10 @@ pub fn level_for(
             .goal(goal)
             .obstacles(obstacles)
             .draw(draw);
+        let request = match shape {
+            Some(shape) => request.aux(AuxAsk::Curve(shape.shifted(quantized - shape.mean()))),
+            None => request,
+        };
         let mut level = match generation::generator_level(generator, &request) {
             Ok(level) => level,
             Err(GenerationError::NoLevel { .. }) => {

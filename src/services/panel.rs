@@ -125,7 +125,8 @@ pub fn play(
 
 /// Plays every level of `levels` with every judge of `panel` (each from its verification's
 /// seed), several levels at once, and rates them together into their statistics; returns the
-/// judges' θ. Levels that `watch.stop` left unplayed are dropped from the end.
+/// judges' θ. A level that already has this panel's plays keeps them (it is only rated again).
+/// Levels that `watch.stop` left unplayed are dropped from the end.
 pub fn play_and_rate(
     panel: &JudgePanel,
     levels: &mut Vec<Level>,
@@ -136,7 +137,11 @@ pub fn play_and_rate(
     let played: Vec<Option<PanelStats>> = levels
         .par_iter()
         .map(|level| {
-            let seed = level.stats.as_ref().map_or(0, |s| s.seed);
+            let stats = level.stats.as_ref();
+            if let Some(played) = stats.and_then(|s| s.panel.clone()) {
+                return Some(played);
+            }
+            let seed = stats.map_or(0, |s| s.seed);
             play(panel, level, trials, seed, watch, &|_, _| {})
                 .expect("judges are loaded for the levels' game")
         })

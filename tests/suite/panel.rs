@@ -226,6 +226,36 @@ fn a_campaign_follows_its_ramp_and_resumes_to_the_same_bytes() {
     );
 }
 
+/// With --pacing, every level follows the curve's shape, moved as a whole to its ramp point.
+#[test]
+fn a_paced_campaign_moves_one_shape_per_level() {
+    let dir = tempfile::tempdir().unwrap();
+    let done = small_campaign(dir.path(), &["--pacing", "0:0.4, 1:-0.4"]);
+    assert!(done.status.success(), "{}", stderr(&done));
+    let record: serde_yaml::Value =
+        serde_yaml::from_slice(&std::fs::read(dir.path().join("campaign.yaml")).unwrap()).unwrap();
+    assert_eq!(record["pacing"].as_str(), Some("0:0.4, 1:-0.4"));
+    for level in record["levels"].as_sequence().unwrap() {
+        assert!(level.get("aux").is_none(), "{level:?}");
+        let curve = level["aux_curve"].as_str().unwrap();
+        let points: Vec<f64> = curve
+            .split(", ")
+            .map(|p| p.split(':').nth(1).unwrap().parse().unwrap())
+            .collect();
+        let [start, end] = points[..] else {
+            panic!("{curve}")
+        };
+        let clamped = start == 1.0 || end == -1.0;
+        assert!(clamped || ((start - end) - 0.8).abs() < 2e-3, "{curve}");
+        assert!(start > end, "{curve}");
+    }
+    let page = std::fs::read_to_string(dir.path().join("campaign.md")).unwrap();
+    assert!(
+        page.contains("each level paced by `0:0.4, 1:-0.4`"),
+        "{page}"
+    );
+}
+
 #[test]
 fn checks_fail_a_batch_with_exit_code_3_and_bad_checks_are_usage_errors() {
     let verify = |checks: &[&str]| {

@@ -496,6 +496,11 @@ pub struct CampaignArgs {
     /// the panel's difficulty b rises along the campaign.
     #[arg(long, value_name = "CURVE", value_parser = Ramp::parse)]
     pub ramp: Ramp,
+    /// The shape of λ along every level, an aux curve of `fraction:λ` points ("0:1, 1:-1": easy,
+    /// then hard). Each level's search moves the whole curve up or down (its mean is the λ
+    /// searched) until the judge's success fits the ramp. Default: one λ per level.
+    #[arg(long, value_name = "CURVE", allow_hyphen_values = true, value_parser = AuxCurve::parse)]
+    pub pacing: Option<AuxCurve>,
     /// Whose success the ramp asks for: a Solver of --policies named by its training mode
     /// (arlpcg, rule-pcg, fixed-track, fixed-aux) or the scripted player (scripted-novice,
     /// scripted-median, scripted-expert). Default: arlpcg.

@@ -10,8 +10,8 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 
 use crate::services::campaign::{
-    Campaign, CampaignAsk, CampaignLevel, PopulationAsk, campaign_files, level_stem, rate,
-    search_level,
+    Campaign, CampaignAsk, CampaignLevel, PopulationAsk, REDRAWS, campaign_files, level_stem, rate,
+    rate_and_mend, search_level,
 };
 use crate::services::checks::{Check, evidence, failures};
 use crate::services::difficulty;
@@ -51,6 +51,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         judge: judge.name(),
         trials: args.trials,
         ramp: args.ramp.clone(),
+        pacing: args.pacing.clone(),
         checks: args.checks.clone(),
         population: match args.population {
             Some((theta_mean, theta_sd)) => PopulationAsk::Given(Population {
@@ -98,7 +99,13 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         return interrupted(args, &built, &files);
     }
     let mut levels: Vec<Level> = built.into_iter().flatten().collect();
-    let Some(campaign) = rate_levels(&ask, &panel, &mut levels, &stop, true)? else {
+    let search = |seed: u64, target: f64| {
+        let pacing = args.pacing.as_ref();
+        search_level(
+            &generator, &solver, &curve, seed, pacing, target, args.trials,
+        )
+    };
+    let Some(campaign) = rate_levels(&ask, &panel, &mut levels, &stop, Some(&search))? else {
         let searched: Vec<Option<Level>> = levels.into_iter().map(Some).collect();
         return interrupted(args, &searched, &files);
     };
@@ -138,6 +145,7 @@ fn search_levels(
                 solver,
                 curve,
                 seed,
+                args.pacing.as_ref(),
                 ask.target(k, n),
                 args.trials,
             )
@@ -230,13 +238,17 @@ fn resumed_levels(
             continue;
         }
         let mut level = yaml::load(&path)?;
-        let slot = level
+        let drawn = level
             .stats
             .as_ref()
             .filter(|s| level.game() == args.game && s.solver == solver.reference())
-            .and_then(|s| s.seed.checked_sub(args.seed))
-            .filter(|&j| j < n as u64)
-            .map(|j| j as usize);
+            .and_then(|s| s.seed.checked_sub(args.seed));
+        // A level drawn anew where b stepped down is drawn again once the panel has rated
+        // the campaign: the draws are seeded, so it comes back the same.
+        if drawn.is_some_and(|j| (n..n + REDRAWS).contains(&(j as usize))) {
+            continue;
+        }
+        let slot = drawn.filter(|&j| j < n as u64).map(|j| j as usize);
         let Some(slot) = slot.filter(|&j| levels[j].is_none()) else {
             anyhow::bail!(
                 "{}: not a level of this campaign (a {} level verified by {} from one of seeds {}..{}, each once); remove it or choose another --out",
@@ -288,23 +300,40 @@ fn interrupted(args: &CampaignArgs, built: &[Option<Level>], files: &[LevelFiles
 }
 
 /// The panel plays every level (a progress bar), the levels are rated together and recorded;
-/// `None` after a Ctrl-C.
+/// with `mend`, reordered and mended where b steps down ([`rate_and_mend`], drawing with
+/// `mend`'s search). `None` after a Ctrl-C.
 fn rate_levels(
     ask: &CampaignAsk,
     panel: &crate::services::panel::JudgePanel,
     levels: &mut Vec<Level>,
     stop: &AtomicBool,
-    reorder: bool,
+    mend: Option<&dyn Fn(u64, f64) -> Result<Level>>,
 ) -> Result<Option<Campaign>> {
-    let runs = (levels.len() * panel.judges.len()) as u64 * ask.trials as u64;
-    let bar = progress_bar(runs, "panel runs");
+    let level_runs = panel.judges.len() as u64 * ask.trials as u64;
+    let bar = progress_bar(levels.len() as u64 * level_runs, "panel runs");
     let watch = Watch {
         on_trial: &|_| bar.inc(1),
         stop: &|| stop.load(Ordering::SeqCst),
     };
-    let campaign = rate(ask, panel, levels, &watch, reorder);
+    let campaign = match mend {
+        None => rate(ask, panel, levels, &watch)?,
+        Some(search) => {
+            let draw = |seed: u64, target: f64| {
+                bar.inc_length(level_runs);
+                search(seed, target)
+            };
+            rate_and_mend(ask, panel, levels, &watch, &draw)?.map(|(campaign, kept)| {
+                for seed in kept {
+                    crate::say!(
+                        "drew a level anew from seed {seed} where the panel's b stepped down"
+                    );
+                }
+                campaign
+            })
+        }
+    };
     bar.finish_and_clear();
-    campaign
+    Ok(campaign)
 }
 
 /// One line per level, then the funnel's end.
@@ -392,7 +421,7 @@ pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
     }
     let mut ask = campaign.ask();
     ask.checks.extend(args.checks.iter().copied());
-    let replayed = rate_levels(&ask, &panel, &mut levels, &AtomicBool::new(false), false)?
+    let replayed = rate_levels(&ask, &panel, &mut levels, &AtomicBool::new(false), None)?
         .expect("a panel without a stop condition plays to the end");
     // The levels keep the files the campaign gives them.
     let replayed = Campaign {

@@ -448,8 +448,7 @@ fn build_levels(
                     generator,
                     who,
                     curve,
-                    *seed,
-                    args.goal,
+                    &LevelRequest::new(*seed, None).goal(args.goal),
                     target,
                     verify_trials.unwrap_or(TARGET_TRIALS),
                 )

@@ -564,8 +564,7 @@ fn target_level(
         generator,
         &Solver::Policy(solver),
         &curve,
-        seed,
-        goal,
+        &crate::services::generation::LevelRequest::new(seed, None).goal(goal),
         target,
         trials,
     )

@@ -172,6 +172,30 @@ impl AuxCurve {
     pub fn points(&self) -> &[(f64, f64)] {
         &self.points
     }
+
+    /// The mean λ over the way to the goal (the curve is flat before its first point and after
+    /// its last).
+    pub fn mean(&self) -> f64 {
+        let (first, last) = (self.points[0], self.points[self.points.len() - 1]);
+        let inside: f64 = self
+            .points
+            .windows(2)
+            .map(|p| (p[1].0 - p[0].0) * (p[0].1 + p[1].1) / 2.0)
+            .sum();
+        first.0 * first.1 + inside + (1.0 - last.0) * last.1
+    }
+
+    /// The same shape moved up by `delta`, each point's λ clamped to [-1, 1] and rounded as
+    /// level files write it.
+    pub fn shifted(&self, delta: f64) -> Self {
+        Self {
+            points: self
+                .points
+                .iter()
+                .map(|&(x, y)| (x, round_aux((y + delta).clamp(-1.0, 1.0))))
+                .collect(),
+        }
+    }
 }
 
 impl fmt::Display for AuxCurve {
@@ -238,6 +262,17 @@ pub fn round_aux(aux: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_curve_has_a_mean_and_moves_as_a_whole() {
+        let ramp = super::AuxCurve::parse("0.25:1, 0.75:-1").unwrap();
+        assert!(ramp.mean().abs() < 1e-12, "{}", ramp.mean());
+        let step = super::AuxCurve::parse("0.5:1, 0.5:-0.5").unwrap();
+        assert!((step.mean() - 0.25).abs() < 1e-12);
+        assert!((super::AuxCurve::parse("0.3:0.4").unwrap().mean() - 0.4).abs() < 1e-12);
+        assert_eq!(ramp.shifted(0.5).to_string(), "0.25:1, 0.75:-0.5");
+        assert_eq!(step.shifted(-0.25).to_string(), "0.5:0.75, 0.5:-0.75");
+    }
+
     use super::*;
 
     #[test]

@@ -241,11 +241,15 @@ pub(crate) fn draw(app: &App, frame: &mut Frame, screen: Rect) {
         format!("{:.2}", record.levels[k].measured)
     }));
     lines.push(row("b", &|k| format!("{:+.2}", record.levels[k].b)));
-    lines.push(row("λ", &|k| {
-        record.levels[k]
-            .aux
-            .map_or("-".into(), |a| format!("{a:+.2}"))
-    }));
+    // A paced level shows its curve's mean λ, marked `~`.
+    lines.push(row(
+        "λ",
+        &|k| match (&record.levels[k].aux, &record.levels[k].aux_curve) {
+            (Some(aux), _) => format!("{aux:+.2}"),
+            (None, Some(curve)) => format!("~{:+.2}", curve.mean()),
+            (None, None) => "-".into(),
+        },
+    ));
     lines.push(row("reach", &|k| {
         format!("{:.0}%", 100.0 * record.levels[k].players.reach)
     }));

@@ -193,7 +193,7 @@ impl Curve {
 /// a new draw of the seed, or of another seed after [`OWN_SCENE_CANDIDATES`] (unless
 /// `asked.goal` is given). When `asked` has a curve of λ (pacing), the search moves the whole
 /// curve, its mean at the λ searched ([`AuxCurve::shifted`]). A candidate that no run completed
-/// is never kept.
+/// is never kept. The level is made for `asked.profile`.
 pub fn level_for(
     generator: &GeneratorPolicy,
     solver: &Solver,
@@ -223,7 +223,8 @@ pub fn level_for(
         let request = LevelRequest::new(candidate_seed, Some(quantized))
             .goal(goal)
             .obstacles(obstacles)
-            .draw(draw);
+            .draw(draw)
+            .profile(asked.profile.clone());
         let request = match shape {
             Some(shape) => request.aux(AuxAsk::Curve(shape.shifted(quantized - shape.mean()))),
             None => request,

@@ -13,6 +13,7 @@ use arlpcg_core::game::generator::{
 };
 use arlpcg_core::game::{PlatformGame, RacingGame};
 use arlpcg_core::level::pacing::{AuxCurve, Pacing, covered, round_aux};
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::racing::RacingRulesConfig;
 use arlpcg_core::level::{Game, Level, PlatformRulesConfig, PolicyRef, Source};
 use arlpcg_core::rl::normalizer::RunningNorm;
@@ -91,6 +92,8 @@ pub struct LevelRequest {
     /// Pieces to keep from another level: the Generator continues after them (its start, goal
     /// and obstacles are that level's).
     pub keep: Option<KeptPrefix>,
+    /// The game profile the level is made for (none: the built-in one); the level records it.
+    pub profile: Option<Profile>,
 }
 
 /// The first `pieces` pieces of `level`, read from the file `from` (`generate --keep`).
@@ -111,6 +114,7 @@ impl LevelRequest {
             obstacles: 0,
             draw: 0,
             keep: None,
+            profile: None,
         }
     }
 
@@ -133,6 +137,11 @@ impl LevelRequest {
         }
     }
 
+    /// Made for `profile` (none: the built-in one).
+    pub fn profile(self, profile: Option<Profile>) -> Self {
+        Self { profile, ..self }
+    }
+
     pub fn aux(self, aux: AuxAsk) -> Self {
         Self {
             aux: Some(aux),
@@ -149,13 +158,14 @@ impl LevelRequest {
     }
 }
 
-/// A rule-based level of `game` (λ is recorded, not used; the rules know no curve).
+/// A rule-based level of `game` (λ is recorded, not used; the rules know no curve), made for
+/// the request's profile.
 pub fn rules_level(game: Game, request: &LevelRequest) -> Result<Level, NoRuleLevel> {
     let LevelRequest {
         seed, goal, draw, ..
     } = *request;
     let aux = request.flat_aux();
-    Ok(match game {
+    let level = match game {
         Game::Platform => arlpcg_core::game::platform::rules::platform_level_draw(
             seed,
             aux,
@@ -170,6 +180,10 @@ pub fn rules_level(game: Game, request: &LevelRequest) -> Result<Level, NoRuleLe
             };
             arlpcg_core::game::racing::rules::racing_level_draw(seed, aux, goal, &config, draw)?
         }
+    };
+    Ok(Level {
+        profile: request.profile.clone(),
+        ..level
     })
 }
 
@@ -312,6 +326,7 @@ fn build_level<G: GeneratorGame>(
                             curve,
                             piece_aux: piece_auxes,
                         }),
+                        profile: request.profile.clone(),
                     });
                 }
             }

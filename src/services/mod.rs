@@ -12,5 +12,6 @@ pub mod level_files;
 pub mod onnx;
 pub mod panel;
 pub mod policies;
+pub mod profile;
 pub mod train;
 pub mod verify;

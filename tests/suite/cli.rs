@@ -999,3 +999,119 @@ fn a_huge_refused_argument_is_not_echoed_whole() {
     );
     assert!(!Path::new("never-written").exists());
 }
+
+/// A game profile: `init` prints one that `check` accepts; a bad one names its field; one under
+/// which no level can be completed is refused; levels made for one record it and are played
+/// under it, and a weaker jumper fails the staircase the built-in character climbs.
+#[test]
+fn a_game_profile_is_checked_recorded_and_played_under() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let init = arlpcg_ok(&["profile", "init", "--game", "platform"]);
+    let text = String::from_utf8(init.stdout).unwrap();
+    let write = |name: &str, text: &str| std::fs::write(path(name), text).unwrap();
+    write("default.yaml", &text);
+    let checked = arlpcg_ok(&["profile", "check", &path("default.yaml")]);
+    let report = String::from_utf8_lossy(&checked.stdout);
+    assert!(
+        report.contains("reach table") && report.contains("+0 m: 6 m"),
+        "{report}"
+    );
+    let low = text
+        .replace("name: default", "name: low-jumper")
+        .replace("jump_speed: 9.25", "jump_speed: 7.5");
+    write("low.yaml", &low);
+    write("nan.yaml", &text.replace("gravity: 20.0", "gravity: .nan"));
+    fails_with(
+        &arlpcg(&["profile", "check", &path("nan.yaml")]),
+        1,
+        "character.gravity must be a number",
+    );
+    write(
+        "flat.yaml",
+        &text.replace("jump_speed: 9.25", "jump_speed: 3.0"),
+    );
+    fails_with(
+        &arlpcg(&["profile", "check", &path("flat.yaml")]),
+        1,
+        "no level can be completed",
+    );
+    fails_with(
+        &arlpcg(&[
+            "generate",
+            "--game",
+            "racing",
+            "--rules",
+            "--profile",
+            &path("low.yaml"),
+            "--out",
+            &path("x"),
+        ]),
+        1,
+        "a platform profile, not a racing one",
+    );
+
+    // Made for the low jumper: the level records it and is verified under it.
+    let out = path("levels");
+    arlpcg_ok(&[
+        "generate",
+        "--rules",
+        "--count",
+        "1",
+        "--seed",
+        "3",
+        "--profile",
+        &path("low.yaml"),
+        "--verify",
+        "10",
+        "--format",
+        "yaml",
+        "--out",
+        &out,
+    ]);
+    let level = std::fs::read_to_string(dir.path().join("levels/platform_seed3.yaml")).unwrap();
+    assert!(
+        level.contains("profile:\n  name: low-jumper\n  sha256: "),
+        "{level}"
+    );
+    let again = arlpcg_ok(&[
+        "verify",
+        &format!("{out}/platform_seed3.yaml"),
+        "--solver",
+        "scripted",
+        "--trials",
+        "5",
+    ]);
+    assert!(String::from_utf8_lossy(&again.stdout).contains("under profile `low-jumper`"));
+    // Its export carries the abilities in the scene's extras.
+    let gltf = path("level.gltf");
+    arlpcg_ok(&[
+        "export",
+        &format!("{out}/platform_seed3.yaml"),
+        "--out",
+        &gltf,
+    ]);
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&gltf).unwrap()).unwrap();
+    let extras = &doc["scenes"][0]["extras"]["profile"];
+    assert_eq!(extras["name"], "low-jumper", "{doc}");
+    assert_eq!(extras["character"]["jump_speed"], 7.5);
+
+    // The staircase: the built-in character climbs it, the low jumper does not.
+    let staircase = concat!(env!("CARGO_MANIFEST_DIR"), "/levels/hand/staircase.yaml");
+    let success = |extra: &[&str]| {
+        let mut args = vec![
+            "verify", staircase, "--solver", "scripted", "--trials", "10", "--json",
+        ];
+        args.extend_from_slice(extra);
+        let out = arlpcg_ok(&args);
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (json["success_ratio"].as_f64().unwrap(), stderr(&out))
+    };
+    assert_eq!(success(&[]).0, 1.0);
+    let (low_success, said) = success(&["--profile", &path("low.yaml")]);
+    assert_eq!(low_success, 0.0);
+    assert!(
+        said.contains("made under the built-in profile; playing it under `low-jumper`"),
+        "{said}"
+    );
+}

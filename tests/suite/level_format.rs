@@ -44,6 +44,7 @@ fn level() -> impl Strategy<Value = Level> {
                     source: Source::Hand,
                     stats: None,
                     pacing: None,
+                    profile: None,
                 })
             },
         )

@@ -1,6 +1,7 @@
 //! The platform world (its determinism is in determinism.rs): the calibrated reach, observations and rewards as the
 //! Solver sees them, and how runs end.
 
+use arlpcg_core::game::platform::character::Body;
 use arlpcg_core::game::platform::reach::{
     self, REACH_HEIGHTS, REACH_TABLE, play_scripted, single_jump,
 };
@@ -43,18 +44,31 @@ fn the_scripted_controller_completes_an_easy_level_and_fails_an_impossible_jump(
 #[test]
 fn the_documented_reach_table_is_what_the_simulation_measures() {
     assert_eq!(
-        reach::measure_reach(),
+        reach::measure_reach(Body::default()),
         REACH_TABLE,
         "heights {REACH_HEIGHTS:?}: update REACH_TABLE and docs/platform-physics.md"
     );
     // From standstill on the start block 5 m up 2 m is made every time, 5.75 m never; right
     // after a landing 5 m is not made every time, which is why the table is measured chained.
-    assert_eq!(reach::successes(&single_jump(5.0, 2.0), 16, 0.3), 16);
-    assert_eq!(reach::successes(&single_jump(5.75, 2.0), 16, 0.3), 0);
-    assert!(reach::successes(&reach::chained_jump(5.0, 2.0, 45.0), 16, 0.3) < 16);
+    assert_eq!(
+        reach::successes(&single_jump(5.0, 2.0), Body::default(), 16, 0.3),
+        16
+    );
+    assert_eq!(
+        reach::successes(&single_jump(5.75, 2.0), Body::default(), 16, 0.3),
+        0
+    );
+    assert!(
+        reach::successes(
+            &reach::chained_jump(5.0, 2.0, 45.0),
+            Body::default(),
+            16,
+            0.3
+        ) < 16
+    );
     // Beyond the largest turn the table's own gap is not made every time.
     let sharp = reach::chained_jump(REACH_TABLE[4], 2.0, reach::MAX_TURN + 45.0);
-    assert!(reach::successes(&sharp, 16, 0.3) < 16);
+    assert!(reach::successes(&sharp, Body::default(), 16, 0.3) < 16);
 }
 
 #[test]

@@ -144,6 +144,7 @@ pub fn generator_golden_episode<G: GeneratorGame>(
         },
         stats: None,
         pacing: None,
+        profile: None,
     };
     let outcome = format!("{outcome:?}");
     Ok(GoldenEpisode::new(

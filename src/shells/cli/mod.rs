@@ -71,6 +71,29 @@ pub enum Command {
     /// Write docs/results.md from the committed results (results/<game>/*.json) and the
     /// shipped policies' cards, or check that it is current; draw runs' learning curves.
     Report(ReportArgs),
+    /// Game profiles: the abilities of your character or car as a file (`profile init` prints
+    /// ours to edit, `profile check` measures what yours allows); commands take it with
+    /// --profile FILE.
+    #[command(subcommand)]
+    Profile(ProfileCommand),
+}
+
+#[derive(Debug, Subcommand)]
+pub enum ProfileCommand {
+    /// Print a game's built-in profile (standard output), a comment per field with its range.
+    Init {
+        #[arg(long, default_value = "platform", value_parser = parse_game)]
+        game: Game,
+    },
+    /// Check a profile file and measure what it allows with the scripted expert playing: the
+    /// jump and reach table (platform), speed and grip (racing), and how many rule levels it
+    /// completes. Exit 1 when the file is wrong or no level can be completed.
+    Check {
+        file: PathBuf,
+        /// Runs per rule level.
+        #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+        trials: u32,
+    },
 }
 
 #[derive(Debug, Args)]
@@ -281,6 +304,10 @@ pub struct GenerateArgs {
     /// seed as its certificate (`verify --replay` re-runs it).
     #[arg(long, requires = "verify")]
     pub allow_unsolved: bool,
+    /// Make the levels for this game profile (`arlpcg profile init`): the character's or car's
+    /// abilities, which --verify plays with; each level records it. Default: the built-in one.
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<PathBuf>,
     /// Acceptance check on every level (repeatable): `success LO..HI` (the success ratio),
     /// `b LO..HI` (the panel's difficulty, with --panel) or `completed`. A level fails a range
     /// only when its 95% interval lies wholly outside it; any failure ends the run with exit
@@ -457,6 +484,10 @@ pub struct VerifyArgs {
     /// policies/<game>).
     #[arg(long)]
     pub policies: Option<PathBuf>,
+    /// Play under this game profile (`arlpcg profile init`): the character's or car's abilities.
+    /// Default: the profile each level records, else the built-in one.
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<PathBuf>,
     /// Acceptance check on every level (repeatable): `success LO..HI` (the success ratio),
     /// `b LO..HI` (the panel's difficulty, with --panel) or `completed`. A level fails a range
     /// only when its 95% interval lies wholly outside it; any failure ends the run with exit

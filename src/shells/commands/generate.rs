@@ -17,6 +17,7 @@ use crate::services::panel::Judge;
 use crate::services::policies::{
     load_generator, load_judge, load_panel, load_solver, policy_paths,
 };
+use crate::services::profile;
 use crate::services::verify::{self, Solver, SolverPolicy};
 use crate::shells::cli::{GenerateArgs, KeepArg, default_solver};
 use arlpcg_core::game::Skill;
@@ -24,11 +25,7 @@ use arlpcg_core::level::{Game, Level};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
     let seeds = check_arguments(args)?;
-    let keep = args
-        .keep
-        .as_ref()
-        .map(|keep| kept_prefix(keep, args.game))
-        .transpose()?;
+    let template = template(args)?;
     let ask = args.ask();
     let verify_trials = args
         .verify
@@ -74,7 +71,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     let mut levels = build_levels(
         args,
         &plans,
-        keep.as_ref(),
+        &template,
         generator.as_ref(),
         &who,
         curve.as_ref(),
@@ -344,24 +341,40 @@ fn stem_of_lambda(args: &GenerateArgs, seed: u64) -> String {
 /// run completes.
 pub const MAX_DRAWS: u32 = 10;
 
-/// Level `seed` (its `draw`-th draw) from the Generator when there is one, else from the rules.
+/// What every level of the batch asks, bar its seed and draw: goal, obstacles, λ or curve, the
+/// kept prefix and the profile.
+fn template(args: &GenerateArgs) -> Result<LevelRequest> {
+    let profile = match &args.profile {
+        Some(file) => Some(profile::for_game(profile::load(file)?, args.game, file)?),
+        None => None,
+    };
+    let mut template = LevelRequest::new(0, None)
+        .goal(args.goal)
+        .obstacles(args.obstacles)
+        .profile(profile);
+    if let Some(aux) = args.ask().as_ref().and_then(Ask::aux) {
+        template = template.aux(aux);
+    }
+    if let Some(keep) = &args.keep {
+        template = template.keep(kept_prefix(keep, args.game)?);
+    }
+    Ok(template)
+}
+
+/// Level `seed` (its `draw`-th draw) as `template` asks, from the Generator when there is one,
+/// else from the rules.
 fn build(
     args: &GenerateArgs,
-    keep: Option<&KeptPrefix>,
+    template: &LevelRequest,
     generator: Option<&GeneratorPolicy>,
     seed: u64,
     draw: u32,
 ) -> Result<Level> {
-    let mut request = LevelRequest::new(seed, None)
-        .goal(args.goal)
-        .obstacles(args.obstacles)
-        .draw(draw);
-    if let Some(aux) = args.ask().as_ref().and_then(Ask::aux) {
-        request = request.aux(aux);
-    }
-    if let Some(keep) = keep {
-        request = request.keep(keep.clone());
-    }
+    let request = LevelRequest {
+        seed,
+        draw,
+        ..template.clone()
+    };
     Ok(match generator {
         Some(generator) => generation::generator_level(generator, &request)?,
         None => generation::rules_level(args.game, &request)?,
@@ -372,14 +385,14 @@ fn build(
 /// next draw (unless --allow-unsolved), and a kept level carries a certificate.
 fn build_verified(
     args: &GenerateArgs,
-    keep: Option<&KeptPrefix>,
+    template: &LevelRequest,
     generator: Option<&GeneratorPolicy>,
     solver: &Solver,
     seed: u64,
     stop: &AtomicBool,
 ) -> Result<Option<Level>> {
     let Some(trials) = args.verify else {
-        return build(args, keep, generator, seed, 0).map(Some);
+        return build(args, template, generator, seed, 0).map(Some);
     };
     // Ctrl-C abandons the trials under way within a tick: the level is not finished.
     let watch = verify::Watch {
@@ -387,7 +400,7 @@ fn build_verified(
         stop: &|| stop.load(Ordering::SeqCst),
     };
     for draw in 0..MAX_DRAWS {
-        let mut level = build(args, keep, generator, seed, draw)?;
+        let mut level = build(args, template, generator, seed, draw)?;
         let Some(mut stats) = verify::verify_watched(&level, solver, trials, seed, &watch)? else {
             return Ok(None);
         };
@@ -429,7 +442,7 @@ fn chosen_solver(args: &GenerateArgs, verify_trials: Option<u32>) -> Result<Opti
 fn build_levels(
     args: &GenerateArgs,
     plans: &[(u64, LevelFiles)],
-    keep: Option<&KeptPrefix>,
+    template: &LevelRequest,
     generator: Option<&GeneratorPolicy>,
     who: &Solver,
     curve: Option<&difficulty::Curve>,
@@ -448,14 +461,16 @@ fn build_levels(
                     generator,
                     who,
                     curve,
-                    &LevelRequest::new(*seed, None).goal(args.goal),
+                    &LevelRequest::new(*seed, None)
+                        .goal(args.goal)
+                        .profile(template.profile.clone()),
                     target,
                     verify_trials.unwrap_or(TARGET_TRIALS),
                 )
                 .map_err(anyhow::Error::from)
                 .and_then(|level| verify::certified(level, who, *seed).map_err(anyhow::Error::from))
                 .map(Some),
-                _ => build_verified(args, keep, generator, who, *seed, stop),
+                _ => build_verified(args, template, generator, who, *seed, stop),
             };
             bar.inc(1);
             level

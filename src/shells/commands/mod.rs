@@ -7,6 +7,7 @@ mod eval;
 mod export;
 mod export_policy;
 mod generate;
+mod profile;
 mod report;
 mod train;
 mod verify;
@@ -28,6 +29,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Campaign(args)) => campaign::run(&args),
         Some(Command::Eval(args)) => eval::run(&args),
         Some(Command::Report(args)) => report::run(&args),
+        Some(Command::Profile(command)) => profile::run(&command),
         Some(Command::Train(args)) => train::run(&args),
         Some(Command::Design(args)) => design(args),
         None => {

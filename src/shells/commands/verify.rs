@@ -12,6 +12,7 @@ use super::campaign::report_checks;
 use crate::services::checks::{Check, failures};
 use crate::services::panel::{JudgePanel, rate};
 use crate::services::policies::{load_panel, load_solver};
+use crate::services::profile;
 use crate::services::verify::{
     FailureConcentration, HalfwaySplit, Solver, SolverPolicy, Summary, Watch, passed_by_piece,
     verify,
@@ -19,6 +20,7 @@ use crate::services::verify::{
 use crate::shells::cli::{Judges, SolverChoice, VerifyArgs, default_solver};
 use arlpcg_core::game::Skill;
 use arlpcg_core::game::facts::facts;
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::stats::{Outcome, PanelStats, SolverRef, SolverStats};
 use arlpcg_core::level::yaml;
 use arlpcg_core::level::{Game, Level};
@@ -41,6 +43,7 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
             chart.display()
         );
     }
+    let profile = args.profile.as_deref().map(profile::load).transpose()?;
     let mut solvers = Solvers::default();
     let mut checked = Vec::new();
     let mut failed = 0;
@@ -51,9 +54,8 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
         if crate::shells::common::stdout_closed() {
             break; // nobody reads the rest
         }
-        let outcome = yaml::load(path)
-            .map_err(anyhow::Error::from)
-            .and_then(|level| {
+        let outcome =
+            load_under(path, profile.as_ref(), args.profile.as_deref()).and_then(|level| {
                 let game = level.game();
                 solvers.resolve(game, args)?;
                 let solver = solvers.get(game);
@@ -166,6 +168,30 @@ fn check_arguments(args: &VerifyArgs) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// The level file `path`, to be played under `profile` (read from `file`) when one is given:
+/// a level recording another profile is played under this one, and says so.
+fn load_under(path: &Path, profile: Option<&Profile>, file: Option<&Path>) -> Result<Level> {
+    let mut level = yaml::load(path)?;
+    let (Some(profile), Some(file)) = (profile, file) else {
+        return Ok(level);
+    };
+    let profile = profile::for_game(profile.clone(), level.game(), file)?;
+    let recorded = level.profile.as_ref().map(|p| (p.name.clone(), p.sha256()));
+    if recorded.as_ref().map(|(_, sha)| sha) != Some(&profile.sha256()) {
+        let was = recorded.map_or("the built-in profile".into(), |(name, sha)| {
+            format!("profile `{name}` ({})", &sha[..12])
+        });
+        crate::warn!(
+            "{}: made under {was}; playing it under `{}` ({})",
+            path.display(),
+            profile.name,
+            &profile.sha256()[..12]
+        );
+    }
+    level.profile = Some(profile);
+    Ok(level)
 }
 
 /// `verify --replay`: each level's certificate run, again, with the Solver that recorded it.
@@ -475,6 +501,9 @@ fn describe(path: &Path, level: &Level, s: &SolverStats) -> String {
         .collect();
     if let (Some(air), Some(dt)) = (s.mean_air_steps, facts(game).air_time_step) {
         text += &format!(", mean air time {:.2} s", air * dt);
+    }
+    if let Some(profile) = &level.profile {
+        text += &format!(", under profile `{}`", profile.name);
     }
     if !failures.is_empty() {
         let causes = match game {

@@ -92,7 +92,8 @@ pub trait GameSpec: Send + Sync + 'static {
     /// ...and its binary ones, after them.
     const BINARY_ACTIONS: &'static [&'static str];
 
-    /// The Solver's environment on `level`, or `None` for a level of another game.
+    /// The Solver's environment on `level` (with the abilities of the profile it records), or
+    /// `None` for a level of another game.
     fn solver_env(level: &crate::level::Level) -> Option<Self::Env>;
     /// The rule-based level of `seed` (its goal drawn from the seed), if the rules find one.
     fn rule_level(seed: u64) -> Option<crate::level::Level>;
@@ -116,11 +117,14 @@ impl GameSpec for PlatformGame {
 
     fn solver_env(level: &crate::level::Level) -> Option<platform::PlatformEnv> {
         let track = level.platform()?;
-        Some(platform::PlatformEnv::new(
-            track,
-            level.goal,
-            platform::PlatformRewards::default(),
-        ))
+        let env =
+            platform::PlatformEnv::new(track, level.goal, platform::PlatformRewards::default());
+        Some(match level.profile.as_ref().map(|p| p.abilities) {
+            Some(crate::level::profile::Abilities::Platform(character)) => {
+                env.with_body(character.into())
+            }
+            _ => env,
+        })
     }
 
     fn rule_level(seed: u64) -> Option<crate::level::Level> {
@@ -151,11 +155,11 @@ impl GameSpec for RacingGame {
         let crate::level::Track::Racing(track) = &level.track else {
             return None;
         };
-        Some(racing::RacingEnv::new(
-            track,
-            level.goal,
-            racing::RacingRewards::default(),
-        ))
+        let env = racing::RacingEnv::new(track, level.goal, racing::RacingRewards::default());
+        Some(match level.profile.as_ref().map(|p| p.abilities) {
+            Some(crate::level::profile::Abilities::Racing(car)) => env.with_car(car.into()),
+            _ => env,
+        })
     }
 
     fn rule_level(seed: u64) -> Option<crate::level::Level> {

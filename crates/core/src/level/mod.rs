@@ -7,6 +7,7 @@ pub mod heading;
 pub mod pacing;
 pub mod params;
 pub mod platform;
+pub mod profile;
 pub mod racing;
 pub mod road;
 pub mod scene;
@@ -195,6 +196,8 @@ pub struct Level {
     pub stats: Option<SolverStats>,
     /// λ along the level, when it was built with an aux curve (then `aux` is none).
     pub pacing: Option<pacing::Pacing>,
+    /// The game profile it was made and verified under; none for the built-in one.
+    pub profile: Option<crate::level::profile::Profile>,
 }
 
 /// Straight-line distance between two points, m.

@@ -171,6 +171,10 @@ impl Scene {
             scene.extras["aux_curve"] = json!(pacing.curve.to_string());
             scene.extras["aux_by_piece"] = json!(pacing.piece_aux);
         }
+        // The abilities the level was made for, so an engine's character can match them.
+        if let Some(profile) = &level.profile {
+            scene.extras["profile"] = json!(profile.record());
+        }
         if let Some(stats) = &level.stats {
             scene.extras["success_ratio"] = json!(stats.success_ratio);
             scene.extras["success_ci95"] = json!(stats.ci95);

@@ -1,31 +1,56 @@
 //! The platform character: a capsule moved by rapier's kinematic character controller under our
-//! own velocity rules (run, turn, jump, gravity, limited air control). The constants are the
+//! own velocity rules (run, turn, jump, gravity, limited air control). Its abilities come from
+//! the game profile ([`crate::level::profile::CharacterProfile`]); the built-in ones are the
 //! calibration described in `docs/platform-physics.md`.
 
 use rapier3d::math::Vector;
 use rapier3d::parry::shape::Capsule;
 
 use super::world::PlatformWorld;
+use crate::level::profile::CharacterProfile;
 
-/// Top horizontal speed, m/s.
-pub const RUN_SPEED: f32 = 8.0;
-/// Backwards the character runs at this fraction of `RUN_SPEED`.
+/// The character's abilities as the simulation steps with them (from a [`CharacterProfile`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Body {
+    /// Top horizontal speed, m/s.
+    pub run_speed: f32,
+    /// Vertical take-off speed of a jump, m/s.
+    pub jump_speed: f32,
+    /// Gravity, m/s².
+    pub gravity: f32,
+    pub ground_accel: f32,
+    pub air_accel: f32,
+    /// Fastest turn, degrees per second.
+    pub turn_rate_deg: f32,
+    /// Capsule radius, m.
+    pub radius: f32,
+    /// Half the length of the capsule's straight part, m.
+    pub half_height: f32,
+}
+
+impl From<CharacterProfile> for Body {
+    fn from(p: CharacterProfile) -> Self {
+        Self {
+            run_speed: p.run_speed as f32,
+            jump_speed: p.jump_speed as f32,
+            gravity: p.gravity as f32,
+            ground_accel: p.ground_accel as f32,
+            air_accel: p.air_accel as f32,
+            turn_rate_deg: p.turn_rate as f32,
+            radius: p.radius as f32,
+            half_height: (0.5 * p.height - p.radius) as f32,
+        }
+    }
+}
+
+impl Default for Body {
+    fn default() -> Self {
+        CharacterProfile::default().into()
+    }
+}
+
+/// Backwards the character runs at this fraction of its run speed.
 pub const BACKWARD_FACTOR: f32 = 0.5;
-/// Gravity, m/s².
-pub const GRAVITY: f32 = 20.0;
-/// Vertical take-off speed of a jump, m/s (apex 2.14 m). Calibrated so that a 6 m gap 2 m up is
-/// out of reach and 5 m is just within it (docs/platform-physics.md).
-pub const JUMP_SPEED: f32 = 9.25;
-/// Fastest turn, degrees per second.
-pub const TURN_RATE_DEG: f32 = 270.0;
-/// Horizontal acceleration toward the commanded velocity on the ground, m/s².
-pub const GROUND_ACCEL: f32 = 60.0;
-/// Horizontal acceleration in the air (a little steering, no second jump), m/s².
-pub const AIR_ACCEL: f32 = 6.0;
-/// Capsule radius, m.
-pub const RADIUS: f32 = 0.4;
-/// Half the length of the capsule's straight part, m (total height 1.8 m).
-pub const HALF_HEIGHT: f32 = 0.5;
 /// Physics steps per second.
 pub const PHYSICS_HZ: f32 = 60.0;
 /// Physics steps per Solver decision (decisions at 30 Hz).
@@ -76,15 +101,17 @@ pub struct Character {
     /// Facing, radians about +Y (0 along +X).
     pub yaw: f32,
     pub grounded: bool,
+    pub body: Body,
 }
 
 impl Character {
-    pub fn new(feet: Vector, yaw: f32) -> Self {
+    pub fn new(feet: Vector, yaw: f32, body: Body) -> Self {
         Self {
             feet,
             velocity: Vector::ZERO,
             yaw,
             grounded: true,
+            body,
         }
     }
 
@@ -93,31 +120,32 @@ impl Character {
         Vector::new(self.yaw.cos(), 0.0, -self.yaw.sin())
     }
 
-    fn shape() -> Capsule {
-        Capsule::new_y(HALF_HEIGHT, RADIUS)
+    fn shape(&self) -> Capsule {
+        Capsule::new_y(self.body.half_height, self.body.radius)
     }
 
-    fn centre_offset() -> Vector {
-        Vector::Y * (HALF_HEIGHT + RADIUS)
+    fn centre_offset(&self) -> Vector {
+        Vector::Y * (self.body.half_height + self.body.radius)
     }
 
     /// Advances one decision (`ACTION_REPEAT` physics steps) under `action`.
     pub fn step(&mut self, world: &PlatformWorld, action: PlatformAction) {
         let action = action.sanitized();
         let dt = 1.0 / PHYSICS_HZ;
-        let shape = Self::shape();
+        let shape = self.shape();
+        let body = self.body;
         for substep in 0..ACTION_REPEAT {
-            self.yaw += action.turn * TURN_RATE_DEG.to_radians() * dt;
+            self.yaw += action.turn * body.turn_rate_deg.to_radians() * dt;
             let speed = if action.forward >= 0.0 {
-                action.forward * RUN_SPEED
+                action.forward * body.run_speed
             } else {
-                action.forward * RUN_SPEED * BACKWARD_FACTOR
+                action.forward * body.run_speed * BACKWARD_FACTOR
             };
             let wanted = self.facing() * speed;
             let accel = if self.grounded {
-                GROUND_ACCEL
+                body.ground_accel
             } else {
-                AIR_ACCEL
+                body.air_accel
             };
             let horizontal = Vector::new(self.velocity.x, 0.0, self.velocity.z);
             let change = wanted - horizontal;
@@ -129,16 +157,15 @@ impl Character {
             };
             let mut vertical = self.velocity.y;
             if action.jump && self.grounded && substep == 0 {
-                vertical = JUMP_SPEED;
+                vertical = body.jump_speed;
             }
             // On the ground, snap-to-ground holds the character down; pushing into the floor
             // as well makes rapier's controller stall now and then (it reads the floor as a wall).
             if !(self.grounded && vertical <= 0.0) {
-                vertical -= GRAVITY * dt;
+                vertical -= body.gravity * dt;
             }
             let desired = Vector::new(horizontal.x, vertical, horizontal.z) * dt;
-            let moved =
-                world.move_character(dt, &shape, self.feet + Self::centre_offset(), desired);
+            let moved = world.move_character(dt, &shape, self.feet + self.centre_offset(), desired);
             self.feet += moved.translation;
             // Blocked by a wall or a ceiling: lose the velocity into it.
             let mut velocity = Vector::new(horizontal.x, vertical, horizontal.z);

@@ -5,7 +5,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rapier3d::math::Vector;
 
-use super::character::{Character, DECISION_DT, PlatformAction, RADIUS};
+use super::character::{Body, Character, DECISION_DT, PlatformAction};
 use super::world::PlatformWorld;
 use crate::game::Step;
 use crate::level::PlatformTrack;
@@ -106,6 +106,8 @@ pub struct PlatformEnv {
     /// the last block is not yet success.
     open: bool,
     character: Character,
+    /// The character's abilities (the game profile's).
+    body: Body,
     /// Highest platform index the character has stood on (0 is the start block).
     furthest: usize,
     steps: u32,
@@ -125,7 +127,8 @@ impl PlatformEnv {
             path_after: Vec::new(),
             max_steps: 0,
             open: false,
-            character: Character::new(start.top, start.heading),
+            character: Character::new(start.top, start.heading, Body::default()),
+            body: Body::default(),
             furthest: 0,
             steps: 0,
             remaining: 0.0,
@@ -134,6 +137,13 @@ impl PlatformEnv {
         env.measure_track();
         env.reset(0);
         env
+    }
+
+    /// The same environment for a character of other abilities (a game profile's).
+    pub fn with_body(mut self, body: Body) -> Self {
+        self.body = body;
+        self.reset(0);
+        self
     }
 
     /// The environment of a track the Generator is still building: it starts with `track`
@@ -182,7 +192,7 @@ impl PlatformEnv {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let block = block.min(self.world.platforms().len() - 1);
         let start = self.world.platforms()[block];
-        let reach = (0.5 * start.size - RADIUS - 0.5).clamp(0.0, 1.0);
+        let reach = (0.5 * start.size - self.body.radius - 0.5).clamp(0.0, 1.0);
         let local = Vector::new(
             rng.random_range(-reach..=reach),
             0.0,
@@ -190,7 +200,7 @@ impl PlatformEnv {
         );
         let offset = rapier3d::math::Rotation::from_rotation_y(start.heading) * local;
         let yaw = start.heading + rng.random_range(-90.0f32..=90.0).to_radians();
-        self.character = Character::new(start.top + offset, yaw);
+        self.character = Character::new(start.top + offset, yaw, self.body);
         self.furthest = block;
         self.steps = 0;
         self.outcome = None;
@@ -250,7 +260,7 @@ impl PlatformEnv {
         self.world
             .platforms()
             .iter()
-            .position(|p| (feet.y - p.top.y).abs() < 0.2 && p.covers(feet, RADIUS))
+            .position(|p| (feet.y - p.top.y).abs() < 0.2 && p.covers(feet, self.body.radius))
     }
 
     /// Index of the next platform to reach (the last one once the run has succeeded).

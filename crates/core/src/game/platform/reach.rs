@@ -3,6 +3,7 @@
 //! two equal jumps, turned), and the function that measures it. `docs/platform-physics.md`
 //! prints the table; a test re-measures it.
 
+use super::character::Body;
 use super::env::{PlatformEnv, PlatformRewards};
 use super::scripted::ScriptedController;
 use crate::level::platform::{BlockParams, PlatformTrack, Start};
@@ -89,10 +90,11 @@ pub fn play_scripted(env: &mut PlatformEnv, seed: u64, jitter: f32) -> TrialResu
     }
 }
 
-/// How many of `trials` seeded scripted runs reach the last block of `track`.
-pub fn successes(track: &PlatformTrack, trials: u64, jitter: f32) -> u64 {
+/// How many of `trials` seeded scripted runs of a character of `body` reach the last block of
+/// `track`.
+pub fn successes(track: &PlatformTrack, body: Body, trials: u64, jitter: f32) -> u64 {
     let goal = track.last().position;
-    let mut env = PlatformEnv::new(track, goal, PlatformRewards::default());
+    let mut env = PlatformEnv::new(track, goal, PlatformRewards::default()).with_body(body);
     (0..trials)
         .filter(|&seed| play_scripted(&mut env, seed, jitter).outcome == Outcome::Success)
         .count() as u64
@@ -100,16 +102,20 @@ pub fn successes(track: &PlatformTrack, trials: u64, jitter: f32) -> u64 {
 
 /// Measures the reach table: for each height change, the largest gap such that every chained
 /// jump up to it (in `REACH_STEP` steps from 1 m, at every turn of `REACH_TURNS`) is cleared in
-/// all `REACH_TRIALS` runs.
-pub fn measure_reach() -> [f64; 5] {
+/// all `REACH_TRIALS` runs, for a character of `body`.
+pub fn measure_reach(body: Body) -> [f64; 5] {
     REACH_HEIGHTS.map(|height| {
         let steps = ((GAP_RANGE.1 - GAP_RANGE.0) / REACH_STEP).round() as usize;
         let mut best = GAP_RANGE.0 - REACH_STEP;
         for k in 0..=steps {
             let gap = GAP_RANGE.0 + k as f64 * REACH_STEP;
             let cleared = REACH_TURNS.iter().all(|&turn| {
-                successes(&chained_jump(gap, height, turn), REACH_TRIALS, REACH_JITTER)
-                    == REACH_TRIALS
+                successes(
+                    &chained_jump(gap, height, turn),
+                    body,
+                    REACH_TRIALS,
+                    REACH_JITTER,
+                ) == REACH_TRIALS
             });
             if !cleared {
                 break;

@@ -94,6 +94,7 @@ pub fn platform_level_draw(
                 source: Source::Rules { rules: *config },
                 stats: None,
                 pacing: None,
+                profile: None,
             });
         }
     }

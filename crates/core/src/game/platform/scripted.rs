@@ -9,9 +9,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rapier3d::math::Vector;
 
-use super::character::{
-    DECISION_DT, GRAVITY, JUMP_SPEED, PlatformAction, RADIUS, RUN_SPEED, TURN_RATE_DEG,
-};
+use super::character::{Body, DECISION_DT, PlatformAction};
 use super::env::PlatformEnv;
 use super::world::PlatformBox;
 use crate::game::Skill;
@@ -106,7 +104,8 @@ impl ScriptedController {
         let to_next = Vector::new(next.top.x - c.feet.x, 0.0, next.top.z - c.feet.z);
         let wanted_yaw = (-to_next.z).atan2(to_next.x);
         let error = wrap_radians(wanted_yaw - c.yaw);
-        let turn = (error / (TURN_RATE_DEG.to_radians() * DECISION_DT)).clamp(-1.0, 1.0);
+        let body = c.body;
+        let turn = (error / (body.turn_rate_deg.to_radians() * DECISION_DT)).clamp(-1.0, 1.0);
         if !c.grounded {
             return PlatformAction {
                 forward: self.forward,
@@ -126,11 +125,12 @@ impl ScriptedController {
         let (enter, leave) = crossing(&next, c.feet, direction);
         // Take off at this block's edge, or sooner where the next block overlaps it: its side
         // stops the capsule one radius short of its footprint.
-        let takeoff = exit_distance(&current, c.feet, direction).min((enter - RADIUS).max(0.0));
+        let takeoff =
+            exit_distance(&current, c.feet, direction).min((enter - body.radius).max(0.0));
         let aim = enter + LANDING_DEPTH.min(0.5 * (leave - enter));
-        let flight = flight_time(next.top.y - c.feet.y);
-        let speed = ((aim - takeoff) / flight).clamp(1.0, RUN_SPEED);
-        self.forward = (self.speed_factor * speed / RUN_SPEED).min(1.0);
+        let flight = flight_time(&body, next.top.y - c.feet.y);
+        let speed = ((aim - takeoff) / flight).clamp(1.0, body.run_speed);
+        self.forward = (self.speed_factor * speed / body.run_speed).min(1.0);
         let jump = takeoff < speed * DECISION_DT + self.takeoff_margin;
         if jump {
             self.draw_next_jump();
@@ -144,10 +144,11 @@ impl ScriptedController {
 }
 
 /// Seconds from take-off until a jump comes down to `rise` metres above the take-off height
-/// (the longest flight when the rise is out of reach).
-fn flight_time(rise: f32) -> f32 {
-    let discriminant = (JUMP_SPEED * JUMP_SPEED - 2.0 * GRAVITY * rise).max(0.0);
-    (JUMP_SPEED + discriminant.sqrt()) / GRAVITY
+/// (the longest flight when the rise is out of reach), for `body`.
+fn flight_time(body: &Body, rise: f32) -> f32 {
+    let (jump, gravity) = (body.jump_speed, body.gravity);
+    let discriminant = (jump * jump - 2.0 * gravity * rise).max(0.0);
+    (jump + discriminant.sqrt()) / gravity
 }
 
 /// Distance along `direction` from `point` (inside the block's footprint) to its edge.

@@ -1,5 +1,6 @@
 //! The car: rapier3d's ray-cast vehicle (`DynamicRayCastVehicleController`) on a dynamic chassis
-//! over the road's triangle mesh, with its calibrated constants (docs/racing-physics.md).
+//! over the road's triangle mesh. Its abilities come from the game profile ([`Car`] from a
+//! [`CarProfile`]); the built-in ones are calibrated in docs/racing-physics.md.
 //!
 //! A [`RacingWorld`] is rebuilt for every run from the road's shared shape (the mesh and its
 //! BVH are built once per track), so a run depends only on the track and its actions: the same
@@ -10,6 +11,7 @@ use rapier3d::math::{Pose, Rotation, Vector};
 use rapier3d::parry::shape::TriMeshFlags;
 use rapier3d::prelude::*;
 
+use crate::level::profile::CarProfile;
 use crate::level::racing::{Obstacle, RacingTrack};
 use crate::level::road::Road;
 
@@ -17,8 +19,6 @@ use crate::level::road::Road;
 pub const DECISION_DT: f32 = 1.0 / 30.0;
 /// Gravity, m/s².
 pub const GRAVITY: f32 = 9.81;
-/// Chassis mass, kg.
-pub const MASS: f32 = 1200.0;
 /// Half extents of the chassis box (length, height, width), m.
 pub const CHASSIS_HALF: [f32; 3] = [2.0, 0.3, 0.9];
 /// The centre of mass sits this far below the box's centre, m.
@@ -32,17 +32,48 @@ const WHEELS: [[f32; 3]; 4] = [
 ];
 pub const WHEEL_RADIUS: f32 = 0.35;
 pub const SUSPENSION_REST: f32 = 0.35;
-/// Total engine force at full throttle (rear wheels), N.
-pub const ENGINE_FORCE: f32 = 7200.0;
-/// Air and rolling drag on the chassis, per second: with the engine it sets the top speed
-/// `ENGINE_FORCE / (MASS · LINEAR_DAMPING)`.
-pub const LINEAR_DAMPING: f32 = 0.21;
-/// Brake impulse cap per wheel per step at full brake, N·s (about 0.8 g on four wheels).
-pub const BRAKE_IMPULSE: f32 = MASS * 0.8 * GRAVITY * DECISION_DT / 4.0;
-/// Front wheels' steering at full lock, radians.
-pub const MAX_STEER: f32 = 0.5;
-/// Tyre friction coefficient (rapier's `friction_slip`).
-pub const FRICTION: f32 = 0.9;
+
+/// The car's abilities as the simulation steps with them (from a [`CarProfile`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Car {
+    /// Total engine force at full throttle (rear wheels), N.
+    pub engine_force: f32,
+    /// Chassis mass, kg.
+    pub mass: f32,
+    /// Tyre friction coefficient (rapier's `friction_slip`).
+    pub grip: f32,
+    /// Front wheels' steering at full lock, radians.
+    pub max_steer: f32,
+    /// Air and rolling drag on the chassis, per second: with the engine it sets the top speed
+    /// `engine_force / (mass · damping)`.
+    pub damping: f32,
+}
+
+impl Car {
+    /// Brake impulse cap per wheel per step at full brake, N·s (about 0.8 g on four wheels).
+    pub fn brake_impulse(&self) -> f32 {
+        self.mass * 0.8 * GRAVITY * DECISION_DT / 4.0
+    }
+}
+
+impl From<CarProfile> for Car {
+    fn from(p: CarProfile) -> Self {
+        Self {
+            engine_force: p.engine_force as f32,
+            mass: p.mass as f32,
+            grip: p.grip as f32,
+            max_steer: p.max_steer as f32,
+            damping: p.damping as f32,
+        }
+    }
+}
+
+impl Default for Car {
+    fn default() -> Self {
+        CarProfile::default().into()
+    }
+}
+
 /// The car starts this far along the road, m, and this high above it.
 pub const START_S: f64 = 5.0;
 const START_LIFT: f32 = 0.25;
@@ -156,12 +187,14 @@ pub struct RacingWorld {
     vehicle: DynamicRayCastVehicleController,
     chassis: RigidBodyHandle,
     road: ColliderHandle,
+    car: Car,
 }
 
 impl RacingWorld {
-    /// A world with the car standing at `position` (its wheels' height), heading `heading`
+    /// A world with `car` standing at `position` (its wheels' height), heading `heading`
     /// radians, at rest.
-    pub fn new(shapes: &TrackShapes, position: Vector, heading: f32) -> Self {
+    pub fn new(shapes: &TrackShapes, car: Car, position: Vector, heading: f32) -> Self {
+        let mass = car.mass;
         let mut bodies = RigidBodySet::new();
         let mut colliders = ColliderSet::new();
         let road = colliders.insert(Self::road_collider(shapes));
@@ -175,21 +208,21 @@ impl RacingWorld {
                     position + Vector::Y * ride,
                     Rotation::from_rotation_y(heading),
                 ))
-                .linear_damping(LINEAR_DAMPING)
+                .linear_damping(car.damping)
                 .angular_damping(0.5)
                 .can_sleep(false),
         );
         let [hx, hy, hz] = CHASSIS_HALF;
         let inertia = Vector::new(
-            MASS / 3.0 * (hy * hy + hz * hz),
-            MASS / 3.0 * (hx * hx + hz * hz),
-            MASS / 3.0 * (hx * hx + hy * hy),
+            mass / 3.0 * (hy * hy + hz * hz),
+            mass / 3.0 * (hx * hx + hz * hz),
+            mass / 3.0 * (hx * hx + hy * hy),
         );
         colliders.insert_with_parent(
             ColliderBuilder::cuboid(hx, hy, hz)
                 .mass_properties(MassProperties::new(
                     Vector::new(0.0, -COM_DROP, 0.0),
-                    MASS,
+                    mass,
                     inertia,
                 ))
                 .friction(0.6),
@@ -203,8 +236,8 @@ impl RacingWorld {
             suspension_damping: 4.0,
             max_suspension_travel: 0.3,
             side_friction_stiffness: 1.0,
-            friction_slip: FRICTION,
-            max_suspension_force: MASS * GRAVITY * 2.0,
+            friction_slip: car.grip,
+            max_suspension_force: mass * GRAVITY * 2.0,
         };
         for [x, y, z] in WHEELS {
             vehicle.add_wheel(
@@ -236,6 +269,7 @@ impl RacingWorld {
             vehicle,
             chassis,
             road,
+            car,
         };
         // Queries see the colliders only after collision detection has run once.
         world.pipeline.step(
@@ -278,9 +312,9 @@ impl RacingWorld {
     /// One decision: set the controls, update the wheels, step the physics.
     pub fn step(&mut self, action: CarAction) {
         let throttle = action.throttle.clamp(-1.0, 1.0);
-        let steer = action.steer.clamp(-1.0, 1.0) * MAX_STEER;
-        let engine = 0.5 * ENGINE_FORCE * throttle.max(0.0);
-        let brake = BRAKE_IMPULSE * (-throttle).max(0.0);
+        let steer = action.steer.clamp(-1.0, 1.0) * self.car.max_steer;
+        let engine = 0.5 * self.car.engine_force * throttle.max(0.0);
+        let brake = self.car.brake_impulse() * (-throttle).max(0.0);
         for (i, wheel) in self.vehicle.wheels_mut().iter_mut().enumerate() {
             let front = i < 2;
             wheel.steering = if front { steer } else { 0.0 };
@@ -310,6 +344,11 @@ impl RacingWorld {
             &(),
             &(),
         );
+    }
+
+    /// The car's abilities.
+    pub fn car(&self) -> &Car {
+        &self.car
     }
 
     fn body(&self) -> &RigidBody {

@@ -7,7 +7,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rapier3d::math::{Rotation, Vector};
 
-use super::car::{CarAction, DECISION_DT, RacingWorld, START_S, TrackShapes};
+use super::car::{Car, CarAction, DECISION_DT, RacingWorld, START_S, TrackShapes};
 use crate::game::Step;
 use crate::level::racing::{RacingTrack, SegmentParams};
 use crate::level::road::{ROAD_WIDTH, Road};
@@ -115,6 +115,8 @@ pub struct RacingEnv {
     shapes: TrackShapes,
     goal: [f64; 3],
     rewards: RacingRewards,
+    /// The car's abilities (the game profile's).
+    car: Car,
     world: RacingWorld,
     max_steps: u32,
     /// Index of the road sample nearest the car.
@@ -141,13 +143,15 @@ impl RacingEnv {
 
     /// The environment of a resolved road and its shapes, with the car at the start.
     fn from_parts(road: Road, shapes: TrackShapes, goal: [f64; 3], rewards: RacingRewards) -> Self {
-        let world = RacingWorld::new(&shapes, Vector::ZERO, 0.0);
+        let car = Car::default();
+        let world = RacingWorld::new(&shapes, car, Vector::ZERO, 0.0);
         let max_steps = Self::time_limit(&road);
         let mut env = Self {
             road,
             shapes,
             goal,
             rewards,
+            car,
             world,
             max_steps,
             nearest: 0,
@@ -161,6 +165,13 @@ impl RacingEnv {
         };
         env.reset(0);
         env
+    }
+
+    /// The same environment for a car of other abilities (a game profile's).
+    pub fn with_car(mut self, car: Car) -> Self {
+        self.car = car;
+        self.reset(0);
+        self
     }
 
     /// The environment of a track a Generator is still building: it starts with `track` (at
@@ -219,6 +230,7 @@ impl RacingEnv {
         let p = sample.across(offset);
         self.world = RacingWorld::new(
             &self.shapes,
+            self.car,
             Vector::new(p[0] as f32, p[1] as f32, p[2] as f32),
             (sample.heading + turn) as f32,
         );

@@ -126,6 +126,7 @@ pub fn racing_level_draw(
                 source: Source::RacingRules { rules: *config },
                 stats: None,
                 pacing: None,
+                profile: None,
             });
         }
     }

@@ -10,7 +10,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rapier3d::math::Vector;
 
-use super::car::{CarAction, FRICTION, GRAVITY, MAX_STEER};
+use super::car::{CarAction, GRAVITY};
 use super::env::RacingEnv;
 use crate::game::Skill;
 
@@ -123,7 +123,7 @@ impl ScriptedDriver {
             // Crests curve the road downward: slope falls along it.
             let crest = (-(b.slope - a.slope) / ds).max(0.0) as f32;
             let bank = a.bank.abs() as f32;
-            let grip = grip_share * GRAVITY * (FRICTION + bank.tan());
+            let grip = grip_share * GRAVITY * (env.world().car().grip + bank.tan());
             let mut here = CRUISE_SPEED;
             if curvature > 1e-4 {
                 here = here.min((grip / curvature).sqrt());
@@ -157,7 +157,7 @@ impl ScriptedDriver {
         let left = -to_target.x * s - to_target.z * c;
         let alpha = left.atan2(ahead);
         let distance = ahead.hypot(left).max(1.0);
-        let mut steer = (2.0 * WHEELBASE * alpha.sin() / distance).atan() / MAX_STEER;
+        let mut steer = (2.0 * WHEELBASE * alpha.sin() / distance).atan() / world.car().max_steer;
         if self.skill.steer_wobble > 0.0 {
             if self.wobble_age.is_multiple_of(WOBBLE_DECISIONS) {
                 let w = self.skill.steer_wobble;

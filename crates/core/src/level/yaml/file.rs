@@ -12,6 +12,7 @@ use crate::level::heading;
 use crate::level::pacing::{AuxCurve, Pacing};
 use crate::level::params::{self, ParamRange};
 use crate::level::platform::{BlockParams, PlatformTrack, Start};
+use crate::level::profile::ProfileRecord;
 use crate::level::racing::{Obstacle, RacingTrack, SegmentParams};
 use crate::level::{Game, Level, SolverStats, Source, Track};
 
@@ -108,6 +109,9 @@ pub(super) struct LevelFile {
     obstacles: Vec<Obstacle>,
     #[serde(default)]
     source: Source,
+    /// The game profile it was made under (none: the built-in one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    profile: Option<ProfileRecord>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     stats: Option<SolverStats>,
 }
@@ -218,12 +222,21 @@ impl LevelFile {
             segments,
             obstacles,
             source: level.source.clone(),
+            profile: level.profile.as_ref().map(|p| p.record()),
             stats: level.stats.clone(),
         }
     }
 
     pub(super) fn into_level(self, text: &str) -> Result<Level, Problem> {
         let pacing = self.pacing(text)?;
+        let profile = match &self.profile {
+            Some(record) => Some(
+                record
+                    .profile(self.game)
+                    .map_err(|e| invalid("profile".into(), line_of_key(text, "profile"), e))?,
+            ),
+            None => None,
+        };
         let (track, default_goal) = match self.game {
             Game::Platform => self.platform_track(text)?,
             Game::Racing => self.racing_track(text)?,
@@ -239,6 +252,7 @@ impl LevelFile {
             source: self.source,
             stats: self.stats,
             pacing,
+            profile,
         };
         level.validate().map_err(|e| {
             let key = |key: &str| (key.to_string(), line_of_key(text, key));

@@ -21,6 +21,7 @@ use crate::services::level_files::{Format, LevelFiles, render};
 use crate::services::panel::{Judge, JudgePanel, play_and_rate};
 use crate::services::verify::{self, Solver, Watch};
 use arlpcg_core::level::pacing::{AuxCurve, CurveWords, parse_points, show_points, value_at};
+use arlpcg_core::level::profile::{Profile, ProfileRecord};
 use arlpcg_core::level::stats::Rating;
 use arlpcg_core::level::{Game, Level};
 use arlpcg_core::statistics::population::{LevelFlow, Population};
@@ -106,6 +107,9 @@ pub struct Campaign {
     /// The shape of λ along each level (pacing), moved as a whole by each level's search.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pacing: Option<AuxCurve>,
+    /// The game profile every level is made for (none: the built-in one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<ProfileRecord>,
     /// Acceptance checks every level must pass (`verify --campaign` applies them).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub checks: Vec<Check>,
@@ -171,11 +175,21 @@ pub struct CampaignAsk {
     pub trials: u32,
     pub ramp: Ramp,
     pub pacing: Option<AuxCurve>,
+    pub profile: Option<Profile>,
     pub checks: Vec<Check>,
     pub population: PopulationAsk,
 }
 
 impl CampaignAsk {
+    /// What level `seed`'s search asks (its λ curve's shape, its profile).
+    pub fn request(&self, seed: u64) -> LevelRequest {
+        let asked = LevelRequest::new(seed, None).profile(self.profile.clone());
+        match &self.pacing {
+            Some(shape) => asked.aux(AuxAsk::Curve(shape.clone())),
+            None => asked,
+        }
+    }
+
     /// The success asked of level `k` of `n`.
     pub fn target(&self, k: usize, n: usize) -> f64 {
         self.ramp.at(position(k, n))
@@ -267,6 +281,7 @@ impl CampaignAsk {
             trials: self.trials,
             ramp: self.ramp.clone(),
             pacing: self.pacing.clone(),
+            profile: self.profile.as_ref().map(Profile::record),
             checks: self.checks.clone(),
             population: Population {
                 theta_mean: round4(population.theta_mean),
@@ -299,6 +314,10 @@ impl Campaign {
             trials: self.trials,
             ramp: self.ramp.clone(),
             pacing: self.pacing.clone(),
+            profile: self
+                .profile
+                .as_ref()
+                .and_then(|record| record.profile(self.game).ok()),
             checks: self.checks.clone(),
             population: match self.population_from.as_str() {
                 "given" => PopulationAsk::Given(self.population),
@@ -368,6 +387,9 @@ impl Campaign {
             self.trials,
             self.pacing.as_ref().map_or(String::new(), |c| format!(
                 ", each level paced by `{c}` moved as a whole"
+            )) + &self.profile.as_ref().map_or(String::new(), |p| format!(
+                ", made for profile `{}`",
+                p.name
             )),
             p.theta_mean,
             p.theta_sd,
@@ -504,25 +526,19 @@ impl Campaign {
     }
 }
 
-/// Level `seed`'s search: a level whose success for `solver`, over `trials` runs, is within
-/// [`difficulty::BAND`] of `target` ([`difficulty::level_for`]; with `pacing`, that curve of λ
-/// moved as a whole), with its certificate.
+/// The search `asked` ([`CampaignAsk::request`]): a level whose success for `solver`, over
+/// `trials` runs, is within [`difficulty::BAND`] of `target` ([`difficulty::level_for`]; with a
+/// curve of λ, that curve moved as a whole), with its certificate.
 pub fn search_level(
     generator: &GeneratorPolicy,
     solver: &Solver,
     curve: &difficulty::Curve,
-    seed: u64,
-    pacing: Option<&AuxCurve>,
+    asked: &LevelRequest,
     target: f64,
     trials: u32,
 ) -> anyhow::Result<Level> {
-    let asked = LevelRequest::new(seed, None);
-    let asked = match pacing {
-        Some(shape) => asked.aux(AuxAsk::Curve(shape.clone())),
-        None => asked,
-    };
     let level = difficulty::level_for(generator, solver, curve, &asked, target, trials)?;
-    Ok(verify::certified(level, solver, seed)?)
+    Ok(verify::certified(level, solver, asked.seed)?)
 }
 
 /// The panel plays `levels` (each verified by the judge; those it has played keep their plays)
@@ -695,10 +711,8 @@ pub fn regenerate_level(
         .unwrap_or(record.seed)
         + 1;
     let target = record.levels[k].asked;
-    let pacing = record.pacing.as_ref();
-    levels[k] = search_level(
-        generator, &solver, &curve, seed, pacing, target, record.trials,
-    )?;
+    let asked = record.ask().request(seed);
+    levels[k] = search_level(generator, &solver, &curve, &asked, target, record.trials)?;
     for level in &mut levels {
         if let Some(stats) = &mut level.stats {
             stats.panel = None;

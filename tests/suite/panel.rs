@@ -226,15 +226,31 @@ fn a_campaign_follows_its_ramp_and_resumes_to_the_same_bytes() {
     );
 }
 
-/// With --pacing, every level follows the curve's shape, moved as a whole to its ramp point.
+/// With --pacing, every level follows the curve's shape, moved as a whole to its ramp point;
+/// with --profile, every level is made for it and the record says so.
 #[test]
 fn a_paced_campaign_moves_one_shape_per_level() {
     let dir = tempfile::tempdir().unwrap();
-    let done = small_campaign(dir.path(), &["--pacing", "0:0.4, 1:-0.4"]);
+    let init = arlpcg_ok(&["profile", "init", "--game", "platform"]);
+    let profile = String::from_utf8(init.stdout)
+        .unwrap()
+        .replace("name: default", "name: quick")
+        .replace("run_speed: 8.0", "run_speed: 8.5");
+    let profile_file = dir.path().join("quick.yaml");
+    std::fs::write(&profile_file, profile).unwrap();
+    let out = dir.path().join("campaign");
+    let profile_arg = profile_file.to_str().unwrap();
+    let done = small_campaign(
+        &out,
+        &["--pacing", "0:0.4, 1:-0.4", "--profile", profile_arg],
+    );
     assert!(done.status.success(), "{}", stderr(&done));
+    let level01 = std::fs::read_to_string(out.join("level01.yaml")).unwrap();
+    assert!(level01.contains("profile:\n  name: quick"), "{level01}");
     let record: serde_yaml::Value =
-        serde_yaml::from_slice(&std::fs::read(dir.path().join("campaign.yaml")).unwrap()).unwrap();
+        serde_yaml::from_slice(&std::fs::read(out.join("campaign.yaml")).unwrap()).unwrap();
     assert_eq!(record["pacing"].as_str(), Some("0:0.4, 1:-0.4"));
+    assert_eq!(record["profile"]["name"].as_str(), Some("quick"));
     for level in record["levels"].as_sequence().unwrap() {
         assert!(level.get("aux").is_none(), "{level:?}");
         let curve = level["aux_curve"].as_str().unwrap();
@@ -249,11 +265,9 @@ fn a_paced_campaign_moves_one_shape_per_level() {
         assert!(clamped || ((start - end) - 0.8).abs() < 2e-3, "{curve}");
         assert!(start > end, "{curve}");
     }
-    let page = std::fs::read_to_string(dir.path().join("campaign.md")).unwrap();
-    assert!(
-        page.contains("each level paced by `0:0.4, 1:-0.4`"),
-        "{page}"
-    );
+    let page = std::fs::read_to_string(out.join("campaign.md")).unwrap();
+    let said = "each level paced by `0:0.4, 1:-0.4` moved as a whole, made for profile `quick`";
+    assert!(page.contains(said), "{page}");
 }
 
 #[test]

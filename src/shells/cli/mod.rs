@@ -532,6 +532,10 @@ pub struct CampaignArgs {
     /// searched) until the judge's success fits the ramp. Default: one λ per level.
     #[arg(long, value_name = "CURVE", allow_hyphen_values = true, value_parser = AuxCurve::parse)]
     pub pacing: Option<AuxCurve>,
+    /// Make every level for this game profile (`arlpcg profile init`); campaign.yaml and each
+    /// level record it. Default: the built-in one.
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<PathBuf>,
     /// Whose success the ramp asks for: a Solver of --policies named by its training mode
     /// (arlpcg, rule-pcg, fixed-track, fixed-aux) or the scripted player (scripted-novice,
     /// scripted-median, scripted-expert). Default: arlpcg.

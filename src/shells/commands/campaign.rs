@@ -22,6 +22,7 @@ use crate::services::panel::Judge;
 use crate::services::policies::{
     difficulty_curve, load_generator, load_panel, policy_paths, shipped_dir,
 };
+use crate::services::profile;
 use crate::services::verify::{self, Solver, Watch};
 use crate::shells::cli::{CampaignArgs, VerifyArgs};
 use crate::shells::common::{ChecksFailed, Interrupted, progress_bar};
@@ -52,6 +53,10 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         trials: args.trials,
         ramp: args.ramp.clone(),
         pacing: args.pacing.clone(),
+        profile: match &args.profile {
+            Some(file) => Some(profile::for_game(profile::load(file)?, args.game, file)?),
+            None => None,
+        },
         checks: args.checks.clone(),
         population: match args.population {
             Some((theta_mean, theta_sd)) => PopulationAsk::Given(Population {
@@ -100,9 +105,13 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     }
     let mut levels: Vec<Level> = built.into_iter().flatten().collect();
     let search = |seed: u64, target: f64| {
-        let pacing = args.pacing.as_ref();
         search_level(
-            &generator, &solver, &curve, seed, pacing, target, args.trials,
+            &generator,
+            &solver,
+            &curve,
+            &ask.request(seed),
+            target,
+            args.trials,
         )
     };
     let Some(campaign) = rate_levels(&ask, &panel, &mut levels, &stop, Some(&search))? else {
@@ -144,8 +153,7 @@ fn search_levels(
                 generator,
                 solver,
                 curve,
-                seed,
-                args.pacing.as_ref(),
+                &ask.request(seed),
                 ask.target(k, n),
                 args.trials,
             )

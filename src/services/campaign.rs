@@ -537,7 +537,7 @@ pub fn search_level(
     target: f64,
     trials: u32,
 ) -> anyhow::Result<Level> {
-    let level = difficulty::level_for(generator, solver, curve, &asked, target, trials)?;
+    let level = difficulty::level_for(generator, solver, curve, asked, target, trials)?;
     Ok(verify::certified(level, solver, asked.seed)?)
 }
 

@@ -123,6 +123,40 @@ fn starts_with_a_level_and_its_statistics() {
     );
 }
 
+/// With a profile (`design --profile`), levels are made and played for it and the header says
+/// so: a low jumper fails rule levels the built-in character completes.
+#[test]
+fn a_profile_makes_the_levels_and_plays_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let low = arlpcg_core::level::profile::Profile::parse(
+        &arlpcg_core::level::profile::Profile::default_of(Game::Platform)
+            .to_yaml()
+            .replace("name: default", "name: low-jumper")
+            .replace("jump_speed: 9.25", "jump_speed: 6.0"),
+    )
+    .unwrap();
+    let policies = Policies {
+        profile: Some(low),
+        ..Policies::default()
+    };
+    let mut h = Harness::new(policies, LoadedInfo::default(), dir.path());
+    h.settle();
+    let level = h.app.level.clone().expect("a level is on screen");
+    assert_eq!(
+        level.profile.as_ref().map(|p| p.name.as_str()),
+        Some("low-jumper")
+    );
+    assert!(h.screen(120, 36).contains("profile: low-jumper"));
+    let low_successes = h.app.trials.as_ref().unwrap().successes();
+    let mut plain = Harness::rules(dir.path());
+    plain.settle();
+    assert_eq!(plain.app.level.as_ref().unwrap().track, level.track);
+    assert!(
+        low_successes < plain.app.trials.as_ref().unwrap().successes(),
+        "the low jumper does worse on the same level"
+    );
+}
+
 #[test]
 fn whole_screen_at_80x24() {
     let dir = tempfile::tempdir().unwrap();

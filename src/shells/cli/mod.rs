@@ -144,6 +144,10 @@ pub struct DesignArgs {
     /// Open on the campaign view of this folder (what `arlpcg campaign` wrote; its game).
     #[arg(long, value_name = "DIR")]
     pub campaign: Option<PathBuf>,
+    /// Make the levels of --game for this game profile (`arlpcg profile init`): they are
+    /// generated and played with its character's or car's abilities, and the header names it.
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]

@@ -41,6 +41,7 @@ pub fn run(cli: Cli) -> Result<()> {
                     out: "levels".into(),
                     seed: 1,
                     campaign: None,
+                    profile: None,
                 })
             } else {
                 use clap::CommandFactory;
@@ -58,5 +59,6 @@ fn design(args: crate::shells::cli::DesignArgs) -> Result<()> {
         out: args.out,
         seed: args.seed,
         campaign: args.campaign,
+        profile: args.profile,
     })
 }

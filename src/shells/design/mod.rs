@@ -36,6 +36,8 @@ pub struct DesignOptions {
     pub seed: u64,
     /// A campaign folder to open the campaign view on (its game is the one shown).
     pub campaign: Option<PathBuf>,
+    /// A game profile the levels of the game opened on are made for.
+    pub profile: Option<PathBuf>,
 }
 
 /// The policies the designer starts on for `game`, and a note when it falls back to rules and
@@ -73,7 +75,13 @@ pub fn run(mut options: DesignOptions) -> Result<()> {
     if let Some(folder) = &options.campaign {
         options.game = crate::services::campaign::open(folder)?.1.game;
     }
-    let (policies, info, note) = starting_policies(&options, options.game)?;
+    let (mut policies, info, note) = starting_policies(&options, options.game)?;
+    if let Some(file) = &options.profile {
+        let profile = crate::services::profile::load(file)?;
+        policies.profile = Some(crate::services::profile::for_game(
+            profile, options.game, file,
+        )?);
+    }
     let other_game = match options.game {
         Game::Platform => Game::Racing,
         Game::Racing => Game::Platform,

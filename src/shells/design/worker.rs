@@ -22,6 +22,7 @@ use crate::services::panel::{Judge, rate};
 use crate::services::policies::{load_generator, load_solver, policy_paths};
 use crate::services::verify::{self, Solver, SolverPolicy, Watch};
 use arlpcg_core::game::Skill;
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::{Game, Level};
 use arlpcg_core::rl::checkpoint::PolicyError;
 
@@ -32,6 +33,8 @@ pub struct Policies {
     pub solver: Option<Arc<SolverPolicy>>,
     /// The scripted player's skill, when it plays (no Solver).
     pub skill: Skill,
+    /// The game profile levels are made for (`design --profile`; none: the built-in one).
+    pub profile: Option<Profile>,
 }
 
 /// The policies of each game.
@@ -68,7 +71,9 @@ impl Policies {
     /// The level of `game` that `request` asks for: the Generator's, or the rules' without
     /// one; racing scenes hold the obstacles evaluation scenes hold.
     pub fn level(&self, game: Game, request: LevelRequest) -> Result<Level, String> {
-        let request = request.obstacles(arlpcg_core::game::facts::facts(game).scene_obstacles);
+        let request = request
+            .obstacles(arlpcg_core::game::facts::facts(game).scene_obstacles)
+            .profile(self.profile.clone());
         match &self.generator {
             Some(generator) => {
                 generation::generator_level(generator, &request).map_err(|e| e.to_string())
@@ -485,6 +490,7 @@ fn load_into(
             generator: loaded.generator.or(old.generator.clone()),
             solver: loaded.solver.or(old.solver.clone()),
             skill: old.skill,
+            profile: old.profile.clone(),
         };
     }
     Ok(Box::new(info))
@@ -564,7 +570,9 @@ fn target_level(
         generator,
         &Solver::Policy(solver),
         &curve,
-        &crate::services::generation::LevelRequest::new(seed, None).goal(goal),
+        &crate::services::generation::LevelRequest::new(seed, None)
+            .goal(goal)
+            .profile(policies.profile.clone()),
         target,
         trials,
     )

@@ -179,6 +179,13 @@ fn header(app: &App, frame: &mut Frame, area: Rect) {
         format!("  Generator: {generator}  Solver: {solver}")
     };
     line.push_span(Span::raw(policies));
+    // The profile the shown level was made for, where the width allows.
+    if let Some(profile) = app.level.as_ref().and_then(|l| l.profile.as_ref()) {
+        let named = format!("  profile: {}", profile.name);
+        if line.width() + named.chars().count() <= area.width as usize {
+            line.push_span(Span::styled(named, Style::new().bold()));
+        }
+    }
     frame.render_widget(Paragraph::new(line), area);
 }
 

@@ -81,7 +81,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
     let resumed = match args.resume {
-        true => resumed_levels(args, &files, &solver)?,
+        true => resumed_levels(args, &ask, &files, &solver)?,
         false => vec![None; n],
     };
     let curve = difficulty_curve(
@@ -228,9 +228,11 @@ fn is_campaign_file(path: &Path, n: usize) -> bool {
 
 /// With --resume, the levels an earlier run of this campaign left in --out, each in the slot of
 /// the seed it was searched from (a finished campaign's files are in the panel's order): each
-/// checked to be this campaign's, its game, verified by the judge from one of its seeds.
+/// checked to be this campaign's, its game and profile, verified by the judge from one of its
+/// seeds.
 fn resumed_levels(
     args: &CampaignArgs,
+    ask: &CampaignAsk,
     files: &[LevelFiles],
     solver: &Solver,
 ) -> Result<Vec<Option<Level>>> {
@@ -250,6 +252,7 @@ fn resumed_levels(
             .stats
             .as_ref()
             .filter(|s| level.game() == args.game && s.solver == solver.reference())
+            .filter(|_| level.profile == ask.profile)
             .and_then(|s| s.seed.checked_sub(args.seed));
         // A level drawn anew where b stepped down is drawn again once the panel has rated
         // the campaign: the draws are seeded, so it comes back the same.
@@ -259,9 +262,12 @@ fn resumed_levels(
         let slot = drawn.filter(|&j| j < n as u64).map(|j| j as usize);
         let Some(slot) = slot.filter(|&j| levels[j].is_none()) else {
             anyhow::bail!(
-                "{}: not a level of this campaign (a {} level verified by {} from one of seeds {}..{}, each once); remove it or choose another --out",
+                "{}: not a level of this campaign (a {} level{} verified by {} from one of seeds {}..{}, each once); remove it or choose another --out",
                 path.display(),
                 args.game,
+                ask.profile
+                    .as_ref()
+                    .map_or(String::new(), |p| format!(" for profile `{}`", p.name)),
                 solver.reference().describe(),
                 args.seed,
                 args.seed.saturating_add(n as u64 - 1),

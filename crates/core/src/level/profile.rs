@@ -126,64 +126,52 @@ impl Default for CarProfile {
     }
 }
 
-/// Each character field: its range and what it is, as `profile init` comments it.
+/// A field: its range (name, bounds, unit) and what it is, as `profile init` comments it.
+const fn field(
+    name: &'static str,
+    min: f64,
+    max: f64,
+    unit: &'static str,
+    what: &'static str,
+) -> (ParamRange, &'static str) {
+    (ParamRange::new(name, min, max, unit), what)
+}
+
+/// Each character field.
 pub const CHARACTER_FIELDS: [(ParamRange, &str); 8] = [
-    (
-        ParamRange::new("character.run_speed", 2.0, 20.0, "m/s"),
-        "top horizontal speed",
+    field(
+        "character.run_speed", 2.0, 20.0, "m/s", "top horizontal speed",
     ),
-    (
-        ParamRange::new("character.jump_speed", 3.0, 20.0, "m/s"),
-        "vertical take-off speed of a jump",
+    field(
+        "character.jump_speed", 3.0, 20.0, "m/s", "vertical take-off speed of a jump",
     ),
-    (
-        ParamRange::new("character.gravity", 2.0, 50.0, "m/s²"),
-        "gravity",
+    field("character.gravity", 2.0, 50.0, "m/s²", "gravity"),
+    field(
+        "character.ground_accel", 5.0, 200.0, "m/s²", "acceleration on the ground",
     ),
-    (
-        ParamRange::new("character.ground_accel", 5.0, 200.0, "m/s²"),
-        "acceleration on the ground",
+    field(
+        "character.air_accel", 0.0, 60.0, "m/s²", "acceleration in the air (air control)",
     ),
-    (
-        ParamRange::new("character.air_accel", 0.0, 60.0, "m/s²"),
-        "acceleration in the air (air control)",
-    ),
-    (
-        ParamRange::new("character.turn_rate", 45.0, 1080.0, "°/s"),
-        "fastest turn",
-    ),
-    (
-        ParamRange::new("character.radius", 0.2, 1.0, "m"),
-        "capsule radius",
-    ),
-    (
-        ParamRange::new("character.height", 0.8, 3.0, "m"),
+    field("character.turn_rate", 45.0, 1080.0, "°/s", "fastest turn"),
+    field("character.radius", 0.2, 1.0, "m", "capsule radius"),
+    field(
+        "character.height",
+        0.8,
+        3.0,
+        "m",
         "capsule height, at least twice the radius",
     ),
 ];
 
-/// Each car field: its range and what it is.
+/// Each car field.
 pub const CAR_FIELDS: [(ParamRange, &str); 5] = [
-    (
-        ParamRange::new("car.engine_force", 1000.0, 30000.0, "N"),
-        "engine force at full throttle",
+    field(
+        "car.engine_force", 1000.0, 30000.0, "N", "engine force at full throttle",
     ),
-    (
-        ParamRange::new("car.mass", 300.0, 5000.0, "kg"),
-        "chassis mass",
-    ),
-    (
-        ParamRange::new("car.grip", 0.2, 3.0, ""),
-        "tyre friction coefficient",
-    ),
-    (
-        ParamRange::new("car.max_steer", 0.1, 1.0, "rad"),
-        "steering at full lock",
-    ),
-    (
-        ParamRange::new("car.damping", 0.02, 1.0, "1/s"),
-        "air and rolling drag",
-    ),
+    field("car.mass", 300.0, 5000.0, "kg", "chassis mass"),
+    field("car.grip", 0.2, 3.0, "", "tyre friction coefficient"),
+    field("car.max_steer", 0.1, 1.0, "rad", "steering at full lock"),
+    field("car.damping", 0.02, 1.0, "1/s", "air and rolling drag"),
 ];
 
 impl CharacterProfile {
@@ -225,6 +213,29 @@ impl CarProfile {
 }
 
 impl Abilities {
+    /// `game`'s abilities from a file's `character:` and `car:` (the one of its game, and
+    /// not the other), each field in range.
+    fn checked(
+        game: Game,
+        character: Option<CharacterProfile>,
+        car: Option<CarProfile>,
+    ) -> Result<Self, String> {
+        match (game, character, car) {
+            (Game::Platform, Some(c), None) => {
+                c.check().map_err(|e| e.to_string())?;
+                Ok(Abilities::Platform(c))
+            }
+            (Game::Racing, None, Some(c)) => {
+                c.check().map_err(|e| e.to_string())?;
+                Ok(Abilities::Racing(c))
+            }
+            (Game::Platform, _, _) => {
+                Err("a platform profile has `character:` and no `car:`".into())
+            }
+            (Game::Racing, _, _) => Err("a racing profile has `car:` and no `character:`".into()),
+        }
+    }
+
     /// The built-in abilities of `game`.
     pub fn default_of(game: Game) -> Self {
         match game {
@@ -274,22 +285,7 @@ impl Profile {
         if file.name.trim().is_empty() || file.name.len() > 64 {
             return Err("name: 1 to 64 characters".into());
         }
-        let abilities = match (file.game, file.character, file.car) {
-            (Game::Platform, Some(character), None) => {
-                character.check().map_err(|e| e.to_string())?;
-                Abilities::Platform(character)
-            }
-            (Game::Racing, None, Some(car)) => {
-                car.check().map_err(|e| e.to_string())?;
-                Abilities::Racing(car)
-            }
-            (Game::Platform, _, _) => {
-                return Err("a platform profile has `character:` and no `car:`".into());
-            }
-            (Game::Racing, _, _) => {
-                return Err("a racing profile has `car:` and no `character:`".into());
-            }
-        };
+        let abilities = Abilities::checked(file.game, file.character, file.car)?;
         Ok(Self {
             name: file.name,
             abilities,
@@ -368,21 +364,7 @@ impl ProfileRecord {
     /// The profile a level records, checked: its game's abilities, in range, and the SHA-256
     /// they hash to.
     pub fn profile(&self, game: Game) -> Result<Profile, String> {
-        let abilities = match (game, self.character, self.car) {
-            (Game::Platform, Some(c), None) => {
-                c.check().map_err(|e| e.to_string())?;
-                Abilities::Platform(c)
-            }
-            (Game::Racing, None, Some(c)) => {
-                c.check().map_err(|e| e.to_string())?;
-                Abilities::Racing(c)
-            }
-            _ => {
-                return Err(format!(
-                    "a {game} level's profile has the {game} abilities only"
-                ));
-            }
-        };
+        let abilities = Abilities::checked(game, self.character, self.car)?;
         let profile = Profile {
             name: self.name.clone(),
             abilities,

@@ -11,6 +11,8 @@ use crate::services::verify::{self, Solver};
 use arlpcg_core::game::Skill;
 use arlpcg_core::game::platform::character::Body;
 use arlpcg_core::game::platform::reach::{REACH_HEIGHTS, measure_reach};
+use arlpcg_core::game::racing::car::Car;
+use arlpcg_core::game::racing::feasibility;
 use arlpcg_core::level::Game;
 use arlpcg_core::level::profile::{Abilities, Profile};
 
@@ -74,18 +76,28 @@ pub fn measure(profile: &Profile, trials: u32) -> Allowance {
             ]
         }
         Abilities::Racing(c) => {
-            let g = 9.81;
+            let car = Car::from(c);
+            let top = feasibility::top_speed(car);
+            let held = |curves: usize| match feasibility::cornering_speed(car, curves, 2) {
+                v if v >= top => "at full speed".to_string(),
+                v => format!("at {v} m/s"),
+            };
+            let crest_speed = top.min(25.0).floor();
+            let crest = feasibility::crest(car, 3.0, crest_speed);
             vec![
                 format!(
-                    "top speed {:.1} m/s ({:.0} km/h), {:.1} m/s² from rest",
-                    c.engine_force / (c.mass * c.damping),
-                    3.6 * c.engine_force / (c.mass * c.damping),
+                    "top speed {top:.1} m/s ({:.0} km/h), {:.1} m/s² from rest",
+                    3.6 * top,
                     c.engine_force / c.mass
                 ),
                 format!(
-                    "cornering grip {:.2} g on the flat: a 30 m bend at {:.1} m/s",
-                    c.grip,
-                    (c.grip * g * 30.0).sqrt()
+                    "the tightest curve (30° over 20 m) taken {} alone, {} four in a row",
+                    held(1),
+                    held(4)
+                ),
+                format!(
+                    "a 3 m crest at {crest_speed} m/s: {:.2} s in the air, {:?}",
+                    crest.air_s, crest.outcome
                 ),
             ]
         }

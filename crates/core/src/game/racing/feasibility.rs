@@ -2,7 +2,7 @@
 //! fastest constant speed through the tightest curve, and the air time crests give at speed.
 //! `docs/racing-physics.md` prints these figures; a test re-measures them.
 
-use super::car::{CarAction, DECISION_DT};
+use super::car::{Car, CarAction, DECISION_DT};
 use super::env::{RacingEnv, RacingRewards};
 use super::scripted::ScriptedDriver;
 use crate::level::racing::{RacingTrack, SegmentParams};
@@ -40,10 +40,15 @@ pub struct DriveOutcome {
     pub top_speed: f32,
 }
 
-/// Drives `track` with `driver` until the run ends.
-pub fn drive(track: &RacingTrack, driver: &mut ScriptedDriver, seed: u64) -> DriveOutcome {
+/// Drives `track` in `car` with `driver` until the run ends.
+pub fn drive(
+    track: &RacingTrack,
+    car: Car,
+    driver: &mut ScriptedDriver,
+    seed: u64,
+) -> DriveOutcome {
     let goal = track.road().end().0;
-    let mut env = RacingEnv::new(track, goal, RacingRewards::default());
+    let mut env = RacingEnv::new(track, goal, RacingRewards::default()).with_car(car);
     env.reset(seed);
     let mut top_speed: f32 = 0.0;
     loop {
@@ -60,11 +65,11 @@ pub fn drive(track: &RacingTrack, driver: &mut ScriptedDriver, seed: u64) -> Dri
     }
 }
 
-/// Top speed at full throttle on a long straight, m/s.
-pub fn top_speed() -> f32 {
+/// Top speed of `car` at full throttle on a long straight, m/s.
+pub fn top_speed(car: Car) -> f32 {
     let track = test_track(12, &[]);
     let goal = track.road().end().0;
-    let mut env = RacingEnv::new(&track, goal, RacingRewards::default());
+    let mut env = RacingEnv::new(&track, goal, RacingRewards::default()).with_car(car);
     let mut top: f32 = 0.0;
     while env
         .step(CarAction {
@@ -79,15 +84,16 @@ pub fn top_speed() -> f32 {
     top
 }
 
-/// The fastest speed (to 1 m/s) that the car holds through `curves` tightest curves in a row
+/// The fastest speed (to 1 m/s) that `car` holds through `curves` tightest curves in a row
 /// without leaving the road, over `seeds` seeded starts.
-pub fn cornering_speed(curves: usize, seeds: u64) -> f32 {
+pub fn cornering_speed(car: Car, curves: usize, seeds: u64) -> f32 {
     let track = test_track(12, &vec![TIGHTEST; curves]);
     (8..=40)
         .map(|v| v as f32)
         .take_while(|&v| {
             (0..seeds).all(|seed| {
-                drive(&track, &mut ScriptedDriver::holding(v), seed).outcome == Outcome::Success
+                drive(&track, car, &mut ScriptedDriver::holding(v), seed).outcome
+                    == Outcome::Success
             })
         })
         .last()
@@ -95,8 +101,8 @@ pub fn cornering_speed(curves: usize, seeds: u64) -> f32 {
 }
 
 /// Air time (s) and outcome of a crest: `height` m up over one 20 m segment and down over the
-/// next, driven at a held `speed`.
-pub fn crest(height: f64, speed: f32) -> DriveOutcome {
+/// next, driven in `car` at a held `speed`.
+pub fn crest(car: Car, height: f64, speed: f32) -> DriveOutcome {
     let up = SegmentParams {
         length: 20.0,
         curve: 0.0,
@@ -108,6 +114,7 @@ pub fn crest(height: f64, speed: f32) -> DriveOutcome {
     };
     drive(
         &test_track(12, &[up, down]),
+        car,
         &mut ScriptedDriver::holding(speed),
         0,
     )
@@ -120,18 +127,18 @@ mod tests {
     #[test]
     #[ignore = "prints the figures of docs/racing-physics.md"]
     fn print_figures() {
-        println!("top speed {:.1} m/s", top_speed());
+        println!("top speed {:.1} m/s", top_speed(Car::default()));
         for curves in [1, 2, 3, 4, 6] {
             println!(
                 "{curves} tightest curves: held at {} m/s",
-                cornering_speed(curves, 3)
+                cornering_speed(Car::default(), curves, 3)
             );
         }
         for h in [1.0, 2.0, 3.0, 4.0, 5.0] {
             let row: Vec<String> = [15.0, 20.0, 25.0, 28.0]
                 .iter()
                 .map(|&v| {
-                    let r = crest(h, v);
+                    let r = crest(Car::default(), h, v);
                     format!("{:.2} s {:?}", r.air_s, r.outcome)
                 })
                 .collect();
@@ -151,6 +158,7 @@ mod tests {
                 };
                 let run = drive(
                     &test_track(12, &[up, down, TIGHTEST]),
+                    Car::default(),
                     &mut ScriptedDriver::holding(v),
                     0,
                 );
@@ -165,22 +173,22 @@ mod tests {
     /// Re-measures the figures docs/racing-physics.md states.
     #[test]
     fn the_documented_feasibility_figures_hold() {
-        let top = top_speed();
+        let top = top_speed(Car::default());
         assert!((27.0..=29.0).contains(&top), "top speed {top} m/s");
         // One tightest curve at top speed; four in a row need braking to about 22 m/s.
-        assert!(cornering_speed(1, 2) >= 28.0);
-        let four = cornering_speed(4, 2);
+        assert!(cornering_speed(Car::default(), 1, 2) >= 28.0);
+        let four = cornering_speed(Car::default(), 4, 2);
         assert!(
             (20.0..=24.0).contains(&four),
             "four tightest curves held at {four} m/s"
         );
         let track = test_track(12, &[TIGHTEST; 4]);
-        let braking = drive(&track, &mut ScriptedDriver::new(0, 0.0), 0);
+        let braking = drive(&track, Car::default(), &mut ScriptedDriver::new(0, 0.0), 0);
         assert_eq!(braking.outcome, Outcome::Success, "{braking:?}");
         // Crests: none at 15 m/s, air at speed, more the higher the crest.
-        assert_eq!(crest(5.0, 15.0).air_s, 0.0);
-        let low = crest(3.0, 25.0);
-        let high = crest(5.0, 25.0);
+        assert_eq!(crest(Car::default(), 5.0, 15.0).air_s, 0.0);
+        let low = crest(Car::default(), 3.0, 25.0);
+        let high = crest(Car::default(), 5.0, 25.0);
         assert!(
             low.air_s > 0.5 && high.air_s > low.air_s + 0.3,
             "{low:?} {high:?}"
@@ -199,6 +207,7 @@ mod tests {
         };
         let jump = drive(
             &test_track(12, &[up, down, TIGHTEST]),
+            Car::default(),
             &mut ScriptedDriver::holding(20.0),
             0,
         );

@@ -79,6 +79,11 @@ pub enum Command {
 }
 
 #[derive(Debug, Subcommand)]
+#[command(after_help = "Examples:\n  \
+    arlpcg profile init --game platform > hero.yaml\n  \
+    arlpcg profile check hero.yaml\n  \
+    arlpcg generate --rules --profile hero.yaml --verify 100 --out hero-levels\n  \
+    arlpcg verify levels/hand/staircase.yaml --solver scripted --profile hero.yaml")]
 pub enum ProfileCommand {
     /// Print a game's built-in profile (standard output), a comment per field with its range.
     Init {

@@ -123,37 +123,61 @@ fn starts_with_a_level_and_its_statistics() {
     );
 }
 
-/// With a profile (`design --profile`), levels are made and played for it and the header says
-/// so: a low jumper fails rule levels the built-in character completes.
+/// With a profile (`design --profile`, `f`), levels are made and played for it and the header
+/// says so: a low jumper fails the rule level the built-in character completes. `[ ]` change the
+/// chosen ability (`e` picks it) by 5% and make the level again.
 #[test]
-fn a_profile_makes_the_levels_and_plays_them() {
+fn a_profile_makes_the_levels_and_its_keys_change_the_abilities() {
     let dir = tempfile::tempdir().unwrap();
-    let low = arlpcg_core::level::profile::Profile::parse(
-        &arlpcg_core::level::profile::Profile::default_of(Game::Platform)
-            .to_yaml()
-            .replace("name: default", "name: low-jumper")
-            .replace("jump_speed: 9.25", "jump_speed: 6.0"),
-    )
-    .unwrap();
-    let policies = Policies {
-        profile: Some(low),
-        ..Policies::default()
-    };
-    let mut h = Harness::new(policies, LoadedInfo::default(), dir.path());
+    let low = arlpcg_core::level::profile::Profile::default_of(Game::Platform)
+        .to_yaml()
+        .replace("name: default", "name: low-jumper")
+        .replace("jump_speed: 9.25", "jump_speed: 6.0");
+    let file = dir.path().join("low.yaml");
+    std::fs::write(&file, low).unwrap();
+    let mut plain = Harness::rules(dir.path());
+    plain.settle();
+    let plain_successes = plain.app.trials.as_ref().unwrap().successes();
+
+    let mut h = Harness::rules(dir.path());
+    h.settle();
+    h.key(KeyCode::Char('f'));
+    h.keys(file.to_str().unwrap());
+    h.key(KeyCode::Enter);
+    assert!(matches!(h.pending[..], [Effect::LoadProfile { .. }]));
     h.settle();
     let level = h.app.level.clone().expect("a level is on screen");
     assert_eq!(
         level.profile.as_ref().map(|p| p.name.as_str()),
         Some("low-jumper")
     );
-    assert!(h.screen(120, 36).contains("profile: low-jumper"));
-    let low_successes = h.app.trials.as_ref().unwrap().successes();
-    let mut plain = Harness::rules(dir.path());
-    plain.settle();
     assert_eq!(plain.app.level.as_ref().unwrap().track, level.track);
+    assert!(h.screen(120, 36).contains("profile: low-jumper"));
     assert!(
-        low_successes < plain.app.trials.as_ref().unwrap().successes(),
+        h.app.trials.as_ref().unwrap().successes() < plain_successes,
         "the low jumper does worse on the same level"
+    );
+
+    // `]` raises the jump speed 5%; `e` then `[` lowers the run speed 5%.
+    h.key(KeyCode::Char(']'));
+    h.settle();
+    h.key(KeyCode::Char('e'));
+    h.key(KeyCode::Char('['));
+    h.settle();
+    let edited = h.app.level.as_ref().unwrap().profile.clone().unwrap();
+    assert_eq!(edited.name, "low-jumper (edited)");
+    assert_eq!(edited.value("character.jump_speed").unwrap().0, 6.3);
+    assert_eq!(edited.value("character.run_speed").unwrap().0, 7.6);
+    // A file that is not a profile is a message, not a crash.
+    h.key(KeyCode::Char('f'));
+    h.keys(dir.path().join("missing.yaml").to_str().unwrap());
+    h.key(KeyCode::Enter);
+    h.settle();
+    assert!(
+        h.app
+            .status
+            .as_ref()
+            .is_some_and(|(text, problem)| *problem && text.contains("missing.yaml"))
     );
 }
 
@@ -488,6 +512,7 @@ fn newer_requests_supersede_older_ones() {
         ask: Ask::Aux(0.0),
         keep: None,
         trials: 100,
+        profile: None,
     };
     workers.submit(generate(101));
     loop {

@@ -23,6 +23,7 @@ pub mod judges;
 mod loaded;
 mod messages;
 pub mod pacing;
+pub mod profile;
 mod responses;
 pub mod sweep;
 pub mod trials;
@@ -82,6 +83,7 @@ pub enum PromptKind {
     Target,
     Curve,
     Campaign,
+    Profile,
 }
 
 impl PromptKind {
@@ -93,6 +95,7 @@ impl PromptKind {
             PromptKind::Policies => "policies folder, or a Generator/Solver .safetensors file",
             PromptKind::Curve => "aux curve, fraction:λ, ... (e.g. 0:1, 0.5:1, 0.6:-1, 1:-1)",
             PromptKind::Campaign => "campaign folder (what `arlpcg campaign` wrote)",
+            PromptKind::Profile => "game profile file (`arlpcg profile init` writes one)",
         }
     }
 }
@@ -148,6 +151,10 @@ pub struct App {
     pub ask: Ask,
     /// The prefix every regeneration keeps.
     pub kept: Option<crate::services::generation::KeptPrefix>,
+    /// The game profile levels are made for, and the ability its keys change ([`profile`]).
+    pub profile: profile::ProfileEdit,
+    /// ...and the other game's (Tab swaps them).
+    pub other_profile: profile::ProfileEdit,
     pub seed: u64,
     pub goal: GoalSetting,
     pub trials_wanted: u32,
@@ -192,6 +199,8 @@ impl App {
             aux: 1.0,
             ask: Ask::Aux(1.0),
             kept: None,
+            profile: profile::ProfileEdit::default(),
+            other_profile: profile::ProfileEdit::default(),
             seed,
             goal: GoalSetting::FromSeed,
             trials_wanted: DEFAULT_TRIALS,
@@ -248,6 +257,7 @@ impl App {
             ask: self.ask.clone(),
             keep: self.kept.clone(),
             trials: self.trials_wanted,
+            profile: self.profile.profile.clone(),
         }]
     }
 
@@ -259,6 +269,7 @@ impl App {
             Game::Racing => Game::Platform,
         };
         std::mem::swap(&mut self.policies, &mut self.other_policies);
+        std::mem::swap(&mut self.profile, &mut self.other_profile);
         self.goal = GoalSetting::FromSeed;
         self.kept = None;
         if self.policies.generator.is_none() && self.ask.curve().is_some() {

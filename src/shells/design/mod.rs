@@ -75,13 +75,15 @@ pub fn run(mut options: DesignOptions) -> Result<()> {
     if let Some(folder) = &options.campaign {
         options.game = crate::services::campaign::open(folder)?.1.game;
     }
-    let (mut policies, info, note) = starting_policies(&options, options.game)?;
-    if let Some(file) = &options.profile {
-        let profile = crate::services::profile::load(file)?;
-        policies.profile = Some(crate::services::profile::for_game(
-            profile, options.game, file,
-        )?);
-    }
+    let (policies, info, note) = starting_policies(&options, options.game)?;
+    let profile = match &options.profile {
+        Some(file) => Some(crate::services::profile::for_game(
+            crate::services::profile::load(file)?,
+            options.game,
+            file,
+        )?),
+        None => None,
+    };
     let other_game = match options.game {
         Game::Platform => Game::Racing,
         Game::Racing => Game::Platform,
@@ -93,6 +95,7 @@ pub fn run(mut options: DesignOptions) -> Result<()> {
     let (answers, responses) = channel();
     let workers = Workers::start(shelf, answers);
     let mut app = App::new(options.game, info, options.seed, options.out);
+    app.profile.profile = profile;
     let opening = options.campaign.map(|folder| app.open_campaign(folder));
     // https://no-color.org: present and not empty.
     app.colour = std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty());

@@ -22,7 +22,6 @@ use crate::services::panel::{Judge, rate};
 use crate::services::policies::{load_generator, load_solver, policy_paths};
 use crate::services::verify::{self, Solver, SolverPolicy, Watch};
 use arlpcg_core::game::Skill;
-use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::{Game, Level};
 use arlpcg_core::rl::checkpoint::PolicyError;
 
@@ -33,8 +32,6 @@ pub struct Policies {
     pub solver: Option<Arc<SolverPolicy>>,
     /// The scripted player's skill, when it plays (no Solver).
     pub skill: Skill,
-    /// The game profile levels are made for (`design --profile`; none: the built-in one).
-    pub profile: Option<Profile>,
 }
 
 /// The policies of each game.
@@ -71,9 +68,7 @@ impl Policies {
     /// The level of `game` that `request` asks for: the Generator's, or the rules' without
     /// one; racing scenes hold the obstacles evaluation scenes hold.
     pub fn level(&self, game: Game, request: LevelRequest) -> Result<Level, String> {
-        let request = request
-            .obstacles(arlpcg_core::game::facts::facts(game).scene_obstacles)
-            .profile(self.profile.clone());
+        let request = request.obstacles(arlpcg_core::game::facts::facts(game).scene_obstacles);
         match &self.generator {
             Some(generator) => {
                 generation::generator_level(generator, &request).map_err(|e| e.to_string())
@@ -155,6 +150,7 @@ fn slot(effect: &Effect) -> (Slot, u64) {
         | Effect::Load { .. }
         | Effect::NextJudge { .. }
         | Effect::OpenCampaign { .. }
+        | Effect::LoadProfile { .. }
         | Effect::RegenerateCampaignLevel { .. } => (Slot::Always, 0),
     }
 }
@@ -259,11 +255,15 @@ pub fn perform(
             ask,
             keep,
             trials,
+            profile,
         } => {
             let result = match (ask.success(), ask.aux()) {
-                (Some(target), _) => target_level(shelf.of(game), seed, goal, target, trials),
+                (Some(target), _) => {
+                    let asked = LevelRequest::new(seed, None).goal(goal).profile(profile);
+                    target_level(shelf.of(game), &asked, target, trials)
+                }
                 (None, aux) => {
-                    let mut request = LevelRequest::new(seed, None).goal(goal);
+                    let mut request = LevelRequest::new(seed, None).goal(goal).profile(profile);
                     if let Some(aux) = aux {
                         request = request.aux(aux);
                     }
@@ -297,13 +297,16 @@ pub fn perform(
             goal,
             auxes,
             trials,
+            profile,
         } => {
             let current = shelf.of(game);
             for (index, aux) in auxes.into_iter().enumerate() {
                 if stop() {
                     return;
                 }
-                let request = LevelRequest::new(seed, Some(aux)).goal(goal);
+                let request = LevelRequest::new(seed, Some(aux))
+                    .goal(goal)
+                    .profile(profile.clone());
                 let Some(point) = sweep_point(current, game, request, trials, stop) else {
                     return;
                 };
@@ -325,6 +328,12 @@ pub fn perform(
         )),
         Effect::Load { path, game } => send(Response::Loaded(load_into(policies, &path, game))),
         Effect::OpenCampaign { folder } => send(Response::Campaign(open_campaign(&folder))),
+        Effect::LoadProfile { path, game } => send(Response::Profile(
+            crate::services::profile::load(&path)
+                .and_then(|p| crate::services::profile::for_game(p, game, &path))
+                .map(Box::new)
+                .map_err(|e| format!("{e:#}")),
+        )),
         Effect::RegenerateCampaignLevel {
             folder,
             game,
@@ -490,7 +499,6 @@ fn load_into(
             generator: loaded.generator.or(old.generator.clone()),
             solver: loaded.solver.or(old.solver.clone()),
             skill: old.skill,
-            profile: old.profile.clone(),
         };
     }
     Ok(Box::new(info))
@@ -542,8 +550,7 @@ fn next_judge(
 /// λ→success curve is read from (or, the first time, measured into) the Generator's folder.
 fn target_level(
     policies: &Policies,
-    seed: u64,
-    goal: Option<[f64; 3]>,
+    asked: &LevelRequest,
     target: f64,
     trials: u32,
 ) -> Result<Level, String> {
@@ -570,9 +577,7 @@ fn target_level(
         generator,
         &Solver::Policy(solver),
         &curve,
-        &crate::services::generation::LevelRequest::new(seed, None)
-            .goal(goal)
-            .profile(policies.profile.clone()),
+        asked,
         target,
         trials,
     )

@@ -343,6 +343,58 @@ impl Profile {
         text
     }
 
+    /// The field named as in [`CHARACTER_FIELDS`] or [`CAR_FIELDS`] (`character.jump_speed`),
+    /// with its range; none for a field of the other game.
+    pub fn value(&self, field: &str) -> Option<(f64, ParamRange)> {
+        let (values, fields): (Vec<f64>, &[(ParamRange, &str)]) = match self.abilities {
+            Abilities::Platform(c) => (c.values().to_vec(), &CHARACTER_FIELDS),
+            Abilities::Racing(c) => (c.values().to_vec(), &CAR_FIELDS),
+        };
+        let at = fields.iter().position(|(r, _)| r.name == field)?;
+        Some((values[at], fields[at].0))
+    }
+
+    /// The same profile with `field` at `value`, when that is a valid profile.
+    pub fn with_value(&self, field: &str, value: f64) -> Option<Self> {
+        let abilities = match self.abilities {
+            Abilities::Platform(c) => {
+                let at = CHARACTER_FIELDS.iter().position(|(r, _)| r.name == field)?;
+                let mut v = c.values();
+                v[at] = value;
+                let c = CharacterProfile {
+                    run_speed: v[0],
+                    jump_speed: v[1],
+                    gravity: v[2],
+                    ground_accel: v[3],
+                    air_accel: v[4],
+                    turn_rate: v[5],
+                    radius: v[6],
+                    height: v[7],
+                };
+                c.check().ok()?;
+                Abilities::Platform(c)
+            }
+            Abilities::Racing(c) => {
+                let at = CAR_FIELDS.iter().position(|(r, _)| r.name == field)?;
+                let mut v = c.values();
+                v[at] = value;
+                let c = CarProfile {
+                    engine_force: v[0],
+                    mass: v[1],
+                    grip: v[2],
+                    max_steer: v[3],
+                    damping: v[4],
+                };
+                c.check().ok()?;
+                Abilities::Racing(c)
+            }
+        };
+        Some(Self {
+            name: self.name.clone(),
+            abilities,
+        })
+    }
+
     /// SHA-256 of [`Profile::to_yaml`], hex.
     pub fn sha256(&self) -> String {
         crate::level::sha256_hex(self.to_yaml().as_bytes())

@@ -100,20 +100,24 @@ impl App {
             KeyCode::Char('P') => self.next_pacing(),
             KeyCode::Char('C') => self.open_prompt(PromptKind::Curve),
             KeyCode::Char('o') => self.campaign_key_o(),
+            KeyCode::Char('f') => self.profile_prompt(),
+            KeyCode::Char('e') => self.next_ability(),
+            KeyCode::Char('[') => self.scale_ability(0.95),
+            KeyCode::Char(']') => self.scale_ability(1.05),
             KeyCode::Char('k') => self.keep_prefix(),
             KeyCode::Char('K') => self.release_prefix(),
             _ => Vec::new(),
         }
     }
 
-    fn open_prompt(&mut self, kind: PromptKind) -> Vec<Effect> {
+    pub(super) fn open_prompt(&mut self, kind: PromptKind) -> Vec<Effect> {
         let text = match kind {
             PromptKind::Seed => self.seed.to_string(),
             PromptKind::Trials => self.trials_wanted.to_string(),
             PromptKind::Target => self.ask.success().map_or(String::new(), |t| format!("{t}")),
             PromptKind::Policies => String::new(),
             PromptKind::Curve => self.ask.curve().map_or(String::new(), ToString::to_string),
-            PromptKind::Campaign => String::new(),
+            PromptKind::Campaign | PromptKind::Profile => String::new(),
         };
         self.overlay = Overlay::Prompt { kind, text };
         Vec::new()
@@ -135,6 +139,8 @@ impl App {
 
     fn submit(&mut self, kind: PromptKind, text: &str) -> Vec<Effect> {
         match kind {
+            PromptKind::Profile if text.is_empty() => Vec::new(),
+            PromptKind::Profile => self.submit_profile(text),
             PromptKind::Campaign if text.is_empty() => Vec::new(),
             PromptKind::Campaign => self.open_campaign(PathBuf::from(text)),
             PromptKind::Seed => match text.parse::<u64>() {

@@ -10,6 +10,7 @@ use super::judges;
 use super::{JudgeSwitch, LoadedInfo, SweepPoint};
 use crate::services::panel::Judge;
 use crate::services::verify::Recording;
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::stats::{SolverStats, TrialResult};
 use arlpcg_core::level::{Game, Level};
 
@@ -66,6 +67,8 @@ pub enum Response {
     },
     /// A campaign folder read back (or why not).
     Campaign(Result<Box<super::campaign::OpenedCampaign>, String>),
+    /// A game profile read from a file (or why not).
+    Profile(Result<Box<Profile>, String>),
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -89,6 +92,8 @@ pub enum Effect {
         ask: crate::services::generation::Ask,
         keep: Option<crate::services::generation::KeptPrefix>,
         trials: u32,
+        /// The game profile the level is made for (none: the built-in one).
+        profile: Option<Profile>,
     },
     Trials {
         id: u64,
@@ -108,6 +113,7 @@ pub enum Effect {
         goal: Option<[f64; 3]>,
         auxes: Vec<f64>,
         trials: u32,
+        profile: Option<Profile>,
     },
     Export {
         level: Box<Level>,
@@ -125,6 +131,8 @@ pub enum Effect {
     },
     /// Read the campaign in `folder` (its campaign.yaml and levels).
     OpenCampaign { folder: PathBuf },
+    /// Read a game profile of `game` from `path`.
+    LoadProfile { path: PathBuf, game: Game },
     /// Search level `level` of the campaign in `folder` anew (the Generator on the shelf, the
     /// judge and the panel from `policies`), rate the campaign again and rewrite its files.
     RegenerateCampaignLevel {

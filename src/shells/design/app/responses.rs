@@ -61,6 +61,7 @@ impl App {
                 self.campaign_opened(result);
                 Vec::new()
             }
+            Response::Profile(result) => self.profile_loaded(result),
             Response::Loaded(result) => match result {
                 Ok(info) => self.loaded(*info),
                 Err(problem) => {

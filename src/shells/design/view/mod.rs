@@ -43,10 +43,13 @@ pub const KEYS: [(&str, &str); 22] = [
     ("k K", "keep pieces up to the selected one / let go"),
     ("x", "export YAML (with the Solver statistics) + .glb"),
     ("p o", "load policies / open a campaign folder (its view)"),
+    (
+        "f e [ ]",
+        "profile: load a file / next ability / ability -/+5%",
+    ),
     ("c j J", "cards / next judge plays trials / all judges play"),
     ("Tab", "game: platform / racing"),
-    ("?", "this help (any key closes it)"),
-    ("q, Esc", "quit"),
+    ("? / q, Esc", "this help (any key closes it) / quit"),
 ];
 
 const HINTS: &str = "←→ λ  ⏎ generate  n seed  r replay  w sweep  x export  p load  ? help  q quit";

@@ -1114,4 +1114,12 @@ fn a_game_profile_is_checked_recorded_and_played_under() {
         said.contains("made under the built-in profile; playing it under `low-jumper`"),
         "{said}"
     );
+    // The shipped Solver policy never trained with the low jumper's abilities, and says so.
+    let low_path = path("low.yaml");
+    let policy = arlpcg_ok(&["verify", staircase, "--trials", "2", "--profile", &low_path]);
+    assert!(
+        stderr(&policy).contains("never trained with them"),
+        "{}",
+        stderr(&policy)
+    );
 }

@@ -58,6 +58,7 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
             load_under(path, profile.as_ref(), args.profile.as_deref()).and_then(|level| {
                 let game = level.game();
                 solvers.resolve(game, args)?;
+                solvers.warn_of_profile(&level);
                 let solver = solvers.get(game);
                 let bar = crate::shells::common::progress_bar(
                     args.trials as u64,
@@ -386,6 +387,8 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
 #[derive(Default)]
 struct Solvers {
     resolved: HashMap<Game, Resolved>,
+    /// Whether the run has said that a policy plays under a profile it never trained with.
+    warned_profile: bool,
 }
 
 enum Resolved {
@@ -428,6 +431,20 @@ impl Solvers {
         }
         self.resolved.insert(game, resolved);
         Ok(())
+    }
+
+    /// Says once that a Solver policy, trained with the built-in abilities, plays a level made
+    /// for other ones: its statistics are not those of a player who trained with them.
+    fn warn_of_profile(&mut self, level: &Level) {
+        let other = level.profile.as_ref().filter(|p| !p.is_default());
+        let policy = matches!(self.resolved.get(&level.game()), Some(Resolved::Policy(_)));
+        if let (Some(profile), true, false) = (other, policy, self.warned_profile) {
+            self.warned_profile = true;
+            crate::warn!(
+                "the Solver policy trained with the built-in abilities plays under profile `{}`: its statistics are of a player who never trained with them (the scripted player, --solver scripted, plays with them)",
+                profile.name
+            );
+        }
     }
 
     fn get(&self, game: Game) -> Solver<'_> {

@@ -314,6 +314,7 @@ impl Campaign {
             trials: self.trials,
             ramp: self.ramp.clone(),
             pacing: self.pacing.clone(),
+            // A record read back was checked ([`Campaign::check`]).
             profile: self
                 .profile
                 .as_ref()
@@ -345,6 +346,11 @@ impl Campaign {
         self.population
             .check()
             .map_err(|e| format!("population.{e}"))?;
+        if let Some(record) = &self.profile {
+            record
+                .profile(self.game)
+                .map_err(|e| format!("profile: {e}"))?;
+        }
         if self.levels.is_empty() {
             return Err("levels: none; a campaign has at least one level".into());
         }
@@ -550,12 +556,9 @@ pub fn rate(
     levels: &mut Vec<Level>,
     watch: &Watch,
 ) -> anyhow::Result<Option<Campaign>> {
-    let searched = levels.clone();
-    let thetas = play_and_rate(panel, levels, ask.trials, watch);
-    if levels.len() < searched.len() {
-        *levels = searched;
+    let Some(thetas) = play_all(panel, levels, ask.trials, watch) else {
         return Ok(None);
-    }
+    };
     ask.named_record(levels, &thetas).map(Some)
 }
 
@@ -615,7 +618,12 @@ pub fn rate_and_mend(
 ) -> anyhow::Result<Option<(Campaign, Vec<u64>)>> {
     let n = levels.len();
     let targets: Vec<f64> = (0..n).map(|k| ask.target(k, n)).collect();
-    let Some(mut thetas) = rate_in_order(panel, levels, ask.trials, watch, &targets) else {
+    let in_order = |levels: &mut Vec<Level>| {
+        let thetas = play_all(panel, levels, ask.trials, watch)?;
+        order_by_difficulty(levels, &targets, difficulty::BAND);
+        Some(thetas)
+    };
+    let Some(mut thetas) = in_order(levels) else {
         return Ok(None);
     };
     let mut kept = Vec::new();
@@ -629,9 +637,7 @@ pub fn rate_and_mend(
         })?;
         let mut candidate = levels.clone();
         candidate[k] = draw(seed, targets[k])?;
-        let Some(candidate_thetas) =
-            rate_in_order(panel, &mut candidate, ask.trials, watch, &targets)
-        else {
+        let Some(candidate_thetas) = in_order(&mut candidate) else {
             return Ok(None);
         };
         if descent(&candidate) < descent(levels) {
@@ -643,14 +649,13 @@ pub fn rate_and_mend(
     Ok(Some((ask.named_record(levels, &thetas)?, kept)))
 }
 
-/// The panel plays the levels not yet played, all are rated together and put in order of b
-/// where `targets` allow; the judges' θ, or `None` after a stop (the levels then as they came).
-fn rate_in_order(
+/// The panel plays the levels not yet played and all are rated together: the judges' θ, or
+/// `None` after a stop (the levels then as they came).
+fn play_all(
     panel: &JudgePanel,
     levels: &mut Vec<Level>,
     trials: u32,
     watch: &Watch,
-    targets: &[f64],
 ) -> Option<Vec<(String, f64)>> {
     let before = levels.clone();
     let thetas = play_and_rate(panel, levels, trials, watch);
@@ -658,7 +663,6 @@ fn rate_in_order(
         *levels = before;
         return None;
     }
-    order_by_difficulty(levels, targets, difficulty::BAND);
     Some(thetas)
 }
 

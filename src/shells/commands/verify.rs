@@ -179,8 +179,9 @@ fn load_under(path: &Path, profile: Option<&Profile>, file: Option<&Path>) -> Re
         return Ok(level);
     };
     let profile = profile::for_game(profile.clone(), level.game(), file)?;
+    let sha = profile.sha256();
     let recorded = level.profile.as_ref().map(|p| (p.name.clone(), p.sha256()));
-    if recorded.as_ref().map(|(_, sha)| sha) != Some(&profile.sha256()) {
+    if recorded.as_ref().map(|(_, recorded)| recorded) != Some(&sha) {
         let was = recorded.map_or("the built-in profile".into(), |(name, sha)| {
             format!("profile `{name}` ({})", &sha[..12])
         });
@@ -188,7 +189,7 @@ fn load_under(path: &Path, profile: Option<&Profile>, file: Option<&Path>) -> Re
             "{}: made under {was}; playing it under `{}` ({})",
             path.display(),
             profile.name,
-            &profile.sha256()[..12]
+            &sha[..12]
         );
     }
     level.profile = Some(profile);

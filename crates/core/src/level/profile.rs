@@ -175,11 +175,17 @@ pub const CAR_FIELDS: [(ParamRange, &str); 5] = [
 ];
 
 impl CharacterProfile {
-    fn values(&self) -> [f64; 8] {
+    /// The fields in the order of [`CHARACTER_FIELDS`], to change in place.
+    fn values_mut(&mut self) -> [&mut f64; 8] {
         [
-            self.run_speed, self.jump_speed, self.gravity, self.ground_accel, self.air_accel,
-            self.turn_rate, self.radius, self.height,
+            &mut self.run_speed, &mut self.jump_speed, &mut self.gravity, &mut self.ground_accel,
+            &mut self.air_accel, &mut self.turn_rate, &mut self.radius, &mut self.height,
         ]
+    }
+
+    fn values(&self) -> [f64; 8] {
+        let mut copy = *self;
+        copy.values_mut().map(|v| *v)
     }
 
     /// Checks every field's range, and the capsule's shape.
@@ -197,10 +203,17 @@ impl CharacterProfile {
 }
 
 impl CarProfile {
-    fn values(&self) -> [f64; 5] {
+    /// The fields in the order of [`CAR_FIELDS`], to change in place.
+    fn values_mut(&mut self) -> [&mut f64; 5] {
         [
-            self.engine_force, self.mass, self.grip, self.max_steer, self.damping,
+            &mut self.engine_force, &mut self.mass, &mut self.grip, &mut self.max_steer,
+            &mut self.damping,
         ]
+    }
+
+    fn values(&self) -> [f64; 5] {
+        let mut copy = *self;
+        copy.values_mut().map(|v| *v)
     }
 
     /// Checks every field's range.
@@ -357,34 +370,15 @@ impl Profile {
     /// The same profile with `field` at `value`, when that is a valid profile.
     pub fn with_value(&self, field: &str, value: f64) -> Option<Self> {
         let abilities = match self.abilities {
-            Abilities::Platform(c) => {
+            Abilities::Platform(mut c) => {
                 let at = CHARACTER_FIELDS.iter().position(|(r, _)| r.name == field)?;
-                let mut v = c.values();
-                v[at] = value;
-                let c = CharacterProfile {
-                    run_speed: v[0],
-                    jump_speed: v[1],
-                    gravity: v[2],
-                    ground_accel: v[3],
-                    air_accel: v[4],
-                    turn_rate: v[5],
-                    radius: v[6],
-                    height: v[7],
-                };
+                *c.values_mut()[at] = value;
                 c.check().ok()?;
                 Abilities::Platform(c)
             }
-            Abilities::Racing(c) => {
+            Abilities::Racing(mut c) => {
                 let at = CAR_FIELDS.iter().position(|(r, _)| r.name == field)?;
-                let mut v = c.values();
-                v[at] = value;
-                let c = CarProfile {
-                    engine_force: v[0],
-                    mass: v[1],
-                    grip: v[2],
-                    max_steer: v[3],
-                    damping: v[4],
-                };
+                *c.values_mut()[at] = value;
                 c.check().ok()?;
                 Abilities::Racing(c)
             }

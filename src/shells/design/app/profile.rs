@@ -69,7 +69,7 @@ impl App {
 
     /// `[` `]`: the chosen ability times `factor`, within its range; the level is made again.
     pub(super) fn scale_ability(&mut self, factor: f64) -> Vec<Effect> {
-        let field = abilities(self.game)[self.profile.ability % abilities(self.game).len()];
+        let field = self.chosen_ability();
         let profile = self.current_profile();
         let Some((value, range)) = profile.value(field) else {
             return Vec::new();
@@ -88,6 +88,12 @@ impl App {
         self.generate()
     }
 
+    /// The ability `[` and `]` change, as the profile file names it.
+    fn chosen_ability(&self) -> &'static str {
+        let all = abilities(self.game);
+        all[self.profile.ability % all.len()]
+    }
+
     /// The profile levels are made for now (the built-in one when none is loaded).
     fn current_profile(&self) -> Profile {
         self.profile
@@ -98,7 +104,7 @@ impl App {
 
     fn say_ability(&mut self) {
         let profile = self.current_profile();
-        let field = abilities(self.game)[self.profile.ability % abilities(self.game).len()];
+        let field = self.chosen_ability();
         if let Some((value, range)) = profile.value(field) {
             let name = field.rsplit('.').next().unwrap_or(field).replace('_', " ");
             self.say(format!(

@@ -20,7 +20,8 @@ struct Worker {
 impl Worker {
     fn new(seed: u64) -> Self {
         let level =
-            rules::platform_level(seed, None, None, &Default::default()).expect("rule level");
+            rules::platform_level(seed, None, None, &Default::default(), &Default::default())
+                .expect("rule level");
         let track = level.platform().expect("platform level");
         Self {
             env: PlatformEnv::new(track, level.goal, PlatformRewards::default()),

@@ -27,6 +27,7 @@ fn trainer(shape: &PolicyShape, ppo: PpoConfig) -> Trainer<SolverEnvs<PlatformGa
         ppo.num_envs,
         SourceRecord::default(),
         shape.action_size(),
+        Default::default(),
     )
     .unwrap();
     let ppo = Ppo::new(ppo, ActorCritic::new(shape.clone(), 0).unwrap()).unwrap();

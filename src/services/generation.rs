@@ -11,7 +11,7 @@
 use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, Placement, TrackBuild, observation_size,
 };
-use arlpcg_core::game::{PlatformGame, RacingGame};
+use arlpcg_core::game::{PlatformGame, Player, RacingGame};
 use arlpcg_core::level::pacing::{AuxCurve, Pacing, covered, round_aux};
 use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::racing::RacingRulesConfig;
@@ -158,6 +158,33 @@ impl LevelRequest {
     }
 }
 
+/// The player of `profile` (none: the built-in one). A platform character's reach is measured
+/// once per process (about a second) and kept, so that a batch, a campaign or the designer's
+/// edits measure each profile once.
+pub fn player_for(profile: Option<&Profile>) -> Player {
+    use std::sync::{Mutex, OnceLock};
+    static MEASURED: OnceLock<Mutex<Vec<Player>>> = OnceLock::new();
+    let Some(abilities) = profile.map(|p| p.abilities) else {
+        return Player::default();
+    };
+    let measured = MEASURED.get_or_init(Default::default);
+    let known = |players: &[Player]| {
+        players
+            .iter()
+            .find(|p| p.abilities == Some(abilities))
+            .copied()
+    };
+    if let Some(player) = known(&measured.lock().unwrap_or_else(|e| e.into_inner())) {
+        return player;
+    }
+    let player = Player::of(Some(abilities));
+    measured
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push(player);
+    player
+}
+
 /// A rule-based level of `game` (λ is recorded, not used; the rules know no curve), made for
 /// the request's profile.
 pub fn rules_level(game: Game, request: &LevelRequest) -> Result<Level, NoRuleLevel> {
@@ -171,6 +198,7 @@ pub fn rules_level(game: Game, request: &LevelRequest) -> Result<Level, NoRuleLe
             aux,
             goal,
             &PlatformRulesConfig::default(),
+            &player_for(request.profile.as_ref()).reach,
             draw,
         )?,
         Game::Racing => {
@@ -252,17 +280,17 @@ fn build_level<G: GeneratorGame>(
     generator: &GeneratorPolicy,
     request: &LevelRequest,
 ) -> Result<Level, GenerationError> {
-    let (empty, mut rng) = G::new_build(
-        request.seed, request.goal, generator.limits, request.obstacles,
-    );
+    let limits = BuildLimits {
+        player: player_for(request.profile.as_ref()),
+        ..generator.limits
+    };
+    let (empty, mut rng) = G::new_build(request.seed, request.goal, limits, request.obstacles);
     // A kept prefix replaces the seed's scene; the seed still drives the Generator's samples.
     let (empty, kept_aux) = match &request.keep {
         None => (empty, Vec::new()),
         Some(keep) => {
-            let build = G::kept_build(
-                &keep.level.track, keep.level.goal, keep.pieces, generator.limits,
-            )
-            .map_err(|problem| GenerationError::Keep { problem })?;
+            let build = G::kept_build(&keep.level.track, keep.level.goal, keep.pieces, limits)
+                .map_err(|problem| GenerationError::Keep { problem })?;
             let aux = (0..keep.pieces)
                 .map(|i| kept_piece_aux(&keep.level, i))
                 .collect();

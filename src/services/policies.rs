@@ -71,12 +71,19 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
     };
     let (loaded, reference) = load_pinned(path, (game, Role::Solver), observation, actions)?;
     let card = loaded.card.clone();
+    let profile = card
+        .profile
+        .as_ref()
+        .map(|record| record.profile(game))
+        .transpose()
+        .map_err(|problem| anyhow::anyhow!("{}: card field profile.{problem}", path.display()))?;
     Ok((
         SolverPolicy {
             game,
             policy: loaded.policy,
             normalizer: loaded.card.normalizer,
             reference,
+            profile,
         },
         card,
     ))
@@ -120,6 +127,7 @@ pub fn generator_limits(path: &Path, card: &PolicyCard) -> Result<BuildLimits> {
     let limits = BuildLimits {
         max_pieces: card.max_pieces.unwrap_or(default_max_pieces),
         curve_offset: card.curve_offset.unwrap_or(DEFAULT_CURVE_OFFSET),
+        player: Default::default(),
     };
     if !(1..=most_pieces).contains(&limits.max_pieces) {
         anyhow::bail!(

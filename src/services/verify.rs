@@ -32,6 +32,8 @@ pub struct SolverPolicy {
     pub policy: ActorCritic,
     pub normalizer: RunningNorm,
     pub reference: PolicyRef,
+    /// The game profile it trained for (none: the built-in game).
+    pub profile: Option<arlpcg_core::level::profile::Profile>,
 }
 
 /// Who plays the trials.

@@ -1034,7 +1034,7 @@ fn a_game_profile_is_checked_recorded_and_played_under() {
     fails_with(
         &arlpcg(&["profile", "check", &path("flat.yaml")]),
         1,
-        "no level can be completed",
+        "most of the game's goals cannot be reached",
     );
     fails_with(
         &arlpcg(&[
@@ -1121,5 +1121,69 @@ fn a_game_profile_is_checked_recorded_and_played_under() {
         stderr(&policy).contains("never trained with them"),
         "{}",
         stderr(&policy)
+    );
+}
+
+#[test]
+fn a_solver_trained_for_a_profile_records_it_and_keeps_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let init = arlpcg_ok(&["profile", "init", "--game", "platform"]);
+    let text = String::from_utf8(init.stdout).unwrap();
+    std::fs::write(path("default.yaml"), &text).unwrap();
+    let low = text
+        .replace("name: default", "name: low-jumper")
+        .replace("jump_speed: 9.25", "jump_speed: 7.5");
+    std::fs::write(path("low.yaml"), low).unwrap();
+    let low_path = path("low.yaml");
+    // Its configuration and card record the profile, a resume keeps it, and it plays under the
+    // low jumper's abilities without a word of warning.
+    let run = path("run");
+    let train = |extra: &[&str]| {
+        let mut args = vec![
+            "train", "--mode", "rule-pcg", "--threads", "1", "--out", &run,
+        ];
+        args.extend_from_slice(extra);
+        arlpcg(&args)
+    };
+    fails_with(
+        &train(&[
+            "--game", "racing", "--steps", "8192", "--profile", &low_path,
+        ]),
+        1,
+        "--profile is a platform profile and the run is a racing one",
+    );
+    assert!(
+        train(&["--steps", "8192", "--profile", &low_path])
+            .status
+            .success()
+    );
+    let card = std::fs::read_to_string(dir.path().join("run/solver.yaml")).unwrap();
+    assert!(card.contains("profile:\n  name: low-jumper"), "{card}");
+    fails_with(
+        &train(&[
+            "--resume",
+            "--steps",
+            "16384",
+            "--profile",
+            &path("default.yaml"),
+        ]),
+        1,
+        "profile cannot change in a resumed run",
+    );
+    let trained = arlpcg_ok(&[
+        "verify",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/levels/hand/staircase.yaml"),
+        "--profile",
+        &low_path,
+        "--policy",
+        &format!("{run}/solver.safetensors"),
+        "--trials",
+        "2",
+    ]);
+    assert!(
+        !stderr(&trained).contains("never trained"),
+        "{}",
+        stderr(&trained)
     );
 }

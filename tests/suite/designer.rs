@@ -132,13 +132,9 @@ fn a_profile_makes_the_levels_and_its_keys_change_the_abilities() {
     let low = arlpcg_core::level::profile::Profile::default_of(Game::Platform)
         .to_yaml()
         .replace("name: default", "name: low-jumper")
-        .replace("jump_speed: 9.25", "jump_speed: 6.0");
+        .replace("jump_speed: 9.25", "jump_speed: 8.0");
     let file = dir.path().join("low.yaml");
     std::fs::write(&file, low).unwrap();
-    let mut plain = Harness::rules(dir.path());
-    plain.settle();
-    let plain_successes = plain.app.trials.as_ref().unwrap().successes();
-
     let mut h = Harness::rules(dir.path());
     h.settle();
     h.key(KeyCode::Char('f'));
@@ -151,12 +147,11 @@ fn a_profile_makes_the_levels_and_its_keys_change_the_abilities() {
         level.profile.as_ref().map(|p| p.name.as_str()),
         Some("low-jumper")
     );
-    assert_eq!(plain.app.level.as_ref().unwrap().track, level.track);
+    // Made within the low jumper's reach: no block more than 1 m above the last.
+    for pair in level.platform().unwrap().platforms().windows(2) {
+        assert!(pair[1].position[1] - pair[0].position[1] <= 1.0 + 1e-9);
+    }
     assert!(h.screen(120, 36).contains("profile: low-jumper"));
-    assert!(
-        h.app.trials.as_ref().unwrap().successes() < plain_successes,
-        "the low jumper does worse on the same level"
-    );
 
     // `]` raises the jump speed 5%; `e` then `[` lowers the run speed 5%.
     h.key(KeyCode::Char(']'));
@@ -166,7 +161,7 @@ fn a_profile_makes_the_levels_and_its_keys_change_the_abilities() {
     h.settle();
     let edited = h.app.level.as_ref().unwrap().profile.clone().unwrap();
     assert_eq!(edited.name, "low-jumper (edited)");
-    assert_eq!(edited.value("character.jump_speed").unwrap().0, 6.3);
+    assert_eq!(edited.value("character.jump_speed").unwrap().0, 8.4);
     assert_eq!(edited.value("character.run_speed").unwrap().0, 7.6);
     // A file that is not a profile is a message, not a crash.
     h.key(KeyCode::Char('f'));

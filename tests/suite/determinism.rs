@@ -10,7 +10,7 @@ use rand_chacha::ChaCha8Rng;
 /// median scripted player (noisy, from its own seed) plays, and every tenth action is drawn at
 /// random from a fixed stream, so that the run exercises falls, slides and air.
 fn run_bits<G: GameSpec>(seed: u64) -> Vec<u32> {
-    let level = G::rule_level(11).expect("rule level 11 builds");
+    let level = G::rule_level(11, &Default::default()).expect("rule level 11 builds");
     let mut env = G::solver_env(&level).expect("a level of this game");
     env.reset(seed);
     let mut player = G::scripted(seed, Skill::Median);

@@ -11,7 +11,14 @@ use arlpcg_core::level::scene::Scene;
 use arlpcg_core::level::{Level, PlatformRulesConfig, gltf as export};
 
 fn level(seed: u64) -> Level {
-    rules::platform_level(seed, Some(-1.0), None, &PlatformRulesConfig::default()).unwrap()
+    rules::platform_level(
+        seed,
+        Some(-1.0),
+        None,
+        &PlatformRulesConfig::default(),
+        &Default::default(),
+    )
+    .unwrap()
 }
 
 /// `q · v · q⁻¹`: `v` turned by the unit quaternion `q` = [x, y, z, w].
@@ -339,7 +346,7 @@ fn every_solid_piece_has_a_collider_and_the_finish_a_trigger() {
     use arlpcg_core::game::{GameSpec, RacingGame};
     let levels = (1..=20)
         .map(level)
-        .chain((1..=20).filter_map(RacingGame::rule_level))
+        .chain((1..=20).filter_map(|seed| RacingGame::rule_level(seed, &Default::default())))
         .chain([racing_with_obstacles()]);
     for level in levels {
         let game = level.game();

@@ -135,9 +135,14 @@ fn bad_curves_are_refused_with_the_reason() {
 
 #[test]
 fn a_piece_aux_without_a_curve_names_the_field() {
-    let level =
-        arlpcg_core::game::platform::rules::platform_level(5, None, None, &Default::default())
-            .unwrap();
+    let level = arlpcg_core::game::platform::rules::platform_level(
+        5,
+        None,
+        None,
+        &Default::default(),
+        &Default::default(),
+    )
+    .unwrap();
     let text = yaml::to_string(&level).replacen("  height:", "  aux: -1.0\n  height:", 1);
     let err = yaml::parse(&text).unwrap_err().to_string();
     assert!(

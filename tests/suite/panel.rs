@@ -11,7 +11,7 @@ use crate::common::{arlpcg, arlpcg_ok, fails_with, files_of, small_campaign, std
 /// Mean success of each skill, weakest first, on `levels` rule levels of `G`, `trials` runs each.
 fn skill_success<G: GameSpec>(levels: u64, trials: u32) -> Vec<f64> {
     let levels: Vec<_> = (0..levels)
-        .filter_map(|k| G::rule_level(9_000 + k))
+        .filter_map(|k| G::rule_level(9_000 + k, &Default::default()))
         .collect();
     assert!(levels.len() >= 4, "the rules build most seeds");
     Skill::ALL

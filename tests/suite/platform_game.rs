@@ -3,10 +3,12 @@
 
 use arlpcg_core::game::platform::character::Body;
 use arlpcg_core::game::platform::reach::{
-    self, REACH_HEIGHTS, REACH_TABLE, play_scripted, single_jump,
+    self, REACH_HEIGHTS, REACH_TABLE, Reach, play_scripted, single_jump,
 };
 use arlpcg_core::game::platform::{OBSERVATION_SIZE, PlatformAction, PlatformEnv, PlatformRewards};
+use arlpcg_core::game::{GameSpec, PlatformGame, Player};
 use arlpcg_core::level::platform::{BlockParams, PlatformTrack, Start};
+use arlpcg_core::level::profile::{Abilities, CharacterProfile};
 use arlpcg_core::level::stats::Outcome;
 
 fn env_of(track: &PlatformTrack) -> PlatformEnv {
@@ -39,6 +41,42 @@ fn the_scripted_controller_completes_an_easy_level_and_fails_an_impossible_jump(
         assert_eq!(run.outcome, Outcome::Fell, "seed {seed}: {run:?}");
         assert_eq!((run.progress, run.target_piece), (0.0, 0));
     }
+}
+
+#[test]
+fn a_weaker_jump_measures_a_shorter_reach_and_its_rule_levels_stay_within_it() {
+    let low = Body {
+        jump_speed: 0.8 * Body::default().jump_speed,
+        ..Body::default()
+    };
+    let reach = Reach::of(low);
+    assert_eq!(Reach::of(Body::default()), Reach::default());
+    assert_ne!(reach, Reach::default(), "{reach:?}");
+    assert_eq!(
+        (Reach::default().max_climb(), reach.max_climb()),
+        (2.0, 1.0),
+        "{reach:?}"
+    );
+    let player = Player::of(Some(Abilities::Platform(CharacterProfile {
+        jump_speed: 0.8 * CharacterProfile::default().jump_speed,
+        ..CharacterProfile::default()
+    })));
+    assert_eq!(player.reach, reach);
+    let (mut cleared, mut runs) = (0, 0);
+    for seed in 0..10 {
+        let level = PlatformGame::rule_level(seed, &player).expect("a rule level");
+        let track = level.platform().unwrap();
+        for pair in track.platforms().windows(2) {
+            let rise = pair[1].position[1] - pair[0].position[1];
+            assert!(rise <= 1.0 + 1e-9, "seed {seed}: a climb of {rise} m");
+        }
+        let mut env = PlatformGame::solver_env_with(&level, player.abilities).unwrap();
+        for run in 0..5 {
+            cleared += (play_scripted(&mut env, run, 0.3).outcome == Outcome::Success) as u32;
+            runs += 1;
+        }
+    }
+    assert!(cleared * 100 >= runs * 95, "{cleared} of {runs}");
 }
 
 #[test]

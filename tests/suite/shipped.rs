@@ -193,8 +193,14 @@ fn each_verification_trial_is_the_run_recorded_from_its_seed() {
     use arlpcg_core::level::stats::TrialResult;
     use std::sync::Mutex;
     for (game, level) in [
-        (Game::Platform, PlatformGame::rule_level(7).unwrap()),
-        (Game::Racing, RacingGame::rule_level(7).unwrap()),
+        (
+            Game::Platform,
+            PlatformGame::rule_level(7, &Default::default()).unwrap(),
+        ),
+        (
+            Game::Racing,
+            RacingGame::rule_level(7, &Default::default()).unwrap(),
+        ),
     ] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("policies")

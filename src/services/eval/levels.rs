@@ -4,6 +4,7 @@
 use crate::services::generation::{self, GeneratorPolicy, LevelRequest};
 use arlpcg_core::game::facts::{facts, piece_values};
 use arlpcg_core::level::Level;
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::seed_ranges::{EVAL_SEED_BASE, VALIDATION_AUX_STRIDE, VALIDATION_SEED_BASE};
 
 use super::{AUX_VALUES, Budget, NamedSolver, PlayLayout};
@@ -12,21 +13,24 @@ use super::{AUX_VALUES, Budget, NamedSolver, PlayLayout};
 /// reach a goal).
 const SEED_TRIES: u64 = 4;
 
-/// Generator levels at `aux`: `count` of them from seeds `base`, `base + 1`, ... (a seed whose
-/// level the Generator cannot build is skipped, within `SEED_TRIES` seeds per level).
+/// Generator levels at `aux` for `profile` (none: the built-in game): `count` of them from
+/// seeds `base`, `base + 1`, ... (a seed whose level the Generator cannot build is skipped,
+/// within `SEED_TRIES` seeds per level).
 pub fn generator_levels(
     generator: &GeneratorPolicy,
     aux: f64,
     base: u64,
     count: u32,
+    profile: Option<&Profile>,
 ) -> Result<Vec<Level>, candle_core::Error> {
     let mut levels = Vec::with_capacity(count as usize);
     for seed in base..base + count as u64 * SEED_TRIES {
         if levels.len() == count as usize {
             break;
         }
-        let request =
-            LevelRequest::new(seed, Some(aux)).obstacles(facts(generator.game).scene_obstacles);
+        let request = LevelRequest::new(seed, Some(aux))
+            .obstacles(facts(generator.game).scene_obstacles)
+            .profile(profile.cloned());
         match generation::generator_level(generator, &request) {
             Ok(level) => levels.push(level),
             // (No prefix is kept here, so `Keep` does not occur.)
@@ -40,18 +44,21 @@ pub fn generator_levels(
     Ok(levels)
 }
 
-/// The validation set: rule levels and Generator levels (λ cycling through [`AUX_VALUES`]),
-/// half each.
+/// The validation set for `profile`: rule levels and Generator levels (λ cycling through
+/// [`AUX_VALUES`]), half each.
 pub fn validation_levels(
     generator: &GeneratorPolicy,
     count: u32,
+    profile: Option<&Profile>,
 ) -> Result<Vec<Level>, candle_core::Error> {
     let base = VALIDATION_SEED_BASE;
     let rule_count = count / 2;
     let game = generator.game;
     let mut levels: Vec<Level> = (0..rule_count as u64)
         .filter_map(|k| {
-            let request = LevelRequest::new(base + k, None).obstacles(facts(game).scene_obstacles);
+            let request = LevelRequest::new(base + k, None)
+                .obstacles(facts(game).scene_obstacles)
+                .profile(profile.cloned());
             generation::rules_level(game, &request).ok()
         })
         .collect();
@@ -59,7 +66,7 @@ pub fn validation_levels(
     for (k, &aux) in AUX_VALUES.iter().enumerate() {
         let seeds = base + (1 + k as u64) * VALIDATION_AUX_STRIDE;
         let wanted = per_aux.min(count - levels.len() as u32);
-        levels.extend(generator_levels(generator, aux, seeds, wanted)?);
+        levels.extend(generator_levels(generator, aux, seeds, wanted, profile)?);
     }
     Ok(levels)
 }
@@ -79,18 +86,19 @@ pub struct Levels {
     pub layout: PlayLayout,
 }
 
-/// Builds every level the evaluation plays (deterministic: the same Generator and budget give
-/// the same levels on every machine).
+/// Builds every level the evaluation plays, for `profile` (deterministic: the same Generator,
+/// budget and profile give the same levels on every machine).
 pub fn levels(
     generator: &GeneratorPolicy,
     solvers: &[NamedSolver],
     budget: Budget,
+    profile: Option<&Profile>,
 ) -> Result<Levels, candle_core::Error> {
     let by_aux: Vec<Vec<Level>> = AUX_VALUES
         .iter()
-        .map(|&aux| generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks))
+        .map(|&aux| generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks, profile))
         .collect::<Result<_, _>>()?;
-    let validation = validation_levels(generator, budget.validation_tracks)?;
+    let validation = validation_levels(generator, budget.validation_tracks, profile)?;
     let game = generator.game;
     let piece_means = by_aux
         .iter()

@@ -75,20 +75,23 @@ pub struct NamedSolver<'a> {
     pub solver: Solver<'a>,
 }
 
-/// Runs the whole evaluation. `solvers` must include the `arlpcg` one (it plays the
+/// Runs the whole evaluation, on levels made for `profile` (none: the built-in game). `solvers`
+/// must include the `arlpcg` one (it plays the
 /// controllability table); `on_level` is called after each level played (progress).
 pub fn evaluate(
     generator: &GeneratorPolicy,
     solvers: &[NamedSolver],
     budget: Budget,
+    profile: Option<&arlpcg_core::level::profile::Profile>,
     on_level: &(dyn Fn() + Sync),
 ) -> Result<Results, candle_core::Error> {
-    let levels = levels(generator, solvers, budget)?;
+    let levels = levels(generator, solvers, budget, profile)?;
     let all: Vec<usize> = (0..levels.layout.plays().len()).collect();
     let stats = play(&levels, solvers, budget, &all, on_level);
-    Ok(assemble(
-        budget, &generator.reference.path, &levels.layout, &stats,
-    ))
+    Ok(Results {
+        profile: profile.map(|p| p.record()),
+        ..assemble(budget, &generator.reference.path, &levels.layout, &stats)
+    })
 }
 
 /// Levels `evaluate` plays in all (for a progress bar).

@@ -71,6 +71,10 @@ pub struct Results {
     pub cross: Vec<CrossRow>,
     /// Every judge (trained Solvers and the scripted player's skills) at every λ.
     pub controllability_by_judge: Vec<JudgeRow>,
+    /// The game profile every level was made and played for (`eval --profile`; absent: the
+    /// built-in game).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<arlpcg_core::level::profile::ProfileRecord>,
 }
 
 /// What a [`Results`] read from JSON holds until [`Results::read`] sets the game.
@@ -204,6 +208,7 @@ pub fn assemble(
         generalization,
         cross,
         controllability_by_judge,
+        profile: None,
     }
 }
 

@@ -88,7 +88,7 @@ pub fn golden_episode<G: GameSpec>(
     reference: PolicyRef,
 ) -> candle_core::Result<GoldenEpisode> {
     let level = (GOLDEN_LEVEL_SEED..)
-        .find_map(G::rule_level)
+        .find_map(|seed| G::rule_level(seed, &Default::default()))
         .expect("the rules find a level within a few seeds");
     let mut env = G::solver_env(&level).expect("a rule level of the game itself");
     env.reset(GOLDEN_RUN_SEED);

@@ -47,6 +47,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             limits: BuildLimits {
                 max_pieces: config.generator.max_pieces,
                 curve_offset: config.generator.curve_offset,
+                player: config.player(G::GAME),
             },
             obstacles: config.generator.obstacles,
             rewards: config.generator.rewards.clone(),

@@ -171,6 +171,7 @@ pub(super) fn card(
         max_pieces: (role == Role::Generator).then_some(config.generator.max_pieces),
         curve_offset: (role == Role::Generator && game == Game::Racing)
             .then_some(config.generator.curve_offset),
+        profile: config.profile.clone(),
     }
 }
 

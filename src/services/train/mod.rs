@@ -33,6 +33,7 @@ use adversarial_run::AdversarialRun;
 use arlpcg_core::game::generator::GeneratorGame;
 use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame};
 use arlpcg_core::level::Game;
+use arlpcg_core::level::profile::{Profile, ProfileRecord};
 use arlpcg_core::rl::checkpoint::TrainMode;
 use cards::{checkpoint_identity, solver_shape};
 use config::load_config;
@@ -52,19 +53,34 @@ pub(super) const UNDER_WAY: &str = "under_way";
 pub(super) const GENERATOR_METRICS: &str = "generator-metrics.csv";
 pub(super) const METRICS_HEADER: &str = "iteration,global_step,wall_time_s,steps_per_s,rollout_s,update_s,learning_rate,episodes,mean_return,success_ratio,policy_loss,value_loss,entropy,approx_kl,clip_fraction,explained_variance,env_s,forward_s,generator_s,gae_s,copies_s,iteration_s,update_mfu";
 
-/// The run in `out`: started afresh with `config` (the game's defaults when `None`; `seed` and
-/// `steps`, if given, replace its seed and budget), or with `resume` continued from its
-/// checkpoints (`config` and `steps`, if given, replace its hyper-parameters and budget from
-/// here on). The caller installs the thread pool the run's environments and updates use.
+/// What a session asks of its run besides its game and mode: a configuration file (the game's
+/// defaults when `None`), a seed, a budget and a game profile, each replacing the
+/// configuration's when given.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct RunAsk<'a> {
+    pub config: Option<&'a Path>,
+    pub seed: Option<u64>,
+    pub steps: Option<u64>,
+    pub profile: Option<&'a Profile>,
+}
+
+/// The run in `out`: started afresh as `ask` asks, or with `resume` continued from its
+/// checkpoints (`ask`'s configuration and steps, if given, replace its hyper-parameters and
+/// budget from here on; its seed and profile cannot change). The caller installs the thread
+/// pool the run's environments and updates use.
 pub fn open(
     game: Option<Game>,
     mode: Option<TrainMode>,
     out: &Path,
-    config: Option<&Path>,
-    seed: Option<u64>,
-    steps: Option<u64>,
+    ask: RunAsk,
     resume: bool,
 ) -> Result<Box<dyn Training>> {
+    let RunAsk {
+        config,
+        seed,
+        steps,
+        profile,
+    } = ask;
     let (game, mode) = if resume {
         resumed_identity(out, game, mode)?
     } else {
@@ -73,11 +89,18 @@ pub fn open(
             mode.unwrap_or(TrainMode::RulePcg),
         )
     };
+    if let Some(profile) = profile.filter(|p| p.game() != game) {
+        bail!(
+            "--profile is a {} profile and the run is a {game} one (--game {game})",
+            profile.game()
+        );
+    }
     let config = if resume {
         Start::Resume(ConfigChange {
             config: config.map(|path| load_config(path, game)).transpose()?,
             seed,
             steps,
+            profile: profile.map(Profile::record),
         })
     } else {
         if out.join(CHECKPOINT).exists() {
@@ -121,6 +144,9 @@ pub fn open(
         }
         if let Some(steps) = steps {
             config.steps = steps;
+        }
+        if let Some(profile) = profile {
+            config.profile = Some(profile.record());
         }
         Start::New(config)
     };
@@ -173,6 +199,7 @@ pub(super) struct ConfigChange {
     pub config: Option<TrainConfig>,
     pub seed: Option<u64>,
     pub steps: Option<u64>,
+    pub profile: Option<ProfileRecord>,
 }
 
 impl ConfigChange {
@@ -184,6 +211,9 @@ impl ConfigChange {
         }
         if let Some(steps) = self.steps {
             new.steps = steps;
+        }
+        if let Some(profile) = self.profile {
+            new.profile = Some(profile);
         }
         new
     }
@@ -215,7 +245,8 @@ fn solver_run<G: GameSpec>(
             None => SourceRecord::default(),
         };
         let action_size = solver_shape(config, G::GAME).action_size();
-        SolverEnvs::<G>::new(source, config.solver.num_envs, record, action_size)
+        let player = config.player(G::GAME);
+        SolverEnvs::<G>::new(source, config.solver.num_envs, record, action_size, player)
             .map_err(|problem| anyhow::anyhow!("level source: {problem}"))
     };
     Ok(Box::new(match start {

@@ -14,7 +14,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use arlpcg_core::game::{GameSpec, SolverEnv};
+use arlpcg_core::game::{GameSpec, Player, SolverEnv};
 use arlpcg_core::level::Level;
 use arlpcg_core::level::stats::Outcome;
 use arlpcg_core::rl::vec_env::{Transition, VecEnv};
@@ -74,6 +74,8 @@ pub struct EpisodeLog {
 /// Many environments of game `G` with automatic reset onto new levels.
 pub struct SolverEnvs<G: GameSpec> {
     mode: SolverMode,
+    /// Who the levels are made for and who plays them.
+    player: Player,
     envs: Vec<G::Env>,
     logs: Vec<EpisodeLog>,
     fixed: Vec<Level>,
@@ -81,23 +83,25 @@ pub struct SolverEnvs<G: GameSpec> {
 }
 
 impl<G: GameSpec> SolverEnvs<G> {
-    /// `num_envs` environments, continuing from `record` (a fresh run starts from the
-    /// default): its episodes under way are replayed, rows of `action_size`. `Err` says why
+    /// `num_envs` environments of `player`, continuing from `record` (a fresh run starts from
+    /// the default): its episodes under way are replayed, rows of `action_size`. `Err` says why
     /// a record's episodes cannot be replayed.
     pub fn new(
         mode: SolverMode,
         num_envs: usize,
         record: SourceRecord,
         action_size: usize,
+        player: Player,
     ) -> Result<Self, String> {
         let fixed = match mode {
             SolverMode::RulePcg => Vec::new(),
             SolverMode::FixedTrack => (0..FIXED_TRACK_COUNT)
-                .map(|k| rule_level::<G>(TRAINING_SEED_BASE + k))
+                .map(|k| rule_level::<G>(TRAINING_SEED_BASE + k, &player))
                 .collect(),
         };
         let mut this = Self {
             mode,
+            player,
             envs: Vec::with_capacity(num_envs),
             logs: record.under_way,
             fixed,
@@ -157,9 +161,10 @@ impl<G: GameSpec> SolverEnvs<G> {
         };
         let level = match fixed {
             Some(level) => level,
-            None => &rule_level::<G>(log.level_seed),
+            None => &rule_level::<G>(log.level_seed, &self.player),
         };
-        let mut env = G::solver_env(level).expect("training levels are of the run's game");
+        let mut env = G::solver_env_with(level, self.player.abilities)
+            .expect("training levels are of the run's game");
         env.reset(log.reset_seed);
         env
     }
@@ -192,10 +197,10 @@ fn play_rows<E: SolverEnv>(
     Ok(())
 }
 
-fn rule_level<G: GameSpec>(seed: u64) -> Level {
+fn rule_level<G: GameSpec>(seed: u64, player: &Player) -> Level {
     // The rules find a level for every seed in practice; if one ever fails, the next seed serves.
     (seed..)
-        .find_map(G::rule_level)
+        .find_map(|seed| G::rule_level(seed, player))
         .expect("the rules produce levels")
 }
 

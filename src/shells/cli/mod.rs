@@ -92,7 +92,7 @@ pub enum ProfileCommand {
     },
     /// Check a profile file and measure what it allows with the scripted expert playing: the
     /// jump and reach table (platform), speed and grip (racing), and how many rule levels it
-    /// completes. Exit 1 when the file is wrong or no level can be completed.
+    /// completes. Exit 1 when the file is wrong or the expert completes under half the levels.
     Check {
         file: PathBuf,
         /// Runs per rule level.
@@ -211,6 +211,10 @@ pub struct EvalArgs {
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
     pub threads: Option<u64>,
+    /// Make and play every level for this game profile (`arlpcg profile init`); results.json
+    /// records it.
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<PathBuf>,
 }
 
 /// Output file formats of `generate`.
@@ -629,6 +633,11 @@ pub struct TrainArgs {
     /// given with --resume, it must be that seed.
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Train for this game profile (`arlpcg profile init`): the Solver plays with its
+    /// character's or car's abilities, on levels made for them; the configuration and the cards
+    /// record it. A resumed run keeps its own.
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<PathBuf>,
     /// Print the default configuration as YAML and exit.
     #[arg(long)]
     pub print_config: bool,

@@ -10,9 +10,11 @@ use crate::services::fsio::{self, Overwrite};
 use crate::services::generation::GeneratorPolicy;
 use crate::services::panel::Judge;
 use crate::services::policies::{GENERATOR_FILE, load_generator, load_solver};
+use crate::services::profile;
 use crate::services::verify::{Solver, SolverPolicy};
 use crate::shells::cli::EvalArgs;
 use arlpcg_core::game::Skill;
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::rl::checkpoint::TrainMode;
 
 pub fn run(args: &EvalArgs) -> Result<()> {
@@ -20,6 +22,11 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         return merge(args);
     }
     if !args.runs.is_empty() {
+        if args.profile.is_some() {
+            bail!(
+                "--profile with --runs: a seeds table is of the built-in game; evaluate each run with --policies and --profile"
+            );
+        }
         return seeds(args);
     }
     if let Some(missing) = args.policies.iter().find(|dir| !dir.is_dir()) {
@@ -33,6 +40,10 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         .with_context(|| format!("no {GENERATOR_FILE} in any --policies folder"))?;
     let (generator, _) = load_generator(&generator_path, args.game)?;
     let solvers = load_solvers(args)?;
+    let profile = match &args.profile {
+        Some(file) => Some(profile::for_game(profile::load(file)?, args.game, file)?),
+        None => None,
+    };
     let budget = budget(args);
     let overwrite = if args.force {
         Overwrite::Allowed
@@ -53,7 +64,8 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         }))
         .collect();
     if let Some(shard) = args.shard {
-        return write_shard(args, shard, &pool, &generator, &named, budget, overwrite);
+        let generated = (&generator, profile.as_ref());
+        return write_shard(args, shard, &pool, generated, &named, budget, overwrite);
     }
     let names = [
         "results.md", "results.json", "results.png", "controllability.csv", "generalization.csv",
@@ -85,7 +97,8 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         eval::levels_to_play(budget, named.len()),
         "levels played",
     );
-    let results = pool.install(|| eval::evaluate(&generator, &named, budget, &|| bar.inc(1)))?;
+    let results = pool
+        .install(|| eval::evaluate(&generator, &named, budget, profile.as_ref(), &|| bar.inc(1)))?;
     bar.finish_and_clear();
     write_results(&results, &args.out, overwrite)
 }
@@ -181,8 +194,9 @@ fn seeds(args: &EvalArgs) -> Result<()> {
     let judges = crate::services::policies::load_panel(folder, args.game, Some(&available))?;
     let budget = budget(args);
     let pool = crate::shells::common::thread_pool(args.threads)?;
-    let validation =
-        pool.install(|| eval::validation_levels(&validation_generator, budget.validation_tracks))?;
+    let validation = pool.install(|| {
+        eval::validation_levels(&validation_generator, budget.validation_tracks, None)
+    })?;
     let rule_levels = validation.iter().filter(|l| eval::is_rule_level(l)).count();
     let arlpcg_generators = runs
         .iter()
@@ -312,7 +326,7 @@ fn write_shard(
     args: &EvalArgs,
     shard: crate::shells::cli::Shard,
     pool: &rayon::ThreadPool,
-    generator: &GeneratorPolicy,
+    (generator, profile): (&GeneratorPolicy, Option<&Profile>),
     named: &[NamedSolver],
     budget: Budget,
     overwrite: Overwrite,
@@ -324,7 +338,7 @@ fn write_shard(
     }
     fsio::check_writable(&path, overwrite)?;
     let part = pool.install(|| -> Result<Part> {
-        let levels = eval::levels(generator, named, budget)?;
+        let levels = eval::levels(generator, named, budget, profile)?;
         let indices: Vec<usize> = (0..levels.layout.plays().len())
             .filter(|&i| shard.owns(i as u64))
             .collect();

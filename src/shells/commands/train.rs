@@ -51,15 +51,23 @@ pub fn run(args: &TrainArgs) -> Result<()> {
             out.display()
         );
     }
+    let profile = args
+        .profile
+        .as_deref()
+        .map(crate::services::profile::load)
+        .transpose()?;
     let pool = crate::shells::common::thread_pool(args.threads)?;
     pool.install(|| {
         let opened = train::open(
             args.game,
             args.mode.map(Into::into),
             out,
-            args.config.as_deref(),
-            args.seed,
-            args.steps,
+            train::RunAsk {
+                config: args.config.as_deref(),
+                seed: args.seed,
+                steps: args.steps,
+                profile: profile.as_ref(),
+            },
             args.resume,
         );
         let mut run = match opened {

@@ -20,7 +20,7 @@ use crate::services::verify::{
 use crate::shells::cli::{Judges, SolverChoice, VerifyArgs, default_solver};
 use arlpcg_core::game::Skill;
 use arlpcg_core::game::facts::facts;
-use arlpcg_core::level::profile::Profile;
+use arlpcg_core::level::profile::{Abilities, Profile};
 use arlpcg_core::level::stats::{Outcome, PanelStats, SolverRef, SolverStats};
 use arlpcg_core::level::yaml;
 use arlpcg_core::level::{Game, Level};
@@ -434,16 +434,27 @@ impl Solvers {
         Ok(())
     }
 
-    /// Says once that a Solver policy, trained with the built-in abilities, plays a level made
-    /// for other ones: its statistics are not those of a player who trained with them.
+    /// Says once that a Solver policy plays a level made for abilities other than those it
+    /// trained with: its statistics are not those of a player who trained with them.
     fn warn_of_profile(&mut self, level: &Level) {
-        let other = level.profile.as_ref().filter(|p| !p.is_default());
-        let policy = matches!(self.resolved.get(&level.game()), Some(Resolved::Policy(_)));
-        if let (Some(profile), true, false) = (other, policy, self.warned_profile) {
+        let Some(Resolved::Policy(policy)) = self.resolved.get(&level.game()) else {
+            return;
+        };
+        let abilities = |profile: Option<&Profile>| {
+            profile.map_or(Abilities::default_of(level.game()), |p| p.abilities)
+        };
+        let name = |profile: Option<&Profile>| {
+            profile.map_or("the built-in abilities".to_string(), |p| {
+                format!("profile `{}`", p.name)
+            })
+        };
+        let (played, trained) = (level.profile.as_ref(), policy.profile.as_ref());
+        if abilities(played) != abilities(trained) && !self.warned_profile {
             self.warned_profile = true;
             crate::warn!(
-                "the Solver policy trained with the built-in abilities plays under profile `{}`: its statistics are of a player who never trained with them (the scripted player, --solver scripted, plays with them)",
-                profile.name
+                "the Solver policy trained for {} plays under {}: its statistics are of a player who never trained with them (the scripted player, --solver scripted, plays with them)",
+                name(trained),
+                name(played)
             );
         }
     }

@@ -241,14 +241,18 @@ pub struct BuildLimits {
     /// Racing: how far, in degrees, the curve action may ask to turn from the goal's bearing
     /// (`segment_from_action` in `crates/core/src/game/racing/generator.rs`); the platform game ignores it.
     pub curve_offset: f64,
+    /// Who the track is made for and played by in a match: the platform keeps every jump
+    /// within the player's reach, and the Solver plays with its abilities.
+    pub player: super::Player,
 }
 
 impl BuildLimits {
-    /// The defaults of game `G`.
+    /// The defaults of game `G`, for the built-in player.
     pub fn default_for<G: GeneratorGame>() -> Self {
         Self {
             max_pieces: G::DEFAULT_MAX_PIECES,
             curve_offset: DEFAULT_CURVE_OFFSET,
+            player: super::Player::default(),
         }
     }
 }

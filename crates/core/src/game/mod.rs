@@ -6,6 +6,7 @@ pub mod generator;
 pub mod platform;
 pub mod racing;
 
+use crate::level::profile::Abilities;
 use crate::level::stats::Outcome;
 pub use crate::level::stats::Skill;
 
@@ -71,6 +72,30 @@ fn coords(v: rapier3d::math::Vector) -> Vec<f64> {
     v.to_array().map(f64::from).to_vec()
 }
 
+/// Who plays a game's levels: a profile's abilities (none: the built-in ones) and what the rules
+/// derive from them, measured once (the platform character's reach). Rule levels, the
+/// Generator's tracks and the Solver's environments are made for one player.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Player {
+    pub abilities: Option<Abilities>,
+    /// The platform character's reach (the built-in table in racing, which has none).
+    pub reach: platform::reach::Reach,
+}
+
+impl Player {
+    /// The player of `abilities` (none, or the built-in ones: the built-in player, measuring
+    /// nothing).
+    pub fn of(abilities: Option<Abilities>) -> Self {
+        let reach = match abilities {
+            Some(Abilities::Platform(character)) => {
+                platform::reach::Reach::of(platform::character::Body::from(character))
+            }
+            _ => platform::reach::Reach::default(),
+        };
+        Self { abilities, reach }
+    }
+}
+
 /// A scripted player of environment `E`.
 pub trait Scripted<E: SolverEnv> {
     fn act(&mut self, env: &E) -> E::Action;
@@ -92,11 +117,19 @@ pub trait GameSpec: Send + Sync + 'static {
     /// ...and its binary ones, after them.
     const BINARY_ACTIONS: &'static [&'static str];
 
-    /// The Solver's environment on `level` (with the abilities of the profile it records), or
-    /// `None` for a level of another game.
-    fn solver_env(level: &crate::level::Level) -> Option<Self::Env>;
-    /// The rule-based level of `seed` (its goal drawn from the seed), if the rules find one.
-    fn rule_level(seed: u64) -> Option<crate::level::Level>;
+    /// The Solver's environment on `level` with `abilities` (none: the built-in ones), or `None`
+    /// for a level of another game.
+    fn solver_env_with(
+        level: &crate::level::Level,
+        abilities: Option<Abilities>,
+    ) -> Option<Self::Env>;
+    /// The Solver's environment on `level` with the abilities of the profile it records.
+    fn solver_env(level: &crate::level::Level) -> Option<Self::Env> {
+        Self::solver_env_with(level, level.profile.as_ref().map(|p| p.abilities))
+    }
+    /// The rule-based level of `seed` (its goal drawn from the seed) for `player`, if the rules
+    /// find one. The level records no profile: its caller names it.
+    fn rule_level(seed: u64, player: &Player) -> Option<crate::level::Level>;
     /// The scripted player of run `seed` at `skill`, as verification uses it.
     fn scripted(seed: u64, skill: Skill) -> Self::Scripted;
 }
@@ -115,24 +148,26 @@ impl GameSpec for PlatformGame {
     const CONTINUOUS_ACTIONS: &'static [&'static str] = &["forward", "turn"];
     const BINARY_ACTIONS: &'static [&'static str] = &["jump"];
 
-    fn solver_env(level: &crate::level::Level) -> Option<platform::PlatformEnv> {
+    fn solver_env_with(
+        level: &crate::level::Level,
+        abilities: Option<Abilities>,
+    ) -> Option<platform::PlatformEnv> {
         let track = level.platform()?;
         let env =
             platform::PlatformEnv::new(track, level.goal, platform::PlatformRewards::default());
-        Some(match level.profile.as_ref().map(|p| p.abilities) {
-            Some(crate::level::profile::Abilities::Platform(character)) => {
-                env.with_body(character.into())
-            }
+        Some(match abilities {
+            Some(Abilities::Platform(character)) => env.with_body(character.into()),
             _ => env,
         })
     }
 
-    fn rule_level(seed: u64) -> Option<crate::level::Level> {
+    fn rule_level(seed: u64, player: &Player) -> Option<crate::level::Level> {
         platform::rules::platform_level(
             seed,
             None,
             None,
             &crate::level::PlatformRulesConfig::default(),
+            &player.reach,
         )
         .ok()
     }
@@ -151,18 +186,23 @@ impl GameSpec for RacingGame {
     const CONTINUOUS_ACTIONS: &'static [&'static str] = &["throttle", "steer"];
     const BINARY_ACTIONS: &'static [&'static str] = &[];
 
-    fn solver_env(level: &crate::level::Level) -> Option<racing::RacingEnv> {
+    fn solver_env_with(
+        level: &crate::level::Level,
+        abilities: Option<Abilities>,
+    ) -> Option<racing::RacingEnv> {
         let crate::level::Track::Racing(track) = &level.track else {
             return None;
         };
         let env = racing::RacingEnv::new(track, level.goal, racing::RacingRewards::default());
-        Some(match level.profile.as_ref().map(|p| p.abilities) {
-            Some(crate::level::profile::Abilities::Racing(car)) => env.with_car(car.into()),
+        Some(match abilities {
+            Some(Abilities::Racing(car)) => env.with_car(car.into()),
             _ => env,
         })
     }
 
-    fn rule_level(seed: u64) -> Option<crate::level::Level> {
+    /// The racing rules keep within what any car of the profile ranges drives (the scripted
+    /// driver brakes for what it cannot take at speed), so they do not read the player.
+    fn rule_level(seed: u64, _player: &Player) -> Option<crate::level::Level> {
         racing::rules::racing_level(seed, None, None, &Default::default()).ok()
     }
 

@@ -111,6 +111,10 @@ pub struct PolicyCard {
     /// degrees (absent: 30, as every racing Generator before it was trained).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curve_offset: Option<f64>,
+    /// The game profile the policy was trained for (`train --profile`; absent: the built-in
+    /// game).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<crate::level::profile::ProfileRecord>,
 }
 
 /// How a policy was trained.
@@ -459,6 +463,7 @@ mod tests {
             results: HashMap::new(),
             max_pieces: None,
             curve_offset: None,
+            profile: None,
         }
     }
 

@@ -193,7 +193,9 @@ pub fn score_runs(
                 .map(|generator| {
                     AUX_VALUES
                         .iter()
-                        .map(|&aux| generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks))
+                        .map(|&aux| {
+                            generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks, None)
+                        })
                         .collect::<Result<Vec<_>, _>>()
                 })
                 .transpose()

@@ -40,6 +40,7 @@ pub(in crate::services::train) fn check_resumable_change(
             "generator.max_pieces",
             old.generator.max_pieces == new.generator.max_pieces,
         ),
+        ("profile", old.profile == new.profile),
     ];
     match fixed.iter().find(|(_, same)| !same) {
         Some((name, _)) => Err(format!(
@@ -151,6 +152,11 @@ pub(in crate::services::train) fn check_config(
     }
     if !(1..=MAX_PHASE_STEPS).contains(&config.steps) {
         return Err(format!("steps must be in [1, {MAX_PHASE_STEPS}]"));
+    }
+    if let Some(record) = &config.profile {
+        record
+            .profile(game)
+            .map_err(|problem| format!("profile.{problem}"))?;
     }
     let minutes = config.checkpoint_minutes;
     if !(minutes.is_finite() && (0.0..=24.0 * 60.0).contains(&minutes)) {

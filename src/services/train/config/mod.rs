@@ -8,9 +8,10 @@ use anyhow::Result;
 use serde::{Deserialize, Serialize};
 
 use super::solver_envs::SolverMode;
-use arlpcg_core::game::PlatformGame;
 use arlpcg_core::game::generator::{GeneratorGame, GeneratorRewards};
+use arlpcg_core::game::{PlatformGame, Player};
 use arlpcg_core::level::Game;
+use arlpcg_core::level::profile::ProfileRecord;
 use arlpcg_core::level::stats::Skill;
 use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::rl::ppo::PpoConfig;
@@ -48,6 +49,10 @@ pub struct TrainConfig {
     pub solver: PpoConfig,
     /// The Generator (adversarial modes only).
     pub generator: GeneratorConfig,
+    /// The game profile the run trains for (`train --profile FILE`): the Solver plays with its
+    /// abilities, on levels made for them. None: the built-in game.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<ProfileRecord>,
 }
 
 /// The Generator's side of an adversarial run.
@@ -241,6 +246,7 @@ impl Default for TrainConfig {
                 ..PpoConfig::default()
             },
             generator: GeneratorConfig::default(),
+            profile: None,
         }
     }
 }
@@ -361,6 +367,16 @@ pub(super) fn load_config(path: &Path, game: Game) -> Result<TrainConfig> {
 }
 
 impl TrainConfig {
+    /// The player the run trains for: its profile's (checked when the configuration was read),
+    /// else the built-in one.
+    pub fn player(&self, game: Game) -> Player {
+        let profile = self
+            .profile
+            .as_ref()
+            .and_then(|record| record.profile(game).ok());
+        crate::services::generation::player_for(profile.as_ref())
+    }
+
     /// An adversarial run's budget in Solver steps: `steps`, then the finish's.
     pub fn adversarial_budget(&self) -> u64 {
         self.steps

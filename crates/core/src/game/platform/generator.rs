@@ -7,14 +7,15 @@
 use rand_chacha::ChaCha8Rng;
 
 use super::env::{PlatformEnv, PlatformRewards};
-use super::reach;
-use crate::game::PlatformGame;
+use super::reach::{self, Reach};
 use crate::game::generator::{BuildLimits, GeneratorGame, GeneratorRewards, Placement, TrackBuild};
 use crate::game::platform::rules::goal_and_start;
+use crate::game::{PlatformGame, Player};
 use crate::level::Track;
 use crate::level::heading::{direction_heading, wrap_degrees};
 use crate::level::params::{self, quantize};
 use crate::level::platform::{BlockParams, PlatformTrack};
+use crate::level::profile::Abilities;
 
 /// The named parts of the Generator's observation, in order, with their lengths (one aux input).
 pub const GENERATOR_OBSERVATION_LAYOUT: [(&str, usize); 9] = [
@@ -73,9 +74,15 @@ pub const DEFAULT_MAX_BLOCKS: usize = 30;
 /// `goal`: each value is clipped to [-1, 1] and mapped onto its range (NaN becomes the middle),
 /// the turn added to the goal's bearing from the last block and kept within
 /// [`reach::MAX_TURN`] of the last jump's direction, the height change to the climb that keeps
-/// the slope toward the goal (see [`GENERATOR_ACTIONS`]), the distance shortened to keep the
-/// edge gap within the reach table ([`reach::max_gap`]) for that height change.
-pub fn block_from_action(track: &PlatformTrack, goal: [f64; 3], row: &[f32]) -> BlockParams {
+/// the slope toward the goal (see [`GENERATOR_ACTIONS`]) and at most `reach`'s highest climb,
+/// the distance shortened to keep the edge gap within `reach` ([`Reach::max_gap`]) for that
+/// height change.
+pub fn block_from_action(
+    track: &PlatformTrack,
+    goal: [f64; 3],
+    row: &[f32],
+    reach: &Reach,
+) -> BlockParams {
     let unit = |v: f32| if v.is_nan() { 0.0 } else { v as f64 };
     let mut block =
         BlockParams::from_unit([unit(row[0]), unit(row[1]), unit(row[2]), unit(row[3])]);
@@ -87,10 +94,14 @@ pub fn block_from_action(track: &PlatformTrack, goal: [f64; 3], row: &[f32]) -> 
     );
     let rise = goal[1] - last.position[1];
     let on_course = rise * (block.distance / dx.hypot(dz).max(1e-6)).min(1.0);
-    block.height = quantize(params::BLOCK_HEIGHT.clamp(on_course + block.height));
+    block.height = quantize(
+        params::BLOCK_HEIGHT
+            .clamp(on_course + block.height)
+            .min(reach.max_climb()),
+    );
     // Never beyond the character's reach: a longer jump makes a level impossible, not harder,
     // and a failure there teaches the Solver nothing.
-    let longest = reach::max_gap(block.height) + 0.5 * (last.size + block.size);
+    let longest = reach.max_gap(block.height) + 0.5 * (last.size + block.size);
     block.distance = quantize(block.distance.min(longest));
     block
 }
@@ -157,6 +168,8 @@ pub struct PlatformBuild {
     pub track: PlatformTrack,
     pub goal: [f64; 3],
     pub max_blocks: usize,
+    /// Who the track is for: its jumps keep within the player's reach.
+    pub player: Player,
 }
 
 impl TrackBuild for PlatformBuild {
@@ -199,7 +212,7 @@ impl TrackBuild for PlatformBuild {
         if self.track.block_count() >= self.max_blocks {
             return Placement::OutOfPieces;
         }
-        let block = block_from_action(&self.track, self.goal, row);
+        let block = block_from_action(&self.track, self.goal, row, &self.player.reach);
         if self.track.push(block).is_err() {
             return Placement::Invalid;
         }
@@ -252,6 +265,7 @@ impl GeneratorGame for PlatformGame {
             track: PlatformTrack::new(start),
             goal,
             max_blocks: limits.max_pieces,
+            player: limits.player,
         };
         (build, rng)
     }
@@ -270,6 +284,7 @@ impl GeneratorGame for PlatformGame {
             track: PlatformTrack::new(*kept.start()),
             goal,
             max_blocks: limits.max_pieces,
+            player: limits.player,
         };
         for params in &kept.block_params()[..pieces] {
             build.track.push(*params).map_err(|e| e.to_string())?;
@@ -283,6 +298,9 @@ impl GeneratorGame for PlatformGame {
     fn open_env(build: &PlatformBuild, complete: bool) -> PlatformEnv {
         let start = PlatformTrack::new(*build.track.start());
         let mut env = PlatformEnv::open(&start, build.goal, PlatformRewards::default());
+        if let Some(Abilities::Platform(character)) = build.player.abilities {
+            env = env.with_body(character.into());
+        }
         env.push_platform(build.track.last(), complete);
         env
     }
@@ -354,7 +372,7 @@ mod tests {
             "a goal to the right is a negative turn"
         );
         let aim = aimed(&track, [20.0, 0.0, 0.0]);
-        let block = block_from_action(&track, [20.0, 0.0, 0.0], &aim);
+        let block = block_from_action(&track, [20.0, 0.0, 0.0], &aim, &Reach::default());
         assert!((block.angle + 90.0).abs() < 1e-3, "{block:?}");
     }
 
@@ -365,6 +383,7 @@ mod tests {
             track: PlatformTrack::new(Start::default()),
             goal,
             max_blocks: 30,
+            player: Player::default(),
         };
         let mut game = Match::<PlatformGame>::new(build, vec![1.0], 7);
         let rewards = GeneratorRewards::default();
@@ -416,6 +435,7 @@ mod tests {
             track: PlatformTrack::new(Start::default()),
             goal,
             max_blocks: 30,
+            player: Player::default(),
         };
         let pacing = MatchPacing {
             before,
@@ -479,6 +499,7 @@ mod tests {
             track: PlatformTrack::new(Start::default()),
             goal,
             max_blocks: 30,
+            player: Player::default(),
         };
         let mut game = Match::<PlatformGame>::new(build, vec![-1.0], 7);
         let rewards = GeneratorRewards {
@@ -550,14 +571,19 @@ mod tests {
             heading: 90.0,
             ..Start::default()
         });
-        let block = block_from_action(&track, [20.0, 4.0, 0.0], &[0.0; 4]);
+        let block = block_from_action(&track, [20.0, 4.0, 0.0], &[0.0; 4], &Reach::default());
         assert_eq!(block.distance, 7.5);
         assert_eq!(
             block.angle, -90.0,
             "a right turn from heading 90 to the goal along +x"
         );
         assert_eq!(block.height, 1.5, "4 m over 20 m, for 7.5 m");
-        let steep = block_from_action(&track, [20.0, 40.0, 0.0], &[0.0, 0.0, 0.0, 1.0]);
+        let steep = block_from_action(
+            &track,
+            [20.0, 40.0, 0.0],
+            &[0.0, 0.0, 0.0, 1.0],
+            &Reach::default(),
+        );
         assert_eq!(
             steep.height, 2.0,
             "clamped to the range of docs/spec.md §1.1"
@@ -572,20 +598,30 @@ mod tests {
         });
         // Longest, smallest, steepest up: 10 m between 4 m blocks would be a 6 m gap 2 m up,
         // where the reach table allows 4.25 m.
-        let far_up = block_from_action(&track, [60.0, 30.0, 0.0], &[1.0, 0.0, -1.0, 1.0]);
+        let far_up = block_from_action(
+            &track,
+            [60.0, 30.0, 0.0],
+            &[1.0, 0.0, -1.0, 1.0],
+            &Reach::default(),
+        );
         assert_eq!(far_up.height, 2.0);
         assert_eq!(far_up.distance, 4.25 + 0.5 * (4.0 + 4.0));
-        let far_flat = block_from_action(&track, [60.0, 0.0, 0.0], &[1.0, 0.0, -1.0, 0.0]);
+        let far_flat = block_from_action(
+            &track,
+            [60.0, 0.0, 0.0],
+            &[1.0, 0.0, -1.0, 0.0],
+            &Reach::default(),
+        );
         assert_eq!(far_flat.distance, 10.0, "a flat 6 m gap is within reach");
         let mut rng = ChaCha8Rng::seed_from_u64(4);
         for _ in 0..2000 {
             let row: [f32; 4] = std::array::from_fn(|_| rng.random_range(-1.5..1.5));
             let goal = [60.0, rng.random_range(-20.0..20.0), 10.0];
-            let block = block_from_action(&track, goal, &row);
+            let block = block_from_action(&track, goal, &row, &Reach::default());
             let placed = track.preview(&block);
             let gap = track.last().edge_gap(&placed);
             assert!(
-                gap <= reach::max_gap(block.height) + 1e-3,
+                gap <= Reach::default().max_gap(block.height) + 1e-3,
                 "{block:?}: gap {gap}"
             );
             assert!(block.angle.abs() <= reach::MAX_TURN, "{block:?}");
@@ -608,6 +644,7 @@ mod tests {
             track,
             goal: [0.0, 0.0, 30.0],
             max_blocks: 4,
+            player: Player::default(),
         };
         let mut game = Match::<PlatformGame>::new(build, vec![-1.0], 1);
         let toward_goal = [-1.0, 0.0, 0.0, 0.0];

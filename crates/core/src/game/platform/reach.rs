@@ -32,16 +32,56 @@ pub const REACH_JITTER: f32 = 0.3;
 /// The gaps the table scans: the ranges allow edge gaps up to 6 m (10 m between 4 m blocks).
 const GAP_RANGE: (f64, f64) = (1.0, 6.0);
 
-/// The largest makeable gap at a height change, interpolated from the table.
-pub fn max_gap(height: f64) -> f64 {
-    let h = height.clamp(REACH_HEIGHTS[0], REACH_HEIGHTS[4]);
-    let i = REACH_HEIGHTS
-        .iter()
-        .rposition(|&x| x <= h)
-        .unwrap_or(0)
-        .min(3);
-    let t = (h - REACH_HEIGHTS[i]) / (REACH_HEIGHTS[i + 1] - REACH_HEIGHTS[i]);
-    REACH_TABLE[i] + t * (REACH_TABLE[i + 1] - REACH_TABLE[i])
+/// How far a character can jump: per height change of [`REACH_HEIGHTS`], the largest edge gap,
+/// m, that the scripted controller clears on chained jumps (see [`measure_reach`]). The rules and
+/// the Generator keep every jump within it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reach(pub [f64; 5]);
+
+impl Default for Reach {
+    /// The built-in character's reach, [`REACH_TABLE`].
+    fn default() -> Self {
+        Self(REACH_TABLE)
+    }
+}
+
+impl Reach {
+    /// The reach of a character of `body`: the built-in table for the built-in body (a test
+    /// measures it), else measured (about a second).
+    pub fn of(body: Body) -> Self {
+        if body == Body::default() {
+            Self::default()
+        } else {
+            Self(measure_reach(body))
+        }
+    }
+
+    /// The highest climb, m, of the table's heights from 0 up that the character still makes
+    /// across the shortest gap scanned (2 m for the built-in character): a block higher above
+    /// the last is out of reach, however close.
+    pub fn max_climb(&self) -> f64 {
+        REACH_HEIGHTS
+            .iter()
+            .zip(self.0)
+            .skip_while(|(h, _)| **h < 0.0)
+            .take_while(|(_, gap)| *gap >= GAP_RANGE.0)
+            .map(|(h, _)| *h)
+            .last()
+            .unwrap_or(REACH_HEIGHTS[0])
+    }
+
+    /// The largest makeable gap at a height change, interpolated from the table (at most
+    /// [`Reach::max_climb`] up: check the climb first).
+    pub fn max_gap(&self, height: f64) -> f64 {
+        let h = height.clamp(REACH_HEIGHTS[0], self.max_climb());
+        let i = REACH_HEIGHTS
+            .iter()
+            .rposition(|&x| x <= h)
+            .unwrap_or(0)
+            .min(3);
+        let t = (h - REACH_HEIGHTS[i]) / (REACH_HEIGHTS[i + 1] - REACH_HEIGHTS[i]);
+        self.0[i] + t * (self.0[i + 1] - self.0[i])
+    }
 }
 
 /// A level of one jump: a 4 m start block, then a 4 m block `gap` metres away and `height`

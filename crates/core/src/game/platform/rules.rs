@@ -6,7 +6,7 @@
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::game::platform::reach;
+use crate::game::platform::reach::Reach;
 use crate::level::heading;
 use crate::level::params::{self, quantize};
 use crate::level::platform::{self, BlockParams, Platform, PlatformTrack, Start};
@@ -59,14 +59,16 @@ pub struct NoLevel {
 }
 
 /// A rule-based platform level, reproducible from `seed`: the goal and start heading are drawn
-/// from it, unless `goal` is given. `aux` is recorded in the level; the rules do not use it.
+/// from it, unless `goal` is given, every jump within `reach`. `aux` is recorded in the level;
+/// the rules do not use it.
 pub fn platform_level(
     seed: u64,
     aux: Option<f64>,
     goal: Option<[f64; 3]>,
     config: &PlatformRulesConfig,
+    reach: &Reach,
 ) -> Result<Level, NoLevel> {
-    platform_level_draw(seed, aux, goal, config, 0)
+    platform_level_draw(seed, aux, goal, config, reach, 0)
 }
 
 /// Draw number `draw` of level `seed`: the `draw`-th valid level (from 0) of the seed's stream,
@@ -76,12 +78,13 @@ pub fn platform_level_draw(
     aux: Option<f64>,
     goal: Option<[f64; 3]>,
     config: &PlatformRulesConfig,
+    reach: &Reach,
     draw: u32,
 ) -> Result<Level, NoLevel> {
     let (goal, start, mut rng) = goal_and_start(seed, goal);
     let mut skip = draw;
     for _ in 0..ATTEMPTS {
-        if let Some(track) = attempt(&mut rng, start, goal, config) {
+        if let Some(track) = attempt(&mut rng, start, goal, config, reach) {
             if skip > 0 {
                 skip -= 1;
                 continue;
@@ -110,12 +113,13 @@ fn attempt(
     start: Start,
     goal: [f64; 3],
     config: &PlatformRulesConfig,
+    reach: &Reach,
 ) -> Option<PlatformTrack> {
     let mut track = PlatformTrack::new(start);
     while track.block_count() < config.max_blocks as usize {
         let placed = (0..CANDIDATES).any(|_| {
-            let candidate = draw(rng, track.last(), goal, config);
-            is_jumpable(track.last(), &track.preview(&candidate), config)
+            let candidate = draw(rng, track.last(), goal, config, reach);
+            is_jumpable(track.last(), &track.preview(&candidate), config, reach)
                 && track.push(candidate).is_ok()
         });
         if !placed {
@@ -129,9 +133,15 @@ fn attempt(
 }
 
 /// Whether the jump from `from` to `to` is within the character's reach, less the margin.
-fn is_jumpable(from: &Platform, to: &Platform, config: &PlatformRulesConfig) -> bool {
+fn is_jumpable(
+    from: &Platform,
+    to: &Platform,
+    config: &PlatformRulesConfig,
+    reach: &Reach,
+) -> bool {
     let rise = to.position[1] - from.position[1];
-    from.edge_gap(to) <= reach::max_gap(rise) - config.reach_margin
+    rise <= reach.max_climb() + 1e-9
+        && from.edge_gap(to) <= reach.max_gap(rise) - config.reach_margin
 }
 
 /// Draws one block's parameters: aimed at the goal when it is within one block's distance,
@@ -141,6 +151,7 @@ fn draw(
     last: &Platform,
     goal: [f64; 3],
     config: &PlatformRulesConfig,
+    reach: &Reach,
 ) -> BlockParams {
     let (dx, dz) = (goal[0] - last.position[0], goal[2] - last.position[2]);
     let horizontal = dx.hypot(dz);
@@ -157,8 +168,9 @@ fn draw(
         let heading = to_goal + rng.random_range(-spread..=spread);
         let blocks_left = (horizontal / 7.5).max(1.0);
         let climb = (rise / blocks_left + rng.random_range(-1.0..=1.0))
-            .clamp(params::BLOCK_HEIGHT.min, params::BLOCK_HEIGHT.max);
-        let longest = (reach::max_gap(climb) - config.reach_margin + 0.5 * (last.size + size))
+            .clamp(params::BLOCK_HEIGHT.min, params::BLOCK_HEIGHT.max)
+            .min(reach.max_climb());
+        let longest = (reach.max_gap(climb) - config.reach_margin + 0.5 * (last.size + size))
             .clamp(params::BLOCK_DISTANCE.min, params::BLOCK_DISTANCE.max);
         let distance = rng.random_range(params::BLOCK_DISTANCE.min..=longest);
         (distance, heading, climb)
@@ -180,14 +192,14 @@ mod tests {
     fn rule_levels_are_valid_reproducible_and_reach_their_goal() {
         let config = PlatformRulesConfig::default();
         for seed in 0..30 {
-            let level = platform_level(seed, None, None, &config).unwrap();
+            let level = platform_level(seed, None, None, &config, &Reach::default()).unwrap();
             level.validate().unwrap();
-            let again = platform_level(seed, None, None, &config).unwrap();
+            let again = platform_level(seed, None, None, &config, &Reach::default()).unwrap();
             assert_eq!(level, again, "seed {seed} is not reproducible");
             let track = level.platform().unwrap();
             for pair in track.platforms().windows(2) {
                 assert!(
-                    is_jumpable(&pair[0], &pair[1], &config),
+                    is_jumpable(&pair[0], &pair[1], &config, &Reach::default()),
                     "seed {seed}: a jump out of reach"
                 );
             }
@@ -197,8 +209,14 @@ mod tests {
     #[test]
     fn every_parameter_stays_in_its_range() {
         for seed in 0..30 {
-            let level =
-                platform_level(seed, Some(0.5), None, &PlatformRulesConfig::default()).unwrap();
+            let level = platform_level(
+                seed,
+                Some(0.5),
+                None,
+                &PlatformRulesConfig::default(),
+                &Reach::default(),
+            )
+            .unwrap();
             for b in level.platform().unwrap().block_params() {
                 BlockParams::new(b.distance, b.angle, b.size, b.height).unwrap();
             }
@@ -212,6 +230,7 @@ mod tests {
             None,
             Some([5.0, 10.0, 0.0]),
             &PlatformRulesConfig::default(),
+            &Reach::default(),
         )
         .unwrap();
         let last = level.platform().unwrap().last();

@@ -8,13 +8,14 @@
 use rand_chacha::ChaCha8Rng;
 
 use super::env::{RacingEnv, RacingRewards, SIGHT};
-use crate::game::RacingGame;
 use crate::game::generator::{
     BuildLimits, DEFAULT_CURVE_OFFSET, GeneratorGame, GeneratorRewards, Placement, TrackBuild,
 };
+use crate::game::{Player, RacingGame};
 use crate::level::Track;
 use crate::level::heading::{direction_heading, heading_direction, wrap_degrees};
 use crate::level::params::{SEGMENT_CURVE, SEGMENT_HEIGHT, SEGMENT_LENGTH, quantize};
+use crate::level::profile::Abilities;
 use crate::level::racing::{self, Obstacle, RacingTrack, SegmentParams};
 use crate::level::road::{CROSSING_ARC, MIN_OBSTACLE_DISTANCE, MIN_SELF_DISTANCE, Road};
 use crate::level::stats::Outcome;
@@ -115,6 +116,8 @@ pub struct RacingBuild {
     pub max_segments: usize,
     /// See [`segment_from_action`].
     pub curve_offset: f64,
+    /// Who drives the road in a match: the Solver's car has the player's abilities.
+    pub player: Player,
 }
 
 impl RacingBuild {
@@ -135,6 +138,7 @@ impl RacingBuild {
             goal,
             max_segments,
             curve_offset: DEFAULT_CURVE_OFFSET,
+            player: Player::default(),
         }
     }
 
@@ -326,6 +330,7 @@ impl GeneratorGame for RacingGame {
         let (goal, heading, obstacles, rng) = super::rules::goal_and_start(seed, goal, obstacles);
         let mut build = RacingBuild::new(heading, goal, obstacles, limits.max_pieces);
         build.curve_offset = limits.curve_offset;
+        build.player = limits.player;
         (build, rng)
     }
 
@@ -347,6 +352,7 @@ impl GeneratorGame for RacingGame {
             goal,
             max_segments: limits.max_pieces,
             curve_offset: limits.curve_offset,
+            player: limits.player,
         };
         if pieces > 0 && racing::reaches(build.road.end().0, goal) {
             return Err(crate::game::generator::prefix_reaches_goal(pieces));
@@ -355,7 +361,11 @@ impl GeneratorGame for RacingGame {
     }
 
     fn open_env(build: &RacingBuild, complete: bool) -> RacingEnv {
-        RacingEnv::open(&build.track, build.goal, RacingRewards::default(), complete)
+        let env = RacingEnv::open(&build.track, build.goal, RacingRewards::default(), complete);
+        match build.player.abilities {
+            Some(Abilities::Racing(car)) => env.with_car(car.into()),
+            _ => env,
+        }
     }
 
     fn extend_env(env: &mut RacingEnv, build: &RacingBuild, complete: bool) {

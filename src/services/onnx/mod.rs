@@ -165,12 +165,28 @@ pub fn sidecar_path(onnx: &std::path::Path) -> std::path::PathBuf {
 }
 
 /// An output of the graph: its dimensions (`None` the batch) and what the sidecar says of it.
+#[derive(Clone)]
 struct Output {
     dims: Vec<Option<usize>>,
     meaning: &'static str,
     columns: Vec<Columns>,
     /// 64-bit integers rather than floats.
     int64: bool,
+}
+
+/// The outputs `name` and `deterministic_<name>` (ML-Agents reads both): `actions`, renamed,
+/// and a copy of it, each with `output`'s shape and meaning.
+fn both_names(
+    graph: &mut GraphBuilder,
+    actions: &str,
+    name: &str,
+    output: Output,
+) -> [(String, Output); 2] {
+    let copy = graph.node("Identity", &[actions], vec![]);
+    graph.rename(actions, name);
+    let deterministic = format!("deterministic_{name}");
+    graph.rename(&copy, &deterministic);
+    [(name.into(), output.clone()), (deterministic, output)]
 }
 
 const CONTINUOUS_MEANING: &str =
@@ -403,18 +419,13 @@ fn mlagents_outputs(
     ));
     if let Some(actions) = continuous_actions {
         let continuous = card.continuous_actions.len();
-        let copy = graph.node("Identity", &[&actions], vec![]);
-        graph.rename(&actions, "continuous_actions");
-        graph.rename(&copy, "deterministic_continuous_actions");
-        for name in ["continuous_actions", "deterministic_continuous_actions"] {
-            let output = Output {
-                dims: vec![None, Some(continuous)],
-                meaning: CONTINUOUS_MEANING,
-                columns: action_columns(&card.continuous_actions),
-                int64: false,
-            };
-            outputs.push((name.into(), output));
-        }
+        let output = Output {
+            dims: vec![None, Some(continuous)],
+            meaning: CONTINUOUS_MEANING,
+            columns: action_columns(&card.continuous_actions),
+            int64: false,
+        };
+        outputs.extend(both_names(graph, &actions, "continuous_actions", output));
         outputs.push(constant(
             graph,
             "continuous_action_output_shape",
@@ -440,19 +451,14 @@ fn mlagents_outputs(
         let chosen = graph.node("Not", &[&below], vec![]);
         // Integers, as ML-Agents' own exporter writes them and its runtime reads them.
         let actions = graph.node("Cast", &[&chosen], vec![attribute_int("to", INT64 as i64)]);
-        let copy = graph.node("Identity", &[&actions], vec![]);
-        graph.rename(&actions, "discrete_actions");
-        graph.rename(&copy, "deterministic_discrete_actions");
-        for name in ["discrete_actions", "deterministic_discrete_actions"] {
-            let output = Output {
-                dims: vec![None, Some(binary)],
-                meaning: "one branch per binary action: 1 (on) when its probability, masked, \
-                    is at least that of 0 (off)",
-                columns: action_columns(&card.binary_actions),
-                int64: true,
-            };
-            outputs.push((name.into(), output));
-        }
+        let output = Output {
+            dims: vec![None, Some(binary)],
+            meaning: "one branch per binary action: 1 (on) when its probability, masked, \
+                is at least that of 0 (off)",
+            columns: action_columns(&card.binary_actions),
+            int64: true,
+        };
+        outputs.extend(both_names(graph, &actions, "discrete_actions", output));
         outputs.push(constant(
             graph,
             "discrete_action_output_shape",

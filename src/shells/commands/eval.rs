@@ -40,10 +40,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         .with_context(|| format!("no {GENERATOR_FILE} in any --policies folder"))?;
     let (generator, _) = load_generator(&generator_path, args.game)?;
     let solvers = load_solvers(args)?;
-    let profile = match &args.profile {
-        Some(file) => Some(profile::for_game(profile::load(file)?, args.game, file)?),
-        None => None,
-    };
+    let profile = asked_profile(args)?;
     let budget = budget(args);
     let overwrite = if args.force {
         Overwrite::Allowed
@@ -101,6 +98,14 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         .install(|| eval::evaluate(&generator, &named, budget, profile.as_ref(), &|| bar.inc(1)))?;
     bar.finish_and_clear();
     write_results(&results, &args.out, overwrite)
+}
+
+/// The game profile `--profile` names, checked against `--game`.
+fn asked_profile(args: &EvalArgs) -> Result<Option<Profile>> {
+    args.profile
+        .as_ref()
+        .map(|file| profile::for_game(profile::load(file)?, args.game, file))
+        .transpose()
 }
 
 /// The budget the arguments ask for.
@@ -194,8 +199,13 @@ fn seeds(args: &EvalArgs) -> Result<()> {
     let judges = crate::services::policies::load_panel(folder, args.game, Some(&available))?;
     let budget = budget(args);
     let pool = crate::shells::common::thread_pool(args.threads)?;
+    let profile = asked_profile(args)?;
     let validation = pool.install(|| {
-        eval::validation_levels(&validation_generator, budget.validation_tracks, None)
+        eval::validation_levels(
+            &validation_generator,
+            budget.validation_tracks,
+            profile.as_ref(),
+        )
     })?;
     let rule_levels = validation.iter().filter(|l| eval::is_rule_level(l)).count();
     let arlpcg_generators = runs
@@ -214,9 +224,15 @@ fn seeds(args: &EvalArgs) -> Result<()> {
     };
     let bar = crate::shells::common::progress_bar(runs.iter().map(per_run).sum(), "levels played");
     let scores = pool.install(|| {
-        eval::seeds::score_runs(&runs, &judges, &validation, rule_levels, budget, &|| {
-            bar.inc(1)
-        })
+        eval::seeds::score_runs(
+            &runs,
+            &judges,
+            &validation,
+            rule_levels,
+            budget,
+            profile.as_ref(),
+            &|| bar.inc(1),
+        )
     })?;
     bar.finish_and_clear();
     let results = eval::seeds::summarize(budget, &validation_generator.reference.path, scores);

@@ -15,7 +15,7 @@ use crate::services::verify::{Solver, SolverPolicy};
 use crate::shells::cli::EvalArgs;
 use arlpcg_core::game::Skill;
 use arlpcg_core::level::profile::Profile;
-use arlpcg_core::rl::checkpoint::TrainMode;
+use arlpcg_core::rl::checkpoint::{PolicyCard, TrainMode};
 
 pub fn run(args: &EvalArgs) -> Result<()> {
     if !args.merge.is_empty() {
@@ -123,21 +123,17 @@ fn budget(args: &EvalArgs) -> Budget {
     }
 }
 
-/// `eval --runs`: every run's Solver on one validation set, each adversarial run's own pair on
-/// its controllability levels, summarized over seeds (seeds.md, seeds.json).
-fn seeds(args: &EvalArgs) -> Result<()> {
-    let overwrite = if args.force {
-        Overwrite::Allowed
-    } else {
-        Overwrite::Never
-    };
-    let targets = [args.out.join("seeds.md"), args.out.join("seeds.json")];
-    for target in &targets {
-        fsio::check_writable(target, overwrite)?;
-    }
-    let shipped = crate::services::policies::shipped_dir(args.game);
-    let folder = args.policies.first().unwrap_or(&shipped);
-    let (validation_generator, _) = load_generator(&folder.join(GENERATOR_FILE), args.game)?;
+/// A run of `--runs`: its folder, Solver, Solver's card and Generator (adversarial runs).
+type LoadedRun<'a> = (
+    &'a PathBuf,
+    SolverPolicy,
+    PolicyCard,
+    Option<GeneratorPolicy>,
+);
+
+/// Each `--runs` folder's Solver, card and (adversarial runs) Generator; a run named twice, or
+/// copied under another name, is refused (it would count as two seeds).
+fn load_runs(args: &EvalArgs) -> Result<Vec<LoadedRun<'_>>> {
     // A run named twice would count as two seeds (and, being its own Generator's, as no other
     // run's on the other Generators' levels).
     for (k, dir) in args.runs.iter().enumerate() {
@@ -153,7 +149,7 @@ fn seeds(args: &EvalArgs) -> Result<()> {
             );
         }
     }
-    let mut loaded: Vec<(&PathBuf, SolverPolicy, _, Option<GeneratorPolicy>)> = Vec::new();
+    let mut loaded: Vec<LoadedRun> = Vec::new();
     for dir in &args.runs {
         let (solver, card) =
             load_solver(&dir.join(crate::services::policies::SOLVER_FILE), args.game)?;
@@ -176,6 +172,25 @@ fn seeds(args: &EvalArgs) -> Result<()> {
         }
         loaded.push((dir, solver, card, generator));
     }
+    Ok(loaded)
+}
+
+/// `eval --runs`: every run's Solver on one validation set, each adversarial run's own pair on
+/// its controllability levels, summarized over seeds (seeds.md, seeds.json).
+fn seeds(args: &EvalArgs) -> Result<()> {
+    let overwrite = if args.force {
+        Overwrite::Allowed
+    } else {
+        Overwrite::Never
+    };
+    let targets = [args.out.join("seeds.md"), args.out.join("seeds.json")];
+    for target in &targets {
+        fsio::check_writable(target, overwrite)?;
+    }
+    let shipped = crate::services::policies::shipped_dir(args.game);
+    let folder = args.policies.first().unwrap_or(&shipped);
+    let (validation_generator, _) = load_generator(&folder.join(GENERATOR_FILE), args.game)?;
+    let loaded = load_runs(args)?;
     let runs: Vec<eval::seeds::SeedRun> = loaded
         .iter()
         .map(|(dir, solver, card, generator)| eval::seeds::SeedRun {

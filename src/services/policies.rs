@@ -10,7 +10,7 @@ use crate::services::panel::{Judge, JudgePanel};
 use crate::services::verify::SolverPolicy;
 use arlpcg_core::game::generator::DEFAULT_CURVE_OFFSET;
 use arlpcg_core::game::generator::{BuildLimits, GeneratorGame, observation_size};
-use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
+use arlpcg_core::game::{ABILITIES_PART, GameSpec, PlatformGame, RacingGame, SolverEnv};
 use arlpcg_core::level::{Game, PolicyRef};
 use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::rl::checkpoint::{
@@ -77,6 +77,16 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
         .map(|record| record.profile(game))
         .transpose()
         .map_err(|problem| anyhow::anyhow!("{}: card field profile.{problem}", path.display()))?;
+    let reads_abilities = card
+        .observation
+        .last()
+        .is_some_and(|(name, _)| name == ABILITIES_PART);
+    if reads_abilities != card.ability_spread.is_some() {
+        anyhow::bail!(
+            "{}: card field ability_spread must be given exactly when the observation ends with `{ABILITIES_PART}`",
+            path.display()
+        );
+    }
     Ok((
         SolverPolicy {
             game,
@@ -84,6 +94,7 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
             normalizer: loaded.card.normalizer,
             reference,
             profile,
+            ability_spread: card.ability_spread,
         },
         card,
     ))

@@ -14,6 +14,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, Scripted, Skill, SolverEnv};
+use arlpcg_core::level::profile::Abilities;
 use arlpcg_core::level::stats::{SolverRef, SolverStats, TrialResult};
 use arlpcg_core::level::{Game, Level, PolicyRef};
 use arlpcg_core::rl::normalizer::RunningNorm;
@@ -34,6 +35,24 @@ pub struct SolverPolicy {
     pub reference: PolicyRef,
     /// The game profile it trained for (none: the built-in game).
     pub profile: Option<arlpcg_core::level::profile::Profile>,
+    /// An ability-aware Solver: it trained with each main ability within this share of its
+    /// profile's, and observes them (none: it trained with one character or car).
+    pub ability_spread: Option<f64>,
+}
+
+impl SolverPolicy {
+    /// What it observes after the game's observation on `level`: for an ability-aware Solver
+    /// the level's main abilities relative to ours, else nothing.
+    fn ability_row(&self, level: &Level) -> Vec<f32> {
+        if self.ability_spread.is_none() {
+            return Vec::new();
+        }
+        let played = level
+            .profile
+            .as_ref()
+            .map_or(Abilities::default_of(level.game()), |p| p.abilities);
+        played.relative_main().to_vec()
+    }
 }
 
 /// Who plays the trials.
@@ -175,7 +194,10 @@ fn play_all<G: GameSpec>(
                 (!(watch.stop)()).then(|| reported(play_random(env, seed.wrapping_add(i))))
             })
             .collect(),
-        Solver::Policy(policy) => play_policy(new_env, policy, seed, range, watch),
+        Solver::Policy(policy) => {
+            let abilities = policy.ability_row(level);
+            play_policy(new_env, policy, &abilities, seed, range, watch)
+        }
     }
 }
 
@@ -194,32 +216,42 @@ pub fn record(level: &Level, solver: &Solver, seed: u64) -> Result<Recording, Wr
     Ok(match level.game() {
         Game::Platform => record_env::<PlatformGame>(
             PlatformGame::solver_env(level).expect(unexpected),
-            solver,
+            (solver, level),
             seed,
         ),
         Game::Racing => record_env::<RacingGame>(
             RacingGame::solver_env(level).expect(unexpected),
-            solver,
+            (solver, level),
             seed,
         ),
     })
 }
 
-fn record_env<G: GameSpec>(mut env: G::Env, solver: &Solver, seed: u64) -> Recording {
+fn record_env<G: GameSpec>(
+    mut env: G::Env,
+    (solver, level): (&Solver, &Level),
+    seed: u64,
+) -> Recording {
     env.reset(seed);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut scripted = match solver {
         Solver::Scripted(skill) => Some(G::scripted(seed, *skill)),
         _ => None,
     };
-    let mut observation = vec![0.0; <G::Env as SolverEnv>::OBSERVATION_SIZE];
+    let abilities = match solver {
+        Solver::Policy(policy) => policy.ability_row(level),
+        _ => Vec::new(),
+    };
+    let base = <G::Env as SolverEnv>::OBSERVATION_SIZE;
+    let mut observation = vec![0.0; base + abilities.len()];
     let mut path = vec![env.marker()];
     loop {
         let action = match solver {
             Solver::Scripted(_) => scripted.as_mut().expect("made above").act(&env),
             Solver::Random => G::Env::random_action(&mut rng),
             Solver::Policy(policy) => {
-                env.observe(&mut observation);
+                env.observe(&mut observation[..base]);
+                observation[base..].copy_from_slice(&abilities);
                 policy.normalizer.normalize(&mut observation);
                 let action = policy
                     .policy
@@ -300,11 +332,12 @@ fn play_random<E: SolverEnv>(env: &mut E, seed: u64) -> TrialResult {
 fn play_policy<E: SolverEnv>(
     new_env: &(dyn Fn() -> E + Sync),
     solver: &SolverPolicy,
+    abilities: &[f32],
     seed: u64,
     range: Range<u64>,
     watch: &Watch,
 ) -> Option<Vec<TrialResult>> {
-    let size = E::OBSERVATION_SIZE;
+    let size = E::OBSERVATION_SIZE + abilities.len();
     let width = solver.policy.shape().action_size();
     let first = range.start;
     let mut results: Vec<Option<TrialResult>> = vec![None; range.clone().count()];
@@ -339,9 +372,11 @@ fn play_policy<E: SolverEnv>(
             return None;
         }
         let rows = &mut observations[..envs.len() * size];
-        rows.par_chunks_mut(size)
-            .zip(&envs)
-            .for_each(|(row, env)| env.observe(row));
+        rows.par_chunks_mut(size).zip(&envs).for_each(|(row, env)| {
+            let (game, own) = row.split_at_mut(E::OBSERVATION_SIZE);
+            env.observe(game);
+            own.copy_from_slice(abilities);
+        });
         solver.normalizer.normalize(rows);
         let actions = solver
             .policy

@@ -57,6 +57,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 TrainMode::FixedAux => 0.0,
                 _ => config.generator.paced_share,
             },
+            ability_spread: config.ability_spread,
         }
     }
 

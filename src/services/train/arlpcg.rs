@@ -30,7 +30,8 @@ use crate::services::train::population::Snapshot;
 use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, GeneratorRewards, Match, MatchPacing, TrackBuild, observation_size,
 };
-use arlpcg_core::game::{Scripted, SolverEnv};
+use arlpcg_core::game::{Scripted, SolverEnv, observe_solver};
+use arlpcg_core::level::profile::{Abilities, MAIN_ABILITIES};
 use arlpcg_core::level::stats::{Outcome, Skill};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::ActMode;
@@ -102,6 +103,9 @@ pub struct MatchRules {
     /// The share of matches whose λ changes along the track
     /// ([`GeneratorConfig::paced_share`](super::GeneratorConfig::paced_share)).
     pub paced_share: f64,
+    /// Above 0: each match's Solver plays with the main abilities drawn within this share of
+    /// the player's, and observes them ([`TrainConfig::ability_spread`](super::TrainConfig)).
+    pub ability_spread: f64,
 }
 
 /// The Generator with its optimizer and normalizer.
@@ -281,7 +285,15 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
     /// The match of `seed` before its first piece (its build and λ drawn from the seed), and
     /// the seed's generator, to draw on from.
     fn match_of(&self, seed: u64) -> (Match<G>, ChaCha8Rng) {
-        let (build, mut rng) = G::new_build(seed, None, self.rules.limits, self.rules.obstacles);
+        let mut limits = self.rules.limits;
+        if self.rules.ability_spread > 0.0 {
+            let own = limits
+                .player
+                .abilities
+                .unwrap_or(Abilities::default_of(G::GAME));
+            limits.player.abilities = Some(own.varied(self.rules.ability_spread, seed));
+        }
+        let (build, mut rng) = G::new_build(seed, None, limits, self.rules.obstacles);
         let values = &self.rules.aux_values;
         let aux = values[rng.random_range(0..values.len())];
         let fresh = Match::new(build, vec![aux], seed);
@@ -316,7 +328,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             return Ok(None);
         }
         let width = actions.len() / self.matches.len();
-        let d = G::Env::OBSERVATION_SIZE;
+        let d = self.observation_size();
         let mut replaced = actions.to_vec();
         for (k, snapshot) in self.population.iter().enumerate() {
             let played: Vec<usize> = (0..self.matches.len())
@@ -327,7 +339,8 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             }
             let mut observations = vec![0.0; played.len() * d];
             for (&i, row) in played.iter().zip(observations.chunks_mut(d)) {
-                self.matches[i].env().observe(row);
+                let game = &self.matches[i];
+                observe_solver::<G>(game.env(), game.build().player().abilities.as_ref(), row);
             }
             snapshot.norm.normalize(&mut observations);
             // Playing, not learning: the actor alone, with the random numbers `act` would draw.
@@ -513,13 +526,20 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
 
     fn observation_size(&self) -> usize {
         G::Env::OBSERVATION_SIZE
+            + if self.rules.ability_spread > 0.0 {
+                MAIN_ABILITIES
+            } else {
+                0
+            }
     }
 
     fn observe(&mut self, out: &mut [f32]) {
         self.matches
             .par_iter()
-            .zip(out.par_chunks_mut(G::Env::OBSERVATION_SIZE))
-            .for_each(|(game, row)| game.env().observe(row));
+            .zip(out.par_chunks_mut(self.observation_size()))
+            .for_each(|(game, row)| {
+                observe_solver::<G>(game.env(), game.build().player().abilities.as_ref(), row)
+            });
     }
 
     fn step(&mut self, actions: &[f32], out: &mut [Transition]) {

@@ -9,8 +9,9 @@ use crate::services::fsio;
 use crate::services::fsio::Overwrite;
 use anyhow::{Context, Result, bail};
 use arlpcg_core::game::generator::GeneratorGame;
-use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame};
+use arlpcg_core::game::{ABILITIES_PART, GameSpec, PlatformGame, RacingGame};
 use arlpcg_core::level::Game;
+use arlpcg_core::level::profile::MAIN_ABILITIES;
 use arlpcg_core::rl::checkpoint;
 use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingRecord, TrainingState};
 use arlpcg_core::rl::normalizer::RunningNorm;
@@ -47,10 +48,19 @@ impl SolverIo {
 pub(super) fn solver_shape(config: &TrainConfig, game: Game) -> PolicyShape {
     let io = SolverIo::of(game);
     PolicyShape {
-        observation: io.observation_size(),
+        observation: io.observation_size() + ability_size(config),
         hidden: config.hidden.clone(),
         continuous: io.continuous.len(),
         binary: io.binary.len(),
+    }
+}
+
+/// How many abilities the run's Solver observes after the game's observation (0: none).
+pub(super) fn ability_size(config: &TrainConfig) -> usize {
+    if config.ability_spread > 0.0 {
+        MAIN_ABILITIES
+    } else {
+        0
     }
 }
 
@@ -128,8 +138,12 @@ pub(super) fn card(
     let (observation, continuous_actions, binary_actions, network) = match role {
         Role::Solver => {
             let io = SolverIo::of(game);
+            let mut observation = layout(io.observation);
+            if config.ability_spread > 0.0 {
+                observation.push((ABILITIES_PART.to_string(), MAIN_ABILITIES));
+            }
             (
-                layout(io.observation),
+                observation,
                 names(io.continuous),
                 names(io.binary),
                 solver_shape(config, game),
@@ -172,6 +186,8 @@ pub(super) fn card(
         curve_offset: (role == Role::Generator && game == Game::Racing)
             .then_some(config.generator.curve_offset),
         profile: config.profile.clone(),
+        ability_spread: (role == Role::Solver && config.ability_spread > 0.0)
+            .then_some(config.ability_spread),
     }
 }
 

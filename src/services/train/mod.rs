@@ -245,7 +245,7 @@ fn solver_run<G: GameSpec>(
             None => SourceRecord::default(),
         };
         let action_size = solver_shape(config, G::GAME).action_size();
-        let player = config.player(G::GAME);
+        let player = (config.player(G::GAME), config.ability_spread);
         SolverEnvs::<G>::new(source, config.solver.num_envs, record, action_size, player)
             .map_err(|problem| anyhow::anyhow!("level source: {problem}"))
     };

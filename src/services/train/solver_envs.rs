@@ -14,8 +14,9 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use arlpcg_core::game::{GameSpec, Player, SolverEnv};
+use arlpcg_core::game::{GameSpec, Player, SolverEnv, observe_solver};
 use arlpcg_core::level::Level;
+use arlpcg_core::level::profile::{Abilities, MAIN_ABILITIES};
 use arlpcg_core::level::stats::Outcome;
 use arlpcg_core::rl::vec_env::{Transition, VecEnv};
 
@@ -76,6 +77,11 @@ pub struct SolverEnvs<G: GameSpec> {
     mode: SolverMode,
     /// Who the levels are made for and who plays them.
     player: Player,
+    /// Above 0: each episode's main abilities are drawn within this share of the player's, and
+    /// the Solver observes them.
+    spread: f64,
+    /// The abilities each environment's episode is played with.
+    played: Vec<Option<Abilities>>,
     envs: Vec<G::Env>,
     logs: Vec<EpisodeLog>,
     fixed: Vec<Level>,
@@ -83,15 +89,16 @@ pub struct SolverEnvs<G: GameSpec> {
 }
 
 impl<G: GameSpec> SolverEnvs<G> {
-    /// `num_envs` environments of `player`, continuing from `record` (a fresh run starts from
-    /// the default): its episodes under way are replayed, rows of `action_size`. `Err` says why
-    /// a record's episodes cannot be replayed.
+    /// `num_envs` environments of `player` (its main abilities drawn within `spread` of its own
+    /// each episode), continuing from `record` (a fresh run starts from the default): its
+    /// episodes under way are replayed, rows of `action_size`. `Err` says why a record's
+    /// episodes cannot be replayed.
     pub fn new(
         mode: SolverMode,
         num_envs: usize,
         record: SourceRecord,
         action_size: usize,
-        player: Player,
+        (player, spread): (Player, f64),
     ) -> Result<Self, String> {
         let fixed = match mode {
             SolverMode::RulePcg => Vec::new(),
@@ -102,6 +109,8 @@ impl<G: GameSpec> SolverEnvs<G> {
         let mut this = Self {
             mode,
             player,
+            spread,
+            played: Vec::new(),
             envs: Vec::with_capacity(num_envs),
             logs: record.under_way,
             fixed,
@@ -120,6 +129,7 @@ impl<G: GameSpec> SolverEnvs<G> {
             .par_iter()
             .map(|log| this.replayed(log, action_size))
             .collect::<Result<_, String>>()?;
+        this.played = this.logs.iter().map(|log| this.abilities(log)).collect();
         Ok(this)
     }
 
@@ -149,6 +159,20 @@ impl<G: GameSpec> SolverEnvs<G> {
         }
     }
 
+    /// The abilities the episode of `log` is played with: the player's, varied from the
+    /// episode's reset seed when the Solver is ability-aware.
+    fn abilities(&self, log: &EpisodeLog) -> Option<Abilities> {
+        if self.spread > 0.0 {
+            let own = self
+                .player
+                .abilities
+                .unwrap_or(Abilities::default_of(G::GAME));
+            Some(own.varied(self.spread, log.reset_seed))
+        } else {
+            self.player.abilities
+        }
+    }
+
     /// The environment of a fresh episode: a fixed level when it is one of them, else the
     /// rule level of its seed.
     fn start(&self, log: &EpisodeLog) -> G::Env {
@@ -163,7 +187,7 @@ impl<G: GameSpec> SolverEnvs<G> {
             Some(level) => level,
             None => &rule_level::<G>(log.level_seed, &self.player),
         };
-        let mut env = G::solver_env_with(level, self.player.abilities)
+        let mut env = G::solver_env_with(level, self.abilities(log))
             .expect("training levels are of the run's game");
         env.reset(log.reset_seed);
         env
@@ -210,14 +234,16 @@ impl<G: GameSpec> VecEnv for SolverEnvs<G> {
     }
 
     fn observation_size(&self) -> usize {
-        G::Env::OBSERVATION_SIZE
+        G::Env::OBSERVATION_SIZE + if self.spread > 0.0 { MAIN_ABILITIES } else { 0 }
     }
 
     fn observe(&mut self, out: &mut [f32]) {
+        let size = self.observation_size();
         self.envs
             .par_iter()
-            .zip(out.par_chunks_mut(G::Env::OBSERVATION_SIZE))
-            .for_each(|(env, row)| env.observe(row));
+            .zip(&self.played)
+            .zip(out.par_chunks_mut(size))
+            .for_each(|((env, played), row)| observe_solver::<G>(env, played.as_ref(), row));
     }
 
     fn step(&mut self, actions: &[f32], out: &mut [Transition]) {
@@ -248,6 +274,7 @@ impl<G: GameSpec> VecEnv for SolverEnvs<G> {
             self.envs[i] = env;
         }
         for (i, log) in restarts {
+            self.played[i] = self.abilities(&log);
             self.logs[i] = log;
         }
     }

@@ -20,7 +20,7 @@ use crate::services::verify::{
 use crate::shells::cli::{Judges, SolverChoice, VerifyArgs, default_solver};
 use arlpcg_core::game::Skill;
 use arlpcg_core::game::facts::facts;
-use arlpcg_core::level::profile::{Abilities, Profile};
+use arlpcg_core::level::profile::{Abilities, Profile, main_abilities};
 use arlpcg_core::level::stats::{Outcome, PanelStats, SolverRef, SolverStats};
 use arlpcg_core::level::yaml;
 use arlpcg_core::level::{Game, Level};
@@ -58,7 +58,7 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
             load_under(path, profile.as_ref(), args.profile.as_deref()).and_then(|level| {
                 let game = level.game();
                 solvers.resolve(game, args)?;
-                solvers.warn_of_profile(&level);
+                solvers.check_profile(&level, path)?;
                 let solver = solvers.get(game);
                 let bar = crate::shells::common::progress_bar(
                     args.trials as u64,
@@ -435,10 +435,12 @@ impl Solvers {
     }
 
     /// Says once that a Solver policy plays a level made for abilities other than those it
-    /// trained with: its statistics are not those of a player who trained with them.
-    fn warn_of_profile(&mut self, level: &Level) {
+    /// trained with: its statistics are not those of a player who trained with them. An
+    /// ability-aware policy plays any profile within its range without a word, and refuses one
+    /// beyond it.
+    fn check_profile(&mut self, level: &Level, file: &Path) -> Result<()> {
         let Some(Resolved::Policy(policy)) = self.resolved.get(&level.game()) else {
-            return;
+            return Ok(());
         };
         let abilities = |profile: Option<&Profile>| {
             profile.map_or(Abilities::default_of(level.game()), |p| p.abilities)
@@ -449,6 +451,20 @@ impl Solvers {
             })
         };
         let (played, trained) = (level.profile.as_ref(), policy.profile.as_ref());
+        if let Some(spread) = policy.ability_spread {
+            if !abilities(played).within(&abilities(trained), spread) {
+                anyhow::bail!(
+                    "{}: {} lies beyond the abilities the Solver policy {} trained over (each of {} within ±{:.0}% of {}): train a Solver for it (arlpcg train --profile FILE)",
+                    file.display(),
+                    name(played),
+                    policy.reference.path,
+                    main_abilities(level.game()).join(", "),
+                    100.0 * spread,
+                    name(trained)
+                );
+            }
+            return Ok(());
+        }
         if abilities(played) != abilities(trained) && !self.warned_profile {
             self.warned_profile = true;
             crate::warn!(
@@ -457,6 +473,7 @@ impl Solvers {
                 name(played)
             );
         }
+        Ok(())
     }
 
     fn get(&self, game: Game) -> Solver<'_> {

@@ -160,6 +160,8 @@ pub trait TrackBuild: Clone + Send + Sync {
     fn goal(&self) -> [f64; 3];
     /// Pieces placed so far.
     fn piece_count(&self) -> usize;
+    /// Who the track is made for and played by in a match.
+    fn player(&self) -> &super::Player;
     /// Writes the Generator's observation at aux inputs `aux` into `out`.
     fn observe(&self, aux: &[f32], out: &mut [f32]);
     /// Places the piece a policy's action row (unbounded samples, clipped here) stands for.

@@ -96,6 +96,22 @@ impl Player {
     }
 }
 
+/// The observation part an ability-aware Solver's observation ends with: the game's
+/// [`main_abilities`](crate::level::profile::main_abilities) relative to ours.
+pub const ABILITIES_PART: &str = "abilities";
+
+/// Writes a Solver's observation of `env` into `out`: the game's observation, then, for an
+/// ability-aware Solver (`out` [`MAIN_ABILITIES`](crate::level::profile::MAIN_ABILITIES)
+/// longer), the main abilities the run is played with relative to ours (none: ours, all 0).
+pub fn observe_solver<G: GameSpec>(env: &G::Env, abilities: Option<&Abilities>, out: &mut [f32]) {
+    let base = G::Env::OBSERVATION_SIZE;
+    env.observe(&mut out[..base]);
+    if out.len() > base {
+        let played = abilities.copied().unwrap_or(Abilities::default_of(G::GAME));
+        out[base..].copy_from_slice(&played.relative_main());
+    }
+}
+
 /// A scripted player of environment `E`.
 pub trait Scripted<E: SolverEnv> {
     fn act(&mut self, env: &E) -> E::Action;

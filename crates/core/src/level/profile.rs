@@ -137,6 +137,23 @@ const fn field(
     (ParamRange::new(name, min, max, unit), what)
 }
 
+/// How many main abilities each game has.
+pub const MAIN_ABILITIES: usize = 3;
+
+/// The main abilities of `game`, as a profile file names them: the designer's keys change them,
+/// and an ability-aware Solver observes them and trains over a range of them.
+pub fn main_abilities(game: Game) -> [&'static str; MAIN_ABILITIES] {
+    match game {
+        Game::Platform => [
+            "character.jump_speed", "character.run_speed", "character.gravity",
+        ],
+        Game::Racing => ["car.engine_force", "car.grip", "car.max_steer"],
+    }
+}
+
+/// The stream [`Abilities::varied`] draws from, apart from every other use of a seed.
+const VARIATION_STREAM: u64 = 0xab11_7135;
+
 /// Each character field.
 pub const CHARACTER_FIELDS: [(ParamRange, &str); 8] = [
     field(
@@ -249,6 +266,71 @@ impl Abilities {
         }
     }
 
+    /// The field named as in [`CHARACTER_FIELDS`] or [`CAR_FIELDS`], with its range; none for a
+    /// field of the other game.
+    pub fn value(&self, field: &str) -> Option<(f64, ParamRange)> {
+        let (values, fields): (Vec<f64>, &[(ParamRange, &str)]) = match self {
+            Abilities::Platform(c) => (c.values().to_vec(), &CHARACTER_FIELDS),
+            Abilities::Racing(c) => (c.values().to_vec(), &CAR_FIELDS),
+        };
+        let at = fields.iter().position(|(r, _)| r.name == field)?;
+        Some((values[at], fields[at].0))
+    }
+
+    /// These abilities with `field` at `value`, when they are then valid.
+    pub fn with_value(&self, field: &str, value: f64) -> Option<Self> {
+        Some(match *self {
+            Abilities::Platform(mut c) => {
+                let at = CHARACTER_FIELDS.iter().position(|(r, _)| r.name == field)?;
+                *c.values_mut()[at] = value;
+                c.check().ok()?;
+                Abilities::Platform(c)
+            }
+            Abilities::Racing(mut c) => {
+                let at = CAR_FIELDS.iter().position(|(r, _)| r.name == field)?;
+                *c.values_mut()[at] = value;
+                c.check().ok()?;
+                Abilities::Racing(c)
+            }
+        })
+    }
+
+    /// Each of the game's [`main_abilities`] relative to the built-in one (0: ours, 0.1: 10%
+    /// more): what an ability-aware Solver observes.
+    pub fn relative_main(&self) -> [f32; MAIN_ABILITIES] {
+        let ours = Self::default_of(self.game());
+        main_abilities(self.game()).map(|field| {
+            let value = |a: &Self| a.value(field).expect("a main ability of the game").0;
+            (value(self) / value(&ours) - 1.0) as f32
+        })
+    }
+
+    /// Whether each main ability lies within `spread` (a share, 0.2 for ±20%) of `base`'s.
+    pub fn within(&self, base: &Self, spread: f64) -> bool {
+        self.game() == base.game()
+            && main_abilities(self.game()).iter().all(|field| {
+                let (value, _) = self.value(field).expect("a main ability of the game");
+                let (from, _) = base.value(field).expect("a main ability of the game");
+                (value / from - 1.0).abs() <= spread + 1e-9
+            })
+    }
+
+    /// These abilities with each main one scaled by `1 + s`, `s` drawn uniformly within
+    /// `±spread` from a generator seeded by `seed` (kept within the field's range): the
+    /// character or car of one training episode.
+    pub fn varied(&self, spread: f64, seed: u64) -> Self {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ VARIATION_STREAM);
+        let mut varied = *self;
+        for field in main_abilities(self.game()) {
+            let (value, range) = varied.value(field).expect("a main ability of the game");
+            let scaled =
+                (value * (1.0 + rng.random_range(-spread..=spread))).clamp(range.min, range.max);
+            varied = varied.with_value(field, scaled).unwrap_or(varied);
+        }
+        varied
+    }
+
     /// The built-in abilities of `game`.
     pub fn default_of(game: Game) -> Self {
         match game {
@@ -359,33 +441,14 @@ impl Profile {
     /// The field named as in [`CHARACTER_FIELDS`] or [`CAR_FIELDS`] (`character.jump_speed`),
     /// with its range; none for a field of the other game.
     pub fn value(&self, field: &str) -> Option<(f64, ParamRange)> {
-        let (values, fields): (Vec<f64>, &[(ParamRange, &str)]) = match self.abilities {
-            Abilities::Platform(c) => (c.values().to_vec(), &CHARACTER_FIELDS),
-            Abilities::Racing(c) => (c.values().to_vec(), &CAR_FIELDS),
-        };
-        let at = fields.iter().position(|(r, _)| r.name == field)?;
-        Some((values[at], fields[at].0))
+        self.abilities.value(field)
     }
 
     /// The same profile with `field` at `value`, when that is a valid profile.
     pub fn with_value(&self, field: &str, value: f64) -> Option<Self> {
-        let abilities = match self.abilities {
-            Abilities::Platform(mut c) => {
-                let at = CHARACTER_FIELDS.iter().position(|(r, _)| r.name == field)?;
-                *c.values_mut()[at] = value;
-                c.check().ok()?;
-                Abilities::Platform(c)
-            }
-            Abilities::Racing(mut c) => {
-                let at = CAR_FIELDS.iter().position(|(r, _)| r.name == field)?;
-                *c.values_mut()[at] = value;
-                c.check().ok()?;
-                Abilities::Racing(c)
-            }
-        };
         Some(Self {
             name: self.name.clone(),
-            abilities,
+            abilities: self.abilities.with_value(field, value)?,
         })
     }
 

@@ -115,6 +115,10 @@ pub struct PolicyCard {
     /// game).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub profile: Option<crate::level::profile::ProfileRecord>,
+    /// Ability-aware Solvers: each main ability was drawn within this share (0.2: ±20%) of the
+    /// profile's (or ours) in training; a profile beyond it is refused.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ability_spread: Option<f64>,
 }
 
 /// How a policy was trained.
@@ -363,8 +367,26 @@ fn read_header(bytes: &[u8]) -> Result<(safetensors::tensor::Metadata, PolicyCar
     Ok((header, card))
 }
 
+/// The size of the ability part a card's observation ends with (0: none); only a Solver's may,
+/// of the game's main abilities.
+fn ability_part(card: &PolicyCard) -> Result<usize, PolicyError> {
+    match card.observation.last() {
+        Some((name, size)) if name == crate::game::ABILITIES_PART => {
+            if card.role == Role::Solver && *size == crate::level::profile::MAIN_ABILITIES {
+                Ok(*size)
+            } else {
+                Err(PolicyError::Card(format!(
+                    "card field observation ends with {size} abilities, but only a Solver reads them, {} of them",
+                    crate::level::profile::MAIN_ABILITIES
+                )))
+            }
+        }
+        _ => Ok(0),
+    }
+}
+
 /// Reads a policy or checkpoint, requiring `game` and `role` and the observation size the game
-/// produces now.
+/// produces now (a Solver's with the abilities its card names after it).
 pub fn load_policy(
     bytes: &[u8],
     game: Game,
@@ -379,6 +401,8 @@ pub fn load_policy(
             expected: format!("{game} {role}"),
         });
     }
+    // An ability-aware Solver observes the game's main abilities after the game's observation.
+    let observation_size = observation_size + ability_part(&card)?;
     if card.network.observation != observation_size {
         return Err(PolicyError::Card(format!(
             "its network observes {} values but the {game} {role} observes {observation_size}",
@@ -464,6 +488,7 @@ mod tests {
             max_pieces: None,
             curve_offset: None,
             profile: None,
+            ability_spread: None,
         }
     }
 

@@ -41,6 +41,7 @@ pub(in crate::services::train) fn check_resumable_change(
             old.generator.max_pieces == new.generator.max_pieces,
         ),
         ("profile", old.profile == new.profile),
+        ("ability_spread", old.ability_spread == new.ability_spread),
     ];
     match fixed.iter().find(|(_, same)| !same) {
         Some((name, _)) => Err(format!(
@@ -152,6 +153,9 @@ pub(in crate::services::train) fn check_config(
     }
     if !(1..=MAX_PHASE_STEPS).contains(&config.steps) {
         return Err(format!("steps must be in [1, {MAX_PHASE_STEPS}]"));
+    }
+    if !(0.0..=0.5).contains(&config.ability_spread) {
+        return Err("ability_spread must be a share within [0, 0.5] (0.2: ±20%)".into());
     }
     if let Some(record) = &config.profile {
         record

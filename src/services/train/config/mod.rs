@@ -53,6 +53,16 @@ pub struct TrainConfig {
     /// abilities, on levels made for them. None: the built-in game.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub profile: Option<ProfileRecord>,
+    /// Above 0, the Solver is ability-aware: each episode (each match) is played with the
+    /// game's main abilities drawn within this share of the profile's (0.2: ±20%), and the
+    /// Solver observes them, so that it plays a profile within the range without retraining.
+    /// In [0, 0.5]; 0 (the default): one character or car.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub ability_spread: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// The Generator's side of an adversarial run.
@@ -247,6 +257,7 @@ impl Default for TrainConfig {
             },
             generator: GeneratorConfig::default(),
             profile: None,
+            ability_spread: 0.0,
         }
     }
 }

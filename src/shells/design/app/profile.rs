@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use super::{App, Effect, PromptKind};
 use arlpcg_core::level::Game;
-use arlpcg_core::level::profile::Profile;
+use arlpcg_core::level::profile::{MAIN_ABILITIES, Profile, main_abilities};
 
 /// The profile levels are made for, and the ability its keys change.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -17,14 +17,9 @@ pub struct ProfileEdit {
     pub ability: usize,
 }
 
-/// The abilities the keys change, as the profile file names them.
-pub fn abilities(game: Game) -> &'static [&'static str] {
-    match game {
-        Game::Platform => &[
-            "character.jump_speed", "character.run_speed", "character.gravity",
-        ],
-        Game::Racing => &["car.engine_force", "car.grip", "car.max_steer"],
-    }
+/// The abilities the keys change, as the profile file names them: the game's main ones.
+pub fn abilities(game: Game) -> [&'static str; MAIN_ABILITIES] {
+    main_abilities(game)
 }
 
 /// What marks a profile changed by the keys.

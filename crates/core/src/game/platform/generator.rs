@@ -173,6 +173,10 @@ pub struct PlatformBuild {
 }
 
 impl TrackBuild for PlatformBuild {
+    fn player(&self) -> &Player {
+        &self.player
+    }
+
     fn goal(&self) -> [f64; 3] {
         self.goal
     }

@@ -188,6 +188,10 @@ impl RacingBuild {
 }
 
 impl TrackBuild for RacingBuild {
+    fn player(&self) -> &Player {
+        &self.player
+    }
+
     fn goal(&self) -> [f64; 3] {
         self.goal
     }

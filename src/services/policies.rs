@@ -10,7 +10,8 @@ use crate::services::panel::{Judge, JudgePanel};
 use crate::services::verify::SolverPolicy;
 use arlpcg_core::game::generator::DEFAULT_CURVE_OFFSET;
 use arlpcg_core::game::generator::{BuildLimits, GeneratorGame, observation_size};
-use arlpcg_core::game::{ABILITIES_PART, GameSpec, PlatformGame, RacingGame, SolverEnv};
+use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
+use arlpcg_core::level::profile::ABILITIES_PART;
 use arlpcg_core::level::{Game, PolicyRef};
 use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::rl::checkpoint::{

@@ -1187,3 +1187,56 @@ fn a_solver_trained_for_a_profile_records_it_and_keeps_it() {
         stderr(&trained)
     );
 }
+
+#[test]
+fn an_ability_aware_solver_plays_within_its_range_and_refuses_beyond() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let init = arlpcg_ok(&["profile", "init", "--game", "platform"]);
+    let text = String::from_utf8(init.stdout).unwrap();
+    for (name, jump) in [("near", "8.5"), ("far", "7.0")] {
+        let profile = text
+            .replace("name: default", &format!("name: {name}"))
+            .replace("jump_speed: 9.25", &format!("jump_speed: {jump}"));
+        std::fs::write(path(&format!("{name}.yaml")), profile).unwrap();
+    }
+    std::fs::write(path("aware.yaml"), "ability_spread: 0.2\n").unwrap();
+    let run = path("run");
+    arlpcg_ok(&[
+        "train",
+        "--mode",
+        "rule-pcg",
+        "--config",
+        &path("aware.yaml"),
+        "--steps",
+        "8192",
+        "--threads",
+        "1",
+        "--out",
+        &run,
+    ]);
+    let card = std::fs::read_to_string(dir.path().join("run/solver.yaml")).unwrap();
+    assert!(
+        card.contains("- - abilities\n  - 3") && card.contains("ability_spread: 0.2"),
+        "{card}"
+    );
+    let staircase = concat!(env!("CARGO_MANIFEST_DIR"), "/levels/hand/staircase.yaml");
+    let policy = format!("{run}/solver.safetensors");
+    let verify = |profile: &str| {
+        arlpcg(&[
+            "verify", staircase, "--policy", &policy, "--trials", "2", "--profile", profile,
+        ])
+    };
+    let near = verify(&path("near.yaml"));
+    assert!(near.status.success(), "{}", stderr(&near));
+    assert!(
+        !stderr(&near).contains("never trained"),
+        "{}",
+        stderr(&near)
+    );
+    fails_with(
+        &verify(&path("far.yaml")),
+        1,
+        "profile `far` lies beyond the abilities the Solver policy",
+    );
+}

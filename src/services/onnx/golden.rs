@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, Placement, TrackBuild, observation_size,
 };
-use arlpcg_core::game::{GameSpec, PortState, SolverEnv};
+use arlpcg_core::game::{GameSpec, PortState, SolverEnv, observe_solver};
 use arlpcg_core::level::PolicyRef;
 use arlpcg_core::rl::checkpoint::PolicyCard;
 use arlpcg_core::rl::policy::{ActMode, ActorCritic};
@@ -94,8 +94,9 @@ pub fn golden_episode<G: GameSpec>(
     env.reset(GOLDEN_RUN_SEED);
     let mut frames = Vec::new();
     let outcome = loop {
-        let mut observation = vec![0.0; G::Env::OBSERVATION_SIZE];
-        env.observe(&mut observation);
+        // An ability-aware Solver also observes the abilities: ours, all 0.
+        let mut observation = vec![0.0; card.network.observation];
+        observe_solver::<G>(&env, None, &mut observation);
         let frame = frame(policy, card, env.port_state(), observation)?;
         let action = G::Env::action_from_policy_row(&frame.action);
         frames.push(frame);

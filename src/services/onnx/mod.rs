@@ -25,6 +25,7 @@ mod builder;
 pub mod golden;
 pub mod proto;
 
+use arlpcg_core::level::profile::{ABILITIES_PART, main_abilities};
 use prost::Message;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -192,7 +193,8 @@ fn both_names(
 const CONTINUOUS_MEANING: &str =
     "the deterministic continuous actions (the Gaussian's mean clipped to [-1, 1])";
 
-/// The observation's columns, each part with what it holds (the game's own words, by name).
+/// The observation's columns, each part with what it holds (the game's own words, by name; an
+/// ability-aware Solver's abilities last).
 fn observation_columns(card: &PolicyCard) -> Vec<Columns> {
     let facts = arlpcg_core::game::facts::facts(card.game);
     let observation = match card.role {
@@ -207,6 +209,12 @@ fn observation_columns(card: &PolicyCard) -> Vec<Columns> {
             .zip(observation.meanings)
             .find(|((name, width), _)| *name == column.name && *width == column.width)
             .map(|(_, meaning)| meaning.to_string());
+        if column.name == ABILITIES_PART {
+            column.meaning = Some(format!(
+                "the profile's {} relative to the built-in ones (value / ours - 1; 0 for ours)",
+                main_abilities(card.game).join(", ")
+            ));
+        }
     }
     columns
 }

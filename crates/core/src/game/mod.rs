@@ -96,10 +96,6 @@ impl Player {
     }
 }
 
-/// The observation part an ability-aware Solver's observation ends with: the game's
-/// [`main_abilities`](crate::level::profile::main_abilities) relative to ours.
-pub const ABILITIES_PART: &str = "abilities";
-
 /// Writes a Solver's observation of `env` into `out`: the game's observation, then, for an
 /// ability-aware Solver (`out` [`MAIN_ABILITIES`](crate::level::profile::MAIN_ABILITIES)
 /// longer), the main abilities the run is played with relative to ours (none: ours, all 0).

@@ -137,6 +137,10 @@ const fn field(
     (ParamRange::new(name, min, max, unit), what)
 }
 
+/// The observation part an ability-aware Solver's observation ends with: the game's
+/// [`main_abilities`] relative to ours.
+pub const ABILITIES_PART: &str = "abilities";
+
 /// How many main abilities each game has.
 pub const MAIN_ABILITIES: usize = 3;
 
@@ -492,6 +496,31 @@ impl ProfileRecord {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn varied_abilities_stay_within_their_spread_and_follow_their_seed() {
+        for game in [Game::Platform, Game::Racing] {
+            let ours = Abilities::default_of(game);
+            assert_eq!(ours.relative_main(), [0.0; MAIN_ABILITIES]);
+            let varied: Vec<Abilities> = (0..50).map(|seed| ours.varied(0.2, seed)).collect();
+            assert_eq!(varied[7], ours.varied(0.2, 7), "seeded");
+            assert!(varied.iter().all(|a| a.within(&ours, 0.2)));
+            assert!(varied.iter().any(|a| !a.within(&ours, 0.1)), "it spreads");
+            for a in &varied {
+                assert!(a.relative_main().iter().all(|r| r.abs() <= 0.2 + 1e-6));
+            }
+            // Only the main abilities vary.
+            let fields: &[(ParamRange, &str)] = match game {
+                Game::Platform => &CHARACTER_FIELDS,
+                Game::Racing => &CAR_FIELDS,
+            };
+            for (range, _) in fields {
+                if !main_abilities(game).contains(&range.name) {
+                    assert_eq!(varied[3].value(range.name), ours.value(range.name));
+                }
+            }
+        }
+    }
 
     #[test]
     fn the_default_profile_reads_back_what_init_prints() {

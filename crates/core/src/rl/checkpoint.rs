@@ -371,7 +371,7 @@ fn read_header(bytes: &[u8]) -> Result<(safetensors::tensor::Metadata, PolicyCar
 /// of the game's main abilities.
 fn ability_part(card: &PolicyCard) -> Result<usize, PolicyError> {
     match card.observation.last() {
-        Some((name, size)) if name == crate::game::ABILITIES_PART => {
+        Some((name, size)) if name == crate::level::profile::ABILITIES_PART => {
             if card.role == Role::Solver && *size == crate::level::profile::MAIN_ABILITIES {
                 Ok(*size)
             } else {

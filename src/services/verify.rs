@@ -40,7 +40,51 @@ pub struct SolverPolicy {
     pub ability_spread: Option<f64>,
 }
 
+/// How a Solver policy stands to the abilities of a profile it is to play under.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ProfileFit {
+    /// It trained with them, or over a range that holds them.
+    Fits,
+    /// A policy of one character or car, trained with others: its statistics are not those of
+    /// a player who trained with them (the message says so).
+    Untrained(String),
+    /// Beyond the range an ability-aware policy trained over: refused (the message says how to
+    /// train for it).
+    Beyond(String),
+}
+
 impl SolverPolicy {
+    /// How it stands to playing under `played` (none: the built-in abilities).
+    pub fn fit(&self, played: Option<&arlpcg_core::level::profile::Profile>) -> ProfileFit {
+        let abilities = |profile: Option<&arlpcg_core::level::profile::Profile>| {
+            profile.map_or(Abilities::default_of(self.game), |p| p.abilities)
+        };
+        let name = |profile: Option<&arlpcg_core::level::profile::Profile>| {
+            profile.map_or("the built-in abilities".to_string(), |p| {
+                format!("profile `{}`", p.name)
+            })
+        };
+        let trained = self.profile.as_ref();
+        match self.ability_spread {
+            Some(spread) if !abilities(played).within(&abilities(trained), spread) => {
+                ProfileFit::Beyond(format!(
+                    "{} lies beyond the abilities the Solver policy {} trained over (each of {} within ±{:.0}% of {}): train a Solver for it (arlpcg train --profile FILE)",
+                    name(played),
+                    self.reference.path,
+                    arlpcg_core::level::profile::main_abilities(self.game).join(", "),
+                    100.0 * spread,
+                    name(trained)
+                ))
+            }
+            None if abilities(played) != abilities(trained) => ProfileFit::Untrained(format!(
+                "the Solver policy trained for {} plays under {}: its statistics are of a player who never trained with them (the scripted player, --solver scripted, plays with them)",
+                name(trained),
+                name(played)
+            )),
+            _ => ProfileFit::Fits,
+        }
+    }
+
     /// What it observes after the game's observation on `level`: for an ability-aware Solver
     /// the level's main abilities relative to ours, else nothing.
     fn ability_row(&self, level: &Level) -> Vec<f32> {

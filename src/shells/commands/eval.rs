@@ -11,7 +11,7 @@ use crate::services::generation::GeneratorPolicy;
 use crate::services::panel::Judge;
 use crate::services::policies::{GENERATOR_FILE, load_generator, load_solver};
 use crate::services::profile;
-use crate::services::verify::{Solver, SolverPolicy};
+use crate::services::verify::{ProfileFit, Solver, SolverPolicy};
 use crate::shells::cli::EvalArgs;
 use arlpcg_core::game::Skill;
 use arlpcg_core::level::profile::Profile;
@@ -41,6 +41,13 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     let (generator, _) = load_generator(&generator_path, args.game)?;
     let solvers = load_solvers(args)?;
     let profile = asked_profile(args)?;
+    for (_, policy) in &solvers {
+        match policy.fit(profile.as_ref()) {
+            ProfileFit::Fits => {}
+            ProfileFit::Untrained(said) => crate::warn!("{said}"),
+            ProfileFit::Beyond(problem) => bail!("{problem}"),
+        }
+    }
     let budget = budget(args);
     let overwrite = if args.force {
         Overwrite::Allowed

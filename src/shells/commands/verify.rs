@@ -14,13 +14,13 @@ use crate::services::panel::{JudgePanel, rate};
 use crate::services::policies::{load_panel, load_solver};
 use crate::services::profile;
 use crate::services::verify::{
-    FailureConcentration, HalfwaySplit, Solver, SolverPolicy, Summary, Watch, passed_by_piece,
-    verify,
+    FailureConcentration, HalfwaySplit, ProfileFit, Solver, SolverPolicy, Summary, Watch,
+    passed_by_piece, verify,
 };
 use crate::shells::cli::{Judges, SolverChoice, VerifyArgs, default_solver};
 use arlpcg_core::game::Skill;
 use arlpcg_core::game::facts::facts;
-use arlpcg_core::level::profile::{Abilities, Profile, main_abilities};
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::stats::{Outcome, PanelStats, SolverRef, SolverStats};
 use arlpcg_core::level::yaml;
 use arlpcg_core::level::{Game, Level};
@@ -435,43 +435,19 @@ impl Solvers {
     }
 
     /// Says once that a Solver policy plays a level made for abilities other than those it
-    /// trained with: its statistics are not those of a player who trained with them. An
-    /// ability-aware policy plays any profile within its range without a word, and refuses one
-    /// beyond it.
+    /// trained with; refuses a level beyond an ability-aware policy's range.
     fn check_profile(&mut self, level: &Level, file: &Path) -> Result<()> {
         let Some(Resolved::Policy(policy)) = self.resolved.get(&level.game()) else {
             return Ok(());
         };
-        let abilities = |profile: Option<&Profile>| {
-            profile.map_or(Abilities::default_of(level.game()), |p| p.abilities)
-        };
-        let name = |profile: Option<&Profile>| {
-            profile.map_or("the built-in abilities".to_string(), |p| {
-                format!("profile `{}`", p.name)
-            })
-        };
-        let (played, trained) = (level.profile.as_ref(), policy.profile.as_ref());
-        if let Some(spread) = policy.ability_spread {
-            if !abilities(played).within(&abilities(trained), spread) {
-                anyhow::bail!(
-                    "{}: {} lies beyond the abilities the Solver policy {} trained over (each of {} within ±{:.0}% of {}): train a Solver for it (arlpcg train --profile FILE)",
-                    file.display(),
-                    name(played),
-                    policy.reference.path,
-                    main_abilities(level.game()).join(", "),
-                    100.0 * spread,
-                    name(trained)
-                );
+        match policy.fit(level.profile.as_ref()) {
+            ProfileFit::Fits => {}
+            ProfileFit::Beyond(problem) => anyhow::bail!("{}: {problem}", file.display()),
+            ProfileFit::Untrained(said) if !self.warned_profile => {
+                self.warned_profile = true;
+                crate::warn!("{said}");
             }
-            return Ok(());
-        }
-        if abilities(played) != abilities(trained) && !self.warned_profile {
-            self.warned_profile = true;
-            crate::warn!(
-                "the Solver policy trained for {} plays under {}: its statistics are of a player who never trained with them (the scripted player, --solver scripted, plays with them)",
-                name(trained),
-                name(played)
-            );
+            ProfileFit::Untrained(_) => {}
         }
         Ok(())
     }

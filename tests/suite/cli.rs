@@ -1124,18 +1124,24 @@ fn a_game_profile_is_checked_recorded_and_played_under() {
     );
 }
 
+/// Writes to `path` our platform profile as `profile init` prints it, named `name`, with jump
+/// speed `jump` (m/s, as written).
+fn write_platform_profile(path: &str, name: &str, jump: &str) {
+    let init = arlpcg_ok(&["profile", "init", "--game", "platform"]);
+    let text = String::from_utf8(init.stdout)
+        .unwrap()
+        .replace("name: default", &format!("name: {name}"))
+        .replace("jump_speed: 9.25", &format!("jump_speed: {jump}"));
+    std::fs::write(path, text).unwrap();
+}
+
 #[test]
 fn a_solver_trained_for_a_profile_records_it_and_keeps_it() {
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
-    let init = arlpcg_ok(&["profile", "init", "--game", "platform"]);
-    let text = String::from_utf8(init.stdout).unwrap();
-    std::fs::write(path("default.yaml"), &text).unwrap();
-    let low = text
-        .replace("name: default", "name: low-jumper")
-        .replace("jump_speed: 9.25", "jump_speed: 7.5");
-    std::fs::write(path("low.yaml"), low).unwrap();
+    write_platform_profile(&path("default.yaml"), "default", "9.25");
     let low_path = path("low.yaml");
+    write_platform_profile(&low_path, "low-jumper", "7.5");
     // Its configuration and card record the profile, a resume keeps it, and it plays under the
     // low jumper's abilities without a word of warning.
     let run = path("run");
@@ -1192,13 +1198,8 @@ fn a_solver_trained_for_a_profile_records_it_and_keeps_it() {
 fn an_ability_aware_solver_plays_within_its_range_and_refuses_beyond() {
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
-    let init = arlpcg_ok(&["profile", "init", "--game", "platform"]);
-    let text = String::from_utf8(init.stdout).unwrap();
     for (name, jump) in [("near", "8.5"), ("far", "7.0")] {
-        let profile = text
-            .replace("name: default", &format!("name: {name}"))
-            .replace("jump_speed: 9.25", &format!("jump_speed: {jump}"));
-        std::fs::write(path(&format!("{name}.yaml")), profile).unwrap();
+        write_platform_profile(&path(&format!("{name}.yaml")), name, jump);
     }
     std::fs::write(path("aware.yaml"), "ability_spread: 0.2\n").unwrap();
     let run = path("run");

@@ -9,7 +9,7 @@
 //! level and a Generator level of the same seed lead to the same goal.
 
 use arlpcg_core::game::generator::{
-    BuildLimits, GeneratorGame, Placement, TrackBuild, observation_size,
+    BuildLimits, GeneratorGame, Placement, TrackBuild, observe_build,
 };
 use arlpcg_core::game::{PlatformGame, Player, RacingGame};
 use arlpcg_core::level::pacing::{AuxCurve, Pacing, covered, round_aux};
@@ -300,14 +300,15 @@ fn build_level<G: GeneratorGame>(
     let goal = empty.goal();
     let mut skip = request.draw;
     let aux_ask = request.aux.as_ref();
-    let mut observation = vec![0.0; observation_size::<G>()];
+    // An ability-aware Generator also observes the abilities of the profile it builds for.
+    let mut observation = vec![0.0; generator.policy.shape().observation];
     for _ in 0..ATTEMPTS {
         let mut build = empty.clone();
         let mut piece_auxes = kept_aux.clone();
         while build.piece_count() < generator.limits.max_pieces {
             let aux = piece_aux(aux_ask, &build);
             piece_auxes.push(Some(aux));
-            build.observe(&[aux as f32], &mut observation);
+            observe_build::<G>(&build, &[aux as f32], &mut observation);
             generator.normalizer.normalize(&mut observation);
             let action = generator
                 .policy

@@ -1195,7 +1195,7 @@ fn a_solver_trained_for_a_profile_records_it_and_keeps_it() {
 }
 
 #[test]
-fn an_ability_aware_solver_plays_within_its_range_and_refuses_beyond() {
+fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
     for (name, jump) in [("near", "8.5"), ("far", "7.0")] {
@@ -1206,7 +1206,7 @@ fn an_ability_aware_solver_plays_within_its_range_and_refuses_beyond() {
     arlpcg_ok(&[
         "train",
         "--mode",
-        "rule-pcg",
+        "arlpcg",
         "--config",
         &path("aware.yaml"),
         "--steps",
@@ -1216,11 +1216,27 @@ fn an_ability_aware_solver_plays_within_its_range_and_refuses_beyond() {
         "--out",
         &run,
     ]);
-    let card = std::fs::read_to_string(dir.path().join("run/solver.yaml")).unwrap();
-    assert!(
-        card.contains("- - abilities\n  - 3") && card.contains("ability_spread: 0.2"),
-        "{card}"
-    );
+    // Both agents observe the abilities, and their cards say over which range.
+    for card in ["solver.yaml", "generator.yaml"] {
+        let card = std::fs::read_to_string(dir.path().join("run").join(card)).unwrap();
+        assert!(
+            card.contains("- - abilities\n  - 3") && card.contains("ability_spread: 0.2"),
+            "{card}"
+        );
+    }
+    // Its Generator builds for a profile within the range.
+    arlpcg_ok(&[
+        "generate",
+        "--policies",
+        &run,
+        "--aux=-1",
+        "--profile",
+        &path("near.yaml"),
+        "--count",
+        "1",
+        "--out",
+        &path("levels"),
+    ]);
     let staircase = concat!(env!("CARGO_MANIFEST_DIR"), "/levels/hand/staircase.yaml");
     let policy = format!("{run}/solver.safetensors");
     let verify = |profile: &str| {

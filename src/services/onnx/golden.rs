@@ -12,7 +12,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use arlpcg_core::game::generator::{
-    BuildLimits, GeneratorGame, Placement, TrackBuild, observation_size,
+    BuildLimits, GeneratorGame, Placement, TrackBuild, observe_build,
 };
 use arlpcg_core::game::{GameSpec, PortState, SolverEnv, observe_solver};
 use arlpcg_core::level::PolicyRef;
@@ -126,8 +126,9 @@ pub fn generator_golden_episode<G: GeneratorGame>(
     let (mut build, _) = G::new_build(GOLDEN_RUN_SEED, None, limits, obstacles);
     let mut frames = Vec::new();
     let outcome = loop {
-        let mut observation = vec![0.0; observation_size::<G>()];
-        build.observe(&[GOLDEN_AUX], &mut observation);
+        // An ability-aware Generator also observes the abilities: ours, all 0.
+        let mut observation = vec![0.0; card.network.observation];
+        observe_build::<G>(&build, &[GOLDEN_AUX], &mut observation);
         let frame = frame(policy, card, build.port_state(), observation)?;
         let placement = build.place(&frame.action);
         frames.push(frame);

@@ -19,7 +19,7 @@ use super::{CHECKPOINT, ConfigChange, GENERATOR_CHECKPOINT, GENERATOR_METRICS, T
 use crate::services::fsio;
 use crate::services::fsio::Overwrite;
 use anyhow::{Context, Result};
-use arlpcg_core::game::generator::{BuildLimits, GeneratorGame, observation_size};
+use arlpcg_core::game::generator::{BuildLimits, GeneratorGame};
 use arlpcg_core::rl::checkpoint;
 use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingState};
 use arlpcg_core::rl::normalizer::RunningNorm;
@@ -70,7 +70,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             policy.set_log_std(config.generator.initial_log_std)?;
             let generator = Generator {
                 ppo: Ppo::new(config.generator.ppo.clone(), policy)?,
-                norm: RunningNorm::new(observation_size::<G>()),
+                norm: RunningNorm::new(generator_shape(config, G::GAME).observation),
             };
             let rng = ChaCha8Rng::seed_from_u64(config.seed.wrapping_add(1));
             AdversarialEnvs::new(

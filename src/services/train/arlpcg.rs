@@ -28,7 +28,7 @@ use serde::{Deserialize, Serialize};
 use crate::services::train::config::ScriptedOpponent;
 use crate::services::train::population::Snapshot;
 use arlpcg_core::game::generator::{
-    BuildLimits, GeneratorGame, GeneratorRewards, Match, MatchPacing, TrackBuild, observation_size,
+    BuildLimits, GeneratorGame, GeneratorRewards, Match, MatchPacing, TrackBuild,
 };
 use arlpcg_core::game::{Scripted, SolverEnv, observe_solver};
 use arlpcg_core::level::profile::{Abilities, MAIN_ABILITIES};
@@ -361,7 +361,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         if indices.is_empty() {
             return Ok(Vec::new());
         }
-        let d = observation_size::<G>();
+        let d = self.generator.norm.mean.len();
         let mut observations = vec![0.0; indices.len() * d];
         for (&i, row) in indices.iter().zip(observations.chunks_mut(d)) {
             self.matches[i].observe_generator(row);

@@ -55,7 +55,7 @@ pub(super) fn solver_shape(config: &TrainConfig, game: Game) -> PolicyShape {
     }
 }
 
-/// How many abilities the run's Solver observes after the game's observation (0: none).
+/// How many abilities the run's agents observe after the game's observation (0: none).
 pub(super) fn ability_size(config: &TrainConfig) -> usize {
     if config.ability_spread > 0.0 {
         MAIN_ABILITIES
@@ -93,7 +93,7 @@ impl GeneratorIo {
 pub(super) fn generator_shape(config: &TrainConfig, game: Game) -> PolicyShape {
     let io = GeneratorIo::of(game);
     PolicyShape {
-        observation: io.observation_size(),
+        observation: io.observation_size() + ability_size(config),
         hidden: config.hidden.clone(),
         continuous: io.actions.len(),
         binary: 0,
@@ -151,8 +151,12 @@ pub(super) fn card(
         }
         Role::Generator => {
             let io = GeneratorIo::of(game);
+            let mut observation = layout(io.observation);
+            if config.ability_spread > 0.0 {
+                observation.push((ABILITIES_PART.to_string(), MAIN_ABILITIES));
+            }
             (
-                layout(io.observation),
+                observation,
                 names(io.actions),
                 Vec::new(),
                 generator_shape(config, game),
@@ -186,8 +190,7 @@ pub(super) fn card(
         curve_offset: (role == Role::Generator && game == Game::Racing)
             .then_some(config.generator.curve_offset),
         profile: config.profile.clone(),
-        ability_spread: (role == Role::Solver && config.ability_spread > 0.0)
-            .then_some(config.ability_spread),
+        ability_spread: (config.ability_spread > 0.0).then_some(config.ability_spread),
     }
 }
 

@@ -279,6 +279,21 @@ pub(crate) fn prefix_reaches_goal(pieces: usize) -> String {
     format!("its first {pieces} pieces already reach the goal: keep fewer")
 }
 
+/// Writes the Generator's observation of `build` at aux inputs `aux` into `out`: the game's, then,
+/// for an ability-aware Generator (`out` [`MAIN_ABILITIES`](crate::level::profile::MAIN_ABILITIES)
+/// longer), the main abilities of the player the track is made for, relative to ours.
+pub fn observe_build<G: GeneratorGame>(build: &G::Build, aux: &[f32], out: &mut [f32]) {
+    let (game, abilities) = out.split_at_mut(observation_size::<G>());
+    build.observe(aux, game);
+    if !abilities.is_empty() {
+        let played = build
+            .player()
+            .abilities
+            .unwrap_or(crate::level::profile::Abilities::default_of(G::GAME));
+        abilities.copy_from_slice(&played.relative_main());
+    }
+}
+
 /// Length of the Generator's observation vector of game `G`.
 pub fn observation_size<G: GeneratorGame>() -> usize {
     G::GENERATOR_OBSERVATION_LAYOUT.iter().map(|(_, k)| k).sum()
@@ -429,8 +444,8 @@ impl<G: GeneratorGame> Match<G> {
     /// The Generator's observation, into `out`.
     pub fn observe_generator(&self, out: &mut [f32]) {
         match self.next_paced_aux() {
-            Some(aux) => self.build.observe(&[aux], out),
-            None => self.build.observe(&self.aux, out),
+            Some(aux) => observe_build::<G>(&self.build, &[aux], out),
+            None => observe_build::<G>(&self.build, &self.aux, out),
         }
     }
 

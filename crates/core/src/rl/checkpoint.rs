@@ -115,8 +115,8 @@ pub struct PolicyCard {
     /// game).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub profile: Option<crate::level::profile::ProfileRecord>,
-    /// Ability-aware Solvers: each main ability was drawn within this share (0.2: ±20%) of the
-    /// profile's (or ours) in training; a profile beyond it is refused.
+    /// Ability-aware policies: each main ability was drawn within this share (0.2: ±20%) of the
+    /// profile's (or ours) in training; a Solver refuses a profile beyond it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ability_spread: Option<f64>,
 }
@@ -367,16 +367,16 @@ fn read_header(bytes: &[u8]) -> Result<(safetensors::tensor::Metadata, PolicyCar
     Ok((header, card))
 }
 
-/// The size of the ability part a card's observation ends with (0: none); only a Solver's may,
-/// of the game's main abilities.
+/// The size of the ability part a card's observation ends with (0: none): the game's main
+/// abilities.
 fn ability_part(card: &PolicyCard) -> Result<usize, PolicyError> {
     match card.observation.last() {
         Some((name, size)) if name == crate::level::profile::ABILITIES_PART => {
-            if card.role == Role::Solver && *size == crate::level::profile::MAIN_ABILITIES {
+            if *size == crate::level::profile::MAIN_ABILITIES {
                 Ok(*size)
             } else {
                 Err(PolicyError::Card(format!(
-                    "card field observation ends with {size} abilities, but only a Solver reads them, {} of them",
+                    "card field observation ends with {size} abilities, not the game's {}",
                     crate::level::profile::MAIN_ABILITIES
                 )))
             }

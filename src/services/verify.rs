@@ -14,7 +14,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, Scripted, Skill, SolverEnv};
-use arlpcg_core::level::profile::Abilities;
+use arlpcg_core::level::profile::{Abilities, Profile, main_abilities};
 use arlpcg_core::level::stats::{SolverRef, SolverStats, TrialResult};
 use arlpcg_core::level::{Game, Level, PolicyRef};
 use arlpcg_core::rl::normalizer::RunningNorm;
@@ -34,7 +34,7 @@ pub struct SolverPolicy {
     pub normalizer: RunningNorm,
     pub reference: PolicyRef,
     /// The game profile it trained for (none: the built-in game).
-    pub profile: Option<arlpcg_core::level::profile::Profile>,
+    pub profile: Option<Profile>,
     /// An ability-aware Solver: it trained with each main ability within this share of its
     /// profile's, and observes them (none: it trained with one character or car).
     pub ability_spread: Option<f64>,
@@ -55,11 +55,9 @@ pub enum ProfileFit {
 
 impl SolverPolicy {
     /// How it stands to playing under `played` (none: the built-in abilities).
-    pub fn fit(&self, played: Option<&arlpcg_core::level::profile::Profile>) -> ProfileFit {
-        let abilities = |profile: Option<&arlpcg_core::level::profile::Profile>| {
-            profile.map_or(Abilities::default_of(self.game), |p| p.abilities)
-        };
-        let name = |profile: Option<&arlpcg_core::level::profile::Profile>| {
+    pub fn fit(&self, played: Option<&Profile>) -> ProfileFit {
+        let abilities = |profile: Option<&Profile>| Abilities::of(profile, self.game);
+        let name = |profile: Option<&Profile>| {
             profile.map_or("the built-in abilities".to_string(), |p| {
                 format!("profile `{}`", p.name)
             })
@@ -71,7 +69,7 @@ impl SolverPolicy {
                     "{} lies beyond the abilities the Solver policy {} trained over (each of {} within ±{:.0}% of {}): train a Solver for it (arlpcg train --profile FILE)",
                     name(played),
                     self.reference.path,
-                    arlpcg_core::level::profile::main_abilities(self.game).join(", "),
+                    main_abilities(self.game).join(", "),
                     100.0 * spread,
                     name(trained)
                 ))
@@ -91,10 +89,7 @@ impl SolverPolicy {
         if self.ability_spread.is_none() {
             return Vec::new();
         }
-        let played = level
-            .profile
-            .as_ref()
-            .map_or(Abilities::default_of(level.game()), |p| p.abilities);
+        let played = Abilities::of(level.profile.as_ref(), level.game());
         played.relative_main().to_vec()
     }
 }

@@ -31,7 +31,7 @@ use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, GeneratorRewards, Match, MatchPacing, TrackBuild,
 };
 use arlpcg_core::game::{Scripted, SolverEnv, observe_solver};
-use arlpcg_core::level::profile::{Abilities, MAIN_ABILITIES};
+use arlpcg_core::level::profile::ability_columns;
 use arlpcg_core::level::stats::{Outcome, Skill};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::ActMode;
@@ -286,13 +286,9 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
     /// the seed's generator, to draw on from.
     fn match_of(&self, seed: u64) -> (Match<G>, ChaCha8Rng) {
         let mut limits = self.rules.limits;
-        if self.rules.ability_spread > 0.0 {
-            let own = limits
-                .player
-                .abilities
-                .unwrap_or(Abilities::default_of(G::GAME));
-            limits.player.abilities = Some(own.varied(self.rules.ability_spread, seed));
-        }
+        limits.player = limits
+            .player
+            .varied(G::GAME, self.rules.ability_spread, seed);
         let (build, mut rng) = G::new_build(seed, None, limits, self.rules.obstacles);
         let values = &self.rules.aux_values;
         let aux = values[rng.random_range(0..values.len())];
@@ -525,12 +521,7 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
     }
 
     fn observation_size(&self) -> usize {
-        G::Env::OBSERVATION_SIZE
-            + if self.rules.ability_spread > 0.0 {
-                MAIN_ABILITIES
-            } else {
-                0
-            }
+        G::Env::OBSERVATION_SIZE + ability_columns(self.rules.ability_spread)
     }
 
     fn observe(&mut self, out: &mut [f32]) {

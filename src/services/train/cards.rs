@@ -11,7 +11,7 @@ use anyhow::{Context, Result, bail};
 use arlpcg_core::game::generator::GeneratorGame;
 use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame};
 use arlpcg_core::level::Game;
-use arlpcg_core::level::profile::{ABILITIES_PART, MAIN_ABILITIES};
+use arlpcg_core::level::profile::{ABILITIES_PART, ability_columns};
 use arlpcg_core::rl::checkpoint;
 use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingRecord, TrainingState};
 use arlpcg_core::rl::normalizer::RunningNorm;
@@ -48,19 +48,10 @@ impl SolverIo {
 pub(super) fn solver_shape(config: &TrainConfig, game: Game) -> PolicyShape {
     let io = SolverIo::of(game);
     PolicyShape {
-        observation: io.observation_size() + ability_size(config),
+        observation: io.observation_size() + ability_columns(config.ability_spread),
         hidden: config.hidden.clone(),
         continuous: io.continuous.len(),
         binary: io.binary.len(),
-    }
-}
-
-/// How many abilities the run's agents observe after the game's observation (0: none).
-pub(super) fn ability_size(config: &TrainConfig) -> usize {
-    if config.ability_spread > 0.0 {
-        MAIN_ABILITIES
-    } else {
-        0
     }
 }
 
@@ -93,7 +84,7 @@ impl GeneratorIo {
 pub(super) fn generator_shape(config: &TrainConfig, game: Game) -> PolicyShape {
     let io = GeneratorIo::of(game);
     PolicyShape {
-        observation: io.observation_size() + ability_size(config),
+        observation: io.observation_size() + ability_columns(config.ability_spread),
         hidden: config.hidden.clone(),
         continuous: io.actions.len(),
         binary: 0,
@@ -135,15 +126,11 @@ pub(super) fn card(
             .map(|(n, k)| (n.to_string(), *k))
             .collect::<Vec<_>>()
     };
-    let (observation, continuous_actions, binary_actions, network) = match role {
+    let (mut observation, continuous_actions, binary_actions, network) = match role {
         Role::Solver => {
             let io = SolverIo::of(game);
-            let mut observation = layout(io.observation);
-            if config.ability_spread > 0.0 {
-                observation.push((ABILITIES_PART.to_string(), MAIN_ABILITIES));
-            }
             (
-                observation,
+                layout(io.observation),
                 names(io.continuous),
                 names(io.binary),
                 solver_shape(config, game),
@@ -151,18 +138,19 @@ pub(super) fn card(
         }
         Role::Generator => {
             let io = GeneratorIo::of(game);
-            let mut observation = layout(io.observation);
-            if config.ability_spread > 0.0 {
-                observation.push((ABILITIES_PART.to_string(), MAIN_ABILITIES));
-            }
             (
-                observation,
+                layout(io.observation),
                 names(io.actions),
                 Vec::new(),
                 generator_shape(config, game),
             )
         }
     };
+    // An ability-aware agent observes the main abilities after the game's observation.
+    let abilities = ability_columns(config.ability_spread);
+    if abilities > 0 {
+        observation.push((ABILITIES_PART.to_string(), abilities));
+    }
     PolicyCard {
         format: checkpoint::POLICY_FORMAT.into(),
         version: checkpoint::POLICY_VERSION,

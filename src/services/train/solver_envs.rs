@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 
 use arlpcg_core::game::{GameSpec, Player, SolverEnv, observe_solver};
 use arlpcg_core::level::Level;
-use arlpcg_core::level::profile::{Abilities, MAIN_ABILITIES};
+use arlpcg_core::level::profile::{Abilities, ability_columns};
 use arlpcg_core::level::stats::Outcome;
 use arlpcg_core::rl::vec_env::{Transition, VecEnv};
 
@@ -162,15 +162,8 @@ impl<G: GameSpec> SolverEnvs<G> {
     /// The abilities the episode of `log` is played with: the player's, varied from the
     /// episode's reset seed when the Solver is ability-aware.
     fn abilities(&self, log: &EpisodeLog) -> Option<Abilities> {
-        if self.spread > 0.0 {
-            let own = self
-                .player
-                .abilities
-                .unwrap_or(Abilities::default_of(G::GAME));
-            Some(own.varied(self.spread, log.reset_seed))
-        } else {
-            self.player.abilities
-        }
+        let player = self.player.varied(G::GAME, self.spread, log.reset_seed);
+        player.abilities
     }
 
     /// The environment of a fresh episode: a fixed level when it is one of them, else the
@@ -234,7 +227,7 @@ impl<G: GameSpec> VecEnv for SolverEnvs<G> {
     }
 
     fn observation_size(&self) -> usize {
-        G::Env::OBSERVATION_SIZE + if self.spread > 0.0 { MAIN_ABILITIES } else { 0 }
+        G::Env::OBSERVATION_SIZE + ability_columns(self.spread)
     }
 
     fn observe(&mut self, out: &mut [f32]) {

@@ -94,6 +94,19 @@ impl Player {
         };
         Self { abilities, reach }
     }
+
+    /// The player of one training episode or match of game `game`: its main abilities drawn
+    /// within `spread` of its own from `seed` (itself when `spread` is 0), its reach kept.
+    pub fn varied(self, game: crate::level::Game, spread: f64, seed: u64) -> Self {
+        if spread <= 0.0 {
+            return self;
+        }
+        let own = self.abilities.unwrap_or(Abilities::default_of(game));
+        Self {
+            abilities: Some(own.varied(spread, seed)),
+            ..self
+        }
+    }
 }
 
 /// Writes a Solver's observation of `env` into `out`: the game's observation, then, for an

@@ -144,6 +144,12 @@ pub const ABILITIES_PART: &str = "abilities";
 /// How many main abilities each game has.
 pub const MAIN_ABILITIES: usize = 3;
 
+/// How many ability columns an agent trained with `spread` observes after the game's
+/// observation: the main abilities when it is ability-aware (spread above 0), else none.
+pub fn ability_columns(spread: f64) -> usize {
+    if spread > 0.0 { MAIN_ABILITIES } else { 0 }
+}
+
 /// The main abilities of `game`, as a profile file names them: the designer's keys change them,
 /// and an ability-aware Solver observes them and trains over a range of them.
 pub fn main_abilities(game: Game) -> [&'static str; MAIN_ABILITIES] {
@@ -273,12 +279,13 @@ impl Abilities {
     /// The field named as in [`CHARACTER_FIELDS`] or [`CAR_FIELDS`], with its range; none for a
     /// field of the other game.
     pub fn value(&self, field: &str) -> Option<(f64, ParamRange)> {
-        let (values, fields): (Vec<f64>, &[(ParamRange, &str)]) = match self {
-            Abilities::Platform(c) => (c.values().to_vec(), &CHARACTER_FIELDS),
-            Abilities::Racing(c) => (c.values().to_vec(), &CAR_FIELDS),
-        };
-        let at = fields.iter().position(|(r, _)| r.name == field)?;
-        Some((values[at], fields[at].0))
+        let at = |fields: &[(ParamRange, &str)]| fields.iter().position(|(r, _)| r.name == field);
+        match self {
+            Abilities::Platform(c) => {
+                at(&CHARACTER_FIELDS).map(|k| (c.values()[k], CHARACTER_FIELDS[k].0))
+            }
+            Abilities::Racing(c) => at(&CAR_FIELDS).map(|k| (c.values()[k], CAR_FIELDS[k].0)),
+        }
     }
 
     /// These abilities with `field` at `value`, when they are then valid.
@@ -333,6 +340,11 @@ impl Abilities {
             varied = varied.with_value(field, scaled).unwrap_or(varied);
         }
         varied
+    }
+
+    /// The abilities of `profile`, or ours when there is none.
+    pub fn of(profile: Option<&Profile>, game: Game) -> Self {
+        profile.map_or(Self::default_of(game), |p| p.abilities)
     }
 
     /// The built-in abilities of `game`.

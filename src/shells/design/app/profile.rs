@@ -5,21 +5,15 @@
 use std::path::PathBuf;
 
 use super::{App, Effect, PromptKind};
-use arlpcg_core::level::Game;
-use arlpcg_core::level::profile::{MAIN_ABILITIES, Profile, main_abilities};
+use arlpcg_core::level::profile::{Profile, main_abilities};
 
 /// The profile levels are made for, and the ability its keys change.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ProfileEdit {
     /// None: the built-in profile.
     pub profile: Option<Profile>,
-    /// Index into the game's [`abilities`].
+    /// Index into the game's [`main_abilities`].
     pub ability: usize,
-}
-
-/// The abilities the keys change, as the profile file names them: the game's main ones.
-pub fn abilities(game: Game) -> [&'static str; MAIN_ABILITIES] {
-    main_abilities(game)
 }
 
 /// What marks a profile changed by the keys.
@@ -57,7 +51,7 @@ impl App {
 
     /// `e`: the next ability of the game for `[` and `]`.
     pub(super) fn next_ability(&mut self) -> Vec<Effect> {
-        self.profile.ability = (self.profile.ability + 1) % abilities(self.game).len();
+        self.profile.ability = (self.profile.ability + 1) % main_abilities(self.game).len();
         self.say_ability();
         Vec::new()
     }
@@ -85,7 +79,7 @@ impl App {
 
     /// The ability `[` and `]` change, as the profile file names it.
     fn chosen_ability(&self) -> &'static str {
-        let all = abilities(self.game);
+        let all = main_abilities(self.game);
         all[self.profile.ability % all.len()]
     }
 

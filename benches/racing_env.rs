@@ -40,7 +40,8 @@ impl Worker {
             obstacles: 2,
             ..RacingRulesConfig::default()
         };
-        let level = rules::racing_level(seed, None, None, &config).expect("rule track");
+        let level = rules::racing_level(seed, None, None, &config, &Default::default())
+            .expect("rule track");
         let Track::Racing(track) = &level.track else {
             unreachable!("a racing level")
         };

@@ -13,7 +13,7 @@ use arlpcg_core::game::generator::{
 };
 use arlpcg_core::game::{PlatformGame, Player, RacingGame};
 use arlpcg_core::level::pacing::{AuxCurve, Pacing, covered, round_aux};
-use arlpcg_core::level::profile::Profile;
+use arlpcg_core::level::profile::{Abilities, Profile};
 use arlpcg_core::level::racing::RacingRulesConfig;
 use arlpcg_core::level::{Game, Level, PlatformRulesConfig, PolicyRef, Source};
 use arlpcg_core::rl::normalizer::RunningNorm;
@@ -158,15 +158,20 @@ impl LevelRequest {
     }
 }
 
-/// The player of `profile` (none: the built-in one). A platform character's reach is measured
-/// once per process (about a second) and kept, so that a batch, a campaign or the designer's
-/// edits measure each profile once.
+/// The player of `profile` (none: the built-in one), drawing pieces from its ranges. A platform
+/// character's reach is measured once per process (about a second) and kept, so that a batch, a
+/// campaign or the designer's edits measure each character once.
 pub fn player_for(profile: Option<&Profile>) -> Player {
-    use std::sync::{Mutex, OnceLock};
-    static MEASURED: OnceLock<Mutex<Vec<Player>>> = OnceLock::new();
-    let Some(abilities) = profile.map(|p| p.abilities) else {
+    let Some(profile) = profile else {
         return Player::default();
     };
+    player_of(profile.abilities).with_pieces(Some(profile.pieces))
+}
+
+/// The player of `abilities`, its reach measured once per process.
+fn player_of(abilities: Abilities) -> Player {
+    use std::sync::{Mutex, OnceLock};
+    static MEASURED: OnceLock<Mutex<Vec<Player>>> = OnceLock::new();
     let measured = MEASURED.get_or_init(Default::default);
     let known = |players: &[Player]| {
         players
@@ -198,7 +203,7 @@ pub fn rules_level(game: Game, request: &LevelRequest) -> Result<Level, NoRuleLe
             aux,
             goal,
             &PlatformRulesConfig::default(),
-            &player_for(request.profile.as_ref()).reach,
+            &player_for(request.profile.as_ref()),
             draw,
         )?,
         Game::Racing => {
@@ -206,7 +211,14 @@ pub fn rules_level(game: Game, request: &LevelRequest) -> Result<Level, NoRuleLe
                 obstacles: request.obstacles,
                 ..RacingRulesConfig::default()
             };
-            arlpcg_core::game::racing::rules::racing_level_draw(seed, aux, goal, &config, draw)?
+            arlpcg_core::game::racing::rules::racing_level_draw(
+                seed,
+                aux,
+                goal,
+                &config,
+                &player_for(request.profile.as_ref()),
+                draw,
+            )?
         }
     };
     Ok(Level {

@@ -1124,6 +1124,71 @@ fn a_game_profile_is_checked_recorded_and_played_under() {
     );
 }
 
+/// A profile's piece ranges: `init` prints them, levels of both games keep within them, and a
+/// range out of the format's or upside down names its field and writes nothing.
+#[test]
+fn a_profiles_piece_ranges_bound_its_levels_and_a_bad_range_names_its_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let init = |game: &str| {
+        String::from_utf8(arlpcg_ok(&["profile", "init", "--game", game]).stdout).unwrap()
+    };
+    let (platform, racing) = (init("platform"), init("racing"));
+    assert!(platform.contains("blocks:\n") && platform.contains("max_distance: 10.0"));
+    let narrow_blocks = platform
+        .replace("max_distance: 10.0", "max_distance: 7.0")
+        .replace("min_size: 4.0", "min_size: 5.0")
+        .replace("max_turn: 180.0", "max_turn: 45.0");
+    let narrow_segments = racing.replace("max_curve: 30.0", "max_curve: 10.0");
+    for (game, text) in [("platform", &narrow_blocks), ("racing", &narrow_segments)] {
+        let (profile, out) = (path(&format!("{game}.yaml")), path(game));
+        std::fs::write(&profile, text).unwrap();
+        arlpcg_ok(&[
+            "generate", "--game", game, "--rules", "--count", "4", "--profile", &profile,
+            "--format", "yaml", "--out", &out,
+        ]);
+        for (_, bytes) in files_of(Path::new(&out)) {
+            let level =
+                arlpcg_core::level::yaml::parse(std::str::from_utf8(&bytes).unwrap()).unwrap();
+            match level.platform() {
+                Some(track) => assert!(
+                    track
+                        .block_params()
+                        .iter()
+                        .all(|b| { b.distance <= 7.0 && b.size >= 5.0 && b.angle.abs() <= 45.0 })
+                ),
+                None => assert!(
+                    level
+                        .racing()
+                        .unwrap()
+                        .segments
+                        .iter()
+                        .all(|s| s.curve.abs() <= 10.0)
+                ),
+            }
+        }
+    }
+    let bad = |from: &str, to: &str, said: &str| {
+        let file = path("bad.yaml");
+        std::fs::write(&file, narrow_blocks.replace(from, to)).unwrap();
+        fails_with(&arlpcg(&["profile", "check", &file]), 1, said);
+        let out = path("never");
+        let made = arlpcg(&["generate", "--rules", "--profile", &file, "--out", &out]);
+        fails_with(&made, 1, said);
+        assert!(!Path::new(&out).exists());
+    };
+    bad(
+        "min_distance: 5.0",
+        "min_distance: 8.0",
+        "blocks.min_distance 8 is above blocks.max_distance 7",
+    );
+    bad(
+        "max_size: 6.0",
+        "max_size: 9.0",
+        "blocks.max_size 9 is out of range [4, 6] m",
+    );
+}
+
 /// Writes to `path` our platform profile as `profile init` prints it, named `name`, with jump
 /// speed `jump` (m/s, as written).
 fn write_platform_profile(path: &str, name: &str, jump: &str) {

@@ -185,6 +185,7 @@ fn every_mesh_faces_outward_and_its_winding_agrees_with_its_normals() {
             obstacles: 6,
             ..Default::default()
         },
+        &Default::default(),
     )
     .unwrap();
     let track = racing.racing().unwrap();
@@ -247,8 +248,14 @@ fn rotate_z(rotation: [f32; 4]) -> [f32; 3] {
 fn spawn_and_finish_nodes_carry_start_heading_and_goal_reach() {
     use arlpcg_core::level::heading::heading_direction;
     let platform = level(6);
-    let racing =
-        arlpcg_core::game::racing::rules::racing_level(6, None, None, &Default::default()).unwrap();
+    let racing = arlpcg_core::game::racing::rules::racing_level(
+        6,
+        None,
+        None,
+        &Default::default(),
+        &Default::default(),
+    )
+    .unwrap();
     for level in [platform, racing] {
         let glb = export::to_glb(&Scene::of_level(&level));
         let (document, _) = import_glb(&glb);
@@ -333,6 +340,7 @@ fn racing_with_obstacles() -> Level {
             obstacles: 6,
             ..Default::default()
         },
+        &Default::default(),
     )
     .unwrap()
 }

@@ -18,7 +18,7 @@ fn rule_level(seed: u64, obstacles: u32) -> Level {
         obstacles,
         ..RacingRulesConfig::default()
     };
-    rules::racing_level(seed, None, None, &config).unwrap()
+    rules::racing_level(seed, None, None, &config, &Default::default()).unwrap()
 }
 
 fn track(level: &Level) -> &RacingTrack {

@@ -130,8 +130,14 @@ fn the_shipped_racing_solvers_load_and_drive() {
     use arlpcg::services::verify::{Solver, verify};
     use arlpcg_core::game::racing::OBSERVATION_SIZE;
     use arlpcg_core::level::Game;
-    let level =
-        arlpcg_core::game::racing::rules::racing_level(3, None, None, &Default::default()).unwrap();
+    let level = arlpcg_core::game::racing::rules::racing_level(
+        3,
+        None,
+        None,
+        &Default::default(),
+        &Default::default(),
+    )
+    .unwrap();
     for (file, mode) in [
         ("solver.safetensors", "arlpcg"),
         ("solver-rule-pcg.safetensors", "rule-pcg"),

@@ -100,7 +100,7 @@ pub fn open(
             config: config.map(|path| load_config(path, game)).transpose()?,
             seed,
             steps,
-            profile: profile.map(Profile::record),
+            profile: profile.map(|p| Box::new(p.record())),
         })
     } else {
         if out.join(CHECKPOINT).exists() {
@@ -199,7 +199,7 @@ pub(super) struct ConfigChange {
     pub config: Option<TrainConfig>,
     pub seed: Option<u64>,
     pub steps: Option<u64>,
-    pub profile: Option<ProfileRecord>,
+    pub profile: Option<Box<ProfileRecord>>,
 }
 
 impl ConfigChange {
@@ -213,7 +213,7 @@ impl ConfigChange {
             new.steps = steps;
         }
         if let Some(profile) = self.profile {
-            new.profile = Some(profile);
+            new.profile = Some(*profile);
         }
         new
     }

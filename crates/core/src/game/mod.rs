@@ -6,7 +6,7 @@ pub mod generator;
 pub mod platform;
 pub mod racing;
 
-use crate::level::profile::Abilities;
+use crate::level::profile::{Abilities, BlockRanges, Pieces, SegmentRanges};
 use crate::level::stats::Outcome;
 pub use crate::level::stats::Skill;
 
@@ -72,14 +72,16 @@ fn coords(v: rapier3d::math::Vector) -> Vec<f64> {
     v.to_array().map(f64::from).to_vec()
 }
 
-/// Who plays a game's levels: a profile's abilities (none: the built-in ones) and what the rules
-/// derive from them, measured once (the platform character's reach). Rule levels, the
-/// Generator's tracks and the Solver's environments are made for one player.
+/// Who plays a game's levels: a profile's abilities (none: the built-in ones), what the rules
+/// derive from them, measured once (the platform character's reach), and the ranges the
+/// profile draws pieces from (none: the built-in ones). Rule levels, the Generator's tracks and
+/// the Solver's environments are made for one player.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Player {
     pub abilities: Option<Abilities>,
     /// The platform character's reach (the built-in table in racing, which has none).
     pub reach: platform::reach::Reach,
+    pub pieces: Option<Pieces>,
 }
 
 impl Player {
@@ -92,7 +94,28 @@ impl Player {
             }
             _ => platform::reach::Reach::default(),
         };
-        Self { abilities, reach }
+        Self {
+            abilities,
+            reach,
+            pieces: None,
+        }
+    }
+
+    /// This player drawing pieces from `pieces` (none: the built-in ranges).
+    pub fn with_pieces(self, pieces: Option<Pieces>) -> Self {
+        Self { pieces, ..self }
+    }
+
+    /// The ranges platform blocks are drawn from.
+    pub fn blocks(&self) -> BlockRanges {
+        self.pieces
+            .map_or_else(BlockRanges::default, |p| p.blocks())
+    }
+
+    /// The ranges racing segments are drawn from.
+    pub fn segments(&self) -> SegmentRanges {
+        self.pieces
+            .map_or_else(SegmentRanges::default, |p| p.segments())
     }
 
     /// The player of one training episode or match of game `game`: its main abilities drawn
@@ -192,7 +215,7 @@ impl GameSpec for PlatformGame {
             None,
             None,
             &crate::level::PlatformRulesConfig::default(),
-            &player.reach,
+            player,
         )
         .ok()
     }
@@ -227,8 +250,8 @@ impl GameSpec for RacingGame {
 
     /// The racing rules keep within what any car of the profile ranges drives (the scripted
     /// driver brakes for what it cannot take at speed), so they do not read the player.
-    fn rule_level(seed: u64, _player: &Player) -> Option<crate::level::Level> {
-        racing::rules::racing_level(seed, None, None, &Default::default()).ok()
+    fn rule_level(seed: u64, player: &Player) -> Option<crate::level::Level> {
+        racing::rules::racing_level(seed, None, None, &Default::default(), player).ok()
     }
 
     fn scripted(seed: u64, skill: Skill) -> racing::ScriptedDriver {

@@ -1,6 +1,6 @@
-//! A game profile: the abilities of the player's character (platform) or car (racing) as a
-//! versioned file (`format: arlpcg-profile`), so that levels are checked for a designer's own
-//! game rather than ours. The built-in default is today's game: a level without a profile is
+//! A game profile: the abilities of the player's character (platform) or car (racing), and the
+//! ranges its level pieces are drawn from, as a versioned file (`format: arlpcg-profile`), so
+//! that levels are made and checked for a designer's own game rather than ours. The built-in default is today's game: a level without a profile is
 //! played exactly as before, and a level made under another profile records it in full (name,
 //! SHA-256 of its values, and the values), so that it is verified under the same abilities.
 
@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 use serde::{Deserialize, Serialize};
 
 use crate::level::Game;
-use crate::level::params::{ParamRange, RangeError};
+use crate::level::params::{self, ParamRange, RangeError};
 
 /// The `format:` of a profile file.
 pub const FORMAT: &str = "arlpcg-profile";
@@ -56,7 +56,41 @@ pub struct CarProfile {
     pub damping: f64,
 }
 
-/// A profile file: which game, a name, and that game's abilities.
+/// The ranges a platform level's blocks are drawn from, by the rules and the Generator; each
+/// within the level format's own (`level::params`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlockRanges {
+    /// Shortest and longest centre-to-centre distance from the previous block, m.
+    pub min_distance: f64,
+    pub max_distance: f64,
+    /// Smallest and largest side of a block's top, m.
+    pub min_size: f64,
+    pub max_size: f64,
+    /// Largest drop (negative) and climb from the previous block, m.
+    pub min_height: f64,
+    pub max_height: f64,
+    /// Sharpest turn off the last jump's direction, degrees (the Generator keeps within
+    /// `game::platform::reach::MAX_TURN` as well).
+    pub max_turn: f64,
+}
+
+/// The ranges a racing level's segments are drawn from, by the rules and the Generator; each
+/// within the level format's own (`level::params`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SegmentRanges {
+    /// Shortest and longest segment along the centre line, m.
+    pub min_length: f64,
+    pub max_length: f64,
+    /// Sharpest heading change over a segment, either way, degrees.
+    pub max_curve: f64,
+    /// Largest height change over a segment, either way, m.
+    pub max_height: f64,
+}
+
+/// A profile file: which game, a name, that game's abilities and (optionally) its pieces'
+/// ranges.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ProfileFile {
@@ -68,6 +102,10 @@ pub struct ProfileFile {
     pub character: Option<CharacterProfile>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub car: Option<CarProfile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blocks: Option<BlockRanges>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub segments: Option<SegmentRanges>,
 }
 
 /// One game's abilities.
@@ -77,11 +115,19 @@ pub enum Abilities {
     Racing(CarProfile),
 }
 
-/// A checked profile: its name and abilities.
+/// One game's piece ranges.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Pieces {
+    Platform(BlockRanges),
+    Racing(SegmentRanges),
+}
+
+/// A checked profile: its name, abilities and piece ranges.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Profile {
     pub name: String,
     pub abilities: Abilities,
+    pub pieces: Pieces,
 }
 
 /// How a level records the profile it was made under (`profile:` in a level file).
@@ -95,6 +141,11 @@ pub struct ProfileRecord {
     pub character: Option<CharacterProfile>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub car: Option<CarProfile>,
+    /// The piece ranges, when they are not the built-in ones.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blocks: Option<BlockRanges>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub segments: Option<SegmentRanges>,
 }
 
 impl Default for CharacterProfile {
@@ -122,6 +173,33 @@ impl Default for CarProfile {
             grip: 0.9,
             max_steer: 0.5,
             damping: 0.21,
+        }
+    }
+}
+
+impl Default for BlockRanges {
+    /// The level format's ranges, and the Generator's sharpest turn.
+    fn default() -> Self {
+        Self {
+            min_distance: params::BLOCK_DISTANCE.min,
+            max_distance: params::BLOCK_DISTANCE.max,
+            min_size: params::BLOCK_SIZE.min,
+            max_size: params::BLOCK_SIZE.max,
+            min_height: params::BLOCK_HEIGHT.min,
+            max_height: params::BLOCK_HEIGHT.max,
+            max_turn: params::BLOCK_ANGLE.max,
+        }
+    }
+}
+
+impl Default for SegmentRanges {
+    /// The level format's ranges.
+    fn default() -> Self {
+        Self {
+            min_length: params::SEGMENT_LENGTH.min,
+            max_length: params::SEGMENT_LENGTH.max,
+            max_curve: params::SEGMENT_CURVE.max,
+            max_height: params::SEGMENT_HEIGHT.max,
         }
     }
 }
@@ -201,25 +279,164 @@ pub const CAR_FIELDS: [(ParamRange, &str); 5] = [
     field("car.damping", 0.02, 1.0, "1/s", "air and rolling drag"),
 ];
 
-impl CharacterProfile {
-    /// The fields in the order of [`CHARACTER_FIELDS`], to change in place.
-    fn values_mut(&mut self) -> [&mut f64; 8] {
-        [
-            &mut self.run_speed, &mut self.jump_speed, &mut self.gravity, &mut self.ground_accel,
-            &mut self.air_accel, &mut self.turn_rate, &mut self.radius, &mut self.height,
-        ]
-    }
+/// Each block range field.
+pub const BLOCK_FIELDS: [(ParamRange, &str); 7] = [
+    field(
+        "blocks.min_distance",
+        params::BLOCK_DISTANCE.min,
+        params::BLOCK_DISTANCE.max,
+        "m",
+        "shortest distance between block centres",
+    ),
+    field(
+        "blocks.max_distance",
+        params::BLOCK_DISTANCE.min,
+        params::BLOCK_DISTANCE.max,
+        "m",
+        "longest distance between block centres",
+    ),
+    field(
+        "blocks.min_size",
+        params::BLOCK_SIZE.min,
+        params::BLOCK_SIZE.max,
+        "m",
+        "smallest block side",
+    ),
+    field(
+        "blocks.max_size",
+        params::BLOCK_SIZE.min,
+        params::BLOCK_SIZE.max,
+        "m",
+        "largest block side",
+    ),
+    field(
+        "blocks.min_height",
+        params::BLOCK_HEIGHT.min,
+        params::BLOCK_HEIGHT.max,
+        "m",
+        "largest drop from block to block (negative)",
+    ),
+    field(
+        "blocks.max_height",
+        params::BLOCK_HEIGHT.min,
+        params::BLOCK_HEIGHT.max,
+        "m",
+        "largest climb from block to block",
+    ),
+    field(
+        "blocks.max_turn",
+        0.0,
+        params::BLOCK_ANGLE.max,
+        "°",
+        "sharpest turn off the last jump (the Generator keeps within 90)",
+    ),
+];
 
-    fn values(&self) -> [f64; 8] {
+/// Each segment range field.
+pub const SEGMENT_FIELDS: [(ParamRange, &str); 4] = [
+    field(
+        "segments.min_length",
+        params::SEGMENT_LENGTH.min,
+        params::SEGMENT_LENGTH.max,
+        "m",
+        "shortest segment",
+    ),
+    field(
+        "segments.max_length",
+        params::SEGMENT_LENGTH.min,
+        params::SEGMENT_LENGTH.max,
+        "m",
+        "longest segment",
+    ),
+    field(
+        "segments.max_curve",
+        0.0,
+        params::SEGMENT_CURVE.max,
+        "°",
+        "sharpest curve of a segment, either way",
+    ),
+    field(
+        "segments.max_height",
+        0.0,
+        params::SEGMENT_HEIGHT.max,
+        "m",
+        "largest climb or drop of a segment",
+    ),
+];
+
+/// A group of a profile's numbers, each with its entry in `FIELDS`: read, checked and changed
+/// by the field's name.
+trait Fields: Copy {
+    const FIELDS: &'static [(ParamRange, &'static str)];
+
+    /// The field at `k` of `FIELDS`, to change in place.
+    fn slot(&mut self, k: usize) -> &mut f64;
+
+    fn get(&self, k: usize) -> f64 {
         let mut copy = *self;
-        copy.values_mut().map(|v| *v)
+        *copy.slot(k)
     }
 
+    /// Checks every field's range.
+    fn check_each(&self) -> Result<(), RangeError> {
+        for (k, (range, _)) in Self::FIELDS.iter().enumerate() {
+            range.check(self.get(k))?;
+        }
+        Ok(())
+    }
+
+    /// The field named `name` (`character.jump_speed`) with its range.
+    fn field(&self, name: &str) -> Option<(f64, ParamRange)> {
+        let k = Self::FIELDS.iter().position(|(r, _)| r.name == name)?;
+        Some((self.get(k), Self::FIELDS[k].0))
+    }
+
+    /// A copy with the field named `name` at `value`, unchecked.
+    fn set(&self, name: &str, value: f64) -> Option<Self> {
+        let k = Self::FIELDS.iter().position(|(r, _)| r.name == name)?;
+        let mut copy = *self;
+        *copy.slot(k) = value;
+        Some(copy)
+    }
+}
+
+/// The `n`-th of `values`.
+fn nth<'a>(values: impl IntoIterator<Item = &'a mut f64>, n: usize) -> &'a mut f64 {
+    values.into_iter().nth(n).expect("a field of the table")
+}
+
+/// Checks that a least value is not above its most, naming both.
+fn ordered(least: (&str, f64), most: (&str, f64)) -> Result<(), String> {
+    if least.1 > most.1 {
+        return Err(format!(
+            "{} {} is above {} {}",
+            least.0,
+            params::show_number(least.1),
+            most.0,
+            params::show_number(most.1)
+        ));
+    }
+    Ok(())
+}
+
+impl Fields for CharacterProfile {
+    const FIELDS: &'static [(ParamRange, &'static str)] = &CHARACTER_FIELDS;
+    fn slot(&mut self, k: usize) -> &mut f64 {
+        nth(
+            [
+                &mut self.run_speed, &mut self.jump_speed, &mut self.gravity,
+                &mut self.ground_accel, &mut self.air_accel, &mut self.turn_rate, &mut self.radius,
+                &mut self.height,
+            ],
+            k,
+        )
+    }
+}
+
+impl CharacterProfile {
     /// Checks every field's range, and the capsule's shape.
     pub fn check(&self) -> Result<(), RangeError> {
-        for ((range, _), value) in CHARACTER_FIELDS.iter().zip(self.values()) {
-            range.check(value)?;
-        }
+        self.check_each()?;
         let least = 2.0 * self.radius;
         ParamRange::new(
             "character.height", least, 3.0, "m (twice the radius at least)",
@@ -229,26 +446,195 @@ impl CharacterProfile {
     }
 }
 
+impl Fields for CarProfile {
+    const FIELDS: &'static [(ParamRange, &'static str)] = &CAR_FIELDS;
+    fn slot(&mut self, k: usize) -> &mut f64 {
+        nth(
+            [
+                &mut self.engine_force, &mut self.mass, &mut self.grip, &mut self.max_steer,
+                &mut self.damping,
+            ],
+            k,
+        )
+    }
+}
+
 impl CarProfile {
-    /// The fields in the order of [`CAR_FIELDS`], to change in place.
-    fn values_mut(&mut self) -> [&mut f64; 5] {
-        [
-            &mut self.engine_force, &mut self.mass, &mut self.grip, &mut self.max_steer,
-            &mut self.damping,
-        ]
-    }
-
-    fn values(&self) -> [f64; 5] {
-        let mut copy = *self;
-        copy.values_mut().map(|v| *v)
-    }
-
     /// Checks every field's range.
     pub fn check(&self) -> Result<(), RangeError> {
-        for ((range, _), value) in CAR_FIELDS.iter().zip(self.values()) {
-            range.check(value)?;
+        self.check_each()
+    }
+}
+
+impl Fields for BlockRanges {
+    const FIELDS: &'static [(ParamRange, &'static str)] = &BLOCK_FIELDS;
+    fn slot(&mut self, k: usize) -> &mut f64 {
+        nth(
+            [
+                &mut self.min_distance, &mut self.max_distance, &mut self.min_size,
+                &mut self.max_size, &mut self.min_height, &mut self.max_height, &mut self.max_turn,
+            ],
+            k,
+        )
+    }
+}
+
+impl BlockRanges {
+    /// Checks every field's range, and that each least is not above its most.
+    pub fn check(&self) -> Result<(), String> {
+        self.check_each().map_err(|e| e.to_string())?;
+        for k in [0, 2, 4] {
+            let name = |k: usize| BLOCK_FIELDS[k].0.name;
+            ordered((name(k), self.get(k)), (name(k + 1), self.get(k + 1)))?;
         }
         Ok(())
+    }
+
+    pub fn distance(&self) -> ParamRange {
+        ParamRange::new("distance", self.min_distance, self.max_distance, "m")
+    }
+
+    pub fn size(&self) -> ParamRange {
+        ParamRange::new("size", self.min_size, self.max_size, "m")
+    }
+
+    pub fn height(&self) -> ParamRange {
+        ParamRange::new("height", self.min_height, self.max_height, "m")
+    }
+
+    pub fn turn(&self) -> ParamRange {
+        ParamRange::new("angle", -self.max_turn, self.max_turn, "degrees")
+    }
+}
+
+impl Fields for SegmentRanges {
+    const FIELDS: &'static [(ParamRange, &'static str)] = &SEGMENT_FIELDS;
+    fn slot(&mut self, k: usize) -> &mut f64 {
+        nth(
+            [
+                &mut self.min_length, &mut self.max_length, &mut self.max_curve,
+                &mut self.max_height,
+            ],
+            k,
+        )
+    }
+}
+
+impl SegmentRanges {
+    /// Checks every field's range, and that the shortest length is not above the longest.
+    pub fn check(&self) -> Result<(), String> {
+        self.check_each().map_err(|e| e.to_string())?;
+        ordered(
+            (SEGMENT_FIELDS[0].0.name, self.min_length),
+            (SEGMENT_FIELDS[1].0.name, self.max_length),
+        )
+    }
+
+    pub fn length(&self) -> ParamRange {
+        ParamRange::new("length", self.min_length, self.max_length, "m")
+    }
+
+    pub fn curve(&self) -> ParamRange {
+        ParamRange::new("curve", -self.max_curve, self.max_curve, "degrees")
+    }
+
+    pub fn height(&self) -> ParamRange {
+        ParamRange::new("height", -self.max_height, self.max_height, "m")
+    }
+}
+
+impl Pieces {
+    /// `game`'s piece ranges from a file's `blocks:` and `segments:` (the one of its game, the
+    /// built-in ranges when it has none, and not the other's), checked.
+    fn checked(
+        game: Game,
+        blocks: Option<BlockRanges>,
+        segments: Option<SegmentRanges>,
+    ) -> Result<Self, String> {
+        match (game, blocks, segments) {
+            (Game::Platform, blocks, None) => {
+                let blocks = blocks.unwrap_or_default();
+                blocks.check()?;
+                Ok(Pieces::Platform(blocks))
+            }
+            (Game::Racing, None, segments) => {
+                let segments = segments.unwrap_or_default();
+                segments.check()?;
+                Ok(Pieces::Racing(segments))
+            }
+            (Game::Platform, _, _) => {
+                Err("a platform profile has `blocks:`, not `segments:`".into())
+            }
+            (Game::Racing, _, _) => Err("a racing profile has `segments:`, not `blocks:`".into()),
+        }
+    }
+
+    /// The built-in ranges of `game`.
+    pub fn default_of(game: Game) -> Self {
+        match game {
+            Game::Platform => Pieces::Platform(BlockRanges::default()),
+            Game::Racing => Pieces::Racing(SegmentRanges::default()),
+        }
+    }
+
+    /// The platform ranges (the built-in ones for a racing profile).
+    pub fn blocks(&self) -> BlockRanges {
+        match self {
+            Pieces::Platform(b) => *b,
+            Pieces::Racing(_) => BlockRanges::default(),
+        }
+    }
+
+    /// The racing ranges (the built-in ones for a platform profile).
+    pub fn segments(&self) -> SegmentRanges {
+        match self {
+            Pieces::Racing(s) => *s,
+            Pieces::Platform(_) => SegmentRanges::default(),
+        }
+    }
+
+    /// The field named as in [`BLOCK_FIELDS`] or [`SEGMENT_FIELDS`], with its range.
+    pub fn value(&self, field: &str) -> Option<(f64, ParamRange)> {
+        match self {
+            Pieces::Platform(b) => b.field(field),
+            Pieces::Racing(s) => s.field(field),
+        }
+    }
+
+    /// These ranges with `field` at `value`, when they are then valid.
+    pub fn with_value(&self, field: &str, value: f64) -> Option<Self> {
+        let changed = match self {
+            Pieces::Platform(b) => Pieces::Platform(b.set(field, value)?),
+            Pieces::Racing(s) => Pieces::Racing(s.set(field, value)?),
+        };
+        let game = changed.game();
+        let (blocks, segments) = changed.sections();
+        Pieces::checked(game, blocks, segments).ok()
+    }
+
+    pub fn game(&self) -> Game {
+        match self {
+            Pieces::Platform(_) => Game::Platform,
+            Pieces::Racing(_) => Game::Racing,
+        }
+    }
+
+    /// The file's `blocks:` and `segments:`.
+    fn sections(&self) -> (Option<BlockRanges>, Option<SegmentRanges>) {
+        match *self {
+            Pieces::Platform(b) => (Some(b), None),
+            Pieces::Racing(s) => (None, Some(s)),
+        }
+    }
+
+    /// The sections a file writes: none for the built-in ranges, so that a profile of
+    /// abilities alone keeps its SHA-256.
+    fn written(&self) -> (Option<BlockRanges>, Option<SegmentRanges>) {
+        if *self == Self::default_of(self.game()) {
+            (None, None)
+        } else {
+            self.sections()
+        }
     }
 }
 
@@ -279,27 +665,22 @@ impl Abilities {
     /// The field named as in [`CHARACTER_FIELDS`] or [`CAR_FIELDS`], with its range; none for a
     /// field of the other game.
     pub fn value(&self, field: &str) -> Option<(f64, ParamRange)> {
-        let at = |fields: &[(ParamRange, &str)]| fields.iter().position(|(r, _)| r.name == field);
         match self {
-            Abilities::Platform(c) => {
-                at(&CHARACTER_FIELDS).map(|k| (c.values()[k], CHARACTER_FIELDS[k].0))
-            }
-            Abilities::Racing(c) => at(&CAR_FIELDS).map(|k| (c.values()[k], CAR_FIELDS[k].0)),
+            Abilities::Platform(c) => c.field(field),
+            Abilities::Racing(c) => c.field(field),
         }
     }
 
     /// These abilities with `field` at `value`, when they are then valid.
     pub fn with_value(&self, field: &str, value: f64) -> Option<Self> {
-        Some(match *self {
-            Abilities::Platform(mut c) => {
-                let at = CHARACTER_FIELDS.iter().position(|(r, _)| r.name == field)?;
-                *c.values_mut()[at] = value;
+        Some(match self {
+            Abilities::Platform(c) => {
+                let c = c.set(field, value)?;
                 c.check().ok()?;
                 Abilities::Platform(c)
             }
-            Abilities::Racing(mut c) => {
-                let at = CAR_FIELDS.iter().position(|(r, _)| r.name == field)?;
-                *c.values_mut()[at] = value;
+            Abilities::Racing(c) => {
+                let c = c.set(field, value)?;
                 c.check().ok()?;
                 Abilities::Racing(c)
             }
@@ -369,6 +750,7 @@ impl Profile {
         Self {
             name: DEFAULT_NAME.into(),
             abilities: Abilities::default_of(game),
+            pieces: Pieces::default_of(game),
         }
     }
 
@@ -376,9 +758,10 @@ impl Profile {
         self.abilities.game()
     }
 
-    /// Whether these are the built-in abilities (whatever the name).
+    /// Whether these are the built-in abilities and piece ranges (whatever the name).
     pub fn is_default(&self) -> bool {
         self.abilities == Abilities::default_of(self.game())
+            && self.pieces == Pieces::default_of(self.game())
     }
 
     /// Reads a profile file's text; `Err` is one line naming the field.
@@ -397,16 +780,25 @@ impl Profile {
             return Err("name: 1 to 64 characters".into());
         }
         let abilities = Abilities::checked(file.game, file.character, file.car)?;
+        let pieces = Pieces::checked(file.game, file.blocks, file.segments)?;
         Ok(Self {
             name: file.name,
             abilities,
+            pieces,
         })
     }
 
-    fn file(&self) -> ProfileFile {
+    /// The profile as a file: its piece ranges in full, or (`full` false) only when they are
+    /// not the built-in ones.
+    fn file(&self, full: bool) -> ProfileFile {
         let (character, car) = match self.abilities {
             Abilities::Platform(c) => (Some(c), None),
             Abilities::Racing(c) => (None, Some(c)),
+        };
+        let (blocks, segments) = if full {
+            self.pieces.sections()
+        } else {
+            self.pieces.written()
         };
         ProfileFile {
             format: FORMAT.into(),
@@ -415,29 +807,39 @@ impl Profile {
             name: self.name.clone(),
             character,
             car,
+            blocks,
+            segments,
         }
     }
 
-    /// The profile as a file, without comments (what its SHA-256 is of).
+    /// The profile as a file, without comments (what its SHA-256 is of); built-in piece ranges
+    /// are left out, so that a profile of abilities alone hashes as it always has.
     pub fn to_yaml(&self) -> String {
-        serde_yaml::to_string(&self.file()).expect("a profile serializes")
+        serde_yaml::to_string(&self.file(false)).expect("a profile serializes")
     }
 
-    /// The profile as `profile init` prints it: a comment per field with its range.
+    /// The profile as `profile init` prints it, piece ranges in full: a comment per field with
+    /// its range.
     pub fn to_commented_yaml(&self) -> String {
-        let fields: &[(ParamRange, &str)] = match self.abilities {
-            Abilities::Platform(_) => &CHARACTER_FIELDS,
-            Abilities::Racing(_) => &CAR_FIELDS,
+        let fields: Vec<&(ParamRange, &str)> = match self.abilities {
+            Abilities::Platform(_) => CHARACTER_FIELDS.iter().chain(&BLOCK_FIELDS).collect(),
+            Abilities::Racing(_) => CAR_FIELDS.iter().chain(&SEGMENT_FIELDS).collect(),
         };
+        let full = serde_yaml::to_string(&self.file(true)).expect("a profile serializes");
         let mut text = format!(
-            "# An arlpcg game profile: the {} abilities levels are made and checked for.\n\
-             # `arlpcg profile check FILE` measures what it allows; pass it with --profile FILE.\n",
+            "# An arlpcg game profile: the {} abilities levels are made and checked for, and the\n\
+             # ranges of their {}. `arlpcg profile check FILE` measures what it allows; pass it\n\
+             # with --profile FILE.\n",
             match self.abilities {
                 Abilities::Platform(_) => "character's",
                 Abilities::Racing(_) => "car's",
+            },
+            match self.abilities {
+                Abilities::Platform(_) => "blocks",
+                Abilities::Racing(_) => "segments",
             }
         );
-        for line in self.to_yaml().lines() {
+        for line in full.lines() {
             let key = line.trim_start().split(':').next().unwrap_or_default();
             let field = fields
                 .iter()
@@ -457,14 +859,22 @@ impl Profile {
     /// The field named as in [`CHARACTER_FIELDS`] or [`CAR_FIELDS`] (`character.jump_speed`),
     /// with its range; none for a field of the other game.
     pub fn value(&self, field: &str) -> Option<(f64, ParamRange)> {
-        self.abilities.value(field)
+        self.abilities
+            .value(field)
+            .or_else(|| self.pieces.value(field))
     }
 
-    /// The same profile with `field` at `value`, when that is a valid profile.
+    /// The same profile with `field` (an ability or a piece range) at `value`, when that is a
+    /// valid profile.
     pub fn with_value(&self, field: &str, value: f64) -> Option<Self> {
+        let (abilities, pieces) = match self.abilities.value(field) {
+            Some(_) => (self.abilities.with_value(field, value)?, self.pieces),
+            None => (self.abilities, self.pieces.with_value(field, value)?),
+        };
         Some(Self {
             name: self.name.clone(),
-            abilities: self.abilities.with_value(field, value)?,
+            abilities,
+            pieces,
         })
     }
 
@@ -475,24 +885,26 @@ impl Profile {
 
     /// How a level made under this profile records it.
     pub fn record(&self) -> ProfileRecord {
-        let file = self.file();
+        let file = self.file(false);
         ProfileRecord {
             name: self.name.clone(),
             sha256: self.sha256(),
             character: file.character,
             car: file.car,
+            blocks: file.blocks,
+            segments: file.segments,
         }
     }
 }
 
 impl ProfileRecord {
-    /// The profile a level records, checked: its game's abilities, in range, and the SHA-256
-    /// they hash to.
+    /// The profile a level records, checked: its game's abilities and piece ranges, in range,
+    /// and the SHA-256 they hash to.
     pub fn profile(&self, game: Game) -> Result<Profile, String> {
-        let abilities = Abilities::checked(game, self.character, self.car)?;
         let profile = Profile {
             name: self.name.clone(),
-            abilities,
+            abilities: Abilities::checked(game, self.character, self.car)?,
+            pieces: Pieces::checked(game, self.blocks, self.segments)?,
         };
         if profile.sha256() != self.sha256 {
             return Err(format!(
@@ -541,6 +953,14 @@ mod tests {
             assert!(profile.is_default());
             let text = profile.to_commented_yaml();
             assert_eq!(Profile::parse(&text).unwrap(), profile, "{text}");
+            // The built-in ranges are printed in full, but hashed as a profile of abilities
+            // alone, as before ranges were part of a profile.
+            let yaml = profile.to_yaml();
+            assert!(text.contains("max_height"), "{text}");
+            assert!(
+                !yaml.contains("blocks:") && !yaml.contains("segments:"),
+                "{yaml}"
+            );
             assert_eq!(profile.record().profile(game).unwrap(), profile);
         }
     }

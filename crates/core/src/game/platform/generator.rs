@@ -7,7 +7,7 @@
 use rand_chacha::ChaCha8Rng;
 
 use super::env::{PlatformEnv, PlatformRewards};
-use super::reach::{self, Reach};
+use super::reach;
 use crate::game::generator::{BuildLimits, GeneratorGame, GeneratorRewards, Placement, TrackBuild};
 use crate::game::platform::rules::goal_and_start;
 use crate::game::{PlatformGame, Player};
@@ -71,38 +71,46 @@ pub const GENERATOR_ACTIONS: [&str; 4] = [
 pub const DEFAULT_MAX_BLOCKS: usize = 30;
 
 /// A policy's action row (unbounded Gaussian samples) as the next block of `track` toward
-/// `goal`: each value is clipped to [-1, 1] and mapped onto its range (NaN becomes the middle),
-/// the turn added to the goal's bearing from the last block and kept within
-/// [`reach::MAX_TURN`] of the last jump's direction, the height change to the climb that keeps
-/// the slope toward the goal (see [`GENERATOR_ACTIONS`]) and at most `reach`'s highest climb,
-/// the distance shortened to keep the edge gap within `reach` ([`Reach::max_gap`]) for that
-/// height change.
+/// `goal` for `player`: each value is clipped to [-1, 1] and mapped onto the player's block
+/// ranges (NaN becomes the middle), the turn added to the goal's bearing from the last block and
+/// kept within [`reach::MAX_TURN`] and the ranges' sharpest turn of the last jump's direction,
+/// the height change to the climb that keeps the slope toward the goal (see
+/// [`GENERATOR_ACTIONS`]) and at most the reach's highest climb, the distance shortened to keep
+/// the edge gap within reach ([`reach::Reach::max_gap`]) for that height change.
 pub fn block_from_action(
     track: &PlatformTrack,
     goal: [f64; 3],
     row: &[f32],
-    reach: &Reach,
+    player: &Player,
 ) -> BlockParams {
     let unit = |v: f32| if v.is_nan() { 0.0 } else { v as f64 };
-    let mut block =
-        BlockParams::from_unit([unit(row[0]), unit(row[1]), unit(row[2]), unit(row[3])]);
+    let ranges = player.blocks();
+    let (distance, size, height) = (ranges.distance(), ranges.size(), ranges.height());
     let last = track.last();
     let (dx, dz) = (goal[0] - last.position[0], goal[2] - last.position[2]);
     let bearing = direction_heading(dx, dz);
-    block.angle = quantize(
-        wrap_degrees(bearing - last.heading + block.angle).clamp(-reach::MAX_TURN, reach::MAX_TURN),
-    );
+    let turn = params::BLOCK_ANGLE.from_unit(unit(row[1]));
+    let sharpest = ranges.max_turn.min(reach::MAX_TURN);
+    let mut block = BlockParams {
+        distance: quantize(distance.from_unit(unit(row[0]))),
+        angle: quantize(
+            wrap_degrees(bearing - last.heading + quantize(turn)).clamp(-sharpest, sharpest),
+        ),
+        size: quantize(size.from_unit(unit(row[2]))),
+        height: quantize(height.from_unit(unit(row[3]))),
+    };
     let rise = goal[1] - last.position[1];
     let on_course = rise * (block.distance / dx.hypot(dz).max(1e-6)).min(1.0);
+    let reach = &player.reach;
     block.height = quantize(
-        params::BLOCK_HEIGHT
+        height
             .clamp(on_course + block.height)
             .min(reach.max_climb()),
     );
     // Never beyond the character's reach: a longer jump makes a level impossible, not harder,
     // and a failure there teaches the Solver nothing.
     let longest = reach.max_gap(block.height) + 0.5 * (last.size + block.size);
-    block.distance = quantize(block.distance.min(longest));
+    block.distance = quantize(block.distance.min(longest).max(distance.min));
     block
 }
 
@@ -216,7 +224,7 @@ impl TrackBuild for PlatformBuild {
         if self.track.block_count() >= self.max_blocks {
             return Placement::OutOfPieces;
         }
-        let block = block_from_action(&self.track, self.goal, row, &self.player.reach);
+        let block = block_from_action(&self.track, self.goal, row, &self.player);
         if self.track.push(block).is_err() {
             return Placement::Invalid;
         }
@@ -334,6 +342,7 @@ impl GeneratorGame for PlatformGame {
 mod tests {
     use super::*;
     use crate::game::generator::Match;
+    use crate::game::platform::reach::Reach;
     use crate::level::params::{BLOCK_DISTANCE, BLOCK_HEIGHT, BLOCK_SIZE};
     use crate::level::platform::Start;
     use crate::level::stats::Outcome;
@@ -376,7 +385,7 @@ mod tests {
             "a goal to the right is a negative turn"
         );
         let aim = aimed(&track, [20.0, 0.0, 0.0]);
-        let block = block_from_action(&track, [20.0, 0.0, 0.0], &aim, &Reach::default());
+        let block = block_from_action(&track, [20.0, 0.0, 0.0], &aim, &Player::default());
         assert!((block.angle + 90.0).abs() < 1e-3, "{block:?}");
     }
 
@@ -575,7 +584,7 @@ mod tests {
             heading: 90.0,
             ..Start::default()
         });
-        let block = block_from_action(&track, [20.0, 4.0, 0.0], &[0.0; 4], &Reach::default());
+        let block = block_from_action(&track, [20.0, 4.0, 0.0], &[0.0; 4], &Player::default());
         assert_eq!(block.distance, 7.5);
         assert_eq!(
             block.angle, -90.0,
@@ -586,7 +595,7 @@ mod tests {
             &track,
             [20.0, 40.0, 0.0],
             &[0.0, 0.0, 0.0, 1.0],
-            &Reach::default(),
+            &Player::default(),
         );
         assert_eq!(
             steep.height, 2.0,
@@ -606,7 +615,7 @@ mod tests {
             &track,
             [60.0, 30.0, 0.0],
             &[1.0, 0.0, -1.0, 1.0],
-            &Reach::default(),
+            &Player::default(),
         );
         assert_eq!(far_up.height, 2.0);
         assert_eq!(far_up.distance, 4.25 + 0.5 * (4.0 + 4.0));
@@ -614,14 +623,14 @@ mod tests {
             &track,
             [60.0, 0.0, 0.0],
             &[1.0, 0.0, -1.0, 0.0],
-            &Reach::default(),
+            &Player::default(),
         );
         assert_eq!(far_flat.distance, 10.0, "a flat 6 m gap is within reach");
         let mut rng = ChaCha8Rng::seed_from_u64(4);
         for _ in 0..2000 {
             let row: [f32; 4] = std::array::from_fn(|_| rng.random_range(-1.5..1.5));
             let goal = [60.0, rng.random_range(-20.0..20.0), 10.0];
-            let block = block_from_action(&track, goal, &row, &Reach::default());
+            let block = block_from_action(&track, goal, &row, &Player::default());
             let placed = track.preview(&block);
             let gap = track.last().edge_gap(&placed);
             assert!(
@@ -630,6 +639,26 @@ mod tests {
             );
             assert!(block.angle.abs() <= reach::MAX_TURN, "{block:?}");
             assert!(BLOCK_DISTANCE.check(block.distance).is_ok(), "{block:?}");
+            // A profile's ranges bound every block.
+            let narrow = crate::level::profile::BlockRanges {
+                max_distance: 6.5,
+                min_size: 5.0,
+                max_height: 0.5,
+                max_turn: 30.0,
+                ..Default::default()
+            };
+            let player = Player::default()
+                .with_pieces(Some(crate::level::profile::Pieces::Platform(narrow)));
+            let block = block_from_action(&track, goal, &row, &player);
+            let within = [
+                (narrow.distance(), block.distance),
+                (narrow.size(), block.size),
+                (narrow.height(), block.height),
+                (narrow.turn(), block.angle),
+            ];
+            for (range, value) in within {
+                assert!(range.check(value).is_ok(), "{block:?} outside {range}");
+            }
         }
     }
 

@@ -6,9 +6,10 @@
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use crate::game::Player;
 use crate::game::platform::reach::Reach;
 use crate::level::heading;
-use crate::level::params::{self, quantize};
+use crate::level::params::quantize;
 use crate::level::platform::{self, BlockParams, Platform, PlatformTrack, Start};
 use crate::level::{Level, PlatformRulesConfig, Source, Track};
 
@@ -59,16 +60,16 @@ pub struct NoLevel {
 }
 
 /// A rule-based platform level, reproducible from `seed`: the goal and start heading are drawn
-/// from it, unless `goal` is given, every jump within `reach`. `aux` is recorded in the level;
-/// the rules do not use it.
+/// from it, unless `goal` is given, every block within the player's ranges and every jump within
+/// its reach. `aux` is recorded in the level; the rules do not use it.
 pub fn platform_level(
     seed: u64,
     aux: Option<f64>,
     goal: Option<[f64; 3]>,
     config: &PlatformRulesConfig,
-    reach: &Reach,
+    player: &Player,
 ) -> Result<Level, NoLevel> {
-    platform_level_draw(seed, aux, goal, config, reach, 0)
+    platform_level_draw(seed, aux, goal, config, player, 0)
 }
 
 /// Draw number `draw` of level `seed`: the `draw`-th valid level (from 0) of the seed's stream,
@@ -78,13 +79,13 @@ pub fn platform_level_draw(
     aux: Option<f64>,
     goal: Option<[f64; 3]>,
     config: &PlatformRulesConfig,
-    reach: &Reach,
+    player: &Player,
     draw: u32,
 ) -> Result<Level, NoLevel> {
     let (goal, start, mut rng) = goal_and_start(seed, goal);
     let mut skip = draw;
     for _ in 0..ATTEMPTS {
-        if let Some(track) = attempt(&mut rng, start, goal, config, reach) {
+        if let Some(track) = attempt(&mut rng, start, goal, config, player) {
             if skip > 0 {
                 skip -= 1;
                 continue;
@@ -113,14 +114,18 @@ fn attempt(
     start: Start,
     goal: [f64; 3],
     config: &PlatformRulesConfig,
-    reach: &Reach,
+    player: &Player,
 ) -> Option<PlatformTrack> {
     let mut track = PlatformTrack::new(start);
     while track.block_count() < config.max_blocks as usize {
         let placed = (0..CANDIDATES).any(|_| {
-            let candidate = draw(rng, track.last(), goal, config, reach);
-            is_jumpable(track.last(), &track.preview(&candidate), config, reach)
-                && track.push(candidate).is_ok()
+            let candidate = draw(rng, track.last(), goal, config, player);
+            is_jumpable(
+                track.last(),
+                &track.preview(&candidate),
+                config,
+                &player.reach,
+            ) && track.push(candidate).is_ok()
         });
         if !placed {
             return None;
@@ -144,41 +149,44 @@ fn is_jumpable(
         && from.edge_gap(to) <= reach.max_gap(rise) - config.reach_margin
 }
 
-/// Draws one block's parameters: aimed at the goal when it is within one block's distance,
-/// otherwise heading for it within the configured spread, climbing toward its height.
+/// Draws one block's parameters within the player's ranges: aimed at the goal when it is within
+/// one block's distance, otherwise heading for it within the configured spread, climbing toward
+/// its height.
 fn draw(
     rng: &mut ChaCha8Rng,
     last: &Platform,
     goal: [f64; 3],
     config: &PlatformRulesConfig,
-    reach: &Reach,
+    player: &Player,
 ) -> BlockParams {
+    let ranges = player.blocks();
+    let (distances, sizes, heights) = (ranges.distance(), ranges.size(), ranges.height());
+    let reach = &player.reach;
     let (dx, dz) = (goal[0] - last.position[0], goal[2] - last.position[2]);
     let horizontal = dx.hypot(dz);
     let rise = goal[1] - last.position[1];
     let to_goal = heading::direction_heading(dx, dz);
-    let size = rng.random_range(params::BLOCK_SIZE.min..=params::BLOCK_SIZE.max);
-    let finish = params::BLOCK_DISTANCE.check(horizontal).is_ok()
-        && rise.abs() <= params::BLOCK_HEIGHT.max + platform::GOAL_REACH_VERTICAL;
+    let size = rng.random_range(sizes.min..=sizes.max);
+    let finish = distances.check(horizontal).is_ok()
+        && rise.abs() <= heights.max.max(-heights.min) + platform::GOAL_REACH_VERTICAL;
     let (distance, heading, height) = if finish && rng.random_bool(0.8) {
-        let height = rise.clamp(params::BLOCK_HEIGHT.min, params::BLOCK_HEIGHT.max);
-        (horizontal, to_goal, height)
+        (horizontal, to_goal, heights.clamp(rise))
     } else {
         let spread = config.angle_spread.clamp(0.0, 180.0);
         let heading = to_goal + rng.random_range(-spread..=spread);
         let blocks_left = (horizontal / 7.5).max(1.0);
-        let climb = (rise / blocks_left + rng.random_range(-1.0..=1.0))
-            .clamp(params::BLOCK_HEIGHT.min, params::BLOCK_HEIGHT.max)
+        let climb = heights
+            .clamp(rise / blocks_left + rng.random_range(-1.0..=1.0))
             .min(reach.max_climb());
-        let longest = (reach.max_gap(climb) - config.reach_margin + 0.5 * (last.size + size))
-            .clamp(params::BLOCK_DISTANCE.min, params::BLOCK_DISTANCE.max);
-        let distance = rng.random_range(params::BLOCK_DISTANCE.min..=longest);
+        let longest =
+            distances.clamp(reach.max_gap(climb) - config.reach_margin + 0.5 * (last.size + size));
+        let distance = rng.random_range(distances.min..=longest);
         (distance, heading, climb)
     };
     let angle = heading::wrap_degrees(heading - last.heading);
     BlockParams {
-        distance: quantize(distance).clamp(params::BLOCK_DISTANCE.min, params::BLOCK_DISTANCE.max),
-        angle: quantize(angle).clamp(params::BLOCK_ANGLE.min, params::BLOCK_ANGLE.max),
+        distance: distances.clamp(quantize(distance)),
+        angle: ranges.turn().clamp(quantize(angle)),
         size: quantize(size),
         height: quantize(height),
     }
@@ -187,14 +195,15 @@ fn draw(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::level::profile::{BlockRanges, Pieces};
 
     #[test]
     fn rule_levels_are_valid_reproducible_and_reach_their_goal() {
         let config = PlatformRulesConfig::default();
         for seed in 0..30 {
-            let level = platform_level(seed, None, None, &config, &Reach::default()).unwrap();
+            let level = platform_level(seed, None, None, &config, &Player::default()).unwrap();
             level.validate().unwrap();
-            let again = platform_level(seed, None, None, &config, &Reach::default()).unwrap();
+            let again = platform_level(seed, None, None, &config, &Player::default()).unwrap();
             assert_eq!(level, again, "seed {seed} is not reproducible");
             let track = level.platform().unwrap();
             for pair in track.platforms().windows(2) {
@@ -207,18 +216,37 @@ mod tests {
     }
 
     #[test]
-    fn every_parameter_stays_in_its_range() {
+    fn every_parameter_stays_in_its_range_and_the_players() {
+        let narrow = BlockRanges {
+            min_distance: 5.5,
+            max_distance: 7.0,
+            min_size: 5.0,
+            max_size: 5.5,
+            min_height: -1.0,
+            max_height: 1.0,
+            max_turn: 45.0,
+        };
+        let narrow_player = Player::default().with_pieces(Some(Pieces::Platform(narrow)));
+        let players = [
+            (Player::default(), BlockRanges::default()),
+            (narrow_player, narrow),
+        ];
         for seed in 0..30 {
-            let level = platform_level(
-                seed,
-                Some(0.5),
-                None,
-                &PlatformRulesConfig::default(),
-                &Reach::default(),
-            )
-            .unwrap();
-            for b in level.platform().unwrap().block_params() {
-                BlockParams::new(b.distance, b.angle, b.size, b.height).unwrap();
+            for (player, ranges) in &players {
+                let config = PlatformRulesConfig::default();
+                let level = platform_level(seed, Some(0.5), None, &config, player).unwrap();
+                for b in level.platform().unwrap().block_params() {
+                    BlockParams::new(b.distance, b.angle, b.size, b.height).unwrap();
+                    let within = [
+                        (ranges.distance(), b.distance),
+                        (ranges.size(), b.size),
+                        (ranges.height(), b.height),
+                        (ranges.turn(), b.angle),
+                    ];
+                    for (range, value) in within {
+                        assert!(range.check(value).is_ok(), "seed {seed}: {b:?}, {range}");
+                    }
+                }
             }
         }
     }
@@ -230,7 +258,7 @@ mod tests {
             None,
             Some([5.0, 10.0, 0.0]),
             &PlatformRulesConfig::default(),
-            &Reach::default(),
+            &Player::default(),
         )
         .unwrap();
         let last = level.platform().unwrap().last();

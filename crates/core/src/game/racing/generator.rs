@@ -15,7 +15,7 @@ use crate::game::{Player, RacingGame};
 use crate::level::Track;
 use crate::level::heading::{direction_heading, heading_direction, wrap_degrees};
 use crate::level::params::{SEGMENT_CURVE, SEGMENT_HEIGHT, SEGMENT_LENGTH, quantize};
-use crate::level::profile::Abilities;
+use crate::level::profile::{Abilities, SegmentRanges};
 use crate::level::racing::{self, Obstacle, RacingTrack, SegmentParams};
 use crate::level::road::{CROSSING_ARC, MIN_OBSTACLE_DISTANCE, MIN_SELF_DISTANCE, Road};
 use crate::level::stats::Outcome;
@@ -78,12 +78,13 @@ pub const GENERATOR_ACTIONS: [&str; 3] = [
 /// A policy's action row (unbounded Gaussian samples) as the next segment of `road` toward
 /// `goal`: each value clipped to [-1, 1] (NaN becomes the middle) and mapped onto its range, the
 /// curve the goal's bearing plus up to ±`curve_offset` degrees (then clipped to the segment's
-/// ±30°), the height change added to the on-course climb.
+/// ±30°), the height change added to the on-course climb; each within `ranges`.
 pub fn segment_from_action(
     road: &Road,
     goal: [f64; 3],
     row: &[f32],
     curve_offset: f64,
+    ranges: &SegmentRanges,
 ) -> SegmentParams {
     let unit = |v: f32| {
         if v.is_nan() {
@@ -93,12 +94,13 @@ pub fn segment_from_action(
         }
     };
     let (end, heading) = road.end();
-    let length = quantize(SEGMENT_LENGTH.from_unit(unit(row[0])));
+    let (lengths, curves, heights) = (ranges.length(), ranges.curve(), ranges.height());
+    let length = quantize(lengths.from_unit(unit(row[0])));
     let bearing = wrap_degrees(direction_heading(goal[0] - end[0], goal[2] - end[2]) - heading);
-    let curve = quantize(SEGMENT_CURVE.clamp(bearing + curve_offset * unit(row[1])));
+    let curve = quantize(curves.clamp(bearing + curve_offset * unit(row[1])));
     let plan = (goal[0] - end[0]).hypot(goal[2] - end[2]).max(1e-6);
     let on_course = (goal[1] - end[1]) * (length / plan).min(1.0);
-    let height = quantize(SEGMENT_HEIGHT.clamp(on_course + SEGMENT_HEIGHT.max * unit(row[2])));
+    let height = quantize(heights.clamp(on_course + heights.max * unit(row[2])));
     SegmentParams {
         length,
         curve,
@@ -266,7 +268,13 @@ impl TrackBuild for RacingBuild {
         if index >= self.max_segments {
             return Placement::OutOfPieces;
         }
-        let segment = segment_from_action(&self.road, self.goal, row, self.curve_offset);
+        let segment = segment_from_action(
+            &self.road,
+            self.goal,
+            row,
+            self.curve_offset,
+            &self.player.segments(),
+        );
         self.road.push(segment);
         self.track.segments.push(segment);
         if self.road.first_crossing(index).is_some()
@@ -416,11 +424,17 @@ mod tests {
         let angle = 40f64.to_radians();
         let goal = [300.0 * angle.cos(), 0.0, -300.0 * angle.sin()];
         let away = [0.0, -1.0, 0.0];
-        let default = segment_from_action(&road, goal, &away, DEFAULT_CURVE_OFFSET);
+        let default = segment_from_action(
+            &road,
+            goal,
+            &away,
+            DEFAULT_CURVE_OFFSET,
+            &SegmentRanges::default(),
+        );
         assert!(default.curve > 0.0, "30°: still turns toward the goal");
-        let wide = segment_from_action(&road, goal, &away, 90.0);
+        let wide = segment_from_action(&road, goal, &away, 90.0, &SegmentRanges::default());
         assert_eq!(wide.curve, -30.0, "90°: turns away as far as a segment may");
-        let toward = segment_from_action(&road, goal, &[0.0; 3], 90.0);
+        let toward = segment_from_action(&road, goal, &[0.0; 3], 90.0, &SegmentRanges::default());
         assert_eq!(toward.curve, 30.0, "0 still heads for the goal");
     }
 
@@ -433,6 +447,7 @@ mod tests {
             [100.0, 10.0, -100.0],
             &[0.0; 3],
             DEFAULT_CURVE_OFFSET,
+            &SegmentRanges::default(),
         );
         assert_eq!(segment.length, 25.0);
         assert_eq!(segment.curve, 30.0, "45° to the goal, clipped to the range");
@@ -445,11 +460,30 @@ mod tests {
             [200.0, 0.0, 0.0],
             &[1.0, -1.0, f32::NAN],
             DEFAULT_CURVE_OFFSET,
+            &SegmentRanges::default(),
         );
         assert_eq!(
             (straight.length, straight.curve, straight.height),
             (30.0, -30.0, 0.0)
         );
+        // A profile's ranges bound every segment.
+        let narrow = SegmentRanges {
+            min_length: 22.0,
+            max_length: 24.0,
+            max_curve: 10.0,
+            max_height: 1.0,
+        };
+        for row in [[1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [0.0; 3]] {
+            let s = segment_from_action(&road, [100.0, 40.0, -100.0], &row, 90.0, &narrow);
+            let within = [
+                (narrow.length(), s.length),
+                (narrow.curve(), s.curve),
+                (narrow.height(), s.height),
+            ];
+            for (range, value) in within {
+                assert!(range.check(value).is_ok(), "{s:?} outside {range}");
+            }
+        }
     }
 
     #[test]

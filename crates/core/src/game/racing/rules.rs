@@ -6,8 +6,10 @@
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use crate::game::Player;
 use crate::level::heading::{direction_heading, heading_direction, wrap_degrees};
-use crate::level::params::{self, quantize};
+use crate::level::params::quantize;
+use crate::level::profile::SegmentRanges;
 use crate::level::racing::{self, Obstacle, RacingRulesConfig, RacingTrack, SegmentParams};
 use crate::level::road::{MIN_OBSTACLE_DISTANCE, Road};
 use crate::level::{Level, Source, Track};
@@ -90,14 +92,16 @@ fn draw_obstacle(rng: &mut ChaCha8Rng, goal: [f64; 3]) -> Option<Obstacle> {
 }
 
 /// A rule-based racing level, reproducible from `seed`: the goal, start heading and obstacles
-/// are drawn from it, unless `goal` is given. `aux` is recorded; the rules do not use it.
+/// are drawn from it, unless `goal` is given; each segment within the player's ranges as well
+/// as the configuration's. `aux` is recorded; the rules do not use it.
 pub fn racing_level(
     seed: u64,
     aux: Option<f64>,
     goal: Option<[f64; 3]>,
     config: &RacingRulesConfig,
+    player: &Player,
 ) -> Result<Level, NoTrack> {
-    racing_level_draw(seed, aux, goal, config, 0)
+    racing_level_draw(seed, aux, goal, config, player, 0)
 }
 
 /// Draw number `draw` of track `seed`: the `draw`-th valid track (from 0) of the seed's
@@ -107,12 +111,20 @@ pub fn racing_level_draw(
     aux: Option<f64>,
     goal: Option<[f64; 3]>,
     config: &RacingRulesConfig,
+    player: &Player,
     draw: u32,
 ) -> Result<Level, NoTrack> {
     let (goal, heading, obstacles, mut rng) = goal_and_start(seed, goal, config.obstacles);
     let mut skip = draw;
     for _ in 0..ATTEMPTS {
-        if let Some(mut track) = attempt(&mut rng, heading, goal, &obstacles, config) {
+        if let Some(mut track) = attempt(
+            &mut rng,
+            heading,
+            goal,
+            &obstacles,
+            config,
+            &player.segments(),
+        ) {
             if skip > 0 {
                 skip -= 1;
                 continue;
@@ -143,6 +155,7 @@ fn attempt(
     goal: [f64; 3],
     obstacles: &[Obstacle],
     config: &RacingRulesConfig,
+    ranges: &SegmentRanges,
 ) -> Option<RacingTrack> {
     let mut track = RacingTrack::new([0.0; 3], heading);
     let mut road = Road::start(track.position, heading);
@@ -152,7 +165,7 @@ fn attempt(
         let before = plan_distance(end, goal);
         let mut best: Option<(f64, SegmentParams, Road)> = None;
         for _ in 0..CANDIDATES {
-            let candidate = draw(rng, end, end_heading, goal, config);
+            let candidate = draw(rng, end, end_heading, goal, config, ranges);
             let mut next = road.clone();
             next.push(candidate);
             if next.first_crossing(index).is_some()
@@ -186,24 +199,25 @@ fn attempt(
 }
 
 /// Draws one segment: a curve anywhere within the configured range (leaning toward the goal
-/// when far off course), climbing toward the goal's height.
+/// when far off course), climbing toward the goal's height, each within `ranges` too.
 fn draw(
     rng: &mut ChaCha8Rng,
     end: [f64; 3],
     heading: f64,
     goal: [f64; 3],
     config: &RacingRulesConfig,
+    ranges: &SegmentRanges,
 ) -> SegmentParams {
-    let length =
-        quantize(rng.random_range(params::SEGMENT_LENGTH.min..=params::SEGMENT_LENGTH.max));
+    let lengths = ranges.length();
+    let length = quantize(rng.random_range(lengths.min..=lengths.max));
     let to_goal = direction_heading(goal[0] - end[0], goal[2] - end[2]);
     let error = wrap_degrees(to_goal - heading);
-    let max_curve = config.max_curve;
+    let max_curve = config.max_curve.min(ranges.max_curve);
     let lean = (0.5 * error).clamp(-max_curve, max_curve);
     let curve =
         quantize((lean + rng.random_range(-max_curve..=max_curve)).clamp(-max_curve, max_curve));
     let segments_left = (plan_distance(end, goal) / 25.0).max(1.0);
-    let max_height = config.max_height;
+    let max_height = config.max_height.min(ranges.max_height);
     let climb = (goal[1] - end[1]) / segments_left;
     let height = quantize(
         (climb + rng.random_range(-max_height..=max_height)).clamp(-max_height, max_height),

@@ -182,3 +182,20 @@ pub fn code_commit() -> String {
         None => "unknown".into(),
     }
 }
+
+/// Whether `policy` may play under `profile` (none: the built-in game): a warning when it trained
+/// with other abilities, an error when they lie beyond the range it trained over.
+pub fn check_fit(
+    policy: &crate::services::verify::SolverPolicy,
+    profile: Option<&arlpcg_core::level::profile::Profile>,
+) -> Result<()> {
+    use crate::services::verify::ProfileFit;
+    match policy.fit(profile) {
+        ProfileFit::Fits => Ok(()),
+        ProfileFit::Untrained(said) => {
+            crate::warn!("{said}");
+            Ok(())
+        }
+        ProfileFit::Beyond(problem) => Err(anyhow::anyhow!("{problem}")),
+    }
+}

@@ -1321,4 +1321,20 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
         1,
         "profile `far` lies beyond the abilities the Solver policy",
     );
+    // A campaign judged by it refuses the same profile before it searches.
+    let campaign = arlpcg(&[
+        "campaign",
+        "--policies",
+        &run,
+        "--profile",
+        &path("far.yaml"),
+        "--levels",
+        "1",
+        "--ramp",
+        "0:0.5, 1:0.5",
+        "--out",
+        &path("campaign"),
+    ]);
+    fails_with(&campaign, 1, "profile `far` lies beyond the abilities");
+    assert!(!Path::new(&path("campaign")).exists());
 }

@@ -71,6 +71,9 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     let generator = load_generator(&policy_paths(&dir).0, args.game)?.0;
     let judged = load_panel(&dir, args.game, Some(&[judge]))?;
     let solver = judged.solver(0);
+    if let Solver::Policy(policy) = &solver {
+        crate::shells::common::check_fit(policy, ask.profile.as_ref())?;
+    }
     let panel = load_panel(&dir, args.game, None)?;
     let files: Vec<LevelFiles> = (0..n)
         .map(|k| LevelFiles::new(&args.out, &level_stem(k, n), &formats))
@@ -423,6 +426,9 @@ pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
         .unwrap_or_else(|| shipped_dir(campaign.game));
     let judged = load_panel(&dir, campaign.game, Some(&[judge]))?;
     let solver = judged.solver(0);
+    if let Solver::Policy(policy) = &solver {
+        crate::shells::common::check_fit(policy, campaign.ask().profile.as_ref())?;
+    }
     let panel = load_panel(&dir, campaign.game, None)?;
     for (level, entry) in levels.iter_mut().zip(&campaign.levels) {
         level.stats = Some(verify::verify(

@@ -11,7 +11,7 @@ use crate::services::generation::GeneratorPolicy;
 use crate::services::panel::Judge;
 use crate::services::policies::{GENERATOR_FILE, load_generator, load_solver};
 use crate::services::profile;
-use crate::services::verify::{ProfileFit, Solver, SolverPolicy};
+use crate::services::verify::{Solver, SolverPolicy};
 use crate::shells::cli::EvalArgs;
 use arlpcg_core::game::Skill;
 use arlpcg_core::level::profile::Profile;
@@ -42,11 +42,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     let solvers = load_solvers(args)?;
     let profile = asked_profile(args)?;
     for (_, policy) in &solvers {
-        match policy.fit(profile.as_ref()) {
-            ProfileFit::Fits => {}
-            ProfileFit::Untrained(said) => crate::warn!("{said}"),
-            ProfileFit::Beyond(problem) => bail!("{problem}"),
-        }
+        crate::shells::common::check_fit(policy, profile.as_ref())?;
     }
     let budget = budget(args);
     let overwrite = if args.force {

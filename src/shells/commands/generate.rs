@@ -36,11 +36,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     };
     let solver = chosen_solver(args, verify_trials)?;
     if let Some(policy) = &solver {
-        match policy.fit(template.profile.as_ref()) {
-            verify::ProfileFit::Fits => {}
-            verify::ProfileFit::Untrained(said) => crate::warn!("{said}"),
-            verify::ProfileFit::Beyond(problem) => anyhow::bail!("{problem}"),
-        }
+        crate::shells::common::check_fit(policy, template.profile.as_ref())?;
     }
     let panel = match args.panel {
         true => Some(load_panel(&policies_dir(args), args.game, None)?),

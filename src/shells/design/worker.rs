@@ -58,6 +58,15 @@ impl GamePolicies {
 }
 
 impl Policies {
+    /// Why the Solver policy may not play `level`: the abilities it is made for lie beyond the
+    /// range the policy trained over (it says to train for them).
+    fn beyond_range(&self, level: &Level) -> Option<String> {
+        match self.solver.as_ref()?.fit(level.profile.as_ref()) {
+            verify::ProfileFit::Beyond(problem) => Some(problem),
+            _ => None,
+        }
+    }
+
     fn solver(&self) -> Solver<'_> {
         match &self.solver {
             Some(policy) => Solver::Policy(policy.as_ref()),
@@ -447,6 +456,9 @@ fn play_trials(
         on_trial: &on_trial,
         stop,
     };
+    if let Some(problem) = current.beyond_range(level) {
+        return send(Response::TrialsFailed { id, problem });
+    }
     match verify::verify_watched(level, &current.solver(), trials, seed, &watch) {
         Ok(Some(stats)) => send(Response::TrialsDone {
             id,
@@ -474,6 +486,9 @@ fn sweep_point(
         Ok(level) => level,
         Err(problem) => return Some(SweepPoint::NoLevel(problem)),
     };
+    if let Some(problem) = current.beyond_range(&level) {
+        return Some(SweepPoint::NoLevel(problem));
+    }
     let watch = Watch {
         on_trial: &|_| {},
         stop,

@@ -176,6 +176,51 @@ fn a_profile_makes_the_levels_and_its_keys_change_the_abilities() {
     );
 }
 
+/// An ability-aware Solver's trials stop, saying to train for it, when the loaded profile lies
+/// beyond the range it trained over; within it, they play.
+#[test]
+fn trials_refuse_a_profile_beyond_an_ability_aware_solvers_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("aware.yaml");
+    std::fs::write(&config, "ability_spread: 0.2\n").unwrap();
+    let run = dir.path().join("run");
+    crate::common::arlpcg_ok(&[
+        "train",
+        "--mode",
+        "arlpcg",
+        "--config",
+        config.to_str().unwrap(),
+        "--steps",
+        "8192",
+        "--threads",
+        "1",
+        "--out",
+        run.to_str().unwrap(),
+    ]);
+    let (policies, info) = worker::load(&run, Game::Platform).unwrap();
+    let mut h = Harness::new(policies, info, dir.path());
+    h.settle();
+    for (jump, refused) in [("8.5", false), ("7.0", true)] {
+        let text = arlpcg_core::level::profile::Profile::default_of(Game::Platform)
+            .to_yaml()
+            .replace("jump_speed: 9.25", &format!("jump_speed: {jump}"));
+        let file = dir.path().join(format!("jump-{jump}.yaml"));
+        std::fs::write(&file, text).unwrap();
+        h.key(KeyCode::Char('f'));
+        h.keys(file.to_str().unwrap());
+        h.key(KeyCode::Enter);
+        h.settle();
+        let trials = h.app.trials.as_ref().expect("trials of the new level");
+        let said = trials.error.clone().unwrap_or_default();
+        assert_eq!(
+            said.contains("lies beyond the abilities"),
+            refused,
+            "{said}"
+        );
+        assert_eq!(trials.stats.is_some(), !refused);
+    }
+}
+
 #[test]
 fn whole_screen_at_80x24() {
     let dir = tempfile::tempdir().unwrap();

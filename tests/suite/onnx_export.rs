@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use arlpcg::services::onnx::{self, Exported, Profile, example_observations, reference_outputs};
+use arlpcg::services::onnx::{self, Contract, Exported, example_observations, reference_outputs};
 use arlpcg_core::level::Game;
 use tract_onnx::prelude::*;
 
@@ -95,7 +95,7 @@ fn every_shipped_policy_runs_in_tract_as_it_plays_here() {
         let (policy, card, reference) = arlpcg::services::policies::load_any(path).unwrap();
         // Observations the export did not see (its examples use seed 0).
         let observations = example_observations(&card.normalizer, ROWS, 1);
-        for profile in [Profile::Plain, Profile::Mlagents] {
+        for profile in [Contract::Plain, Contract::Mlagents] {
             let exported = onnx::export(&policy, &card, reference.clone(), profile).unwrap();
             let expected = reference_outputs(&policy, &card, profile, &observations).unwrap();
             let got = run_tract(&exported, &observations, None);
@@ -117,7 +117,7 @@ fn every_shipped_policy_runs_in_tract_as_it_plays_here() {
                     profile.name()
                 );
             }
-            if profile == Profile::Mlagents {
+            if profile == Contract::Mlagents {
                 let constant = |name: &str| got.iter().find(|(n, _)| n == name).unwrap().1.clone();
                 assert_eq!(constant("version_number"), vec![3.0]);
                 assert_eq!(constant("memory_size"), vec![0.0]);
@@ -144,7 +144,7 @@ fn mlagents_action_masks_decide_a_masked_branch() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform/solver.safetensors");
     let (policy, card, reference) = arlpcg::services::policies::load_any(&path).unwrap();
     assert_eq!(card.network.binary, 1, "the platform Solver jumps");
-    let exported = onnx::export(&policy, &card, reference, Profile::Mlagents).unwrap();
+    let exported = onnx::export(&policy, &card, reference, Contract::Mlagents).unwrap();
     let observations = example_observations(&card.normalizer, ROWS, 2);
     let jump = |masks: &[f32]| {
         let masks: Vec<f32> = masks.iter().copied().cycle().take(2 * ROWS).collect();

@@ -51,26 +51,26 @@ const EXAMPLE_ROWS: usize = 4;
 /// Whose names and outputs the graph follows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
-pub enum Profile {
+pub enum Contract {
     /// Names of this tool.
     Plain,
     /// ML-Agents' model contract, for Unity.
     Mlagents,
 }
 
-impl Profile {
+impl Contract {
     pub fn name(self) -> &'static str {
         match self {
-            Profile::Plain => "plain",
-            Profile::Mlagents => "mlagents",
+            Contract::Plain => "plain",
+            Contract::Mlagents => "mlagents",
         }
     }
 
     /// The name of the observation input.
     pub fn observation_input(self) -> &'static str {
         match self {
-            Profile::Plain => "observation",
-            Profile::Mlagents => "obs_0",
+            Contract::Plain => "observation",
+            Contract::Mlagents => "obs_0",
         }
     }
 }
@@ -80,7 +80,7 @@ impl Profile {
 pub struct Sidecar {
     pub format: String,
     pub version: u32,
-    pub profile: Profile,
+    pub profile: Contract,
     pub opset: i64,
     pub game: String,
     pub role: String,
@@ -230,7 +230,7 @@ pub fn export(
     policy: &ActorCritic,
     card: &PolicyCard,
     reference: PolicyRef,
-    profile: Profile,
+    profile: Contract,
 ) -> candle_core::Result<Exported> {
     let shape = policy.shape();
     let (observation, continuous, binary) = (shape.observation, shape.continuous, shape.binary);
@@ -244,8 +244,8 @@ pub fn export(
     let logits = (binary > 0).then(|| graph.columns(&head, continuous, continuous + binary));
     let continuous_actions = mean.map(|m| graph.clip(&m, -1.0, 1.0));
     let outputs = match profile {
-        Profile::Plain => plain_outputs(&mut graph, card, continuous_actions, logits),
-        Profile::Mlagents => mlagents_outputs(&mut graph, card, continuous_actions, logits),
+        Contract::Plain => plain_outputs(&mut graph, card, continuous_actions, logits),
+        Contract::Mlagents => mlagents_outputs(&mut graph, card, continuous_actions, logits),
     };
     for (name, output) in &outputs {
         let element = if output.int64 { INT64 } else { FLOAT };
@@ -293,7 +293,7 @@ pub fn export(
         element_type: None,
         columns: observation_columns(card),
     }];
-    if profile == Profile::Mlagents && binary > 0 {
+    if profile == Contract::Mlagents && binary > 0 {
         inputs.push(Port {
             name: "action_masks".into(),
             shape: dims_json(&[None, Some(2 * binary)]),
@@ -523,7 +523,7 @@ fn actor_head(
 fn examples(
     policy: &ActorCritic,
     card: &PolicyCard,
-    profile: Profile,
+    profile: Contract,
 ) -> candle_core::Result<Examples> {
     let observations = example_observations(&card.normalizer, EXAMPLE_ROWS, 0);
     let outputs = reference_outputs(policy, card, profile, &observations)?;
@@ -554,7 +554,7 @@ pub fn example_observations(normalizer: &RunningNorm, rows: usize, seed: u64) ->
 pub fn reference_outputs(
     policy: &ActorCritic,
     card: &PolicyCard,
-    profile: Profile,
+    profile: Contract,
     observations: &[f32],
 ) -> candle_core::Result<std::collections::BTreeMap<String, Vec<Vec<f32>>>> {
     let shape = policy.shape();
@@ -575,12 +575,12 @@ pub fn reference_outputs(
     let probabilities = rows(&head, c + b, c, c + b, &|v| 1.0 / (1.0 + (-v).exp()));
     let mut outputs = std::collections::BTreeMap::new();
     let named: Vec<(&str, &Vec<Vec<f32>>, bool)> = match profile {
-        Profile::Plain => vec![
+        Contract::Plain => vec![
             ("continuous_actions", &continuous, c > 0),
             ("binary_probabilities", &probabilities, b > 0),
             ("binary_actions", &binary, b > 0),
         ],
-        Profile::Mlagents => vec![
+        Contract::Mlagents => vec![
             ("continuous_actions", &continuous, c > 0),
             ("deterministic_continuous_actions", &continuous, c > 0),
             ("discrete_actions", &binary, b > 0),

@@ -8,8 +8,8 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 mod values;
 pub use values::{Judges, KeepArg, Shard};
 use values::{
-    parse_aux, parse_game, parse_judges, parse_keep, parse_minutes, parse_point, parse_population,
-    parse_profile, parse_retry, parse_shard, parse_target,
+    parse_aux, parse_contract, parse_game, parse_judges, parse_keep, parse_minutes, parse_point,
+    parse_population, parse_retry, parse_shard, parse_target,
 };
 
 use crate::services::campaign::Ramp;
@@ -357,7 +357,7 @@ pub struct ExportArgs {
     layout, each output's meaning and example rows with their expected outputs.\n\n\
     Examples:\n  \
     arlpcg export-policy policies/racing/solver.safetensors --out racing-solver.onnx\n  \
-    arlpcg export-policy policies/platform/solver.safetensors --profile mlagents --out Platform.onnx"
+    arlpcg export-policy policies/platform/solver.safetensors --contract mlagents --out Platform.onnx"
 )]
 pub struct ExportPolicyArgs {
     /// The policy file (.safetensors): a Solver or a Generator of either game.
@@ -366,9 +366,9 @@ pub struct ExportPolicyArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// Whose names the graph uses: `plain` (this tool's) or `mlagents` (ML-Agents' model
-    /// contract, for Unity's Inference Engine).
-    #[arg(long, default_value = "plain", value_parser = parse_profile)]
-    pub profile: crate::services::onnx::Profile,
+    /// contract, for Unity's Inference Engine). Also accepted as --profile, its former name.
+    #[arg(long, alias = "profile", default_value = "plain", value_parser = parse_contract)]
+    pub contract: crate::services::onnx::Contract,
     /// Replace files that already exist.
     #[arg(long)]
     pub force: bool,

@@ -64,10 +64,10 @@ pub(super) fn parse_shard(s: &str) -> Result<Shard, String> {
     Ok(Shard { index, count })
 }
 
-pub(super) fn parse_profile(s: &str) -> Result<crate::services::onnx::Profile, String> {
+pub(super) fn parse_contract(s: &str) -> Result<crate::services::onnx::Contract, String> {
     match s {
-        "plain" => Ok(crate::services::onnx::Profile::Plain),
-        "mlagents" => Ok(crate::services::onnx::Profile::Mlagents),
+        "plain" => Ok(crate::services::onnx::Contract::Plain),
+        "mlagents" => Ok(crate::services::onnx::Contract::Mlagents),
         _ => Err(format!("unknown profile {s}: plain or mlagents")),
     }
 }

@@ -30,7 +30,7 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
     }
     // Loaded through the game's own loader: game, role, shape and normalizer all checked.
     let (policy, card, reference) = crate::services::policies::load_any(&args.policy)?;
-    let exported = crate::services::onnx::export(&policy, &card, reference, args.profile)
+    let exported = crate::services::onnx::export(&policy, &card, reference, args.contract)
         .with_context(|| format!("{}: exporting the actor", args.policy.display()))?;
     let sidecar = serde_json::to_string_pretty(&exported.sidecar)? + "\n";
     // The policy's golden episode, for a port of its observation (docs/engines.md).
@@ -71,11 +71,11 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
         None => String::new(),
     };
     crate::say!(
-        "wrote {} ({} {}, profile {}, opset {}), {}{golden}",
+        "wrote {} ({} {}, contract {}, opset {}), {}{golden}",
         args.out.display(),
         card.game,
         card.role,
-        args.profile.name(),
+        args.contract.name(),
         crate::services::onnx::OPSET,
         sidecar_path.display()
     );

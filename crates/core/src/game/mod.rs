@@ -249,7 +249,8 @@ impl GameSpec for RacingGame {
     }
 
     /// The racing rules keep within what any car of the profile ranges drives (the scripted
-    /// driver brakes for what it cannot take at speed), so they do not read the player.
+    /// driver brakes for what it cannot take at speed), so they read only the player's segment
+    /// ranges, not its car.
     fn rule_level(seed: u64, player: &Player) -> Option<crate::level::Level> {
         racing::rules::racing_level(seed, None, None, &Default::default(), player).ok()
     }

@@ -505,6 +505,18 @@ impl BlockRanges {
     pub fn turn(&self) -> ParamRange {
         ParamRange::new("angle", -self.max_turn, self.max_turn, "degrees")
     }
+
+    /// Checks that each of `block`'s parameters lies within these ranges.
+    #[cfg(test)]
+    pub(crate) fn check_block(
+        &self,
+        block: &crate::level::platform::BlockParams,
+    ) -> Result<(), RangeError> {
+        self.distance().check(block.distance)?;
+        self.size().check(block.size)?;
+        self.height().check(block.height)?;
+        self.turn().check(block.angle).map(drop)
+    }
 }
 
 impl Fields for SegmentRanges {

@@ -650,14 +650,8 @@ mod tests {
             let player = Player::default()
                 .with_pieces(Some(crate::level::profile::Pieces::Platform(narrow)));
             let block = block_from_action(&track, goal, &row, &player);
-            let within = [
-                (narrow.distance(), block.distance),
-                (narrow.size(), block.size),
-                (narrow.height(), block.height),
-                (narrow.turn(), block.angle),
-            ];
-            for (range, value) in within {
-                assert!(range.check(value).is_ok(), "{block:?} outside {range}");
+            if let Err(outside) = narrow.check_block(&block) {
+                panic!("{block:?}: {outside}");
             }
         }
     }

@@ -237,14 +237,8 @@ mod tests {
                 let level = platform_level(seed, Some(0.5), None, &config, player).unwrap();
                 for b in level.platform().unwrap().block_params() {
                     BlockParams::new(b.distance, b.angle, b.size, b.height).unwrap();
-                    let within = [
-                        (ranges.distance(), b.distance),
-                        (ranges.size(), b.size),
-                        (ranges.height(), b.height),
-                        (ranges.turn(), b.angle),
-                    ];
-                    for (range, value) in within {
-                        assert!(range.check(value).is_ok(), "seed {seed}: {b:?}, {range}");
+                    if let Err(outside) = ranges.check_block(b) {
+                        panic!("seed {seed}: {b:?}: {outside}");
                     }
                 }
             }

@@ -1,8 +1,12 @@
 //! End-to-end training speed of the platform Solver: rollouts over 64 parallel worlds plus PPO
 //! updates of the paper's 2 × 512 actor-critic, in environment steps per second, with where the
 //! time goes (the buckets `train` logs) and the update's share of this machine's matmul peak.
-//! The recipe's PPO settings run beside one update epoch (the trial of docs/trials.md,
+//! The recipe's PPO settings run beside two update epochs (the candidate of docs/trials.md,
 //! 2026-11-28), alternating, so that the ratio is measured in one run on one machine.
+//!
+//! Then a Generator phase's playing tick: the current Solver and four snapshots share 64
+//! matches; the Solver run on every row and the snapshots one after another (as before
+//! 2026-11-29), beside the Solver run on its own rows and the actors side by side (now).
 //!
 //! Run with `cargo bench --bench train_e2e`. Target: 20,000 environment steps per second.
 
@@ -12,10 +16,12 @@ use arlpcg::services::train::TrainConfig;
 use arlpcg::services::train::solver_envs::{SolverEnvs, SolverMode, SourceRecord};
 use arlpcg_core::game::PlatformGame;
 use arlpcg_core::rl::fused::matmul_peak_flops;
-use arlpcg_core::rl::policy::{ActorCritic, PolicyShape};
+use arlpcg_core::rl::policy::{ActMode, ActorCritic, PolicyShape};
 use arlpcg_core::rl::ppo::{Ppo, PpoConfig};
 use arlpcg_core::rl::timing::TimeSplit;
 use arlpcg_core::rl::vec_env::Trainer;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
@@ -57,14 +63,13 @@ fn main() {
         continuous: 2,
         binary: 1,
     };
-    let one_epoch = PpoConfig {
-        update_epochs: 1,
-        learning_rate: 6e-4,
+    let two_epochs = PpoConfig {
+        update_epochs: 2,
         ..recipe.solver.clone()
     };
     let settings = [
         ("the recipe", recipe.solver.clone()),
-        ("one epoch", one_epoch),
+        ("two epochs", two_epochs),
     ];
     let mut trainers: Vec<_> = settings
         .iter()
@@ -99,13 +104,76 @@ fn main() {
             peak / 1e9
         );
     }
-    let verdict = if rates[0] >= 20_000.0 {
-        "reached"
-    } else {
-        "MISSED"
+    let verdict = |rate: f64| {
+        if rate >= 20_000.0 {
+            "reached"
+        } else {
+            "MISSED"
+        }
     };
     println!(
-        "  one epoch runs {:.2}x the recipe; the recipe's target, 20000 env steps/s: {verdict}",
-        rates[1] / rates[0]
+        "  two epochs run {:.2}x the recipe; the target, 20000 env steps/s: the recipe {}, two epochs {}",
+        rates[1] / rates[0],
+        verdict(rates[0]),
+        verdict(rates[1])
+    );
+    playing_tick(&shape);
+}
+
+/// Seconds per playing tick of a Generator phase, played both ways, alternating.
+fn playing_tick(shape: &PolicyShape) {
+    let policies: Vec<ActorCritic> = (0..5)
+        .map(|seed| ActorCritic::new(shape.clone(), seed).unwrap())
+        .collect();
+    let d = shape.observation;
+    let observations: Vec<f32> = (0..64 * d).map(|i| (i as f32 * 0.37).sin()).collect();
+    // Match i is played by policy i % 5 (0: the current Solver).
+    let played: Vec<bool> = (0..64).map(|i| i % 5 == 0).collect();
+    let rows_of = |k: usize| -> Vec<f32> {
+        (0..64)
+            .filter(|i| i % 5 == k)
+            .flat_map(|i| observations[i * d..(i + 1) * d].to_vec())
+            .collect()
+    };
+    let snapshot_rows: Vec<Vec<f32>> = (1..5).map(rows_of).collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    let (mut before, mut now) = (0.0, 0.0);
+    for _ in 0..10 {
+        let start = Instant::now();
+        for _ in 0..100 {
+            policies[0]
+                .choose(&observations, ActMode::Sample, &mut rng)
+                .unwrap();
+            for (policy, rows) in policies[1..].iter().zip(&snapshot_rows) {
+                policy.choose(rows, ActMode::Sample, &mut rng).unwrap();
+            }
+        }
+        before += start.elapsed().as_secs_f64() / 100.0;
+        let start = Instant::now();
+        for _ in 0..100 {
+            let learner_rows = rows_of(0);
+            let players: Vec<(&ActorCritic, &[f32])> = std::iter::once(&learner_rows)
+                .chain(&snapshot_rows)
+                .zip(&policies)
+                .map(|(rows, policy)| (policy, &rows[..]))
+                .collect();
+            let mut heads = ActorCritic::heads(&players).unwrap().into_iter();
+            policies[0]
+                .draw_rows(heads.next().unwrap(), &played, ActMode::Sample, &mut rng)
+                .unwrap();
+            for ((policy, rows), head) in players[1..].iter().zip(heads) {
+                let every_row = vec![true; rows.len() / d];
+                policy
+                    .draw_rows(head, &every_row, ActMode::Sample, &mut rng)
+                    .unwrap();
+            }
+        }
+        now += start.elapsed().as_secs_f64() / 100.0;
+    }
+    println!(
+        "a Generator phase's playing tick (the Solver and 4 snapshots over 64 matches): {:.0} us before, {:.0} us now ({:.2}x)",
+        before * 1e5,
+        now * 1e5,
+        before / now
     );
 }

@@ -37,7 +37,7 @@ use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::ActMode;
 use arlpcg_core::rl::ppo::{Batch, Ppo, gae};
 use arlpcg_core::rl::timing::{Clock, InnerTime};
-use arlpcg_core::rl::vec_env::{Transition, VecEnv};
+use arlpcg_core::rl::vec_env::{OtherPlayers, Seat, Transition, VecEnv};
 use arlpcg_core::seed_ranges::TRAINING_SEED_BASE;
 
 mod replay;
@@ -317,40 +317,6 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         }
     }
 
-    /// The actions with those of the matches that snapshots play replaced by the snapshots'
-    /// (one batched forward pass per snapshot), while the Generator learns.
-    fn with_opponents(&mut self, actions: &[f32]) -> candle_core::Result<Option<Vec<f32>>> {
-        if !self.learning() || self.opponents.iter().all(Option::is_none) {
-            return Ok(None);
-        }
-        let width = actions.len() / self.matches.len();
-        let d = self.observation_size();
-        let mut replaced = actions.to_vec();
-        for (k, snapshot) in self.population.iter().enumerate() {
-            let played: Vec<usize> = (0..self.matches.len())
-                .filter(|&i| self.opponents[i] == Some(k))
-                .collect();
-            if played.is_empty() {
-                continue;
-            }
-            let mut observations = vec![0.0; played.len() * d];
-            for (&i, row) in played.iter().zip(observations.chunks_mut(d)) {
-                let game = &self.matches[i];
-                observe_solver::<G>(game.env(), game.build().player().abilities.as_ref(), row);
-            }
-            snapshot.norm.normalize(&mut observations);
-            // Playing, not learning: the actor alone, with the random numbers `act` would draw.
-            let actions = snapshot
-                .policy
-                .choose(&observations, ActMode::Sample, &mut self.rng)?;
-            for (n, &i) in played.iter().enumerate() {
-                replaced[i * width..(i + 1) * width]
-                    .copy_from_slice(&actions[n * width..(n + 1) * width]);
-            }
-        }
-        Ok(Some(replaced))
-    }
-
     /// Lets the Generator place a piece in each of the matches `indices`; returns the matches
     /// that ended because the placement was invalid.
     fn decide(&mut self, indices: &[usize]) -> candle_core::Result<Vec<usize>> {
@@ -537,13 +503,33 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
         self.step_timed(actions, out, &|| 0.0);
     }
 
+    /// While the Generator learns, the snapshots and scripted players that play some matches.
+    fn other_players(&mut self) -> Option<OtherPlayers<'_>> {
+        let seats: Vec<Seat> = self
+            .opponents
+            .iter()
+            .zip(&self.scripted)
+            .map(|(opponent, scripted)| match (opponent, scripted) {
+                (Some(k), _) => Seat::Other(*k),
+                (None, Some(_)) => Seat::Scripted,
+                (None, None) => Seat::Learner,
+            })
+            .collect();
+        if !self.learning() || seats.iter().all(|&s| s == Seat::Learner) {
+            return None;
+        }
+        Some(OtherPlayers {
+            seats,
+            policies: self
+                .population
+                .iter()
+                .map(|snapshot| (&snapshot.policy, &snapshot.norm))
+                .collect(),
+            rng: &mut self.rng,
+        })
+    }
+
     fn step_timed(&mut self, actions: &[f32], out: &mut [Transition], clock: Clock) -> InnerTime {
-        let start = clock();
-        let replaced = self
-            .with_opponents(actions)
-            .expect("the snapshots' forward pass runs on the CPU");
-        let opponents_done = clock();
-        let actions = replaced.as_deref().unwrap_or(actions);
         let width = actions.len() / self.matches.len();
         let rewards = &self.rules.rewards;
         let learning = self.learning();
@@ -606,7 +592,6 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
         self.first_pieces(restarted)
             .expect("the Generator's forward pass runs on the CPU");
         InnerTime {
-            forward_s: opponents_done - start,
             generator_s: clock() - generator_start,
         }
     }

@@ -10,6 +10,7 @@ use rand::RngExt;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// ln(2π) / 2
@@ -30,6 +31,18 @@ impl Draws<'_> {
             Draws::PerRow(rngs) => &mut rngs[i],
         }
     }
+}
+
+/// The actor's output for some rows, from [`ActorCritic::heads`], to draw actions from.
+pub struct Head(Vec<Vec<f32>>);
+
+/// The rows (of `width` values) where `keep` is true, in order.
+pub fn rows_where(rows: &[f32], width: usize, keep: &[bool]) -> Vec<f32> {
+    rows.chunks(width)
+        .zip(keep)
+        .filter(|&(_, &k)| k)
+        .flat_map(|(row, _)| row.iter().copied())
+        .collect()
 }
 
 /// The sizes of a policy.
@@ -207,11 +220,14 @@ impl ActorCritic {
         rng: &mut ChaCha8Rng,
     ) -> candle_core::Result<Acted> {
         let obs = self.observation_tensor(observations)?;
-        let (actions, log_probs) = self.sample(&obs, mode, Draws::Shared(rng))?;
+        // The two networks side by side: a rollout's batch is too small for one product to use
+        // every thread well.
+        let (head, values) = rayon::join(|| self.head(&obs), || self.critic_values(&obs));
+        let (actions, log_probs) = self.draw(&head?, mode, Draws::Shared(rng))?;
         Ok(Acted {
             actions,
             log_probs,
-            values: self.critic_values(&obs)?,
+            values: values?,
         })
     }
 
@@ -236,7 +252,62 @@ impl ActorCritic {
         rng: &mut ChaCha8Rng,
     ) -> candle_core::Result<Vec<f32>> {
         let obs = self.observation_tensor(observations)?;
-        Ok(self.sample(&obs, mode, Draws::Shared(rng))?.0)
+        Ok(self.draw(&self.head(&obs)?, mode, Draws::Shared(rng))?.0)
+    }
+
+    /// [`Self::choose`] for the rows where `played` is true, the actor run on those alone; the
+    /// other rows get zeros. Draws what [`Self::choose`] would for every row, so the rows played
+    /// and `rng` end as after `choose`.
+    pub fn choose_rows(
+        &self,
+        observations: &[f32],
+        played: &[bool],
+        mode: ActMode,
+        rng: &mut ChaCha8Rng,
+    ) -> candle_core::Result<Vec<f32>> {
+        let kept = rows_where(observations, self.shape.observation, played);
+        let head = Self::heads(&[(self, &kept)])?.remove(0);
+        self.draw_rows(head, played, mode, rng)
+    }
+
+    /// The actors' outputs for each policy's own observations, run side by side: a playing
+    /// tick's batches are small, and one product alone leaves threads idle.
+    pub fn heads(players: &[(&ActorCritic, &[f32])]) -> candle_core::Result<Vec<Head>> {
+        players
+            .par_iter()
+            .map(|(policy, observations)| match observations.is_empty() {
+                true => Ok(Head(Vec::new())),
+                false => Ok(Head(
+                    policy.head(&policy.observation_tensor(observations)?)?,
+                )),
+            })
+            .collect()
+    }
+
+    /// The actions [`Self::choose`] draws, from `head` (the actor's output for the rows where
+    /// `played` is true, in order); the other rows get zeros, but their random numbers are drawn
+    /// all the same (the draws do not depend on the actor's output).
+    pub fn draw_rows(
+        &self,
+        head: Head,
+        played: &[bool],
+        mode: ActMode,
+        rng: &mut ChaCha8Rng,
+    ) -> candle_core::Result<Vec<f32>> {
+        let width = self.shape.action_size();
+        let mut heads = head.0.into_iter();
+        let rows: Vec<Vec<f32>> = played
+            .iter()
+            .map(|&p| match p {
+                true => heads.next().expect("one head row per row played"),
+                false => vec![0.0; width],
+            })
+            .collect();
+        let (mut actions, _) = self.draw(&rows, mode, Draws::Shared(rng))?;
+        for (row, _) in actions.chunks_mut(width).zip(played).filter(|&(_, &p)| !p) {
+            row.fill(0.0);
+        }
+        Ok(actions)
     }
 
     /// [`Self::choose`] with one random stream per row: row `k` draws from `rngs[k]` only, so
@@ -248,7 +319,7 @@ impl ActorCritic {
         rngs: &mut [ChaCha8Rng],
     ) -> candle_core::Result<Vec<f32>> {
         let obs = self.observation_tensor(observations)?;
-        Ok(self.sample(&obs, mode, Draws::PerRow(rngs))?.0)
+        Ok(self.draw(&self.head(&obs)?, mode, Draws::PerRow(rngs))?.0)
     }
 
     /// The actor's raw output for a batch of (normalized) observations: rows of the continuous
@@ -266,14 +337,18 @@ impl ActorCritic {
         Tensor::from_slice(observations, (n, self.shape.observation), &Device::Cpu)
     }
 
-    /// Runs the actor and draws each row's action: continuous values first, then binaries.
-    fn sample(
+    /// The actor's output, a row per observation.
+    fn head(&self, obs: &Tensor) -> candle_core::Result<Vec<Vec<f32>>> {
+        self.actor.forward(obs, false)?.to_vec2::<f32>()
+    }
+
+    /// Draws each row's action from the actor's output: continuous values first, then binaries.
+    fn draw(
         &self,
-        obs: &Tensor,
+        head: &[Vec<f32>],
         mode: ActMode,
         mut draws: Draws<'_>,
     ) -> candle_core::Result<(Vec<f32>, Vec<f32>)> {
-        let head = self.actor.forward(obs, false)?.to_vec2::<f32>()?;
         let log_std = self.log_std.as_tensor().flatten_all()?.to_vec1::<f32>()?;
         let (c, b) = (self.shape.continuous, self.shape.binary);
         let mut actions = Vec::with_capacity(head.len() * (c + b));
@@ -425,6 +500,47 @@ mod tests {
             assert_eq!(chosen, acted.actions, "{mode:?}");
             assert_eq!(policy.values(&obs).unwrap(), acted.values);
         }
+    }
+
+    #[test]
+    fn choosing_some_rows_or_policy_by_policy_draws_what_choosing_all_in_turn_does() {
+        let policies: Vec<ActorCritic> = (0..3)
+            .map(|seed| ActorCritic::new(shape(), seed).unwrap())
+            .collect();
+        let obs: Vec<f32> = (0..30).map(|i| (i as f32 * 0.7).sin()).collect();
+        let played = [
+            true, false, false, true, true, false, true, false, false, true,
+        ];
+        let (mut all, mut some) = (ChaCha8Rng::seed_from_u64(4), ChaCha8Rng::seed_from_u64(4));
+        let every = policies[0].choose(&obs, ActMode::Sample, &mut all).unwrap();
+        let rows = policies[0]
+            .choose_rows(&obs, &played, ActMode::Sample, &mut some)
+            .unwrap();
+        for (k, (a, b)) in every.chunks(3).zip(rows.chunks(3)).enumerate() {
+            assert_eq!(b, if played[k] { a } else { &[0.0; 3][..] }, "row {k}");
+        }
+        assert_eq!(all, some, "the same draws");
+        let none = policies[1]
+            .choose_rows(&obs, &[false; 10], ActMode::Sample, &mut some)
+            .unwrap();
+        assert_eq!(none, vec![0.0; 30]);
+        policies[1].choose(&obs, ActMode::Sample, &mut all).unwrap();
+        assert_eq!(all, some);
+
+        let parts = [&obs[..9], &obs[9..12], &obs[12..]];
+        let players: Vec<(&ActorCritic, &[f32])> = policies.iter().zip(parts).collect();
+        let heads = ActorCritic::heads(&players).unwrap();
+        for ((policy, part), head) in players.iter().zip(heads) {
+            let every_row = vec![true; part.len() / 3];
+            let drawn = policy
+                .draw_rows(head, &every_row, ActMode::Sample, &mut some)
+                .unwrap();
+            assert_eq!(
+                drawn,
+                policy.choose(part, ActMode::Sample, &mut all).unwrap()
+            );
+        }
+        assert_eq!(all, some);
     }
 
     #[test]

@@ -76,8 +76,7 @@ impl TimeSplit {
     /// Adds a `seconds`-long [`super::vec_env::VecEnv::step`] whose `inner` work was not the
     /// environments' own.
     pub fn add_step(&mut self, seconds: f64, inner: InnerTime) {
-        self.env_s += seconds - inner.forward_s - inner.generator_s;
-        self.forward_s += inner.forward_s;
+        self.env_s += seconds - inner.generator_s;
         self.generator_s += inner.generator_s;
     }
 
@@ -144,8 +143,6 @@ impl<'a> Stopwatch<'a> {
 /// Seconds spent inside one `VecEnv::step` on work that is not the environments' own.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct InnerTime {
-    /// Forward passes of other policies (earlier Solvers playing some matches).
-    pub forward_s: f64,
     /// A Generator's decisions and the matches it restarts.
     pub generator_s: f64,
 }

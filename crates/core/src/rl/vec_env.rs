@@ -1,11 +1,12 @@
 //! Many environments stepped together, and the rollout loop that drives them: one batched forward
-//! pass of the policy per tick for all environments, then PPO on the collected batch.
+//! pass of the policy per tick for all environments (beside the other players' passes when some
+//! play other policies), then PPO on the collected batch.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::normalizer::RunningNorm;
-use super::policy::{ActMode, Acted};
+use super::policy::{ActMode, Acted, ActorCritic, rows_where};
 use super::ppo::{Batch, Ppo, UpdateStats, gae};
 use super::timing::{Clock, InnerTime, Stopwatch, TimeSplit};
 
@@ -28,13 +29,38 @@ pub trait VecEnv {
     /// Steps environment `i` with action row `i` and records its transition in `out[i]`.
     fn step(&mut self, actions: &[f32], out: &mut [Transition]);
     /// [`VecEnv::step`], with the seconds by `clock` of the work inside it that is not the
-    /// environments' own (other policies' forward passes, a Generator's work); environments
+    /// environments' own (a Generator's work); environments
     /// without such work have none to report.
     fn step_timed(&mut self, actions: &[f32], out: &mut [Transition], clock: Clock) -> InnerTime {
         let _ = clock;
         self.step(actions, out);
         InnerTime::default()
     }
+    /// Who plays each environment on the next playing tick, when the trainer's policy does not
+    /// play them all (earlier snapshots of it, scripted players). None: it plays every one.
+    fn other_players(&mut self) -> Option<OtherPlayers<'_>> {
+        None
+    }
+}
+
+/// Who plays an environment on a playing tick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Seat {
+    /// The trainer's policy.
+    Learner,
+    /// Policy `k` of [`OtherPlayers::policies`].
+    Other(usize),
+    /// Something that is not a policy (a scripted player): the action row is not read.
+    Scripted,
+}
+
+/// The players of a playing tick besides the trainer's policy: each environment's seat, the
+/// other policies with their observation normalizers, and the stream their actions are drawn
+/// from (policy after policy, each over its own environments in order).
+pub struct OtherPlayers<'a> {
+    pub seats: Vec<Seat>,
+    pub policies: Vec<(&'a ActorCritic, &'a RunningNorm)>,
+    pub rng: &'a mut ChaCha8Rng,
 }
 
 /// Episode statistics of one rollout.
@@ -181,10 +207,18 @@ impl<E: VecEnv> Trainer<E> {
     pub fn play_tick(&mut self, clock: Clock) -> candle_core::Result<TimeSplit> {
         let mut time = TimeSplit::default();
         let mut watch = Stopwatch::new(clock);
-        let actions = self
-            .ppo
-            .policy
-            .choose(&self.normalized(), ActMode::Sample, &mut self.rng)?;
+        let actions = match self.env.other_players() {
+            Some(others) => play_beside(
+                (&self.ppo.policy, &self.norm, &mut self.rng),
+                &self.observations,
+                others,
+            )?,
+            None => {
+                let observations = self.normalized();
+                let policy = &self.ppo.policy;
+                policy.choose(&observations, ActMode::Sample, &mut self.rng)?
+            }
+        };
         time.forward_s += watch.lap();
         let mut transitions = vec![Transition::default(); self.env.num_envs()];
         let inner = self.env.step_timed(&actions, &mut transitions, clock);
@@ -206,4 +240,51 @@ impl<E: VecEnv> Trainer<E> {
     pub fn learn(&mut self, batch: &Batch, learning_rate: f64) -> candle_core::Result<UpdateStats> {
         self.ppo.update(batch, learning_rate, &mut self.rng)
     }
+}
+
+/// The actions of a playing tick where other policies play some environments: every policy's
+/// actor run side by side on its own rows (each normalized by its own normalizer), then the
+/// learner's draws over every row (as [`ActorCritic::choose`] of all would draw) and each other
+/// policy's over its rows, in order.
+fn play_beside(
+    (policy, norm, rng): (&ActorCritic, &RunningNorm, &mut ChaCha8Rng),
+    observations: &[f32],
+    others: OtherPlayers<'_>,
+) -> candle_core::Result<Vec<f32>> {
+    let OtherPlayers {
+        seats,
+        policies,
+        rng: others_rng,
+    } = others;
+    let d = observations.len() / seats.len();
+    let seated = |seat: Seat, norm: &RunningNorm| {
+        let mask: Vec<bool> = seats.iter().map(|&s| s == seat).collect();
+        let mut rows = rows_where(observations, d, &mask);
+        norm.normalize(&mut rows);
+        (mask, rows)
+    };
+    let mut tables = vec![seated(Seat::Learner, norm)];
+    tables.extend((0..policies.len()).map(|k| seated(Seat::Other(k), policies[k].1)));
+    let players: Vec<(&ActorCritic, &[f32])> = std::iter::once(policy)
+        .chain(policies.iter().map(|(p, _)| *p))
+        .zip(&tables)
+        .map(|(p, (_, rows))| (p, &rows[..]))
+        .collect();
+    let mut heads = ActorCritic::heads(&players)?.into_iter();
+    let learner = heads.next().expect("the learner's head");
+    let mut actions = policy.draw_rows(learner, &tables[0].0, ActMode::Sample, rng)?;
+    let width = actions.len() / seats.len();
+    for (((other, _), (mask, _)), head) in policies.iter().zip(&tables[1..]).zip(heads) {
+        let played = mask.iter().filter(|&&m| m).count();
+        // A policy that plays no environment draws nothing.
+        if played == 0 {
+            continue;
+        }
+        let drawn = other.draw_rows(head, &vec![true; played], ActMode::Sample, others_rng)?;
+        let rows = mask.iter().enumerate().filter(|&(_, &m)| m).map(|(i, _)| i);
+        for (i, row) in rows.zip(drawn.chunks(width)) {
+            actions[i * width..(i + 1) * width].copy_from_slice(row);
+        }
+    }
+    Ok(actions)
 }

@@ -78,7 +78,8 @@ pub fn measure(profile: &Profile, trials: u32) -> Allowance {
         Abilities::Racing(c) => {
             let car = Car::from(c);
             let top = feasibility::top_speed(car);
-            let held = |curves: usize| match feasibility::cornering_speed(car, curves, 2) {
+            let road = profile.pieces.segments().road();
+            let held = |curves: usize| match feasibility::cornering_speed(car, curves, 2, road) {
                 v if v >= top => "at full speed".to_string(),
                 v => format!("at {v} m/s"),
             };

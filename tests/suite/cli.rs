@@ -1139,7 +1139,10 @@ fn a_profiles_piece_ranges_bound_its_levels_and_a_bad_range_names_its_field() {
         .replace("max_distance: 10.0", "max_distance: 7.0")
         .replace("min_size: 4.0", "min_size: 5.0")
         .replace("max_turn: 180.0", "max_turn: 45.0");
-    let narrow_segments = racing.replace("max_curve: 30.0", "max_curve: 10.0");
+    let narrow_segments = racing
+        .replace("max_curve: 30.0", "max_curve: 10.0")
+        .replace("road_width: 9.0", "road_width: 7.0")
+        .replace("banking: 10.0", "banking: 0.0");
     for (game, text) in [("platform", &narrow_blocks), ("racing", &narrow_segments)] {
         let (profile, out) = (path(&format!("{game}.yaml")), path(game));
         std::fs::write(&profile, text).unwrap();
@@ -1157,14 +1160,16 @@ fn a_profiles_piece_ranges_bound_its_levels_and_a_bad_range_names_its_field() {
                         .iter()
                         .all(|b| { b.distance <= 7.0 && b.size >= 5.0 && b.angle.abs() <= 45.0 })
                 ),
-                None => assert!(
-                    level
-                        .racing()
-                        .unwrap()
-                        .segments
-                        .iter()
-                        .all(|s| s.curve.abs() <= 10.0)
-                ),
+                None => {
+                    let track = level.racing().unwrap();
+                    assert!(track.segments.iter().all(|s| s.curve.abs() <= 10.0));
+                    // The road of the profile: 7 m wide and flat, in the file and the export.
+                    let road = track.road();
+                    assert_eq!((road.shape().width, road.shape().banking), (7.0, 0.0));
+                    assert!(road.samples().iter().all(|p| p.bank == 0.0));
+                    let scene = arlpcg_core::level::scene::Scene::of_level(&level);
+                    assert_eq!(scene.extras["road_width"], 7.0);
+                }
             }
         }
     }
@@ -1186,6 +1191,13 @@ fn a_profiles_piece_ranges_bound_its_levels_and_a_bad_range_names_its_field() {
         "max_size: 6.0",
         "max_size: 9.0",
         "blocks.max_size 9 is out of range [4, 6] m",
+    );
+    let file = path("bad-road.yaml");
+    std::fs::write(&file, racing.replace("road_width: 9.0", "road_width: 20.0")).unwrap();
+    fails_with(
+        &arlpcg(&["profile", "check", &file]),
+        1,
+        "segments.road_width 20 is out of range [6, 14] m",
     );
 }
 

@@ -6,7 +6,7 @@ use arlpcg_core::game::platform::rules;
 use arlpcg_core::level::Track;
 use arlpcg_core::level::platform::BLOCK_THICKNESS;
 use arlpcg_core::level::racing::FINISH_LENGTH;
-use arlpcg_core::level::road::ROAD_WIDTH;
+use arlpcg_core::level::racing::ROAD_WIDTH;
 use arlpcg_core::level::scene::Scene;
 use arlpcg_core::level::{Level, PlatformRulesConfig, gltf as export};
 

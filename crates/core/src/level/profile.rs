@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::level::Game;
 use crate::level::params::{self, ParamRange, RangeError};
+use crate::level::racing::{self, RoadShape};
 
 /// The `format:` of a profile file.
 pub const FORMAT: &str = "arlpcg-profile";
@@ -87,6 +88,20 @@ pub struct SegmentRanges {
     pub max_curve: f64,
     /// Largest height change over a segment, either way, m.
     pub max_height: f64,
+    /// Width of the road, m (a level made under the profile records it, with the banking).
+    #[serde(default = "default_road_width")]
+    pub road_width: f64,
+    /// Bank angle per unit of curvature, ° per °/m (0: a flat road).
+    #[serde(default = "default_banking")]
+    pub banking: f64,
+}
+
+fn default_road_width() -> f64 {
+    racing::ROAD_WIDTH
+}
+
+fn default_banking() -> f64 {
+    racing::BANK_GAIN
 }
 
 /// A profile file: which game, a name, that game's abilities and (optionally) its pieces'
@@ -200,6 +215,8 @@ impl Default for SegmentRanges {
             max_length: params::SEGMENT_LENGTH.max,
             max_curve: params::SEGMENT_CURVE.max,
             max_height: params::SEGMENT_HEIGHT.max,
+            road_width: racing::ROAD_WIDTH,
+            banking: racing::BANK_GAIN,
         }
     }
 }
@@ -333,7 +350,7 @@ pub const BLOCK_FIELDS: [(ParamRange, &str); 7] = [
 ];
 
 /// Each segment range field.
-pub const SEGMENT_FIELDS: [(ParamRange, &str); 4] = [
+pub const SEGMENT_FIELDS: [(ParamRange, &str); 6] = [
     field(
         "segments.min_length",
         params::SEGMENT_LENGTH.min,
@@ -361,6 +378,20 @@ pub const SEGMENT_FIELDS: [(ParamRange, &str); 4] = [
         params::SEGMENT_HEIGHT.max,
         "m",
         "largest climb or drop of a segment",
+    ),
+    field(
+        "segments.road_width",
+        racing::WIDTH_RANGE.min,
+        racing::WIDTH_RANGE.max,
+        "m",
+        "width of the road",
+    ),
+    field(
+        "segments.banking",
+        racing::BANKING_RANGE.min,
+        racing::BANKING_RANGE.max,
+        "° per °/m",
+        "bank angle per unit of curvature (0: flat)",
     ),
 ];
 
@@ -525,7 +556,7 @@ impl Fields for SegmentRanges {
         nth(
             [
                 &mut self.min_length, &mut self.max_length, &mut self.max_curve,
-                &mut self.max_height,
+                &mut self.max_height, &mut self.road_width, &mut self.banking,
             ],
             k,
         )
@@ -552,6 +583,14 @@ impl SegmentRanges {
 
     pub fn height(&self) -> ParamRange {
         ParamRange::new("height", -self.max_height, self.max_height, "m")
+    }
+
+    /// The road of the levels made with these ranges.
+    pub fn road(&self) -> RoadShape {
+        RoadShape {
+            width: self.road_width,
+            banking: self.banking,
+        }
     }
 }
 

@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::params::{self, RangeError};
+use super::params::{self, ParamRange, RangeError};
 
 /// The most segments a track may have (a 10 km road).
 pub const MAX_SEGMENTS: usize = 400;
@@ -17,6 +17,68 @@ pub const GOAL_REACH_HORIZONTAL: f64 = 12.0;
 pub const GOAL_REACH_VERTICAL: f64 = 6.0;
 /// A run succeeds on the last this many metres of a complete road, within its edges.
 pub const FINISH_LENGTH: f64 = 3.0;
+
+/// Width of the road surface, m: the built-in game's.
+pub const ROAD_WIDTH: f64 = 9.0;
+/// Bank angle per unit of curvature: bank (degrees) = `BANK_GAIN` · curve (degrees) / length (m),
+/// the built-in game's.
+pub const BANK_GAIN: f64 = 10.0;
+/// The road widths a track (and a profile) may have, m.
+pub const WIDTH_RANGE: ParamRange = ParamRange::new("road width", 6.0, 14.0, "m");
+/// The banking gains a track (and a profile) may have (0: a flat road).
+pub const BANKING_RANGE: ParamRange = ParamRange::new("banking", 0.0, 20.0, "° per °/m");
+/// How wide a road is and how steeply it banks in its curves: a property of each track (a
+/// profile's `segments.road_width` and `segments.banking` set it for the levels made under it).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoadShape {
+    /// Width of the road surface, m.
+    pub width: f64,
+    /// Bank angle per unit of curvature: bank (degrees) = banking · curve (degrees) / length
+    /// (m), clipped to ±15° (the road's steepest banking).
+    pub banking: f64,
+}
+
+impl Default for RoadShape {
+    fn default() -> Self {
+        Self {
+            width: ROAD_WIDTH,
+            banking: BANK_GAIN,
+        }
+    }
+}
+
+impl RoadShape {
+    /// Checks both against their ranges (NaN fails): `Err("field: what it must be")`.
+    pub fn check(&self) -> Result<(), String> {
+        WIDTH_RANGE
+            .check(self.width)
+            .map_err(|e| format!("width: {e}"))?;
+        BANKING_RANGE
+            .check(self.banking)
+            .map_err(|e| format!("banking: {e}"))?;
+        Ok(())
+    }
+
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
+
+    /// Two parts of the road further apart along it than this must not come near each other, m.
+    pub fn crossing_arc(&self) -> f64 {
+        4.0 * self.width
+    }
+
+    /// The least horizontal distance between two such parts' centre lines, m.
+    pub fn min_self_distance(&self) -> f64 {
+        self.width + 3.0
+    }
+
+    /// The least horizontal distance from the centre line to an obstacle, m.
+    pub fn min_obstacle_distance(&self) -> f64 {
+        0.5 * self.width + 1.5
+    }
+}
 
 /// The Generator's action for one road segment.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -199,16 +261,19 @@ pub struct RacingTrack {
     pub heading: f64,
     pub segments: Vec<SegmentParams>,
     pub obstacles: Vec<Obstacle>,
+    /// How wide the road is and how it banks.
+    pub road: RoadShape,
 }
 
 impl RacingTrack {
-    /// An empty track starting at `position`, heading `heading` degrees.
+    /// An empty track of the built-in road, starting at `position`, heading `heading` degrees.
     pub fn new(position: [f64; 3], heading: f64) -> Self {
         Self {
             position,
             heading,
             segments: Vec::new(),
             obstacles: Vec::new(),
+            road: RoadShape::default(),
         }
     }
 }

@@ -8,30 +8,23 @@
 //!   zero at every join (C1 in height). Two segments that rise then fall make a crest whose
 //!   vertical curvature is `6·height / length²`; a car leaves the ground there once
 //!   `speed² · curvature > g` (docs/racing-physics.md).
-//! - **Banking**: `bank = BANK_GAIN · curve / length`, clipped to ±[`MAX_BANK_DEGREES`], tilted
-//!   into the turn; blended linearly over [`BANK_BLEND`] m either side of a join so the surface
-//!   has no step.
+//! - **Banking**: `bank = banking · curve / length` (the track's [`RoadShape::banking`]), clipped
+//!   to ±[`MAX_BANK_DEGREES`], tilted into the turn; blended linearly over [`BANK_BLEND`] m
+//!   either side of a join so the surface has no step.
+//! - **Width**: the track's [`RoadShape::width`]; how near the road may come to itself and to
+//!   an obstacle follows from it.
 //!
 //! Heading `h` (degrees about +Y) points along `(cos h, 0, −sin h)`; positive curve turns left.
 
-use super::racing::{Obstacle, RacingTrack, SegmentParams};
+use super::racing::{Obstacle, RacingTrack, RoadShape, SegmentParams};
 
-/// Width of the road surface, m.
-pub const ROAD_WIDTH: f64 = 9.0;
-/// Bank angle per unit of curvature: bank (degrees) = `BANK_GAIN` · curve (degrees) / length (m).
-pub const BANK_GAIN: f64 = 10.0;
-/// The steepest banking, degrees (reached by the tightest curve, 30° over 20 m).
+/// The steepest banking, degrees (reached at the built-in gain by the tightest curve, 30° over
+/// 20 m).
 pub const MAX_BANK_DEGREES: f64 = 15.0;
 /// Banking changes linearly over this many metres either side of a join.
 pub const BANK_BLEND: f64 = 6.0;
 /// Distance between cross-sections of the mesh along the centre line, at most, m.
 pub const SAMPLE_SPACING: f64 = 1.0;
-/// Two parts of the road further apart along it than this must not come near each other, m.
-pub const CROSSING_ARC: f64 = 4.0 * ROAD_WIDTH;
-/// The least horizontal distance between two such parts' centre lines, m.
-pub const MIN_SELF_DISTANCE: f64 = ROAD_WIDTH + 3.0;
-/// The least horizontal distance from the centre line to an obstacle, m.
-pub const MIN_OBSTACLE_DISTANCE: f64 = 0.5 * ROAD_WIDTH + 1.5;
 /// How far the skirts along the road's edges hang below it (glTF only), m.
 pub const SKIRT_DEPTH: f64 = 0.8;
 
@@ -80,6 +73,7 @@ impl RoadSample {
 /// The road of a track, sampled along its centre line.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Road {
+    shape: RoadShape,
     samples: Vec<RoadSample>,
     /// Where each segment starts along the road, m; one more entry: the road's length.
     starts: Vec<f64>,
@@ -93,22 +87,24 @@ pub struct Road {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum TrackError {
     #[error(
-        "segment {later} crosses segment {earlier}: the road's centre lines come {distance:.1} m apart, less than {min} m",
-        min = MIN_SELF_DISTANCE
+        "segment {later} crosses segment {earlier}: the road's centre lines come {distance:.1} m apart, less than {min} m"
     )]
     Crosses {
         earlier: usize,
         later: usize,
         distance: f64,
+        /// The least distance allowed (the road's width + 3 m).
+        min: f64,
     },
     #[error(
-        "segment {segment} runs into obstacle {obstacle}: its centre line passes {distance:.1} m from it, less than {min} m",
-        min = MIN_OBSTACLE_DISTANCE
+        "segment {segment} runs into obstacle {obstacle}: its centre line passes {distance:.1} m from it, less than {min} m"
     )]
     HitsObstacle {
         segment: usize,
         obstacle: usize,
         distance: f64,
+        /// The least distance allowed (half the road's width + 1.5 m).
+        min: f64,
     },
 }
 
@@ -132,16 +128,18 @@ impl RacingTrack {
 impl Road {
     /// The road of `track`'s segments.
     pub fn new(track: &RacingTrack) -> Self {
-        let mut road = Self::start(track.position, track.heading);
+        let mut road = Self::start(track.position, track.heading, track.road);
         for segment in &track.segments {
             road.push(*segment);
         }
         road
     }
 
-    /// A road with no segments yet, starting at `position`, heading `heading` degrees.
-    pub fn start(position: [f64; 3], heading: f64) -> Self {
+    /// A road of `shape` with no segments yet, starting at `position`, heading `heading`
+    /// degrees.
+    pub fn start(position: [f64; 3], heading: f64, shape: RoadShape) -> Self {
         Self {
+            shape,
             samples: Vec::new(),
             starts: vec![0.0],
             banks: Vec::new(),
@@ -156,7 +154,7 @@ impl Road {
         let (origin, heading) = self.end;
         let length = params.length;
         let curvature = params.curve.to_radians() / length;
-        let bank = (BANK_GAIN * params.curve / length)
+        let bank = (self.shape.banking * params.curve / length)
             .clamp(-MAX_BANK_DEGREES, MAX_BANK_DEGREES)
             .to_radians();
         self.banks.push(bank);
@@ -241,13 +239,20 @@ impl Road {
         (self.end.0, self.end.1.to_degrees())
     }
 
+    /// How wide the road is and how it banks.
+    pub fn shape(&self) -> RoadShape {
+        self.shape
+    }
+
     /// The first crossing that involves a segment numbered `from` or later: a point of it
-    /// comes too near a part of the road that is more than [`CROSSING_ARC`] away along it.
+    /// comes too near a part of the road that is more than [`RoadShape::crossing_arc`] away
+    /// along it.
     pub fn first_crossing(&self, from: usize) -> Option<TrackError> {
+        let (arc, min) = (self.shape.crossing_arc(), self.shape.min_self_distance());
         let first_new = self.samples.iter().position(|p| p.segment >= from)?;
         for (j, later) in self.samples.iter().enumerate().skip(first_new) {
             for earlier in &self.samples[..j] {
-                if later.s - earlier.s <= CROSSING_ARC {
+                if later.s - earlier.s <= arc {
                     break;
                 }
                 let (dx, dz) = (
@@ -255,11 +260,12 @@ impl Road {
                     later.centre[2] - earlier.centre[2],
                 );
                 let squared = dx * dx + dz * dz;
-                if squared < MIN_SELF_DISTANCE * MIN_SELF_DISTANCE {
+                if squared < min * min {
                     return Some(TrackError::Crosses {
                         earlier: earlier.segment,
                         later: later.segment,
                         distance: squared.sqrt(),
+                        min,
                     });
                 }
             }
@@ -269,16 +275,18 @@ impl Road {
 
     /// The first obstacle that a segment numbered `from` or later comes too near.
     pub fn first_obstacle_hit(&self, obstacles: &[Obstacle], from: usize) -> Option<TrackError> {
+        let min = self.shape.min_obstacle_distance();
         self.samples
             .iter()
             .filter(|p| p.segment >= from)
             .find_map(|p| {
                 obstacles.iter().enumerate().find_map(|(k, o)| {
                     let distance = o.plan_distance(p.centre[0], p.centre[2]);
-                    (distance < MIN_OBSTACLE_DISTANCE).then_some(TrackError::HitsObstacle {
+                    (distance < min).then_some(TrackError::HitsObstacle {
                         segment: p.segment,
                         obstacle: k,
                         distance,
+                        min,
                     })
                 })
             })
@@ -336,11 +344,12 @@ impl Road {
     /// The top surface between cross-sections `first` and `last` (inclusive).
     pub fn surface_between(&self, first: usize, last: usize) -> TriangleMesh {
         let mut mesh = TriangleMesh::default();
+        let width = self.shape.width;
         for p in &self.samples[first..=last] {
             let up = p.up().map(|c| c as f32);
-            let v = (p.s / ROAD_WIDTH) as f32;
-            mesh.vertex(p.across(0.5 * ROAD_WIDTH), up, [0.0, v]);
-            mesh.vertex(p.across(-0.5 * ROAD_WIDTH), up, [1.0, v]);
+            let v = (p.s / width) as f32;
+            mesh.vertex(p.across(0.5 * width), up, [0.0, v]);
+            mesh.vertex(p.across(-0.5 * width), up, [1.0, v]);
         }
         mesh.strip(0, last - first + 1, 0, 1);
         mesh
@@ -351,13 +360,14 @@ impl Road {
     pub fn skirts_between(&self, first: usize, last: usize) -> TriangleMesh {
         let mut mesh = TriangleMesh::default();
         let rows = last - first + 1;
+        let width = self.shape.width;
         for side in [1.0, -1.0] {
             let base = mesh.positions.len() as u32;
             for p in &self.samples[first..=last] {
                 let outward = p.left().map(|c| (side * c) as f32);
-                let top = p.across(side * 0.5 * ROAD_WIDTH);
+                let top = p.across(side * 0.5 * width);
                 let bottom = [top[0], top[1] - SKIRT_DEPTH, top[2]];
-                let v = (p.s / ROAD_WIDTH) as f32;
+                let v = (p.s / width) as f32;
                 mesh.vertex(top, outward, [0.0, v]);
                 mesh.vertex(bottom, outward, [1.0, v]);
             }

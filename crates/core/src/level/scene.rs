@@ -5,7 +5,7 @@ use serde_json::{Value, json};
 
 use super::platform::{BLOCK_THICKNESS, Platform, PlatformTrack};
 use super::racing::{Obstacle, RacingTrack};
-use super::road::{ROAD_WIDTH, TriangleMesh};
+use super::road::TriangleMesh;
 use super::{Level, Track};
 
 /// What a node is, which picks its material.
@@ -282,7 +282,7 @@ fn finish_zone(level: &Level) -> ScenePoint {
                     centre[2],
                 ],
                 end.heading.to_degrees(),
-                [super::road::ROAD_WIDTH, height, length],
+                [road.shape().width, height, length],
                 format!("the car is on the road within its last {length} m"),
             )
         }
@@ -444,7 +444,7 @@ fn racing_scene(level: &Level, track: &RacingTrack) -> Scene {
             "seed": level.seed,
             "aux": level.aux,
             "segments": track.segments.len(),
-            "road_width": ROAD_WIDTH,
+            "road_width": road.shape().width,
             "road_length": road.length(),
         }),
     }

@@ -13,7 +13,7 @@ use crate::shells::design::app::App;
 use arlpcg_core::level::Level;
 use arlpcg_core::level::heading::heading_direction;
 use arlpcg_core::level::racing::{Obstacle, RacingTrack};
-use arlpcg_core::level::road::{ROAD_WIDTH, Road};
+use arlpcg_core::level::road::Road;
 
 use super::{MOST_FAILED_MARK, draw_replay, map_canvas, most_failed_piece, piece_colours};
 
@@ -84,7 +84,7 @@ pub(super) fn map(
 ) {
     let colours = piece_colours(app, track.segments.len());
     let most_failed = most_failed_piece(app, track.segments.len());
-    let half = 0.5 * ROAD_WIDTH;
+    let half = 0.5 * road.shape().width;
     let edges: Vec<([f64; 3], [f64; 3], usize, f64)> = road
         .samples()
         .iter()

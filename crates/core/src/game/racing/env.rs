@@ -10,7 +10,7 @@ use rapier3d::math::{Rotation, Vector};
 use super::car::{Car, CarAction, DECISION_DT, RacingWorld, START_S, TrackShapes};
 use crate::game::Step;
 use crate::level::racing::{RacingTrack, SegmentParams};
-use crate::level::road::{ROAD_WIDTH, Road};
+use crate::level::road::Road;
 use crate::level::stats::Outcome;
 
 /// Centre-line points the observation looks ahead to, m along the road from the car.
@@ -70,7 +70,7 @@ pub const OBSERVATION_MEANINGS: [&str; 9] = [
     "linear velocity in the body frame (x forward, y up, z right) / 20 m/s",
     "angular velocity in the body frame, rad/s",
     "world +Y in the body frame",
-    "the chassis centre's signed distance from the nearest centre-line point across the road's heading there (+ left) / 4.5 m (±1 at the edges)",
+    "the chassis centre's signed distance from the nearest centre-line point across the road's heading there (+ left) / half the road's width (4.5 m on the built-in road; ±1 at the edges)",
     "sin, cos of (the road's heading at the nearest centre-line point - the car's heading)",
     "the centre line 8, 16, 26, 40, 60 m further along than the car, each in the level heading frame as x / 60 m then z / 20 m",
     "(6 - d) / 6 for 20 rays straight down from 6 m above the chassis centre, d the distance to road or obstacle (18 m: none); forward-major: rows 5, 11, 19, 30 m ahead, each from 7 m right to 7 m left in 3.5 m steps, in the level heading frame",
@@ -262,7 +262,7 @@ impl RacingEnv {
             self.air_steps += 1;
         }
         let lateral = self.lateral_offset(position);
-        let beyond_edge = lateral.abs() > 0.5 * ROAD_WIDTH;
+        let beyond_edge = lateral.abs() > 0.5 * self.road.shape().width;
         self.loose_steps = if wheels == 0 && beyond_edge {
             self.loose_steps + 1
         } else {
@@ -373,7 +373,8 @@ impl RacingEnv {
             .chain((velocity / 20.0).to_array())
             .chain(spin.to_array())
             .chain(up.to_array())
-            .chain([self.lateral_offset(to_f64(position)) as f32 / (0.5 * ROAD_WIDTH as f32)])
+            .chain([self.lateral_offset(to_f64(position)) as f32
+                / (0.5 * self.road.shape().width as f32)])
             .chain([road_bearing.sin(), road_bearing.cos()])
             .chain(ahead.into_iter().flatten());
         for (slot, value) in out[..OBSERVATION_SIZE - FAN_SIZE].iter_mut().zip(state) {

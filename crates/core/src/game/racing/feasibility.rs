@@ -5,7 +5,7 @@
 use super::car::{Car, CarAction, DECISION_DT};
 use super::env::{RacingEnv, RacingRewards};
 use super::scripted::ScriptedDriver;
-use crate::level::racing::{RacingTrack, SegmentParams};
+use crate::level::racing::{RacingTrack, RoadShape, SegmentParams};
 use crate::level::stats::Outcome;
 
 /// The tightest curve the ranges allow: 30 degrees over 20 m (radius 38 m, banked 15 degrees).
@@ -85,9 +85,10 @@ pub fn top_speed(car: Car) -> f32 {
 }
 
 /// The fastest speed (to 1 m/s) that `car` holds through `curves` tightest curves in a row
-/// without leaving the road, over `seeds` seeded starts.
-pub fn cornering_speed(car: Car, curves: usize, seeds: u64) -> f32 {
-    let track = test_track(12, &vec![TIGHTEST; curves]);
+/// of a road of `road`'s width and banking without leaving it, over `seeds` seeded starts.
+pub fn cornering_speed(car: Car, curves: usize, seeds: u64, road: RoadShape) -> f32 {
+    let mut track = test_track(12, &vec![TIGHTEST; curves]);
+    track.road = road;
     (8..=40)
         .map(|v| v as f32)
         .take_while(|&v| {
@@ -131,7 +132,7 @@ mod tests {
         for curves in [1, 2, 3, 4, 6] {
             println!(
                 "{curves} tightest curves: held at {} m/s",
-                cornering_speed(Car::default(), curves, 3)
+                cornering_speed(Car::default(), curves, 3, RoadShape::default())
             );
         }
         for h in [1.0, 2.0, 3.0, 4.0, 5.0] {
@@ -176,12 +177,20 @@ mod tests {
         let top = top_speed(Car::default());
         assert!((27.0..=29.0).contains(&top), "top speed {top} m/s");
         // One tightest curve at top speed; four in a row need braking to about 22 m/s.
-        assert!(cornering_speed(Car::default(), 1, 2) >= 28.0);
-        let four = cornering_speed(Car::default(), 4, 2);
+        let road = RoadShape::default();
+        assert!(cornering_speed(Car::default(), 1, 2, road) >= 28.0);
+        let four = cornering_speed(Car::default(), 4, 2, road);
         assert!(
             (20.0..=24.0).contains(&four),
             "four tightest curves held at {four} m/s"
         );
+        // A narrower road without banking must be taken slower.
+        let flat = RoadShape {
+            width: 7.0,
+            banking: 0.0,
+        };
+        let on_flat = cornering_speed(Car::default(), 4, 2, flat);
+        assert!(on_flat < four, "held at {on_flat} m/s on the flat road");
         let track = test_track(12, &[TIGHTEST; 4]);
         let braking = drive(&track, Car::default(), &mut ScriptedDriver::new(0, 0.0), 0);
         assert_eq!(braking.outcome, Outcome::Success, "{braking:?}");

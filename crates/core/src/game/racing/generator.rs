@@ -17,7 +17,7 @@ use crate::level::heading::{direction_heading, heading_direction, wrap_degrees};
 use crate::level::params::{SEGMENT_CURVE, SEGMENT_HEIGHT, SEGMENT_LENGTH, quantize};
 use crate::level::profile::{Abilities, SegmentRanges};
 use crate::level::racing::{self, Obstacle, RacingTrack, SegmentParams};
-use crate::level::road::{CROSSING_ARC, MIN_OBSTACLE_DISTANCE, MIN_SELF_DISTANCE, Road};
+use crate::level::road::Road;
 use crate::level::stats::Outcome;
 
 /// The next segment is requested when the car is this close to the road's end, m: the Solver's
@@ -150,12 +150,13 @@ impl RacingBuild {
     fn plan_rays(&self) -> ([f32; RAYS], [f32; RAYS]) {
         let mut obstacle_rays = [0.0; RAYS];
         let obstacles = &self.track.obstacles;
+        let shape = self.road.shape();
+        let clearance = shape.min_obstacle_distance();
         self.rays(&mut obstacle_rays, |x, z| {
-            obstacles
-                .iter()
-                .any(|o| o.plan_distance(x, z) < MIN_OBSTACLE_DISTANCE)
+            obstacles.iter().any(|o| o.plan_distance(x, z) < clearance)
         });
-        let reach = self.road.length() - CROSSING_ARC;
+        let reach = self.road.length() - shape.crossing_arc();
+        let apart = shape.min_self_distance();
         let earlier: Vec<[f64; 2]> = self
             .road
             .samples()
@@ -166,9 +167,9 @@ impl RacingBuild {
             .collect();
         let mut road_rays = [0.0; RAYS];
         self.rays(&mut road_rays, |x, z| {
-            earlier.iter().any(|c| {
-                (c[0] - x).powi(2) + (c[1] - z).powi(2) < MIN_SELF_DISTANCE * MIN_SELF_DISTANCE
-            })
+            earlier
+                .iter()
+                .any(|c| (c[0] - x).powi(2) + (c[1] - z).powi(2) < apart * apart)
         });
         (obstacle_rays, road_rays)
     }
@@ -342,6 +343,9 @@ impl GeneratorGame for RacingGame {
         let (goal, heading, obstacles, rng) = super::rules::goal_and_start(seed, goal, obstacles);
         let mut build = RacingBuild::new(heading, goal, obstacles, limits.max_pieces);
         build.curve_offset = limits.curve_offset;
+        // The road of the player's profile.
+        build.track.road = limits.player.segments().road();
+        build.road = build.track.road();
         build.player = limits.player;
         (build, rng)
     }
@@ -420,7 +424,7 @@ mod tests {
     fn a_wider_curve_offset_lets_the_road_bend_away_from_its_goal() {
         // The road's end points 40° to the right of the goal (straight ahead along +x, the goal
         // at 40° to the left).
-        let road = Road::start([0.0; 3], 0.0);
+        let road = Road::start([0.0; 3], 0.0, Default::default());
         let angle = 40f64.to_radians();
         let goal = [300.0 * angle.cos(), 0.0, -300.0 * angle.sin()];
         let away = [0.0, -1.0, 0.0];
@@ -440,7 +444,7 @@ mod tests {
 
     #[test]
     fn a_zero_action_turns_and_climbs_toward_the_goal() {
-        let road = Road::start([0.0; 3], 0.0);
+        let road = Road::start([0.0; 3], 0.0, Default::default());
         // Heading 0 runs along +x; a goal off to the left (−z) at 45°.
         let segment = segment_from_action(
             &road,
@@ -472,6 +476,7 @@ mod tests {
             max_length: 24.0,
             max_curve: 10.0,
             max_height: 1.0,
+            ..SegmentRanges::default()
         };
         for row in [[1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [0.0; 3]] {
             let s = segment_from_action(&road, [100.0, 40.0, -100.0], &row, 90.0, &narrow);

@@ -10,8 +10,9 @@ use crate::game::Player;
 use crate::level::heading::{direction_heading, heading_direction, wrap_degrees};
 use crate::level::params::quantize;
 use crate::level::profile::SegmentRanges;
+use crate::level::racing::RoadShape;
 use crate::level::racing::{self, Obstacle, RacingRulesConfig, RacingTrack, SegmentParams};
-use crate::level::road::{MIN_OBSTACLE_DISTANCE, Road};
+use crate::level::road::Road;
 use crate::level::{Level, Source, Track};
 
 /// Goals are drawn this far from the start, horizontally, m...
@@ -86,7 +87,9 @@ fn draw_obstacle(rng: &mut ChaCha8Rng, goal: [f64; 3]) -> Option<Obstacle> {
             height: quantize(rng.random_range(3.0..=10.0)),
         }
     };
-    let clear = MIN_OBSTACLE_DISTANCE + 12.0;
+    // The built-in road's clearance and 12 m more: the scene is drawn before any profile's
+    // road, and the margin covers the widest road one may ask for.
+    let clear = RoadShape::default().min_obstacle_distance() + 12.0;
     let far_from = |p: [f64; 3]| obstacle.plan_distance(p[0], p[2]) > clear;
     (far_from([0.0; 3]) && far_from(goal)).then_some(obstacle)
 }
@@ -158,7 +161,8 @@ fn attempt(
     ranges: &SegmentRanges,
 ) -> Option<RacingTrack> {
     let mut track = RacingTrack::new([0.0; 3], heading);
-    let mut road = Road::start(track.position, heading);
+    track.road = ranges.road();
+    let mut road = track.road();
     while track.segments.len() < config.max_segments as usize {
         let index = track.segments.len();
         let (end, end_heading) = road.end();

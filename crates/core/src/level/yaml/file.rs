@@ -13,7 +13,7 @@ use crate::level::pacing::{AuxCurve, Pacing};
 use crate::level::params::{self, ParamRange};
 use crate::level::platform::{BlockParams, PlatformTrack, Start};
 use crate::level::profile::ProfileRecord;
-use crate::level::racing::{Obstacle, RacingTrack, SegmentParams};
+use crate::level::racing::{self, Obstacle, RacingTrack, RoadShape, SegmentParams};
 use crate::level::{Game, Level, SolverStats, Source, Track};
 
 /// A number that must lie in the range `B` names; checked while parsing, so serde_yaml's error
@@ -48,6 +48,8 @@ bounds! {
     Aux => params::AUX,
     Heading => params::HEADING,
     Coordinate => params::COORDINATE,
+    RoadWidth => racing::WIDTH_RANGE,
+    Banking => racing::BANKING_RANGE,
 }
 
 impl<B> Bounded<B> {
@@ -107,6 +109,9 @@ pub(super) struct LevelFile {
     /// Racing levels: what the road goes around.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     obstacles: Vec<Obstacle>,
+    /// Racing levels: the road's width and banking (none: the built-in road's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    road: Option<RoadFile>,
     #[serde(default)]
     source: Source,
     /// The game profile it was made under (none: the built-in one).
@@ -114,6 +119,13 @@ pub(super) struct LevelFile {
     profile: Option<ProfileRecord>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     stats: Option<SolverStats>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RoadFile {
+    width: Bounded<RoadWidth>,
+    banking: Bounded<Banking>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -163,6 +175,13 @@ impl LevelFile {
                 .as_ref()
                 .and_then(|p| p.piece_aux.get(i).copied().flatten())
                 .map(Bounded::new)
+        };
+        let road = match &level.track {
+            Track::Racing(track) if !track.road.is_default() => Some(RoadFile {
+                width: Bounded::new(track.road.width),
+                banking: Bounded::new(track.road.banking),
+            }),
+            _ => None,
         };
         let (start, blocks, segments, obstacles) = match &level.track {
             Track::Platform(track) => {
@@ -221,6 +240,7 @@ impl LevelFile {
             blocks,
             segments,
             obstacles,
+            road,
             source: level.source.clone(),
             profile: level.profile.as_ref().map(|p| p.record()),
             stats: level.stats.clone(),
@@ -293,6 +313,13 @@ impl LevelFile {
                 "obstacles".into(),
                 line_of_key(text, "obstacles"),
                 "a platform level has no obstacles".into(),
+            ));
+        }
+        if self.road.is_some() {
+            return Err(invalid(
+                "road".into(),
+                line_of_key(text, "road"),
+                "a platform level has no road".into(),
             ));
         }
         let blocks = self.blocks.as_ref().ok_or_else(|| {
@@ -403,6 +430,13 @@ impl LevelFile {
             heading: self.start.heading.0,
             segments,
             obstacles: self.obstacles.clone(),
+            road: self
+                .road
+                .as_ref()
+                .map_or_else(RoadShape::default, |r| RoadShape {
+                    width: r.width.0,
+                    banking: r.banking.0,
+                }),
         };
         // Checked here (not only in `validate`) to name the segment's line.
         track.check_geometry().map_err(|e| {

@@ -103,3 +103,34 @@ fn line_of_item_finds_block_style_items() {
     assert_eq!(line_of_item(text, "blocks", 1), Some(5));
     assert_eq!(line_of_item(text, "blocks", 2), None);
 }
+
+#[test]
+fn a_racing_level_keeps_its_road_and_a_bad_one_is_named() {
+    let hand_made = "\
+format: arlpcg-level
+version: 1
+game: racing
+start: {position: [0, 0, 0], heading: 0}
+segments:
+- {length: 30, curve: 20, height: 0}
+- {length: 30, curve: 0, height: 1}
+";
+    // Without `road:`, the built-in road, and none is written back.
+    let built_in = parse(hand_made).unwrap();
+    assert!(built_in.racing().unwrap().road.is_default());
+    assert!(!to_string(&built_in).contains("road:"));
+    let narrow = format!("{hand_made}road: {{width: 7, banking: 0}}\n");
+    let level = parse(&narrow).unwrap();
+    let road = level.racing().unwrap().road();
+    assert_eq!(road.shape().width, 7.0);
+    assert!(road.samples().iter().all(|p| p.bank == 0.0));
+    assert!(built_in.racing().unwrap().road().samples()[5].bank > 0.0);
+    assert_eq!(parse(&to_string(&level)).unwrap(), level);
+    let msg = problem(&narrow.replace("width: 7", "width: 20"));
+    assert!(
+        msg.contains("road") && msg.contains("road width 20 is out of range [6, 14] m"),
+        "{msg}"
+    );
+    let msg = problem(&format!("{HAND_MADE}road: {{width: 7, banking: 0}}\n"));
+    assert!(msg.contains("a platform level has no road"), "{msg}");
+}

@@ -255,21 +255,6 @@ impl ActorCritic {
         Ok(self.draw(&self.head(&obs)?, mode, Draws::Shared(rng))?.0)
     }
 
-    /// [`Self::choose`] for the rows where `played` is true, the actor run on those alone; the
-    /// other rows get zeros. Draws what [`Self::choose`] would for every row, so the rows played
-    /// and `rng` end as after `choose`.
-    pub fn choose_rows(
-        &self,
-        observations: &[f32],
-        played: &[bool],
-        mode: ActMode,
-        rng: &mut ChaCha8Rng,
-    ) -> candle_core::Result<Vec<f32>> {
-        let kept = rows_where(observations, self.shape.observation, played);
-        let head = Self::heads(&[(self, &kept)])?.remove(0);
-        self.draw_rows(head, played, mode, rng)
-    }
-
     /// The actors' outputs for each policy's own observations, run side by side: a playing
     /// tick's batches are small, and one product alone leaves threads idle.
     pub fn heads(players: &[(&ActorCritic, &[f32])]) -> candle_core::Result<Vec<Head>> {
@@ -513,15 +498,23 @@ mod tests {
         ];
         let (mut all, mut some) = (ChaCha8Rng::seed_from_u64(4), ChaCha8Rng::seed_from_u64(4));
         let every = policies[0].choose(&obs, ActMode::Sample, &mut all).unwrap();
+        let kept = rows_where(&obs, 3, &played);
+        let head = ActorCritic::heads(&[(&policies[0], &kept)])
+            .unwrap()
+            .remove(0);
         let rows = policies[0]
-            .choose_rows(&obs, &played, ActMode::Sample, &mut some)
+            .draw_rows(head, &played, ActMode::Sample, &mut some)
             .unwrap();
         for (k, (a, b)) in every.chunks(3).zip(rows.chunks(3)).enumerate() {
             assert_eq!(b, if played[k] { a } else { &[0.0; 3][..] }, "row {k}");
         }
         assert_eq!(all, some, "the same draws");
+        // A policy that plays no row still draws for every row.
+        let head = ActorCritic::heads(&[(&policies[1], &[][..])])
+            .unwrap()
+            .remove(0);
         let none = policies[1]
-            .choose_rows(&obs, &[false; 10], ActMode::Sample, &mut some)
+            .draw_rows(head, &[false; 10], ActMode::Sample, &mut some)
             .unwrap();
         assert_eq!(none, vec![0.0; 30]);
         policies[1].choose(&obs, ActMode::Sample, &mut all).unwrap();

@@ -16,7 +16,7 @@ use crate::level::Track;
 use crate::level::heading::{direction_heading, heading_direction, wrap_degrees};
 use crate::level::params::{SEGMENT_CURVE, SEGMENT_HEIGHT, SEGMENT_LENGTH, quantize};
 use crate::level::profile::{Abilities, SegmentRanges};
-use crate::level::racing::{self, Obstacle, RacingTrack, SegmentParams};
+use crate::level::racing::{self, Obstacle, RacingTrack, RoadShape, SegmentParams};
 use crate::level::road::Road;
 use crate::level::stats::Outcome;
 
@@ -123,16 +123,18 @@ pub struct RacingBuild {
 }
 
 impl RacingBuild {
-    /// An empty road at the origin heading `heading` degrees, among `obstacles`, with the
-    /// default [`DEFAULT_CURVE_OFFSET`].
+    /// An empty road of `shape` at the origin heading `heading` degrees, among `obstacles`,
+    /// with the default [`DEFAULT_CURVE_OFFSET`].
     pub fn new(
         heading: f64,
         goal: [f64; 3],
         obstacles: Vec<Obstacle>,
         max_segments: usize,
+        shape: RoadShape,
     ) -> Self {
         let mut track = RacingTrack::new([0.0; 3], heading);
         track.obstacles = obstacles;
+        track.road = shape;
         let road = track.road();
         Self {
             track,
@@ -341,11 +343,9 @@ impl GeneratorGame for RacingGame {
         obstacles: u32,
     ) -> (RacingBuild, ChaCha8Rng) {
         let (goal, heading, obstacles, rng) = super::rules::goal_and_start(seed, goal, obstacles);
-        let mut build = RacingBuild::new(heading, goal, obstacles, limits.max_pieces);
+        let road = limits.player.segments().road();
+        let mut build = RacingBuild::new(heading, goal, obstacles, limits.max_pieces, road);
         build.curve_offset = limits.curve_offset;
-        // The road of the player's profile.
-        build.track.road = limits.player.segments().road();
-        build.road = build.track.road();
         build.player = limits.player;
         (build, rng)
     }
@@ -498,7 +498,13 @@ mod tests {
             radius: 3.0,
             height: 5.0,
         };
-        let build = RacingBuild::new(0.0, [300.0, 0.0, 0.0], vec![obstacle], 30);
+        let build = RacingBuild::new(
+            0.0,
+            [300.0, 0.0, 0.0],
+            vec![obstacle],
+            30,
+            RoadShape::default(),
+        );
         let mut out = vec![0.0; observation_size::<RacingGame>()];
         build.observe(&[-1.0], &mut out);
         let rays = &out[12..12 + RAYS];
@@ -511,7 +517,13 @@ mod tests {
         );
         assert_eq!(*out.last().unwrap(), -1.0, "aux last");
         // A road that has turned 270° on a circle sees its own beginning ahead, to the left.
-        let mut turning = RacingBuild::new(0.0, [-300.0, 0.0, 0.0], Vec::new(), 30);
+        let mut turning = RacingBuild::new(
+            0.0,
+            [-300.0, 0.0, 0.0],
+            Vec::new(),
+            30,
+            RoadShape::default(),
+        );
         for _ in 0..9 {
             turning.road.push(SegmentParams {
                 length: 20.0,
@@ -615,19 +627,27 @@ mod tests {
             size: [6.0, 4.0, 6.0],
             heading: 0.0,
         };
-        let mut build = RacingBuild::new(0.0, [300.0, 0.0, 0.0], vec![obstacle], 2);
+        let mut build = RacingBuild::new(
+            0.0,
+            [300.0, 0.0, 0.0],
+            vec![obstacle],
+            2,
+            RoadShape::default(),
+        );
         assert_eq!(
             build.place(&[0.0; 3]),
             Placement::Invalid,
             "straight into the box"
         );
-        let mut short = RacingBuild::new(0.0, [300.0, 0.0, 0.0], Vec::new(), 2);
+        let mut short =
+            RacingBuild::new(0.0, [300.0, 0.0, 0.0], Vec::new(), 2, RoadShape::default());
         assert_eq!(short.place(&[0.0; 3]), Placement::Placed);
         assert_eq!(short.place(&[0.0; 3]), Placement::Placed);
         assert_eq!(short.place(&[0.0; 3]), Placement::OutOfPieces);
         // A goal at the centre of the tightest circle stays 90° to the left: every segment
         // turns 30° left, and the road comes back onto itself.
-        let mut circling = RacingBuild::new(0.0, [0.0, 0.0, -38.2], Vec::new(), 30);
+        let mut circling =
+            RacingBuild::new(0.0, [0.0, 0.0, -38.2], Vec::new(), 30, RoadShape::default());
         let placements: Vec<Placement> =
             (0..14).map(|_| circling.place(&[-1.0, 1.0, 0.0])).collect();
         assert!(placements.contains(&Placement::Invalid), "{placements:?}");

@@ -10,8 +10,9 @@ use crate::game::Player;
 use crate::level::heading::{direction_heading, heading_direction, wrap_degrees};
 use crate::level::params::quantize;
 use crate::level::profile::SegmentRanges;
-use crate::level::racing::RoadShape;
-use crate::level::racing::{self, Obstacle, RacingRulesConfig, RacingTrack, SegmentParams};
+use crate::level::racing::{
+    self, Obstacle, RacingRulesConfig, RacingTrack, RoadShape, SegmentParams,
+};
 use crate::level::road::Road;
 use crate::level::{Level, Source, Track};
 

@@ -454,7 +454,12 @@ fn stopped_by(signal: &str) {
         .spawn()
         .unwrap();
     let start = Instant::now();
-    while !out.join("metrics.csv").exists() || curve(&out).len() < 2 {
+    // Counted in whole lines: the run may be writing the next row while it is read.
+    let rows = || {
+        std::fs::read_to_string(out.join("metrics.csv"))
+            .map_or(0, |text| text.matches('\n').count().saturating_sub(1))
+    };
+    while rows() < 2 {
         assert!(
             start.elapsed() < Duration::from_secs(120),
             "the run made no progress"

@@ -18,6 +18,7 @@ use arlpcg_core::level::racing::RacingRulesConfig;
 use arlpcg_core::level::{Game, Level, PlatformRulesConfig, PolicyRef, Source};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::{ActMode, ActorCritic};
+use std::fmt;
 
 /// Why the rules built no level.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -34,6 +35,29 @@ pub enum NoRuleLevel {
 pub enum AuxAsk {
     Flat(f64),
     Curve(AuxCurve),
+}
+
+impl AuxAsk {
+    /// The same ask `step` easier (λ up, clamped to 1, a curve moved up whole); none when it is
+    /// already λ = 1 everywhere.
+    pub fn eased(&self, step: f64) -> Option<AuxAsk> {
+        match self {
+            AuxAsk::Flat(aux) if *aux < 1.0 => Some(AuxAsk::Flat(round_aux((aux + step).min(1.0)))),
+            AuxAsk::Curve(curve) if curve.points().iter().any(|&(_, aux)| aux < 1.0) => {
+                Some(AuxAsk::Curve(curve.shifted(step)))
+            }
+            _ => None,
+        }
+    }
+}
+
+impl fmt::Display for AuxAsk {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AuxAsk::Flat(aux) => write!(f, "λ = {aux:+.2}"),
+            AuxAsk::Curve(curve) => write!(f, "the curve \"{curve}\""),
+        }
+    }
 }
 
 /// What difficulty a designer asks for, one shape for `generate` (`--aux`, `--aux-curve`,
@@ -452,5 +476,22 @@ mod tests {
         )
         .unwrap_err();
         assert!(err.to_string().contains("no valid level"), "{err}");
+    }
+
+    #[test]
+    fn an_eased_ask_moves_lambda_up_to_one_and_no_further() {
+        assert_eq!(AuxAsk::Flat(-1.0).eased(0.25), Some(AuxAsk::Flat(-0.75)));
+        assert_eq!(AuxAsk::Flat(0.9).eased(0.25), Some(AuxAsk::Flat(1.0)));
+        assert_eq!(AuxAsk::Flat(1.0).eased(0.25), None);
+        let curve = AuxCurve::parse("0:1, 0.5:1, 0.5:-1, 1:-1").unwrap();
+        let eased = AuxAsk::Curve(curve).eased(0.25).unwrap();
+        assert_eq!(
+            eased.to_string(),
+            "the curve \"0:1, 0.5:1, 0.5:-0.75, 1:-0.75\""
+        );
+        assert_eq!(
+            AuxAsk::Curve(AuxCurve::parse("0:1, 1:1").unwrap()).eased(0.25),
+            None
+        );
     }
 }

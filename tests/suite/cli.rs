@@ -917,6 +917,65 @@ fn generate_verifies_with_the_solver_policy_it_is_given() {
     fails_with(&refused, 2, "--solver-policy");
 }
 
+/// A seed whose draws no run completes is asked again easier, λ up by 0.25 after each 10
+/// draws, each step said; the batch fails only when λ = 1 fails too (here an untrained Solver
+/// completes nothing).
+#[test]
+fn generate_verify_eases_a_seed_that_no_run_completes_up_to_lambda_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.yaml");
+    std::fs::write(
+        &config,
+        "seed: 3\nhidden: [16, 16]\nppo:\n  num_envs: 4\n  num_steps: 32\n",
+    )
+    .unwrap();
+    let run = dir.path().join("run");
+    arlpcg_ok(&[
+        "train",
+        "--mode",
+        "rule-pcg",
+        "--steps",
+        "128",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap(),
+    ]);
+    let policies = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    let out = arlpcg(&[
+        "generate",
+        "--policies",
+        policies.to_str().unwrap(),
+        "--aux=-0.5",
+        "--count",
+        "1",
+        "--verify",
+        "2",
+        "--solver-policy",
+        run.join("solver.safetensors").to_str().unwrap(),
+        "--out",
+        dir.path().join("levels").to_str().unwrap(),
+    ]);
+    fails_with(
+        &out,
+        1,
+        "none of the 10 levels drawn for this seed at λ = +1.00",
+    );
+    let err = stderr(&out);
+    let asked: Vec<&str> = err
+        .lines()
+        .filter_map(|line| line.split("; asking ").nth(1))
+        .collect();
+    assert_eq!(
+        asked,
+        [
+            "λ = -0.25", "λ = +0.00", "λ = +0.25", "λ = +0.50", "λ = +0.75", "λ = +1.00"
+        ],
+        "{err}"
+    );
+    assert!(!dir.path().join("levels").exists(), "nothing written");
+}
+
 #[test]
 fn options_that_would_do_nothing_or_count_twice_are_refused_by_name() {
     let dir = tempfile::tempdir().unwrap();

@@ -340,9 +340,12 @@ fn stem_of_lambda(args: &GenerateArgs, seed: u64) -> String {
     }
 }
 
-/// Draws of one seed tried before `generate --verify` gives up on finding a level that some
-/// run completes.
+/// Draws of one seed tried at one λ before `generate --verify` eases it.
 pub const MAX_DRAWS: u32 = 10;
+
+/// How much easier (λ up) a seed is asked again when none of its `MAX_DRAWS` draws was
+/// completed by any run: a batch keeps every seed, each level recording the λ it was built at.
+pub const EASE_STEP: f64 = 0.25;
 
 /// What every level of the batch asks, bar its seed and draw: goal, obstacles, λ or curve, the
 /// kept prefix and the profile.
@@ -385,7 +388,8 @@ fn build(
 }
 
 /// Level `seed`, verified when asked: a draw that no run completes is replaced by the seed's
-/// next draw (unless --allow-unsolved), and a kept level carries a certificate.
+/// next draw (unless --allow-unsolved); after `MAX_DRAWS` of them a Generator's λ is eased by
+/// `EASE_STEP`, and so on up to λ = 1. A kept level carries a certificate.
 fn build_verified(
     args: &GenerateArgs,
     template: &LevelRequest,
@@ -402,21 +406,36 @@ fn build_verified(
         on_trial: &|_| {},
         stop: &|| stop.load(Ordering::SeqCst),
     };
-    for draw in 0..MAX_DRAWS {
-        let mut level = build(args, template, generator, seed, draw)?;
-        let Some(mut stats) = verify::verify_watched(&level, solver, trials, seed, &watch)? else {
-            return Ok(None);
-        };
-        if stats.successes == 0 && !args.allow_unsolved {
-            continue;
+    let mut request = template.clone();
+    let mut replaced = 0;
+    loop {
+        for draw in 0..MAX_DRAWS {
+            let mut level = build(args, &request, generator, seed, draw)?;
+            let Some(mut stats) = verify::verify_watched(&level, solver, trials, seed, &watch)?
+            else {
+                return Ok(None);
+            };
+            if stats.successes == 0 && !args.allow_unsolved {
+                replaced += 1;
+                continue;
+            }
+            stats.redraws = replaced;
+            level.stats = Some(stats);
+            return Ok(Some(verify::certified(level, solver, seed)?));
         }
-        stats.redraws = draw;
-        level.stats = Some(stats);
-        return Ok(Some(verify::certified(level, solver, seed)?));
+        let asked = request.aux.as_ref().filter(|_| generator.is_some());
+        let Some((asked, easier)) = asked.and_then(|a| Some((a.clone(), a.eased(EASE_STEP)?)))
+        else {
+            let at = asked.map_or(String::new(), |a| format!(" at {a}"));
+            bail!(
+                "none of the {MAX_DRAWS} levels drawn for this seed{at} was completed by any of {trials} runs (--allow-unsolved keeps the first anyway)"
+            )
+        };
+        crate::warn!(
+            "seed {seed}: none of {MAX_DRAWS} levels at {asked} was completed by any of {trials} runs; asking {easier}"
+        );
+        request.aux = Some(easier);
     }
-    bail!(
-        "none of the {MAX_DRAWS} levels drawn for this seed was completed by any of {trials} runs (--allow-unsolved keeps the first anyway)"
-    )
 }
 
 /// The Solver that plays `--verify` and `--target-success`: the judge asked for, the file asked

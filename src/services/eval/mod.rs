@@ -4,7 +4,9 @@
 //! - **Controllability**: Generator levels at λ ∈ {1, 0.5, 0, -0.5, -1} (the same goals at every
 //!   λ), played by the ARLPCG Solver: success ratio ± std over levels, the fraction completed by
 //!   at least one run, the pieces' mean parameters (platform: block distance and size; racing:
-//!   segment curve, length and height change) and, racing, the car's time in the air per run.
+//!   segment curve, length and height change), racing, the car's time in the air per run, and
+//!   where the runs fail: pieces per level and the failures' shares on each level's last piece
+//!   and on its most-failed one ([`tables::PieceFailures`]).
 //! - **Generalization**: every Solver on one held-out validation set (half rule levels, half
 //!   Generator levels cycling through the λ values), success ± std, completed by any, mean steps
 //!   of successful runs.

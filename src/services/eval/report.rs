@@ -38,6 +38,13 @@ pub fn markdown(results: &Results) -> String {
         for (name, unit) in game.piece_columns {
             md += &format!(" {}{unit} |", num(row.pieces[*name], 2));
         }
+        let [pieces, last, worst] = row.failure_columns().map(|v| v.unwrap_or(f64::NAN));
+        md += &format!(
+            " {} | {} | {} |",
+            num(pieces, 1),
+            num(last, 2),
+            num(worst, 2)
+        );
         md += &format!(" {} | {paper} |\n", row.tracks);
     }
     md += "\n## Solver generalization (held-out validation levels)\n\n";
@@ -111,7 +118,7 @@ pub fn csv_tables(results: &Results) -> Vec<(&'static str, String)> {
         .collect();
     let air = facts(results.game).air_time_step.is_some();
     let mut controllability = format!(
-        "aux,success_ratio,success_std,completed_by_any,{}{},tracks\n",
+        "aux,success_ratio,success_std,completed_by_any,{}{},pieces_per_level,failures_on_last_piece,failures_on_worst_piece,tracks\n",
         if air { "air_time," } else { "" },
         columns.join(",")
     );
@@ -125,6 +132,9 @@ pub fn csv_tables(results: &Results) -> Vec<(&'static str, String)> {
         }
         for name in &columns {
             controllability += &format!("{:.4},", r.pieces[*name]);
+        }
+        for value in r.failure_columns() {
+            controllability += &value.map_or(",".into(), |v| format!("{v:.4},"));
         }
         controllability += &format!("{}\n", r.tracks);
     }

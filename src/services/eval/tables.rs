@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use crate::services::verify::Summary;
+use crate::services::verify::{FailureConcentration, Summary};
 use arlpcg_core::game::facts::facts;
 use arlpcg_core::level::Game;
 use arlpcg_core::level::stats::SolverStats;
@@ -23,7 +23,58 @@ pub struct ControllabilityRow {
     /// Racing: mean seconds per run with the car in the air.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub air_time: Option<f64>,
+    /// Where the failures are ([`PieceFailures`]; absent from results written before).
+    #[serde(default, flatten, skip_serializing_if = "Option::is_none")]
+    pub failures: Option<PieceFailures>,
     pub tracks: usize,
+}
+
+/// How long the levels of one λ are and where their failed runs fail: a Generator that makes a
+/// level hard by a wall before the goal has most failures on the last piece, one whose
+/// difficulty lies along the way spreads them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
+pub struct PieceFailures {
+    /// Mean pieces per level.
+    pub pieces_per_level: f64,
+    /// Of all failed runs, the share that failed on their level's last piece...
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failures_on_last_piece: Option<f64>,
+    /// ...and on the piece of their level that fails most (none: no run failed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failures_on_worst_piece: Option<f64>,
+}
+
+impl ControllabilityRow {
+    /// Pieces per level, and the failures' shares on the last and on the worst piece (none: not
+    /// measured, or no run failed).
+    pub fn failure_columns(&self) -> [Option<f64>; 3] {
+        self.failures.map_or([None; 3], |f| {
+            [
+                Some(f.pieces_per_level),
+                f.failures_on_last_piece,
+                f.failures_on_worst_piece,
+            ]
+        })
+    }
+}
+
+impl PieceFailures {
+    /// From the statistics of each level of one λ (none without levels).
+    pub fn of(stats: &[&SolverStats]) -> Option<PieceFailures> {
+        if stats.is_empty() {
+            return None;
+        }
+        let mut gathered = FailureConcentration::default();
+        for level in stats {
+            gathered.add(level);
+        }
+        let shares = gathered.shares();
+        Some(PieceFailures {
+            pieces_per_level: gathered.pieces_per_level(),
+            failures_on_last_piece: shares.map(|[last, _]| last),
+            failures_on_worst_piece: shares.map(|[_, worst]| worst),
+        })
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
@@ -133,12 +184,13 @@ pub fn assemble(
                     (name.to_string(), mean)
                 })
                 .collect();
-            let air: Vec<f64> = plays
+            let at_aux: Vec<&SolverStats> = plays
                 .iter()
                 .zip(stats)
                 .filter(|(p, _)| matches!(p, Play::Controllability { aux, .. } if *aux == a))
-                .filter_map(|(_, s)| s.mean_air_steps)
+                .map(|(_, s)| s)
                 .collect();
+            let air: Vec<f64> = at_aux.iter().filter_map(|s| s.mean_air_steps).collect();
             let air_time = facts(layout.game)
                 .air_time_step
                 .map(|dt| dt * air.iter().sum::<f64>() / air.len().max(1) as f64);
@@ -149,6 +201,7 @@ pub fn assemble(
                 completed_by_any: s.completed_by_any,
                 pieces,
                 air_time,
+                failures: PieceFailures::of(&at_aux),
                 tracks: layout.levels_per_aux[a],
             }
         })
@@ -338,5 +391,22 @@ pub(super) mod tests {
         let results = assemble(Budget::QUICK, "gen", &layout, &outcomes(&layout));
         assert!(results.controllability.iter().all(|r| r.air_time.is_none()));
         assert_eq!(results.controllability[0].pieces["avg_block_size"], 7.0);
+    }
+
+    /// Failures on the last piece and on each level's worst piece, as shares of all failures.
+    #[test]
+    fn piece_failures_say_where_the_runs_fail() {
+        let level = |by_piece: &[u32]| SolverStats {
+            failures_by_piece: by_piece.to_vec(),
+            ..stats(0, 0)
+        };
+        let (wall, spread) = (level(&[0, 1, 3]), level(&[2, 0, 0, 0]));
+        let failures = PieceFailures::of(&[&wall, &spread]).unwrap();
+        assert_eq!(failures.pieces_per_level, 3.5);
+        assert_eq!(failures.failures_on_last_piece, Some(3.0 / 6.0));
+        assert_eq!(failures.failures_on_worst_piece, Some(5.0 / 6.0));
+        let clean = PieceFailures::of(&[&level(&[0, 0])]).unwrap();
+        assert_eq!(clean.failures_on_last_piece, None, "no failure, no share");
+        assert_eq!(PieceFailures::of(&[]), None);
     }
 }

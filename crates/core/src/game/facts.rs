@@ -77,7 +77,7 @@ pub const PLATFORM: GameFacts = GameFacts {
         "0.97, 6.73 m, 5.95 m", "0.92, 6.98 m, 5.77 m", "0.88, 7.15 m, 5.42 m",
         "0.74, 7.11 m, 4.52 m", "0.69, 7.46 m, 4.01 m",
     ],
-    controllability_header: "| λ | success ratio | completed by any | avg block distance | avg block size | levels | paper: success, distance, size |\n|---|---|---|---|---|---|---|\n",
+    controllability_header: "| λ | success ratio | completed by any | avg block distance | avg block size | blocks | failures on the last block | on the worst block | levels | paper: success, distance, size |\n|---|---|---|---|---|---|---|---|---|---|\n",
     paper_generalization: [
         ("fixed-track", "0.081 ± 0.205, 0.20 (54 steps)"),
         ("rule-pcg", "0.233 ± 0.200, 0.95 (451 steps)"),
@@ -114,7 +114,7 @@ pub const RACING: GameFacts = GameFacts {
         "0.99, 14.4°, 28.4 m, 1.5 m", "0.89, 14.7°, 27.1 m, 2.0 m", "0.77, 15.1°, 25.1 m, 2.5 m",
         "0.64, 15.3°, 23.0 m, 3.1 m", "0.61, 16.8°, 21.8 m, 3.9 m",
     ],
-    controllability_header: "| λ | success ratio | completed by any | air time per run | avg segment curve | avg segment length | avg segment height change | tracks | paper: success, angle, length, height |\n|---|---|---|---|---|---|---|---|---|\n",
+    controllability_header: "| λ | success ratio | completed by any | air time per run | avg segment curve | avg segment length | avg segment height change | segments | failures on the last segment | on the worst segment | tracks | paper: success, angle, length, height |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     paper_generalization: [
         ("fixed-track", "0.219 ± 0.280, 0.7 (431 m)"),
         ("rule-pcg", "0.174 ± 0.160, 0.9 (355 m)"),

@@ -6,7 +6,7 @@
 //!   at least one run, the pieces' mean parameters (platform: block distance and size; racing:
 //!   segment curve, length and height change), racing, the car's time in the air per run, and
 //!   where the runs fail: pieces per level and the failures' shares on each level's last piece
-//!   and on its most-failed one ([`tables::PieceFailures`]).
+//!   and on its most-failed one (`tables::PieceFailures`).
 //! - **Generalization**: every Solver on one held-out validation set (half rule levels, half
 //!   Generator levels cycling through the λ values), success ± std, completed by any, mean steps
 //!   of successful runs.

@@ -7,7 +7,7 @@ use arlpcg_core::level::Level;
 use arlpcg_core::level::profile::Profile;
 use arlpcg_core::seed_ranges::{EVAL_SEED_BASE, VALIDATION_AUX_STRIDE, VALIDATION_SEED_BASE};
 
-use super::{AUX_VALUES, Budget, NamedSolver, PlayLayout};
+use super::{AUX_VALUES, Budget, KNOB_BETWEEN, NamedSolver, PlayLayout};
 
 /// Seeds tried per wanted level before the table notes a shortfall (the Generator may fail to
 /// reach a goal).
@@ -82,6 +82,8 @@ pub fn is_rule_level(level: &Level) -> bool {
 /// The levels of an evaluation and its layout.
 pub struct Levels {
     pub by_aux: Vec<Vec<Level>>,
+    /// The same goals at each λ of [`KNOB_BETWEEN`].
+    pub between: Vec<Vec<Level>>,
     pub validation: Vec<Level>,
     pub layout: PlayLayout,
 }
@@ -95,6 +97,10 @@ pub fn levels(
     profile: Option<&Profile>,
 ) -> Result<Levels, candle_core::Error> {
     let by_aux: Vec<Vec<Level>> = AUX_VALUES
+        .iter()
+        .map(|&aux| generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks, profile))
+        .collect::<Result<_, _>>()?;
+    let between: Vec<Vec<Level>> = KNOB_BETWEEN
         .iter()
         .map(|&aux| generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks, profile))
         .collect::<Result<_, _>>()?;
@@ -114,6 +120,7 @@ pub fn levels(
     let layout = PlayLayout {
         game,
         levels_per_aux: by_aux.iter().map(Vec::len).collect(),
+        levels_between: between.iter().map(Vec::len).collect(),
         piece_means,
         validation_levels: validation.len(),
         validation_rule_levels: validation.iter().filter(|l| is_rule_level(l)).count(),
@@ -121,6 +128,7 @@ pub fn levels(
     };
     Ok(Levels {
         by_aux,
+        between,
         validation,
         layout,
     })

@@ -11,6 +11,7 @@
 //!   Generator levels cycling through the λ values), success ± std, completed by any, mean steps
 //!   of successful runs.
 //! - **Cross**: every Solver on the controllability levels, success ratio at each λ.
+//! - **Knob**: the ARLPCG Solver on the same goals every 0.25 of λ, how far success moves a step.
 //!
 //! In parts, as an evaluation flows: [`levels`] builds every level and the [`PlayLayout`] of the
 //! tables; [`plays`] numbers the plays (one Solver on one level) and plays any subset of them,
@@ -30,7 +31,7 @@ pub use levels::{Levels, generator_levels, is_rule_level, levels, validation_lev
 pub use merge::{PART_FILE, Part, merge};
 pub use plays::{Play, PlayLayout, play};
 pub use report::{chart, csv_tables, markdown};
-pub use tables::{ControllabilityRow, CrossRow, GeneralizationRow, Results, assemble};
+pub use tables::{ControllabilityRow, CrossRow, GeneralizationRow, Knob, Results, assemble};
 
 use serde::Serialize;
 
@@ -39,6 +40,10 @@ use crate::services::verify::Solver;
 
 /// The λ values of the tables, easy to hard.
 pub const AUX_VALUES: [f64; 5] = [1.0, 0.5, 0.0, -0.5, -1.0];
+
+/// The λ values between the tables' own: with them the ARLPCG Solver plays the same goals every
+/// 0.25 from 1 to -1, to show how smoothly the knob turns ([`tables::Knob`]).
+pub const KNOB_BETWEEN: [f64; 4] = [0.75, 0.25, -0.25, -0.75];
 
 /// How much to evaluate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
@@ -99,5 +104,6 @@ pub fn evaluate(
 /// Levels `evaluate` plays in all (for a progress bar).
 pub fn levels_to_play(budget: Budget, solvers: usize) -> u64 {
     let per_table = AUX_VALUES.len() as u64 * budget.tracks as u64;
-    per_table + solvers as u64 * (budget.validation_tracks as u64 + per_table)
+    let between = KNOB_BETWEEN.len() as u64 * budget.tracks as u64;
+    per_table + between + solvers as u64 * (budget.validation_tracks as u64 + per_table)
 }

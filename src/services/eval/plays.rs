@@ -19,6 +19,9 @@ pub struct PlayLayout {
     pub game: Game,
     /// Levels per λ of [`AUX_VALUES`] (the Generator may build fewer than the budget asks).
     pub levels_per_aux: Vec<usize>,
+    /// Levels per λ of [`KNOB_BETWEEN`](super::KNOB_BETWEEN) (none in parts written before).
+    #[serde(default)]
+    pub levels_between: Vec<usize>,
     /// The pieces' mean parameters (the game's piece columns) at each λ (`None`: no levels).
     pub piece_means: Vec<Option<Vec<f64>>>,
     /// Levels in the validation set: its rule levels first, then the Generator's.
@@ -34,6 +37,8 @@ pub struct PlayLayout {
 pub enum Play {
     /// The ARLPCG Solver on level `level` at λ number `aux`.
     Controllability { aux: usize, level: usize },
+    /// The ARLPCG Solver on level `level` at λ number `aux` of the knob's in-between values.
+    Knob { aux: usize, level: usize },
     /// Solver `solver` on validation level `level`.
     Generalization { solver: usize, level: usize },
     /// Solver `solver` on level `level` at λ number `aux`.
@@ -48,7 +53,8 @@ impl PlayLayout {
     /// How many plays [`PlayLayout::plays`] lists, without listing them.
     pub fn play_count(&self) -> usize {
         let per_table: usize = self.levels_per_aux.iter().sum();
-        per_table + self.solvers.len() * (self.validation_levels + per_table)
+        let between: usize = self.levels_between.iter().sum();
+        per_table + between + self.solvers.len() * (self.validation_levels + per_table)
     }
 
     /// Every play of the evaluation, in a fixed order; shard I of K plays those whose index
@@ -57,6 +63,9 @@ impl PlayLayout {
         let mut plays = Vec::new();
         for (aux, &n) in self.levels_per_aux.iter().enumerate() {
             plays.extend((0..n).map(|level| Play::Controllability { aux, level }));
+        }
+        for (aux, &n) in self.levels_between.iter().enumerate() {
+            plays.extend((0..n).map(|level| Play::Knob { aux, level }));
         }
         for solver in 0..self.solvers.len() {
             plays.extend(
@@ -95,6 +104,7 @@ pub fn play(
                 Play::Controllability { aux, level } => {
                     (main, &levels.by_aux[aux][level], budget.trials)
                 }
+                Play::Knob { aux, level } => (main, &levels.between[aux][level], budget.trials),
                 Play::Generalization { solver, level } => {
                     (solver, &levels.validation[level], budget.validation_trials)
                 }

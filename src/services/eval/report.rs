@@ -47,6 +47,16 @@ pub fn markdown(results: &Results) -> String {
         );
         md += &format!(" {} | {paper} |\n", row.tracks);
     }
+    if let Some(knob) = &results.knob {
+        let success: Vec<String> = knob.success.iter().map(|s| num(*s, 2)).collect();
+        md += &format!(
+            "\nThe knob on the same goals, λ from +1 to -1 every 0.25: success {}; one step moves a goal's success by at most {} in {:.0}% of {} steps.\n",
+            success.join(", "),
+            super::Knob::SMOOTH_STEP,
+            100.0 * knob.smooth_steps,
+            knob.steps
+        );
+    }
     md += "\n## Solver generalization (held-out validation levels)\n\n";
     md += "| mode | success ratio | on rule levels | on Generator levels | completed by any | avg steps | paper |\n|---|---|---|---|---|---|---|\n";
     for row in &results.generalization {

@@ -9,7 +9,7 @@ use arlpcg_core::game::facts::facts;
 use arlpcg_core::level::Game;
 use arlpcg_core::level::stats::SolverStats;
 
-use super::{AUX_VALUES, Budget, Play, PlayLayout};
+use super::{AUX_VALUES, Budget, KNOB_BETWEEN, Play, PlayLayout};
 
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct ControllabilityRow {
@@ -108,6 +108,68 @@ pub struct JudgeRow {
     pub completed_by_any: f64,
 }
 
+/// How smoothly λ turns difficulty: the ARLPCG Solver on the same goals at every λ from 1 to -1,
+/// 0.25 apart ([`AUX_VALUES`] and [`KNOB_BETWEEN`]).
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+pub struct Knob {
+    /// λ, easy to hard.
+    pub aux: Vec<f64>,
+    /// Mean success at each.
+    pub success: Vec<f64>,
+    /// Steps from one λ to the next on the same goal...
+    pub steps: usize,
+    /// ...and the share of them in which success moved by at most [`Knob::SMOOTH_STEP`].
+    pub smooth_steps: f64,
+}
+
+impl Knob {
+    /// The most a step of 0.25 in λ may move one goal's success and still count as smooth.
+    pub const SMOOTH_STEP: f64 = 0.5;
+
+    /// From the ARLPCG Solver's plays at every λ (none when the knob's levels were not played).
+    fn of(plays: &[Play], stats: &[SolverStats]) -> Option<Knob> {
+        let aux: Vec<f64> = (0..AUX_VALUES.len() + KNOB_BETWEEN.len())
+            .map(|k| match k % 2 {
+                0 => AUX_VALUES[k / 2],
+                _ => KNOB_BETWEEN[k / 2],
+            })
+            .collect();
+        // Each λ's success by goal (the level's seed, the same at every λ).
+        let mut by_aux = vec![BTreeMap::new(); aux.len()];
+        for (play, s) in plays.iter().zip(stats) {
+            let k = match *play {
+                Play::Controllability { aux, .. } => 2 * aux,
+                Play::Knob { aux, .. } => 2 * aux + 1,
+                _ => continue,
+            };
+            by_aux[k].insert(s.seed, s.success_ratio);
+        }
+        if by_aux.iter().any(BTreeMap::is_empty) {
+            return None;
+        }
+        let success = by_aux
+            .iter()
+            .map(|goals| goals.values().sum::<f64>() / goals.len() as f64)
+            .collect();
+        let moves: Vec<f64> = by_aux
+            .windows(2)
+            .flat_map(|pair| {
+                let next = &pair[1];
+                pair[0]
+                    .iter()
+                    .filter_map(|(seed, a)| next.get(seed).map(|b| (a - b).abs()))
+            })
+            .collect();
+        let smooth = moves.iter().filter(|&&m| m <= Self::SMOOTH_STEP).count();
+        Some(Knob {
+            aux,
+            success,
+            steps: moves.len(),
+            smooth_steps: smooth as f64 / moves.len().max(1) as f64,
+        })
+    }
+}
+
 /// Everything `eval` measures.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct Results {
@@ -122,6 +184,9 @@ pub struct Results {
     pub cross: Vec<CrossRow>,
     /// Every judge (trained Solvers and the scripted player's skills) at every λ.
     pub controllability_by_judge: Vec<JudgeRow>,
+    /// The knob every 0.25 of λ (absent from results written before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub knob: Option<Knob>,
     /// The game profile every level was made and played for (`eval --profile`; absent: the
     /// built-in game).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -261,6 +326,7 @@ pub fn assemble(
         generalization,
         cross,
         controllability_by_judge,
+        knob: Knob::of(&plays, stats),
         profile: None,
     }
 }
@@ -310,6 +376,7 @@ pub(super) mod tests {
         PlayLayout {
             game,
             levels_per_aux: vec![1, 2, 0, 1, 1],
+            levels_between: vec![1, 1, 1, 1],
             piece_means: vec![
                 Some(vec![7.0; columns]),
                 Some(vec![8.0; columns]),
@@ -341,6 +408,7 @@ pub(super) mod tests {
                     stats(if level < 1 { 4 } else { solver as u32 * 2 }, 4)
                 }
                 Play::Cross { solver, .. } => stats(solver as u32 + 1, 4),
+                Play::Knob { .. } => stats(3, 4),
             })
             .collect()
     }
@@ -408,5 +476,51 @@ pub(super) mod tests {
         let clean = PieceFailures::of(&[&level(&[0, 0])]).unwrap();
         assert_eq!(clean.failures_on_last_piece, None, "no failure, no share");
         assert_eq!(PieceFailures::of(&[]), None);
+    }
+
+    /// The knob reads each goal's success at the nine λ in order, 1 to -1, and counts the steps
+    /// where it moved by more than half.
+    #[test]
+    fn the_knob_follows_each_goal_from_one_lambda_to_the_next() {
+        // Goal 7 falls evenly from 1 to 0.2 (0.1 a step); goal 8 drops from 1 to 0 between λ = 0
+        // and -0.25 (the first play of the knob's third in-between λ).
+        let success = |goal: u64, k: usize| match goal {
+            7 => 1.0 - 0.1 * k as f64,
+            _ => f64::from(u8::from(k < 5)),
+        };
+        let mut plays = Vec::new();
+        let mut all = Vec::new();
+        for k in 0..9 {
+            for (level, goal) in [7u64, 8].into_iter().enumerate() {
+                plays.push(match k % 2 {
+                    0 => Play::Controllability { aux: k / 2, level },
+                    _ => Play::Knob { aux: k / 2, level },
+                });
+                let mut s = stats((20.0 * success(goal, k)).round() as u32, 20);
+                s.seed = goal;
+                all.push(s);
+            }
+        }
+        plays.push(Play::Generalization {
+            solver: 0,
+            level: 0,
+        });
+        all.push(stats(0, 20));
+        let knob = Knob::of(&plays, &all).unwrap();
+        assert_eq!(
+            knob.aux,
+            [1.0, 0.75, 0.5, 0.25, 0.0, -0.25, -0.5, -0.75, -1.0]
+        );
+        assert!((knob.success[0] - 1.0).abs() < 1e-9 && (knob.success[8] - 0.1).abs() < 1e-9);
+        assert_eq!(knob.steps, 16);
+        assert_eq!(knob.smooth_steps, 15.0 / 16.0);
+        let tables_only: Vec<Play> = plays
+            .iter()
+            .map(|p| match *p {
+                Play::Knob { level, .. } => Play::Generalization { solver: 0, level },
+                p => p,
+            })
+            .collect();
+        assert_eq!(Knob::of(&tables_only, &all), None, "no knob levels played");
     }
 }

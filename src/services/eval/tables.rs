@@ -207,6 +207,55 @@ impl Results {
     }
 }
 
+/// The summary of some plays' statistics (NaN figures for none).
+fn summarized(chosen: Vec<SolverStats>) -> Summary {
+    if chosen.is_empty() {
+        return Summary {
+            levels: 0,
+            mean_success: f64::NAN,
+            std_success: f64::NAN,
+            completed_by_any: f64::NAN,
+            mean_progress: f64::NAN,
+            mean_success_steps: f64::NAN,
+        };
+    }
+    Summary::of(&chosen)
+}
+
+/// The controllability row of λ number `a` of [`AUX_VALUES`], from the ARLPCG Solver's
+/// statistics on its levels.
+fn controllability_row(
+    layout: &PlayLayout,
+    a: usize,
+    at_aux: &[&SolverStats],
+) -> ControllabilityRow {
+    let s = summarized(at_aux.iter().map(|&s| s.clone()).collect());
+    let game = facts(layout.game);
+    let pieces = game
+        .piece_columns
+        .iter()
+        .enumerate()
+        .map(|(k, (name, _))| {
+            let mean = layout.piece_means[a].as_ref().map_or(f64::NAN, |m| m[k]);
+            (name.to_string(), mean)
+        })
+        .collect();
+    let air: Vec<f64> = at_aux.iter().filter_map(|s| s.mean_air_steps).collect();
+    let air_time = game
+        .air_time_step
+        .map(|dt| dt * air.iter().sum::<f64>() / air.len().max(1) as f64);
+    ControllabilityRow {
+        aux: AUX_VALUES[a],
+        success_ratio: s.mean_success,
+        success_std: s.std_success,
+        completed_by_any: s.completed_by_any,
+        pieces,
+        air_time,
+        failures: PieceFailures::of(at_aux),
+        tracks: layout.levels_per_aux[a],
+    }
+}
+
 /// The tables from the layout and the statistics of every play (`stats[i]` of play `i`).
 pub fn assemble(
     budget: Budget,
@@ -217,58 +266,24 @@ pub fn assemble(
     let plays = layout.plays();
     assert_eq!(plays.len(), stats.len(), "one statistics entry per play");
     let summary = |wanted: &dyn Fn(&Play) -> bool| {
-        let chosen: Vec<SolverStats> = plays
-            .iter()
-            .zip(stats)
-            .filter(|(p, _)| wanted(p))
-            .map(|(_, s)| s.clone())
-            .collect();
-        if chosen.is_empty() {
-            return Summary {
-                levels: 0,
-                mean_success: f64::NAN,
-                std_success: f64::NAN,
-                completed_by_any: f64::NAN,
-                mean_progress: f64::NAN,
-                mean_success_steps: f64::NAN,
-            };
-        }
-        Summary::of(&chosen)
-    };
-    let controllability = AUX_VALUES
-        .iter()
-        .enumerate()
-        .map(|(a, &aux)| {
-            let s = summary(&|p| matches!(p, Play::Controllability { aux, .. } if *aux == a));
-            let pieces = facts(layout.game)
-                .piece_columns
+        summarized(
+            plays
                 .iter()
-                .enumerate()
-                .map(|(k, (name, _))| {
-                    let mean = layout.piece_means[a].as_ref().map_or(f64::NAN, |m| m[k]);
-                    (name.to_string(), mean)
-                })
-                .collect();
+                .zip(stats)
+                .filter(|(p, _)| wanted(p))
+                .map(|(_, s)| s.clone())
+                .collect(),
+        )
+    };
+    let controllability = (0..AUX_VALUES.len())
+        .map(|a| {
             let at_aux: Vec<&SolverStats> = plays
                 .iter()
                 .zip(stats)
                 .filter(|(p, _)| matches!(p, Play::Controllability { aux, .. } if *aux == a))
                 .map(|(_, s)| s)
                 .collect();
-            let air: Vec<f64> = at_aux.iter().filter_map(|s| s.mean_air_steps).collect();
-            let air_time = facts(layout.game)
-                .air_time_step
-                .map(|dt| dt * air.iter().sum::<f64>() / air.len().max(1) as f64);
-            ControllabilityRow {
-                aux,
-                success_ratio: s.mean_success,
-                success_std: s.std_success,
-                completed_by_any: s.completed_by_any,
-                pieces,
-                air_time,
-                failures: PieceFailures::of(&at_aux),
-                tracks: layout.levels_per_aux[a],
-            }
+            controllability_row(layout, a, &at_aux)
         })
         .collect();
     let mut generalization = Vec::new();

@@ -253,6 +253,7 @@ impl Default for TrainConfig {
                 num_envs: 64,
                 num_steps: 128,
                 ent_coef: 0.005,
+                update_epochs: SOLVER_UPDATE_EPOCHS,
                 ..PpoConfig::default()
             },
             generator: GeneratorConfig::default(),
@@ -345,6 +346,10 @@ const MAX_CONFIG_BYTES: u64 = 1 << 20;
 
 /// The platform recipe's budget in Solver steps learned from ([`TrainConfig::steps`]).
 pub const PLATFORM_STEPS: u64 = 8_000_000;
+
+/// Passes of the Solver's update over each batch, in every mode and game. Why:
+/// docs/decisions.md#d15.
+pub const SOLVER_UPDATE_EPOCHS: usize = 2;
 
 /// The platform recipe's finish: one Generator phase, entropy bonus 0.01, against the final
 /// Solver, frozen (no snapshots), and the median scripted controller, each playing half the

@@ -322,7 +322,7 @@ impl Default for GeneratorConfig {
                 ent_coef: 0.001,
                 ..PpoConfig::default()
             },
-            rewards: GeneratorRewards::default(),
+            rewards: PlatformGame::default_rewards(),
             aux_values: vec![-1.0, -1.0, -0.5, 0.5, 1.0, 1.0],
             max_pieces: PlatformGame::DEFAULT_MAX_PIECES,
             obstacles: 0,

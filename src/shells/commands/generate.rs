@@ -423,16 +423,16 @@ fn build_verified(
             level.stats = Some(stats);
             return Ok(Some(verify::certified(level, solver, seed)?));
         }
+        // Only a Generator's λ can be eased; rule levels have none.
         let asked = request.aux.as_ref().filter(|_| generator.is_some());
-        let Some((asked, easier)) = asked.and_then(|a| Some((a.clone(), a.eased(EASE_STEP)?)))
-        else {
-            let at = asked.map_or(String::new(), |a| format!(" at {a}"));
+        let at = asked.map_or(String::new(), |a| format!(" at {a}"));
+        let Some(easier) = asked.and_then(|a| a.eased(EASE_STEP)) else {
             bail!(
                 "none of the {MAX_DRAWS} levels drawn for this seed{at} was completed by any of {trials} runs (--allow-unsolved keeps the first anyway)"
             )
         };
         crate::warn!(
-            "seed {seed}: none of {MAX_DRAWS} levels at {asked} was completed by any of {trials} runs; asking {easier}"
+            "seed {seed}: none of {MAX_DRAWS} levels{at} was completed by any of {trials} runs; asking {easier}"
         );
         request.aux = Some(easier);
     }

@@ -347,9 +347,13 @@ const MAX_CONFIG_BYTES: u64 = 1 << 20;
 /// The platform recipe's budget in Solver steps learned from ([`TrainConfig::steps`]).
 pub const PLATFORM_STEPS: u64 = 8_000_000;
 
-/// Passes of the Solver's update over each batch, in every mode and game. Why:
-/// docs/decisions.md#d15.
+/// Passes of the Solver's update over each batch where a Generator trains beside it (`arlpcg`,
+/// `fixed-aux`). Why: docs/decisions.md#d15.
 pub const SOLVER_UPDATE_EPOCHS: usize = 2;
+
+/// Passes of a Solver trained alone (`rule-pcg`, `fixed-track`: the baselines). Why:
+/// docs/decisions.md#d15.
+pub const SOLO_SOLVER_UPDATE_EPOCHS: usize = 4;
 
 /// The platform recipe's finish: one Generator phase, entropy bonus 0.01, against the final
 /// Solver, frozen (no snapshots), and the median scripted controller, each playing half the

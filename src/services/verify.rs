@@ -625,12 +625,12 @@ mod tests {
         assert_eq!(FailureConcentration::default().shares(), None);
     }
 
-    /// The shipped easy-then-hard level winds back and forth near halfway, so its pieces'
-    /// fractions of the way are not in order; the chart still reads left to right.
+    /// The shipped hard example level (platform, seed 7, λ = -1) winds back toward its start,
+    /// so its pieces' fractions of the way are not in order; the chart still reads left to right.
     #[test]
     fn the_pacing_chart_counts_pieces_in_order_whatever_way_the_level_winds() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("levels/pacing/platform_seed102_curve-8c91a45e.yaml");
+            .join("levels/platform/platform_seed7_aux-1.00.yaml");
         let level = arlpcg_core::level::yaml::load(&path).unwrap();
         let stats = level.stats.clone().unwrap();
         let fractions = level.piece_start_fractions();
@@ -638,11 +638,11 @@ mod tests {
             fractions.windows(2).any(|w| w[1] < w[0]),
             "a level whose pieces go back toward the start: {fractions:?}"
         );
-        let chart = pacing_chart("seed102", &level, &stats);
+        let chart = pacing_chart("seed7", &level, &stats);
         assert_eq!(
             chart.series.len(),
-            2,
-            "runs past each piece and the λ asked"
+            1,
+            "runs past each piece (one λ asked: no curve)"
         );
         for series in &chart.series {
             assert_eq!(series.points.len(), fractions.len(), "{}", series.name);

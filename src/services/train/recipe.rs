@@ -5,7 +5,7 @@
 //! paced matches and its finish.
 //! docs/decisions.md says why each value is what it is.
 
-use super::config::{Finish, ScriptedOpponent, TrainConfig};
+use super::config::{Finish, SOLO_SOLVER_UPDATE_EPOCHS, ScriptedOpponent, TrainConfig};
 use arlpcg_core::game::RacingGame;
 use arlpcg_core::game::generator::GeneratorGame;
 use arlpcg_core::level::Game;
@@ -72,11 +72,16 @@ impl TrainConfig {
     }
 
     /// The defaults for training `game` in `mode`: the game's, without the finish in
-    /// `fixed-aux` (docs/decisions.md#d14).
+    /// `fixed-aux` (docs/decisions.md#d14), with four update passes for a Solver trained alone
+    /// (docs/decisions.md#d15).
     pub fn for_run(game: Game, mode: TrainMode) -> TrainConfig {
         let mut config = Self::for_game(game);
-        if mode == TrainMode::FixedAux {
-            config.generator.finish = Finish::NONE;
+        match mode {
+            TrainMode::FixedAux => config.generator.finish = Finish::NONE,
+            TrainMode::RulePcg | TrainMode::FixedTrack => {
+                config.solver.update_epochs = SOLO_SOLVER_UPDATE_EPOCHS;
+            }
+            TrainMode::Arlpcg => {}
         }
         config
     }
@@ -85,6 +90,7 @@ impl TrainConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::services::train::config::SOLVER_UPDATE_EPOCHS;
 
     #[test]
     fn the_racing_recipe_has_short_generator_phases_and_a_frozen_finish() {
@@ -111,17 +117,21 @@ mod tests {
     }
 
     #[test]
-    fn fixed_aux_runs_end_with_their_budget_and_other_modes_keep_the_finish() {
+    fn fixed_aux_drops_the_finish_and_solvers_alone_update_in_four_passes() {
         for game in [Game::Platform, Game::Racing] {
             let fixed_aux = TrainConfig::for_run(game, TrainMode::FixedAux);
             assert_eq!(fixed_aux.generator.finish, Finish::NONE);
             assert_eq!(fixed_aux.adversarial_budget(), fixed_aux.steps);
             assert!(!fixed_aux.in_finish(fixed_aux.steps));
-            for mode in [TrainMode::Arlpcg, TrainMode::RulePcg, TrainMode::FixedTrack] {
-                assert_eq!(
-                    TrainConfig::for_run(game, mode),
-                    TrainConfig::for_game(game)
-                );
+            assert_eq!(
+                TrainConfig::for_run(game, TrainMode::Arlpcg),
+                TrainConfig::for_game(game)
+            );
+            for mode in [TrainMode::RulePcg, TrainMode::FixedTrack] {
+                let mut solo = TrainConfig::for_run(game, mode);
+                assert_eq!(solo.solver.update_epochs, SOLO_SOLVER_UPDATE_EPOCHS);
+                solo.solver.update_epochs = SOLVER_UPDATE_EPOCHS;
+                assert_eq!(solo, TrainConfig::for_game(game));
             }
         }
     }

@@ -253,6 +253,7 @@ impl Default for TrainConfig {
                 num_envs: 64,
                 num_steps: 128,
                 ent_coef: 0.005,
+                update_epochs: SOLVER_UPDATE_EPOCHS,
                 ..PpoConfig::default()
             },
             generator: GeneratorConfig::default(),
@@ -321,7 +322,7 @@ impl Default for GeneratorConfig {
                 ent_coef: 0.001,
                 ..PpoConfig::default()
             },
-            rewards: GeneratorRewards::default(),
+            rewards: PlatformGame::default_rewards(),
             aux_values: vec![-1.0, -1.0, -0.5, 0.5, 1.0, 1.0],
             max_pieces: PlatformGame::DEFAULT_MAX_PIECES,
             obstacles: 0,
@@ -345,6 +346,14 @@ const MAX_CONFIG_BYTES: u64 = 1 << 20;
 
 /// The platform recipe's budget in Solver steps learned from ([`TrainConfig::steps`]).
 pub const PLATFORM_STEPS: u64 = 8_000_000;
+
+/// Passes of the Solver's update over each batch where a Generator trains beside it (`arlpcg`,
+/// `fixed-aux`). Why: docs/decisions.md#d15.
+pub const SOLVER_UPDATE_EPOCHS: usize = 2;
+
+/// Passes of a Solver trained alone (`rule-pcg`, `fixed-track`: the baselines). Why:
+/// docs/decisions.md#d15.
+pub const SOLO_SOLVER_UPDATE_EPOCHS: usize = 4;
 
 /// The platform recipe's finish: one Generator phase, entropy bonus 0.01, against the final
 /// Solver, frozen (no snapshots), and the median scripted controller, each playing half the

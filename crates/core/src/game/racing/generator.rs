@@ -327,11 +327,17 @@ impl GeneratorGame for RacingGame {
 
     /// Progress pays 0.02 per metre (a racing goal is 220-360 m away, so a whole track pays
     /// about what a platform track's 30-70 m pay at 0.1, and stays below the failure term), and
-    /// each step in the air 0.05 at λ = -1 (a 3 m crest at speed: about 1.4).
+    /// each step in the air 0.05 at λ = -1 (a 3 m crest at speed: about 1.4). The Solver has
+    /// two retries, and a failure is paid on its segment, best at a hazard of 0.25 per segment
+    /// at λ = -1 (weight 40): difficulty along the track, not a wall before the goal. Why:
+    /// docs/decisions.md#d16.
     fn default_rewards() -> GeneratorRewards {
         GeneratorRewards {
             progress_per_metre: 0.02,
             air_step: 0.05,
+            retries: 2,
+            hazard_at_hardest: 0.25,
+            piece_failure_weight: 40.0,
             ..GeneratorRewards::default()
         }
     }

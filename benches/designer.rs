@@ -2,7 +2,9 @@
 //! 80×24 TestBackend), on the shipped policies of each game (rules and the scripted player where
 //! a game ships none): from the key that asks for a new level to the level drawn, to the first
 //! Solver statistics, and to 100 trials done. Twice per game: a new seed (`n`) each round, and
-//! a pacing edit (`P`: the next preset, or back to one λ) each round.
+//! a pacing edit (`P`: the next preset, or back to one λ) each round; on platform also an
+//! ability edit (`[` and `]` in turn: jump speed -5% and +5%, statistics from the shipped
+//! ability-aware Solver; issue 62: ≤ 2 s).
 //!
 //! Run with `cargo bench --bench designer`. Targets (issues 5 and 16): level on screen < 100 ms,
 //! first statistics < 300 ms, 100 trials < 2 s on 2 cores. Then the campaign view: from the
@@ -30,10 +32,11 @@ fn main() {
     // SAFETY: first thing in main, before any other thread exists.
     unsafe { arlpcg::shells::common::fix_thread_count() };
     for game in [Game::Platform, Game::Racing] {
-        for (key, what) in [('n', "new seed"), ('P', "pacing edit")] {
-            measure(game, key, what);
+        for (keys, what) in [(&['n'][..], "new seed"), (&['P'][..], "pacing edit")] {
+            measure(game, keys, what);
         }
     }
+    measure(Game::Platform, &['[', ']'], "ability edit");
     campaign_view();
 }
 
@@ -91,13 +94,15 @@ fn campaign_view() {
     );
 }
 
-fn measure(game: Game, pressed_key: char, what: &str) {
+/// Each round presses the next of `keys`, cyclically.
+fn measure(game: Game, keys: &[char], what: &str) {
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("policies")
         .join(game.name());
     let (policies, info) = worker::load(&shipped, game).unwrap_or_default();
     println!(
-        "{game}, {what} (`{pressed_key}`): Generator {}, Solver {}",
+        "{game}, {what} (`{}`): Generator {}, Solver {}",
+        keys.iter().collect::<String>(),
         info.generator
             .as_ref()
             .map_or("none (rules)", |p| p.card.training.mode.name()),
@@ -116,7 +121,7 @@ fn measure(game: Game, pressed_key: char, what: &str) {
     let mut no_level = 0;
     for round in 0..=LEVELS {
         let pressed = Instant::now();
-        let key = KeyEvent::new(KeyCode::Char(pressed_key), KeyModifiers::NONE);
+        let key = KeyEvent::new(KeyCode::Char(keys[round % keys.len()]), KeyModifiers::NONE);
         for effect in app::update(&mut app, Message::Key(key)) {
             workers.submit(effect);
         }

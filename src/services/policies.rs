@@ -7,11 +7,11 @@ use anyhow::{Context, Result};
 
 use crate::services::generation::GeneratorPolicy;
 use crate::services::panel::{Judge, JudgePanel};
-use crate::services::verify::SolverPolicy;
+use crate::services::verify::{ProfileFit, SolverPolicy};
 use arlpcg_core::game::generator::DEFAULT_CURVE_OFFSET;
 use arlpcg_core::game::generator::{BuildLimits, GeneratorGame, observation_size};
 use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
-use arlpcg_core::level::profile::ABILITIES_PART;
+use arlpcg_core::level::profile::{ABILITIES_PART, Profile};
 use arlpcg_core::level::{Game, PolicyRef};
 use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::rl::checkpoint::{
@@ -22,6 +22,9 @@ use arlpcg_core::rl::policy::ActorCritic;
 /// File names inside a policies folder.
 pub const GENERATOR_FILE: &str = "generator.safetensors";
 pub const SOLVER_FILE: &str = "solver.safetensors";
+/// An ability-aware Solver beside a folder's Solver: it plays where a profile's abilities differ
+/// from those `solver.safetensors` trained with ([`SolverPolicy::or_aware`]).
+pub const AWARE_SOLVER_FILE: &str = "solver-aware.safetensors";
 
 /// What a policy of one game and role must act with: `(continuous, binary)` action names.
 type Actions = (&'static [&'static str], &'static [&'static str]);
@@ -99,6 +102,40 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
         },
         card,
     ))
+}
+
+/// Loads the ability-aware Solver of the policies folder `dir` ([`AWARE_SOLVER_FILE`]), if it
+/// holds one; an error when that file's card trained one character or car.
+pub fn load_aware_solver(dir: &Path, game: Game) -> Result<Option<SolverPolicy>> {
+    let path = dir.join(AWARE_SOLVER_FILE);
+    if !path.exists() {
+        return Ok(None);
+    }
+    let (policy, _) = load_solver(&path, game)?;
+    if policy.ability_spread.is_none() {
+        anyhow::bail!(
+            "{}: card field ability_spread is missing: {AWARE_SOLVER_FILE} must be an ability-aware Solver (trained with ability_spread above 0)",
+            path.display()
+        );
+    }
+    Ok(Some(policy))
+}
+
+/// The Solver of the policies folder `dir` that plays under `profile` (none: the built-in game):
+/// its `solver.safetensors`, or its ability-aware one where [`SolverPolicy::or_aware`] picks it.
+pub fn load_folder_solver(
+    dir: &Path,
+    game: Game,
+    profile: Option<&Profile>,
+) -> Result<SolverPolicy> {
+    let solver = load_solver(&dir.join(SOLVER_FILE), game)?.0;
+    if solver.fit(profile) == ProfileFit::Fits {
+        return Ok(solver);
+    }
+    Ok(match load_aware_solver(dir, game)? {
+        Some(aware) if std::ptr::eq(solver.or_aware(Some(&aware), profile), &aware) => aware,
+        _ => solver,
+    })
 }
 
 /// Loads a Generator policy of `game`.
@@ -364,6 +401,43 @@ mod tests {
         assert_eq!(
             foreign,
             dir.path().join("difficulty-curve-solver-fedcba987654.yaml")
+        );
+    }
+
+    /// A folder's Solver plays under the abilities it trained with; its ability-aware Solver
+    /// under others within its range; and a file named as the ability-aware one that is not is
+    /// refused, naming the file and the field.
+    #[test]
+    fn a_folders_ability_aware_solver_plays_under_other_abilities_within_its_range() {
+        let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+        let jumping = |jump_speed: f64| {
+            Profile::default_of(Game::Platform)
+                .with_value("character.jump_speed", jump_speed)
+                .unwrap()
+        };
+        let played = |profile: Option<&Profile>| {
+            let solver = load_folder_solver(&shipped, Game::Platform, profile).unwrap();
+            let path = PathBuf::from(&solver.reference.path);
+            path.file_name().unwrap().to_str().unwrap().to_string()
+        };
+        assert_eq!(played(None), SOLVER_FILE);
+        assert_eq!(played(Some(&jumping(8.0))), AWARE_SOLVER_FILE);
+        assert_eq!(played(Some(&jumping(6.0))), SOLVER_FILE);
+
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::copy(shipped.join(SOLVER_FILE), dir.path().join(SOLVER_FILE)).unwrap();
+        std::fs::copy(
+            shipped.join(SOLVER_FILE),
+            dir.path().join(AWARE_SOLVER_FILE),
+        )
+        .unwrap();
+        let problem = load_folder_solver(dir.path(), Game::Platform, Some(&jumping(8.0)))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            problem.contains(AWARE_SOLVER_FILE) && problem.contains("card field ability_spread"),
+            "{problem}"
         );
     }
 }

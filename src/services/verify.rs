@@ -83,6 +83,25 @@ impl SolverPolicy {
         }
     }
 
+    /// Of this Solver and a folder's ability-aware one, the one that plays under `played`: the
+    /// ability-aware one when this one did not train with those abilities and its range holds
+    /// them; else this one (its [`fit`](Self::fit) says why it may not).
+    pub fn or_aware<'a>(
+        &'a self,
+        aware: Option<&'a SolverPolicy>,
+        played: Option<&Profile>,
+    ) -> &'a SolverPolicy {
+        match aware {
+            Some(aware)
+                if self.fit(played) != ProfileFit::Fits
+                    && aware.fit(played) == ProfileFit::Fits =>
+            {
+                aware
+            }
+            _ => self,
+        }
+    }
+
     /// What it observes after the game's observation on `level`: for an ability-aware Solver
     /// the level's main abilities relative to ours, else nothing.
     fn ability_row(&self, level: &Level) -> Vec<f32> {

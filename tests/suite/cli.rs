@@ -1173,13 +1173,41 @@ fn a_game_profile_is_checked_recorded_and_played_under() {
         said.contains("made under the built-in profile; playing it under `low-jumper`"),
         "{said}"
     );
-    // The shipped Solver policy never trained with the low jumper's abilities, and says so.
-    let low_path = path("low.yaml");
-    let policy = arlpcg_ok(&["verify", staircase, "--trials", "2", "--profile", &low_path]);
+}
+
+/// The shipped Solver never trained with a low jumper's abilities: the shipped ability-aware
+/// Solver plays (its range, ±20%, holds 7.5 m/s). Beyond that range the shipped Solver plays,
+/// and says that it never trained with them; without a profile it plays as before.
+#[test]
+fn the_shipped_ability_aware_solver_plays_a_profile_within_its_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    write_platform_profile(&path("low.yaml"), "low-jumper", "7.5");
+    let staircase = concat!(env!("CARGO_MANIFEST_DIR"), "/levels/hand/staircase.yaml");
+    write_platform_profile(&path("lower.yaml"), "lower-jumper", "7.0");
+    let played = |profile: &[&str]| {
+        let mut args = vec!["verify", staircase, "--trials", "2", "--json"];
+        args.extend_from_slice(profile);
+        let out = arlpcg_ok(&args);
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (json["solver"].as_str().unwrap().to_string(), stderr(&out))
+    };
+    let (aware, said) = played(&["--profile", &path("low.yaml")]);
     assert!(
-        stderr(&policy).contains("never trained with them"),
-        "{}",
-        stderr(&policy)
+        aware.ends_with("policies/platform/solver-aware.safetensors"),
+        "{aware}"
+    );
+    assert!(!said.contains("never trained"), "{said}");
+    let (shipped, said) = played(&["--profile", &path("lower.yaml")]);
+    assert!(
+        shipped.ends_with("policies/platform/solver.safetensors"),
+        "{shipped}"
+    );
+    assert!(said.contains("never trained with them"), "{said}");
+    let (built_in, _) = played(&[]);
+    assert!(
+        built_in.ends_with("policies/platform/solver.safetensors"),
+        "{built_in}"
     );
 }
 

@@ -176,6 +176,36 @@ fn a_profile_makes_the_levels_and_its_keys_change_the_abilities() {
     );
 }
 
+/// On the shipped platform policies, a loaded profile whose abilities the Solver did not train
+/// with is played by the shipped ability-aware Solver; ours by the Solver.
+#[test]
+fn a_profile_of_other_abilities_is_played_by_the_shipped_ability_aware_solver() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::shipped(dir.path());
+    h.settle();
+    for (jump, file) in [
+        ("8.5", "solver-aware.safetensors"),
+        ("9.25", "solver.safetensors"),
+    ] {
+        let text = arlpcg_core::level::profile::Profile::default_of(Game::Platform)
+            .to_yaml()
+            .replace("jump_speed: 9.25", &format!("jump_speed: {jump}"));
+        let path = dir.path().join(format!("jump-{jump}.yaml"));
+        std::fs::write(&path, text).unwrap();
+        h.key(KeyCode::Char('f'));
+        h.keys(path.to_str().unwrap());
+        h.key(KeyCode::Enter);
+        h.settle();
+        let trials = h.app.trials.as_ref().expect("trials of the new level");
+        let stats = trials.stats.as_ref().expect("statistics");
+        let played = stats.solver.describe();
+        assert!(
+            played.ends_with(&format!("policies/platform/{file}")),
+            "{played}"
+        );
+    }
+}
+
 /// An ability-aware Solver's trials stop, saying to train for it, when the loaded profile lies
 /// beyond the range it trained over; within it, they play.
 #[test]

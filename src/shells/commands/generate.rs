@@ -15,12 +15,14 @@ use crate::services::generation::{self, Ask, GeneratorPolicy, KeptPrefix, LevelR
 use crate::services::level_files::{Format, LevelFiles, file_stem, render};
 use crate::services::panel::Judge;
 use crate::services::policies::{
-    load_generator, load_judge, load_panel, load_solver, policy_paths,
+    load_folder_solver, load_generator, load_judge, load_panel, load_solver, policy_paths,
+    shipped_dir,
 };
 use crate::services::profile;
 use crate::services::verify::{self, Solver, SolverPolicy};
 use crate::shells::cli::{GenerateArgs, KeepArg, default_solver};
 use arlpcg_core::game::Skill;
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::{Game, Level};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
@@ -34,7 +36,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         Some(dir) => Some(load_generator(&policy_paths(dir).0, args.game)?.0),
         None => None,
     };
-    let solver = chosen_solver(args, verify_trials)?;
+    let solver = chosen_solver(args, verify_trials, template.profile.as_ref())?;
     if let Some(policy) = &solver {
         crate::shells::common::check_fit(policy, template.profile.as_ref())?;
     }
@@ -439,9 +441,13 @@ fn build_verified(
 }
 
 /// The Solver that plays `--verify` and `--target-success`: the judge asked for, the file asked
-/// for, the one beside the Generator, or the shipped one; none for the scripted player or when
-/// nothing is verified.
-fn chosen_solver(args: &GenerateArgs, verify_trials: Option<u32>) -> Result<Option<SolverPolicy>> {
+/// for, the one beside the Generator, or the shipped one (of a folder, the one that plays under
+/// `profile`); none for the scripted player or when nothing is verified.
+fn chosen_solver(
+    args: &GenerateArgs,
+    verify_trials: Option<u32>,
+    profile: Option<&Profile>,
+) -> Result<Option<SolverPolicy>> {
     let shipped = default_solver(args.game);
     Ok(match (verify_trials, args.judge, &args.solver_policy) {
         (None, _, _) => None,
@@ -451,8 +457,12 @@ fn chosen_solver(args: &GenerateArgs, verify_trials: Option<u32>) -> Result<Opti
         }
         (Some(_), None, Some(path)) => Some(load_solver(path, args.game)?.0),
         (Some(_), None, None) => match &args.policies {
-            Some(dir) => Some(load_solver(&policy_paths(dir).1, args.game)?.0),
-            None if shipped.exists() => Some(load_solver(&shipped, args.game)?.0),
+            Some(dir) => Some(load_folder_solver(dir, args.game, profile)?),
+            None if shipped.exists() => Some(load_folder_solver(
+                &shipped_dir(args.game),
+                args.game,
+                profile,
+            )?),
             None => None,
         },
     })

@@ -17,10 +17,13 @@ use arlpcg_core::rl::checkpoint::PolicyCard;
 /// The largest results file, card or page read.
 const MAX_FILE_BYTES: u64 = 64 * 1024 * 1024;
 
-/// The shipped policies a game's table lists, in its order.
-const POLICIES: [&str; 5] = [
-    "generator", "solver", "solver-rule-pcg", "solver-fixed-track", "solver-fixed-aux",
+/// The shipped policies a game's table lists, in its order; [`OPTIONAL_POLICY`] where a game
+/// ships one.
+const POLICIES: [&str; 6] = [
+    "generator", "solver", "solver-aware", "solver-rule-pcg", "solver-fixed-track",
+    "solver-fixed-aux",
 ];
+const OPTIONAL_POLICY: &str = "solver-aware";
 
 pub fn run(args: &ReportArgs) -> Result<()> {
     if !args.curves.is_empty() {
@@ -85,6 +88,10 @@ fn read_game(game: Game, results: &Path, policies: &Path) -> Result<GamePage> {
     }
     let cards = POLICIES
         .iter()
+        .filter(|name| {
+            let card = policies.join(game.name()).join(format!("{name}.yaml"));
+            **name != OPTIONAL_POLICY || card.is_file()
+        })
         .map(|name| {
             let path = policies.join(game.name()).join(format!("{name}.yaml"));
             let card: PolicyCard = serde_yaml::from_slice(&read(&path)?)
@@ -99,6 +106,22 @@ fn read_game(game: Game, results: &Path, policies: &Path) -> Result<GamePage> {
         true => Some(crate::services::campaign::read_record(&campaign_file)?),
         false => None,
     };
+    let mut profiles = Vec::new();
+    if dir.join("profiles").is_dir() {
+        for folder in subfolders(&dir.join("profiles"))? {
+            let file = folder.join("results.json");
+            if file.is_file() {
+                let results = Results::read(game, &read(&file)?)
+                    .with_context(|| format!("{}", file.display()))?;
+                let name = folder
+                    .file_name()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .to_string();
+                profiles.push((name, results));
+            }
+        }
+    }
     Ok(GamePage {
         game,
         cards,
@@ -106,6 +129,7 @@ fn read_game(game: Game, results: &Path, policies: &Path) -> Result<GamePage> {
         seeds,
         more_seeds,
         campaign,
+        profiles,
     })
 }
 

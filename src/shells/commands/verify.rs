@@ -11,7 +11,7 @@ use serde_json::json;
 use super::campaign::report_checks;
 use crate::services::checks::{Check, failures};
 use crate::services::panel::{JudgePanel, rate};
-use crate::services::policies::{load_panel, load_solver};
+use crate::services::policies::{load_aware_solver, load_panel, load_solver, shipped_dir};
 use crate::services::profile;
 use crate::services::verify::{
     FailureConcentration, HalfwaySplit, ProfileFit, Solver, SolverPolicy, Summary, Watch,
@@ -59,7 +59,7 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
                 let game = level.game();
                 solvers.resolve(game, args)?;
                 solvers.check_profile(&level, path)?;
-                let solver = solvers.get(game);
+                let solver = solvers.get(&level);
                 let bar = crate::shells::common::progress_bar(
                     args.trials as u64,
                     &path.display().to_string(),
@@ -393,7 +393,9 @@ struct Solvers {
 }
 
 enum Resolved {
-    Policy(Box<SolverPolicy>),
+    /// A Solver policy and, for the shipped one, the shipped ability-aware Solver that plays
+    /// levels made for abilities it did not train with ([`SolverPolicy::or_aware`]).
+    Policy(Box<SolverPolicy>, Option<Box<SolverPolicy>>),
     Scripted(Skill),
     Random,
 }
@@ -414,13 +416,23 @@ impl Solvers {
                 SolverChoice::ScriptedExpert
             });
         let resolved = match choice {
-            SolverChoice::Policy => Resolved::Policy(Box::new(load_solver(&policy, game)?.0)),
+            SolverChoice::Policy => {
+                let aware = match args.policy {
+                    Some(_) => None,
+                    None => load_aware_solver(&shipped_dir(game), game)?.map(Box::new),
+                };
+                Resolved::Policy(Box::new(load_solver(&policy, game)?.0), aware)
+            }
             SolverChoice::Random => Resolved::Random,
             scripted => Resolved::Scripted(scripted.skill().expect("the other choices")),
         };
         if !args.json {
             let who = match &resolved {
-                Resolved::Policy(p) => format!("policy {}", p.reference.path),
+                Resolved::Policy(p, None) => format!("policy {}", p.reference.path),
+                Resolved::Policy(p, Some(aware)) => format!(
+                    "policy {} (under other abilities, {})",
+                    p.reference.path, aware.reference.path
+                ),
                 Resolved::Scripted(_) if args.solver.is_none() => format!(
                     "scripted player (no trained Solver at {})",
                     shipped.display()
@@ -437,10 +449,11 @@ impl Solvers {
     /// Says once that a Solver policy plays a level made for abilities other than those it
     /// trained with; refuses a level beyond an ability-aware policy's range.
     fn check_profile(&mut self, level: &Level, file: &Path) -> Result<()> {
-        let Some(Resolved::Policy(policy)) = self.resolved.get(&level.game()) else {
+        let Solver::Policy(policy) = self.get(level) else {
             return Ok(());
         };
-        match policy.fit(level.profile.as_ref()) {
+        let fit = policy.fit(level.profile.as_ref());
+        match fit {
             ProfileFit::Fits => {}
             ProfileFit::Beyond(problem) => anyhow::bail!("{}: {problem}", file.display()),
             ProfileFit::Untrained(said) if !self.warned_profile => {
@@ -452,9 +465,12 @@ impl Solvers {
         Ok(())
     }
 
-    fn get(&self, game: Game) -> Solver<'_> {
-        match &self.resolved[&game] {
-            Resolved::Policy(p) => Solver::Policy(p),
+    /// Who plays `level`.
+    fn get(&self, level: &Level) -> Solver<'_> {
+        match &self.resolved[&level.game()] {
+            Resolved::Policy(p, aware) => {
+                Solver::Policy(p.or_aware(aware.as_deref(), level.profile.as_ref()))
+            }
             Resolved::Scripted(skill) => Solver::Scripted(*skill),
             Resolved::Random => Solver::Random,
         }

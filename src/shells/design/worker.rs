@@ -19,17 +19,20 @@ use crate::services::fsio::Overwrite;
 use crate::services::generation::{self, GeneratorPolicy, LevelRequest};
 use crate::services::level_files::{Format, LevelFiles, write_level_files};
 use crate::services::panel::{Judge, rate};
-use crate::services::policies::{load_generator, load_solver, policy_paths};
+use crate::services::policies::{load_aware_solver, load_generator, load_solver, policy_paths};
 use crate::services::verify::{self, Solver, SolverPolicy, Watch};
 use arlpcg_core::game::Skill;
 use arlpcg_core::level::{Game, Level};
-use arlpcg_core::rl::checkpoint::PolicyError;
+use arlpcg_core::rl::checkpoint::{PolicyError, TrainMode};
 
 /// The policies of one game in use; either may be missing (rule levels; the scripted player).
 #[derive(Default, Clone)]
 pub struct Policies {
     pub generator: Option<Arc<GeneratorPolicy>>,
     pub solver: Option<Arc<SolverPolicy>>,
+    /// The folder's ability-aware Solver, which plays levels made for abilities the Solver did
+    /// not train with ([`SolverPolicy::or_aware`]).
+    pub aware: Option<Arc<SolverPolicy>>,
     /// The scripted player's skill, when it plays (no Solver).
     pub skill: Skill,
 }
@@ -61,15 +64,22 @@ impl Policies {
     /// Why the Solver policy may not play `level`: the abilities it is made for lie beyond the
     /// range the policy trained over (it says to train for them).
     fn beyond_range(&self, level: &Level) -> Option<String> {
-        match self.solver.as_ref()?.fit(level.profile.as_ref()) {
+        match self.policy_for(level)?.fit(level.profile.as_ref()) {
             verify::ProfileFit::Beyond(problem) => Some(problem),
             _ => None,
         }
     }
 
-    fn solver(&self) -> Solver<'_> {
-        match &self.solver {
-            Some(policy) => Solver::Policy(policy.as_ref()),
+    /// The Solver policy that plays `level`, if one does.
+    fn policy_for(&self, level: &Level) -> Option<&SolverPolicy> {
+        let solver = self.solver.as_deref()?;
+        Some(solver.or_aware(self.aware.as_deref(), level.profile.as_ref()))
+    }
+
+    /// Who plays `level`.
+    fn solver(&self, level: &Level) -> Solver<'_> {
+        match self.policy_for(level) {
+            Some(policy) => Solver::Policy(policy),
             None => Solver::Scripted(self.skill),
         }
     }
@@ -118,6 +128,7 @@ pub fn load(path: &Path, game: Game) -> Result<(Policies, LoadedInfo)> {
         if solver.exists() {
             let (policy, card) = load_solver(&solver, game)?;
             policies.solver = Some(Arc::new(policy));
+            policies.aware = load_aware_solver(path, game)?.map(Arc::new);
             info.solver = Some(PolicyInfo { path: solver, card });
         }
         return Ok((policies, info));
@@ -295,7 +306,7 @@ pub fn perform(
         } => play_trials(shelf.of(level.game()), id, &level, trials, seed, stop, send),
         Effect::Record { id, level, seed } => send(Response::Recorded {
             id,
-            result: verify::record(&level, &shelf.of(level.game()).solver(), seed)
+            result: verify::record(&level, &shelf.of(level.game()).solver(&level), seed)
                 .map(Box::new)
                 .map_err(|e| e.to_string()),
         }),
@@ -459,7 +470,7 @@ fn play_trials(
     if let Some(problem) = current.beyond_range(level) {
         return send(Response::TrialsFailed { id, problem });
     }
-    match verify::verify_watched(level, &current.solver(), trials, seed, &watch) {
+    match verify::verify_watched(level, &current.solver(level), trials, seed, &watch) {
         Ok(Some(stats)) => send(Response::TrialsDone {
             id,
             stats: Box::new(stats),
@@ -493,7 +504,7 @@ fn sweep_point(
         on_trial: &|_| {},
         stop,
     };
-    match verify::verify_watched(&level, &current.solver(), trials, seed, &watch) {
+    match verify::verify_watched(&level, &current.solver(&level), trials, seed, &watch) {
         Ok(Some(stats)) => Some(SweepPoint::Success(stats.success_ratio)),
         Ok(None) => None,
         Err(e) => Some(SweepPoint::NoLevel(e.to_string())),
@@ -512,6 +523,10 @@ fn load_into(
         let old = shared.of_mut(game);
         *old = Policies {
             generator: loaded.generator.or(old.generator.clone()),
+            aware: match loaded.solver {
+                Some(_) => loaded.aware,
+                None => old.aware.clone(),
+            },
             solver: loaded.solver.or(old.solver.clone()),
             skill: old.skill,
         };
@@ -531,7 +546,7 @@ fn next_judge(
     for k in 1..=Judge::ALL.len() {
         let judge = Judge::ALL[(start + k) % Judge::ALL.len()];
         let (solver, info, skill) = match judge {
-            Judge::Scripted(skill) => (None, None, skill),
+            Judge::Scripted(skill) => ((None, None), None, skill),
             Judge::Solver(_) => {
                 let path = crate::services::policies::judge_file(folder, judge)
                     .expect("a Solver judge has a file");
@@ -541,8 +556,15 @@ fn next_judge(
                 let (policy, card) = crate::services::policies::load_judge(folder, game, judge)
                     .map_err(|e| format!("{e:#}"))?
                     .expect("a Solver judge is loaded with its policy");
+                // The ARLPCG judge brings the folder's ability-aware Solver with it.
+                let aware = match judge {
+                    Judge::Solver(TrainMode::Arlpcg) => load_aware_solver(folder, game)
+                        .map_err(|e| format!("{e:#}"))?
+                        .map(Arc::new),
+                    Judge::Solver(_) | Judge::Scripted(_) => None,
+                };
                 (
-                    Some(Arc::new(policy)),
+                    (Some(Arc::new(policy)), aware),
                     Some(PolicyInfo { path, card }),
                     Skill::Expert,
                 )
@@ -550,7 +572,7 @@ fn next_judge(
         };
         if let Ok(mut shared) = policies.lock() {
             let current = shared.of_mut(game);
-            current.solver = solver;
+            (current.solver, current.aware) = solver;
             current.skill = skill;
         }
         return Ok(JudgeSwitch {

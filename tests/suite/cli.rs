@@ -1365,20 +1365,17 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
     for (name, jump) in [("near", "8.5"), ("far", "7.0")] {
         write_platform_profile(&path(&format!("{name}.yaml")), name, jump);
     }
-    std::fs::write(path("aware.yaml"), "ability_spread: 0.2\n").unwrap();
     let run = path("run");
+    // A share beyond ±50% is refused before anything is made.
+    fails_with(
+        &arlpcg(&["train", "--ability-spread", "0.7", "--out", &run]),
+        2,
+        "`0.7` is not a share within [0, 0.5]",
+    );
+    assert!(!Path::new(&run).exists());
     arlpcg_ok(&[
-        "train",
-        "--mode",
-        "arlpcg",
-        "--config",
-        &path("aware.yaml"),
-        "--steps",
-        "8192",
-        "--threads",
-        "1",
-        "--out",
-        &run,
+        "train", "--mode", "arlpcg", "--ability-spread", "0.2", "--steps", "8192", "--threads",
+        "1", "--out", &run,
     ]);
     // Both agents observe the abilities, and their cards say over which range.
     for card in ["solver.yaml", "generator.yaml"] {

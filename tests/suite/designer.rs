@@ -52,6 +52,20 @@ impl Harness {
         Self::new(Policies::default(), LoadedInfo::default(), out)
     }
 
+    /// Loads (`f`) our platform profile with the jump speed `jump`, written into `dir`, and
+    /// waits for its level and statistics.
+    fn load_profile_with_jump(&mut self, dir: &Path, jump: &str) {
+        let text = arlpcg_core::level::profile::Profile::default_of(Game::Platform)
+            .to_yaml()
+            .replace("jump_speed: 9.25", &format!("jump_speed: {jump}"));
+        let path = dir.join(format!("jump-{jump}.yaml"));
+        std::fs::write(&path, text).unwrap();
+        self.key(KeyCode::Char('f'));
+        self.keys(path.to_str().unwrap());
+        self.key(KeyCode::Enter);
+        self.settle();
+    }
+
     /// A designer on the shipped platform policies.
     fn shipped(out: &Path) -> Self {
         let (policies, info) = worker::load(&shipped_platform(), Game::Platform).unwrap();
@@ -187,15 +201,7 @@ fn a_profile_of_other_abilities_is_played_by_the_shipped_ability_aware_solver() 
         ("8.5", "solver-aware.safetensors"),
         ("9.25", "solver.safetensors"),
     ] {
-        let text = arlpcg_core::level::profile::Profile::default_of(Game::Platform)
-            .to_yaml()
-            .replace("jump_speed: 9.25", &format!("jump_speed: {jump}"));
-        let path = dir.path().join(format!("jump-{jump}.yaml"));
-        std::fs::write(&path, text).unwrap();
-        h.key(KeyCode::Char('f'));
-        h.keys(path.to_str().unwrap());
-        h.key(KeyCode::Enter);
-        h.settle();
+        h.load_profile_with_jump(dir.path(), jump);
         let trials = h.app.trials.as_ref().expect("trials of the new level");
         let stats = trials.stats.as_ref().expect("statistics");
         let played = stats.solver.describe();
@@ -231,15 +237,7 @@ fn trials_refuse_a_profile_beyond_an_ability_aware_solvers_range() {
     let mut h = Harness::new(policies, info, dir.path());
     h.settle();
     for (jump, refused) in [("8.5", false), ("7.0", true)] {
-        let text = arlpcg_core::level::profile::Profile::default_of(Game::Platform)
-            .to_yaml()
-            .replace("jump_speed: 9.25", &format!("jump_speed: {jump}"));
-        let file = dir.path().join(format!("jump-{jump}.yaml"));
-        std::fs::write(&file, text).unwrap();
-        h.key(KeyCode::Char('f'));
-        h.keys(file.to_str().unwrap());
-        h.key(KeyCode::Enter);
-        h.settle();
+        h.load_profile_with_jump(dir.path(), jump);
         let trials = h.app.trials.as_ref().expect("trials of the new level");
         let said = trials.error.clone().unwrap_or_default();
         assert_eq!(

@@ -62,6 +62,8 @@ pub struct RunAsk<'a> {
     pub seed: Option<u64>,
     pub steps: Option<u64>,
     pub profile: Option<&'a Profile>,
+    /// The share each main ability varies by (`ability_spread`).
+    pub ability_spread: Option<f64>,
 }
 
 /// The run in `out`: started afresh as `ask` asks, or with `resume` continued from its
@@ -80,6 +82,7 @@ pub fn open(
         seed,
         steps,
         profile,
+        ability_spread,
     } = ask;
     let (game, mode) = if resume {
         resumed_identity(out, game, mode)?
@@ -101,6 +104,7 @@ pub fn open(
             seed,
             steps,
             profile: profile.map(|p| Box::new(p.record())),
+            ability_spread,
         })
     } else {
         if out.join(CHECKPOINT).exists() {
@@ -147,6 +151,9 @@ pub fn open(
         }
         if let Some(profile) = profile {
             config.profile = Some(profile.record());
+        }
+        if let Some(spread) = ability_spread {
+            config.ability_spread = spread;
         }
         Start::New(config)
     };
@@ -200,6 +207,7 @@ pub(super) struct ConfigChange {
     pub seed: Option<u64>,
     pub steps: Option<u64>,
     pub profile: Option<Box<ProfileRecord>>,
+    pub ability_spread: Option<f64>,
 }
 
 impl ConfigChange {
@@ -214,6 +222,9 @@ impl ConfigChange {
         }
         if let Some(profile) = self.profile {
             new.profile = Some(*profile);
+        }
+        if let Some(spread) = self.ability_spread {
+            new.ability_spread = spread;
         }
         new
     }

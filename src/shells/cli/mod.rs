@@ -8,8 +8,8 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 mod values;
 pub use values::{Judges, KeepArg, Shard};
 use values::{
-    parse_aux, parse_contract, parse_game, parse_judges, parse_keep, parse_minutes, parse_point,
-    parse_population, parse_retry, parse_shard, parse_target,
+    parse_ability_spread, parse_aux, parse_contract, parse_game, parse_judges, parse_keep,
+    parse_minutes, parse_point, parse_population, parse_retry, parse_shard, parse_target,
 };
 
 use crate::services::campaign::Ramp;
@@ -639,6 +639,12 @@ pub struct TrainArgs {
     /// record it. A resumed run keeps its own.
     #[arg(long, value_name = "FILE")]
     pub profile: Option<PathBuf>,
+    /// Train ability-aware agents, in place of the configuration's `ability_spread`: each
+    /// episode and match draws jump speed, run speed and gravity (racing: engine force, grip,
+    /// steering) within this share of the profile's (0.2: ±20%), and both agents observe them.
+    /// A resumed run keeps its own.
+    #[arg(long, value_name = "SHARE", value_parser = parse_ability_spread)]
+    pub ability_spread: Option<f64>,
     /// Print the default configuration as YAML and exit.
     #[arg(long)]
     pub print_config: bool,

@@ -100,6 +100,13 @@ pub(super) fn parse_minutes(s: &str) -> Result<f64, String> {
     }
 }
 
+pub(super) fn parse_ability_spread(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(share) if (0.0..=0.5).contains(&share) => Ok(share),
+        _ => Err(format!("`{s}` is not a share within [0, 0.5] (0.2: ±20%)")),
+    }
+}
+
 pub(super) fn parse_game(s: &str) -> Result<Game, String> {
     s.parse()
 }

@@ -67,6 +67,7 @@ pub fn run(args: &TrainArgs) -> Result<()> {
                 seed: args.seed,
                 steps: args.steps,
                 profile: profile.as_ref(),
+                ability_spread: args.ability_spread,
             },
             args.resume,
         );

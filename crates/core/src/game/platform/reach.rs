@@ -143,25 +143,31 @@ pub fn successes(track: &PlatformTrack, body: Body, trials: u64, jitter: f32) ->
 /// Measures the reach table: for each height change, the largest gap such that every chained
 /// jump up to it (in `REACH_STEP` steps from 1 m, at every turn of `REACH_TURNS`) is cleared in
 /// all `REACH_TRIALS` runs, for a character of `body`.
+/// The heights and, at each gap, the turns are measured side by side (rayon): the same table.
 pub fn measure_reach(body: Body) -> [f64; 5] {
-    REACH_HEIGHTS.map(|height| {
-        let steps = ((GAP_RANGE.1 - GAP_RANGE.0) / REACH_STEP).round() as usize;
-        let mut best = GAP_RANGE.0 - REACH_STEP;
-        for k in 0..=steps {
-            let gap = GAP_RANGE.0 + k as f64 * REACH_STEP;
-            let cleared = REACH_TURNS.iter().all(|&turn| {
-                successes(
-                    &chained_jump(gap, height, turn),
-                    body,
-                    REACH_TRIALS,
-                    REACH_JITTER,
-                ) == REACH_TRIALS
-            });
-            if !cleared {
-                break;
+    use rayon::prelude::*;
+    let gaps: Vec<f64> = REACH_HEIGHTS
+        .par_iter()
+        .map(|&height| {
+            let steps = ((GAP_RANGE.1 - GAP_RANGE.0) / REACH_STEP).round() as usize;
+            let mut best = GAP_RANGE.0 - REACH_STEP;
+            for k in 0..=steps {
+                let gap = GAP_RANGE.0 + k as f64 * REACH_STEP;
+                let cleared = REACH_TURNS.par_iter().all(|&turn| {
+                    successes(
+                        &chained_jump(gap, height, turn),
+                        body,
+                        REACH_TRIALS,
+                        REACH_JITTER,
+                    ) == REACH_TRIALS
+                });
+                if !cleared {
+                    break;
+                }
+                best = gap;
             }
-            best = gap;
-        }
-        best
-    })
+            best
+        })
+        .collect();
+    std::array::from_fn(|k| gaps[k])
 }

@@ -167,7 +167,7 @@ pub struct EvalArgs {
     pub game: Game,
     /// Folders of trained policies: the Generator (generator.safetensors, from the first folder
     /// that has one) and every Solver (solver*.safetensors; each named by its card's training
-    /// mode). One Solver must be the arlpcg one.
+    /// mode, solver-aware.safetensors as `arlpcg-aware`). One Solver must be the arlpcg one.
     #[arg(long, num_args = 1.., required_unless_present_any = ["merge", "runs"], value_name = "DIR")]
     pub policies: Vec<PathBuf>,
     /// Score training runs over their seeds instead: each folder is one run (its
@@ -285,7 +285,9 @@ pub struct GenerateArgs {
     #[arg(long)]
     pub collision_names: bool,
     /// Play each level this many times with the Solver (with --policies the one beside the
-    /// Generator, with --rules the shipped one) and store the statistics in the YAML.
+    /// Generator, with --rules the shipped one; under a --profile whose abilities it did not
+    /// train with, the folder's solver-aware.safetensors where its range holds them) and store
+    /// the statistics in the YAML.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub verify: Option<u32>,
     /// Play --verify and --target-success with this Solver policy (.safetensors) instead of the
@@ -473,7 +475,9 @@ pub struct VerifyArgs {
     #[arg(long, value_enum)]
     pub solver: Option<SolverChoice>,
     /// The Solver policy file (.safetensors) for --solver policy (default:
-    /// policies/<game>/solver.safetensors for each level's game).
+    /// policies/<game>/solver.safetensors for each level's game, and on a level made for
+    /// abilities it did not train with policies/<game>/solver-aware.safetensors where that
+    /// file's range holds them).
     #[arg(long)]
     pub policy: Option<PathBuf>,
     /// Print one JSON object per level instead of text.

@@ -134,6 +134,18 @@ PORTS = {
 }
 
 
+def abilities(sidecar, episode):
+    """An ability-aware Solver's last columns (`abilities`): the profile's main abilities, each
+    as value / ours - 1. A golden episode's level records no profile (our character): all 0."""
+    columns = next(i for i in sidecar["inputs"] if i["name"] == "observation")["columns"]
+    last = columns[-1]
+    if last["name"] != "abilities":
+        return []
+    if "\nprofile:" in episode["level"]:
+        raise SystemExit("a golden episode under a profile: port its abilities")
+    return [0.0] * last["width"]
+
+
 def check(onnx_path):
     sidecar = json.load(open(onnx_path + ".json"))
     if sidecar["profile"] != "plain":
@@ -141,8 +153,9 @@ def check(onnx_path):
     episode = json.load(open(onnx_path + ".golden.json"))
     port = PORTS[(episode["game"], episode["role"])]
     aux = episode.get("aux")
+    extra = abilities(sidecar, episode)
     recorded = np.array([f["observation"] for f in episode["frames"]], dtype=np.float64)
-    ported = np.array([port(f["state"], aux) for f in episode["frames"]], dtype=np.float64)
+    ported = np.array([port(f["state"], aux) + extra for f in episode["frames"]], dtype=np.float64)
     if ported.shape != recorded.shape:
         raise SystemExit(f"{onnx_path}: ported {ported.shape}, recorded {recorded.shape}")
     observation_error = float(np.abs(ported - recorded).max())

@@ -133,7 +133,7 @@ pub fn load_folder_solver(
         return Ok(solver);
     }
     Ok(match load_aware_solver(dir, game)? {
-        Some(aware) if std::ptr::eq(solver.or_aware(Some(&aware), profile), &aware) => aware,
+        Some(aware) if solver.yields_to(&aware, profile) => aware,
         _ => solver,
     })
 }

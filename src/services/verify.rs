@@ -92,14 +92,14 @@ impl SolverPolicy {
         played: Option<&Profile>,
     ) -> &'a SolverPolicy {
         match aware {
-            Some(aware)
-                if self.fit(played) != ProfileFit::Fits
-                    && aware.fit(played) == ProfileFit::Fits =>
-            {
-                aware
-            }
+            Some(aware) if self.yields_to(aware, played) => aware,
             _ => self,
         }
+    }
+
+    /// Whether `aware` plays under `played` in place of this Solver ([`Self::or_aware`]).
+    pub fn yields_to(&self, aware: &SolverPolicy, played: Option<&Profile>) -> bool {
+        self.fit(played) != ProfileFit::Fits && aware.fit(played) == ProfileFit::Fits
     }
 
     /// What it observes after the game's observation on `level`: for an ability-aware Solver

@@ -88,12 +88,14 @@ fn read_game(game: Game, results: &Path, policies: &Path) -> Result<GamePage> {
     }
     let cards = POLICIES
         .iter()
-        .filter(|name| {
-            let card = policies.join(game.name()).join(format!("{name}.yaml"));
-            **name != OPTIONAL_POLICY || card.is_file()
-        })
         .map(|name| {
-            let path = policies.join(game.name()).join(format!("{name}.yaml"));
+            (
+                name,
+                policies.join(game.name()).join(format!("{name}.yaml")),
+            )
+        })
+        .filter(|(name, path)| **name != OPTIONAL_POLICY || path.is_file())
+        .map(|(name, path)| {
             let card: PolicyCard = serde_yaml::from_slice(&read(&path)?)
                 .with_context(|| format!("{}", path.display()))?;
             Ok((format!("{name}.safetensors"), card))

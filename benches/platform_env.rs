@@ -5,6 +5,7 @@
 
 use std::time::{Duration, Instant};
 
+use arlpcg_core::game::SolverEnv;
 use arlpcg_core::game::platform::rules;
 use arlpcg_core::game::platform::{OBSERVATION_SIZE, PlatformAction, PlatformEnv, PlatformRewards};
 use rayon::prelude::*;

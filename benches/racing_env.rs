@@ -6,6 +6,7 @@
 
 use std::time::{Duration, Instant};
 
+use arlpcg_core::game::SolverEnv;
 use arlpcg_core::game::racing::car::CarAction;
 use arlpcg_core::game::racing::{
     OBSERVATION_SIZE, RacingEnv, RacingRewards, ScriptedDriver, rules,

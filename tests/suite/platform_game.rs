@@ -1,6 +1,7 @@
 //! The platform world (its determinism is in determinism.rs): the calibrated reach, observations and rewards as the
 //! Solver sees them, and how runs end.
 
+use arlpcg_core::game::SolverEnv;
 use arlpcg_core::game::platform::character::Body;
 use arlpcg_core::game::platform::reach::{
     self, REACH_HEIGHTS, REACH_TABLE, Reach, play_scripted, single_jump,

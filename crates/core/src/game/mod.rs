@@ -33,6 +33,21 @@ impl Step {
             outcome: Some(outcome),
         }
     }
+
+    /// The step of a decision that earned `reward`: where it ends the run with `outcome`, the
+    /// ending's reward (`success`, or `failure` for every other ending) is added.
+    pub fn after(outcome: Option<Outcome>, reward: f32, success: f32, failure: f32) -> Self {
+        match outcome {
+            Some(Outcome::Success) => Self::finished(Outcome::Success, reward + success),
+            Some(outcome) => Self::finished(outcome, reward + failure),
+            None => Self {
+                reward,
+                terminated: false,
+                truncated: false,
+                outcome: None,
+            },
+        }
+    }
 }
 
 /// What verification and the designer need from a game's Solver environment. Code written

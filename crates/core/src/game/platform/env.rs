@@ -7,6 +7,7 @@ use rapier3d::math::Vector;
 
 use super::character::{Body, Character, DECISION_DT, PlatformAction};
 use super::world::PlatformWorld;
+use crate::game::SolverEnv;
 use crate::game::Step;
 use crate::level::PlatformTrack;
 use crate::level::platform::Platform;
@@ -180,12 +181,6 @@ impl PlatformEnv {
         self.open && self.outcome.is_none() && self.furthest == self.world.platforms().len() - 1
     }
 
-    /// Starts a new run: the character stands on the start block, placed and turned at random
-    /// (seeded) within a metre of its centre and 90 degrees of the track's direction.
-    pub fn reset(&mut self, seed: u64) {
-        self.reset_on(0, seed);
-    }
-
     /// Starts a new run on block `block` (0: the start block), as [`PlatformEnv::reset`] does on
     /// the start block; the blocks before it count as left behind.
     pub fn reset_on(&mut self, block: usize, seed: u64) {
@@ -205,50 +200,6 @@ impl PlatformEnv {
         self.steps = 0;
         self.outcome = None;
         self.remaining = self.path_remaining();
-    }
-
-    /// Advances one decision.
-    pub fn step(&mut self, action: PlatformAction) -> Step {
-        if let Some(outcome) = self.outcome {
-            // A finished run stays finished.
-            return Step::finished(outcome, 0.0);
-        }
-        self.character.step(&self.world, action);
-        self.steps += 1;
-        if let Some(index) = self.standing_on() {
-            self.furthest = self.furthest.max(index);
-        }
-        let remaining = self.path_remaining();
-        let mut reward = self.rewards.progress_per_metre * (self.remaining - remaining);
-        self.remaining = remaining;
-        let last = self.world.platforms().len() - 1;
-        let outcome = if self.furthest == last && !self.open {
-            Some(Outcome::Success)
-        } else if self.character.feet.y < self.world.lowest_top() - FALL_MARGIN {
-            Some(Outcome::Fell)
-        } else if self.steps >= self.max_steps {
-            Some(Outcome::TimedOut)
-        } else {
-            None
-        };
-        match outcome {
-            Some(outcome) => {
-                reward += match outcome {
-                    Outcome::Success => self.rewards.success,
-                    Outcome::Fell | Outcome::TimedOut | Outcome::OffRoad | Outcome::Flipped => {
-                        self.rewards.failure
-                    }
-                };
-                self.outcome = Some(outcome);
-                Step::finished(outcome, reward)
-            }
-            None => Step {
-                reward,
-                terminated: false,
-                truncated: false,
-                outcome: None,
-            },
-        }
     }
 
     /// The platform the character stands on, if grounded on one.
@@ -279,40 +230,6 @@ impl PlatformEnv {
             .feet
             .distance(self.world.platforms()[next].top)
             + self.path_after[next]
-    }
-
-    /// Writes the observation (see [`OBSERVATION_LAYOUT`]) into `out`.
-    pub fn observe(&self, out: &mut [f32]) {
-        assert_eq!(
-            out.len(),
-            OBSERVATION_SIZE,
-            "observation buffer of the wrong size"
-        );
-        let c = &self.character;
-        let forward = c.facing();
-        let left = Vector::new(forward.z, 0.0, -forward.x);
-        let local = |v: Vector| [v.dot(forward), v.y, v.dot(left)];
-        let next = self.world.platforms()[self.next_index()];
-        let to_goal = self.goal - c.feet;
-        let to_next = next.top - c.feet;
-        let bearing = to_next.dot(left).atan2(to_next.dot(forward));
-        let state = local(to_goal)
-            .map(|x| x / 50.0)
-            .into_iter()
-            .chain([to_goal.length() / 50.0])
-            .chain(local(to_next).map(|x| x / 10.0))
-            .chain([next.size / 6.0])
-            .chain(local(c.velocity).map(|x| x / 10.0))
-            .chain([bearing.sin(), bearing.cos()])
-            .chain([if c.grounded { 1.0 } else { 0.0 }])
-            .chain([1.0 - self.steps as f32 / self.max_steps as f32]);
-        let (state_out, map) = out.split_at_mut(STATE_SIZE);
-        for (slot, value) in state_out.iter_mut().zip(state) {
-            *slot = value;
-        }
-        for (slot, depth) in map.iter_mut().zip(self.height_map_hits()) {
-            *slot = (RAY_START_HEIGHT - depth) / 4.0;
-        }
     }
 
     /// How far each height-map ray travels down before it hits something ([`RAY_LENGTH`] where
@@ -371,16 +288,72 @@ impl crate::game::SolverEnv for PlatformEnv {
     type Action = PlatformAction;
     const OBSERVATION_SIZE: usize = OBSERVATION_SIZE;
 
+    /// Starts a new run: the character stands on the start block, placed and turned at random
+    /// (seeded) within a metre of its centre and 90 degrees of the track's direction.
     fn reset(&mut self, seed: u64) {
-        PlatformEnv::reset(self, seed);
+        self.reset_on(0, seed);
     }
 
+    /// Advances one decision.
     fn step(&mut self, action: PlatformAction) -> Step {
-        PlatformEnv::step(self, action)
+        if let Some(outcome) = self.outcome {
+            // A finished run stays finished.
+            return Step::finished(outcome, 0.0);
+        }
+        self.character.step(&self.world, action);
+        self.steps += 1;
+        if let Some(index) = self.standing_on() {
+            self.furthest = self.furthest.max(index);
+        }
+        let remaining = self.path_remaining();
+        let reward = self.rewards.progress_per_metre * (self.remaining - remaining);
+        self.remaining = remaining;
+        let last = self.world.platforms().len() - 1;
+        let outcome = if self.furthest == last && !self.open {
+            Some(Outcome::Success)
+        } else if self.character.feet.y < self.world.lowest_top() - FALL_MARGIN {
+            Some(Outcome::Fell)
+        } else if self.steps >= self.max_steps {
+            Some(Outcome::TimedOut)
+        } else {
+            None
+        };
+        self.outcome = outcome;
+        Step::after(outcome, reward, self.rewards.success, self.rewards.failure)
     }
 
+    /// Writes the observation (see [`OBSERVATION_LAYOUT`]) into `out`.
     fn observe(&self, out: &mut [f32]) {
-        PlatformEnv::observe(self, out);
+        assert_eq!(
+            out.len(),
+            OBSERVATION_SIZE,
+            "observation buffer of the wrong size"
+        );
+        let c = &self.character;
+        let forward = c.facing();
+        let left = Vector::new(forward.z, 0.0, -forward.x);
+        let local = |v: Vector| [v.dot(forward), v.y, v.dot(left)];
+        let next = self.world.platforms()[self.next_index()];
+        let to_goal = self.goal - c.feet;
+        let to_next = next.top - c.feet;
+        let bearing = to_next.dot(left).atan2(to_next.dot(forward));
+        let state = local(to_goal)
+            .map(|x| x / 50.0)
+            .into_iter()
+            .chain([to_goal.length() / 50.0])
+            .chain(local(to_next).map(|x| x / 10.0))
+            .chain([next.size / 6.0])
+            .chain(local(c.velocity).map(|x| x / 10.0))
+            .chain([bearing.sin(), bearing.cos()])
+            .chain([if c.grounded { 1.0 } else { 0.0 }])
+            .chain([1.0 - self.steps as f32 / self.max_steps as f32]);
+        let (state_out, map) = out.split_at_mut(STATE_SIZE);
+        for (slot, value) in state_out.iter_mut().zip(state) {
+            *slot = value;
+        }
+        for (slot, depth) in map.iter_mut().zip(self.height_map_hits()) {
+            *slot = (RAY_START_HEIGHT - depth) / 4.0;
+        }
     }
 
     fn action_from_policy_row(row: &[f32]) -> PlatformAction {

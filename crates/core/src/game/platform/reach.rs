@@ -6,6 +6,7 @@
 use super::character::Body;
 use super::env::{PlatformEnv, PlatformRewards};
 use super::scripted::ScriptedController;
+use crate::game::SolverEnv;
 use crate::level::platform::{BlockParams, PlatformTrack, Start};
 use crate::level::stats::{Outcome, TrialResult};
 

@@ -8,6 +8,7 @@ use rand_chacha::ChaCha8Rng;
 use rapier3d::math::{Rotation, Vector};
 
 use super::car::{Car, CarAction, DECISION_DT, RacingWorld, START_S, TrackShapes};
+use crate::game::SolverEnv;
 use crate::game::Step;
 use crate::level::racing::{RacingTrack, SegmentParams};
 use crate::level::road::Road;
@@ -208,12 +209,6 @@ impl RacingEnv {
         self.road.length() - self.along
     }
 
-    /// Starts a new run: the car at rest [`START_S`] m along the road, shifted and turned at
-    /// random (seeded) within a metre and a few degrees.
-    pub fn reset(&mut self, seed: u64) {
-        self.reset_on(0, seed);
-    }
-
     /// Starts a new run [`START_S`] m into segment `segment`, as [`RacingEnv::reset`] does at
     /// the road's start.
     pub fn reset_on(&mut self, segment: usize, seed: u64) {
@@ -243,72 +238,6 @@ impl RacingEnv {
         self.outcome = None;
     }
 
-    /// Advances one decision.
-    pub fn step(&mut self, action: CarAction) -> Step {
-        if let Some(outcome) = self.outcome {
-            return Step::finished(outcome, 0.0);
-        }
-        self.world.step(action);
-        self.steps += 1;
-        let position = to_f64(self.world.position());
-        self.nearest = self.road.nearest(position, Some(self.nearest), 8);
-        let sample = self.road.samples()[self.nearest];
-        let along = self.along_at(position);
-        let mut reward = self.rewards.progress_per_metre * (along - self.along) as f32;
-        self.along = along;
-
-        let wheels = self.world.wheels_in_contact();
-        if wheels == 0 && self.height_over_ground() > AIR_HEIGHT {
-            self.air_steps += 1;
-        }
-        let lateral = self.lateral_offset(position);
-        let beyond_edge = lateral.abs() > 0.5 * self.road.shape().width;
-        self.loose_steps = if wheels == 0 && beyond_edge {
-            self.loose_steps + 1
-        } else {
-            0
-        };
-        let up = self.world.rotation() * Vector::Y;
-        self.flipped_steps = if up.y < FLIP_UP {
-            self.flipped_steps + 1
-        } else {
-            0
-        };
-        let outcome = if self.complete
-            && along >= self.road.length() - crate::level::racing::FINISH_LENGTH
-            && !beyond_edge
-        {
-            Some(Outcome::Success)
-        } else if position[1] < sample.centre[1] - BELOW_ROAD
-            || self.loose_steps as f32 * DECISION_DT >= OFF_ROAD_S
-        {
-            Some(Outcome::OffRoad)
-        } else if self.flipped_steps as f32 * DECISION_DT >= FLIP_S {
-            Some(Outcome::Flipped)
-        } else if self.steps >= self.max_steps {
-            Some(Outcome::TimedOut)
-        } else {
-            None
-        };
-        match outcome {
-            Some(outcome) => {
-                reward += if outcome == Outcome::Success {
-                    self.rewards.success
-                } else {
-                    self.rewards.failure
-                };
-                self.outcome = Some(outcome);
-                Step::finished(outcome, reward)
-            }
-            None => Step {
-                reward,
-                terminated: false,
-                truncated: false,
-                outcome: None,
-            },
-        }
-    }
-
     /// Distance along the road of the point of the centre line nearest `position`.
     fn along_at(&self, position: [f64; 3]) -> f64 {
         let sample = self.road.samples()[self.nearest];
@@ -336,55 +265,6 @@ impl RacingEnv {
             &mut distance,
         );
         distance[0]
-    }
-
-    /// Writes the observation (see [`OBSERVATION_LAYOUT`]) into `out`.
-    pub fn observe(&self, out: &mut [f32]) {
-        assert_eq!(
-            out.len(),
-            OBSERVATION_SIZE,
-            "observation buffer of the wrong size"
-        );
-        let position = self.world.position();
-        let rotation = self.world.rotation();
-        let into_car = rotation.inverse();
-        let yaw = self.yaw();
-        let level = Rotation::from_rotation_y(yaw);
-        let into_level = level.inverse();
-        let goal = Vector::new(
-            self.goal[0] as f32, self.goal[1] as f32, self.goal[2] as f32,
-        );
-        let to_goal = into_level * (goal - position);
-        let bearing = (-to_goal.z).atan2(to_goal.x);
-        let sample = self.road.samples()[self.nearest];
-        let road_bearing = wrap(sample.heading as f32 - yaw);
-        let velocity = into_car * self.world.velocity();
-        let spin = into_car * self.world.angular_velocity();
-        let up = into_car * Vector::Y;
-        let ahead = self.centre_line_ahead().map(|point| {
-            let local = into_level * (to_f32(point) - position);
-            [local.x / 60.0, local.z / 20.0]
-        });
-        // Written straight into `out`: no allocation per decision.
-        let state = (to_goal / 100.0)
-            .to_array()
-            .into_iter()
-            .chain([bearing.sin(), bearing.cos()])
-            .chain((velocity / 20.0).to_array())
-            .chain(spin.to_array())
-            .chain(up.to_array())
-            .chain([self.lateral_offset(to_f64(position)) as f32
-                / (0.5 * self.road.shape().width as f32)])
-            .chain([road_bearing.sin(), road_bearing.cos()])
-            .chain(ahead.into_iter().flatten());
-        for (slot, value) in out[..OBSERVATION_SIZE - FAN_SIZE].iter_mut().zip(state) {
-            *slot = value;
-        }
-        let fan = &mut out[OBSERVATION_SIZE - FAN_SIZE..];
-        for (slot, depth) in fan.iter_mut().zip(self.fan_hits()) {
-            // Height of what the ray hit relative to the chassis; nothing hit reads -12 m.
-            *slot = (FAN_START_HEIGHT - depth) / 6.0;
-        }
     }
 
     /// The car's heading in the level (radians about +Y, 0 along +X), from its forward axis.
@@ -483,16 +363,110 @@ impl crate::game::SolverEnv for RacingEnv {
     type Action = CarAction;
     const OBSERVATION_SIZE: usize = OBSERVATION_SIZE;
 
+    /// Starts a new run: the car at rest [`START_S`] m along the road, shifted and turned at
+    /// random (seeded) within a metre and a few degrees.
     fn reset(&mut self, seed: u64) {
-        RacingEnv::reset(self, seed);
+        self.reset_on(0, seed);
     }
 
+    /// Advances one decision.
     fn step(&mut self, action: CarAction) -> Step {
-        RacingEnv::step(self, action)
+        if let Some(outcome) = self.outcome {
+            return Step::finished(outcome, 0.0);
+        }
+        self.world.step(action);
+        self.steps += 1;
+        let position = to_f64(self.world.position());
+        self.nearest = self.road.nearest(position, Some(self.nearest), 8);
+        let sample = self.road.samples()[self.nearest];
+        let along = self.along_at(position);
+        let reward = self.rewards.progress_per_metre * (along - self.along) as f32;
+        self.along = along;
+
+        let wheels = self.world.wheels_in_contact();
+        if wheels == 0 && self.height_over_ground() > AIR_HEIGHT {
+            self.air_steps += 1;
+        }
+        let lateral = self.lateral_offset(position);
+        let beyond_edge = lateral.abs() > 0.5 * self.road.shape().width;
+        self.loose_steps = if wheels == 0 && beyond_edge {
+            self.loose_steps + 1
+        } else {
+            0
+        };
+        let up = self.world.rotation() * Vector::Y;
+        self.flipped_steps = if up.y < FLIP_UP {
+            self.flipped_steps + 1
+        } else {
+            0
+        };
+        let outcome = if self.complete
+            && along >= self.road.length() - crate::level::racing::FINISH_LENGTH
+            && !beyond_edge
+        {
+            Some(Outcome::Success)
+        } else if position[1] < sample.centre[1] - BELOW_ROAD
+            || self.loose_steps as f32 * DECISION_DT >= OFF_ROAD_S
+        {
+            Some(Outcome::OffRoad)
+        } else if self.flipped_steps as f32 * DECISION_DT >= FLIP_S {
+            Some(Outcome::Flipped)
+        } else if self.steps >= self.max_steps {
+            Some(Outcome::TimedOut)
+        } else {
+            None
+        };
+        self.outcome = outcome;
+        Step::after(outcome, reward, self.rewards.success, self.rewards.failure)
     }
 
+    /// Writes the observation (see [`OBSERVATION_LAYOUT`]) into `out`.
     fn observe(&self, out: &mut [f32]) {
-        RacingEnv::observe(self, out);
+        assert_eq!(
+            out.len(),
+            OBSERVATION_SIZE,
+            "observation buffer of the wrong size"
+        );
+        let position = self.world.position();
+        let rotation = self.world.rotation();
+        let into_car = rotation.inverse();
+        let yaw = self.yaw();
+        let level = Rotation::from_rotation_y(yaw);
+        let into_level = level.inverse();
+        let goal = Vector::new(
+            self.goal[0] as f32, self.goal[1] as f32, self.goal[2] as f32,
+        );
+        let to_goal = into_level * (goal - position);
+        let bearing = (-to_goal.z).atan2(to_goal.x);
+        let sample = self.road.samples()[self.nearest];
+        let road_bearing = wrap(sample.heading as f32 - yaw);
+        let velocity = into_car * self.world.velocity();
+        let spin = into_car * self.world.angular_velocity();
+        let up = into_car * Vector::Y;
+        let ahead = self.centre_line_ahead().map(|point| {
+            let local = into_level * (to_f32(point) - position);
+            [local.x / 60.0, local.z / 20.0]
+        });
+        // Written straight into `out`: no allocation per decision.
+        let state = (to_goal / 100.0)
+            .to_array()
+            .into_iter()
+            .chain([bearing.sin(), bearing.cos()])
+            .chain((velocity / 20.0).to_array())
+            .chain(spin.to_array())
+            .chain(up.to_array())
+            .chain([self.lateral_offset(to_f64(position)) as f32
+                / (0.5 * self.road.shape().width as f32)])
+            .chain([road_bearing.sin(), road_bearing.cos()])
+            .chain(ahead.into_iter().flatten());
+        for (slot, value) in out[..OBSERVATION_SIZE - FAN_SIZE].iter_mut().zip(state) {
+            *slot = value;
+        }
+        let fan = &mut out[OBSERVATION_SIZE - FAN_SIZE..];
+        for (slot, depth) in fan.iter_mut().zip(self.fan_hits()) {
+            // Height of what the ray hit relative to the chassis; nothing hit reads -12 m.
+            *slot = (FAN_START_HEIGHT - depth) / 6.0;
+        }
     }
 
     fn action_from_policy_row(row: &[f32]) -> CarAction {

@@ -5,6 +5,7 @@
 use super::car::{Car, CarAction, DECISION_DT};
 use super::env::{RacingEnv, RacingRewards};
 use super::scripted::ScriptedDriver;
+use crate::game::SolverEnv;
 use crate::level::racing::{RacingTrack, RoadShape, SegmentParams};
 use crate::level::stats::Outcome;
 

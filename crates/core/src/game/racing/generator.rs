@@ -423,6 +423,7 @@ impl GeneratorGame for RacingGame {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::game::SolverEnv;
     use crate::game::generator::{Match, observation_size};
     use crate::game::racing::{OBSERVATION_SIZE, ScriptedDriver};
 

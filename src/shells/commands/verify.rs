@@ -46,15 +46,12 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
     let profile = args.profile.as_deref().map(profile::load).transpose()?;
     let mut solvers = Solvers::default();
     let mut checked = Vec::new();
-    let mut failed = 0;
     let mut all = Vec::new();
     let mut halfway = HalfwaySplit::default();
     let mut concentration = FailureConcentration::default();
-    for path in &args.levels {
-        if crate::shells::common::stdout_closed() {
-            break; // nobody reads the rest
-        }
-        let outcome =
+    let failed = each_level(
+        &args.levels,
+        |path| {
             load_under(path, profile.as_ref(), args.profile.as_deref()).and_then(|level| {
                 let game = level.game();
                 solvers.resolve(game, args)?;
@@ -67,38 +64,34 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
                 let stats = verify(&level, &solver, args.trials, args.seed, &|| bar.inc(1))?;
                 bar.finish_and_clear();
                 Ok((level, stats))
-            });
-        match outcome {
-            Ok((level, stats)) => {
-                if args.json {
-                    crate::say!("{}", to_json(path, &level, &stats));
-                } else {
-                    crate::say!("{}", describe(path, &level, &stats));
-                }
-                halfway.add(&level, &stats);
-                concentration.add(&stats);
-                checked.extend(failures(
-                    &args.checks,
-                    [(path.display().to_string(), Some(&stats), None)],
-                ));
-                if let Some(chart) = &args.chart {
-                    let name = path.file_stem().unwrap_or_default().to_string_lossy();
-                    let png = crate::services::verify::pacing_chart(&name, &level, &stats).to_png();
-                    crate::services::fsio::write_atomic(
-                        chart,
-                        &png,
-                        crate::services::fsio::Overwrite::Never,
-                    )?;
-                    crate::warn!("wrote {}", chart.display());
-                }
-                all.push(stats);
+            })
+        },
+        |path, (level, stats)| {
+            if args.json {
+                crate::say!("{}", to_json(path, &level, &stats));
+            } else {
+                crate::say!("{}", describe(path, &level, &stats));
             }
-            Err(err) => {
-                failed += 1;
-                crate::warn!("error: {}", one_line(&format!("{err:#}")));
+            halfway.add(&level, &stats);
+            concentration.add(&stats);
+            checked.extend(failures(
+                &args.checks,
+                [(path.display().to_string(), Some(&stats), None)],
+            ));
+            if let Some(chart) = &args.chart {
+                let name = path.file_stem().unwrap_or_default().to_string_lossy();
+                let png = crate::services::verify::pacing_chart(&name, &level, &stats).to_png();
+                crate::services::fsio::write_atomic(
+                    chart,
+                    &png,
+                    crate::services::fsio::Overwrite::Never,
+                )?;
+                crate::warn!("wrote {}", chart.display());
             }
-        }
-    }
+            all.push(stats);
+            Ok(())
+        },
+    )?;
     if all.len() > 1 && !args.json {
         let s = Summary::of(&all);
         let steps = match s.completed_by_any > 0.0 {
@@ -198,22 +191,14 @@ fn load_under(path: &Path, profile: Option<&Profile>, file: Option<&Path>) -> Re
 
 /// `verify --replay`: each level's certificate run, again, with the Solver that recorded it.
 fn replay(args: &VerifyArgs) -> Result<()> {
-    let mut failed = 0;
-    for path in &args.levels {
-        if crate::shells::common::stdout_closed() {
-            break; // nobody reads the rest
-        }
-        let outcome = yaml::load(path)
-            .map_err(anyhow::Error::from)
-            .and_then(|level| replay_one(&level));
-        match outcome {
-            Ok(said) => crate::say!("{}: {said}", path.display()),
-            Err(err) => {
-                failed += 1;
-                report_error(path, &err);
-            }
-        }
-    }
+    let failed = each_level(
+        &args.levels,
+        |path| replay_one(&yaml::load(path)?),
+        |path, said| {
+            crate::say!("{}: {said}", path.display());
+            Ok(())
+        },
+    )?;
     if failed > 0 {
         anyhow::bail!(
             "{failed} of {} certificates did not replay",
@@ -266,56 +251,53 @@ fn replay_one(level: &arlpcg_core::level::Level) -> Result<String> {
 fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
     let mut panels: HashMap<Game, JudgePanel> = HashMap::new();
     let mut rated: Vec<(&Path, Game, PanelStats)> = Vec::new();
-    let mut failed = 0;
-    for path in &args.levels {
-        if crate::shells::common::stdout_closed() {
-            break; // nobody reads the rest
-        }
-        let outcome = yaml::load(path)
-            .map_err(anyhow::Error::from)
-            .and_then(|level| {
-                let game = level.game();
-                let panel = match panels.entry(game) {
-                    Entry::Occupied(known) => known.into_mut(),
-                    Entry::Vacant(new) => {
-                        let dir = args
-                            .policies
-                            .clone()
-                            .unwrap_or_else(|| crate::services::policies::shipped_dir(game));
-                        let chosen = (!chosen.0.is_empty()).then_some(chosen.0.as_slice());
-                        let panel = load_panel(&dir, game, chosen)?;
-                        if !args.json {
-                            crate::warn!("{game} panel: {}", panel.names().join(", "));
+    let failed = each_level(
+        &args.levels,
+        |path| {
+            yaml::load(path)
+                .map_err(anyhow::Error::from)
+                .and_then(|level| {
+                    let game = level.game();
+                    let panel = match panels.entry(game) {
+                        Entry::Occupied(known) => known.into_mut(),
+                        Entry::Vacant(new) => {
+                            let dir = args
+                                .policies
+                                .clone()
+                                .unwrap_or_else(|| crate::services::policies::shipped_dir(game));
+                            let chosen = (!chosen.0.is_empty()).then_some(chosen.0.as_slice());
+                            let panel = load_panel(&dir, game, chosen)?;
+                            if !args.json {
+                                crate::warn!("{game} panel: {}", panel.names().join(", "));
+                            }
+                            new.insert(panel)
                         }
-                        new.insert(panel)
-                    }
-                };
-                let runs = args.trials as u64 * panel.judges.len() as u64;
-                let bar = crate::shells::common::progress_bar(runs, &path.display().to_string());
-                let watch = Watch {
-                    on_trial: &|_| bar.inc(1),
-                    stop: &|| false,
-                };
-                let played = crate::services::panel::play(
-                    panel,
-                    &level,
-                    args.trials,
-                    args.seed,
-                    &watch,
-                    &|_, _| {},
-                )?
-                .expect("a panel without a stop condition plays to the end");
-                bar.finish_and_clear();
-                Ok((game, played))
-            });
-        match outcome {
-            Ok((game, stats)) => rated.push((path, game, stats)),
-            Err(err) => {
-                failed += 1;
-                report_error(path, &err);
-            }
-        }
-    }
+                    };
+                    let runs = args.trials as u64 * panel.judges.len() as u64;
+                    let bar =
+                        crate::shells::common::progress_bar(runs, &path.display().to_string());
+                    let watch = Watch {
+                        on_trial: &|_| bar.inc(1),
+                        stop: &|| false,
+                    };
+                    let played = crate::services::panel::play(
+                        panel,
+                        &level,
+                        args.trials,
+                        args.seed,
+                        &watch,
+                        &|_, _| {},
+                    )?
+                    .expect("a panel without a stop condition plays to the end");
+                    bar.finish_and_clear();
+                    Ok((game, played))
+                })
+        },
+        |path, (game, stats)| {
+            rated.push((path, game, stats));
+            Ok(())
+        },
+    )?;
     for game in [Game::Platform, Game::Racing] {
         let mut of_game: Vec<&mut PanelStats> = rated
             .iter_mut()
@@ -574,6 +556,30 @@ fn describe(path: &Path, level: &Level, s: &SolverStats) -> String {
         );
     }
     text
+}
+
+/// Plays each level file in turn (`play`), hands what it found to `done`, and prints each file's
+/// error on one line: how many failed. It stops when nobody reads stdout any more; an error of
+/// `done` (writing a chart) ends it.
+fn each_level<'a, T>(
+    levels: &'a [std::path::PathBuf],
+    mut play: impl FnMut(&'a Path) -> Result<T>,
+    mut done: impl FnMut(&'a Path, T) -> Result<()>,
+) -> Result<usize> {
+    let mut failed = 0;
+    for path in levels {
+        if crate::shells::common::stdout_closed() {
+            break; // nobody reads the rest
+        }
+        match play(path) {
+            Ok(found) => done(path, found)?,
+            Err(err) => {
+                failed += 1;
+                report_error(path, &err);
+            }
+        }
+    }
+    Ok(failed)
 }
 
 /// Prints a level file's error on one line.

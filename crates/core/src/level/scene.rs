@@ -358,19 +358,12 @@ fn platform_scene(level: &Level, track: &PlatformTrack) -> Scene {
         Material::StartMarker,
     ));
     nodes.push(marker("goal", level.goal, 3.0, Material::GoalMarker));
-    Scene {
-        name: format!("{}_level", level.game()),
+    level_scene(
+        level,
         nodes,
-        meshes: Vec::new(),
-        points: Vec::new(),
-        extras: json!({
-            "format": super::yaml::FORMAT_NAME,
-            "game": level.game().name(),
-            "seed": level.seed,
-            "aux": level.aux,
-            "blocks": track.block_count(),
-        }),
-    }
+        Vec::new(),
+        json!({ "blocks": track.block_count() }),
+    )
 }
 
 fn racing_scene(level: &Level, track: &RacingTrack) -> Scene {
@@ -433,20 +426,41 @@ fn racing_scene(level: &Level, track: &RacingTrack) -> Scene {
             }),
         }
     }
+    level_scene(
+        level,
+        nodes,
+        meshes,
+        json!({
+            "segments": track.segments.len(),
+            "road_width": road.shape().width,
+            "road_length": road.length(),
+        }),
+    )
+}
+
+/// A level's scene: its nodes and meshes, with the extras every level carries (the format, the
+/// game, the seed, λ) followed by its game's own.
+fn level_scene(
+    level: &Level,
+    nodes: Vec<SceneNode>,
+    meshes: Vec<SceneMesh>,
+    game_extras: Value,
+) -> Scene {
+    let mut extras = json!({
+        "format": super::yaml::FORMAT_NAME,
+        "game": level.game().name(),
+        "seed": level.seed,
+        "aux": level.aux,
+    });
+    if let (Value::Object(all), Value::Object(own)) = (&mut extras, game_extras) {
+        all.extend(own);
+    }
     Scene {
         name: format!("{}_level", level.game()),
         nodes,
         meshes,
         points: Vec::new(),
-        extras: json!({
-            "format": super::yaml::FORMAT_NAME,
-            "game": level.game().name(),
-            "seed": level.seed,
-            "aux": level.aux,
-            "segments": track.segments.len(),
-            "road_width": road.shape().width,
-            "road_length": road.length(),
-        }),
+        extras,
     }
 }
 

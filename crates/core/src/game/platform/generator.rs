@@ -395,15 +395,21 @@ mod tests {
         assert!((block.angle + 90.0).abs() < 1e-3, "{block:?}");
     }
 
-    #[test]
-    fn a_match_grows_its_track_as_the_solver_advances_and_ends_at_the_goal() {
-        let goal = [30.0, 2.0, 0.0];
-        let build = PlatformBuild {
+    /// A track from the default start towards `goal`, of at most 30 blocks, for the built-in
+    /// character.
+    fn test_build(goal: [f64; 3]) -> PlatformBuild {
+        PlatformBuild {
             track: PlatformTrack::new(Start::default()),
             goal,
             max_blocks: 30,
             player: Player::default(),
-        };
+        }
+    }
+
+    #[test]
+    fn a_match_grows_its_track_as_the_solver_advances_and_ends_at_the_goal() {
+        let goal = [30.0, 2.0, 0.0];
+        let build = test_build(goal);
         let mut game = Match::<PlatformGame>::new(build, vec![1.0], 7);
         let rewards = GeneratorRewards::default();
         let mut controller = crate::game::platform::ScriptedController::new(7, 0.0);
@@ -450,12 +456,7 @@ mod tests {
     fn paced_match(before: f32, after: f32, stop_after: usize) -> (Vec<f32>, Vec<f32>, f32) {
         use crate::game::generator::MatchPacing;
         let goal = [40.0, 0.0, 0.0];
-        let build = PlatformBuild {
-            track: PlatformTrack::new(Start::default()),
-            goal,
-            max_blocks: 30,
-            player: Player::default(),
-        };
+        let build = test_build(goal);
         let pacing = MatchPacing {
             before,
             after,
@@ -514,12 +515,7 @@ mod tests {
     /// failure, the share of the way of the block it failed to reach, and the match.
     fn retried_match(stop_after: usize) -> (Vec<f32>, f64, Match<PlatformGame>) {
         let goal = [40.0, 0.0, 0.0];
-        let build = PlatformBuild {
-            track: PlatformTrack::new(Start::default()),
-            goal,
-            max_blocks: 30,
-            player: Player::default(),
-        };
+        let build = test_build(goal);
         let mut game = Match::<PlatformGame>::new(build, vec![-1.0], 7);
         let rewards = GeneratorRewards {
             retries: 1,

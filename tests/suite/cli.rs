@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use crate::common::{arlpcg, arlpcg_ok, fails_with, files_of, stderr};
+use crate::common::{arlpcg, arlpcg_ok, fails_with, files_of, stderr, words};
 
 fn generate(dir: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
@@ -52,20 +52,10 @@ fn generate_is_reproducible_byte_for_byte_and_files_load_back() {
 fn racing_tracks_are_reproducible_and_the_scripted_driver_clears_them() {
     let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
     for dir in [&a, &b] {
-        arlpcg_ok(&[
-            "generate",
-            "--game",
-            "racing",
-            "--rules",
-            "--count",
-            "20",
-            "--seed",
-            "1",
-            "--format",
-            "yaml,glb",
-            "--out",
-            dir.path().to_str().unwrap(),
-        ]);
+        arlpcg_ok(words(
+            "generate --game racing --rules --count 20 --seed 1 --format yaml,glb --out {}",
+            &[&dir.path()],
+        ));
     }
     let files = files_of(a.path());
     assert_eq!(files.len(), 40);
@@ -212,13 +202,7 @@ fn export_writes_glb_and_gltf_with_bin() {
     let exports = gltf_export_dir();
     for name in ["cli_export.glb", "cli_export.gltf"] {
         let target = exports.join(name);
-        arlpcg_ok(&[
-            "export",
-            level.to_str().unwrap(),
-            "--out",
-            target.to_str().unwrap(),
-            "--force",
-        ]);
+        arlpcg_ok(words("export {} --out {} --force", &[&level, &target]));
     }
     assert!(exports.join("cli_export.bin").exists());
     // The exported .glb equals the one generate wrote: one exporter.
@@ -227,14 +211,9 @@ fn export_writes_glb_and_gltf_with_bin() {
         std::fs::read(dir.path().join("platform_seed3.glb")).unwrap()
     );
     let existing = exports.join("cli_export.glb");
-    let out = arlpcg(&[
-        "export",
-        level.to_str().unwrap(),
-        "--out",
-        existing.to_str().unwrap(),
-    ]);
+    let out = arlpcg(words("export {} --out {}", &[&level, &existing]));
     fails_with(&out, 1, "already exists");
-    let out = arlpcg(&["export", level.to_str().unwrap(), "--out", "level.obj"]);
+    let out = arlpcg(words("export {} --out level.obj", &[&level]));
     assert!(
         stderr(&out).contains("must end in .glb or .gltf"),
         "{}",
@@ -251,15 +230,10 @@ fn verify_reports_json_with_the_documented_keys() {
             .success()
     );
     let level = dir.path().join("platform_seed2.yaml");
-    let out = arlpcg_ok(&[
-        "verify",
-        level.to_str().unwrap(),
-        "--trials",
-        "20",
-        "--json",
-        "--solver",
-        "scripted",
-    ]);
+    let out = arlpcg_ok(words(
+        "verify {} --trials 20 --json --solver scripted",
+        &[&level],
+    ));
     let line = String::from_utf8(out.stdout).unwrap();
     let report: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
     for key in [
@@ -331,7 +305,7 @@ fn hand_broken_level_files_get_one_clear_line_and_a_non_zero_exit() {
         .into_bytes()
     };
     let good = dir_with_level(&stats("1.0", "1.0"));
-    arlpcg_ok(&["verify", good.1.to_str().unwrap(), "--solver", "scripted"]);
+    arlpcg_ok(words("verify {} --solver scripted", &[&good.1]));
     good.0.close().unwrap();
     let random: Vec<u8> = (0..4096u32)
         .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
@@ -430,16 +404,16 @@ fn dir_with_level(bytes: &[u8]) -> (tempfile::TempDir, PathBuf) {
 
 #[test]
 fn a_missing_level_file_is_named() {
-    let out = arlpcg(&["verify", "/no/such/level.yaml", "--solver", "scripted"]);
+    let out = arlpcg(words("verify /no/such/level.yaml --solver scripted", &[]));
     fails_with(&out, 1, "/no/such/level.yaml: cannot read the file");
 }
 
 #[test]
 fn a_generator_of_the_other_game_is_refused_by_name() {
-    let out = arlpcg(&[
-        "generate", "--game", "racing", "--policies", "policies/platform", "--aux", "0", "--out",
-        "x",
-    ]);
+    let out = arlpcg(words(
+        "generate --game racing --policies policies/platform --aux 0 --out x",
+        &[],
+    ));
     assert_eq!(out.status.code(), Some(1));
     assert!(
         stderr(&out)
@@ -451,9 +425,9 @@ fn a_generator_of_the_other_game_is_refused_by_name() {
 
 #[test]
 fn bad_arguments_are_usage_errors() {
-    let out = arlpcg(&["generate", "--rules", "--out", "x", "--aux", "3"]);
+    let out = arlpcg(words("generate --rules --out x --aux 3", &[]));
     fails_with(&out, 2, "aux 3 is out of range [-1, 1]");
-    let out = arlpcg(&["generate", "--rules", "--obstacles", "3", "--out", "x"]);
+    let out = arlpcg(words("generate --rules --obstacles 3 --out x", &[]));
     fails_with(&out, 2, "--obstacles is for racing tracks");
 }
 
@@ -482,7 +456,7 @@ fn arguments_that_do_not_fit_together_exit_2() {
             stderr(&out)
         );
     }
-    let out = arlpcg(&["eval", "--policies", "/nonexistent", "--out", "x"]);
+    let out = arlpcg(words("eval --policies /nonexistent --out x", &[]));
     fails_with(&out, 1, "--policies /nonexistent: no such folder");
 }
 
@@ -501,7 +475,7 @@ fn minus_zero_aux_is_zero() {
 
 #[test]
 fn running_without_a_command_prints_usage() {
-    let out = arlpcg_ok(&[]);
+    let out = arlpcg_ok::<&str>([]);
     let text = String::from_utf8(out.stdout).unwrap();
     for word in ["generate", "export", "verify", "Examples"] {
         assert!(text.contains(word), "usage lacks {word}: {text}");
@@ -522,14 +496,10 @@ fn policy_paths_that_are_not_policy_files_are_refused_unread() {
         (big.to_str().unwrap(), "more than the 268435456"),
     ];
     for (path, expected) in cases {
-        let out = arlpcg(&[
-            "verify",
-            "levels/platform/platform_seed7_aux+1.00.yaml",
-            "--solver",
-            "policy",
-            "--policy",
-            path,
-        ]);
+        let out = arlpcg(words(
+            "verify levels/platform/platform_seed7_aux+1.00.yaml --solver policy --policy {}",
+            &[&path],
+        ));
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(1), "{path}: {err}");
         assert!(
@@ -563,7 +533,7 @@ fn yaml_nesting_and_alias_bombs_are_refused_at_once() {
     ] {
         let path = dir.path().join(name);
         std::fs::write(&path, text).unwrap();
-        let out = arlpcg(&["verify", path.to_str().unwrap(), "--solver", "scripted"]);
+        let out = arlpcg(words("verify {} --solver scripted", &[&path]));
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(1), "{err}");
         assert!(err.contains(name) && err.contains(expected), "{err}");
@@ -626,14 +596,7 @@ fn ctrl_c_in_a_batch_keeps_finished_levels_and_no_temporaries() {
     );
     for (name, _) in files.iter().filter(|(n, _)| n.ends_with(".yaml")) {
         let path = dir.path().join(name);
-        arlpcg_ok(&[
-            "verify",
-            path.to_str().unwrap(),
-            "--solver",
-            "scripted",
-            "--trials",
-            "1",
-        ]);
+        arlpcg_ok(words("verify {} --solver scripted --trials 1", &[&path]));
     }
 }
 
@@ -683,10 +646,10 @@ fn sharded_eval_merges_into_the_unsharded_results() {
     let out = merge(&["part0", "part2"], "short");
     fails_with(&out, 1, "shard 1/3 is missing");
     let other_dir = at("other");
-    arlpcg_ok(&[
-        "eval", "--policies", "policies/platform", "--tracks", "2", "--trials", "2",
-        "--validation-tracks", "4", "--shard", "1/3", "--out", &other_dir,
-    ]);
+    arlpcg_ok(words(
+        "eval --policies policies/platform --tracks 2 --trials 2 --validation-tracks 4 --shard 1/3 --out {}",
+        &[&other_dir],
+    ));
     let out = merge(&["part0", "other", "part2"], "mixed");
     fails_with(&out, 1, "their budget differ");
 }
@@ -696,21 +659,10 @@ fn sharded_eval_merges_into_the_unsharded_results() {
 #[test]
 fn verified_levels_are_completable_and_their_certificates_replay() {
     let dir = tempfile::tempdir().unwrap();
-    let out = arlpcg_ok(&[
-        "generate",
-        "--policies",
-        "policies/platform",
-        "--aux",
-        "-1",
-        "--count",
-        "12",
-        "--verify",
-        "3",
-        "--format",
-        "yaml",
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
+    let out = arlpcg_ok(words(
+        "generate --policies policies/platform --aux -1 --count 12 --verify 3 --format yaml --out {}",
+        &[&dir.path()],
+    ));
     let said = String::from_utf8_lossy(&out.stdout);
     let mut levels = Vec::new();
     let mut redraws = 0;
@@ -737,11 +689,11 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
     let at = text.rfind("sha256: ").unwrap() + "sha256: ".len();
     let forged = format!("{}{}{}", &text[..at], "0".repeat(64), &text[at + 64..]);
     std::fs::write(first, forged).unwrap();
-    let out = arlpcg(&["verify", "--replay", first]);
+    let out = arlpcg(words("verify --replay {}", &[&first]));
     fails_with(&out, 1, "is not the policy that recorded the certificate");
-    let out = arlpcg(&["verify", "--replay", "levels/hand/staircase.yaml"]);
+    let out = arlpcg(words("verify --replay levels/hand/staircase.yaml", &[]));
     fails_with(&out, 1, "no statistics");
-    let out = arlpcg(&["generate", "--rules", "--allow-unsolved", "--out", "x"]);
+    let out = arlpcg(words("generate --rules --allow-unsolved --out x", &[]));
     assert_eq!(out.status.code(), Some(2));
 }
 
@@ -752,21 +704,10 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
 #[test]
 fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band() {
     let dir = tempfile::tempdir().unwrap();
-    arlpcg_ok(&[
-        "generate",
-        "--policies",
-        "policies/platform",
-        "--target-success",
-        "0.2",
-        "--seed",
-        "1",
-        "--verify",
-        "100",
-        "--format",
-        "yaml",
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
+    arlpcg_ok(words(
+        "generate --policies policies/platform --target-success 0.2 --seed 1 --verify 100 --format yaml --out {}",
+        &[&dir.path()],
+    ));
     let files = files_of(dir.path());
     assert_eq!(files.len(), 1);
     let (name, _) = &files[0];
@@ -785,56 +726,28 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
     );
     // Given the goal, the search keeps to it, and seed 1's goal rules 0.2 out (closest 0.31).
     let own = dir.path().join("own");
-    arlpcg_ok(&[
-        "generate",
-        "--policies",
-        "policies/platform",
-        "--aux",
-        "-1",
-        "--seed",
-        "1",
-        "--format",
-        "yaml",
-        "--out",
-        own.to_str().unwrap(),
-    ]);
+    arlpcg_ok(words(
+        "generate --policies policies/platform --aux -1 --seed 1 --format yaml --out {}",
+        &[&own],
+    ));
     let goal = arlpcg_core::level::yaml::load(&own.join("platform_seed1_aux-1.00.yaml"))
         .unwrap()
         .goal;
     let goal = format!("{},{},{}", goal[0], goal[1], goal[2]);
-    let out = arlpcg(&[
-        "generate",
-        "--policies",
-        "policies/platform",
-        "--target-success",
-        "0.2",
-        "--seed",
-        "1",
-        &format!("--goal={goal}"),
-        "--out",
-        dir.path().join("given").to_str().unwrap(),
-    ]);
+    let out = arlpcg(words(
+        "generate --policies policies/platform --target-success 0.2 --seed 1 {} --out {}",
+        &[&format!("--goal={goal}"), &dir.path().join("given")],
+    ));
     fails_with(&out, 1, "no level within ±0.1 of success 0.2");
 }
 
 #[test]
 fn target_success_levels_measure_within_the_band() {
     let dir = tempfile::tempdir().unwrap();
-    let out = arlpcg_ok(&[
-        "generate",
-        "--policies",
-        "policies/platform",
-        "--target-success",
-        "0.6",
-        "--count",
-        "3",
-        "--verify",
-        "50",
-        "--format",
-        "yaml",
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
+    let out = arlpcg_ok(words(
+        "generate --policies policies/platform --target-success 0.6 --count 3 --verify 50 --format yaml --out {}",
+        &[&dir.path()],
+    ));
     assert!(
         !stderr(&out).contains("measuring"),
         "the shipped policies' curve is current: {}",
@@ -859,14 +772,13 @@ fn target_success_levels_measure_within_the_band() {
     // 0.6 level comes from well below it.
     assert!(auxes.iter().sum::<f64>() / 3.0 < 0.25, "{auxes:?}");
     for bad in ["0", "1", "1.5", "nan"] {
-        let out = arlpcg(&[
-            "generate", "--policies", "policies/platform", "--target-success", bad, "--out", "x",
-        ]);
+        let out = arlpcg(words(
+            "generate --policies policies/platform --target-success {} --out x",
+            &[&bad],
+        ));
         assert_eq!(out.status.code(), Some(2), "{bad}");
     }
-    let out = arlpcg(&[
-        "generate", "--rules", "--target-success", "0.5", "--out", "x",
-    ]);
+    let out = arlpcg(words("generate --rules --target-success 0.5 --out x", &[]));
     assert_eq!(
         out.status.code(),
         Some(2),
@@ -883,37 +795,19 @@ fn generate_verifies_with_the_solver_policy_it_is_given() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let policies = root.join("policies/platform");
     let other = policies.join("solver-rule-pcg.safetensors");
-    arlpcg_ok(&[
-        "generate",
-        "--policies",
-        policies.to_str().unwrap(),
-        "--aux",
-        "1",
-        "--verify",
-        "4",
-        "--solver-policy",
-        other.to_str().unwrap(),
-        "--format",
-        "yaml",
-        "--out",
-        out,
-    ]);
+    arlpcg_ok(words(
+        "generate --policies {} --aux 1 --verify 4 --solver-policy {} --format yaml --out {}",
+        &[&policies, &other, &out],
+    ));
     let yaml = std::fs::read_to_string(dir.path().join("platform_seed0_aux+1.00.yaml")).unwrap();
     let stats = &yaml[yaml.find("stats:").expect("verified")..];
     assert!(stats.contains("solver-rule-pcg.safetensors"), "{stats}");
     assert!(!stats.contains("solver.safetensors"), "{stats}");
 
-    let refused = arlpcg(&[
-        "generate",
-        "--policies",
-        policies.to_str().unwrap(),
-        "--aux",
-        "1",
-        "--solver-policy",
-        other.to_str().unwrap(),
-        "--out",
-        out,
-    ]);
+    let refused = arlpcg(words(
+        "generate --policies {} --aux 1 --solver-policy {} --out {}",
+        &[&policies, &other, &out],
+    ));
     fails_with(&refused, 2, "--solver-policy");
 }
 
@@ -930,32 +824,19 @@ fn generate_verify_eases_a_seed_that_no_run_completes_up_to_lambda_one() {
     )
     .unwrap();
     let run = dir.path().join("run");
-    arlpcg_ok(&[
-        "train",
-        "--mode",
-        "rule-pcg",
-        "--steps",
-        "128",
-        "--config",
-        config.to_str().unwrap(),
-        "--out",
-        run.to_str().unwrap(),
-    ]);
+    arlpcg_ok(words(
+        "train --mode rule-pcg --steps 128 --config {} --out {}",
+        &[&config, &run],
+    ));
     let policies = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
-    let out = arlpcg(&[
-        "generate",
-        "--policies",
-        policies.to_str().unwrap(),
-        "--aux=-0.5",
-        "--count",
-        "1",
-        "--verify",
-        "2",
-        "--solver-policy",
-        run.join("solver.safetensors").to_str().unwrap(),
-        "--out",
-        dir.path().join("levels").to_str().unwrap(),
-    ]);
+    let out = arlpcg(words(
+        "generate --policies {} --aux=-0.5 --count 1 --verify 2 --solver-policy {} --out {}",
+        &[
+            &policies,
+            &run.join("solver.safetensors"),
+            &dir.path().join("levels"),
+        ],
+    ));
     fails_with(
         &out,
         1,
@@ -1046,10 +927,10 @@ fn options_that_would_do_nothing_or_count_twice_are_refused_by_name() {
 #[test]
 fn a_huge_refused_argument_is_not_echoed_whole() {
     let curve = vec!["0:0"; 25_000].join(", ");
-    let output = arlpcg(&[
-        "generate", "--policies", "policies/platform", "--aux-curve", &curve, "--out",
-        "never-written",
-    ]);
+    let output = arlpcg(words(
+        "generate --policies policies/platform --aux-curve {} --out never-written",
+        &[&curve],
+    ));
     fails_with(&output, 2, "an aux curve has 1 to 32 points, not 25000");
     assert!(
         stderr(&output).len() < 1_000,
@@ -1066,11 +947,11 @@ fn a_huge_refused_argument_is_not_echoed_whole() {
 fn a_game_profile_is_checked_recorded_and_played_under() {
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
-    let init = arlpcg_ok(&["profile", "init", "--game", "platform"]);
+    let init = arlpcg_ok(words("profile init --game platform", &[]));
     let text = String::from_utf8(init.stdout).unwrap();
     let write = |name: &str, text: &str| std::fs::write(path(name), text).unwrap();
     write("default.yaml", &text);
-    let checked = arlpcg_ok(&["profile", "check", &path("default.yaml")]);
+    let checked = arlpcg_ok(words("profile check {}", &[&path("default.yaml")]));
     let report = String::from_utf8_lossy(&checked.stdout);
     assert!(
         report.contains("reach table") && report.contains("+0 m: 6 m"),
@@ -1082,7 +963,7 @@ fn a_game_profile_is_checked_recorded_and_played_under() {
     write("low.yaml", &low);
     write("nan.yaml", &text.replace("gravity: 20.0", "gravity: .nan"));
     fails_with(
-        &arlpcg(&["profile", "check", &path("nan.yaml")]),
+        &arlpcg(words("profile check {}", &[&path("nan.yaml")])),
         1,
         "character.gravity must be a number",
     );
@@ -1091,65 +972,41 @@ fn a_game_profile_is_checked_recorded_and_played_under() {
         &text.replace("jump_speed: 9.25", "jump_speed: 3.0"),
     );
     fails_with(
-        &arlpcg(&["profile", "check", &path("flat.yaml")]),
+        &arlpcg(words("profile check {}", &[&path("flat.yaml")])),
         1,
         "most of the game's goals cannot be reached",
     );
     fails_with(
-        &arlpcg(&[
-            "generate",
-            "--game",
-            "racing",
-            "--rules",
-            "--profile",
-            &path("low.yaml"),
-            "--out",
-            &path("x"),
-        ]),
+        &arlpcg(words(
+            "generate --game racing --rules --profile {} --out {}",
+            &[&path("low.yaml"), &path("x")],
+        )),
         1,
         "a platform profile, not a racing one",
     );
 
     // Made for the low jumper: the level records it and is verified under it.
     let out = path("levels");
-    arlpcg_ok(&[
-        "generate",
-        "--rules",
-        "--count",
-        "1",
-        "--seed",
-        "3",
-        "--profile",
-        &path("low.yaml"),
-        "--verify",
-        "10",
-        "--format",
-        "yaml",
-        "--out",
-        &out,
-    ]);
+    arlpcg_ok(words(
+        "generate --rules --count 1 --seed 3 --profile {} --verify 10 --format yaml --out {}",
+        &[&path("low.yaml"), &out],
+    ));
     let level = std::fs::read_to_string(dir.path().join("levels/platform_seed3.yaml")).unwrap();
     assert!(
         level.contains("profile:\n  name: low-jumper\n  sha256: "),
         "{level}"
     );
-    let again = arlpcg_ok(&[
-        "verify",
-        &format!("{out}/platform_seed3.yaml"),
-        "--solver",
-        "scripted",
-        "--trials",
-        "5",
-    ]);
+    let again = arlpcg_ok(words(
+        "verify {} --solver scripted --trials 5",
+        &[&format!("{out}/platform_seed3.yaml")],
+    ));
     assert!(String::from_utf8_lossy(&again.stdout).contains("under profile `low-jumper`"));
     // Its export carries the abilities in the scene's extras.
     let gltf = path("level.gltf");
-    arlpcg_ok(&[
-        "export",
-        &format!("{out}/platform_seed3.yaml"),
-        "--out",
-        &gltf,
-    ]);
+    arlpcg_ok(words(
+        "export {} --out {}",
+        &[&format!("{out}/platform_seed3.yaml"), &gltf],
+    ));
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&gltf).unwrap()).unwrap();
     let extras = &doc["scenes"][0]["extras"]["profile"];
     assert_eq!(extras["name"], "low-jumper", "{doc}");
@@ -1218,7 +1075,7 @@ fn a_profiles_piece_ranges_bound_its_levels_and_a_bad_range_names_its_field() {
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
     let init = |game: &str| {
-        String::from_utf8(arlpcg_ok(&["profile", "init", "--game", game]).stdout).unwrap()
+        String::from_utf8(arlpcg_ok(words("profile init --game {}", &[&game])).stdout).unwrap()
     };
     let (platform, racing) = (init("platform"), init("racing"));
     assert!(platform.contains("blocks:\n") && platform.contains("max_distance: 10.0"));
@@ -1233,10 +1090,10 @@ fn a_profiles_piece_ranges_bound_its_levels_and_a_bad_range_names_its_field() {
     for (game, text) in [("platform", &narrow_blocks), ("racing", &narrow_segments)] {
         let (profile, out) = (path(&format!("{game}.yaml")), path(game));
         std::fs::write(&profile, text).unwrap();
-        arlpcg_ok(&[
-            "generate", "--game", game, "--rules", "--count", "4", "--profile", &profile,
-            "--format", "yaml", "--out", &out,
-        ]);
+        arlpcg_ok(words(
+            "generate --game {} --rules --count 4 --profile {} --format yaml --out {}",
+            &[&game, &profile, &out],
+        ));
         for (_, bytes) in files_of(Path::new(&out)) {
             let level =
                 arlpcg_core::level::yaml::parse(std::str::from_utf8(&bytes).unwrap()).unwrap();
@@ -1263,9 +1120,12 @@ fn a_profiles_piece_ranges_bound_its_levels_and_a_bad_range_names_its_field() {
     let bad = |from: &str, to: &str, said: &str| {
         let file = path("bad.yaml");
         std::fs::write(&file, narrow_blocks.replace(from, to)).unwrap();
-        fails_with(&arlpcg(&["profile", "check", &file]), 1, said);
+        fails_with(&arlpcg(words("profile check {}", &[&file])), 1, said);
         let out = path("never");
-        let made = arlpcg(&["generate", "--rules", "--profile", &file, "--out", &out]);
+        let made = arlpcg(words(
+            "generate --rules --profile {} --out {}",
+            &[&file, &out],
+        ));
         fails_with(&made, 1, said);
         assert!(!Path::new(&out).exists());
     };
@@ -1282,7 +1142,7 @@ fn a_profiles_piece_ranges_bound_its_levels_and_a_bad_range_names_its_field() {
     let file = path("bad-road.yaml");
     std::fs::write(&file, racing.replace("road_width: 9.0", "road_width: 20.0")).unwrap();
     fails_with(
-        &arlpcg(&["profile", "check", &file]),
+        &arlpcg(words("profile check {}", &[&file])),
         1,
         "segments.road_width 20 is out of range [6, 14] m",
     );
@@ -1291,7 +1151,7 @@ fn a_profiles_piece_ranges_bound_its_levels_and_a_bad_range_names_its_field() {
 /// Writes to `path` our platform profile as `profile init` prints it, named `name`, with jump
 /// speed `jump` (m/s, as written).
 fn write_platform_profile(path: &str, name: &str, jump: &str) {
-    let init = arlpcg_ok(&["profile", "init", "--game", "platform"]);
+    let init = arlpcg_ok(words("profile init --game platform", &[]));
     let text = String::from_utf8(init.stdout)
         .unwrap()
         .replace("name: default", &format!("name: {name}"))
@@ -1341,16 +1201,14 @@ fn a_solver_trained_for_a_profile_records_it_and_keeps_it() {
         1,
         "profile cannot change in a resumed run",
     );
-    let trained = arlpcg_ok(&[
-        "verify",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/levels/hand/staircase.yaml"),
-        "--profile",
-        &low_path,
-        "--policy",
-        &format!("{run}/solver.safetensors"),
-        "--trials",
-        "2",
-    ]);
+    let trained = arlpcg_ok(words(
+        "verify {} --profile {} --policy {} --trials 2",
+        &[
+            &concat!(env!("CARGO_MANIFEST_DIR"), "/levels/hand/staircase.yaml"),
+            &low_path,
+            &format!("{run}/solver.safetensors"),
+        ],
+    ));
     assert!(
         !stderr(&trained).contains("never trained"),
         "{}",
@@ -1368,15 +1226,15 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
     let run = path("run");
     // A share beyond ±50% is refused before anything is made.
     fails_with(
-        &arlpcg(&["train", "--ability-spread", "0.7", "--out", &run]),
+        &arlpcg(words("train --ability-spread 0.7 --out {}", &[&run])),
         2,
         "`0.7` is not a share within [0, 0.5]",
     );
     assert!(!Path::new(&run).exists());
-    arlpcg_ok(&[
-        "train", "--mode", "arlpcg", "--ability-spread", "0.2", "--steps", "8192", "--threads",
-        "1", "--out", &run,
-    ]);
+    arlpcg_ok(words(
+        "train --mode arlpcg --ability-spread 0.2 --steps 8192 --threads 1 --out {}",
+        &[&run],
+    ));
     // Both agents observe the abilities, and their cards say over which range.
     for card in ["solver.yaml", "generator.yaml"] {
         let card = std::fs::read_to_string(dir.path().join("run").join(card)).unwrap();
@@ -1386,24 +1244,17 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
         );
     }
     // Its Generator builds for a profile within the range.
-    arlpcg_ok(&[
-        "generate",
-        "--policies",
-        &run,
-        "--aux=-1",
-        "--profile",
-        &path("near.yaml"),
-        "--count",
-        "1",
-        "--out",
-        &path("levels"),
-    ]);
+    arlpcg_ok(words(
+        "generate --policies {} --aux=-1 --profile {} --count 1 --out {}",
+        &[&run, &path("near.yaml"), &path("levels")],
+    ));
     let staircase = concat!(env!("CARGO_MANIFEST_DIR"), "/levels/hand/staircase.yaml");
     let policy = format!("{run}/solver.safetensors");
     let verify = |profile: &str| {
-        arlpcg(&[
-            "verify", staircase, "--policy", &policy, "--trials", "2", "--profile", profile,
-        ])
+        arlpcg(words(
+            "verify {} --policy {} --trials 2 --profile {}",
+            &[&staircase, &policy, &profile],
+        ))
     };
     let near = verify(&path("near.yaml"));
     assert!(near.status.success(), "{}", stderr(&near));
@@ -1418,19 +1269,10 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
         "profile `far` lies beyond the abilities the Solver policy",
     );
     // A campaign judged by it refuses the same profile before it searches.
-    let campaign = arlpcg(&[
-        "campaign",
-        "--policies",
-        &run,
-        "--profile",
-        &path("far.yaml"),
-        "--levels",
-        "1",
-        "--ramp",
-        "0:0.5, 1:0.5",
-        "--out",
-        &path("campaign"),
-    ]);
+    let campaign = arlpcg(words(
+        "campaign --policies {} --profile {} --levels 1 --ramp {} --out {}",
+        &[&run, &path("far.yaml"), &"0:0.5, 1:0.5", &path("campaign")],
+    ));
     fails_with(&campaign, 1, "profile `far` lies beyond the abilities");
     assert!(!Path::new(&path("campaign")).exists());
 }

@@ -220,19 +220,10 @@ fn trials_refuse_a_profile_beyond_an_ability_aware_solvers_range() {
     let config = dir.path().join("aware.yaml");
     std::fs::write(&config, "ability_spread: 0.2\n").unwrap();
     let run = dir.path().join("run");
-    crate::common::arlpcg_ok(&[
-        "train",
-        "--mode",
-        "arlpcg",
-        "--config",
-        config.to_str().unwrap(),
-        "--steps",
-        "8192",
-        "--threads",
-        "1",
-        "--out",
-        run.to_str().unwrap(),
-    ]);
+    crate::common::arlpcg_ok(crate::common::words(
+        "train --mode arlpcg --config {} --steps 8192 --threads 1 --out {}",
+        &[&config, &run],
+    ));
     let (policies, info) = worker::load(&run, Game::Platform).unwrap();
     let mut h = Harness::new(policies, info, dir.path());
     h.settle();
@@ -897,16 +888,10 @@ fn the_whole_panel_plays_the_level_on_screen_and_the_export_records_it() {
         .panel
         .expect("the export records the panel");
     assert_eq!(Some(&recorded), again.stats.as_ref());
-    let verified = crate::common::arlpcg_ok(&[
-        "verify",
-        file.to_str().unwrap(),
-        "--panel",
-        "--trials",
-        "40",
-        "--json",
-        "--policies",
-        shipped_platform().to_str().unwrap(),
-    ]);
+    let verified = crate::common::arlpcg_ok(crate::common::words(
+        "verify {} --panel --trials 40 --json --policies {}",
+        &[&file, &shipped_platform()],
+    ));
     let row: serde_json::Value = serde_json::from_slice(&verified.stdout).unwrap();
     for judge in &recorded.judges {
         assert_eq!(

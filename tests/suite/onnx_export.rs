@@ -7,7 +7,7 @@ use arlpcg::services::onnx::{self, Contract, Exported, example_observations, ref
 use arlpcg_core::level::Game;
 use tract_onnx::prelude::*;
 
-use crate::common::{arlpcg, arlpcg_ok, stderr};
+use crate::common::{arlpcg, arlpcg_ok, stderr, words};
 
 const ROWS: usize = 64;
 
@@ -175,7 +175,7 @@ fn export_policy_writes_the_graph_and_its_sidecar_once() {
         env!("CARGO_MANIFEST_DIR"),
         "/policies/racing/solver.safetensors"
     );
-    arlpcg_ok(&["export-policy", policy, "--out", out_arg]);
+    arlpcg_ok(words("export-policy {} --out {}", &[&policy, &out_arg]));
     let bytes = std::fs::read(&out).unwrap();
     let sidecar: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("racing.onnx.json")).unwrap())
@@ -185,19 +185,22 @@ fn export_policy_writes_the_graph_and_its_sidecar_once() {
     assert_eq!(sidecar["outputs"][0]["columns"][1]["name"], "steer");
 
     // Existing files stay unless --force; the same policy gives the same bytes.
-    let again = arlpcg(&["export-policy", policy, "--out", out_arg]);
+    let again = arlpcg(words("export-policy {} --out {}", &[&policy, &out_arg]));
     assert!(!again.status.success());
     assert!(stderr(&again).contains("racing.onnx"), "{}", stderr(&again));
-    arlpcg_ok(&["export-policy", policy, "--out", out_arg, "--force"]);
+    arlpcg_ok(words(
+        "export-policy {} --out {} --force",
+        &[&policy, &out_arg],
+    ));
     assert_eq!(std::fs::read(&out).unwrap(), bytes);
 
     // Not a policy, or not an .onnx name: a clear error, nothing written.
     let level = concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.toml");
     let other = dir.path().join("other.onnx");
-    let bad = arlpcg(&["export-policy", level, "--out", other.to_str().unwrap()]);
+    let bad = arlpcg(words("export-policy {} --out {}", &[&level, &other]));
     assert!(!bad.status.success());
     assert!(stderr(&bad).contains("Cargo.toml"), "{}", stderr(&bad));
-    let wrong_name = arlpcg(&["export-policy", policy, "--out", "model.pt"]);
+    let wrong_name = arlpcg(words("export-policy {} --out model.pt", &[&policy]));
     assert!(!wrong_name.status.success());
     assert!(
         stderr(&wrong_name).contains(".onnx"),
@@ -263,7 +266,7 @@ fn a_policys_golden_episode_replays_from_its_level_and_actions() {
             "{}/policies/{game}/solver.safetensors",
             env!("CARGO_MANIFEST_DIR")
         );
-        arlpcg_ok(&["export-policy", &policy, "--out", out.to_str().unwrap()]);
+        arlpcg_ok(words("export-policy {} --out {}", &[&policy, &out]));
         every_observation_part_says_what_it_holds(&dir.path().join(format!("{game}.onnx.json")));
         let golden = dir.path().join(format!("{game}.onnx.golden.json"));
         let episode: serde_json::Value =
@@ -281,7 +284,7 @@ fn a_policys_golden_episode_replays_from_its_level_and_actions() {
             env!("CARGO_MANIFEST_DIR")
         );
         let out = dir.path().join(format!("{game}-generator.onnx"));
-        arlpcg_ok(&["export-policy", &generator, "--out", out.to_str().unwrap()]);
+        arlpcg_ok(words("export-policy {} --out {}", &[&generator, &out]));
         every_observation_part_says_what_it_holds(
             &dir.path().join(format!("{game}-generator.onnx.json")),
         );

@@ -11,7 +11,7 @@ use arlpcg::services::verify::{HalfwaySplit, Solver, verify};
 use arlpcg_core::level::pacing::{AuxCurve, round_aux};
 use arlpcg_core::level::{Game, yaml};
 
-use crate::common::{arlpcg, arlpcg_ok, stderr};
+use crate::common::{arlpcg, arlpcg_ok, stderr, words};
 
 const EASY_THEN_HARD: &str = "0:1, 0.5:1, 0.5:-1, 1:-1";
 
@@ -188,47 +188,25 @@ fn a_kept_prefix_is_written_byte_for_byte_and_the_generator_builds_the_rest() {
         let policies = shipped(game);
         let policies = policies.to_str().unwrap();
         let first = dir.path().join(format!("{game}-first"));
-        arlpcg_ok(&[
-            "generate",
-            "--game",
-            game.name(),
-            "--policies",
-            policies,
-            "--aux-curve",
-            EASY_THEN_HARD,
-            "--obstacles",
-            obstacles,
-            "--seed",
-            "3",
-            "--format",
-            "yaml",
-            "--out",
-            first.to_str().unwrap(),
-        ]);
+        arlpcg_ok(words(
+            "generate --game {} --policies {} --aux-curve {} --obstacles {} --seed 3 --format yaml --out {}",
+            &[&game.name(), &policies, &EASY_THEN_HARD, &obstacles, &first],
+        ));
         let first_file = only_file(&first);
         let first_text = std::fs::read_to_string(&first_file).unwrap();
         let first_items = items(&first_text, key);
         let keep = first_items.len() / 2;
         assert!(keep >= 1, "{first_text}");
         let second = dir.path().join(format!("{game}-second"));
-        arlpcg_ok(&[
-            "generate",
-            "--game",
-            game.name(),
-            "--policies",
-            policies,
-            "--aux=-1",
-            "--keep",
-            &format!("{}:{keep}", first_file.display()),
-            "--seed",
-            "11",
-            "--verify",
-            "5",
-            "--format",
-            "yaml",
-            "--out",
-            second.to_str().unwrap(),
-        ]);
+        arlpcg_ok(words(
+            "generate --game {} --policies {} --aux=-1 --keep {} --seed 11 --verify 5 --format yaml --out {}",
+            &[
+                &game.name(),
+                &policies,
+                &format!("{}:{keep}", first_file.display()),
+                &second,
+            ],
+        ));
         let second_file = only_file(&second);
         assert!(
             second_file
@@ -319,17 +297,22 @@ fn verify_draws_the_difficulty_along_one_level() {
     let chart_s = chart.to_str().unwrap();
     let policy = shipped(Game::Platform).join("solver.safetensors");
     let policy = policy.to_str().unwrap();
-    let output = arlpcg_ok(&[
-        "verify", level, "--trials", "20", "--policy", policy, "--chart", chart_s,
-    ]);
+    let output = arlpcg_ok(words(
+        "verify {} --trials 20 --policy {} --chart {}",
+        &[&level, &policy, &chart_s],
+    ));
     assert!(std::fs::read(&chart).unwrap().starts_with(b"\x89PNG"));
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(stdout.contains("runs past each block: "), "{stdout}");
     // Not over a file that is there; one level only.
-    let again = arlpcg(&[
-        "verify", level, "--trials", "5", "--policy", policy, "--chart", chart_s,
-    ]);
+    let again = arlpcg(words(
+        "verify {} --trials 5 --policy {} --chart {}",
+        &[&level, &policy, &chart_s],
+    ));
     assert_eq!(again.status.code(), Some(1), "{}", stderr(&again));
-    let two = arlpcg(&["verify", level, level, "--chart", chart_s]);
+    let two = arlpcg(words(
+        "verify {} {} --chart {}",
+        &[&level, &level, &chart_s],
+    ));
     assert_eq!(two.status.code(), Some(2), "{}", stderr(&two));
 }

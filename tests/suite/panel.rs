@@ -6,7 +6,7 @@
 use arlpcg::services::verify::{Solver, verify};
 use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, Skill};
 
-use crate::common::{arlpcg, arlpcg_ok, fails_with, files_of, small_campaign, stderr};
+use crate::common::{arlpcg, arlpcg_ok, fails_with, files_of, small_campaign, stderr, words};
 
 /// Mean success of each skill, weakest first, on `levels` rule levels of `G`, `trials` runs each.
 fn skill_success<G: GameSpec>(levels: u64, trials: u32) -> Vec<f64> {
@@ -90,14 +90,15 @@ fn verify_panel_reports_every_judge_and_rates_the_levels_together() {
         "the λ = 1 level rates easier than the λ = -1 one"
     );
 
-    let some = arlpcg_ok(&[
-        "verify", levels[0], "--panel", "scripted-median,arlpcg", "--trials", "4", "--json",
-    ]);
+    let some = arlpcg_ok(words(
+        "verify {} --panel scripted-median,arlpcg --trials 4 --json",
+        &[&levels[0]],
+    ));
     let row: serde_json::Value = serde_json::from_slice(&some.stdout).unwrap();
     let names: Vec<&String> = row["panel"].as_object().unwrap().keys().collect();
     assert_eq!(names, ["arlpcg", "scripted-median"]);
 
-    let bad = arlpcg(&["verify", levels[0], "--panel", "scripted-wizard"]);
+    let bad = arlpcg(words("verify {} --panel scripted-wizard", &[&levels[0]]));
     fails_with(&bad, 2, "scripted-expert");
 }
 
@@ -105,27 +106,10 @@ fn verify_panel_reports_every_judge_and_rates_the_levels_together() {
 fn generate_records_the_panel_and_the_rating_and_verifies_with_a_judge() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("rated");
-    arlpcg_ok(&[
-        "generate",
-        "--game",
-        "platform",
-        "--policies",
-        "policies/platform",
-        "--aux=-1",
-        "--seed",
-        "100",
-        "--count",
-        "2",
-        "--verify",
-        "6",
-        "--panel",
-        "--judge",
-        "scripted-median",
-        "--format",
-        "yaml",
-        "--out",
-        out_dir.to_str().unwrap(),
-    ]);
+    arlpcg_ok(words(
+        "generate --game platform --policies policies/platform --aux=-1 --seed 100 --count 2 --verify 6 --panel --judge scripted-median --format yaml --out {}",
+        &[&out_dir],
+    ));
     let path = out_dir.join("platform_seed100_aux-1.00.yaml");
     let level = arlpcg_core::level::yaml::load(&path).unwrap();
     let stats = level.stats.unwrap();
@@ -207,16 +191,13 @@ fn a_campaign_follows_its_ramp_and_resumes_to_the_same_bytes() {
 
     // verify --campaign plays it again and applies the campaign's checks and more.
     let record = out.join("campaign.yaml");
-    let replayed = arlpcg_ok(&["verify", "--campaign", record.to_str().unwrap()]);
+    let replayed = arlpcg_ok(words("verify --campaign {}", &[&record]));
     let report = String::from_utf8_lossy(&replayed.stdout);
     assert!(report.contains("| 1 | level01.yaml | 0.90 |"), "{report}");
-    let strict = arlpcg(&[
-        "verify",
-        "--campaign",
-        record.to_str().unwrap(),
-        "--check",
-        "success 0.99..1",
-    ]);
+    let strict = arlpcg(words(
+        "verify --campaign {} --check {}",
+        &[&record, &"success 0.99..1"],
+    ));
     assert_eq!(strict.status.code(), Some(3), "{}", stderr(&strict));
     assert!(
         String::from_utf8_lossy(&strict.stdout)
@@ -231,7 +212,7 @@ fn a_campaign_follows_its_ramp_and_resumes_to_the_same_bytes() {
 #[test]
 fn a_paced_campaign_moves_one_shape_per_level() {
     let dir = tempfile::tempdir().unwrap();
-    let init = arlpcg_ok(&["profile", "init", "--game", "platform"]);
+    let init = arlpcg_ok(words("profile init --game platform", &[]));
     let profile = String::from_utf8(init.stdout)
         .unwrap()
         .replace("name: default", "name: quick")
@@ -297,18 +278,21 @@ fn checks_fail_a_batch_with_exit_code_3_and_bad_checks_are_usage_errors() {
         2,
         "--check b reads the panel's rating",
     );
-    let panel = arlpcg(&["verify", LEVEL, "--panel", "--check", "completed"]);
+    let panel = arlpcg(words("verify {} --panel --check completed", &[&LEVEL]));
     fails_with(&panel, 2, "with --panel, a check is `b LO..HI`");
 
     // generate writes its files, then fails the batch.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
-    let generated = arlpcg(&[
-        "generate", "--rules", "--count", "2", "--verify", "10", "--judge", "scripted-expert",
-        "--format", "yaml", "--check", "success 0..0.05", "--out", out,
-    ]);
+    let generated = arlpcg(words(
+        "generate --rules --count 2 --verify 10 --judge scripted-expert --format yaml --check {} --out {}",
+        &[&"success 0..0.05", &out],
+    ));
     fails_with(&generated, 3, "2 of 2 levels failed their checks");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
-    let unverified = arlpcg(&["generate", "--rules", "--check", "completed", "--out", out]);
+    let unverified = arlpcg(words(
+        "generate --rules --check completed --out {}",
+        &[&out],
+    ));
     fails_with(&unverified, 2, "--check reads the levels' statistics");
 }

@@ -1,7 +1,7 @@
 //! docs/results.md is what `arlpcg report` writes from the committed results and cards; the
 //! check fails on a page that differs, naming the line; curves are drawn from a run's metrics.
 
-use crate::common::{arlpcg, arlpcg_ok, stderr};
+use crate::common::{arlpcg, arlpcg_ok, stderr, words};
 
 #[test]
 fn the_committed_results_page_is_what_report_writes() {
@@ -18,13 +18,13 @@ fn a_page_that_differs_fails_the_check_naming_the_line() {
     let dir = tempfile::tempdir().unwrap();
     let page = dir.path().join("results.md");
     let page_arg = page.to_str().unwrap();
-    arlpcg_ok(&["report", "--out", page_arg]);
-    arlpcg_ok(&["report", "--check", "--out", page_arg]);
+    arlpcg_ok(words("report --out {}", &[&page_arg]));
+    arlpcg_ok(words("report --check --out {}", &[&page_arg]));
     let written = std::fs::read_to_string(&page).unwrap();
     let edited = written.replacen("0.896 ± 0.200", "0.990 ± 0.200", 1);
     assert_ne!(edited, written);
     std::fs::write(&page, &edited).unwrap();
-    let output = arlpcg(&["report", "--check", "--out", page_arg]);
+    let output = arlpcg(words("report --check --out {}", &[&page_arg]));
     assert_eq!(output.status.code(), Some(1));
     let line = 1 + written
         .lines()
@@ -47,7 +47,7 @@ fn curves_are_drawn_from_a_runs_metrics() {
         dir.path().join("metrics.csv"),
     )
     .unwrap();
-    arlpcg_ok(&["report", "--curves", dir.path().to_str().unwrap()]);
+    arlpcg_ok(words("report --curves {}", &[&dir.path()]));
     let png = std::fs::read(dir.path().join("learning-curve.png")).unwrap();
     assert!(
         png.starts_with(b"\x89PNG") && png.len() > 10_000,
@@ -56,6 +56,6 @@ fn curves_are_drawn_from_a_runs_metrics() {
     );
     // A folder without metrics is refused by name.
     let empty = tempfile::tempdir().unwrap();
-    let output = arlpcg(&["report", "--curves", empty.path().to_str().unwrap()]);
+    let output = arlpcg(words("report --curves {}", &[&empty.path()]));
     assert!(!output.status.success());
 }

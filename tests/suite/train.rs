@@ -11,7 +11,7 @@ use arlpcg_core::game::platform::generator::GENERATOR_OBSERVATION_SIZE;
 use arlpcg_core::level::Game;
 use arlpcg_core::rl::checkpoint::{LoadedPolicy, Role, load_policy};
 
-use crate::common::{arlpcg, arlpcg_ok, fails_with, stderr};
+use crate::common::{arlpcg, arlpcg_ok, fails_with, stderr, words};
 
 const TINY: &str = "\
 seed: 3
@@ -137,18 +137,10 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
     wrong_resumes_are_refused(out_s);
 
     let target = state.global_step + 3 * 128;
-    arlpcg_ok(&[
-        "train",
-        "--mode",
-        "fixed-track",
-        "--steps",
-        &target.to_string(),
-        "--out",
-        out_s,
-        "--resume",
-        "--threads",
-        "2",
-    ]);
+    arlpcg_ok(words(
+        "train --mode fixed-track --steps {} --out {} --resume --threads 2",
+        &[&target.to_string(), &out_s],
+    ));
     assert!(!lock.exists(), "a finished session removes its lock");
     let after = curve(&out);
     // The rows up to the checkpoint are kept, later ones (written after it) dropped and redone.
@@ -166,9 +158,10 @@ fn a_killed_run_resumes_where_its_checkpoint_stopped() {
     assert_eq!(after.last().unwrap().1, target);
     // The budget is stored with the run: the first command plus --resume (no --steps) stops
     // at it at once.
-    arlpcg_ok(&[
-        "train", "--mode", "fixed-track", "--seed", "3", "--out", out_s, "--resume",
-    ]);
+    arlpcg_ok(words(
+        "train --mode fixed-track --seed 3 --out {} --resume",
+        &[&out_s],
+    ));
     assert_eq!(curve(&out), after);
     the_card_records_the_whole_run(&out, target);
 }
@@ -215,9 +208,10 @@ fn a_live_lock_refuses_a_second_session(out: &Path) {
         .spawn()
         .unwrap();
     std::thread::sleep(Duration::from_millis(300));
-    let busy = arlpcg(&[
-        "train", "--mode", "fixed-track", "--steps", "100000", "--out", out_s, "--resume",
-    ]);
+    let busy = arlpcg(words(
+        "train --mode fixed-track --steps 100000 --out {} --resume",
+        &[&out_s],
+    ));
     holder.kill().unwrap();
     holder.wait().unwrap();
     fails_with(&busy, 1, "in use by another training session");
@@ -227,21 +221,24 @@ fn a_live_lock_refuses_a_second_session(out: &Path) {
 
 /// Resuming without --resume, or with another mode or seed, is refused.
 fn wrong_resumes_are_refused(out_s: &str) {
-    let refused = arlpcg(&[
-        "train", "--mode", "fixed-track", "--steps", "100", "--out", out_s,
-    ]);
+    let refused = arlpcg(words(
+        "train --mode fixed-track --steps 100 --out {}",
+        &[&out_s],
+    ));
     fails_with(&refused, 1, "add --resume");
     // A resume with another mode or game is refused, naming the run's own.
     for other in [["--mode", "rule-pcg"], ["--game", "racing"]] {
-        let refused = arlpcg(&[
-            "train", other[0], other[1], "--steps", "100", "--out", out_s, "--resume",
-        ]);
+        let refused = arlpcg(words(
+            "train {} {} --steps 100 --out {} --resume",
+            &[&other[0], &other[1], &out_s],
+        ));
         fails_with(&refused, 1, "is a platform fixed-track run");
     }
     // A resume with another seed is refused by name; the run's own seed may be given again.
-    let refused = arlpcg(&[
-        "train", "--mode", "fixed-track", "--seed", "5", "--out", out_s, "--resume",
-    ]);
+    let refused = arlpcg(words(
+        "train --mode fixed-track --seed 5 --out {} --resume",
+        &[&out_s],
+    ));
     fails_with(&refused, 1, "seed cannot change");
     files_of_another_run_are_refused(Path::new(out_s));
 }
@@ -257,7 +254,7 @@ fn files_of_another_run_are_refused(out: &Path) {
         out.to_str().unwrap(),
         "--resume",
     ];
-    let racing = arlpcg_ok(&["train", "--game", "racing", "--print-config"]).stdout;
+    let racing = arlpcg_ok(words("train --game racing --print-config", &[])).stdout;
     let metrics = "racing,columns\n1,2\n";
     for (name, foreign) in [
         ("config.yaml", &racing[..]),
@@ -283,15 +280,10 @@ fn bad_training_configs_are_named() {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("bad.yaml");
     std::fs::write(&config, "ppo:\n  learning_rat: 0.1\n").unwrap();
-    let out = arlpcg(&[
-        "train",
-        "--steps",
-        "10",
-        "--config",
-        config.to_str().unwrap(),
-        "--out",
-        dir.path().join("r").to_str().unwrap(),
-    ]);
+    let out = arlpcg(words(
+        "train --steps 10 --config {} --out {}",
+        &[&config, &dir.path().join("r")],
+    ));
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1));
     assert!(
@@ -346,15 +338,10 @@ fn out_of_range_training_configs_are_refused_before_anything_is_written() {
         let config = dir.path().join(format!("bad-{k}.yaml"));
         std::fs::write(&config, &text).unwrap();
         let run = dir.path().join(format!("run-{k}"));
-        let out = arlpcg(&[
-            "train",
-            "--steps",
-            "10",
-            "--config",
-            config.to_str().unwrap(),
-            "--out",
-            run.to_str().unwrap(),
-        ]);
+        let out = arlpcg(words(
+            "train --steps 10 --config {} --out {}",
+            &[&config, &run],
+        ));
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(1), "{text}: {err}");
         assert!(
@@ -376,23 +363,17 @@ fn out_of_range_training_configs_are_refused_before_anything_is_written() {
 #[test]
 fn a_fixed_aux_run_refuses_a_finish_that_waits_for_hard_matches() {
     let dir = tempfile::tempdir().unwrap();
-    let recipe = arlpcg(&[
-        "train", "--game", "racing", "--mode", "arlpcg", "--print-config",
-    ]);
+    let recipe = arlpcg(words(
+        "train --game racing --mode arlpcg --print-config",
+        &[],
+    ));
     let config = dir.path().join("racing-arlpcg.yaml");
     std::fs::write(&config, &recipe.stdout).unwrap();
     let run = dir.path().join("run");
-    let out = arlpcg(&[
-        "train",
-        "--game",
-        "racing",
-        "--mode",
-        "fixed-aux",
-        "--config",
-        config.to_str().unwrap(),
-        "--out",
-        run.to_str().unwrap(),
-    ]);
+    let out = arlpcg(words(
+        "train --game racing --mode fixed-aux --config {} --out {}",
+        &[&config, &run],
+    ));
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
@@ -400,9 +381,10 @@ fn a_fixed_aux_run_refuses_a_finish_that_waits_for_hard_matches() {
         "{err}"
     );
     assert!(!run.exists(), "a refused run left {}", run.display());
-    let defaults = arlpcg(&[
-        "train", "--game", "racing", "--mode", "fixed-aux", "--print-config",
-    ]);
+    let defaults = arlpcg(words(
+        "train --game racing --mode fixed-aux --print-config",
+        &[],
+    ));
     // What --print-config prints for fixed-aux reads back as fixed-aux's defaults: the
     // racing finish's stop is not filled in from the game's defaults.
     let text = String::from_utf8(defaults.stdout).unwrap();
@@ -560,9 +542,10 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     let (dir, config, out) = scratch(TINY_ADVERSARIAL);
     let out_s = out.to_str().unwrap();
     let config_s = config.to_str().unwrap();
-    arlpcg_ok(&[
-        "train", "--mode", "arlpcg", "--steps", "512", "--config", config_s, "--out", out_s,
-    ]);
+    arlpcg_ok(words(
+        "train --mode arlpcg --steps 512 --config {} --out {}",
+        &[&config_s, &out_s],
+    ));
     // 512 Solver steps in phases of 128: both agents learned, in turn; then the finish's 128.
     assert_eq!(curve(&out).last().unwrap().1, 512 + 128);
     let generator_before = generator_rows(&out);
@@ -576,9 +559,10 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
         !first_population.is_empty() && first_population.len() <= 2,
         "{first_population:?}"
     );
-    arlpcg_ok(&[
-        "train", "--mode", "arlpcg", "--steps", "1024", "--out", out_s, "--resume",
-    ]);
+    arlpcg_ok(words(
+        "train --mode arlpcg --steps 1024 --out {} --resume",
+        &[&out_s],
+    ));
     assert_eq!(curve(&out).last().unwrap().1, 1024 + 128);
     assert!(
         generator_rows(&out) > generator_before,
@@ -609,7 +593,7 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     let metrics = out.join("generator-metrics.csv");
     let own = std::fs::read_to_string(&metrics).unwrap();
     std::fs::write(&metrics, own.replacen("distance_easy", "curve_easy", 1)).unwrap();
-    let refused = arlpcg(&["train", "--steps", "2048", "--out", out_s, "--resume"]);
+    let refused = arlpcg(words("train --steps 2048 --out {} --resume", &[&out_s]));
     fails_with(
         &refused,
         1,
@@ -635,10 +619,10 @@ fn a_staged_run_with_a_finish_resumes_to_the_same_bytes_on_any_thread_count() {
         // 640 Solver steps and the finish's 128 (the stage begins at 768)...
         arlpcg_ok(&[&first[..], &["--steps", "640", "--threads", threads]].concat());
         // ...then resumed to a budget of 1024, inside the stage, and the finish after it.
-        arlpcg_ok(&[
-            "train", "--mode", "arlpcg", "--steps", "1024", "--out", out_s, "--resume",
-            "--threads", threads,
-        ]);
+        arlpcg_ok(words(
+            "train --mode arlpcg --steps 1024 --out {} --resume --threads {}",
+            &[&out_s, &threads],
+        ));
         out
     };
     let (one, two) = (train("1"), train("2"));
@@ -701,7 +685,7 @@ fn a_run_paused_mid_stage_resumes_to_the_bytes_of_one_never_paused() {
                 let paused = curve(&out).last().unwrap().1;
                 let (at, steps): (u64, u64) = (at.parse().unwrap(), steps.parse().unwrap());
                 assert!((at..steps).contains(&paused), "paused at {paused}");
-                arlpcg_ok(&["train", "--mode", mode, "--out", out_s, "--resume"]);
+                arlpcg_ok(words("train --mode {} --out {} --resume", &[&mode, &out_s]));
             }
         }
         out
@@ -755,7 +739,7 @@ fn a_run_killed_while_its_generator_learns_resumes_to_the_same_bytes() {
     // The first Generator phase runs iterations 1 to 6: kill it after its third.
     kill_after_generator_rows(&args(&killed), &killed, 3);
     let killed_s = killed.to_str().unwrap();
-    arlpcg_ok(&["train", "--mode", "arlpcg", "--out", killed_s, "--resume"]);
+    arlpcg_ok(words("train --mode arlpcg --out {} --resume", &[&killed_s]));
     assert_same_training(&whole, &killed, &[SOLVER, GENERATOR]);
 }
 
@@ -819,17 +803,10 @@ fn train_tiny_to_640(dir: &Path, config: &str) -> std::path::PathBuf {
     let path = dir.join("variant.yaml");
     std::fs::write(&path, config).unwrap();
     let out = dir.join("run");
-    arlpcg_ok(&[
-        "train",
-        "--mode",
-        "arlpcg",
-        "--steps",
-        "640",
-        "--config",
-        path.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    arlpcg_ok(words(
+        "train --mode arlpcg --steps 640 --config {} --out {}",
+        &[&path, &out],
+    ));
     out
 }
 
@@ -1048,7 +1025,7 @@ fn a_finish_with_a_scripted_opponent_changes_the_finish_alone_and_resumes_to_the
         rows(&killed).len() < with_opponent.len(),
         "killed inside the finish"
     );
-    arlpcg_ok(&["train", "--mode", "arlpcg", "--out", killed_s, "--resume"]);
+    arlpcg_ok(words("train --mode arlpcg --out {} --resume", &[&killed_s]));
     assert_same_training(&whole, &killed, &[SOLVER, GENERATOR]);
 }
 
@@ -1071,10 +1048,10 @@ fn generate_and_verify_with_a_run(dir: &Path, run: &str) {
     let levels = dir.join("levels");
     let levels_s = levels.to_str().unwrap();
     let generate = |goal: &str| {
-        arlpcg(&[
-            "generate", "--policies", run, "--aux", "-0.5", "--seed", "3", "--verify", "4",
-            "--goal", goal, "--format", "yaml", "--out", levels_s,
-        ])
+        arlpcg(words(
+            "generate --policies {} --aux -0.5 --seed 3 --verify 4 --goal {} --format yaml --out {}",
+            &[&run, &goal, &levels_s],
+        ))
     };
     // An untrained Generator may find no way to an arbitrary goal; a goal on the start block's
     // own spot is never reached either (blocks are at least 5 m apart), so expect the clear error.
@@ -1099,17 +1076,12 @@ fn generate_and_verify_with_a_run(dir: &Path, run: &str) {
     assert_eq!(stats.trials, 4);
     assert!(stats.solver.describe().contains("solver.safetensors"));
 
-    let missing_aux = arlpcg(&["generate", "--policies", run, "--out", levels_s]);
+    let missing_aux = arlpcg(words("generate --policies {} --out {}", &[&run, &levels_s]));
     assert!(stderr(&missing_aux).contains("--aux"));
-    let wrong = arlpcg(&[
-        "generate",
-        "--policies",
-        dir.to_str().unwrap(),
-        "--aux",
-        "1",
-        "--out",
-        levels_s,
-    ]);
+    let wrong = arlpcg(words(
+        "generate --policies {} --aux 1 --out {}",
+        &[&dir, &levels_s],
+    ));
     assert!(stderr(&wrong).contains("generator.safetensors"));
 }
 
@@ -1118,10 +1090,10 @@ fn generate_and_verify_with_a_run(dir: &Path, run: &str) {
 fn evaluate_a_run(dir: &Path, run: &str) {
     let results = dir.join("results");
     let results_s = results.to_str().unwrap();
-    arlpcg_ok(&[
-        "eval", "--policies", run, "--tracks", "2", "--trials", "2", "--validation-tracks", "4",
-        "--out", results_s,
-    ]);
+    arlpcg_ok(words(
+        "eval --policies {} --tracks 2 --trials 2 --validation-tracks 4 --out {}",
+        &[&run, &results_s],
+    ));
     let json: serde_json::Value = crate::common::results_json(&results);
     let rows = json["controllability"].as_array().unwrap();
     assert_eq!(rows.len(), 5);
@@ -1159,7 +1131,7 @@ fn evaluate_a_run(dir: &Path, run: &str) {
     ] {
         assert!(results.join(name).exists(), "{name}");
     }
-    let again = arlpcg(&["eval", "--policies", run, "--out", results_s]);
+    let again = arlpcg(words("eval --policies {} --out {}", &[&run, &results_s]));
     assert!(
         stderr(&again).contains("--force"),
         "results are not clobbered"
@@ -1171,21 +1143,10 @@ fn evaluate_a_run(dir: &Path, run: &str) {
 fn score_a_run_as_one_seed(dir: &Path, run: &str) {
     let run_dir = run;
     let seeds = dir.join("seeds");
-    arlpcg_ok(&[
-        "eval",
-        "--runs",
-        run,
-        "--policies",
-        run,
-        "--tracks",
-        "2",
-        "--trials",
-        "2",
-        "--validation-tracks",
-        "4",
-        "--out",
-        seeds.to_str().unwrap(),
-    ]);
+    arlpcg_ok(words(
+        "eval --runs {} --policies {} --tracks 2 --trials 2 --validation-tracks 4 --out {}",
+        &[&run, &run, &seeds],
+    ));
     let seeds_json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(seeds.join("seeds.json")).unwrap()).unwrap();
     assert_eq!(seeds_json["modes"][0]["mode"], "arlpcg");
@@ -1213,16 +1174,15 @@ fn score_a_run_as_one_seed(dir: &Path, run: &str) {
         "{seeds_json}"
     );
     // A run named twice is not two seeds.
-    let twice = arlpcg(&[
-        "eval",
-        "--runs",
-        run_dir,
-        &format!("{run_dir}/."),
-        "--policies",
-        run_dir,
-        "--out",
-        dir.join("twice").to_str().unwrap(),
-    ]);
+    let twice = arlpcg(words(
+        "eval --runs {} {} --policies {} --out {}",
+        &[
+            &run_dir,
+            &format!("{run_dir}/."),
+            &run_dir,
+            &dir.join("twice"),
+        ],
+    ));
     fails_with(&twice, 1, "twice");
     assert!(!dir.join("twice").exists());
     // Nor is a copy of its folder under another name.
@@ -1234,16 +1194,10 @@ fn score_a_run_as_one_seed(dir: &Path, run: &str) {
             std::fs::copy(entry.path(), copy.join(entry.file_name())).unwrap();
         }
     }
-    let copied = arlpcg(&[
-        "eval",
-        "--runs",
-        run_dir,
-        copy.to_str().unwrap(),
-        "--policies",
-        run_dir,
-        "--out",
-        dir.join("copied").to_str().unwrap(),
-    ]);
+    let copied = arlpcg(words(
+        "eval --runs {} {} --policies {} --out {}",
+        &[&run_dir, &copy, &run_dir, &dir.join("copied")],
+    ));
     fails_with(&copied, 1, "one run counted as two seeds");
     assert!(!dir.join("copied").exists());
 }
@@ -1255,14 +1209,15 @@ fn a_resumed_run_takes_new_hyper_parameters_but_not_a_new_shape() {
     let (dir, config, out) = scratch(TINY);
     let (config_s, out_s) = (config.to_str().unwrap(), out.to_str().unwrap());
     let train = |steps: &str, config: &str| {
-        arlpcg(&[
-            "train", "--mode", "rule-pcg", "--steps", steps, "--config", config, "--out", out_s,
-            "--resume",
-        ])
+        arlpcg(words(
+            "train --mode rule-pcg --steps {} --config {} --out {} --resume",
+            &[&steps, &config, &out_s],
+        ))
     };
-    arlpcg_ok(&[
-        "train", "--mode", "rule-pcg", "--steps", "128", "--config", config_s, "--out", out_s,
-    ]);
+    arlpcg_ok(words(
+        "train --mode rule-pcg --steps 128 --config {} --out {}",
+        &[&config_s, &out_s],
+    ));
 
     let reshaped = dir.path().join("reshaped.yaml");
     std::fs::write(
@@ -1292,21 +1247,12 @@ fn a_resumed_run_takes_new_hyper_parameters_but_not_a_new_shape() {
 fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
     let (dir, config, out) = scratch(TINY);
     let out_s = out.to_str().unwrap();
-    arlpcg_ok(&[
-        "train",
-        "--game",
-        "racing",
-        "--mode",
-        "rule-pcg",
-        "--steps",
-        "256",
-        "--config",
-        config.to_str().unwrap(),
-        "--out",
-        out_s,
-    ]);
+    arlpcg_ok(words(
+        "train --game racing --mode rule-pcg --steps 256 --config {} --out {}",
+        &[&config, &out_s],
+    ));
     // A resume takes the game and mode from the run.
-    arlpcg_ok(&["train", "--steps", "512", "--out", out_s, "--resume"]);
+    arlpcg_ok(words("train --steps 512 --out {} --resume", &[&out_s]));
     assert_eq!(curve(&out).last().map(|r| r.1), Some(512));
     let stored = std::fs::read_to_string(out.join("config.yaml")).unwrap();
     assert!(stored.contains("gamma: 0.998"), "{stored}");
@@ -1323,32 +1269,18 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
     assert!(load_policy(&bytes, Game::Platform, Role::Solver, OBSERVATION_SIZE).is_err());
 
     let tracks = dir.path().join("tracks");
-    arlpcg_ok(&[
-        "generate",
-        "--game",
-        "racing",
-        "--rules",
-        "--out",
-        tracks.to_str().unwrap(),
-    ]);
+    arlpcg_ok(words("generate --game racing --rules --out {}", &[&tracks]));
     let policy = out.join("solver.safetensors");
-    let played = arlpcg_ok(&[
-        "verify",
-        tracks.join("racing_seed0.yaml").to_str().unwrap(),
-        "--policy",
-        policy.to_str().unwrap(),
-        "--trials",
-        "4",
-        "--json",
-    ]);
+    let played = arlpcg_ok(words(
+        "verify {} --policy {} --trials 4 --json",
+        &[&tracks.join("racing_seed0.yaml"), &policy],
+    ));
     let report: serde_json::Value = serde_json::from_slice(&played.stdout).unwrap();
     assert_eq!(report["trials"], 4);
-    let refused = arlpcg(&[
-        "verify",
-        "levels/hand/staircase.yaml",
-        "--policy",
-        policy.to_str().unwrap(),
-    ]);
+    let refused = arlpcg(words(
+        "verify levels/hand/staircase.yaml --policy {}",
+        &[&policy],
+    ));
     assert_eq!(refused.status.code(), Some(1));
     let said = stderr(&refused);
     assert!(said.contains("racing solver policy"), "{said}");
@@ -1390,20 +1322,10 @@ fn a_racing_generator_trains_builds_tracks_and_is_evaluated() {
         TINY_ADVERSARIAL.replace("generator:\n", "generator:\n  curve_offset: 30\n"),
     )
     .unwrap();
-    let refused = arlpcg(&[
-        "train",
-        "--game",
-        "racing",
-        "--mode",
-        "arlpcg",
-        "--steps",
-        "1536",
-        "--out",
-        out_s,
-        "--resume",
-        "--config",
-        narrower.to_str().unwrap(),
-    ]);
+    let refused = arlpcg(words(
+        "train --game racing --mode arlpcg --steps 1536 --out {} --resume --config {}",
+        &[&out_s, &narrower],
+    ));
     assert_eq!(refused.status.code(), Some(1));
     let message = stderr(&refused);
     assert!(
@@ -1457,26 +1379,10 @@ fn generate_racing_tracks_with_a_run(dir: &Path, run: &str) {
     let (_, heading, _, _) = arlpcg_core::game::racing::rules::goal_and_start(2, None, 0);
     let [x, z] = arlpcg_core::level::heading::heading_direction(heading);
     let goal = format!("{},0,{}", 50.0 * x, 50.0 * z);
-    arlpcg_ok(&[
-        "generate",
-        "--game",
-        "racing",
-        "--policies",
-        run,
-        "--aux",
-        "-1",
-        "--seed",
-        "2",
-        "--goal",
-        &goal,
-        "--verify",
-        "2",
-        "--allow-unsolved",
-        "--format",
-        "yaml,glb",
-        "--out",
-        tracks.to_str().unwrap(),
-    ]);
+    arlpcg_ok(words(
+        "generate --game racing --policies {} --aux -1 --seed 2 --goal {} --verify 2 --allow-unsolved --format yaml,glb --out {}",
+        &[&run, &goal, &tracks],
+    ));
     let level = arlpcg_core::level::yaml::load(&tracks.join("racing_seed2_aux-1.00.yaml")).unwrap();
     assert!(matches!(
         level.source,
@@ -1489,21 +1395,10 @@ fn generate_racing_tracks_with_a_run(dir: &Path, run: &str) {
 /// `eval` of a racing run: the racing columns and the paper's racing figures.
 fn evaluate_a_racing_run(dir: &Path, run: &str) {
     let results = dir.join("results");
-    arlpcg_ok(&[
-        "eval",
-        "--game",
-        "racing",
-        "--policies",
-        run,
-        "--tracks",
-        "1",
-        "--trials",
-        "1",
-        "--validation-tracks",
-        "2",
-        "--out",
-        results.to_str().unwrap(),
-    ]);
+    arlpcg_ok(words(
+        "eval --game racing --policies {} --tracks 1 --trials 1 --validation-tracks 2 --out {}",
+        &[&run, &results],
+    ));
     let json: serde_json::Value = crate::common::results_json(&results);
     let rows = json["controllability"].as_array().unwrap();
     assert_eq!(rows.len(), 5);
@@ -1548,17 +1443,10 @@ fn tamper_training_state(path: &Path, change: impl Fn(&mut serde_json::Value)) {
 fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume() {
     let (_dir, config, out) = scratch(TINY);
     let out_s = out.to_str().unwrap();
-    arlpcg_ok(&[
-        "train",
-        "--mode",
-        "fixed-track",
-        "--steps",
-        "128",
-        "--config",
-        config.to_str().unwrap(),
-        "--out",
-        out_s,
-    ]);
+    arlpcg_ok(words(
+        "train --mode fixed-track --steps 128 --config {} --out {}",
+        &[&config, &out_s],
+    ));
     let checkpoint = out.join("checkpoint.safetensors");
     let cases: [(&str, serde_json::Value, &str); 2] = [
         ("num_envs", serde_json::json!(100_000_000), "num_envs"),
@@ -1566,9 +1454,10 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
     ];
     let original = std::fs::read(&checkpoint).unwrap();
     let resume = || {
-        arlpcg(&[
-            "train", "--mode", "fixed-track", "--steps", "512", "--out", out_s, "--resume",
-        ])
+        arlpcg(words(
+            "train --mode fixed-track --steps 512 --out {} --resume",
+            &[&out_s],
+        ))
     };
     for (field, value, expected) in cases {
         std::fs::write(&checkpoint, &original).unwrap();
@@ -1617,17 +1506,10 @@ fn a_checkpoint_whose_stored_configuration_is_out_of_range_is_refused_on_resume(
 #[test]
 fn the_time_buckets_add_up_to_each_iteration_and_reach_the_cards() {
     let (_dir, config, out) = scratch(TINY_ADVERSARIAL);
-    let trained = arlpcg_ok(&[
-        "train",
-        "--mode",
-        "arlpcg",
-        "--steps",
-        "512",
-        "--config",
-        config.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let trained = arlpcg_ok(words(
+        "train --mode arlpcg --steps 512 --config {} --out {}",
+        &[&config, &out],
+    ));
     let said = String::from_utf8_lossy(&trained.stdout);
     assert!(
         said.contains("time, all sessions: env ") && said.contains("GFLOP/s matmul peak"),

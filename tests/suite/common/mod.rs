@@ -1,14 +1,37 @@
 //! What the integration tests share: running the binary, reading its output and its files.
 
+use std::ffi::{OsStr, OsString};
 use std::path::Path;
 use std::process::{Command, Output};
 
 /// Runs the `arlpcg` binary with `args` and waits for it.
-pub fn arlpcg(args: &[&str]) -> Output {
+pub fn arlpcg<S: AsRef<OsStr>>(args: impl IntoIterator<Item = S>) -> Output {
     Command::new(env!("CARGO_BIN_EXE_arlpcg"))
         .args(args)
         .output()
         .expect("the binary runs")
+}
+
+/// A command line's arguments: the words of `line` (split at white space), each `{}` standing
+/// for the next of `values`, whole (a path with a space in it stays one argument).
+pub fn words(line: &str, values: &[&dyn AsRef<OsStr>]) -> Vec<OsString> {
+    let mut values = values.iter();
+    let args = line
+        .split_whitespace()
+        .map(|word| match word {
+            "{}" => values
+                .next()
+                .unwrap_or_else(|| panic!("no value for a {{}} of `{line}`"))
+                .as_ref()
+                .to_owned(),
+            word => word.into(),
+        })
+        .collect();
+    assert!(
+        values.next().is_none(),
+        "more values than {{}}s in `{line}`"
+    );
+    args
 }
 
 /// What a run printed on stderr.
@@ -17,12 +40,13 @@ pub fn stderr(output: &Output) -> String {
 }
 
 /// `arlpcg args`, which must succeed (the failure shows its stderr).
-pub fn arlpcg_ok(args: &[&str]) -> Output {
-    let output = arlpcg(args);
+pub fn arlpcg_ok<S: AsRef<OsStr>>(args: impl IntoIterator<Item = S>) -> Output {
+    let args: Vec<OsString> = args.into_iter().map(|a| a.as_ref().to_owned()).collect();
+    let output = arlpcg(&args);
     assert!(
         output.status.success(),
         "arlpcg {}: {}",
-        args.join(" "),
+        args.join(OsStr::new(" ")).to_string_lossy(),
         stderr(&output)
     );
     output

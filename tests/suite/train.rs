@@ -263,7 +263,7 @@ fn files_of_another_run_are_refused(out: &Path) {
         let path = out.join(name);
         let own = std::fs::read(&path).unwrap();
         std::fs::write(&path, foreign).unwrap();
-        let refused = arlpcg(&resume);
+        let refused = arlpcg(resume);
         fails_with(&refused, 1, "holds files of two different runs");
         assert!(stderr(&refused).contains(name), "{}", stderr(&refused));
         assert_eq!(
@@ -617,7 +617,7 @@ fn a_staged_run_with_a_finish_resumes_to_the_same_bytes_on_any_thread_count() {
             "train", "--mode", "arlpcg", "--config", config_s, "--out", out_s,
         ];
         // 640 Solver steps and the finish's 128 (the stage begins at 768)...
-        arlpcg_ok(&[&first[..], &["--steps", "640", "--threads", threads]].concat());
+        arlpcg_ok([&first[..], &["--steps", "640", "--threads", threads]].concat());
         // ...then resumed to a budget of 1024, inside the stage, and the finish after it.
         arlpcg_ok(words(
             "train --mode arlpcg --steps 1024 --out {} --resume --threads {}",
@@ -678,10 +678,10 @@ fn a_run_paused_mid_stage_resumes_to_the_bytes_of_one_never_paused() {
         ];
         match pause_at {
             None => {
-                arlpcg_ok(&start);
+                arlpcg_ok(start);
             }
             Some(at) => {
-                arlpcg_ok(&[&start[..], &["--pause-at", at]].concat());
+                arlpcg_ok([&start[..], &["--pause-at", at]].concat());
                 let paused = curve(&out).last().unwrap().1;
                 let (at, steps): (u64, u64) = (at.parse().unwrap(), steps.parse().unwrap());
                 assert!((at..steps).contains(&paused), "paused at {paused}");
@@ -734,7 +734,7 @@ fn a_run_killed_while_its_generator_learns_resumes_to_the_same_bytes() {
         .to_vec()
     };
     let whole = dir.path().join("whole");
-    arlpcg_ok(&args(&whole).iter().map(String::as_str).collect::<Vec<_>>());
+    arlpcg_ok(args(&whole));
     let killed = dir.path().join("killed");
     // The first Generator phase runs iterations 1 to 6: kill it after its third.
     kill_after_generator_rows(&args(&killed), &killed, 3);

@@ -7,10 +7,10 @@
 
 use std::time::{Duration, Instant};
 
-use arlpcg_core::game::SolverEnv;
 use arlpcg_core::game::platform::{PlatformAction, PlatformEnv, PlatformRewards};
 use arlpcg_core::game::racing::car::CarAction;
 use arlpcg_core::game::racing::{RacingEnv, RacingRewards, ScriptedDriver};
+use arlpcg_core::game::{GameSpec, PlatformGame, SolverEnv};
 use arlpcg_core::level::racing::RacingRulesConfig;
 use rayon::prelude::*;
 
@@ -75,14 +75,7 @@ impl<E: SolverEnv> Worker<E> {
 /// A platform rule level's world with random actions leaning forward (a policy early in
 /// training).
 fn platform_worker(seed: u64) -> Worker<PlatformEnv> {
-    let level = arlpcg_core::game::platform::rules::platform_level(
-        seed,
-        None,
-        None,
-        &Default::default(),
-        &Default::default(),
-    )
-    .expect("rule level");
+    let level = PlatformGame::rule_level(seed, &Default::default()).expect("rule level");
     let track = level.platform().expect("platform level");
     let env = PlatformEnv::new(track, level.goal, PlatformRewards::default());
     let driver: Driver<PlatformEnv> = Box::new(|_, units| PlatformAction {

@@ -2,6 +2,7 @@
 //! markers, names, extras, and world bounds that match the level.
 
 use crate::common::import_glb;
+use arlpcg_core::game::GameSpec;
 use arlpcg_core::game::platform::rules;
 use arlpcg_core::level::Track;
 use arlpcg_core::level::platform::BLOCK_THICKNESS;
@@ -248,14 +249,7 @@ fn rotate_z(rotation: [f32; 4]) -> [f32; 3] {
 fn spawn_and_finish_nodes_carry_start_heading_and_goal_reach() {
     use arlpcg_core::level::heading::heading_direction;
     let platform = level(6);
-    let racing = arlpcg_core::game::racing::rules::racing_level(
-        6,
-        None,
-        None,
-        &Default::default(),
-        &Default::default(),
-    )
-    .unwrap();
+    let racing = arlpcg_core::game::RacingGame::rule_level(6, &Default::default()).unwrap();
     for level in [platform, racing] {
         let glb = export::to_glb(&Scene::of_level(&level));
         let (document, _) = import_glb(&glb);

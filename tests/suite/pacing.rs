@@ -12,6 +12,7 @@ use arlpcg_core::level::pacing::{AuxCurve, round_aux};
 use arlpcg_core::level::{Game, yaml};
 
 use crate::common::{arlpcg, arlpcg_ok, stderr, words};
+use arlpcg_core::game::GameSpec;
 
 const EASY_THEN_HARD: &str = "0:1, 0.5:1, 0.5:-1, 1:-1";
 
@@ -133,14 +134,7 @@ fn bad_curves_are_refused_with_the_reason() {
 
 #[test]
 fn a_piece_aux_without_a_curve_names_the_field() {
-    let level = arlpcg_core::game::platform::rules::platform_level(
-        5,
-        None,
-        None,
-        &Default::default(),
-        &Default::default(),
-    )
-    .unwrap();
+    let level = arlpcg_core::game::PlatformGame::rule_level(5, &Default::default()).unwrap();
     let text = yaml::to_string(&level).replacen("  height:", "  aux: -1.0\n  height:", 1);
     let err = yaml::parse(&text).unwrap_err().to_string();
     assert!(

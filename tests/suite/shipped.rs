@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use arlpcg_core::game::GameSpec;
 use arlpcg_core::level::scene::Scene;
 use arlpcg_core::level::{gltf, yaml};
 
@@ -130,14 +131,7 @@ fn the_shipped_racing_solvers_load_and_drive() {
     use arlpcg::services::verify::{Solver, verify};
     use arlpcg_core::game::racing::OBSERVATION_SIZE;
     use arlpcg_core::level::Game;
-    let level = arlpcg_core::game::racing::rules::racing_level(
-        3,
-        None,
-        None,
-        &Default::default(),
-        &Default::default(),
-    )
-    .unwrap();
+    let level = arlpcg_core::game::RacingGame::rule_level(3, &Default::default()).unwrap();
     for (file, mode) in [
         ("solver.safetensors", "arlpcg"),
         ("solver-rule-pcg.safetensors", "rule-pcg"),

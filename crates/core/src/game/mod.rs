@@ -225,14 +225,7 @@ impl GameSpec for PlatformGame {
     }
 
     fn rule_level(seed: u64, player: &Player) -> Option<crate::level::Level> {
-        platform::rules::platform_level(
-            seed,
-            None,
-            None,
-            &crate::level::PlatformRulesConfig::default(),
-            player,
-        )
-        .ok()
+        platform::rules::platform_level(seed, None, None, &Default::default(), player).ok()
     }
 
     fn scripted(seed: u64, skill: Skill) -> platform::ScriptedController {

@@ -9,7 +9,7 @@ use crate::services::fsio;
 use crate::services::fsio::Overwrite;
 use anyhow::{Context, Result, bail};
 use arlpcg_core::game::generator::GeneratorGame;
-use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame};
+use arlpcg_core::game::{PlatformGame, RacingGame};
 use arlpcg_core::level::Game;
 use arlpcg_core::level::profile::{ABILITIES_PART, ability_columns};
 use arlpcg_core::rl::checkpoint;
@@ -17,25 +17,32 @@ use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingRecord, T
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::{ActorCritic, PolicyShape};
 
-/// What a game's Solver observes and does, as a policy card names it.
-pub(super) struct SolverIo {
+/// What a game's agent (Solver or Generator) observes and does, as a policy card names it.
+pub(super) struct AgentIo {
     observation: &'static [(&'static str, usize)],
     continuous: &'static [&'static str],
     binary: &'static [&'static str],
 }
 
-impl SolverIo {
-    fn of(game: Game) -> Self {
-        fn io<G: GameSpec>() -> SolverIo {
-            SolverIo {
-                observation: G::OBSERVATION_LAYOUT,
-                continuous: G::CONTINUOUS_ACTIONS,
-                binary: G::BINARY_ACTIONS,
+impl AgentIo {
+    fn of(game: Game, role: Role) -> Self {
+        fn io<G: GeneratorGame>(role: Role) -> AgentIo {
+            match role {
+                Role::Solver => AgentIo {
+                    observation: G::OBSERVATION_LAYOUT,
+                    continuous: G::CONTINUOUS_ACTIONS,
+                    binary: G::BINARY_ACTIONS,
+                },
+                Role::Generator => AgentIo {
+                    observation: G::GENERATOR_OBSERVATION_LAYOUT,
+                    continuous: G::GENERATOR_ACTIONS,
+                    binary: &[],
+                },
             }
         }
         match game {
-            Game::Platform => io::<PlatformGame>(),
-            Game::Racing => io::<RacingGame>(),
+            Game::Platform => io::<PlatformGame>(role),
+            Game::Racing => io::<RacingGame>(role),
         }
     }
 
@@ -44,9 +51,10 @@ impl SolverIo {
     }
 }
 
-/// The Solver's policy shape.
-pub(super) fn solver_shape(config: &TrainConfig, game: Game) -> PolicyShape {
-    let io = SolverIo::of(game);
+/// The policy shape of `role`'s agent: the game's observation (and the abilities, for an
+/// ability-aware run) in, its actions out.
+pub(super) fn agent_shape(config: &TrainConfig, game: Game, role: Role) -> PolicyShape {
+    let io = AgentIo::of(game, role);
     PolicyShape {
         observation: io.observation_size() + ability_columns(config.ability_spread),
         hidden: config.hidden.clone(),
@@ -55,40 +63,14 @@ pub(super) fn solver_shape(config: &TrainConfig, game: Game) -> PolicyShape {
     }
 }
 
-/// What a game's Generator observes and does, as a policy card names it.
-pub(super) struct GeneratorIo {
-    observation: &'static [(&'static str, usize)],
-    actions: &'static [&'static str],
-}
-
-impl GeneratorIo {
-    fn of(game: Game) -> Self {
-        fn io<G: GeneratorGame>() -> GeneratorIo {
-            GeneratorIo {
-                observation: G::GENERATOR_OBSERVATION_LAYOUT,
-                actions: G::GENERATOR_ACTIONS,
-            }
-        }
-        match game {
-            Game::Platform => io::<PlatformGame>(),
-            Game::Racing => io::<RacingGame>(),
-        }
-    }
-
-    fn observation_size(&self) -> usize {
-        self.observation.iter().map(|(_, k)| k).sum()
-    }
+/// The Solver's policy shape.
+pub(super) fn solver_shape(config: &TrainConfig, game: Game) -> PolicyShape {
+    agent_shape(config, game, Role::Solver)
 }
 
 /// The Generator's policy shape.
 pub(super) fn generator_shape(config: &TrainConfig, game: Game) -> PolicyShape {
-    let io = GeneratorIo::of(game);
-    PolicyShape {
-        observation: io.observation_size() + ability_columns(config.ability_spread),
-        hidden: config.hidden.clone(),
-        continuous: io.actions.len(),
-        binary: 0,
-    }
+    agent_shape(config, game, Role::Generator)
 }
 
 /// Records the run's sessions in `card`: `commands[0]` started it, the others resumed it.
@@ -126,26 +108,8 @@ pub(super) fn card(
             .map(|(n, k)| (n.to_string(), *k))
             .collect::<Vec<_>>()
     };
-    let (mut observation, continuous_actions, binary_actions, network) = match role {
-        Role::Solver => {
-            let io = SolverIo::of(game);
-            (
-                layout(io.observation),
-                names(io.continuous),
-                names(io.binary),
-                solver_shape(config, game),
-            )
-        }
-        Role::Generator => {
-            let io = GeneratorIo::of(game);
-            (
-                layout(io.observation),
-                names(io.actions),
-                Vec::new(),
-                generator_shape(config, game),
-            )
-        }
-    };
+    let io = AgentIo::of(game, role);
+    let mut observation = layout(io.observation);
     // An ability-aware agent observes the main abilities after the game's observation.
     let abilities = ability_columns(config.ability_spread);
     if abilities > 0 {
@@ -157,9 +121,9 @@ pub(super) fn card(
         game,
         role,
         observation,
-        continuous_actions,
-        binary_actions,
-        network,
+        continuous_actions: names(io.continuous),
+        binary_actions: names(io.binary),
+        network: agent_shape(config, game, role),
         normalizer: normalizer.clone(),
         training: TrainingRecord {
             mode,
@@ -221,10 +185,7 @@ pub(super) fn read_checkpoint(
     let bytes =
         crate::services::fsio::read_limited(path, checkpoint::MAX_POLICY_BYTES, "checkpoint")
             .context("cannot resume")?;
-    let observation = match role {
-        Role::Solver => SolverIo::of(game).observation_size(),
-        Role::Generator => GeneratorIo::of(game).observation_size(),
-    };
+    let observation = AgentIo::of(game, role).observation_size();
     let loaded = checkpoint::load_policy(&bytes, game, role, observation)
         .with_context(|| format!("{}", path.display()))?;
     let state = loaded

@@ -14,6 +14,11 @@ fn num(x: f64, decimals: usize) -> String {
     }
 }
 
+/// A success ratio and its standard deviation over levels: `0.457 ± 0.211`.
+fn ratio_and_std(ratio: f64, std: f64) -> String {
+    format!("{} ± {}", num(ratio, 3), num(std, 3))
+}
+
 /// The three tables as markdown, beside the paper's figures.
 pub fn markdown(results: &Results) -> String {
     let game = facts(results.game);
@@ -26,10 +31,9 @@ pub fn markdown(results: &Results) -> String {
         .zip(game.paper_controllability)
     {
         md += &format!(
-            "| {:+.1} | {} ± {} | {} |",
+            "| {:+.1} | {} | {} |",
             row.aux,
-            num(row.success_ratio, 3),
-            num(row.success_std, 3),
+            ratio_and_std(row.success_ratio, row.success_std),
             num(row.completed_by_any, 2),
         );
         if let Some(air) = row.air_time {
@@ -62,10 +66,9 @@ pub fn markdown(results: &Results) -> String {
     for row in &results.generalization {
         let paper = game.paper_generalization(&row.mode);
         md += &format!(
-            "| {} | {} ± {} | {} | {} | {} | {} | {paper} |\n",
+            "| {} | {} | {} | {} | {} | {} | {paper} |\n",
             row.mode,
-            num(row.success_ratio, 3),
-            num(row.success_std, 3),
+            ratio_and_std(row.success_ratio, row.success_std),
             num(row.success_rule_levels, 3),
             num(row.success_generator_levels, 3),
             num(row.completed_by_any, 2),

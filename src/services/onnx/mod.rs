@@ -413,6 +413,18 @@ fn mlagents_outputs(
         };
         (name.to_string(), output)
     };
+    // Actions under both of ML-Agents' names, then their shape.
+    let actions_and_shape = |graph: &mut GraphBuilder,
+                             (actions, name, output): (&str, &str, Output),
+                             (shape_name, shape): (&str, &[f32]),
+                             meaning| {
+        let [named, deterministic] = both_names(graph, actions, name, output);
+        [
+            named,
+            deterministic,
+            constant(graph, shape_name, shape, meaning),
+        ]
+    };
     outputs.push(constant(
         graph,
         "version_number",
@@ -433,11 +445,10 @@ fn mlagents_outputs(
             columns: action_columns(&card.continuous_actions),
             int64: false,
         };
-        outputs.extend(both_names(graph, &actions, "continuous_actions", output));
-        outputs.push(constant(
+        outputs.extend(actions_and_shape(
             graph,
-            "continuous_action_output_shape",
-            &[continuous as f32],
+            (&actions, "continuous_actions", output),
+            ("continuous_action_output_shape", &[continuous as f32]),
             "how many continuous actions",
         ));
     }
@@ -466,11 +477,10 @@ fn mlagents_outputs(
             columns: action_columns(&card.binary_actions),
             int64: true,
         };
-        outputs.extend(both_names(graph, &actions, "discrete_actions", output));
-        outputs.push(constant(
+        outputs.extend(actions_and_shape(
             graph,
-            "discrete_action_output_shape",
-            &vec![2.0; binary],
+            (&actions, "discrete_actions", output),
+            ("discrete_action_output_shape", &vec![2.0; binary]),
             "each branch's size (2)",
         ));
     }

@@ -16,7 +16,7 @@ fn root() -> &'static Path {
 /// The pure parts, from the repository's root: the core crate and the services that compute.
 const PURE: &[&str] = &[
     "crates/core/src", "src/services/train", "src/services/eval", "src/services/onnx",
-    "src/services/verify.rs", "src/services/generation.rs", "src/services/difficulty.rs",
+    "src/services/verify", "src/services/generation.rs", "src/services/difficulty.rs",
     "src/services/panel.rs",
 ];
 

@@ -1,0 +1,94 @@
+//! A trained Solver ready to play, and how it stands to the abilities of a profile it is to play
+//! under (who plays a level made for other abilities: [`SolverPolicy::or_aware`]).
+
+use arlpcg_core::level::profile::{Abilities, Profile, main_abilities};
+use arlpcg_core::level::{Game, Level, PolicyRef};
+use arlpcg_core::rl::normalizer::RunningNorm;
+use arlpcg_core::rl::policy::ActorCritic;
+
+/// A trained Solver, ready to play.
+pub struct SolverPolicy {
+    /// The game it was trained for.
+    pub game: Game,
+    pub policy: ActorCritic,
+    pub normalizer: RunningNorm,
+    pub reference: PolicyRef,
+    /// The game profile it trained for (none: the built-in game).
+    pub profile: Option<Profile>,
+    /// An ability-aware Solver: it trained with each main ability within this share of its
+    /// profile's, and observes them (none: it trained with one character or car).
+    pub ability_spread: Option<f64>,
+}
+
+/// How a Solver policy stands to the abilities of a profile it is to play under.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ProfileFit {
+    /// It trained with them, or over a range that holds them.
+    Fits,
+    /// A policy of one character or car, trained with others: its statistics are not those of
+    /// a player who trained with them (the message says so).
+    Untrained(String),
+    /// Beyond the range an ability-aware policy trained over: refused (the message says how to
+    /// train for it).
+    Beyond(String),
+}
+
+impl SolverPolicy {
+    /// How it stands to playing under `played` (none: the built-in abilities).
+    pub fn fit(&self, played: Option<&Profile>) -> ProfileFit {
+        let abilities = |profile: Option<&Profile>| Abilities::of(profile, self.game);
+        let name = |profile: Option<&Profile>| {
+            profile.map_or("the built-in abilities".to_string(), |p| {
+                format!("profile `{}`", p.name)
+            })
+        };
+        let trained = self.profile.as_ref();
+        match self.ability_spread {
+            Some(spread) if !abilities(played).within(&abilities(trained), spread) => {
+                ProfileFit::Beyond(format!(
+                    "{} lies beyond the abilities the Solver policy {} trained over (each of {} within ±{:.0}% of {}): train a Solver for it (arlpcg train --profile FILE)",
+                    name(played),
+                    self.reference.path,
+                    main_abilities(self.game).join(", "),
+                    100.0 * spread,
+                    name(trained)
+                ))
+            }
+            None if abilities(played) != abilities(trained) => ProfileFit::Untrained(format!(
+                "the Solver policy trained for {} plays under {}: its statistics are of a player who never trained with them (the scripted player, --solver scripted, plays with them)",
+                name(trained),
+                name(played)
+            )),
+            _ => ProfileFit::Fits,
+        }
+    }
+
+    /// Of this Solver and a folder's ability-aware one, the one that plays under `played`: the
+    /// ability-aware one when this one did not train with those abilities and its range holds
+    /// them; else this one (its [`fit`](Self::fit) says why it may not).
+    pub fn or_aware<'a>(
+        &'a self,
+        aware: Option<&'a SolverPolicy>,
+        played: Option<&Profile>,
+    ) -> &'a SolverPolicy {
+        match aware {
+            Some(aware) if self.yields_to(aware, played) => aware,
+            _ => self,
+        }
+    }
+
+    /// Whether `aware` plays under `played` in place of this Solver ([`Self::or_aware`]).
+    pub fn yields_to(&self, aware: &SolverPolicy, played: Option<&Profile>) -> bool {
+        self.fit(played) != ProfileFit::Fits && aware.fit(played) == ProfileFit::Fits
+    }
+
+    /// What it observes after the game's observation on `level`: for an ability-aware Solver
+    /// the level's main abilities relative to ours, else nothing.
+    pub(super) fn ability_row(&self, level: &Level) -> Vec<f32> {
+        if self.ability_spread.is_none() {
+            return Vec::new();
+        }
+        let played = Abilities::of(level.profile.as_ref(), level.game());
+        played.relative_main().to_vec()
+    }
+}

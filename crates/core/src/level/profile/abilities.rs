@@ -1,0 +1,299 @@
+//! The abilities of the player's character (platform) or car (racing): the fields a profile
+//! sets, their ranges, and how an ability-aware agent observes and varies the main ones.
+
+use serde::{Deserialize, Serialize};
+
+use super::{Fields, Profile, field, nth};
+use crate::level::Game;
+use crate::level::params::{ParamRange, RangeError};
+
+/// The platform character's abilities.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CharacterProfile {
+    /// Top horizontal speed, m/s.
+    pub run_speed: f64,
+    /// Vertical take-off speed of a jump, m/s.
+    pub jump_speed: f64,
+    /// Gravity, m/s².
+    pub gravity: f64,
+    /// Horizontal acceleration toward the commanded velocity on the ground, m/s².
+    pub ground_accel: f64,
+    /// Horizontal acceleration in the air (air control), m/s².
+    pub air_accel: f64,
+    /// Fastest turn, degrees per second.
+    pub turn_rate: f64,
+    /// Capsule radius, m.
+    pub radius: f64,
+    /// Capsule height, m (at least twice the radius).
+    pub height: f64,
+}
+
+/// The racing car's abilities.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CarProfile {
+    /// Total engine force at full throttle, N.
+    pub engine_force: f64,
+    /// Chassis mass, kg.
+    pub mass: f64,
+    /// Tyre grip (friction coefficient).
+    pub grip: f64,
+    /// Front wheels' steering at full lock, radians.
+    pub max_steer: f64,
+    /// Air and rolling drag, per second (with the engine it sets the top speed).
+    pub damping: f64,
+}
+
+/// One game's abilities.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Abilities {
+    Platform(CharacterProfile),
+    Racing(CarProfile),
+}
+
+impl Default for CharacterProfile {
+    /// Today's character (src/game/platform/character.rs; docs/platform-physics.md).
+    fn default() -> Self {
+        Self {
+            run_speed: 8.0,
+            jump_speed: 9.25,
+            gravity: 20.0,
+            ground_accel: 60.0,
+            air_accel: 6.0,
+            turn_rate: 270.0,
+            radius: 0.4,
+            height: 1.8,
+        }
+    }
+}
+
+impl Default for CarProfile {
+    /// Today's car (docs/racing-physics.md).
+    fn default() -> Self {
+        Self {
+            engine_force: 7200.0,
+            mass: 1200.0,
+            grip: 0.9,
+            max_steer: 0.5,
+            damping: 0.21,
+        }
+    }
+}
+
+/// The observation part an ability-aware Solver's observation ends with: the game's
+/// [`main_abilities`] relative to ours.
+pub const ABILITIES_PART: &str = "abilities";
+
+/// How many main abilities each game has.
+pub const MAIN_ABILITIES: usize = 3;
+
+/// How many ability columns an agent trained with `spread` observes after the game's
+/// observation: the main abilities when it is ability-aware (spread above 0), else none.
+pub fn ability_columns(spread: f64) -> usize {
+    if spread > 0.0 { MAIN_ABILITIES } else { 0 }
+}
+
+/// The main abilities of `game`, as a profile file names them: the designer's keys change them,
+/// and an ability-aware Solver observes them and trains over a range of them.
+pub fn main_abilities(game: Game) -> [&'static str; MAIN_ABILITIES] {
+    match game {
+        Game::Platform => [
+            "character.jump_speed", "character.run_speed", "character.gravity",
+        ],
+        Game::Racing => ["car.engine_force", "car.grip", "car.max_steer"],
+    }
+}
+
+/// The stream [`Abilities::varied`] draws from, apart from every other use of a seed.
+const VARIATION_STREAM: u64 = 0xab11_7135;
+
+/// Each character field.
+pub const CHARACTER_FIELDS: [(ParamRange, &str); 8] = [
+    field(
+        "character.run_speed", 2.0, 20.0, "m/s", "top horizontal speed",
+    ),
+    field(
+        "character.jump_speed", 3.0, 20.0, "m/s", "vertical take-off speed of a jump",
+    ),
+    field("character.gravity", 2.0, 50.0, "m/s²", "gravity"),
+    field(
+        "character.ground_accel", 5.0, 200.0, "m/s²", "acceleration on the ground",
+    ),
+    field(
+        "character.air_accel", 0.0, 60.0, "m/s²", "acceleration in the air (air control)",
+    ),
+    field("character.turn_rate", 45.0, 1080.0, "°/s", "fastest turn"),
+    field("character.radius", 0.2, 1.0, "m", "capsule radius"),
+    field(
+        "character.height",
+        0.8,
+        3.0,
+        "m",
+        "capsule height, at least twice the radius",
+    ),
+];
+
+/// Each car field.
+pub const CAR_FIELDS: [(ParamRange, &str); 5] = [
+    field(
+        "car.engine_force", 1000.0, 30000.0, "N", "engine force at full throttle",
+    ),
+    field("car.mass", 300.0, 5000.0, "kg", "chassis mass"),
+    field("car.grip", 0.2, 3.0, "", "tyre friction coefficient"),
+    field("car.max_steer", 0.1, 1.0, "rad", "steering at full lock"),
+    field("car.damping", 0.02, 1.0, "1/s", "air and rolling drag"),
+];
+
+impl Fields for CharacterProfile {
+    const FIELDS: &'static [(ParamRange, &'static str)] = &CHARACTER_FIELDS;
+    fn slot(&mut self, k: usize) -> &mut f64 {
+        nth(
+            [
+                &mut self.run_speed, &mut self.jump_speed, &mut self.gravity,
+                &mut self.ground_accel, &mut self.air_accel, &mut self.turn_rate, &mut self.radius,
+                &mut self.height,
+            ],
+            k,
+        )
+    }
+}
+
+impl CharacterProfile {
+    /// Checks every field's range, and the capsule's shape.
+    pub fn check(&self) -> Result<(), RangeError> {
+        self.check_each()?;
+        let least = 2.0 * self.radius;
+        ParamRange::new(
+            "character.height", least, 3.0, "m (twice the radius at least)",
+        )
+        .check(self.height)
+        .map(drop)
+    }
+}
+
+impl Fields for CarProfile {
+    const FIELDS: &'static [(ParamRange, &'static str)] = &CAR_FIELDS;
+    fn slot(&mut self, k: usize) -> &mut f64 {
+        nth(
+            [
+                &mut self.engine_force, &mut self.mass, &mut self.grip, &mut self.max_steer,
+                &mut self.damping,
+            ],
+            k,
+        )
+    }
+}
+
+impl CarProfile {
+    /// Checks every field's range.
+    pub fn check(&self) -> Result<(), RangeError> {
+        self.check_each()
+    }
+}
+
+impl Abilities {
+    /// `game`'s abilities from a file's `character:` and `car:` (the one of its game, and
+    /// not the other), each field in range.
+    pub(super) fn checked(
+        game: Game,
+        character: Option<CharacterProfile>,
+        car: Option<CarProfile>,
+    ) -> Result<Self, String> {
+        match (game, character, car) {
+            (Game::Platform, Some(c), None) => {
+                c.check().map_err(|e| e.to_string())?;
+                Ok(Abilities::Platform(c))
+            }
+            (Game::Racing, None, Some(c)) => {
+                c.check().map_err(|e| e.to_string())?;
+                Ok(Abilities::Racing(c))
+            }
+            (Game::Platform, _, _) => {
+                Err("a platform profile has `character:` and no `car:`".into())
+            }
+            (Game::Racing, _, _) => Err("a racing profile has `car:` and no `character:`".into()),
+        }
+    }
+
+    /// The field named as in [`CHARACTER_FIELDS`] or [`CAR_FIELDS`], with its range; none for a
+    /// field of the other game.
+    pub fn value(&self, field: &str) -> Option<(f64, ParamRange)> {
+        match self {
+            Abilities::Platform(c) => c.field(field),
+            Abilities::Racing(c) => c.field(field),
+        }
+    }
+
+    /// These abilities with `field` at `value`, when they are then valid.
+    pub fn with_value(&self, field: &str, value: f64) -> Option<Self> {
+        Some(match self {
+            Abilities::Platform(c) => {
+                let c = c.set(field, value)?;
+                c.check().ok()?;
+                Abilities::Platform(c)
+            }
+            Abilities::Racing(c) => {
+                let c = c.set(field, value)?;
+                c.check().ok()?;
+                Abilities::Racing(c)
+            }
+        })
+    }
+
+    /// Each of the game's [`main_abilities`] relative to the built-in one (0: ours, 0.1: 10%
+    /// more): what an ability-aware Solver observes.
+    pub fn relative_main(&self) -> [f32; MAIN_ABILITIES] {
+        let ours = Self::default_of(self.game());
+        main_abilities(self.game()).map(|field| {
+            let value = |a: &Self| a.value(field).expect("a main ability of the game").0;
+            (value(self) / value(&ours) - 1.0) as f32
+        })
+    }
+
+    /// Whether each main ability lies within `spread` (a share, 0.2 for ±20%) of `base`'s.
+    pub fn within(&self, base: &Self, spread: f64) -> bool {
+        self.game() == base.game()
+            && main_abilities(self.game()).iter().all(|field| {
+                let (value, _) = self.value(field).expect("a main ability of the game");
+                let (from, _) = base.value(field).expect("a main ability of the game");
+                (value / from - 1.0).abs() <= spread + 1e-9
+            })
+    }
+
+    /// These abilities with each main one scaled by `1 + s`, `s` drawn uniformly within
+    /// `±spread` from a generator seeded by `seed` (kept within the field's range): the
+    /// character or car of one training episode.
+    pub fn varied(&self, spread: f64, seed: u64) -> Self {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ VARIATION_STREAM);
+        let mut varied = *self;
+        for field in main_abilities(self.game()) {
+            let (value, range) = varied.value(field).expect("a main ability of the game");
+            let scaled =
+                (value * (1.0 + rng.random_range(-spread..=spread))).clamp(range.min, range.max);
+            varied = varied.with_value(field, scaled).unwrap_or(varied);
+        }
+        varied
+    }
+
+    /// The abilities of `profile`, or ours when there is none.
+    pub fn of(profile: Option<&Profile>, game: Game) -> Self {
+        profile.map_or(Self::default_of(game), |p| p.abilities)
+    }
+
+    /// The built-in abilities of `game`.
+    pub fn default_of(game: Game) -> Self {
+        match game {
+            Game::Platform => Abilities::Platform(CharacterProfile::default()),
+            Game::Racing => Abilities::Racing(CarProfile::default()),
+        }
+    }
+
+    pub fn game(&self) -> Game {
+        match self {
+            Abilities::Platform(_) => Game::Platform,
+            Abilities::Racing(_) => Game::Racing,
+        }
+    }
+}

@@ -129,6 +129,17 @@ pub fn load_folder_solver(
     profile: Option<&Profile>,
 ) -> Result<SolverPolicy> {
     let solver = load_solver(&dir.join(SOLVER_FILE), game)?.0;
+    or_folders_aware(dir, game, solver, profile)
+}
+
+/// `solver`, or the ability-aware Solver of the policies folder `dir` where it plays in its
+/// place under `profile` ([`SolverPolicy::or_aware`]).
+fn or_folders_aware(
+    dir: &Path,
+    game: Game,
+    solver: SolverPolicy,
+    profile: Option<&Profile>,
+) -> Result<SolverPolicy> {
     if solver.fit(profile) == ProfileFit::Fits {
         return Ok(solver);
     }
@@ -323,7 +334,14 @@ pub fn load_panel(dir: &Path, game: Game, chosen: Option<&[Judge]>) -> Result<Ju
             .filter(|&j| judge_file(dir, j).is_none_or(|p| p.exists()))
             .collect(),
     };
-    let mut panel = JudgePanel { judges: Vec::new() };
+    let aware = match judges.contains(&Judge::Solver(TrainMode::Arlpcg)) {
+        true => load_aware_solver(dir, game)?,
+        false => None,
+    };
+    let mut panel = JudgePanel {
+        judges: Vec::new(),
+        aware,
+    };
     for judge in judges {
         let policy = load_judge(dir, game, judge)?.map(|(policy, _)| policy);
         panel.judges.push((judge, policy));
@@ -353,6 +371,24 @@ pub fn load_judge(
         );
     }
     Ok(Some((policy, card)))
+}
+
+/// The policy that plays for `judge` of the policies folder `dir` under `profile`: the judge's
+/// own, or for the ARLPCG judge the folder's ability-aware Solver where it plays in its place
+/// (as in a panel); `None` for the scripted player.
+pub fn load_judge_under(
+    dir: &Path,
+    game: Game,
+    judge: Judge,
+    profile: Option<&Profile>,
+) -> Result<Option<SolverPolicy>> {
+    let Some((policy, _)) = load_judge(dir, game, judge)? else {
+        return Ok(None);
+    };
+    Ok(Some(match judge {
+        Judge::Solver(TrainMode::Arlpcg) => or_folders_aware(dir, game, policy, profile)?,
+        Judge::Solver(_) | Judge::Scripted(_) => policy,
+    }))
 }
 
 /// The paths of the Generator and the Solver in a policies folder.

@@ -1066,6 +1066,26 @@ fn the_shipped_ability_aware_solver_plays_a_profile_within_its_range() {
         built_in.ends_with("policies/platform/solver.safetensors"),
         "{built_in}"
     );
+    // The ARLPCG judge, verifying or on the panel, plays them with the ability-aware Solver too.
+    let rated = path("rated");
+    arlpcg_ok(words(
+        "generate --policies policies/platform --aux 1 --profile {} --count 1 --verify 2 --judge arlpcg --panel --format yaml --out {}",
+        &[&path("low.yaml"), &rated],
+    ));
+    let (_, yaml) = files_of(Path::new(&rated)).remove(0);
+    let level = arlpcg_core::level::yaml::parse(std::str::from_utf8(&yaml).unwrap()).unwrap();
+    let stats = level.stats.unwrap();
+    let arlpcg_core::level::SolverRef::Policy { policy } = &stats.solver else {
+        panic!("the ARLPCG judge verifies: {:?}", stats.solver)
+    };
+    let played = &policy.path;
+    assert!(
+        played.ends_with("platform/solver-aware.safetensors"),
+        "{played}"
+    );
+    let panel = stats.panel.expect("--panel records the panel");
+    let arlpcg = panel.judges.iter().find(|j| j.judge == "arlpcg").unwrap();
+    assert_eq!(arlpcg.policy.as_ref(), Some(policy));
 }
 
 /// A profile's piece ranges: `init` prints them, levels of both games keep within them, and a

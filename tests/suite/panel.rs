@@ -122,6 +122,14 @@ fn generate_records_the_panel_and_the_rating_and_verifies_with_a_judge() {
     let panel = stats.panel.expect("--panel records the panel");
     assert_eq!(panel.judges.len(), 7);
     assert_eq!(panel.trials, 6);
+    let arlpcg = &panel.judges[0];
+    assert_eq!(arlpcg.judge, "arlpcg");
+    let played = &arlpcg
+        .policy
+        .as_ref()
+        .expect("a Solver judge's policy")
+        .path;
+    assert!(played.ends_with("platform/solver.safetensors"), "{played}");
     let rating = panel.rating.expect("and the rating");
     assert_eq!(rating.levels, 2);
     assert!(rating.ci95[0] < rating.b && rating.b < rating.ci95[1]);

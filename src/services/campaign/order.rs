@@ -183,7 +183,7 @@ pub fn regenerate_level(
     let (folder, record, mut levels) = open(folder)?;
     let judge = Judge::parse(&record.judge).map_err(anyhow::Error::msg)?;
     let judged = crate::services::policies::load_panel(dir, record.game, Some(&[judge]))?;
-    let solver = judged.solver(0);
+    let solver = judged.solver(0, record.ask().profile.as_ref());
     let curve = crate::services::policies::difficulty_curve(dir, generator, &solver, || {}, stop)?;
     let seed = record
         .levels

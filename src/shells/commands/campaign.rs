@@ -70,7 +70,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     let n = args.levels as usize;
     let generator = load_generator(&policy_paths(&dir).0, args.game)?.0;
     let judged = load_panel(&dir, args.game, Some(&[judge]))?;
-    let solver = judged.solver(0);
+    let solver = judged.solver(0, ask.profile.as_ref());
     if let Solver::Policy(policy) = &solver {
         crate::shells::common::check_fit(policy, ask.profile.as_ref())?;
     }
@@ -425,9 +425,10 @@ pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
         .clone()
         .unwrap_or_else(|| shipped_dir(campaign.game));
     let judged = load_panel(&dir, campaign.game, Some(&[judge]))?;
-    let solver = judged.solver(0);
+    let profile = campaign.ask().profile;
+    let solver = judged.solver(0, profile.as_ref());
     if let Solver::Policy(policy) = &solver {
-        crate::shells::common::check_fit(policy, campaign.ask().profile.as_ref())?;
+        crate::shells::common::check_fit(policy, profile.as_ref())?;
     }
     let panel = load_panel(&dir, campaign.game, None)?;
     for (level, entry) in levels.iter_mut().zip(&campaign.levels) {

@@ -15,7 +15,7 @@ use crate::services::generation::{self, Ask, GeneratorPolicy, KeptPrefix, LevelR
 use crate::services::level_files::{Format, LevelFiles, file_stem, render};
 use crate::services::panel::Judge;
 use crate::services::policies::{
-    load_folder_solver, load_generator, load_judge, load_panel, load_solver, policy_paths,
+    load_folder_solver, load_generator, load_judge_under, load_panel, load_solver, policy_paths,
     shipped_dir,
 };
 use crate::services::profile;
@@ -453,7 +453,7 @@ fn chosen_solver(
         (None, _, _) => None,
         // A Solver judge's policy; none for the scripted player.
         (Some(_), Some(judge), _) => {
-            load_judge(&policies_dir(args), args.game, judge)?.map(|(policy, _)| policy)
+            load_judge_under(&policies_dir(args), args.game, judge, profile)?
         }
         (Some(_), None, Some(path)) => Some(load_solver(path, args.game)?.0),
         (Some(_), None, None) => match &args.policies {

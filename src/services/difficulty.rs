@@ -18,6 +18,7 @@ use crate::services::verify::{Solver, Watch, WrongGame, stats_of, trial_results,
 use arlpcg_core::level::Level;
 #[cfg(doc)]
 use arlpcg_core::level::pacing::AuxCurve;
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::stats::{Outcome, wilson_interval};
 
 /// A kept level measures within this of the wanted success ratio.
@@ -42,6 +43,9 @@ pub struct Curve {
     /// player, its judge name: `scripted-median`).
     pub generator_sha256: String,
     pub solver_sha256: String,
+    /// SHA-256 of the profile its levels were made for (none: the built-in game).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile_sha256: Option<String>,
     /// (λ, mean success ratio), easy to hard.
     pub points: Vec<(f64, f64)>,
 }
@@ -118,13 +122,15 @@ fn set_aside(uncompleted: u32, unbuilt: u32) -> String {
     }
 }
 
-/// Measures the curve: [`CURVE_LEVELS`] levels at each λ, [`CURVE_TRIALS`] runs each;
+/// Measures the curve: [`CURVE_LEVELS`] levels at each λ, made for `profile` (none: the
+/// built-in game), [`CURVE_TRIALS`] runs each;
 /// `stopped` is asked before each level (a Ctrl-C ends the measurement with
 /// [`TargetError::Stopped`]).
 pub fn measure(
     generator: &GeneratorPolicy,
     solver: &Solver,
     solver_sha256: &str,
+    profile: Option<&Profile>,
     stopped: &dyn Fn() -> bool,
 ) -> Result<Curve, TargetError> {
     let mut points = Vec::with_capacity(CURVE_AUX.len());
@@ -137,7 +143,9 @@ pub fn measure(
             }
             let seed = arlpcg_core::seed_ranges::CURVE_SEED_BASE + k;
             let obstacles = arlpcg_core::game::facts::facts(generator.game).scene_obstacles;
-            let request = LevelRequest::new(seed, Some(aux)).obstacles(obstacles);
+            let request = LevelRequest::new(seed, Some(aux))
+                .obstacles(obstacles)
+                .profile(profile.cloned());
             match generation::generator_level(generator, &request) {
                 Ok(level) => {
                     total += verify(&level, solver, CURVE_TRIALS, seed, &|| {})?.success_ratio;
@@ -154,6 +162,7 @@ pub fn measure(
     Ok(Curve {
         generator_sha256: generator.reference.sha256.clone(),
         solver_sha256: solver_sha256.to_string(),
+        profile_sha256: profile.map(Profile::sha256),
         points,
     })
 }
@@ -322,12 +331,7 @@ mod tests {
 
     #[test]
     fn a_damaged_curve_is_named_by_its_point() {
-        let curve = |points: Vec<(f64, f64)>| Curve {
-            generator_sha256: String::new(),
-            solver_sha256: String::new(),
-            points,
-        };
-        curve(vec![(1.0, 1.0), (0.0, 0.8), (-1.0, 0.3)])
+        curve(&[(1.0, 1.0), (0.0, 0.8), (-1.0, 0.3)])
             .check()
             .unwrap();
         let cases = [
@@ -341,7 +345,7 @@ mod tests {
             (vec![(f64::NAN, 1.0)], "points[0]: λ NaN"),
         ];
         for (points, expected) in cases {
-            let err = curve(points).check().unwrap_err();
+            let err = curve(&points).check().unwrap_err();
             assert!(err.starts_with(expected), "{err}");
         }
     }
@@ -350,6 +354,7 @@ mod tests {
         Curve {
             generator_sha256: String::new(),
             solver_sha256: String::new(),
+            profile_sha256: None,
             points: points.to_vec(),
         }
     }

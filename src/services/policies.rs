@@ -251,14 +251,16 @@ pub fn load_any(path: &Path) -> Result<(ActorCritic, PolicyCard, PolicyRef)> {
     })
 }
 
-/// The λ→success curve of `generator` with `solver`, kept in `dir` (see [`curve_path`]): read
-/// when it was measured with these two policies (by SHA-256), else measured (`on_measure` is
-/// told first: it takes a while; `stopped` can end it) and kept there when the folder can be
+/// The λ→success curve of `generator` with `solver` on levels made for `profile` (none, or the
+/// default: the built-in game), kept in `dir` (see [`curve_path`]): read when it was measured
+/// with these two policies and this profile (by SHA-256), else measured (`on_measure` is told
+/// first: it takes a while; `stopped` can end it) and kept there when the folder can be
 /// written.
 pub fn difficulty_curve(
     dir: &Path,
     generator: &GeneratorPolicy,
     solver: &crate::services::verify::Solver,
+    profile: Option<&Profile>,
     on_measure: impl FnOnce(),
     stopped: &dyn Fn() -> bool,
 ) -> Result<crate::services::difficulty::Curve> {
@@ -275,8 +277,18 @@ pub fn difficulty_curve(
         }
         Solver::Random => anyhow::bail!("random actions have no difficulty curve to aim with"),
     };
+    let profile = profile.filter(|p| !p.is_default());
+    let profile_sha256 = profile.map(Profile::sha256);
+    // Another profile's curve is kept beside the built-in game's, as
+    // `….profile-<its SHA-256's first 12 digits>.yaml`.
+    let path = match &profile_sha256 {
+        Some(sha) => path.with_extension(format!("profile-{}.yaml", &sha[..12])),
+        None => path,
+    };
     let current = |c: &crate::services::difficulty::Curve| {
-        c.generator_sha256 == generator.reference.sha256 && c.solver_sha256 == identity
+        c.generator_sha256 == generator.reference.sha256
+            && c.solver_sha256 == identity
+            && c.profile_sha256 == profile_sha256
     };
     if let Ok(bytes) = crate::services::fsio::read_limited(&path, 1 << 20, "difficulty curve")
         && let Ok(curve) = serde_yaml::from_slice::<crate::services::difficulty::Curve>(&bytes)
@@ -292,7 +304,8 @@ pub fn difficulty_curve(
         return Ok(curve);
     }
     on_measure();
-    let curve = crate::services::difficulty::measure(generator, solver, &identity, stopped)?;
+    let curve =
+        crate::services::difficulty::measure(generator, solver, &identity, profile, stopped)?;
     // A folder that cannot be written only costs a new measurement next time.
     let _ = crate::services::fsio::write_atomic(
         &path,
@@ -399,6 +412,64 @@ pub fn policy_paths(dir: &Path) -> (PathBuf, PathBuf) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A profile's λ→success curve is kept in its own file: the built-in game's curve is never
+    /// used for a profile's levels, nor the profile's for the built-in game's.
+    #[test]
+    fn a_profiles_curve_is_kept_apart_from_the_built_in_games() {
+        use crate::services::difficulty::{Curve, TargetError};
+        use crate::services::verify::Solver;
+        let dir = tempfile::tempdir().unwrap();
+        let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+        let generator = load_generator(&shipped.join(GENERATOR_FILE), Game::Platform)
+            .unwrap()
+            .0;
+        let solver = Solver::Scripted(arlpcg_core::game::Skill::Median);
+        let profile = Profile::default_of(Game::Platform)
+            .with_value("character.jump_speed", 7.5)
+            .unwrap();
+        let built_in = Curve {
+            generator_sha256: generator.reference.sha256.clone(),
+            solver_sha256: "scripted-median".into(),
+            profile_sha256: None,
+            points: vec![(1.0, 0.9)],
+        };
+        let for_profile = Curve {
+            profile_sha256: Some(profile.sha256()),
+            points: vec![(1.0, 0.4)],
+            ..built_in.clone()
+        };
+        let stem = dir.path().join("difficulty-curve-scripted-median");
+        let profile_file = stem.with_extension(format!("profile-{}.yaml", &profile.sha256()[..12]));
+        for (curve, path) in [
+            (&built_in, stem.with_extension("yaml")),
+            (&for_profile, profile_file.clone()),
+        ] {
+            std::fs::write(path, serde_yaml::to_string(curve).unwrap()).unwrap();
+        }
+        let read = |profile: Option<&Profile>| {
+            let measured = std::cell::Cell::new(false);
+            let curve = difficulty_curve(
+                dir.path(),
+                &generator,
+                &solver,
+                profile,
+                || measured.set(true),
+                &|| true,
+            );
+            (curve, measured.get())
+        };
+        assert_eq!(read(None).0.unwrap(), built_in);
+        assert_eq!(read(Some(&profile)).0.unwrap(), for_profile);
+        // Without its own file, the profile's curve is measured (here stopped at once).
+        std::fs::remove_file(&profile_file).unwrap();
+        let (curve, measured) = read(Some(&profile));
+        assert!(measured);
+        assert!(matches!(
+            curve.unwrap_err().downcast_ref(),
+            Some(TargetError::Stopped)
+        ));
+    }
 
     #[test]
     fn only_the_folders_own_solver_uses_the_folders_curve_file() {

@@ -183,8 +183,16 @@ pub fn regenerate_level(
     let (folder, record, mut levels) = open(folder)?;
     let judge = Judge::parse(&record.judge).map_err(anyhow::Error::msg)?;
     let judged = crate::services::policies::load_panel(dir, record.game, Some(&[judge]))?;
-    let solver = judged.solver(0, record.ask().profile.as_ref());
-    let curve = crate::services::policies::difficulty_curve(dir, generator, &solver, || {}, stop)?;
+    let profile = record.ask().profile;
+    let solver = judged.solver(0, profile.as_ref());
+    let curve = crate::services::policies::difficulty_curve(
+        dir,
+        generator,
+        &solver,
+        profile.as_ref(),
+        || {},
+        stop,
+    )?;
     let seed = record
         .levels
         .iter()

@@ -91,6 +91,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         &dir,
         &generator,
         &solver,
+        ask.profile.as_ref(),
         || {
             crate::warn!(
                 "measuring the policies' λ→success curve for {} ({} λ values × {} levels × {} runs), once",

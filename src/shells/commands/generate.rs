@@ -72,7 +72,13 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     let who = solver
         .as_ref()
         .map_or(Solver::Scripted(skill), Solver::Policy);
-    let curve = target_curve(args, generator.as_ref(), &who, &stop)?;
+    let curve = target_curve(
+        args,
+        generator.as_ref(),
+        &who,
+        template.profile.as_ref(),
+        &stop,
+    )?;
     let mut levels = build_levels(
         args,
         &plans,
@@ -165,8 +171,6 @@ fn report_verification(levels: &[Level]) {
     }
 }
 
-/// With `--target-success`: the policies' λ→success curve, read from beside them or measured
-/// once (Ctrl-C in `stop` ends the measurement: exit 130, nothing written).
 /// The folder the judges come from: --policies, else the shipped policies of the game.
 fn policies_dir(args: &GenerateArgs) -> PathBuf {
     args.policies
@@ -174,10 +178,14 @@ fn policies_dir(args: &GenerateArgs) -> PathBuf {
         .unwrap_or_else(|| crate::services::policies::shipped_dir(args.game))
 }
 
+/// With `--target-success`: the policies' λ→success curve on levels made for `profile`, read
+/// from beside them or measured once (Ctrl-C in `stop` ends the measurement: exit 130, nothing
+/// written).
 fn target_curve(
     args: &GenerateArgs,
     generator: Option<&GeneratorPolicy>,
     solver: &Solver,
+    profile: Option<&Profile>,
     stop: &AtomicBool,
 ) -> Result<Option<difficulty::Curve>> {
     let (Some(Ask::Success(_)), Some(generator), Some(dir)) =
@@ -193,7 +201,7 @@ fn target_curve(
             difficulty::CURVE_TRIALS
         )
     };
-    crate::services::policies::difficulty_curve(dir, generator, solver, announce, &|| {
+    crate::services::policies::difficulty_curve(dir, generator, solver, profile, announce, &|| {
         stop.load(Ordering::SeqCst)
     })
     .map(Some)

@@ -402,7 +402,8 @@ fn target_level(
     let solver = policies
         .solver
         .as_deref()
-        .ok_or("a success target needs a trained Solver to measure success with (p loads one)")?;
+        .ok_or("a success target needs a trained Solver to measure success with (p loads one)")?
+        .or_aware(policies.aware.as_deref(), asked.profile.as_ref());
     let folder = Path::new(&generator.reference.path)
         .parent()
         .unwrap_or(Path::new("."));
@@ -410,6 +411,7 @@ fn target_level(
         folder,
         generator,
         &Solver::Policy(solver),
+        asked.profile.as_ref(),
         || {},
         &|| false,
     )

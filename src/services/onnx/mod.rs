@@ -242,10 +242,13 @@ pub fn export(
     let head = actor_head(&mut graph, policy, &card.normalizer, input)?;
     let mean = (continuous > 0).then(|| graph.columns(&head, 0, continuous));
     let logits = (binary > 0).then(|| graph.columns(&head, continuous, continuous + binary));
-    let continuous_actions = mean.map(|m| graph.clip(&m, -1.0, 1.0));
+    let actions = ActionNodes {
+        continuous: mean.map(|m| graph.clip(&m, -1.0, 1.0)),
+        logits,
+    };
     let outputs = match profile {
-        Contract::Plain => plain_outputs(&mut graph, card, continuous_actions, logits),
-        Contract::Mlagents => mlagents_outputs(&mut graph, card, continuous_actions, logits),
+        Contract::Plain => plain_outputs(&mut graph, card, actions),
+        Contract::Mlagents => mlagents_outputs(&mut graph, card, actions),
     };
     for (name, output) in &outputs {
         let element = if output.int64 { INT64 } else { FLOAT };
@@ -341,15 +344,21 @@ pub fn export(
     })
 }
 
+/// The graph's nodes a contract's outputs are made from: the continuous actions (the mean,
+/// clipped) and the binary actions' logits, where the policy has them.
+struct ActionNodes {
+    continuous: Option<String>,
+    logits: Option<String>,
+}
+
 /// This tool's names: the continuous actions, and each binary action's probability and choice.
 fn plain_outputs(
     graph: &mut GraphBuilder,
     card: &PolicyCard,
-    continuous_actions: Option<String>,
-    logits: Option<String>,
+    nodes: ActionNodes,
 ) -> Vec<(String, Output)> {
     let mut outputs = Vec::new();
-    if let Some(actions) = continuous_actions {
+    if let Some(actions) = nodes.continuous {
         graph.rename(&actions, "continuous_actions");
         outputs.push((
             "continuous_actions".into(),
@@ -361,7 +370,7 @@ fn plain_outputs(
             },
         ));
     }
-    if let Some(logits) = logits {
+    if let Some(logits) = nodes.logits {
         let binary = card.binary_actions.len();
         let probability = graph.node("Sigmoid", &[&logits], vec![]);
         graph.rename(&probability, "binary_probabilities");
@@ -398,8 +407,7 @@ fn plain_outputs(
 fn mlagents_outputs(
     graph: &mut GraphBuilder,
     card: &PolicyCard,
-    continuous_actions: Option<String>,
-    logits: Option<String>,
+    nodes: ActionNodes,
 ) -> Vec<(String, Output)> {
     let mut outputs = Vec::new();
     let constant = |graph: &mut GraphBuilder, name: &str, values: &[f32], meaning| {
@@ -437,7 +445,7 @@ fn mlagents_outputs(
         &[0.0],
         "no recurrent memory",
     ));
-    if let Some(actions) = continuous_actions {
+    if let Some(actions) = nodes.continuous {
         let continuous = card.continuous_actions.len();
         let output = Output {
             dims: vec![None, Some(continuous)],
@@ -452,7 +460,7 @@ fn mlagents_outputs(
             "how many continuous actions",
         ));
     }
-    if let Some(logits) = logits {
+    if let Some(logits) = nodes.logits {
         let binary = card.binary_actions.len();
         graph
             .inputs

@@ -8,7 +8,7 @@
 //! binary action is on when its probability is at least one half. Opset 9 (the oldest the
 //! engines above read, and ML-Agents' own), IR version 4.
 //!
-//! Two profiles ([`Profile`]): `plain` names things after this tool (`observation`,
+//! Two contracts ([`Contract`]): `plain` names things after this tool (`observation`,
 //! `continuous_actions`, `binary_probabilities`, `binary_actions`); `mlagents` follows
 //! ML-Agents' model contract (version 3: `obs_0`, `action_masks`, `version_number`,
 //! `memory_size`, `continuous_actions`, `deterministic_continuous_actions`,
@@ -80,6 +80,7 @@ impl Contract {
 pub struct Sidecar {
     pub format: String,
     pub version: u32,
+    /// The contract (the field's name predates the word; files keep it).
     pub profile: Contract,
     pub opset: i64,
     pub game: String,
@@ -224,18 +225,18 @@ fn action_columns(names: &[String]) -> Vec<Columns> {
     columns(names.iter().map(|n| (n.clone(), 1)))
 }
 
-/// Exports the actor of `policy` (with its card's normalizer) in `profile`. Pure: the same
+/// Exports the actor of `policy` (with its card's normalizer) in `contract`. Pure: the same
 /// policy gives the same bytes.
 pub fn export(
     policy: &ActorCritic,
     card: &PolicyCard,
     reference: PolicyRef,
-    profile: Contract,
+    contract: Contract,
 ) -> candle_core::Result<Exported> {
     let shape = policy.shape();
     let (observation, continuous, binary) = (shape.observation, shape.continuous, shape.binary);
     let mut graph = GraphBuilder::default();
-    let input = profile.observation_input();
+    let input = contract.observation_input();
     graph
         .inputs
         .push(value_info(input, &[None, Some(observation)]));
@@ -246,7 +247,7 @@ pub fn export(
         continuous: mean.map(|m| graph.clip(&m, -1.0, 1.0)),
         logits,
     };
-    let outputs = match profile {
+    let outputs = match contract {
         Contract::Plain => plain_outputs(&mut graph, card, actions),
         Contract::Mlagents => mlagents_outputs(&mut graph, card, actions),
     };
@@ -285,7 +286,7 @@ pub fn export(
         metadata_props: vec![
             entry("arlpcg.game", &card.game.to_string()),
             entry("arlpcg.role", &card.role.to_string()),
-            entry("arlpcg.profile", profile.name()),
+            entry("arlpcg.profile", contract.name()),
             entry("arlpcg.policy_sha256", &reference.sha256),
         ],
     };
@@ -296,7 +297,7 @@ pub fn export(
         element_type: None,
         columns: observation_columns(card),
     }];
-    if profile == Contract::Mlagents && binary > 0 {
+    if contract == Contract::Mlagents && binary > 0 {
         inputs.push(Port {
             name: "action_masks".into(),
             shape: dims_json(&[None, Some(2 * binary)]),
@@ -311,13 +312,13 @@ pub fn export(
             ),
         });
     }
-    let examples = examples(policy, card, profile)?;
+    let examples = examples(policy, card, contract)?;
     Ok(Exported {
         onnx: model.encode_to_vec(),
         sidecar: Sidecar {
             format: "arlpcg-onnx".into(),
             version: 1,
-            profile,
+            profile: contract,
             opset: OPSET,
             game: card.game.to_string(),
             role: card.role.to_string(),
@@ -541,10 +542,10 @@ fn actor_head(
 fn examples(
     policy: &ActorCritic,
     card: &PolicyCard,
-    profile: Contract,
+    contract: Contract,
 ) -> candle_core::Result<Examples> {
     let observations = example_observations(&card.normalizer, EXAMPLE_ROWS, 0);
-    let outputs = reference_outputs(policy, card, profile, &observations)?;
+    let outputs = reference_outputs(policy, card, contract, &observations)?;
     Ok(Examples {
         observations: observations
             .chunks(card.normalizer.size())
@@ -572,7 +573,7 @@ pub fn example_observations(normalizer: &RunningNorm, rows: usize, seed: u64) ->
 pub fn reference_outputs(
     policy: &ActorCritic,
     card: &PolicyCard,
-    profile: Contract,
+    contract: Contract,
     observations: &[f32],
 ) -> candle_core::Result<std::collections::BTreeMap<String, Vec<Vec<f32>>>> {
     let shape = policy.shape();
@@ -592,7 +593,7 @@ pub fn reference_outputs(
     let binary = rows(&actions, c + b, c, c + b, &|v| v);
     let probabilities = rows(&head, c + b, c, c + b, &|v| 1.0 / (1.0 + (-v).exp()));
     let mut outputs = std::collections::BTreeMap::new();
-    let named: Vec<(&str, &Vec<Vec<f32>>, bool)> = match profile {
+    let named: Vec<(&str, &Vec<Vec<f32>>, bool)> = match contract {
         Contract::Plain => vec![
             ("continuous_actions", &continuous, c > 0),
             ("binary_probabilities", &probabilities, b > 0),

@@ -402,10 +402,14 @@ fn dir_with_level(bytes: &[u8]) -> (tempfile::TempDir, PathBuf) {
     (dir, path)
 }
 
+/// A level that cannot be read is named once, in `verify` as in `--replay`.
 #[test]
 fn a_missing_level_file_is_named() {
-    let out = arlpcg(words("verify /no/such/level.yaml --solver scripted", &[]));
-    fails_with(&out, 1, "/no/such/level.yaml: cannot read the file");
+    for mode in ["--solver scripted", "--replay"] {
+        let out = arlpcg(words(&format!("verify /no/such/level.yaml {mode}"), &[]));
+        fails_with(&out, 1, "error: /no/such/level.yaml: cannot read the file");
+        assert_eq!(stderr(&out).matches("/no/such/level.yaml").count(), 1);
+    }
 }
 
 #[test]

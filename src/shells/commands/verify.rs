@@ -582,13 +582,14 @@ fn each_level<'a, T>(
     Ok(failed)
 }
 
-/// Prints a level file's error on one line.
+/// Prints a level file's error on one line, naming the file once.
 fn report_error(path: &Path, err: &anyhow::Error) {
-    crate::warn!(
-        "error: {}: {}",
-        path.display(),
-        one_line(&format!("{err:#}"))
-    );
+    let message = one_line(&format!("{err:#}"));
+    let file = path.display().to_string();
+    match message.starts_with(&file) {
+        true => crate::warn!("error: {message}"),
+        false => crate::warn!("error: {file}: {message}"),
+    }
 }
 
 /// Folds a multi-line error message onto one line.

@@ -400,10 +400,8 @@ fn target_level(
         .as_deref()
         .ok_or("a success target needs a Generator")?;
     let solver = policies
-        .solver
-        .as_deref()
-        .ok_or("a success target needs a trained Solver to measure success with (p loads one)")?
-        .or_aware(policies.aware.as_deref(), asked.profile.as_ref());
+        .policy_under(asked.profile.as_ref())
+        .ok_or("a success target needs a trained Solver to measure success with (p loads one)")?;
     let folder = Path::new(&generator.reference.path)
         .parent()
         .unwrap_or(Path::new("."));

@@ -12,6 +12,7 @@ use crate::services::panel::Judge;
 use crate::services::policies::{load_aware_solver, load_generator, load_solver, policy_paths};
 use crate::services::verify::{self, Solver, SolverPolicy};
 use arlpcg_core::game::Skill;
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::{Game, Level};
 use arlpcg_core::rl::checkpoint::{PolicyError, TrainMode};
 
@@ -54,21 +55,24 @@ impl Policies {
     /// Why the Solver policy may not play `level`: the abilities it is made for lie beyond the
     /// range the policy trained over (it says to train for them).
     pub(super) fn beyond_range(&self, level: &Level) -> Option<String> {
-        match self.policy_for(level)?.fit(level.profile.as_ref()) {
+        match self
+            .policy_under(level.profile.as_ref())?
+            .fit(level.profile.as_ref())
+        {
             verify::ProfileFit::Beyond(problem) => Some(problem),
             _ => None,
         }
     }
 
-    /// The Solver policy that plays `level`, if one does.
-    fn policy_for(&self, level: &Level) -> Option<&SolverPolicy> {
+    /// The Solver policy that plays under `profile` (none: the built-in abilities), if one does.
+    pub(super) fn policy_under(&self, profile: Option<&Profile>) -> Option<&SolverPolicy> {
         let solver = self.solver.as_deref()?;
-        Some(solver.or_aware(self.aware.as_deref(), level.profile.as_ref()))
+        Some(solver.or_aware(self.aware.as_deref(), profile))
     }
 
     /// Who plays `level`.
     pub(super) fn solver(&self, level: &Level) -> Solver<'_> {
-        match self.policy_for(level) {
+        match self.policy_under(level.profile.as_ref()) {
             Some(policy) => Solver::Policy(policy),
             None => Solver::Scripted(self.skill),
         }

@@ -4,6 +4,7 @@
 //! Run with `cargo bench --bench ppo_update` (`RAYON_NUM_THREADS=T` for T threads). Target:
 //! 30,000 samples per second per epoch on 2 threads, what PyTorch's CPU update of the same
 //! network and batch reaches on 2 threads (`docs/perf/torch_ppo_update.py`).
+#![allow(clippy::unwrap_used)] // a measurement or a test may unwrap (Cargo.toml, [lints])
 
 use std::time::Instant;
 

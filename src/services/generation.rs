@@ -8,26 +8,17 @@
 //! The goal and start heading are drawn from the seed exactly as the rules draw them, so a rule
 //! level and a Generator level of the same seed lead to the same goal.
 
+pub use arlpcg_core::game::NoRuleLevel;
 use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, Placement, TrackBuild, observe_build,
 };
-use arlpcg_core::game::{PlatformGame, Player, RacingGame};
+use arlpcg_core::game::{GameSpec, Player, RuleAsk};
 use arlpcg_core::level::pacing::{AuxCurve, Pacing, covered, round_aux};
-use arlpcg_core::level::profile::{Abilities, Profile};
-use arlpcg_core::level::racing::RacingRulesConfig;
-use arlpcg_core::level::{Game, Level, PlatformRulesConfig, PolicyRef, Source};
+use arlpcg_core::level::profile::Profile;
+use arlpcg_core::level::{Game, Level, PolicyRef, Source};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::{ActMode, ActorCritic};
 use std::fmt;
-
-/// Why the rules built no level.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum NoRuleLevel {
-    #[error(transparent)]
-    Platform(#[from] arlpcg_core::game::platform::rules::NoLevel),
-    #[error(transparent)]
-    Racing(#[from] arlpcg_core::game::racing::rules::NoTrack),
-}
 
 /// λ for a level: one value for the whole level, or a curve along it (docs/designer.md,
 /// pacing).
@@ -182,69 +173,25 @@ impl LevelRequest {
     }
 }
 
-/// The player of `profile` (none: the built-in one), drawing pieces from its ranges. A platform
-/// character's reach is measured once per process (about a second) and kept, so that a batch, a
-/// campaign or the designer's edits measure each character once.
+/// The player of `profile` (none: the built-in one), drawing pieces from its ranges.
 pub fn player_for(profile: Option<&Profile>) -> Player {
-    let Some(profile) = profile else {
-        return Player::default();
-    };
-    player_of(profile.abilities).with_pieces(Some(profile.pieces))
-}
-
-/// The player of `abilities`, its reach measured once per process.
-fn player_of(abilities: Abilities) -> Player {
-    use std::sync::{Mutex, OnceLock};
-    static MEASURED: OnceLock<Mutex<Vec<Player>>> = OnceLock::new();
-    let measured = MEASURED.get_or_init(Default::default);
-    let known = |players: &[Player]| {
-        players
-            .iter()
-            .find(|p| p.abilities == Some(abilities))
-            .copied()
-    };
-    if let Some(player) = known(&measured.lock().unwrap_or_else(|e| e.into_inner())) {
-        return player;
-    }
-    let player = Player::of(Some(abilities));
-    measured
-        .lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .push(player);
-    player
+    profile.map_or_else(Player::default, |profile| {
+        Player::of(Some(profile.abilities)).with_pieces(Some(profile.pieces))
+    })
 }
 
 /// A rule-based level of `game` (λ is recorded, not used; the rules know no curve), made for
 /// the request's profile.
 pub fn rules_level(game: Game, request: &LevelRequest) -> Result<Level, NoRuleLevel> {
-    let LevelRequest {
-        seed, goal, draw, ..
-    } = *request;
-    let aux = request.flat_aux();
-    let level = match game {
-        Game::Platform => arlpcg_core::game::platform::rules::platform_level_draw(
-            seed,
-            aux,
-            goal,
-            &PlatformRulesConfig::default(),
-            &player_for(request.profile.as_ref()),
-            draw,
-        )?,
-        Game::Racing => {
-            let config = RacingRulesConfig {
-                obstacles: request.obstacles,
-                ..RacingRulesConfig::default()
-            };
-            arlpcg_core::game::racing::rules::racing_level_draw(
-                seed,
-                aux,
-                goal,
-                &config,
-                &player_for(request.profile.as_ref()),
-                draw,
-            )?
-        }
+    let ask = RuleAsk {
+        seed: request.seed,
+        aux: request.flat_aux(),
+        goal: request.goal,
+        obstacles: request.obstacles,
+        draw: request.draw,
     };
+    let player = player_for(request.profile.as_ref());
+    let level = arlpcg_core::for_game!(game, G => G::rule_level_draw(ask, &player))?;
     Ok(Level {
         profile: request.profile.clone(),
         ..level
@@ -283,10 +230,7 @@ pub fn generator_level(
     generator: &GeneratorPolicy,
     request: &LevelRequest,
 ) -> Result<Level, GenerationError> {
-    match generator.game {
-        Game::Platform => build_level::<PlatformGame>(generator, request),
-        Game::Racing => build_level::<RacingGame>(generator, request),
-    }
+    arlpcg_core::for_game!(generator.game, G => build_level::<G>(generator, request))
 }
 
 /// The λ piece `i` of a kept level records (only a paced level's pieces record one), so that

@@ -9,6 +9,7 @@ pub mod eval;
 pub mod fsio;
 pub mod generation;
 pub mod level_files;
+pub mod making;
 pub mod onnx;
 pub mod panel;
 pub mod policies;

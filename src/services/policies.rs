@@ -10,7 +10,7 @@ use crate::services::panel::{Judge, JudgePanel};
 use crate::services::verify::{ProfileFit, SolverPolicy};
 use arlpcg_core::game::generator::DEFAULT_CURVE_OFFSET;
 use arlpcg_core::game::generator::{BuildLimits, GeneratorGame, observation_size};
-use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
+use arlpcg_core::game::{GameSpec, SolverEnv};
 use arlpcg_core::level::profile::{ABILITIES_PART, Profile};
 use arlpcg_core::level::{Game, PolicyRef};
 use arlpcg_core::rl::checkpoint::TrainMode;
@@ -60,19 +60,10 @@ fn load_pinned(
 
 /// Loads a Solver policy of `game`.
 pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)> {
-    let (observation, actions): (usize, Actions) = match game {
-        Game::Platform => (
-            <PlatformGame as GameSpec>::Env::OBSERVATION_SIZE,
-            (
-                PlatformGame::CONTINUOUS_ACTIONS,
-                PlatformGame::BINARY_ACTIONS,
-            ),
-        ),
-        Game::Racing => (
-            <RacingGame as GameSpec>::Env::OBSERVATION_SIZE,
-            (RacingGame::CONTINUOUS_ACTIONS, RacingGame::BINARY_ACTIONS),
-        ),
-    };
+    let (observation, actions): (usize, Actions) = arlpcg_core::for_game!(game, G => (
+        <G as GameSpec>::Env::OBSERVATION_SIZE,
+        (G::CONTINUOUS_ACTIONS, G::BINARY_ACTIONS),
+    ));
     let (loaded, reference) = load_pinned(path, (game, Role::Solver), observation, actions)?;
     let card = loaded.card.clone();
     let profile = card
@@ -151,16 +142,8 @@ fn or_folders_aware(
 
 /// Loads a Generator policy of `game`.
 pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, PolicyCard)> {
-    let (observation, actions) = match game {
-        Game::Platform => (
-            observation_size::<PlatformGame>(),
-            PlatformGame::GENERATOR_ACTIONS,
-        ),
-        Game::Racing => (
-            observation_size::<RacingGame>(),
-            RacingGame::GENERATOR_ACTIONS,
-        ),
-    };
+    let (observation, actions) =
+        arlpcg_core::for_game!(game, G => (observation_size::<G>(), G::GENERATOR_ACTIONS));
     let (loaded, reference) =
         load_pinned(path, (game, Role::Generator), observation, (actions, &[]))?;
     let card = loaded.card.clone();
@@ -180,10 +163,8 @@ pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, Polic
 /// The piece budget and curve offset a Generator's card (of the file at `path`) records, each
 /// checked against its game's range, or the game's defaults where the card has none.
 pub fn generator_limits(path: &Path, card: &PolicyCard) -> Result<BuildLimits> {
-    let (default_max_pieces, most_pieces) = match card.game {
-        Game::Platform => (PlatformGame::DEFAULT_MAX_PIECES, PlatformGame::MAX_PIECES),
-        Game::Racing => (RacingGame::DEFAULT_MAX_PIECES, RacingGame::MAX_PIECES),
-    };
+    let (default_max_pieces, most_pieces) =
+        arlpcg_core::for_game!(card.game, G => (G::DEFAULT_MAX_PIECES, G::MAX_PIECES));
     let limits = BuildLimits {
         max_pieces: card.max_pieces.unwrap_or(default_max_pieces),
         curve_offset: card.curve_offset.unwrap_or(DEFAULT_CURVE_OFFSET),

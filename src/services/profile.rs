@@ -8,13 +8,9 @@ use rayon::prelude::*;
 
 use crate::services::generation::{LevelRequest, rules_level};
 use crate::services::verify::{self, Solver};
-use arlpcg_core::game::Skill;
-use arlpcg_core::game::platform::character::Body;
-use arlpcg_core::game::platform::reach::{REACH_HEIGHTS, measure_reach};
-use arlpcg_core::game::racing::car::Car;
-use arlpcg_core::game::racing::feasibility;
+use arlpcg_core::game::{GameSpec, Skill};
 use arlpcg_core::level::Game;
-use arlpcg_core::level::profile::{Abilities, Profile};
+use arlpcg_core::level::profile::Profile;
 
 /// Rule levels the scripted expert plays to see whether a profile allows any level.
 pub const CHECK_LEVELS: u64 = 10;
@@ -51,58 +47,7 @@ pub struct Allowance {
 /// Measures what `profile` allows: its jump (platform) or its speed and grip (racing), and how
 /// many of [`CHECK_LEVELS`] rule levels the scripted expert completes in `trials` runs each.
 pub fn measure(profile: &Profile, trials: u32) -> Allowance {
-    let mut lines = match profile.abilities {
-        Abilities::Platform(c) => {
-            let apex = c.jump_speed * c.jump_speed / (2.0 * c.gravity);
-            let flight = 2.0 * c.jump_speed / c.gravity;
-            let table = measure_reach(Body::from(c));
-            let reach: Vec<String> = REACH_HEIGHTS
-                .iter()
-                .zip(table)
-                .map(|(h, gap)| match gap < 1.0 {
-                    true => format!("{h:+} m: none (under 1 m)"),
-                    false => format!("{h:+} m: {gap} m"),
-                })
-                .collect();
-            vec![
-                format!(
-                    "jump apex {apex:.2} m, {flight:.2} s in the air on the flat, {:.1} m at full speed",
-                    c.run_speed * flight
-                ),
-                format!(
-                    "reach table (largest edge gap the scripted expert clears, by height change): {}",
-                    reach.join(", ")
-                ),
-            ]
-        }
-        Abilities::Racing(c) => {
-            let car = Car::from(c);
-            let top = feasibility::top_speed(car);
-            let road = profile.pieces.segments().road();
-            let held = |curves: usize| match feasibility::cornering_speed(car, curves, 2, road) {
-                v if v >= top => "at full speed".to_string(),
-                v => format!("at {v} m/s"),
-            };
-            let crest_speed = top.min(25.0).floor();
-            let crest = feasibility::crest(car, 3.0, crest_speed);
-            vec![
-                format!(
-                    "top speed {top:.1} m/s ({:.0} km/h), {:.1} m/s² from rest",
-                    3.6 * top,
-                    c.engine_force / c.mass
-                ),
-                format!(
-                    "the tightest curve (30° over 20 m) taken {} alone, {} four in a row",
-                    held(1),
-                    held(4)
-                ),
-                format!(
-                    "a 3 m crest at {crest_speed} m/s: {:.2} s in the air, {:?}",
-                    crest.air_s, crest.outcome
-                ),
-            ]
-        }
-    };
+    let mut lines = arlpcg_core::for_game!(profile.game(), G => G::ability_figures(profile));
     let game = profile.game();
     let played: Vec<Option<(u32, u32)>> = (0..CHECK_LEVELS)
         .into_par_iter()

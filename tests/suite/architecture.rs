@@ -16,8 +16,8 @@ fn root() -> &'static Path {
 /// The pure parts, from the repository's root: the core crate and the services that compute.
 const PURE: &[&str] = &[
     "crates/core/src", "src/services/train", "src/services/eval", "src/services/onnx",
-    "src/services/verify", "src/services/generation.rs", "src/services/difficulty.rs",
-    "src/services/panel.rs",
+    "src/services/verify", "src/services/generation.rs", "src/services/making.rs",
+    "src/services/difficulty.rs", "src/services/panel.rs",
 ];
 
 /// What the pure parts may not name, and why.
@@ -384,4 +384,54 @@ fn no_two_modules_import_each_other() {
     // The check sees imports: level::road names level::racing.
     let road = std::fs::read_to_string(root().join("crates/core/src/level/road.rs")).unwrap();
     assert!(names_module(&road, "level::road", "level::racing"));
+}
+
+/// A game's names (its `Game` variant, its module, its `GameSpec` type)...
+const GAME_NAMES: &[&str] = &[
+    "Game::Platform", "Game::Racing", "game::platform", "game::racing", "PlatformGame",
+    "RacingGame",
+];
+
+/// ...may appear only in these files and folders (tests and benches aside, which pick games to
+/// try): the dispatch, each game's folder, the level types that hold each game's pieces and
+/// abilities, and the designer's views, which draw each game's pieces. Everything else meets a
+/// game through `GameSpec`, `GameFacts` and `for_game!`, so that a new game touches only these.
+const GAME_PLACES: &[&str] = &[
+    "crates/core/src/game/mod.rs",
+    "crates/core/src/game/platform/",
+    "crates/core/src/game/racing/",
+    "crates/core/src/level/mod.rs",
+    "crates/core/src/level/yaml/file.rs",
+    "crates/core/src/level/profile/abilities.rs",
+    "crates/core/src/level/profile/pieces.rs",
+    "src/shells/design/view/",
+];
+
+#[test]
+fn a_game_is_named_only_in_its_folder_its_level_types_the_designers_views_and_the_dispatch() {
+    let rule = Never {
+        within: "",
+        names: GAME_NAMES,
+        why: "a game is met through `GameSpec`, `GameFacts` and `for_game!` outside its own places",
+        except: GAME_PLACES,
+    };
+    let mut files = Vec::new();
+    for part in ["src", "crates/core/src"] {
+        rust_files(&root().join(part), &mut files);
+    }
+    // A module's tests in their own file (`tests.rs`) pick games as any test does.
+    files.retain(|f| f.file_name().is_none_or(|n| n != "tests.rs"));
+    let problems = broken(&rule, &files);
+    assert!(
+        problems.is_empty(),
+        "a game is named outside its places:\n{}",
+        problems.join("\n")
+    );
+    // The check sees names: the dispatch names both games.
+    let strict = Never {
+        except: &[],
+        ..rule
+    };
+    let dispatch = [root().join("crates/core/src/game/mod.rs")];
+    assert!(broken(&strict, &dispatch).len() >= 2);
 }

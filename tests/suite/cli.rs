@@ -432,7 +432,7 @@ fn bad_arguments_are_usage_errors() {
     let out = arlpcg(words("generate --rules --out x --aux 3", &[]));
     fails_with(&out, 2, "aux 3 is out of range [-1, 1]");
     let out = arlpcg(words("generate --rules --obstacles 3 --out x", &[]));
-    fails_with(&out, 2, "--obstacles is for racing tracks");
+    fails_with(&out, 2, "--obstacles is for racing levels");
 }
 
 /// Arguments that cannot go together are usage errors (exit 2) as clap's own are; a missing

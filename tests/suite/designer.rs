@@ -39,9 +39,10 @@ impl Harness {
         let pending = app.start();
         Self {
             app,
-            policies: Mutex::new(GamePolicies {
-                platform: policies,
-                racing: Policies::default(),
+            policies: Mutex::new({
+                let mut shelf = GamePolicies::default();
+                shelf[Game::Platform] = policies;
+                shelf
             }),
             pending,
         }
@@ -474,7 +475,7 @@ fn loading_a_wrong_file_is_a_message_not_a_crash() {
         assert!(is_error, "{text}");
         assert!(text.contains(&path), "the message names the file: {text}");
     }
-    assert_eq!(h.app.policies, LoadedInfo::default());
+    assert_eq!(*h.app.policies(), LoadedInfo::default());
 }
 
 /// Tab switches to racing: a track of the same seed, its Solver statistics with the racing
@@ -815,7 +816,7 @@ fn the_judge_key_cycles_through_the_panel() {
     for _ in 0..7 {
         h.key(KeyCode::Char('j'));
         h.settle();
-        let judge = h.app.policies.judge().name();
+        let judge = h.app.policies().judge().name();
         let trials = h
             .app
             .trials

@@ -1,5 +1,6 @@
 //! The integration tests, in one binary: the dependencies (rapier3d, candle, ratatui) are linked
 //! once rather than once per file. Each module is one area; `common` holds what they share.
+#![allow(clippy::unwrap_used)] // a measurement or a test may unwrap (Cargo.toml, [lints])
 
 mod common;
 

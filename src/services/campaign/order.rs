@@ -8,8 +8,9 @@ use super::{Campaign, CampaignAsk, campaign_files, level_stem, open};
 use crate::services::difficulty;
 use crate::services::generation::{GeneratorPolicy, LevelRequest};
 use crate::services::level_files::Format;
+use crate::services::making::{self, LevelSource, Proof};
 use crate::services::panel::{Judge, JudgePanel, play_and_rate};
-use crate::services::verify::{self, Solver, Watch};
+use crate::services::verify::{Solver, Watch};
 use arlpcg_core::level::Level;
 use arlpcg_core::level::stats::Rating;
 
@@ -45,8 +46,19 @@ pub fn search_level(
     target: f64,
     trials: u32,
 ) -> anyhow::Result<Level> {
-    let level = difficulty::level_for(generator, solver, curve, asked, target, trials)?;
-    Ok(verify::certified(level, solver, asked.seed)?)
+    let proof = Proof::Target {
+        solver,
+        curve,
+        target,
+        trials,
+    };
+    let watch = Watch {
+        on_trial: &|_| {},
+        stop: &|| false,
+    };
+    let source = LevelSource::Generator(generator);
+    making::verified_level(source, asked, &proof, &watch, &|_| {})?
+        .ok_or_else(|| anyhow::anyhow!("the search was stopped"))
 }
 
 /// The panel plays `levels` (each verified by the judge; those it has played keep their plays)

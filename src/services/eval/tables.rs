@@ -195,7 +195,7 @@ pub struct Results {
 
 /// What a [`Results`] read from JSON holds until [`Results::read`] sets the game.
 fn unread_game() -> Game {
-    Game::Platform
+    Game::default()
 }
 
 impl Results {

@@ -8,8 +8,8 @@ use super::config::TrainConfig;
 use crate::services::fsio;
 use crate::services::fsio::Overwrite;
 use anyhow::{Context, Result, bail};
+use arlpcg_core::game::facts::facts;
 use arlpcg_core::game::generator::GeneratorGame;
-use arlpcg_core::game::{PlatformGame, RacingGame};
 use arlpcg_core::level::Game;
 use arlpcg_core::level::profile::{ABILITIES_PART, ability_columns};
 use arlpcg_core::rl::checkpoint;
@@ -40,10 +40,7 @@ impl AgentIo {
                 },
             }
         }
-        match game {
-            Game::Platform => io::<PlatformGame>(role),
-            Game::Racing => io::<RacingGame>(role),
-        }
+        arlpcg_core::for_game!(game, G => io::<G>(role))
     }
 
     fn observation_size(&self) -> usize {
@@ -139,7 +136,7 @@ pub(super) fn card(
         },
         results: Default::default(),
         max_pieces: (role == Role::Generator).then_some(config.generator.max_pieces),
-        curve_offset: (role == Role::Generator && game == Game::Racing)
+        curve_offset: (role == Role::Generator && facts(game).curve_offset)
             .then_some(config.generator.curve_offset),
         profile: config.profile.clone(),
         ability_spread: (config.ability_spread > 0.0).then_some(config.ability_spread),

@@ -30,8 +30,8 @@ use anyhow::{Context, Result, bail};
 
 use crate::services::fsio;
 use adversarial_run::AdversarialRun;
+use arlpcg_core::game::GameSpec;
 use arlpcg_core::game::generator::GeneratorGame;
-use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame};
 use arlpcg_core::level::Game;
 use arlpcg_core::level::profile::{Profile, ProfileRecord};
 use arlpcg_core::rl::checkpoint::TrainMode;
@@ -87,10 +87,7 @@ pub fn open(
     let (game, mode) = if resume {
         resumed_identity(out, game, mode)?
     } else {
-        (
-            game.unwrap_or(Game::Platform),
-            mode.unwrap_or(TrainMode::RulePcg),
-        )
+        (game.unwrap_or_default(), mode.unwrap_or(TrainMode::RulePcg))
     };
     if let Some(profile) = profile.filter(|p| p.game() != game) {
         bail!(
@@ -157,12 +154,10 @@ pub fn open(
         }
         Start::New(config)
     };
-    match (config::solver_only(mode), game) {
-        (Some(source), Game::Platform) => solver_run::<PlatformGame>(out, mode, source, config),
-        (Some(source), Game::Racing) => solver_run::<RacingGame>(out, mode, source, config),
-        (None, Game::Platform) => adversarial_run::<PlatformGame>(out, mode, config),
-        (None, Game::Racing) => adversarial_run::<RacingGame>(out, mode, config),
-    }
+    arlpcg_core::for_game!(game, G => match config::solver_only(mode) {
+        Some(source) => solver_run::<G>(out, mode, source, config),
+        None => adversarial_run::<G>(out, mode, config),
+    })
 }
 
 /// The game and mode a resumed run goes on with: its checkpoint's, which `--game` and `--mode`,

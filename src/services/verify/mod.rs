@@ -16,7 +16,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, Scripted, Skill, SolverEnv};
+use arlpcg_core::game::{GameSpec, Scripted, Skill, SolverEnv};
 use arlpcg_core::level::stats::{SolverRef, SolverStats, TrialResult};
 use arlpcg_core::level::{Game, Level, PolicyRef};
 use arlpcg_core::rl::policy::ActMode;
@@ -133,10 +133,9 @@ pub fn trial_results(
     watch: &Watch,
 ) -> Result<Option<Vec<TrialResult>>, WrongGame> {
     solver.check_game(level.game())?;
-    Ok(match level.game() {
-        Game::Platform => play_all::<PlatformGame>(level, solver, range, seed, watch),
-        Game::Racing => play_all::<RacingGame>(level, solver, range, seed, watch),
-    })
+    Ok(arlpcg_core::for_game!(level.game(), G => {
+        play_all::<G>(level, solver, range, seed, watch)
+    }))
 }
 
 /// The statistics of a verification from `seed` whose trials gave `results` (trials `0..n`).
@@ -190,18 +189,9 @@ pub struct Recording {
 pub fn record(level: &Level, solver: &Solver, seed: u64) -> Result<Recording, WrongGame> {
     solver.check_game(level.game())?;
     let unexpected = "a level's environment is of its own game";
-    Ok(match level.game() {
-        Game::Platform => record_env::<PlatformGame>(
-            PlatformGame::solver_env(level).expect(unexpected),
-            (solver, level),
-            seed,
-        ),
-        Game::Racing => record_env::<RacingGame>(
-            RacingGame::solver_env(level).expect(unexpected),
-            (solver, level),
-            seed,
-        ),
-    })
+    Ok(arlpcg_core::for_game!(level.game(), G => {
+        record_env::<G>(G::solver_env(level).expect(unexpected), (solver, level), seed)
+    }))
 }
 
 fn record_env<G: GameSpec>(

@@ -2,8 +2,6 @@
 
 use anyhow::{Context, Result};
 
-use arlpcg_core::game::{PlatformGame, RacingGame};
-use arlpcg_core::level::Game;
 use arlpcg_core::rl::checkpoint::Role;
 
 use crate::services::fsio::{FileBatch, Overwrite};
@@ -37,24 +35,17 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
     let golden = match card.role {
         Role::Solver => {
             let reference = exported.sidecar.policy.clone();
-            let episode = match card.game {
-                Game::Platform => golden_episode::<PlatformGame>(&policy, &card, reference),
-                Game::Racing => golden_episode::<RacingGame>(&policy, &card, reference),
-            }
+            let episode =
+                arlpcg_core::for_game!(card.game, G => golden_episode::<G>(&policy, &card, reference))
             .with_context(|| format!("{}: playing its golden episode", args.policy.display()))?;
             Some(serde_json::to_string(&episode)? + "\n")
         }
         Role::Generator => {
             let reference = exported.sidecar.policy.clone();
             let limits = crate::services::policies::generator_limits(&args.policy, &card)?;
-            let episode = match card.game {
-                Game::Platform => {
-                    generator_golden_episode::<PlatformGame>(&policy, &card, reference, limits)
-                }
-                Game::Racing => {
-                    generator_golden_episode::<RacingGame>(&policy, &card, reference, limits)
-                }
-            }
+            let episode = arlpcg_core::for_game!(card.game, G => {
+                generator_golden_episode::<G>(&policy, &card, reference, limits)
+            })
             .with_context(|| format!("{}: building its golden episode", args.policy.display()))?;
             Some(serde_json::to_string(&episode)? + "\n")
         }

@@ -5,14 +5,15 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use rayon::prelude::*;
 
 use crate::services::checks;
 use crate::services::difficulty;
 use crate::services::fsio;
-use crate::services::generation::{self, Ask, GeneratorPolicy, KeptPrefix, LevelRequest};
+use crate::services::generation::{Ask, GeneratorPolicy, KeptPrefix, LevelRequest};
 use crate::services::level_files::{Format, LevelFiles, file_stem, render};
+use crate::services::making::{self, LevelSource, Proof, Redraw};
 use crate::services::panel::Judge;
 use crate::services::policies::{
     load_folder_solver, load_generator, load_judge_under, load_panel, load_solver, policy_paths,
@@ -22,6 +23,7 @@ use crate::services::profile;
 use crate::services::verify::{self, Solver, SolverPolicy};
 use crate::shells::cli::{GenerateArgs, KeepArg, default_solver};
 use arlpcg_core::game::Skill;
+use arlpcg_core::game::facts::facts;
 use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::{Game, Level};
 
@@ -224,8 +226,17 @@ fn check_arguments(args: &GenerateArgs) -> Result<Vec<u64>> {
     if success.is_some() && args.policies.is_none() {
         return usage("--target-success needs --policies: a Generator that λ steers");
     }
-    if args.obstacles > 0 && args.game != Game::Racing {
-        return usage("--obstacles is for racing tracks (--game racing)");
+    if args.obstacles > 0 && facts(args.game).max_obstacles == 0 {
+        let with: Vec<&str> = Game::ALL
+            .into_iter()
+            .filter(|g| facts(*g).max_obstacles > 0)
+            .map(Game::name)
+            .collect();
+        return usage(&format!(
+            "--obstacles is for {} levels: {} levels have none",
+            with.join(" or "),
+            args.game
+        ));
     }
     if ask.as_ref().and_then(Ask::curve).is_some() && args.policies.is_none() {
         return usage("--aux-curve needs --policies: the rules know no λ, a Generator follows it");
@@ -350,13 +361,6 @@ fn stem_of_lambda(args: &GenerateArgs, seed: u64) -> String {
     }
 }
 
-/// Draws of one seed tried at one λ before `generate --verify` eases it.
-pub const MAX_DRAWS: u32 = 10;
-
-/// How much easier (λ up) a seed is asked again when none of its `MAX_DRAWS` draws was
-/// completed by any run: a batch keeps every seed, each level recording the λ it was built at.
-pub const EASE_STEP: f64 = 0.25;
-
 /// What every level of the batch asks, bar its seed and draw: goal, obstacles, λ or curve, the
 /// kept prefix and the profile.
 fn template(args: &GenerateArgs) -> Result<LevelRequest> {
@@ -375,77 +379,6 @@ fn template(args: &GenerateArgs) -> Result<LevelRequest> {
         template = template.keep(kept_prefix(keep, args.game)?);
     }
     Ok(template)
-}
-
-/// Level `seed` (its `draw`-th draw) as `template` asks, from the Generator when there is one,
-/// else from the rules.
-fn build(
-    args: &GenerateArgs,
-    template: &LevelRequest,
-    generator: Option<&GeneratorPolicy>,
-    seed: u64,
-    draw: u32,
-) -> Result<Level> {
-    let request = LevelRequest {
-        seed,
-        draw,
-        ..template.clone()
-    };
-    Ok(match generator {
-        Some(generator) => generation::generator_level(generator, &request)?,
-        None => generation::rules_level(args.game, &request)?,
-    })
-}
-
-/// Level `seed`, verified when asked: a draw that no run completes is replaced by the seed's
-/// next draw (unless --allow-unsolved); after `MAX_DRAWS` of them a Generator's λ is eased by
-/// `EASE_STEP`, and so on up to λ = 1. A kept level carries a certificate.
-fn build_verified(
-    args: &GenerateArgs,
-    template: &LevelRequest,
-    generator: Option<&GeneratorPolicy>,
-    solver: &Solver,
-    seed: u64,
-    stop: &AtomicBool,
-) -> Result<Option<Level>> {
-    let Some(trials) = args.verify else {
-        return build(args, template, generator, seed, 0).map(Some);
-    };
-    // Ctrl-C abandons the trials under way within a tick: the level is not finished.
-    let watch = verify::Watch {
-        on_trial: &|_| {},
-        stop: &|| stop.load(Ordering::SeqCst),
-    };
-    let mut request = template.clone();
-    let mut replaced = 0;
-    loop {
-        for draw in 0..MAX_DRAWS {
-            let mut level = build(args, &request, generator, seed, draw)?;
-            let Some(mut stats) = verify::verify_watched(&level, solver, trials, seed, &watch)?
-            else {
-                return Ok(None);
-            };
-            if stats.successes == 0 && !args.allow_unsolved {
-                replaced += 1;
-                continue;
-            }
-            stats.redraws = replaced;
-            level.stats = Some(stats);
-            return Ok(Some(verify::certified(level, solver, seed)?));
-        }
-        // Only a Generator's λ can be eased; rule levels have none.
-        let asked = request.aux.as_ref().filter(|_| generator.is_some());
-        let at = asked.map_or(String::new(), |a| format!(" at {a}"));
-        let Some(easier) = asked.and_then(|a| a.eased(EASE_STEP)) else {
-            bail!(
-                "none of the {MAX_DRAWS} levels drawn for this seed{at} was completed by any of {trials} runs (--allow-unsolved keeps the first anyway)"
-            )
-        };
-        crate::warn!(
-            "seed {seed}: none of {MAX_DRAWS} levels{at} was completed by any of {trials} runs; asking {easier}"
-        );
-        request.aux = Some(easier);
-    }
 }
 
 /// The Solver that plays `--verify` and `--target-success`: the judge asked for, the file asked
@@ -476,8 +409,9 @@ fn chosen_solver(
     })
 }
 
-/// Builds (and verifies) the level of every plan, several at once; after a Ctrl-C, the levels
-/// finished before it, a prefix of the batch, so that a re-run resumes it.
+/// Builds (and verifies) the level of every plan, several at once ([`making::verified_level`]);
+/// after a Ctrl-C, the levels finished before it, a prefix of the batch, so that a re-run
+/// resumes it.
 #[allow(clippy::too_many_arguments)]
 fn build_levels(
     args: &GenerateArgs,
@@ -489,6 +423,30 @@ fn build_levels(
     verify_trials: Option<u32>,
     stop: &AtomicBool,
 ) -> Result<Vec<Level>> {
+    let source = generator.map_or(LevelSource::Rules(args.game), LevelSource::Generator);
+    let target = args.ask().as_ref().and_then(Ask::success);
+    let proof = match (target, curve, verify_trials) {
+        (Some(target), Some(curve), _) => Proof::Target {
+            solver: who,
+            curve,
+            target,
+            trials: verify_trials.unwrap_or(TARGET_TRIALS),
+        },
+        (_, _, Some(trials)) if args.verify.is_some() => Proof::Played {
+            solver: who,
+            trials,
+            redraw: Redraw {
+                keep_unsolved: args.allow_unsolved,
+                ..Redraw::default()
+            },
+        },
+        _ => Proof::Unplayed,
+    };
+    // Ctrl-C abandons the trials under way within a tick: the level is not finished.
+    let watch = verify::Watch {
+        on_trial: &|_| {},
+        stop: &|| stop.load(Ordering::SeqCst),
+    };
     let bar = crate::shells::common::progress_bar(plans.len() as u64, "generating");
     let built: Vec<Option<Result<Level>>> = plans
         .par_iter()
@@ -496,22 +454,19 @@ fn build_levels(
             if stop.load(Ordering::SeqCst) {
                 return None;
             }
-            let level = match (args.ask().as_ref().and_then(Ask::success), curve, generator) {
-                (Some(target), Some(curve), Some(generator)) => difficulty::level_for(
-                    generator,
-                    who,
-                    curve,
-                    &LevelRequest::new(*seed, None)
-                        .goal(args.goal)
-                        .profile(template.profile.clone()),
-                    target,
-                    verify_trials.unwrap_or(TARGET_TRIALS),
-                )
-                .map_err(anyhow::Error::from)
-                .and_then(|level| verify::certified(level, who, *seed).map_err(anyhow::Error::from))
-                .map(Some),
-                _ => build_verified(args, template, generator, who, *seed, stop),
+            // A success target searches its own draws, λ and (without a goal) seeds.
+            let request = match proof {
+                Proof::Target { .. } => LevelRequest::new(*seed, None)
+                    .goal(args.goal)
+                    .profile(template.profile.clone()),
+                _ => LevelRequest {
+                    seed: *seed,
+                    ..template.clone()
+                },
             };
+            let level = making::verified_level(source, &request, &proof, &watch, &|eased| {
+                crate::warn!("{eased}")
+            });
             bar.inc(1);
             level
                 .with_context(|| format!("seed {seed} (nothing was written)"))

@@ -36,7 +36,7 @@ pub fn run(cli: Cli) -> Result<()> {
             use std::io::IsTerminal;
             if std::io::stdin().is_terminal() && std::io::stdout().is_terminal() {
                 design(crate::shells::cli::DesignArgs {
-                    game: arlpcg_core::level::Game::Platform,
+                    game: arlpcg_core::level::Game::default(),
                     policies: None,
                     out: "levels".into(),
                     seed: 1,

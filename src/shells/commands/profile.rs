@@ -34,10 +34,7 @@ pub fn run(command: &ProfileCommand) -> Result<()> {
                     "{}: under this profile the scripted expert completes {} of {CHECK_LEVELS} rule levels: most of the game's goals cannot be reached; give the {} more ability",
                     file.display(),
                     allowance.completed,
-                    match profile.game() {
-                        arlpcg_core::level::Game::Platform => "character",
-                        arlpcg_core::level::Game::Racing => "car",
-                    }
+                    arlpcg_core::game::facts::facts(profile.game()).player_kind
                 );
             }
             Ok(())

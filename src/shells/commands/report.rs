@@ -40,7 +40,7 @@ pub fn run(args: &ReportArgs) -> Result<()> {
         }
         return Ok(());
     }
-    let games = [Game::Platform, Game::Racing]
+    let games = Game::ALL
         .into_iter()
         .map(|game| read_game(game, &args.results, &args.policies))
         .collect::<Result<Vec<_>>>()?;

@@ -17,7 +17,7 @@ pub fn run(args: &TrainArgs) -> Result<()> {
         crate::shells::common::say(format_args!(
             "{}",
             serde_yaml::to_string(&TrainConfig::for_run(
-                args.game.unwrap_or(arlpcg_core::level::Game::Platform),
+                args.game.unwrap_or_default(),
                 args.mode
                     .map_or(arlpcg_core::rl::checkpoint::TrainMode::RulePcg, Into::into)
             ))?

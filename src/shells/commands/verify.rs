@@ -298,7 +298,7 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
             Ok(())
         },
     )?;
-    for game in [Game::Platform, Game::Racing] {
+    for game in Game::ALL {
         let mut of_game: Vec<&mut PanelStats> = rated
             .iter_mut()
             .filter(|(_, g, _)| *g == game)
@@ -474,15 +474,14 @@ fn to_json(path: &Path, level: &Level, s: &SolverStats) -> serde_json::Value {
         "fell": s.fell,
         "timed_out": s.timed_out,
     });
-    match game {
-        Game::Platform => value["failures_by_block"] = json!(s.failures_by_piece),
-        Game::Racing => {
-            value["off_road"] = json!(s.off_road);
-            value["flipped"] = json!(s.flipped);
-            value["mean_air_steps"] = json!(s.mean_air_steps);
-            value["failures_by_segment"] = json!(s.failures_by_piece);
-        }
+    let facts = facts(game);
+    for (ending, _) in facts.endings {
+        value[*ending] = json!(s.ending_count(ending));
     }
+    if facts.air_time_step.is_some() {
+        value["mean_air_steps"] = json!(s.mean_air_steps);
+    }
+    value[format!("failures_by_{}", facts.piece)] = json!(s.failures_by_piece);
     if let Some(pacing) = &level.pacing {
         value["aux_curve"] = json!(pacing.curve.to_string());
         value["aux_by_piece"] = json!(pacing.piece_aux);
@@ -526,13 +525,12 @@ fn describe(path: &Path, level: &Level, s: &SolverStats) -> String {
         text += &format!(", under profile `{}`", profile.name);
     }
     if !failures.is_empty() {
-        let causes = match game {
-            Game::Platform => format!("fell {}, out of time {}", s.fell, s.timed_out),
-            Game::Racing => format!(
-                "off the road {}, flipped {}, out of time {}",
-                s.off_road, s.flipped, s.timed_out
-            ),
-        };
+        let causes = facts(game)
+            .endings
+            .iter()
+            .map(|(ending, words)| format!("{words} {}", s.ending_count(ending).unwrap_or(0)))
+            .collect::<Vec<_>>()
+            .join(", ");
         text += &format!(
             "\n  failed {} {} ({causes})",
             facts(game).failed_at,

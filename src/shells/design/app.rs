@@ -13,7 +13,7 @@ use arlpcg_core::level::params::quantize;
 
 pub use crate::services::generation::Ask;
 use crate::services::verify::Recording;
-use arlpcg_core::level::{Game, Level};
+use arlpcg_core::level::{Game, Level, PerGame};
 
 use super::layout::Areas;
 
@@ -141,20 +141,17 @@ pub struct Replay {
 #[derive(Debug, Clone, PartialEq)]
 pub struct App {
     pub game: Game,
-    /// The policies of the game on screen...
-    pub policies: LoadedInfo,
-    /// ...and of the other game (Tab swaps them).
-    pub other_policies: LoadedInfo,
+    /// Each game's policies ([`App::policies`]: the game on screen's).
+    pub loaded: PerGame<LoadedInfo>,
     /// The slider's λ (in target-success mode, the λ of the level found).
     pub aux: f64,
     /// What difficulty is asked for: the slider's λ, a success rate, or λ along the level.
     pub ask: Ask,
     /// The prefix every regeneration keeps.
     pub kept: Option<crate::services::generation::KeptPrefix>,
-    /// The game profile levels are made for, and the ability its keys change ([`profile`]).
-    pub profile: profile::ProfileEdit,
-    /// ...and the other game's (Tab swaps them).
-    pub other_profile: profile::ProfileEdit,
+    /// Each game's profile levels are made for, and the ability its keys change ([`profile`];
+    /// [`App::profile`]: the game on screen's).
+    pub profiles: PerGame<profile::ProfileEdit>,
     pub seed: u64,
     pub goal: GoalSetting,
     pub trials_wanted: u32,
@@ -194,13 +191,15 @@ impl App {
     pub fn new(game: Game, policies: LoadedInfo, seed: u64, out_dir: PathBuf) -> Self {
         Self {
             game,
-            policies,
-            other_policies: LoadedInfo::default(),
+            loaded: {
+                let mut loaded = PerGame::<LoadedInfo>::default();
+                loaded[game] = policies;
+                loaded
+            },
             aux: 1.0,
             ask: Ask::Aux(1.0),
             kept: None,
-            profile: profile::ProfileEdit::default(),
-            other_profile: profile::ProfileEdit::default(),
+            profiles: PerGame::default(),
             seed,
             goal: GoalSetting::FromSeed,
             trials_wanted: DEFAULT_TRIALS,
@@ -257,22 +256,35 @@ impl App {
             ask: self.ask.clone(),
             keep: self.kept.clone(),
             trials: self.trials_wanted,
-            profile: self.profile.profile.clone(),
+            profile: self.profile().profile.clone(),
         }]
     }
 
-    /// Tab: the other game, with its own policies, from the same seed and λ (a goal set by hand
-    /// goes back to the seed's: the games' goals lie at different distances).
+    /// The policies of the game on screen.
+    pub fn policies(&self) -> &LoadedInfo {
+        &self.loaded[self.game]
+    }
+
+    pub(super) fn policies_mut(&mut self) -> &mut LoadedInfo {
+        &mut self.loaded[self.game]
+    }
+
+    /// The profile of the game on screen.
+    pub fn profile(&self) -> &profile::ProfileEdit {
+        &self.profiles[self.game]
+    }
+
+    pub fn profile_mut(&mut self) -> &mut profile::ProfileEdit {
+        &mut self.profiles[self.game]
+    }
+
+    /// Tab: the next game, with its own policies and profile, from the same seed and λ (a goal
+    /// set by hand goes back to the seed's: the games' goals lie at different distances).
     pub(super) fn switch_game(&mut self) -> Vec<Effect> {
-        self.game = match self.game {
-            Game::Platform => Game::Racing,
-            Game::Racing => Game::Platform,
-        };
-        std::mem::swap(&mut self.policies, &mut self.other_policies);
-        std::mem::swap(&mut self.profile, &mut self.other_profile);
+        self.game = self.game.next();
         self.goal = GoalSetting::FromSeed;
         self.kept = None;
-        if self.policies.generator.is_none() && self.ask.curve().is_some() {
+        if self.policies().generator.is_none() && self.ask.curve().is_some() {
             self.ask = Ask::Aux(self.aux);
         }
         self.level = None;
@@ -300,7 +312,7 @@ impl App {
 
     /// Target-success mode on (`Some`) or off: a Generator is needed to steer.
     pub(super) fn set_target(&mut self, target: Option<f64>) -> Vec<Effect> {
-        if target.is_some() && self.policies.generator.is_none() {
+        if target.is_some() && self.policies().generator.is_none() {
             self.complain(
                 "a success target needs a Generator (p loads one): rule levels have no λ to steer",
             );

@@ -84,22 +84,24 @@ pub fn run(mut options: DesignOptions) -> Result<()> {
         )?),
         None => None,
     };
-    let other_game = match options.game {
-        Game::Platform => Game::Racing,
-        Game::Racing => Game::Platform,
-    };
-    let (other_policies, other_info, _) = starting_policies(&options, other_game)?;
     let mut shelf = GamePolicies::default();
-    *shelf.of_mut(options.game) = policies;
-    *shelf.of_mut(other_game) = other_policies;
+    shelf[options.game] = policies;
+    let mut others = Vec::new();
+    for game in Game::ALL.into_iter().filter(|g| *g != options.game) {
+        let (policies, info, _) = starting_policies(&options, game)?;
+        shelf[game] = policies;
+        others.push((game, info));
+    }
     let (answers, responses) = channel();
     let workers = Workers::start(shelf, answers);
     let mut app = App::new(options.game, info, options.seed, options.out);
-    app.profile.profile = profile;
+    app.profile_mut().profile = profile;
+    for (game, info) in others {
+        app.loaded[game] = info;
+    }
     let opening = options.campaign.map(|folder| app.open_campaign(folder));
     // https://no-color.org: present and not empty.
     app.colour = std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty());
-    app.other_policies = other_info;
     if let Some(note) = note {
         app.status = Some((note, true));
     }

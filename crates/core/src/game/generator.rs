@@ -192,6 +192,9 @@ pub trait GeneratorGame: GameSpec {
     const MAX_PIECES: usize;
     /// The names of the two [`TrackBuild::piece_features`], as the metrics columns call them.
     const PIECE_FEATURES: [&'static str; 2];
+    /// The game's training recipe: a training configuration (`train --config`'s YAML) laid
+    /// over the defaults, which are the platform game's ("{}": nothing changed).
+    const RECIPE: &'static str;
     /// The Generator reward defaults of the game.
     fn default_rewards() -> GeneratorRewards;
     /// The empty track of `seed`: goal (drawn unless given), start and scene drawn from the seed

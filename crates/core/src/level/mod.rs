@@ -23,22 +23,62 @@ pub use platform::{BlockParams, Platform, PlatformTrack, Start};
 pub use racing::{Obstacle, RacingTrack, SegmentParams};
 pub use stats::{SolverRef, SolverStats};
 
-/// The two games of the paper.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+/// The two games of the paper; each is a [`GameSpec`](../game/trait.GameSpec.html) in its own
+/// folder under `game/`, and `game::for_game!` turns a `Game` into its type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Game {
-    /// Jump across blocks to the goal block.
+    /// Jump across blocks to the goal block (the game a command plays when none is named).
+    #[default]
     Platform,
     /// Drive a banked road to the goal.
     Racing,
 }
 
 impl Game {
+    /// Every game, in the order lists and the designer's Tab go through them.
+    pub const ALL: [Game; 2] = [Game::Platform, Game::Racing];
+
     pub fn name(self) -> &'static str {
         match self {
             Game::Platform => "platform",
             Game::Racing => "racing",
         }
+    }
+
+    /// The game after this one in [`Game::ALL`], the first after the last.
+    pub fn next(self) -> Game {
+        let k = Game::ALL.iter().position(|g| *g == self).unwrap_or(0);
+        Game::ALL[(k + 1) % Game::ALL.len()]
+    }
+
+    /// Where this game stands in [`Game::ALL`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// One value per game, indexed by [`Game`] (the designer's loaded policies and profile of each).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PerGame<T>([T; Game::ALL.len()]);
+
+impl<T> PerGame<T> {
+    /// Each game's value, made by `make`.
+    pub fn from_fn(mut make: impl FnMut(Game) -> T) -> Self {
+        Self(std::array::from_fn(|k| make(Game::ALL[k])))
+    }
+}
+
+impl<T> std::ops::Index<Game> for PerGame<T> {
+    type Output = T;
+    fn index(&self, game: Game) -> &T {
+        &self.0[game.index()]
+    }
+}
+
+impl<T> std::ops::IndexMut<Game> for PerGame<T> {
+    fn index_mut(&mut self, game: Game) -> &mut T {
+        &mut self.0[game.index()]
     }
 }
 
@@ -50,7 +90,8 @@ impl std::str::FromStr for Game {
             "platform" => Ok(Game::Platform),
             "racing" => Ok(Game::Racing),
             other => Err(format!(
-                "unknown game `{other}`: expected platform or racing"
+                "unknown game `{other}`: expected {}",
+                Game::ALL.map(Game::name).join(" or ")
             )),
         }
     }

@@ -163,6 +163,18 @@ fn is_zero(count: &u32) -> bool {
 }
 
 impl SolverStats {
+    /// How many runs ended as `ending` (`fell`, `timed_out`, `off_road`, `flipped`: the keys
+    /// a game's facts list its endings by); none for a key that is no ending.
+    pub fn ending_count(&self, ending: &str) -> Option<u32> {
+        match ending {
+            "fell" => Some(self.fell),
+            "timed_out" => Some(self.timed_out),
+            "off_road" => Some(self.off_road),
+            "flipped" => Some(self.flipped),
+            _ => None,
+        }
+    }
+
     /// Aggregates trial results over a level with `pieces` pieces.
     pub fn from_trials(
         solver: SolverRef,

@@ -398,8 +398,7 @@ impl ActorCritic {
 
     /// Log-probabilities of `actions`, the entropy of each row's distribution and the value
     /// estimates, as tensors that gradients flow through: the autograd definition of what
-    /// [`super::fused`] differentiates by hand, which its tests check it against.
-    #[cfg(test)]
+    /// [`super::fused`] differentiates by hand ([`super::ppo::readable_loss`] is built on it).
     pub fn evaluate(
         &self,
         observations: &Tensor,
@@ -451,7 +450,6 @@ pub(super) fn softplus(x: f32) -> f32 {
 }
 
 /// softplus(x) = max(x, 0) + ln(1 + e^-|x|), stable for large |x|.
-#[cfg(test)]
 fn softplus_tensor(x: &Tensor) -> candle_core::Result<Tensor> {
     x.relu()?
         .add(&x.abs()?.neg()?.exp()?.affine(1.0, 1.0)?.log()?)

@@ -1,13 +1,33 @@
 //! Proximal Policy Optimization, shaped like CleanRL's `ppo.py`: one documented config, `gae`,
 //! the clipped surrogate loss, and `update` over shuffled minibatches with Adam, advantage
 //! normalization, an entropy bonus and gradient-norm clipping.
+//!
+//! One iteration, and the file each line lives in (`rl/` unless named):
+//!
+//! ```text
+//! for tick in 0..num_steps:                                     vec_env.rs  Trainer::collect
+//!     norm.update(obs); x = norm(obs)                           normalizer.rs
+//!     action, log_prob, value = policy.act(x)  (sampled)        policy.rs   ActorCritic::act
+//!     reward, ended = envs.step(action)  (a game, or a match)   vec_env.rs  VecEnv; game/
+//! advantages, returns = gae(rewards, values, ended, γ, λ)       ppo.rs      gae (no bootstrap past an ending)
+//! for epoch in 0..update_epochs: for minibatch in shuffle(batch):   ppo.rs  Ppo::update
+//!     normalize(advantages)
+//!     loss = clipped surrogate - ent_coef·entropy + vf_coef·½(v - R)²   ppo.rs readable_loss
+//!     gradients = ∂loss, fused on gemm (checked against readable_loss)  fused/mod.rs
+//!     clip the global norm to max_grad_norm; Adam step               adam.rs
+//! ```
+//!
+//! [`readable_loss`] is the loss written plainly in candle; the update computes the same loss
+//! and its gradients by hand in [`super::fused`] (several times faster), and the fused tests
+//! check both against candle's autograd of [`readable_loss`].
 
 use rand::seq::SliceRandom;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::adam::Adam;
-use super::fused::{LossWeights, Minibatch, ParamLayout, Workspace, global_norm};
+pub use super::fused::{LossWeights, Minibatch};
+use super::fused::{ParamLayout, Workspace, global_norm};
 use super::policy::ActorCritic;
 
 /// Every PPO hyper-parameter, with CleanRL's meanings.
@@ -404,10 +424,39 @@ pub fn explained_variance(values: &[f32], returns: &[f32]) -> f32 {
     1.0 - variance(&mut returns.iter().zip(values).map(|(r, v)| r - v)) / var_returns
 }
 
+/// PPO's loss on a minibatch, written plainly in candle (to minimize): the clipped surrogate
+/// ([`clipped_policy_loss`]), minus `ent_coef` times the mean entropy, plus `vf_coef` times half
+/// the mean squared value error. [`Ppo::update`] computes the same loss and its gradients with
+/// the fused pass ([`super::fused`]); its tests check them against candle's autograd of this.
+pub fn readable_loss(
+    policy: &ActorCritic,
+    minibatch: &Minibatch,
+    weights: LossWeights,
+) -> candle_core::Result<candle_core::Tensor> {
+    use candle_core::{Device, Tensor};
+    let rows = minibatch.old_log_probs.len();
+    let shape = policy.shape();
+    let observations = Tensor::from_slice(
+        minibatch.observations,
+        (rows, shape.observation),
+        &Device::Cpu,
+    )?;
+    let actions = Tensor::from_slice(minibatch.actions, (rows, shape.action_size()), &Device::Cpu)?;
+    let column = |v: &[f32]| Tensor::from_slice(v, rows, &Device::Cpu);
+    let (new_log_prob, entropy, values) = policy.evaluate(&observations, &actions)?;
+    let policy_loss = clipped_policy_loss(
+        &new_log_prob,
+        &column(minibatch.old_log_probs)?,
+        &column(minibatch.advantages)?,
+        weights.clip_coef,
+    )?;
+    let value_loss = ((values - column(minibatch.returns)?)?.sqr()?.mean_all()? * 0.5)?;
+    let entropy = entropy.mean_all()?;
+    (policy_loss - (entropy * weights.ent_coef as f64)?)? + (value_loss * weights.vf_coef as f64)?
+}
+
 /// PPO's clipped surrogate objective in candle (to minimize), the mean over the batch of
-/// `max(-A·r, -A·clip(r, 1-ε, 1+ε))` with `r = exp(new_log_prob - old_log_prob)`: the autograd
-/// reference that [`super::fused`]'s tests check the hand-written gradients against.
-#[cfg(test)]
+/// `max(-A·r, -A·clip(r, 1-ε, 1+ε))` with `r = exp(new_log_prob - old_log_prob)`.
 pub fn clipped_policy_loss(
     new_log_prob: &candle_core::Tensor,
     old_log_prob: &candle_core::Tensor,

@@ -2,8 +2,8 @@
 //! numbers), and which fields a resumed run may change. Problems name the field.
 
 use super::{GeneratorConfig, TrainConfig};
+use arlpcg_core::game::facts::facts;
 use arlpcg_core::game::generator::GeneratorGame;
-use arlpcg_core::game::{PlatformGame, RacingGame};
 use arlpcg_core::level::Game;
 
 /// Limits on the networks' size (a 4096-unit layer is already 64 MB of weights and moments).
@@ -224,10 +224,7 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
             "population_every_steps must be within [1, {MAX_PHASE_STEPS}]"
         ));
     }
-    let max_pieces = match game {
-        Game::Platform => PlatformGame::MAX_PIECES,
-        Game::Racing => RacingGame::MAX_PIECES,
-    };
+    let max_pieces = arlpcg_core::for_game!(game, G => G::MAX_PIECES);
     if !(1..=max_pieces).contains(&g.max_pieces) {
         return Err(format!("max_pieces must be within [1, {max_pieces}]"));
     }
@@ -235,9 +232,9 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
     if !(0.0..=180.0).contains(&g.curve_offset) {
         return Err("curve_offset must be a number of degrees in [0, 180]".into());
     }
-    if game == Game::Platform && g.curve_offset != default_offset {
+    if !facts(game).curve_offset && g.curve_offset != default_offset {
         return Err(format!(
-            "curve_offset is the racing Generator's: the platform game has no curve (leave it at {default_offset})"
+            "curve_offset does not steer the {game} Generator (leave it at {default_offset})"
         ));
     }
     if g.obstacles > arlpcg_core::level::racing::MAX_OBSTACLES as u32 {

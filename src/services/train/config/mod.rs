@@ -8,8 +8,8 @@ use anyhow::Result;
 use serde::{Deserialize, Serialize};
 
 use super::solver_envs::SolverMode;
+use arlpcg_core::game::Player;
 use arlpcg_core::game::generator::{GeneratorGame, GeneratorRewards};
-use arlpcg_core::game::{PlatformGame, Player};
 use arlpcg_core::level::Game;
 use arlpcg_core::level::profile::ProfileRecord;
 use arlpcg_core::level::stats::Skill;
@@ -322,9 +322,9 @@ impl Default for GeneratorConfig {
                 ent_coef: 0.001,
                 ..PpoConfig::default()
             },
-            rewards: PlatformGame::default_rewards(),
+            rewards: arlpcg_core::for_game!(Game::default(), G => G::default_rewards()),
             aux_values: vec![-1.0, -1.0, -0.5, 0.5, 1.0, 1.0],
-            max_pieces: PlatformGame::DEFAULT_MAX_PIECES,
+            max_pieces: arlpcg_core::for_game!(Game::default(), G => G::DEFAULT_MAX_PIECES),
             obstacles: 0,
             curve_offset: arlpcg_core::game::generator::DEFAULT_CURVE_OFFSET,
             initial_log_std: -1.6,
@@ -456,7 +456,7 @@ impl TrainConfig {
 impl TrainConfig {
     /// [`TrainConfig::parse_for`] the platform game.
     pub fn parse(text: &str) -> Result<TrainConfig, String> {
-        Self::parse_for(text, Game::Platform)
+        Self::parse_for(text, Game::default())
     }
 }
 
@@ -478,7 +478,7 @@ fn rename_aliases(given: &mut serde_yaml::Value) {
 
 /// `given` laid over `defaults`: mappings merge key by key (recursively), anything else given
 /// replaces the default.
-fn overlay(defaults: serde_yaml::Value, given: serde_yaml::Value) -> serde_yaml::Value {
+pub(super) fn overlay(defaults: serde_yaml::Value, given: serde_yaml::Value) -> serde_yaml::Value {
     use serde_yaml::Value;
     match (defaults, given) {
         (Value::Mapping(mut base), Value::Mapping(top)) => {

@@ -85,7 +85,7 @@ fn out_of_range_generator_fields_are_named() {
         (
             "generator:\n  curve_offset: 90\n",
             Game::Platform,
-            "platform game has no curve",
+            "does not steer the platform Generator",
         ),
         (
             "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n  - {from_steps: 5, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n",

@@ -129,7 +129,7 @@ impl App {
                     folder,
                     game,
                     level,
-                    policies: self.policies.folder(game),
+                    policies: self.policies().folder(game),
                 }];
             }
             KeyCode::Char('o') => {

@@ -52,8 +52,8 @@ impl App {
                 self.say("switching judge".to_string());
                 vec![Effect::NextJudge {
                     game: self.game,
-                    after: self.policies.judge(),
-                    folder: self.policies.folder(self.game),
+                    after: self.policies().judge(),
+                    folder: self.policies().folder(self.game),
                 }]
             }
             KeyCode::Tab => self.switch_game(),

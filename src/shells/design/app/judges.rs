@@ -75,7 +75,7 @@ impl App {
         vec![Effect::Panel {
             id,
             level,
-            folder: self.policies.folder(self.game),
+            folder: self.policies().folder(self.game),
             trials: PANEL_TRIALS,
         }]
     }

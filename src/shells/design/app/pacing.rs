@@ -56,7 +56,7 @@ impl App {
 
     /// Pacing on (`Some`) or off: a Generator is needed to follow a curve.
     pub(super) fn set_pacing(&mut self, pacing: Option<AuxCurve>) -> Vec<Effect> {
-        if pacing.is_some() && self.policies.generator.is_none() {
+        if pacing.is_some() && self.policies().generator.is_none() {
             self.complain("pacing needs a Generator (p loads one): rule levels have no λ");
             return Vec::new();
         }
@@ -74,7 +74,7 @@ impl App {
             self.complain("select the last piece to keep with ↑ ↓ first");
             return Vec::new();
         };
-        if self.policies.generator.is_none() {
+        if self.policies().generator.is_none() {
             self.complain("keeping a prefix needs a Generator (p loads one) to build the rest");
             return Vec::new();
         }

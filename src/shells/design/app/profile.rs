@@ -37,7 +37,7 @@ impl App {
     pub(super) fn profile_loaded(&mut self, result: Result<Box<Profile>, String>) -> Vec<Effect> {
         match result {
             Ok(profile) if profile.game() == self.game => {
-                self.profile.profile = Some(*profile);
+                self.profile_mut().profile = Some(*profile);
                 self.say_ability();
                 self.generate()
             }
@@ -51,7 +51,9 @@ impl App {
 
     /// `e`: the next ability of the game for `[` and `]`.
     pub(super) fn next_ability(&mut self) -> Vec<Effect> {
-        self.profile.ability = (self.profile.ability + 1) % main_abilities(self.game).len();
+        let count = main_abilities(self.game).len();
+        let edit = self.profile_mut();
+        edit.ability = (edit.ability + 1) % count;
         self.say_ability();
         Vec::new()
     }
@@ -72,7 +74,7 @@ impl App {
             let base: String = changed.name.chars().take(54).collect();
             changed.name = format!("{base}{EDITED}");
         }
-        self.profile.profile = Some(changed);
+        self.profile_mut().profile = Some(changed);
         self.say_ability();
         self.generate()
     }
@@ -80,12 +82,12 @@ impl App {
     /// The ability `[` and `]` change, as the profile file names it.
     fn chosen_ability(&self) -> &'static str {
         let all = main_abilities(self.game);
-        all[self.profile.ability % all.len()]
+        all[self.profile().ability % all.len()]
     }
 
     /// The profile levels are made for now (the built-in one when none is loaded).
     fn current_profile(&self) -> Profile {
-        self.profile
+        self.profile()
             .profile
             .clone()
             .unwrap_or_else(|| Profile::default_of(self.game))

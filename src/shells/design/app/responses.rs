@@ -40,11 +40,11 @@ impl App {
             }
             Response::Judged(result) => match result {
                 Ok(switch) => {
-                    self.policies.solver = switch.solver;
-                    self.policies.skill = switch.skill;
+                    self.policies_mut().solver = switch.solver;
+                    self.policies_mut().skill = switch.skill;
                     self.say(format!(
                         "judge: {} plays the trials",
-                        self.policies.judge().name()
+                        self.policies().judge().name()
                     ));
                     self.generate()
                 }
@@ -153,10 +153,10 @@ impl App {
                 .join(" and ")
         ));
         if info.generator.is_some() {
-            self.policies.generator = info.generator;
+            self.policies_mut().generator = info.generator;
         }
         if info.solver.is_some() {
-            self.policies.solver = info.solver;
+            self.policies_mut().solver = info.solver;
         }
         self.generate()
     }

@@ -49,7 +49,7 @@ impl App {
             goal: self.goal.position(),
             auxes: SWEEP_AUX.to_vec(),
             trials: SWEEP_TRIALS,
-            profile: self.profile.profile.clone(),
+            profile: self.profile().profile.clone(),
         }]
     }
 

@@ -153,11 +153,11 @@ fn header(app: &App, frame: &mut Frame, area: Rect) {
         };
         Span::styled(format!(" {} ", g.name()), style)
     };
-    let mut line = Line::from(vec![
-        Span::styled(" arlpcg designer ", Style::new().bold()),
-        game(Game::Platform),
-        game(Game::Racing),
-    ]);
+    let mut line = Line::from(
+        std::iter::once(Span::styled(" arlpcg designer ", Style::new().bold()))
+            .chain(Game::ALL.map(game))
+            .collect::<Vec<_>>(),
+    );
     // The training budgets, in each policy's own unit, where the width allows.
     let mode = |info: &Option<PolicyInfo>, none: &str| match info {
         Some(p) => {
@@ -171,9 +171,9 @@ fn header(app: &App, frame: &mut Frame, area: Rect) {
         }
         None => (none.to_string(), String::new()),
     };
-    let (generator, generator_budget) = mode(&app.policies.generator, "rules");
-    let scripted = Judge::Scripted(app.policies.skill).name();
-    let (solver, solver_budget) = mode(&app.policies.solver, &scripted);
+    let (generator, generator_budget) = mode(&app.policies().generator, "rules");
+    let scripted = Judge::Scripted(app.policies().skill).name();
+    let (solver, solver_budget) = mode(&app.policies().solver, &scripted);
     let long =
         format!("  Generator: {generator}{generator_budget}  Solver: {solver}{solver_budget}");
     let policies = if line.width() + long.chars().count() <= area.width as usize {
@@ -331,8 +331,8 @@ fn draw_replay(app: &App, ctx: &mut Context, project: impl Fn(&[f32; 3]) -> [f64
 }
 
 fn stats(app: &App, frame: &mut Frame, area: Rect) {
-    let scripted = Judge::Scripted(app.policies.skill).name();
-    let solver = policy_label(&app.policies.solver, &scripted);
+    let scripted = Judge::Scripted(app.policies().skill).name();
+    let solver = policy_label(&app.policies().solver, &scripted);
     let mut lines = Vec::new();
     match &app.trials {
         Some(t) => {

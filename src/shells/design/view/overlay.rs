@@ -44,8 +44,8 @@ pub(super) fn overlay(app: &App, frame: &mut Frame, screen: Rect) {
         Overlay::Cards => {
             let mut lines = Vec::new();
             for (role, info) in [
-                ("Generator", &app.policies.generator),
-                ("Solver", &app.policies.solver),
+                ("Generator", &app.policies().generator),
+                ("Solver", &app.policies().solver),
             ] {
                 match info {
                     Some(p) => {

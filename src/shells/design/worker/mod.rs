@@ -16,6 +16,7 @@ use super::app::{Effect, ExportOutcome, Response, SweepPoint};
 use crate::services::fsio::Overwrite;
 use crate::services::generation::LevelRequest;
 use crate::services::level_files::{Format, LevelFiles, write_level_files};
+use crate::services::making::{self, LevelSource, Proof};
 use crate::services::panel::rate;
 use crate::services::verify::{self, Solver, Watch};
 use arlpcg_core::level::{Game, Level};
@@ -156,7 +157,7 @@ pub fn perform(
             let result = match (ask.success(), ask.aux()) {
                 (Some(target), _) => {
                     let asked = LevelRequest::new(seed, None).goal(goal).profile(profile);
-                    target_level(shelf.of(game), &asked, target, trials)
+                    target_level(&shelf[game], &asked, target, trials)
                 }
                 (None, aux) => {
                     let mut request = LevelRequest::new(seed, None).goal(goal).profile(profile);
@@ -166,7 +167,7 @@ pub fn perform(
                     if let Some(keep) = keep {
                         request = request.keep(keep);
                     }
-                    shelf.of(game).level(game, request)
+                    shelf[game].level(game, request)
                 }
             };
             send(Response::Level {
@@ -179,10 +180,10 @@ pub fn perform(
             level,
             trials,
             seed,
-        } => play_trials(shelf.of(level.game()), id, &level, trials, seed, stop, send),
+        } => play_trials(&shelf[level.game()], id, &level, trials, seed, stop, send),
         Effect::Record { id, level, seed } => send(Response::Recorded {
             id,
-            result: verify::record(&level, &shelf.of(level.game()).solver(&level), seed)
+            result: verify::record(&level, &shelf[level.game()].solver(&level), seed)
                 .map(Box::new)
                 .map_err(|e| e.to_string()),
         }),
@@ -195,7 +196,7 @@ pub fn perform(
             trials,
             profile,
         } => {
-            let current = shelf.of(game);
+            let current = &shelf[game];
             for (index, aux) in auxes.into_iter().enumerate() {
                 if stop() {
                     return;
@@ -275,7 +276,7 @@ fn regenerate_campaign_level(
     let generator = policies
         .lock()
         .ok()
-        .and_then(|shelf| shelf.of(game).generator.clone())
+        .and_then(|shelf| shelf[game].generator.clone())
         .ok_or_else(|| anyhow::anyhow!("no {game} Generator is loaded (p loads one)"))?;
     let (folder, record, levels) =
         crate::services::campaign::regenerate_level(folder, k, &generator, dir, stop)?;
@@ -414,15 +415,25 @@ fn target_level(
         &|| false,
     )
     .map_err(|e| format!("{e:#}"))?;
-    crate::services::difficulty::level_for(
-        generator,
-        &Solver::Policy(solver),
-        &curve,
-        asked,
+    let proof = Proof::Target {
+        solver: &Solver::Policy(solver),
+        curve: &curve,
         target,
         trials,
+    };
+    let watch = verify::Watch {
+        on_trial: &|_| {},
+        stop: &|| false,
+    };
+    making::verified_level(
+        LevelSource::Generator(generator),
+        asked,
+        &proof,
+        &watch,
+        &|_| {},
     )
-    .map_err(|e| e.to_string())
+    .map_err(|e| format!("{e:#}"))?
+    .ok_or_else(|| "the search was stopped".to_string())
 }
 
 /// Writes the level's YAML and `.glb` into `dir` as `stem.*`, unless one exists and `overwrite`

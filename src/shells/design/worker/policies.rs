@@ -7,13 +7,14 @@ use std::sync::{Arc, Mutex};
 use anyhow::Result;
 
 use super::super::app::{JudgeSwitch, LoadedInfo, PolicyInfo};
-use crate::services::generation::{self, GeneratorPolicy, LevelRequest};
+use crate::services::generation::{GeneratorPolicy, LevelRequest};
+use crate::services::making::LevelSource;
 use crate::services::panel::Judge;
 use crate::services::policies::{load_aware_solver, load_generator, load_solver, policy_paths};
 use crate::services::verify::{self, Solver, SolverPolicy};
 use arlpcg_core::game::Skill;
 use arlpcg_core::level::profile::Profile;
-use arlpcg_core::level::{Game, Level};
+use arlpcg_core::level::{Game, Level, PerGame};
 use arlpcg_core::rl::checkpoint::{PolicyError, TrainMode};
 
 /// The policies of one game in use; either may be missing (rule levels; the scripted player).
@@ -29,27 +30,7 @@ pub struct Policies {
 }
 
 /// The policies of each game.
-#[derive(Default, Clone)]
-pub struct GamePolicies {
-    pub platform: Policies,
-    pub racing: Policies,
-}
-
-impl GamePolicies {
-    pub fn of(&self, game: Game) -> &Policies {
-        match game {
-            Game::Platform => &self.platform,
-            Game::Racing => &self.racing,
-        }
-    }
-
-    pub fn of_mut(&mut self, game: Game) -> &mut Policies {
-        match game {
-            Game::Platform => &mut self.platform,
-            Game::Racing => &mut self.racing,
-        }
-    }
-}
+pub type GamePolicies = PerGame<Policies>;
 
 impl Policies {
     /// Why the Solver policy may not play `level`: the abilities it is made for lie beyond the
@@ -82,12 +63,11 @@ impl Policies {
     /// one; racing scenes hold the obstacles evaluation scenes hold.
     pub fn level(&self, game: Game, request: LevelRequest) -> Result<Level, String> {
         let request = request.obstacles(arlpcg_core::game::facts::facts(game).scene_obstacles);
-        match &self.generator {
-            Some(generator) => {
-                generation::generator_level(generator, &request).map_err(|e| e.to_string())
-            }
-            None => generation::rules_level(game, &request).map_err(|e| e.to_string()),
-        }
+        let source = self
+            .generator
+            .as_deref()
+            .map_or(LevelSource::Rules(game), LevelSource::Generator);
+        source.level(&request).map_err(|e| e.to_string())
     }
 }
 
@@ -151,7 +131,7 @@ pub(super) fn load_into(
 ) -> Result<Box<LoadedInfo>, String> {
     let (loaded, info) = load(path, game).map_err(|e| format!("{e:#}"))?;
     if let Ok(mut shared) = policies.lock() {
-        let old = shared.of_mut(game);
+        let old = &mut shared[game];
         *old = Policies {
             generator: loaded.generator.or(old.generator.clone()),
             aware: match loaded.solver {
@@ -202,7 +182,7 @@ pub(super) fn next_judge(
             }
         };
         if let Ok(mut shared) = policies.lock() {
-            let current = shared.of_mut(game);
+            let current = &mut shared[game];
             (current.solver, current.aware) = solver;
             current.skill = skill;
         }

@@ -387,14 +387,14 @@ impl crate::game::SolverEnv for PlatformEnv {
         let c = &self.character;
         let next = self.world.platforms()[self.next_index()];
         vec![
-            ("feet", super::super::coords(c.feet)),
+            ("feet", crate::game::spec::coords(c.feet)),
             ("yaw", vec![f64::from(c.yaw)]),
-            ("velocity", super::super::coords(c.velocity)),
+            ("velocity", crate::game::spec::coords(c.velocity)),
             ("grounded", vec![f64::from(u8::from(c.grounded))]),
             ("steps", vec![f64::from(self.steps)]),
             ("max_steps", vec![f64::from(self.max_steps)]),
-            ("goal", super::super::coords(self.goal)),
-            ("next_block_top", super::super::coords(next.top)),
+            ("goal", crate::game::spec::coords(self.goal)),
+            ("next_block_top", crate::game::spec::coords(next.top)),
             ("next_block_size", vec![f64::from(next.size)]),
             (
                 "height_map_hits",

@@ -7,7 +7,7 @@
 use rand_chacha::ChaCha8Rng;
 
 use super::env::{PlatformEnv, PlatformRewards};
-use super::reach;
+use super::reach::{self, Reach};
 use crate::game::generator::{BuildLimits, GeneratorGame, GeneratorRewards, Placement, TrackBuild};
 use crate::game::platform::rules::goal_and_start;
 use crate::game::{PlatformGame, Player};
@@ -81,7 +81,7 @@ pub fn block_from_action(
     track: &PlatformTrack,
     goal: [f64; 3],
     row: &[f32],
-    player: &Player,
+    (player, reach): (&Player, &Reach),
 ) -> BlockParams {
     let unit = |v: f32| if v.is_nan() { 0.0 } else { v as f64 };
     let ranges = player.blocks();
@@ -101,7 +101,6 @@ pub fn block_from_action(
     };
     let rise = goal[1] - last.position[1];
     let on_course = rise * (block.distance / dx.hypot(dz).max(1e-6)).min(1.0);
-    let reach = &player.reach;
     block.height = quantize(
         height
             .clamp(on_course + block.height)
@@ -176,8 +175,10 @@ pub struct PlatformBuild {
     pub track: PlatformTrack,
     pub goal: [f64; 3],
     pub max_blocks: usize,
-    /// Who the track is for: its jumps keep within the player's reach.
+    /// Who the track is for: its jumps keep within the player's reach...
     pub player: Player,
+    /// ...measured once, as the build opens ([`Reach::of_player`]).
+    pub reach: Reach,
 }
 
 impl TrackBuild for PlatformBuild {
@@ -224,7 +225,7 @@ impl TrackBuild for PlatformBuild {
         if self.track.block_count() >= self.max_blocks {
             return Placement::OutOfPieces;
         }
-        let block = block_from_action(&self.track, self.goal, row, &self.player);
+        let block = block_from_action(&self.track, self.goal, row, (&self.player, &self.reach));
         if self.track.push(block).is_err() {
             return Placement::Invalid;
         }
@@ -261,6 +262,8 @@ impl GeneratorGame for PlatformGame {
     const DEFAULT_MAX_PIECES: usize = DEFAULT_MAX_BLOCKS;
     const MAX_PIECES: usize = crate::level::platform::MAX_BLOCKS;
     const PIECE_FEATURES: [&'static str; 2] = ["distance", "size"];
+    /// The training configuration's defaults are the platform game's recipe.
+    const RECIPE: &'static str = "{}";
 
     /// The paper's rewards, but each block placed at λ < 0 costs 0.5·|λ| (the paper's 0.1 let
     /// a hard level be a long one: 22.6 blocks at λ = -1 for 8.4 at +1). Why:
@@ -284,6 +287,7 @@ impl GeneratorGame for PlatformGame {
             goal,
             max_blocks: limits.max_pieces,
             player: limits.player,
+            reach: Reach::of_player(&limits.player),
         };
         (build, rng)
     }
@@ -303,6 +307,7 @@ impl GeneratorGame for PlatformGame {
             goal,
             max_blocks: limits.max_pieces,
             player: limits.player,
+            reach: Reach::of_player(&limits.player),
         };
         for params in &kept.block_params()[..pieces] {
             build.track.push(*params).map_err(|e| e.to_string())?;
@@ -348,7 +353,6 @@ impl GeneratorGame for PlatformGame {
 mod tests {
     use super::*;
     use crate::game::generator::Match;
-    use crate::game::platform::reach::Reach;
     use crate::level::params::{BLOCK_DISTANCE, BLOCK_HEIGHT, BLOCK_SIZE};
     use crate::level::platform::Start;
     use crate::level::stats::Outcome;
@@ -391,7 +395,12 @@ mod tests {
             "a goal to the right is a negative turn"
         );
         let aim = aimed(&track, [20.0, 0.0, 0.0]);
-        let block = block_from_action(&track, [20.0, 0.0, 0.0], &aim, &Player::default());
+        let block = block_from_action(
+            &track,
+            [20.0, 0.0, 0.0],
+            &aim,
+            (&Player::default(), &Reach::default()),
+        );
         assert!((block.angle + 90.0).abs() < 1e-3, "{block:?}");
     }
 
@@ -403,6 +412,7 @@ mod tests {
             goal,
             max_blocks: 30,
             player: Player::default(),
+            reach: Reach::default(),
         }
     }
 
@@ -586,7 +596,12 @@ mod tests {
             heading: 90.0,
             ..Start::default()
         });
-        let block = block_from_action(&track, [20.0, 4.0, 0.0], &[0.0; 4], &Player::default());
+        let block = block_from_action(
+            &track,
+            [20.0, 4.0, 0.0],
+            &[0.0; 4],
+            (&Player::default(), &Reach::default()),
+        );
         assert_eq!(block.distance, 7.5);
         assert_eq!(
             block.angle, -90.0,
@@ -597,7 +612,7 @@ mod tests {
             &track,
             [20.0, 40.0, 0.0],
             &[0.0, 0.0, 0.0, 1.0],
-            &Player::default(),
+            (&Player::default(), &Reach::default()),
         );
         assert_eq!(
             steep.height, 2.0,
@@ -617,7 +632,7 @@ mod tests {
             &track,
             [60.0, 30.0, 0.0],
             &[1.0, 0.0, -1.0, 1.0],
-            &Player::default(),
+            (&Player::default(), &Reach::default()),
         );
         assert_eq!(far_up.height, 2.0);
         assert_eq!(far_up.distance, 4.25 + 0.5 * (4.0 + 4.0));
@@ -625,14 +640,15 @@ mod tests {
             &track,
             [60.0, 0.0, 0.0],
             &[1.0, 0.0, -1.0, 0.0],
-            &Player::default(),
+            (&Player::default(), &Reach::default()),
         );
         assert_eq!(far_flat.distance, 10.0, "a flat 6 m gap is within reach");
         let mut rng = ChaCha8Rng::seed_from_u64(4);
         for _ in 0..2000 {
             let row: [f32; 4] = std::array::from_fn(|_| rng.random_range(-1.5..1.5));
             let goal = [60.0, rng.random_range(-20.0..20.0), 10.0];
-            let block = block_from_action(&track, goal, &row, &Player::default());
+            let block =
+                block_from_action(&track, goal, &row, (&Player::default(), &Reach::default()));
             let placed = track.preview(&block);
             let gap = track.last().edge_gap(&placed);
             assert!(
@@ -651,7 +667,7 @@ mod tests {
             };
             let player = Player::default()
                 .with_pieces(Some(crate::level::profile::Pieces::Platform(narrow)));
-            let block = block_from_action(&track, goal, &row, &player);
+            let block = block_from_action(&track, goal, &row, (&player, &Reach::default()));
             if let Err(outside) = narrow.check_block(&block) {
                 panic!("{block:?}: {outside}");
             }
@@ -674,6 +690,7 @@ mod tests {
             goal: [0.0, 0.0, 30.0],
             max_blocks: 4,
             player: Player::default(),
+            reach: Reach::default(),
         };
         let mut game = Match::<PlatformGame>::new(build, vec![-1.0], 1);
         let toward_goal = [-1.0, 0.0, 0.0, 0.0];

@@ -8,6 +8,7 @@ use super::env::{PlatformEnv, PlatformRewards};
 use super::scripted::ScriptedController;
 use crate::game::SolverEnv;
 use crate::level::platform::{BlockParams, PlatformTrack, Start};
+use crate::level::profile::{Abilities, CharacterProfile};
 use crate::level::stats::{Outcome, TrialResult};
 
 /// The height changes the table lists, m.
@@ -55,6 +56,31 @@ impl Reach {
         } else {
             Self(measure_reach(body))
         }
+    }
+
+    /// The reach of `player`'s character (the built-in one's when it has no platform
+    /// abilities), measured once per process and kept: a batch, a campaign, a training run or
+    /// the designer's edits measure each character once. The same abilities always give the
+    /// same table, so keeping it changes no result.
+    pub fn of_player(player: &crate::game::Player) -> Self {
+        use std::sync::{Mutex, OnceLock};
+        let Some(Abilities::Platform(character)) = player.abilities else {
+            return Self::default();
+        };
+        static MEASURED: OnceLock<Mutex<Vec<(CharacterProfile, Reach)>>> = OnceLock::new();
+        let measured = MEASURED.get_or_init(Default::default);
+        let known = |all: &[(CharacterProfile, Reach)]| {
+            all.iter().find(|(c, _)| *c == character).map(|(_, r)| *r)
+        };
+        if let Some(reach) = known(&measured.lock().unwrap_or_else(|e| e.into_inner())) {
+            return reach;
+        }
+        let reach = Self::of(Body::from(character));
+        measured
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push((character, reach));
+        reach
     }
 
     /// The highest climb, m, of the table's heights from 0 up that the character still makes

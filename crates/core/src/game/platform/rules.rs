@@ -83,9 +83,10 @@ pub fn platform_level_draw(
     draw: u32,
 ) -> Result<Level, NoLevel> {
     let (goal, start, mut rng) = goal_and_start(seed, goal);
+    let reach = Reach::of_player(player);
     let mut skip = draw;
     for _ in 0..ATTEMPTS {
-        if let Some(track) = attempt(&mut rng, start, goal, config, player) {
+        if let Some(track) = attempt(&mut rng, start, goal, config, (player, &reach)) {
             if skip > 0 {
                 skip -= 1;
                 continue;
@@ -108,24 +109,21 @@ pub fn platform_level_draw(
     })
 }
 
-/// One try at a whole track; `None` when it gets stuck or runs out of blocks.
+/// One try at a whole track for a player and its reach; `None` when it gets stuck or runs out
+/// of blocks.
 fn attempt(
     rng: &mut ChaCha8Rng,
     start: Start,
     goal: [f64; 3],
     config: &PlatformRulesConfig,
-    player: &Player,
+    (player, reach): (&Player, &Reach),
 ) -> Option<PlatformTrack> {
     let mut track = PlatformTrack::new(start);
     while track.block_count() < config.max_blocks as usize {
         let placed = (0..CANDIDATES).any(|_| {
-            let candidate = draw(rng, track.last(), goal, config, player);
-            is_jumpable(
-                track.last(),
-                &track.preview(&candidate),
-                config,
-                &player.reach,
-            ) && track.push(candidate).is_ok()
+            let candidate = draw(rng, track.last(), goal, config, (player, reach));
+            is_jumpable(track.last(), &track.preview(&candidate), config, reach)
+                && track.push(candidate).is_ok()
         });
         if !placed {
             return None;
@@ -157,11 +155,10 @@ fn draw(
     last: &Platform,
     goal: [f64; 3],
     config: &PlatformRulesConfig,
-    player: &Player,
+    (player, reach): (&Player, &Reach),
 ) -> BlockParams {
     let ranges = player.blocks();
     let (distances, sizes, heights) = (ranges.distance(), ranges.size(), ranges.height());
-    let reach = &player.reach;
     let (dx, dz) = (goal[0] - last.position[0], goal[2] - last.position[2]);
     let horizontal = dx.hypot(dz);
     let rise = goal[1] - last.position[1];

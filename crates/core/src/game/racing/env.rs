@@ -498,17 +498,17 @@ impl crate::game::SolverEnv for RacingEnv {
         let rotation = self.world.rotation();
         let sample = self.road.samples()[self.nearest];
         vec![
-            ("position", super::super::coords(self.world.position())),
+            ("position", crate::game::spec::coords(self.world.position())),
             (
                 "rotation_xyzw",
                 [rotation.x, rotation.y, rotation.z, rotation.w]
                     .map(f64::from)
                     .to_vec(),
             ),
-            ("velocity", super::super::coords(self.world.velocity())),
+            ("velocity", crate::game::spec::coords(self.world.velocity())),
             (
                 "angular_velocity",
-                super::super::coords(self.world.angular_velocity()),
+                crate::game::spec::coords(self.world.angular_velocity()),
             ),
             ("goal", self.goal.to_vec()),
             ("road_point", sample.centre.to_vec()),

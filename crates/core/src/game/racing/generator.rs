@@ -324,6 +324,7 @@ impl GeneratorGame for RacingGame {
     const DEFAULT_MAX_PIECES: usize = DEFAULT_MAX_SEGMENTS;
     const MAX_PIECES: usize = racing::MAX_SEGMENTS;
     const PIECE_FEATURES: [&'static str; 2] = ["curve", "height"];
+    const RECIPE: &'static str = include_str!("recipe.yaml");
 
     /// Progress pays 0.02 per metre (a racing goal is 220-360 m away, so a whole track pays
     /// about what a platform track's 30-70 m pay at 0.1, and stays below the failure term), and

@@ -4,7 +4,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::*;
 use crate::rl::policy::ActorCritic;
-use crate::rl::ppo::clipped_policy_loss;
+use crate::rl::ppo::readable_loss;
 
 fn flat_parameters(policy: &ActorCritic) -> Vec<f32> {
     policy
@@ -20,35 +20,8 @@ fn flat_parameters(policy: &ActorCritic) -> Vec<f32> {
         .collect()
 }
 
-/// The fused gradients against candle's autograd of the same loss, on random inputs, for
+/// The fused gradients against candle's autograd of [`readable_loss`], on random inputs, for
 /// shapes with and without each kind of action.
-/// The PPO loss of `policy` on `(observations, actions)` as candle computes it, for its
-/// autograd to differentiate.
-fn autograd_loss(
-    policy: &ActorCritic,
-    (observations, actions): (&Tensor, &Tensor),
-    old_log_probs: &Tensor,
-    advantages: &Tensor,
-    returns: &Tensor,
-    weights: LossWeights,
-) -> Tensor {
-    let (new_log_prob, entropy, values) = policy.evaluate(observations, actions).unwrap();
-    let policy_loss =
-        clipped_policy_loss(&new_log_prob, old_log_probs, advantages, weights.clip_coef).unwrap();
-    let value_loss = ((values - returns)
-        .unwrap()
-        .sqr()
-        .unwrap()
-        .mean_all()
-        .unwrap()
-        * 0.5)
-        .unwrap();
-    let entropy = entropy.mean_all().unwrap();
-    ((&policy_loss - (&entropy * weights.ent_coef as f64).unwrap()).unwrap()
-        + (&value_loss * weights.vf_coef as f64).unwrap())
-    .unwrap()
-}
-
 #[test]
 fn gradients_match_candle_autograd() {
     for (continuous, binary, rows) in [(2, 1, 150), (3, 0, 64), (0, 2, 70)] {
@@ -101,27 +74,15 @@ fn gradients_match_candle_autograd() {
         let layout = ParamLayout::new(&shape);
         let mut workspace = Workspace::new(layout, rows + 10);
         let params = flat_parameters(&policy);
-        let terms = workspace.loss_and_gradients(
-            &params,
-            &Minibatch {
-                observations: &observations,
-                actions: &actions,
-                old_log_probs: &old_log_probs,
-                advantages: &advantages,
-                returns: &returns,
-            },
-            weights,
-        );
-
-        let column = |v: &[f32]| Tensor::from_slice(v, rows, &Device::Cpu).unwrap();
-        let loss = autograd_loss(
-            &policy,
-            (&obs_t, &act_t),
-            &column(&old_log_probs),
-            &column(&advantages),
-            &column(&returns),
-            weights,
-        );
+        let minibatch = Minibatch {
+            observations: &observations,
+            actions: &actions,
+            old_log_probs: &old_log_probs,
+            advantages: &advantages,
+            returns: &returns,
+        };
+        let terms = workspace.loss_and_gradients(&params, &minibatch, weights);
+        let loss = readable_loss(&policy, &minibatch, weights).unwrap();
         let reference_loss = loss.to_scalar::<f32>().unwrap();
         assert!(
             (terms.total(weights) - reference_loss).abs() < 1e-5 * reference_loss.abs().max(1.0),

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use arlpcg::services::generation::{Ask, LevelRequest};
 use arlpcg::shells::design::app::{
-    self, App, Effect, GoalSetting, LoadedInfo, Message, Overlay, Response,
+    self, App, Effect, GoalSetting, LoadedInfo, Loading, Message, Mode, Overlay, Response,
 };
 use arlpcg::shells::design::layout::Areas;
 use arlpcg::shells::design::view;
@@ -276,9 +276,9 @@ fn slider_keys_and_mouse_change_lambda_and_regenerate() {
     h.key(KeyCode::Home);
     assert_eq!(h.app.aux, -1.0);
     // Only the newest generation's level is shown.
-    let newest = h.app.requested;
+    assert!(h.app.generating());
     h.settle();
-    assert_eq!(h.app.shown, newest);
+    assert_eq!(h.app.loading, Loading::Idle);
     assert_eq!(h.app.level.as_ref().unwrap().aux, Some(-1.0));
 
     h.send(Message::Resize {
@@ -535,7 +535,7 @@ fn racing_tracks_are_designed_like_platform_levels() {
         "the same platform level as before"
     );
     h.key(KeyCode::Char('q'));
-    assert!(h.app.quit);
+    assert_eq!(h.app.mode, Mode::Quitting);
 }
 
 /// The workers answer the newest request of a kind: trials of a level the slider has moved

@@ -100,6 +100,25 @@ impl PromptKind {
     }
 }
 
+/// Whether a level is on its way.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Loading {
+    /// None: the level on screen (or its error) answers the newest request.
+    #[default]
+    Idle,
+    /// Generation `id` is in flight; an older one's level is dropped when it arrives.
+    Generating { id: u64 },
+}
+
+/// Whether the designer runs on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Mode {
+    #[default]
+    Designing,
+    /// `q`, Esc or Ctrl-C: the loop ends and the terminal is restored.
+    Quitting,
+}
+
 /// What covers the screen, if anything.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Overlay {
@@ -158,9 +177,8 @@ pub struct App {
     pub out_dir: PathBuf,
     /// The level on screen.
     pub level: Option<Arc<Level>>,
-    /// The id of the newest generation asked for; the level on screen answers it when equal.
-    pub requested: u64,
-    pub shown: u64,
+    /// The generation in flight, if any.
+    pub loading: Loading,
     pub generation_error: Option<String>,
     pub trials: Option<Trials>,
     pub replay: Option<Replay>,
@@ -183,7 +201,7 @@ pub struct App {
     next_id: u64,
     /// Whether the screen is drawn in colour (not under `NO_COLOR`).
     pub colour: bool,
-    pub quit: bool,
+    pub mode: Mode,
 }
 
 impl App {
@@ -205,8 +223,7 @@ impl App {
             trials_wanted: DEFAULT_TRIALS,
             out_dir,
             level: None,
-            requested: 0,
-            shown: 0,
+            loading: Loading::Idle,
             generation_error: None,
             trials: None,
             replay: None,
@@ -223,7 +240,7 @@ impl App {
             dragging: false,
             next_id: 1,
             colour: true,
-            quit: false,
+            mode: Mode::Designing,
         }
     }
 
@@ -240,12 +257,12 @@ impl App {
 
     /// Whether a generation is in flight.
     pub fn generating(&self) -> bool {
-        self.requested != self.shown
+        self.loading != Loading::Idle
     }
 
     fn generate(&mut self) -> Vec<Effect> {
         let id = self.id();
-        self.requested = id;
+        self.loading = Loading::Generating { id };
         self.replay = None;
         self.recording = None;
         vec![Effect::Generate {

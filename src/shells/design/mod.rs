@@ -19,7 +19,7 @@ use ratatui::DefaultTerminal;
 use ratatui::crossterm::event::{self, DisableMouseCapture, EnableMouseCapture, Event};
 use ratatui::crossterm::execute;
 
-use app::{App, LoadedInfo, Message, Response};
+use app::{App, LoadedInfo, Message, Mode, Response};
 use arlpcg_core::level::Game;
 use worker::{GamePolicies, Policies, Workers};
 
@@ -142,7 +142,7 @@ fn event_loop(
     for effect in app.start() {
         workers.submit(effect);
     }
-    while !app.quit {
+    while app.mode == Mode::Designing {
         terminal.draw(|frame| view::render(app, frame))?;
         let message = if event::poll(TICK)? {
             match event::read()? {

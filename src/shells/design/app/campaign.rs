@@ -17,7 +17,7 @@ use ratatui::style::{Style, Stylize};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Clear, Paragraph};
 
-use super::{App, Effect, Overlay, PromptKind};
+use super::{App, Effect, Loading, Overlay, PromptKind};
 use crate::services::campaign::Campaign;
 use arlpcg_core::level::Level;
 
@@ -160,9 +160,8 @@ impl App {
             return Vec::new();
         }
         self.overlay = Overlay::None;
-        let id = self.id();
-        self.requested = id;
-        self.shown = id;
+        // A level already in flight is dropped when it arrives.
+        self.loading = Loading::Idle;
         self.replay = None;
         self.selected = None;
         self.generation_error = None;

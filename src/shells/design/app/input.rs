@@ -14,7 +14,7 @@ impl App {
             return Vec::new();
         }
         if key.modifiers.contains(KeyModifiers::CONTROL) && key.code == KeyCode::Char('c') {
-            self.quit = true;
+            self.mode = Mode::Quitting;
             return Vec::new();
         }
         match std::mem::replace(&mut self.overlay, Overlay::None) {
@@ -37,7 +37,7 @@ impl App {
         self.status = None;
         match key.code {
             KeyCode::Char('q') | KeyCode::Esc => {
-                self.quit = true;
+                self.mode = Mode::Quitting;
                 Vec::new()
             }
             KeyCode::Char('?') => {

@@ -74,10 +74,10 @@ impl App {
 
     /// The requested level (or why there is none) arrives; an older request's is dropped.
     fn level_arrived(&mut self, id: u64, result: Result<Arc<Level>, String>) -> Vec<Effect> {
-        if id != self.requested {
+        if self.loading != (Loading::Generating { id }) {
             return Vec::new();
         }
-        self.shown = id;
+        self.loading = Loading::Idle;
         match result {
             Ok(level) => {
                 self.generation_error = None;

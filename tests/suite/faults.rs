@@ -2,31 +2,10 @@
 //! level, a policy, a configuration or an output file should be is refused at once (opening it
 //! would block forever), and nothing is overwritten without `--force`.
 
-use crate::common::{files_of, stderr};
+use crate::common::{arlpcg_within, files_of, stderr};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
-
-/// Runs the binary, killed after `limit` (so that a hang fails the test instead of stalling it).
-fn arlpcg_within(args: &[&str], limit: Duration) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
-        .args(args)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the binary runs");
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > limit {
-            child.kill().unwrap();
-            let _ = child.wait();
-            panic!("{args:?} still ran after {limit:?}: it hangs");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    child.wait_with_output().unwrap()
-}
 
 /// Sends Ctrl-C (SIGINT) to `child`; when it was sent.
 fn interrupt(child: &std::process::Child) -> Instant {
@@ -340,7 +319,7 @@ fn ctrl_c_stops_the_difficulty_curve_measurement_at_once() {
         std::fs::copy(shipped.join(name), policies.join(name)).unwrap();
     }
     let out = dir.path().join("out");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+    let mut child = crate::common::test_command()
         .args([
             "generate",
             "--policies",
@@ -502,5 +481,37 @@ fn an_argument_that_is_not_utf8_is_refused_before_anything_is_made() {
             "{err}"
         );
         assert!(!odd.exists(), "{command:?}: nothing made");
+    }
+}
+
+/// A standard output that cannot be written for another reason than a closed pipe (a full
+/// disk: `> /dev/full`) is an error in one line, exit 1, not a panic.
+#[test]
+fn a_full_disk_on_standard_output_is_an_error_not_a_panic() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        eprintln!("skipped: no /dev/full here");
+        return;
+    };
+    for args in [
+        vec!["profile", "init", "--game", "racing"],
+        vec!["verify", "--trials", "2", "--json"],
+    ] {
+        let mut command = crate::common::test_command();
+        command.args(&args);
+        if args[0] == "verify" {
+            command.arg(shipped_level());
+        }
+        let output = command
+            .stdout(full.try_clone().unwrap())
+            .stderr(Stdio::piped())
+            .output()
+            .unwrap();
+        let err = stderr(&output);
+        assert_eq!(output.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("cannot write to standard output") && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{err}");
     }
 }

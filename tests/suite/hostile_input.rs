@@ -316,3 +316,59 @@ fn a_card_that_disagrees_with_its_weights_or_its_game_is_refused_by_name() {
         }
     }
 }
+
+/// Text from files is made safe before it reaches a terminal: a profile name with a line break
+/// or escape codes is refused, and what a file says is echoed with its control characters
+/// escaped (a profile's format here); `-0.0` in a profile reads as 0, the same level as `0.0`.
+#[test]
+fn file_text_is_safe_for_a_terminal_and_minus_zero_is_zero() {
+    use crate::common::{arlpcg, arlpcg_ok, fails_with, stderr, words};
+    let dir = tempfile::tempdir().unwrap();
+    let init = arlpcg_ok(words("profile init --game platform", &[]));
+    let profile = String::from_utf8(init.stdout).unwrap();
+    let named = dir.path().join("named.yaml");
+    let name = "name: \"evil\\n\\e[2J\\e[31mred\"";
+    std::fs::write(&named, profile.replacen("name: default", name, 1)).unwrap();
+    let refused = arlpcg(words("profile check {}", &[&named]));
+    fails_with(
+        &refused,
+        1,
+        "name: a line of text without control characters",
+    );
+    assert!(!refused.stderr.contains(&0x1b), "{}", stderr(&refused));
+
+    // What a file says, quoted back in a message, has its control characters escaped.
+    let format = dir.path().join("format.yaml");
+    let forged = "format: \"\\e[2Jwho\\rforged\"";
+    std::fs::write(
+        &format,
+        profile.replacen("format: arlpcg-profile", forged, 1),
+    )
+    .unwrap();
+    let refused = arlpcg(words("profile check {}", &[&format]));
+    assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
+    assert!(
+        !refused.stderr.contains(&0x1b) && !refused.stderr.contains(&b'\r'),
+        "{:?}",
+        stderr(&refused)
+    );
+    assert!(
+        stderr(&refused).contains("`\\u{1b}[2Jwho forged`"),
+        "{}",
+        stderr(&refused)
+    );
+
+    // -0.0 and 0.0: one profile, one SHA-256, one level.
+    let level = |drop: &str| {
+        let path = dir.path().join(format!("drop{drop}.yaml"));
+        let text = profile.replacen("min_height: ", &format!("min_height: {drop} #"), 1);
+        std::fs::write(&path, text).unwrap();
+        let out = dir.path().join(format!("levels{drop}"));
+        arlpcg_ok(words(
+            "generate --rules --profile {} --seed 3 --format yaml --out {}",
+            &[&path, &out],
+        ));
+        std::fs::read(out.join("platform_seed3.yaml")).unwrap()
+    };
+    assert_eq!(level("-0.0"), level("0.0"));
+}

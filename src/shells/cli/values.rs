@@ -113,8 +113,8 @@ pub(super) fn parse_game(s: &str) -> Result<Game, String> {
 
 pub(super) fn parse_aux(s: &str) -> Result<f64, String> {
     let value: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    // -0 is 0: the same level, file name and YAML.
-    params::AUX.check(value + 0.0).map_err(|e| e.to_string())
+    // -0 is 0 (`check` returns it so): the same level, file name and YAML.
+    params::AUX.check(value).map_err(|e| e.to_string())
 }
 
 pub(super) fn parse_point(s: &str) -> Result<[f64; 3], String> {

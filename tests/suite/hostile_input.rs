@@ -317,6 +317,51 @@ fn a_card_that_disagrees_with_its_weights_or_its_game_is_refused_by_name() {
     }
 }
 
+/// Files are held to the limits of the arguments that would make them: a population beyond
+/// `--population`'s limits is refused as an argument (exit 2), and in a campaign.yaml, as are
+/// more runs than `campaign --trials` allows and a number out of its range, by file and field,
+/// before anything is played.
+#[test]
+fn files_meet_the_limits_of_the_arguments_that_make_them() {
+    use crate::common::{arlpcg, arlpcg_within, fails_with, stderr, words};
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("campaign");
+    let asked = arlpcg(words(
+        "campaign --ramp 0:0.5 --population 0,1e308 --out {}",
+        &[&out],
+    ));
+    fails_with(&asked, 2, "theta_sd 1e308 must be a number within [0, 50]");
+    assert!(!out.exists());
+    let shipped = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/results/platform/campaign/campaign.yaml"
+    ))
+    .unwrap();
+    let file = dir.path().join("campaign.yaml");
+    for (from, to, expected) in [
+        (
+            "trials: 100\n",
+            "trials: 4000000000\n",
+            "trials: 4000000000 is not within [10, 100000]",
+        ),
+        (
+            "theta_sd: 2.9968", "theta_sd: 1.0e308", "population.theta_sd 1e308 must be",
+        ),
+        (
+            "  measured: 1.0\n",
+            "  measured: 1.0e308\n",
+            "levels[0].measured: 1e308 is not a number within [0, 1]",
+        ),
+    ] {
+        assert!(shipped.contains(from), "{from}");
+        std::fs::write(&file, shipped.replacen(from, to, 1)).unwrap();
+        let args = ["verify", "--campaign", file.to_str().unwrap()];
+        let refused = arlpcg_within(&args, std::time::Duration::from_secs(60));
+        fails_with(&refused, 1, expected);
+        assert!(stderr(&refused).contains(file.to_str().unwrap()));
+    }
+}
+
 /// Text from files is made safe before it reaches a terminal: a profile name with a line break
 /// or escape codes is refused, and what a file says is echoed with its control characters
 /// escaped (a profile's format here); `-0.0` in a profile reads as 0, the same level as `0.0`.

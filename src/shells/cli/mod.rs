@@ -536,7 +536,7 @@ pub struct CampaignArgs {
     #[arg(long, value_name = "DIR")]
     pub policies: Option<PathBuf>,
     /// How many levels.
-    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=crate::services::campaign::MOST_LEVELS as i64))]
     pub levels: u32,
     /// The success asked for along the campaign: control points `position:success`, position 0
     /// the first level and 1 the last, linear between them ("0:0.95, 1:0.5"; two points at one
@@ -560,7 +560,7 @@ pub struct CampaignArgs {
     #[arg(long, value_name = "NAME", value_parser = Judge::parse)]
     pub judge: Option<Judge>,
     /// Runs per level, for the judge's search and for each judge of the panel.
-    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(10..=100_000))]
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(crate::services::campaign::TRIALS.0 as i64..=crate::services::campaign::TRIALS.1 as i64))]
     pub trials: u32,
     /// Level k is searched from seed SEED + k: the same seed gives the same campaign, byte for
     /// byte.

@@ -362,6 +362,95 @@ fn files_meet_the_limits_of_the_arguments_that_make_them() {
     }
 }
 
+/// `report` reads files of both games: a results.json, a campaign or a card of the other game
+/// where one game's belongs is refused in one line naming the file (it once panicked on the
+/// results, and quoted the campaign and listed the card), as is a number out of its range (it
+/// once wrote a 309-digit success ratio); the page is left as it was.
+#[test]
+fn report_refuses_the_other_games_files_and_numbers_out_of_range() {
+    use crate::common::{arlpcg, arlpcg_ok, fails_with, stderr, words};
+    let dir = tempfile::tempdir().unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let (results, policies) = (dir.path().join("results"), dir.path().join("policies"));
+    copy_tree(&root.join("results"), &results, &|_| true);
+    copy_tree(&root.join("policies"), &policies, &|p| {
+        p.extension().is_none_or(|e| e == "yaml")
+    });
+    let page = dir.path().join("results.md");
+    let report = |extra: &str| {
+        arlpcg(words(
+            &format!("report --results {{}} --policies {{}} --out {{}}{extra}"),
+            &[&results, &policies, &page],
+        ))
+    };
+    arlpcg_ok(words(
+        "report --results {} --policies {} --out {}",
+        &[&results, &policies, &page],
+    ));
+    let written = std::fs::read(&page).unwrap();
+    let platform = results.join("platform");
+    let swap = |target: &std::path::Path, from: &std::path::Path, expected: &str| {
+        let own = std::fs::read(target).unwrap();
+        std::fs::copy(from, target).unwrap();
+        for extra in ["", " --check"] {
+            let refused = report(extra);
+            fails_with(&refused, 1, expected);
+            let said = stderr(&refused);
+            assert_eq!(said.lines().count(), 1, "{said}");
+            assert!(said.contains(target.to_str().unwrap()), "{said}");
+        }
+        std::fs::write(target, own).unwrap();
+    };
+    swap(
+        &platform.join("results.json"),
+        &results.join("racing/results.json"),
+        "its columns are not the platform game's",
+    );
+    swap(
+        &platform.join("campaign/campaign.yaml"),
+        &results.join("racing/campaign/campaign.yaml"),
+        "a racing campaign in the platform results",
+    );
+    swap(
+        &policies.join("platform/solver.yaml"),
+        &policies.join("racing/solver.yaml"),
+        "the card of a racing policy",
+    );
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(platform.join("results.json")).unwrap()).unwrap();
+    json["controllability"][0]["success_ratio"] = serde_json::json!(1e308);
+    let huge = dir.path().join("huge.json");
+    std::fs::write(&huge, serde_json::to_vec(&json).unwrap()).unwrap();
+    swap(
+        &platform.join("results.json"),
+        &huge,
+        "controllability[0].success_ratio: 1e308 is not a number within [0, 1]",
+    );
+    assert_eq!(
+        std::fs::read(&page).unwrap(),
+        written,
+        "the page was rewritten"
+    );
+}
+
+/// Copies the files of `from` that `keep` keeps into `to`, folders and all.
+fn copy_tree(
+    from: &std::path::Path,
+    to: &std::path::Path,
+    keep: &dyn Fn(&std::path::Path) -> bool,
+) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let path = entry.unwrap().path();
+        let target = to.join(path.file_name().unwrap());
+        if path.is_dir() {
+            copy_tree(&path, &target, keep);
+        } else if keep(&path) {
+            std::fs::copy(&path, &target).unwrap();
+        }
+    }
+}
+
 /// Text from files is made safe before it reaches a terminal: a profile name with a line break
 /// or escape codes is refused, and what a file says is echoed with its control characters
 /// escaped (a profile's format here); `-0.0` in a profile reads as 0, the same level as `0.0`.

@@ -515,3 +515,31 @@ fn a_full_disk_on_standard_output_is_an_error_not_a_panic() {
         assert_eq!(err.lines().count(), 1, "{err}");
     }
 }
+
+/// Ctrl-C while a campaign searches a level (thousands of runs per candidate) stops the search
+/// under way: the campaign ends soon after (exit 130) and writes no level it did not finish.
+#[test]
+fn ctrl_c_stops_a_campaign_while_it_searches_a_level() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("campaign");
+    let child = crate::common::test_command()
+        .args(["campaign", "--levels", "2", "--ramp", "0:0.6, 1:0.5"])
+        .args(["--judge", "scripted-median", "--trials", "100000"])
+        .args(["--format", "yaml", "--out", out.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Past loading the policies and reading the shipped curve: into the search.
+    std::thread::sleep(Duration::from_secs(5));
+    let sent = interrupt(&child);
+    let output = child.wait_with_output().unwrap();
+    assert!(
+        sent.elapsed() < Duration::from_secs(10),
+        "took {:?}",
+        sent.elapsed()
+    );
+    assert_eq!(output.status.code(), Some(130), "{}", stderr(&output));
+    let written = std::fs::read_dir(&out).map_or(0, |files| files.count());
+    assert_eq!(written, 0, "no unfinished level");
+}

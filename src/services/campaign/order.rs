@@ -36,16 +36,16 @@ pub fn order_by_difficulty(levels: &mut [Level], targets: &[f64], band: f64) {
 
 /// The search `asked` ([`CampaignAsk::request`]): a level whose success for `solver`, over
 /// `trials` runs, is within [`difficulty::BAND`] of `target` ([`difficulty::level_for`]; with a
-/// curve of λ, that curve moved as a whole), with its certificate.
+/// curve of λ, that curve moved as a whole), with its certificate. `stopped` ends the search
+/// ([`difficulty::TargetError::SearchStopped`]).
 pub fn search_level(
-    generator: &GeneratorPolicy,
-    solver: &Solver,
+    (generator, solver): (&GeneratorPolicy, &Solver),
     curve: &difficulty::Curve,
     asked: &LevelRequest,
-    target: f64,
-    trials: u32,
+    (target, trials): (f64, u32),
+    stopped: &(dyn Fn() -> bool + Sync),
 ) -> anyhow::Result<Level> {
-    let level = difficulty::level_for(generator, solver, curve, asked, target, trials)?;
+    let level = difficulty::level_for(generator, solver, curve, asked, (target, trials), stopped)?;
     Ok(verify::certified(level, solver, asked.seed)?)
 }
 
@@ -202,7 +202,13 @@ pub fn regenerate_level(
         + 1;
     let target = record.levels[k].asked;
     let asked = record.ask().request(seed);
-    levels[k] = search_level(generator, &solver, &curve, &asked, target, record.trials)?;
+    levels[k] = search_level(
+        (generator, &solver),
+        &curve,
+        &asked,
+        (target, record.trials),
+        stop,
+    )?;
     for level in &mut levels {
         if let Some(stats) = &mut level.stats {
             stats.panel = None;

@@ -31,6 +31,13 @@ use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::statistics::population::Population;
 
 pub fn run(args: &CampaignArgs) -> Result<()> {
+    // Ctrl-C from the start stops the campaign at its next safe point: the levels finished
+    // are written for --resume.
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
     if args.out.exists() && !args.out.is_dir() {
         anyhow::bail!("--out {} is not a folder", args.out.display());
     }
@@ -78,11 +85,6 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     let files: Vec<LevelFiles> = (0..n)
         .map(|k| LevelFiles::new(&args.out, &level_stem(k, n), &formats))
         .collect();
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
-    }
     let resumed = match args.resume {
         true => resumed_levels(args, &ask, &files, &solver)?,
         false => vec![None; n],
@@ -102,7 +104,15 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
             )
         },
         &|| stop.load(Ordering::SeqCst),
-    )?;
+    )
+    .map_err(|e| match e.downcast_ref::<difficulty::TargetError>() {
+        Some(difficulty::TargetError::Stopped) => Interrupted(
+            "interrupted (Ctrl-C) while the λ→success curve was measured; nothing was written"
+                .into(),
+        )
+        .into(),
+        _ => e,
+    })?;
     let built = search_levels(args, &ask, &generator, &solver, &curve, resumed, &stop)?;
     if built.iter().any(Option::is_none) {
         return interrupted(args, &built, &files);
@@ -110,12 +120,11 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     let mut levels: Vec<Level> = built.into_iter().flatten().collect();
     let search = |seed: u64, target: f64| {
         search_level(
-            &generator,
-            &solver,
+            (&generator, &solver),
             &curve,
             &ask.request(seed),
-            target,
-            args.trials,
+            (target, args.trials),
+            &|| stop.load(Ordering::SeqCst),
         )
     };
     let Some(campaign) = rate_levels(&ask, &panel, &mut levels, &stop, Some(&search))? else {
@@ -153,15 +162,18 @@ fn search_levels(
                 return Ok(None);
             }
             let seed = level_seed(args.seed, k)?;
-            let level = search_level(
-                generator,
-                solver,
+            let searched = search_level(
+                (generator, solver),
                 curve,
                 &ask.request(seed),
-                ask.target(k, n),
-                args.trials,
-            )
-            .with_context(|| {
+                (ask.target(k, n), args.trials),
+                &|| stop.load(Ordering::SeqCst),
+            );
+            // A Ctrl-C during the search leaves the level unsearched.
+            if is_search_stopped(&searched) {
+                return Ok(None);
+            }
+            let level = searched.with_context(|| {
                 format!(
                     "level {} of {n} (seed {seed}, success {:.2} asked); nothing was written",
                     k + 1,
@@ -174,6 +186,16 @@ fn search_levels(
         .collect::<Result<_>>()?;
     bar.finish_and_clear();
     Ok(built)
+}
+
+/// Whether `searched` is a search a Ctrl-C ended.
+fn is_search_stopped<T>(searched: &Result<T>) -> bool {
+    searched.as_ref().is_err_and(|e| {
+        matches!(
+            e.downcast_ref(),
+            Some(difficulty::TargetError::SearchStopped)
+        )
+    })
 }
 
 /// Writes the levels, campaign.yaml, campaign.md and campaign.png, all or none, and says so.
@@ -340,7 +362,13 @@ fn rate_levels(
                 bar.inc_length(level_runs);
                 search(seed, target)
             };
-            rate_and_mend(ask, panel, levels, &watch, &draw)?.map(|(campaign, kept)| {
+            let mended = rate_and_mend(ask, panel, levels, &watch, &draw);
+            // A Ctrl-C while a level was drawn anew stops the campaign as one during the panel.
+            if is_search_stopped(&mended) {
+                bar.finish_and_clear();
+                return Ok(None);
+            }
+            mended?.map(|(campaign, kept)| {
                 for seed in kept {
                     crate::say!(
                         "drew a level anew from seed {seed} where the panel's b stepped down"

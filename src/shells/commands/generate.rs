@@ -497,19 +497,24 @@ fn build_levels(
                 return None;
             }
             let level = match (args.ask().as_ref().and_then(Ask::success), curve, generator) {
-                (Some(target), Some(curve), Some(generator)) => difficulty::level_for(
+                (Some(target), Some(curve), Some(generator)) => match difficulty::level_for(
                     generator,
                     who,
                     curve,
                     &LevelRequest::new(*seed, None)
                         .goal(args.goal)
                         .profile(template.profile.clone()),
-                    target,
-                    verify_trials.unwrap_or(TARGET_TRIALS),
-                )
-                .map_err(anyhow::Error::from)
-                .and_then(|level| verify::certified(level, who, *seed).map_err(anyhow::Error::from))
-                .map(Some),
+                    (target, verify_trials.unwrap_or(TARGET_TRIALS)),
+                    &|| stop.load(Ordering::SeqCst),
+                ) {
+                    // A Ctrl-C during the search leaves the level unmade.
+                    Err(difficulty::TargetError::SearchStopped) => Ok(None),
+                    searched => searched.map_err(anyhow::Error::from).and_then(|level| {
+                        verify::certified(level, who, *seed)
+                            .map(Some)
+                            .map_err(anyhow::Error::from)
+                    }),
+                },
                 _ => build_verified(args, template, generator, who, *seed, stop),
             };
             bar.inc(1);

@@ -156,7 +156,7 @@ pub fn perform(
             let result = match (ask.success(), ask.aux()) {
                 (Some(target), _) => {
                     let asked = LevelRequest::new(seed, None).goal(goal).profile(profile);
-                    target_level(shelf.of(game), &asked, target, trials)
+                    target_level(shelf.of(game), &asked, (target, trials), stop)
                 }
                 (None, aux) => {
                     let mut request = LevelRequest::new(seed, None).goal(goal).profile(profile);
@@ -388,12 +388,13 @@ fn sweep_point(
 }
 
 /// The target-success search of `generate --target-success` with the designer's policies: the
-/// λ→success curve is read from (or, the first time, measured into) the Generator's folder.
+/// λ→success curve is read from (or, the first time, measured into) the Generator's folder. A
+/// newer request (`stop`) ends the measurement and the search.
 fn target_level(
     policies: &Policies,
     asked: &LevelRequest,
-    target: f64,
-    trials: u32,
+    (target, trials): (f64, u32),
+    stop: &(dyn Fn() -> bool + Sync),
 ) -> Result<Level, String> {
     let generator = policies
         .generator
@@ -411,7 +412,7 @@ fn target_level(
         &Solver::Policy(solver),
         asked.profile.as_ref(),
         || {},
-        &|| false,
+        stop,
     )
     .map_err(|e| format!("{e:#}"))?;
     crate::services::difficulty::level_for(
@@ -419,8 +420,8 @@ fn target_level(
         &Solver::Policy(solver),
         &curve,
         asked,
-        target,
-        trials,
+        (target, trials),
+        stop,
     )
     .map_err(|e| e.to_string())
 }

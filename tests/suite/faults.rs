@@ -543,3 +543,34 @@ fn ctrl_c_stops_a_campaign_while_it_searches_a_level() {
     let written = std::fs::read_dir(&out).map_or(0, |files| files.count());
     assert_eq!(written, 0, "no unfinished level");
 }
+
+/// A racing profile whose roads cannot turn (`max_curve: 0`, within its range) leaves most rule
+/// goals out of reach: each is refused at once instead of after every attempt, so `profile
+/// check` answers in seconds (it took minutes of attempts before).
+#[test]
+fn a_profile_whose_roads_cannot_turn_is_checked_in_seconds() {
+    let dir = tempfile::tempdir().unwrap();
+    let init = crate::common::arlpcg_ok(["profile", "init", "--game", "racing"]).stdout;
+    let text = String::from_utf8(init).unwrap();
+    assert!(text.contains("  max_curve: "), "{text}");
+    let straight = dir.path().join("straight.yaml");
+    std::fs::write(
+        &straight,
+        text.replacen("  max_curve: ", "  max_curve: 0 #", 1),
+    )
+    .unwrap();
+    let args = [
+        "profile",
+        "check",
+        straight.to_str().unwrap(),
+        "--trials",
+        "2",
+    ];
+    let checked = arlpcg_within(&args, Duration::from_secs(60));
+    let said = stderr(&checked);
+    assert_eq!(checked.status.code(), Some(1), "{said}");
+    assert!(
+        said.contains("most of the game's goals cannot be reached"),
+        "{said}"
+    );
+}

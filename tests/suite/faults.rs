@@ -544,6 +544,41 @@ fn ctrl_c_stops_a_campaign_while_it_searches_a_level() {
     assert_eq!(written, 0, "no unfinished level");
 }
 
+/// `campaign --resume` with another `--ramp` (or `--trials`) than the campaign in `--out` was
+/// made with is refused, naming a level and what differs: the levels were searched for the
+/// other ramp.
+#[test]
+fn a_campaign_resumed_with_another_ramp_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("campaign");
+    let done = crate::common::small_campaign(&out, &[]);
+    assert!(done.status.success(), "{}", stderr(&done));
+    let before = files_of(&out);
+    let other = crate::common::arlpcg([
+        "campaign",
+        "--game",
+        "platform",
+        "--levels",
+        "3",
+        "--ramp",
+        "0:0.2, 1:0.2",
+        "--judge",
+        "scripted-median",
+        "--trials",
+        "20",
+        "--seed",
+        "40",
+        "--format",
+        "yaml",
+        "--resume",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    crate::common::fails_with(&other, 1, "it was searched for another ramp");
+    assert!(stderr(&other).contains("level0"), "{}", stderr(&other));
+    assert_eq!(files_of(&out), before, "nothing rewritten");
+}
+
 /// A racing profile whose roads cannot turn (`max_curve: 0`, within its range) leaves most rule
 /// goals out of reach: each is refused at once instead of after every attempt, so `profile
 /// check` answers in seconds (it took minutes of attempts before).

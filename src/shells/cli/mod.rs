@@ -585,7 +585,9 @@ pub struct CampaignArgs {
     /// Folder to write into (created if missing).
     #[arg(long)]
     pub out: PathBuf,
-    /// Finish an interrupted campaign in --out: its level files are kept and the rest made.
+    /// Finish an interrupted campaign in --out: its level files are kept and the rest made. The
+    /// same arguments: a level searched for another --ramp or verified with other --trials is
+    /// refused.
     #[arg(long)]
     pub resume: bool,
 }

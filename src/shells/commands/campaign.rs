@@ -299,6 +299,8 @@ fn resumed_levels(
                 args.seed.saturating_add(n as u64 - 1),
             );
         };
+        // A level searched for another ramp or with other trials is not this campaign's level.
+        check_resumed(&level, &path, ask.target(slot, n), args.trials)?;
         // The panel plays the whole campaign again: its rating is of all the levels together.
         if let Some(stats) = &mut level.stats {
             stats.panel = None;
@@ -306,6 +308,32 @@ fn resumed_levels(
         levels[slot] = Some(level);
     }
     Ok(levels)
+}
+
+/// Refuses a resumed level that the campaign asked for now would not have kept: one whose
+/// judge's success lies off its ramp point (it was searched for another `--ramp`), or that
+/// was verified with another `--trials`.
+fn check_resumed(level: &Level, path: &Path, target: f64, trials: u32) -> Result<()> {
+    let Some(stats) = &level.stats else {
+        return Ok(());
+    };
+    let again = "resume with the arguments it was made with, or choose another --out";
+    if stats.trials != trials {
+        anyhow::bail!(
+            "{}: verified with {} runs, and --trials asks {trials}: {again}",
+            path.display(),
+            stats.trials
+        );
+    }
+    if (stats.success_ratio - target).abs() > difficulty::BAND + 1e-9 {
+        anyhow::bail!(
+            "{}: measured success {:.2}, and --ramp asks {target:.2} ± {} of this level: it was searched for another ramp; {again}",
+            path.display(),
+            stats.success_ratio,
+            difficulty::BAND
+        );
+    }
+    Ok(())
 }
 
 /// After a Ctrl-C: writes the levels finished so far (without the panel's rating, which is of

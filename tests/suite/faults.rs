@@ -544,6 +544,33 @@ fn ctrl_c_stops_a_campaign_while_it_searches_a_level() {
     assert_eq!(written, 0, "no unfinished level");
 }
 
+/// `--json` promises JSON on standard output: with `--check` the verdict goes to standard
+/// error, and every line of standard output is a JSON object.
+#[test]
+fn with_json_standard_output_carries_json_alone() {
+    let level = shipped_level();
+    for check in ["completed", "success 0..0.01"] {
+        let args = [
+            "verify", "--trials", "5", "--solver", "scripted-expert", "--json", "--check", check,
+            &level,
+        ];
+        let output = crate::common::arlpcg(args);
+        assert!(
+            matches!(output.status.code(), Some(0 | 3)),
+            "{}",
+            stderr(&output)
+        );
+        let text = String::from_utf8(output.stdout.clone()).unwrap();
+        assert_eq!(text.lines().count(), 1, "{text}");
+        for line in text.lines() {
+            let value: serde_json::Value =
+                serde_json::from_str(line).unwrap_or_else(|e| panic!("`{line}` is not JSON: {e}"));
+            assert!(value.is_object(), "{line}");
+        }
+        assert!(stderr(&output).contains("check"), "{}", stderr(&output));
+    }
+}
+
 /// `campaign --resume` with another `--ramp` (or `--trials`) than the campaign in `--out` was
 /// made with is refused, naming a level and what differs: the levels were searched for the
 /// other ramp.

@@ -444,19 +444,29 @@ fn apply_checks(campaign: &Campaign, levels: &[Level]) -> Result<()> {
         (entry.file.clone(), stats, rating)
     });
     let failed = failures(&campaign.checks, evidence);
-    report_checks(&campaign.checks, failed, levels.len())
+    report_checks(&campaign.checks, failed, levels.len(), false)
 }
 
-/// Exit code 3, naming each level and check that failed, when any did.
-pub fn report_checks(checks: &[Check], failed: Vec<(String, String)>, levels: usize) -> Result<()> {
+/// Exit code 3, naming each level and check that failed, when any did. The verdict goes to
+/// standard output, or with `json` to standard error (standard output then carries only JSON).
+pub fn report_checks(
+    checks: &[Check],
+    failed: Vec<(String, String)>,
+    levels: usize,
+    json: bool,
+) -> Result<()> {
+    let tell = |line: String| match json {
+        true => crate::warn!("{line}"),
+        false => crate::say!("{line}"),
+    };
     if failed.is_empty() {
         if !checks.is_empty() {
-            crate::say!("every level passed its checks ({})", checks.len());
+            tell(format!("every level passed its checks ({})", checks.len()));
         }
         return Ok(());
     }
     for (level, why) in &failed {
-        crate::say!("check failed: {level}: {why}");
+        tell(format!("check failed: {level}: {why}"));
     }
     let levels_failed = {
         let mut names: Vec<&String> = failed.iter().map(|(n, _)| n).collect();

@@ -142,7 +142,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         )
     });
     let failed = checks::failures(&args.checks, named);
-    super::campaign::report_checks(&args.checks, failed, levels.len())
+    super::campaign::report_checks(&args.checks, failed, levels.len(), false)
 }
 
 /// What verification did across the batch: redrawn, unsolved and uncertified levels.

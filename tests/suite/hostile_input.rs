@@ -506,3 +506,37 @@ fn file_text_is_safe_for_a_terminal_and_minus_zero_is_zero() {
     };
     assert_eq!(level("-0.0"), level("0.0"));
 }
+
+/// A run trained for a profile is not one more seed of the built-in game: `eval --runs`
+/// refuses it by its card, naming the file and the profile.
+#[test]
+fn a_run_trained_for_a_profile_is_not_a_seed_of_the_built_in_game() {
+    use arlpcg_core::level::profile::Profile;
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    std::fs::create_dir(&run).unwrap();
+    let solver = policy_with_card(&run, "solver.safetensors", None, |card| {
+        let profile = Profile::default_of(Game::Platform)
+            .with_value("character.jump_speed", 8.0)
+            .unwrap();
+        card.profile = Some(
+            Profile {
+                name: "jumpy".into(),
+                ..profile
+            }
+            .record(),
+        );
+    });
+    let out = dir.path().join("out");
+    let args = [
+        "eval",
+        "--runs",
+        run.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let refused = crate::common::arlpcg(args);
+    crate::common::fails_with(&refused, 1, "was trained for profile `jumpy`");
+    assert!(crate::common::stderr(&refused).contains(&solver));
+    assert!(!out.exists());
+}

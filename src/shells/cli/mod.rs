@@ -212,8 +212,9 @@ pub struct EvalArgs {
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
     pub threads: Option<u64>,
     /// Make and play every level for this game profile (`arlpcg profile init`); results.json
-    /// records it.
-    #[arg(long, value_name = "FILE")]
+    /// records it (a shard's part too, which --merge then keeps). Not with --runs, whose seeds
+    /// tables are of the built-in game.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["merge", "runs"])]
     pub profile: Option<PathBuf>,
 }
 

@@ -15,7 +15,6 @@ use crate::services::generation::GeneratorPolicy;
 use crate::services::panel::JudgePanel;
 use crate::services::verify::{Solver, SolverPolicy, verify};
 use arlpcg_core::level::Level;
-use arlpcg_core::level::profile::Profile;
 use arlpcg_core::seed_ranges::EVAL_SEED_BASE;
 use arlpcg_core::statistics::over_seeds::{
     Aggregate, Estimate, estimate, probability_of_improvement,
@@ -275,15 +274,14 @@ pub struct SeedRun<'a> {
 /// Plays the validation set (rule levels first, `rule_levels` of them) with every run's Solver,
 /// each adversarial run's own pair and the `judges` on its controllability levels, and every
 /// Solver on the λ = -1 levels of the ARLPCG Generators other than its run's own
-/// ([`other_generators_plays`] of them); `on_level` after each level played. Generator levels
-/// are made for `profile` (none: the built-in game), as the validation set must be.
+/// ([`other_generators_plays`] of them); `on_level` after each level played. Levels are of the
+/// built-in game, as the runs' are.
 pub fn score_runs(
     runs: &[SeedRun],
     judges: &JudgePanel,
     validation: &[Level],
     rule_levels: usize,
     budget: Budget,
-    profile: Option<&Profile>,
     on_level: &(dyn Fn() + Sync),
 ) -> Result<Vec<RunScores>, candle_core::Error> {
     // Each level's success ratio with `solver`.
@@ -309,7 +307,7 @@ pub fn score_runs(
                     AUX_VALUES
                         .iter()
                         .map(|&aux| {
-                            generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks, profile)
+                            generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks, None)
                         })
                         .collect::<Result<Vec<_>, _>>()
                 })

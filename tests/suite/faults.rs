@@ -544,6 +544,48 @@ fn ctrl_c_stops_a_campaign_while_it_searches_a_level() {
     assert_eq!(written, 0, "no unfinished level");
 }
 
+/// Arguments that do not fit together exit 2 (`--profile` with `--runs`, or with `--merge`,
+/// whose parts record their profile), and a command refused for a file it reads (a profile
+/// that is not a number) leaves no folder it would have made.
+#[test]
+fn misfits_exit_2_and_a_refused_run_leaves_no_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let profile = dir.path().join("nan.yaml");
+    let init = crate::common::arlpcg_ok(["profile", "init", "--game", "platform"]).stdout;
+    let text = String::from_utf8(init).unwrap();
+    let nan = text.replacen("jump_speed: ", "jump_speed: .nan #", 1);
+    std::fs::write(&profile, nan).unwrap();
+    let profile = profile.to_str().unwrap();
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    for args in [
+        vec![
+            "eval", "--runs", out_s, "--profile", profile, "--out", out_s,
+        ],
+        vec![
+            "eval", "--merge", out_s, "--profile", profile, "--out", out_s,
+        ],
+    ] {
+        let output = crate::common::arlpcg(&args);
+        assert_eq!(
+            output.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            stderr(&output)
+        );
+        assert!(stderr(&output).contains("--profile"), "{}", stderr(&output));
+    }
+    for missing in [profile, "/nonexistent/profile.yaml"] {
+        let args = [
+            "train", "--steps", "10", "--profile", missing, "--out", out_s,
+        ];
+        let output = crate::common::arlpcg(args);
+        assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+        assert!(stderr(&output).contains(missing), "{}", stderr(&output));
+        assert!(!out.exists(), "{args:?} left the folder it made");
+    }
+}
+
 /// `--json` promises JSON on standard output: with `--check` the verdict goes to standard
 /// error, and every line of standard output is a JSON object.
 #[test]

@@ -220,6 +220,20 @@ pub fn code_commit() -> String {
     }
 }
 
+/// The folder where measured λ→success curves are kept between runs (never beside the
+/// policies they are of, which are inputs): `$ARLPCG_CACHE`, else `$XDG_CACHE_HOME/arlpcg`,
+/// else `$HOME/.cache/arlpcg`; none (each run measures anew) without any of them.
+pub fn cache_dir() -> Option<std::path::PathBuf> {
+    let var = |name: &str| {
+        std::env::var_os(name)
+            .filter(|v| !v.is_empty())
+            .map(std::path::PathBuf::from)
+    };
+    var("ARLPCG_CACHE")
+        .or_else(|| var("XDG_CACHE_HOME").map(|dir| dir.join("arlpcg")))
+        .or_else(|| var("HOME").map(|home| home.join(".cache").join("arlpcg")))
+}
+
 /// Whether `policy` may play under `profile` (none: the built-in game): a warning when it trained
 /// with other abilities, an error when they lie beyond the range it trained over.
 pub fn check_fit(

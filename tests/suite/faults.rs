@@ -544,6 +544,47 @@ fn ctrl_c_stops_a_campaign_while_it_searches_a_level() {
     assert_eq!(written, 0, "no unfinished level");
 }
 
+/// A measured λ→success curve goes to the cache folder (`ARLPCG_CACHE`), keyed by the
+/// policies' SHA-256, and is read from there the next time; the policies folder, an input, is
+/// never written.
+#[test]
+fn a_measured_curve_is_cached_apart_from_the_policies_it_was_measured_with() {
+    let dir = tempfile::tempdir().unwrap();
+    let policies = dir.path().join("policies");
+    std::fs::create_dir(&policies).unwrap();
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    for name in ["generator.safetensors", "generator.yaml"] {
+        std::fs::copy(shipped.join(name), policies.join(name)).unwrap();
+    }
+    let before = files_of(&policies);
+    let cache = dir.path().join("cache");
+    let generate = |out: &str| {
+        let output = crate::common::test_command()
+            .env("ARLPCG_CACHE", &cache)
+            .args(["generate", "--policies", policies.to_str().unwrap()])
+            .args(["--target-success", "0.6", "--judge", "scripted-median"])
+            .args(["--verify", "20", "--format", "yaml", "--seed", "5"])
+            .args(["--out", dir.path().join(out).to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", stderr(&output));
+        stderr(&output)
+    };
+    assert!(generate("first").contains("measuring"));
+    assert_eq!(
+        files_of(&policies),
+        before,
+        "nothing written beside the policies"
+    );
+    let curves = files_of(&cache.join("curves"));
+    assert_eq!(curves.len(), 1, "{curves:?}");
+    assert!(curves[0].0.contains("scripted-median"), "{}", curves[0].0);
+    assert!(
+        !generate("again").contains("measuring"),
+        "read from the cache"
+    );
+}
+
 /// Arguments that do not fit together exit 2 (`--profile` with `--runs`, or with `--merge`,
 /// whose parts record their profile), and a command refused for a file it reads (a profile
 /// that is not a number) leaves no folder it would have made.

@@ -170,14 +170,15 @@ fn play_all(
 
 /// Level `k` of the campaign in `folder` searched anew from a seed the campaign has not used
 /// (one past its largest), with `generator` and the campaign's judge from the policies folder
-/// `dir`, to its ramp point; then the panel of `dir` rates the campaign again (the levels stay
-/// in their places) and every file of the campaign is rewritten in the formats it has. Returns
-/// the campaign as [`open`] would read it now.
+/// `dir`, to its ramp point (the λ→success curve from `dir` or the cache folder `cache`); then
+/// the panel of `dir` rates the campaign again (the levels stay in their places) and every file
+/// of the campaign is rewritten in the formats it has. Returns the campaign as [`open`] would
+/// read it now.
 pub fn regenerate_level(
     folder: &Path,
     k: usize,
     generator: &GeneratorPolicy,
-    dir: &Path,
+    (dir, cache): (&Path, Option<&Path>),
     stop: &(dyn Fn() -> bool + Sync),
 ) -> anyhow::Result<(PathBuf, Campaign, Vec<Level>)> {
     let (folder, record, mut levels) = open(folder)?;
@@ -186,7 +187,7 @@ pub fn regenerate_level(
     let profile = record.ask().profile;
     let solver = judged.solver(0, profile.as_ref());
     let curve = crate::services::policies::difficulty_curve(
-        dir,
+        (dir, cache),
         generator,
         &solver,
         profile.as_ref(),

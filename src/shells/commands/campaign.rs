@@ -89,8 +89,9 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         true => resumed_levels(args, &ask, &files, &solver)?,
         false => vec![None; n],
     };
+    let cache = crate::shells::common::cache_dir();
     let curve = difficulty_curve(
-        &dir,
+        (&dir, cache.as_deref()),
         &generator,
         &solver,
         ask.profile.as_ref(),

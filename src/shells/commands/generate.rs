@@ -201,9 +201,15 @@ fn target_curve(
             difficulty::CURVE_TRIALS
         )
     };
-    crate::services::policies::difficulty_curve(dir, generator, solver, profile, announce, &|| {
-        stop.load(Ordering::SeqCst)
-    })
+    let cache = crate::shells::common::cache_dir();
+    crate::services::policies::difficulty_curve(
+        (dir, cache.as_deref()),
+        generator,
+        solver,
+        profile,
+        announce,
+        &|| stop.load(Ordering::SeqCst),
+    )
     .map(Some)
     .map_err(|e| match e.downcast_ref::<difficulty::TargetError>() {
         Some(difficulty::TargetError::Stopped) => crate::shells::common::Interrupted(

@@ -277,8 +277,13 @@ fn regenerate_campaign_level(
         .ok()
         .and_then(|shelf| shelf.of(game).generator.clone())
         .ok_or_else(|| anyhow::anyhow!("no {game} Generator is loaded (p loads one)"))?;
-    let (folder, record, levels) =
-        crate::services::campaign::regenerate_level(folder, k, &generator, dir, stop)?;
+    let (folder, record, levels) = crate::services::campaign::regenerate_level(
+        folder,
+        k,
+        &generator,
+        (dir, crate::shells::common::cache_dir().as_deref()),
+        stop,
+    )?;
     Ok(Box::new(OpenedCampaign {
         folder,
         record,
@@ -388,8 +393,8 @@ fn sweep_point(
 }
 
 /// The target-success search of `generate --target-success` with the designer's policies: the
-/// λ→success curve is read from (or, the first time, measured into) the Generator's folder. A
-/// newer request (`stop`) ends the measurement and the search.
+/// λ→success curve is read from the Generator's folder or the cache (or, the first time,
+/// measured into the cache). A newer request (`stop`) ends the measurement and the search.
 fn target_level(
     policies: &Policies,
     asked: &LevelRequest,
@@ -406,8 +411,9 @@ fn target_level(
     let folder = Path::new(&generator.reference.path)
         .parent()
         .unwrap_or(Path::new("."));
+    let cache = crate::shells::common::cache_dir();
     let curve = crate::services::policies::difficulty_curve(
-        folder,
+        (folder, cache.as_deref()),
         generator,
         &Solver::Policy(solver),
         asked.profile.as_ref(),

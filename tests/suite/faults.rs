@@ -522,7 +522,7 @@ fn a_full_disk_on_standard_output_is_an_error_not_a_panic() {
 fn ctrl_c_stops_a_campaign_while_it_searches_a_level() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("campaign");
-    let child = crate::common::test_command()
+    let mut child = crate::common::test_command()
         .args(["campaign", "--levels", "2", "--ramp", "0:0.6, 1:0.5"])
         .args(["--judge", "scripted-median", "--trials", "100000"])
         .args(["--format", "yaml", "--out", out.to_str().unwrap()])
@@ -533,12 +533,15 @@ fn ctrl_c_stops_a_campaign_while_it_searches_a_level() {
     // Past loading the policies and reading the shipped curve: into the search.
     std::thread::sleep(Duration::from_secs(5));
     let sent = interrupt(&child);
+    while child.try_wait().unwrap().is_none() {
+        if sent.elapsed() > Duration::from_secs(10) {
+            child.kill().unwrap();
+            let _ = child.wait();
+            panic!("still searching {:?} after Ctrl-C", sent.elapsed());
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
     let output = child.wait_with_output().unwrap();
-    assert!(
-        sent.elapsed() < Duration::from_secs(10),
-        "took {:?}",
-        sent.elapsed()
-    );
     assert_eq!(output.status.code(), Some(130), "{}", stderr(&output));
     let written = std::fs::read_dir(&out).map_or(0, |files| files.count());
     assert_eq!(written, 0, "no unfinished level");
@@ -711,7 +714,8 @@ fn a_profile_whose_roads_cannot_turn_is_checked_in_seconds() {
         "--trials",
         "2",
     ];
-    let checked = arlpcg_within(&args, Duration::from_secs(60));
+    // About 2 s now; 30 s of hopeless attempts before.
+    let checked = arlpcg_within(&args, Duration::from_secs(15));
     let said = stderr(&checked);
     assert_eq!(checked.status.code(), Some(1), "{said}");
     assert!(

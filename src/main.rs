@@ -36,7 +36,13 @@ fn main() -> ExitCode {
         }
         Err(e) => e.exit(), // --help and --version
     };
-    match arlpcg::shells::commands::run(cli) {
+    let done = arlpcg::shells::commands::run(cli);
+    // Standard output could not be written (a full disk): what was to be said is lost.
+    if let (Ok(()), Some(failed)) = (&done, arlpcg::shells::common::stdout_failed()) {
+        arlpcg::warn!("error: {failed}");
+        return ExitCode::FAILURE;
+    }
+    match done {
         // What the command wrote to files is whole; what it had left to say had nowhere to go.
         Ok(()) if arlpcg::shells::common::stdout_closed() => {
             ExitCode::from(arlpcg::shells::common::BROKEN_PIPE_EXIT)

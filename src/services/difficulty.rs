@@ -95,6 +95,8 @@ pub enum TargetError {
     },
     #[error("stopped while the λ→success curve was measured")]
     Stopped,
+    #[error("stopped while a level was searched")]
+    SearchStopped,
     #[error(transparent)]
     Generation(#[from] GenerationError),
     #[error(transparent)]
@@ -202,14 +204,16 @@ impl Curve {
 /// a new draw of the seed, or of another seed after [`OWN_SCENE_CANDIDATES`] (unless
 /// `asked.goal` is given). When `asked` has a curve of λ (pacing), the search moves the whole
 /// curve, its mean at the λ searched ([`AuxCurve::shifted`]). A candidate that no run completed
-/// is never kept. The level is made for `asked.profile`.
+/// is never kept. The level is made for `asked.profile`. `stopped` is asked before each
+/// candidate and between the runs it plays (a Ctrl-C ends the search with
+/// [`TargetError::SearchStopped`]).
 pub fn level_for(
     generator: &GeneratorPolicy,
     solver: &Solver,
     curve: &Curve,
     asked: &LevelRequest,
-    target: f64,
-    trials: u32,
+    (target, trials): (f64, u32),
+    stopped: &(dyn Fn() -> bool + Sync),
 ) -> Result<Level, TargetError> {
     let (seed, goal) = (asked.seed, asked.goal);
     let shape = match &asked.aux {
@@ -221,6 +225,9 @@ pub fn level_for(
     let (mut uncompleted, mut unbuilt) = (0, 0);
     let obstacles = arlpcg_core::game::facts::facts(generator.game).scene_obstacles;
     for draw in 0..MAX_CANDIDATES {
+        if stopped() {
+            return Err(TargetError::SearchStopped);
+        }
         let quantized = (aux * 1000.0).round() / 1000.0;
         // Another seed supplies the whole scene (start, goal, obstacles), so it stays one the
         // Generator was trained on; the level records that seed.
@@ -246,7 +253,8 @@ pub fn level_for(
             }
             Err(e) => return Err(e.into()),
         };
-        let stats = screened_stats(&level, solver, trials, seed, target)?;
+        let stats = screened_stats(&level, solver, (trials, seed), target, stopped)?
+            .ok_or(TargetError::SearchStopped)?;
         let miss = stats.success_ratio - target;
         if miss.abs() < closest.0 {
             closest = (miss.abs(), stats.success_ratio, quantized);
@@ -272,22 +280,22 @@ pub fn level_for(
 
 /// The statistics of `trials` runs of a candidate, or of its first [`SCREEN_TRIALS`] alone when
 /// their 95% interval lies outside [`BAND`] of `target` (the rest cannot bring it in, bar a
-/// 1-in-40 chance).
+/// 1-in-40 chance); `None` when `stopped` ended the runs.
 fn screened_stats(
     level: &Level,
     solver: &Solver,
-    trials: u32,
-    seed: u64,
+    (trials, seed): (u32, u64),
     target: f64,
-) -> Result<arlpcg_core::level::stats::SolverStats, WrongGame> {
+    stopped: &(dyn Fn() -> bool + Sync),
+) -> Result<Option<arlpcg_core::level::stats::SolverStats>, WrongGame> {
     let watch = Watch {
         on_trial: &|_| {},
-        stop: &|| false,
+        stop: stopped,
     };
-    let unstopped = "a search without a stop condition plays every run";
     let screen = SCREEN_TRIALS.min(trials);
-    let mut results =
-        trial_results(level, solver, 0..screen as u64, seed, &watch)?.expect(unstopped);
+    let Some(mut results) = trial_results(level, solver, 0..screen as u64, seed, &watch)? else {
+        return Ok(None);
+    };
     let successes = results
         .iter()
         .filter(|r| r.outcome == Outcome::Success)
@@ -295,9 +303,12 @@ fn screened_stats(
     let [low, high] = wilson_interval(successes, screen);
     if high >= target - BAND && low <= target + BAND {
         let rest = trial_results(level, solver, screen as u64..trials as u64, seed, &watch)?;
-        results.extend(rest.expect(unstopped));
+        let Some(rest) = rest else {
+            return Ok(None);
+        };
+        results.extend(rest);
     }
-    Ok(stats_of(level, solver, seed, &results))
+    Ok(Some(stats_of(level, solver, seed, &results)))
 }
 
 #[cfg(test)]

@@ -103,7 +103,17 @@ pub fn verified_level(
             let LevelSource::Generator(generator) = source else {
                 anyhow::bail!("a success target needs a Generator: the rules know no λ");
             };
-            let level = difficulty::level_for(generator, solver, curve, request, target, trials)?;
+            let level = match difficulty::level_for(
+                generator,
+                solver,
+                curve,
+                request,
+                (target, trials),
+                watch.stop,
+            ) {
+                Err(difficulty::TargetError::SearchStopped) => return Ok(None),
+                searched => searched?,
+            };
             Ok(Some(verify::certified(level, solver, seed)?))
         }
         Proof::Played {

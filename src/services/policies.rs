@@ -233,12 +233,13 @@ pub fn load_any(path: &Path) -> Result<(ActorCritic, PolicyCard, PolicyRef)> {
 }
 
 /// The λ→success curve of `generator` with `solver` on levels made for `profile` (none, or the
-/// default: the built-in game), kept in `dir` (see [`curve_path`]): read when it was measured
-/// with these two policies and this profile (by SHA-256), else measured (`on_measure` is told
-/// first: it takes a while; `stopped` can end it) and kept there when the folder can be
-/// written.
+/// default: the built-in game): read from the policies folder `dir` (see [`curve_path`]; the
+/// shipped curves) or from the cache folder `cache` when it was measured with these two
+/// policies and this profile (by SHA-256), else measured (`on_measure` is told first: it takes
+/// a while; `stopped` can end it) and kept in `cache` ([`cached_curve_path`]). Nothing is
+/// written into `dir`: it is an input, perhaps read-only or under version control.
 pub fn difficulty_curve(
-    dir: &Path,
+    (dir, cache): (&Path, Option<&Path>),
     generator: &GeneratorPolicy,
     solver: &crate::services::verify::Solver,
     profile: Option<&Profile>,
@@ -271,29 +272,67 @@ pub fn difficulty_curve(
             && c.solver_sha256 == identity
             && c.profile_sha256 == profile_sha256
     };
-    if let Ok(bytes) = crate::services::fsio::read_limited(&path, 1 << 20, "difficulty curve")
-        && let Ok(curve) = serde_yaml::from_slice::<crate::services::difficulty::Curve>(&bytes)
-        && current(&curve)
-    {
-        // The curve of these very policies, damaged: say so rather than aim with it.
-        curve.check().map_err(|problem| {
-            anyhow::anyhow!(
-                "{}: {problem} (delete the file and it is measured again)",
-                path.display()
-            )
-        })?;
-        return Ok(curve);
+    let cached = cache.map(|cache| {
+        cached_curve_path(
+            cache,
+            &generator.reference.sha256,
+            &identity,
+            profile_sha256.as_deref(),
+        )
+    });
+    for path in std::iter::once(&path).chain(&cached) {
+        if let Ok(bytes) = crate::services::fsio::read_limited(path, 1 << 20, "difficulty curve")
+            && let Ok(curve) = serde_yaml::from_slice::<crate::services::difficulty::Curve>(&bytes)
+            && current(&curve)
+        {
+            // The curve of these very policies, damaged: say so rather than aim with it.
+            curve.check().map_err(|problem| {
+                anyhow::anyhow!(
+                    "{}: {problem} (delete the file and it is measured again)",
+                    path.display()
+                )
+            })?;
+            return Ok(curve);
+        }
     }
     on_measure();
     let curve =
         crate::services::difficulty::measure(generator, solver, &identity, profile, stopped)?;
-    // A folder that cannot be written only costs a new measurement next time.
-    let _ = crate::services::fsio::write_atomic(
-        &path,
-        serde_yaml::to_string(&curve)?.as_bytes(),
-        crate::services::fsio::Overwrite::Allowed,
-    );
+    // A cache that cannot be written only costs a new measurement next time.
+    if let Some(cached) = &cached
+        && let Some(folder) = cached.parent()
+        && std::fs::create_dir_all(folder).is_ok()
+    {
+        let _ = crate::services::fsio::write_atomic(
+            cached,
+            serde_yaml::to_string(&curve)?.as_bytes(),
+            crate::services::fsio::Overwrite::Allowed,
+        );
+    }
     Ok(curve)
+}
+
+/// Where the cache folder `cache` keeps a measured λ→success curve: `curves/` and a name made
+/// of the Generator's SHA-256, the Solver's (or the scripted player's judge name) and the
+/// profile's, each cut to 12 digits, so that policies of the same file names in other folders
+/// never share a curve.
+pub fn cached_curve_path(
+    cache: &Path,
+    generator_sha256: &str,
+    solver: &str,
+    profile_sha256: Option<&str>,
+) -> PathBuf {
+    // A SHA-256 is cut to 12 hex digits; a judge name is kept whole.
+    let short = |id: &str| match id.len() {
+        64 => id[..12].to_string(),
+        _ => id.to_string(),
+    };
+    let profile = profile_sha256.map_or(String::new(), |sha| format!("-profile-{}", short(sha)));
+    cache.join("curves").join(format!(
+        "difficulty-curve-{}-{}{profile}.yaml",
+        short(generator_sha256),
+        short(solver)
+    ))
 }
 
 /// The folder of the policies shipped for `game`: `policies/<game>`.
@@ -431,7 +470,7 @@ mod tests {
         let read = |profile: Option<&Profile>| {
             let measured = std::cell::Cell::new(false);
             let curve = difficulty_curve(
-                dir.path(),
+                (dir.path(), None),
                 &generator,
                 &solver,
                 profile,

@@ -27,11 +27,17 @@ pub struct ChecksFailed(pub String);
 /// [`BROKEN_PIPE_EXIT`].
 static STDOUT_CLOSED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
+/// Why standard output could not be written, when it was not a closed pipe (a full disk:
+/// `> /dev/full`): the process then exits 1 with this reason.
+static STDOUT_FAILED: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+
 /// The exit code after standard output closed: 128 + SIGPIPE, as a shell reports a command a
 /// closed pipe ended.
 pub const BROKEN_PIPE_EXIT: u8 = 141;
 
-/// Writes to standard output; a failed write (a closed pipe) is remembered, never a panic.
+/// Writes to standard output; a failed write is remembered, never a panic: a closed pipe ends
+/// the command quietly ([`stdout_closed`]), any other failure (a full disk) is an error
+/// ([`stdout_failed`]). Control characters from files are escaped ([`printable`]).
 /// [`say!`](crate::say) is the `println!` of the commands.
 pub fn say(text: std::fmt::Arguments) {
     use std::io::Write;
@@ -39,16 +45,42 @@ pub fn say(text: std::fmt::Arguments) {
         return;
     }
     let mut out = std::io::stdout().lock();
-    if out.write_fmt(text).and_then(|()| out.flush()).is_err() {
+    if let Err(e) = out
+        .write_all(printable(&text.to_string()).as_bytes())
+        .and_then(|()| out.flush())
+    {
+        if e.kind() != std::io::ErrorKind::BrokenPipe {
+            let _ = STDOUT_FAILED.set(format!("cannot write to standard output: {e}"));
+        }
         STDOUT_CLOSED.store(true, std::sync::atomic::Ordering::SeqCst);
     }
 }
 
 /// Writes to standard error, dropping the text where it cannot be written (a closed pipe).
-/// [`warn!`](crate::warn) is the `eprintln!` of the commands.
+/// Control characters are escaped as in [`say`]. [`warn!`](crate::warn) is the `eprintln!` of
+/// the commands.
 pub fn warn(text: std::fmt::Arguments) {
     use std::io::Write;
-    let _ = std::io::stderr().lock().write_fmt(text);
+    let _ = std::io::stderr()
+        .lock()
+        .write_all(printable(&text.to_string()).as_bytes());
+}
+
+/// `text` safe for a terminal: every control character but the line break and the tab (a
+/// terminal's escape codes, a carriage return that overwrites a line, text a file holds) is
+/// written as its escape (`\u{1b}`).
+pub fn printable(text: &str) -> std::borrow::Cow<'_, str> {
+    let unsafe_char = |c: char| c.is_control() && c != '\n' && c != '\t';
+    if !text.contains(unsafe_char) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    text.chars()
+        .map(|c| match unsafe_char(c) {
+            true => c.escape_default().to_string(),
+            false => c.to_string(),
+        })
+        .collect::<String>()
+        .into()
 }
 
 /// The most characters of one line of a message; a longer line (a huge argument quoted back)
@@ -79,6 +111,11 @@ pub fn cut_long_lines(text: &str) -> String {
 /// Whether standard output has closed (see [`say`]).
 pub fn stdout_closed() -> bool {
     STDOUT_CLOSED.load(std::sync::atomic::Ordering::SeqCst)
+}
+
+/// Why standard output failed, when it was not a closed pipe (see [`say`]).
+pub fn stdout_failed() -> Option<&'static str> {
+    STDOUT_FAILED.get().map(String::as_str)
 }
 
 /// `println!` to standard output through [`say`]: a closed pipe ends nothing.
@@ -181,6 +218,20 @@ pub fn code_commit() -> String {
         Some(commit) => commit,
         None => "unknown".into(),
     }
+}
+
+/// The folder where measured λ→success curves are kept between runs (never beside the
+/// policies they are of, which are inputs): `$ARLPCG_CACHE`, else `$XDG_CACHE_HOME/arlpcg`,
+/// else `$HOME/.cache/arlpcg`; none (each run measures anew) without any of them.
+pub fn cache_dir() -> Option<std::path::PathBuf> {
+    let var = |name: &str| {
+        std::env::var_os(name)
+            .filter(|v| !v.is_empty())
+            .map(std::path::PathBuf::from)
+    };
+    var("ARLPCG_CACHE")
+        .or_else(|| var("XDG_CACHE_HOME").map(|dir| dir.join("arlpcg")))
+        .or_else(|| var("HOME").map(|home| home.join(".cache").join("arlpcg")))
 }
 
 /// Whether `policy` may play under `profile` (none: the built-in game): a warning when it trained

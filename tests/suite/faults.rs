@@ -2,31 +2,10 @@
 //! level, a policy, a configuration or an output file should be is refused at once (opening it
 //! would block forever), and nothing is overwritten without `--force`.
 
-use crate::common::{files_of, stderr};
+use crate::common::{arlpcg_within, files_of, stderr};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
-
-/// Runs the binary, killed after `limit` (so that a hang fails the test instead of stalling it).
-fn arlpcg_within(args: &[&str], limit: Duration) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
-        .args(args)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the binary runs");
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > limit {
-            child.kill().unwrap();
-            let _ = child.wait();
-            panic!("{args:?} still ran after {limit:?}: it hangs");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    child.wait_with_output().unwrap()
-}
 
 /// Sends Ctrl-C (SIGINT) to `child`; when it was sent.
 fn interrupt(child: &std::process::Child) -> Instant {
@@ -340,7 +319,7 @@ fn ctrl_c_stops_the_difficulty_curve_measurement_at_once() {
         std::fs::copy(shipped.join(name), policies.join(name)).unwrap();
     }
     let out = dir.path().join("out");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+    let mut child = crate::common::test_command()
         .args([
             "generate",
             "--policies",
@@ -503,4 +482,244 @@ fn an_argument_that_is_not_utf8_is_refused_before_anything_is_made() {
         );
         assert!(!odd.exists(), "{command:?}: nothing made");
     }
+}
+
+/// A standard output that cannot be written for another reason than a closed pipe (a full
+/// disk: `> /dev/full`) is an error in one line, exit 1, not a panic.
+#[test]
+fn a_full_disk_on_standard_output_is_an_error_not_a_panic() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        eprintln!("skipped: no /dev/full here");
+        return;
+    };
+    for args in [
+        vec!["profile", "init", "--game", "racing"],
+        vec!["verify", "--trials", "2", "--json"],
+    ] {
+        let mut command = crate::common::test_command();
+        command.args(&args);
+        if args[0] == "verify" {
+            command.arg(shipped_level());
+        }
+        let output = command
+            .stdout(full.try_clone().unwrap())
+            .stderr(Stdio::piped())
+            .output()
+            .unwrap();
+        let err = stderr(&output);
+        assert_eq!(output.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("cannot write to standard output") && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
+}
+
+/// Ctrl-C while a campaign searches a level (thousands of runs per candidate) stops the search
+/// under way: the campaign ends soon after (exit 130) and writes no level it did not finish.
+#[test]
+fn ctrl_c_stops_a_campaign_while_it_searches_a_level() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("campaign");
+    let mut child = crate::common::test_command()
+        .args(["campaign", "--levels", "2", "--ramp", "0:0.6, 1:0.5"])
+        .args(["--judge", "scripted-median", "--trials", "100000"])
+        .args(["--format", "yaml", "--out", out.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Past loading the policies and reading the shipped curve: into the search.
+    std::thread::sleep(Duration::from_secs(5));
+    let sent = interrupt(&child);
+    while child.try_wait().unwrap().is_none() {
+        if sent.elapsed() > Duration::from_secs(10) {
+            child.kill().unwrap();
+            let _ = child.wait();
+            panic!("still searching {:?} after Ctrl-C", sent.elapsed());
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let output = child.wait_with_output().unwrap();
+    assert_eq!(output.status.code(), Some(130), "{}", stderr(&output));
+    let written = std::fs::read_dir(&out).map_or(0, |files| files.count());
+    assert_eq!(written, 0, "no unfinished level");
+}
+
+/// A measured λ→success curve goes to the cache folder (`ARLPCG_CACHE`), keyed by the
+/// policies' SHA-256, and is read from there the next time; the policies folder, an input, is
+/// never written.
+#[test]
+fn a_measured_curve_is_cached_apart_from_the_policies_it_was_measured_with() {
+    let dir = tempfile::tempdir().unwrap();
+    let policies = dir.path().join("policies");
+    std::fs::create_dir(&policies).unwrap();
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    for name in ["generator.safetensors", "generator.yaml"] {
+        std::fs::copy(shipped.join(name), policies.join(name)).unwrap();
+    }
+    let before = files_of(&policies);
+    let cache = dir.path().join("cache");
+    let generate = |out: &str| {
+        let output = crate::common::test_command()
+            .env("ARLPCG_CACHE", &cache)
+            .args(["generate", "--policies", policies.to_str().unwrap()])
+            .args(["--target-success", "0.6", "--judge", "scripted-median"])
+            .args(["--verify", "20", "--format", "yaml", "--seed", "5"])
+            .args(["--out", dir.path().join(out).to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", stderr(&output));
+        stderr(&output)
+    };
+    assert!(generate("first").contains("measuring"));
+    assert_eq!(
+        files_of(&policies),
+        before,
+        "nothing written beside the policies"
+    );
+    let curves = files_of(&cache.join("curves"));
+    assert_eq!(curves.len(), 1, "{curves:?}");
+    assert!(curves[0].0.contains("scripted-median"), "{}", curves[0].0);
+    assert!(
+        !generate("again").contains("measuring"),
+        "read from the cache"
+    );
+}
+
+/// Arguments that do not fit together exit 2 (`--profile` with `--runs`, or with `--merge`,
+/// whose parts record their profile), and a command refused for a file it reads (a profile
+/// that is not a number) leaves no folder it would have made.
+#[test]
+fn misfits_exit_2_and_a_refused_run_leaves_no_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let profile = dir.path().join("nan.yaml");
+    let init = crate::common::arlpcg_ok(["profile", "init", "--game", "platform"]).stdout;
+    let text = String::from_utf8(init).unwrap();
+    let nan = text.replacen("jump_speed: ", "jump_speed: .nan #", 1);
+    std::fs::write(&profile, nan).unwrap();
+    let profile = profile.to_str().unwrap();
+    let out = dir.path().join("out");
+    let out_s = out.to_str().unwrap();
+    for args in [
+        vec![
+            "eval", "--runs", out_s, "--profile", profile, "--out", out_s,
+        ],
+        vec![
+            "eval", "--merge", out_s, "--profile", profile, "--out", out_s,
+        ],
+    ] {
+        let output = crate::common::arlpcg(&args);
+        assert_eq!(
+            output.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            stderr(&output)
+        );
+        assert!(stderr(&output).contains("--profile"), "{}", stderr(&output));
+    }
+    for missing in [profile, "/nonexistent/profile.yaml"] {
+        let args = [
+            "train", "--steps", "10", "--profile", missing, "--out", out_s,
+        ];
+        let output = crate::common::arlpcg(args);
+        assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+        assert!(stderr(&output).contains(missing), "{}", stderr(&output));
+        assert!(!out.exists(), "{args:?} left the folder it made");
+    }
+}
+
+/// `--json` promises JSON on standard output: with `--check` the verdict goes to standard
+/// error, and every line of standard output is a JSON object.
+#[test]
+fn with_json_standard_output_carries_json_alone() {
+    let level = shipped_level();
+    for check in ["completed", "success 0..0.01"] {
+        let args = [
+            "verify", "--trials", "5", "--solver", "scripted-expert", "--json", "--check", check,
+            &level,
+        ];
+        let output = crate::common::arlpcg(args);
+        assert!(
+            matches!(output.status.code(), Some(0 | 3)),
+            "{}",
+            stderr(&output)
+        );
+        let text = String::from_utf8(output.stdout.clone()).unwrap();
+        assert_eq!(text.lines().count(), 1, "{text}");
+        for line in text.lines() {
+            let value: serde_json::Value =
+                serde_json::from_str(line).unwrap_or_else(|e| panic!("`{line}` is not JSON: {e}"));
+            assert!(value.is_object(), "{line}");
+        }
+        assert!(stderr(&output).contains("check"), "{}", stderr(&output));
+    }
+}
+
+/// `campaign --resume` with another `--ramp` (or `--trials`) than the campaign in `--out` was
+/// made with is refused, naming a level and what differs: the levels were searched for the
+/// other ramp.
+#[test]
+fn a_campaign_resumed_with_another_ramp_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("campaign");
+    let done = crate::common::small_campaign(&out, &[]);
+    assert!(done.status.success(), "{}", stderr(&done));
+    let before = files_of(&out);
+    let other = crate::common::arlpcg([
+        "campaign",
+        "--game",
+        "platform",
+        "--levels",
+        "3",
+        "--ramp",
+        "0:0.2, 1:0.2",
+        "--judge",
+        "scripted-median",
+        "--trials",
+        "20",
+        "--seed",
+        "40",
+        "--format",
+        "yaml",
+        "--resume",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    crate::common::fails_with(&other, 1, "it was searched for another ramp");
+    assert!(stderr(&other).contains("level0"), "{}", stderr(&other));
+    assert_eq!(files_of(&out), before, "nothing rewritten");
+}
+
+/// A racing profile whose roads cannot turn (`max_curve: 0`, within its range) leaves most rule
+/// goals out of reach: each is refused at once instead of after every attempt, so `profile
+/// check` answers in seconds (it took minutes of attempts before).
+#[test]
+fn a_profile_whose_roads_cannot_turn_is_checked_in_seconds() {
+    let dir = tempfile::tempdir().unwrap();
+    let init = crate::common::arlpcg_ok(["profile", "init", "--game", "racing"]).stdout;
+    let text = String::from_utf8(init).unwrap();
+    assert!(text.contains("  max_curve: "), "{text}");
+    let straight = dir.path().join("straight.yaml");
+    std::fs::write(
+        &straight,
+        text.replacen("  max_curve: ", "  max_curve: 0 #", 1),
+    )
+    .unwrap();
+    let args = [
+        "profile",
+        "check",
+        straight.to_str().unwrap(),
+        "--trials",
+        "2",
+    ];
+    // About 2 s now; 30 s of hopeless attempts before.
+    let checked = arlpcg_within(&args, Duration::from_secs(15));
+    let said = stderr(&checked);
+    assert_eq!(checked.status.code(), Some(1), "{said}");
+    assert!(
+        said.contains("most of the game's goals cannot be reached"),
+        "{said}"
+    );
 }

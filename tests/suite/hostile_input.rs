@@ -316,3 +316,227 @@ fn a_card_that_disagrees_with_its_weights_or_its_game_is_refused_by_name() {
         }
     }
 }
+
+/// Files are held to the limits of the arguments that would make them: a population beyond
+/// `--population`'s limits is refused as an argument (exit 2), and in a campaign.yaml, as are
+/// more runs than `campaign --trials` allows and a number out of its range, by file and field,
+/// before anything is played.
+#[test]
+fn files_meet_the_limits_of_the_arguments_that_make_them() {
+    use crate::common::{arlpcg, arlpcg_within, fails_with, stderr, words};
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("campaign");
+    let asked = arlpcg(words(
+        "campaign --ramp 0:0.5 --population 0,1e308 --out {}",
+        &[&out],
+    ));
+    fails_with(&asked, 2, "theta_sd 1e308 must be a number within [0, 50]");
+    assert!(!out.exists());
+    let shipped = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/results/platform/campaign/campaign.yaml"
+    ))
+    .unwrap();
+    let file = dir.path().join("campaign.yaml");
+    for (from, to, expected) in [
+        (
+            "trials: 100\n",
+            "trials: 4000000000\n",
+            "trials: 4000000000 is not within [10, 100000]",
+        ),
+        (
+            "theta_sd: 2.9968", "theta_sd: 1.0e308", "population.theta_sd 1e308 must be",
+        ),
+        (
+            "  measured: 1.0\n",
+            "  measured: 1.0e308\n",
+            "levels[0].measured: 1e308 is not a number within [0, 1]",
+        ),
+    ] {
+        assert!(shipped.contains(from), "{from}");
+        std::fs::write(&file, shipped.replacen(from, to, 1)).unwrap();
+        let args = ["verify", "--campaign", file.to_str().unwrap()];
+        let refused = arlpcg_within(&args, std::time::Duration::from_secs(60));
+        fails_with(&refused, 1, expected);
+        assert!(stderr(&refused).contains(file.to_str().unwrap()));
+    }
+}
+
+/// `report` reads files of both games: a results.json, a campaign or a card of the other game
+/// where one game's belongs is refused in one line naming the file (it once panicked on the
+/// results, and quoted the campaign and listed the card), as is a number out of its range (it
+/// once wrote a 309-digit success ratio); the page is left as it was.
+#[test]
+fn report_refuses_the_other_games_files_and_numbers_out_of_range() {
+    use crate::common::{arlpcg, arlpcg_ok, fails_with, stderr, words};
+    let dir = tempfile::tempdir().unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let (results, policies) = (dir.path().join("results"), dir.path().join("policies"));
+    copy_tree(&root.join("results"), &results, &|_| true);
+    copy_tree(&root.join("policies"), &policies, &|p| {
+        p.extension().is_none_or(|e| e == "yaml")
+    });
+    let page = dir.path().join("results.md");
+    let report = |extra: &str| {
+        arlpcg(words(
+            &format!("report --results {{}} --policies {{}} --out {{}}{extra}"),
+            &[&results, &policies, &page],
+        ))
+    };
+    arlpcg_ok(words(
+        "report --results {} --policies {} --out {}",
+        &[&results, &policies, &page],
+    ));
+    let written = std::fs::read(&page).unwrap();
+    let platform = results.join("platform");
+    let swap = |target: &std::path::Path, from: &std::path::Path, expected: &str| {
+        let own = std::fs::read(target).unwrap();
+        std::fs::copy(from, target).unwrap();
+        for extra in ["", " --check"] {
+            let refused = report(extra);
+            fails_with(&refused, 1, expected);
+            let said = stderr(&refused);
+            assert_eq!(said.lines().count(), 1, "{said}");
+            assert!(said.contains(target.to_str().unwrap()), "{said}");
+        }
+        std::fs::write(target, own).unwrap();
+    };
+    swap(
+        &platform.join("results.json"),
+        &results.join("racing/results.json"),
+        "its columns are not the platform game's",
+    );
+    swap(
+        &platform.join("campaign/campaign.yaml"),
+        &results.join("racing/campaign/campaign.yaml"),
+        "a racing campaign in the platform results",
+    );
+    swap(
+        &policies.join("platform/solver.yaml"),
+        &policies.join("racing/solver.yaml"),
+        "the card of a racing policy",
+    );
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(platform.join("results.json")).unwrap()).unwrap();
+    json["controllability"][0]["success_ratio"] = serde_json::json!(1e308);
+    let huge = dir.path().join("huge.json");
+    std::fs::write(&huge, serde_json::to_vec(&json).unwrap()).unwrap();
+    swap(
+        &platform.join("results.json"),
+        &huge,
+        "controllability[0].success_ratio: 1e308 is not a number within [0, 1]",
+    );
+    assert_eq!(
+        std::fs::read(&page).unwrap(),
+        written,
+        "the page was rewritten"
+    );
+}
+
+/// Copies the files of `from` that `keep` keeps into `to`, folders and all.
+fn copy_tree(
+    from: &std::path::Path,
+    to: &std::path::Path,
+    keep: &dyn Fn(&std::path::Path) -> bool,
+) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let path = entry.unwrap().path();
+        let target = to.join(path.file_name().unwrap());
+        if path.is_dir() {
+            copy_tree(&path, &target, keep);
+        } else if keep(&path) {
+            std::fs::copy(&path, &target).unwrap();
+        }
+    }
+}
+
+/// Text from files is made safe before it reaches a terminal: a profile name with a line break
+/// or escape codes is refused, and what a file says is echoed with its control characters
+/// escaped (a profile's format here); `-0.0` in a profile reads as 0, the same level as `0.0`.
+#[test]
+fn file_text_is_safe_for_a_terminal_and_minus_zero_is_zero() {
+    use crate::common::{arlpcg, arlpcg_ok, fails_with, stderr, words};
+    let dir = tempfile::tempdir().unwrap();
+    let init = arlpcg_ok(words("profile init --game platform", &[]));
+    let profile = String::from_utf8(init.stdout).unwrap();
+    let named = dir.path().join("named.yaml");
+    let name = "name: \"evil\\n\\e[2J\\e[31mred\"";
+    std::fs::write(&named, profile.replacen("name: default", name, 1)).unwrap();
+    let refused = arlpcg(words("profile check {}", &[&named]));
+    fails_with(
+        &refused,
+        1,
+        "name: a line of text without control characters",
+    );
+    assert!(!refused.stderr.contains(&0x1b), "{}", stderr(&refused));
+
+    // What a file says, quoted back in a message, has its control characters escaped.
+    let format = dir.path().join("format.yaml");
+    let forged = "format: \"\\e[2Jwho\\rforged\"";
+    std::fs::write(
+        &format,
+        profile.replacen("format: arlpcg-profile", forged, 1),
+    )
+    .unwrap();
+    let refused = arlpcg(words("profile check {}", &[&format]));
+    assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
+    assert!(
+        !refused.stderr.contains(&0x1b) && !refused.stderr.contains(&b'\r'),
+        "{:?}",
+        stderr(&refused)
+    );
+    assert!(
+        stderr(&refused).contains("`\\u{1b}[2Jwho forged`"),
+        "{}",
+        stderr(&refused)
+    );
+
+    // -0.0 and 0.0: one profile, one SHA-256, one level.
+    let level = |drop: &str| {
+        let path = dir.path().join(format!("drop{drop}.yaml"));
+        let text = profile.replacen("min_height: ", &format!("min_height: {drop} #"), 1);
+        std::fs::write(&path, text).unwrap();
+        let out = dir.path().join(format!("levels{drop}"));
+        arlpcg_ok(words(
+            "generate --rules --profile {} --seed 3 --format yaml --out {}",
+            &[&path, &out],
+        ));
+        std::fs::read(out.join("platform_seed3.yaml")).unwrap()
+    };
+    assert_eq!(level("-0.0"), level("0.0"));
+}
+
+/// A run trained for a profile is not one more seed of the built-in game: `eval --runs`
+/// refuses it by its card, naming the file and the profile.
+#[test]
+fn a_run_trained_for_a_profile_is_not_a_seed_of_the_built_in_game() {
+    use arlpcg_core::level::profile::Profile;
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    std::fs::create_dir(&run).unwrap();
+    let solver = policy_with_card(&run, "solver.safetensors", None, |card| {
+        let profile = Profile::default_of(Game::Platform)
+            .with_value("character.jump_speed", 8.0)
+            .unwrap();
+        card.profile = Some(
+            Profile {
+                name: "jumpy".into(),
+                ..profile
+            }
+            .record(),
+        );
+    });
+    let out = dir.path().join("out");
+    let args = [
+        "eval",
+        "--runs",
+        run.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let refused = crate::common::arlpcg(args);
+    crate::common::fails_with(&refused, 1, "was trained for profile `jumpy`");
+    assert!(crate::common::stderr(&refused).contains(&solver));
+    assert!(!out.exists());
+}

@@ -1254,6 +1254,7 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
     // A resume takes the game and mode from the run.
     arlpcg_ok(words("train --steps 512 --out {} --resume", &[&out_s]));
     assert_eq!(curve(&out).last().map(|r| r.1), Some(512));
+    a_checkpoint_of_the_other_game_is_refused(dir.path(), &out);
     let stored = std::fs::read_to_string(out.join("config.yaml")).unwrap();
     assert!(stored.contains("gamma: 0.998"), "{stored}");
     let bytes = std::fs::read(out.join("solver.safetensors")).unwrap();
@@ -1284,6 +1285,33 @@ fn a_racing_solver_trains_resumes_and_plays_racing_tracks_only() {
     assert_eq!(refused.status.code(), Some(1));
     let said = stderr(&refused);
     assert!(said.contains("racing solver policy"), "{said}");
+}
+
+/// A platform run folder (the shipped Solver and its card) whose checkpoint, configuration and
+/// metrics are the racing run `racing`'s does not resume: its Solver is another game's, and
+/// resuming would replace it. The folder's policy and card are left as they were.
+fn a_checkpoint_of_the_other_game_is_refused(dir: &Path, racing: &Path) {
+    let platform = dir.join("platform-run");
+    std::fs::create_dir(&platform).unwrap();
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+    for name in ["solver.safetensors", "solver.yaml"] {
+        std::fs::copy(shipped.join(name), platform.join(name)).unwrap();
+    }
+    for name in ["checkpoint.safetensors", "config.yaml", "metrics.csv"] {
+        std::fs::copy(racing.join(name), platform.join(name)).unwrap();
+    }
+    let before = std::fs::read(platform.join("solver.safetensors")).unwrap();
+    let refused = arlpcg(words("train --steps 768 --out {} --resume", &[&platform]));
+    fails_with(&refused, 1, "holds files of two different runs");
+    let said = stderr(&refused);
+    assert!(
+        said.contains("solver.yaml: a platform solver") && said.contains("racing run"),
+        "{said}"
+    );
+    assert_eq!(
+        std::fs::read(platform.join("solver.safetensors")).unwrap(),
+        before
+    );
 }
 
 /// The racing Generator trains through the adversarial loop written for both games: it

@@ -35,6 +35,12 @@ pub use order::{
 /// The record's file name, beside the levels.
 pub const CAMPAIGN_FILE: &str = "campaign.yaml";
 
+/// Runs per level a campaign may ask for, least and most (`campaign --trials`); a campaign
+/// file is held to the same.
+pub const TRIALS: (u32, u32) = (10, 100_000);
+/// The most levels a campaign may have (`campaign --levels`, and a campaign file).
+pub const MOST_LEVELS: u32 = 1000;
+
 /// The `format:` of a campaign file.
 pub const FORMAT: &str = "arlpcg-campaign";
 /// The campaign file's version.
@@ -346,8 +352,12 @@ impl Campaign {
                 self.version
             ));
         }
-        if self.trials == 0 {
-            return Err("trials: at least 1".into());
+        // The limits of `campaign --trials` and `--levels`: a file asks no more than they do.
+        if !(TRIALS.0..=TRIALS.1).contains(&self.trials) {
+            return Err(format!(
+                "trials: {} is not within [{}, {}] (campaign --trials)",
+                self.trials, TRIALS.0, TRIALS.1
+            ));
         }
         self.population
             .check()
@@ -357,8 +367,14 @@ impl Campaign {
                 .profile(self.game)
                 .map_err(|e| format!("profile: {e}"))?;
         }
-        if self.levels.is_empty() {
-            return Err("levels: none; a campaign has at least one level".into());
+        if self.levels.is_empty() || self.levels.len() > MOST_LEVELS as usize {
+            return Err(format!(
+                "levels: {}; a campaign has 1 to {MOST_LEVELS} levels (campaign --levels)",
+                self.levels.len()
+            ));
+        }
+        for (k, judge) in self.judges_theta.iter().enumerate() {
+            within(&format!("judges_theta[{k}].theta"), judge.theta, LOGITS)?;
         }
         for (k, level) in self.levels.iter().enumerate() {
             let plain = Path::new(&level.file)
@@ -370,6 +386,56 @@ impl Campaign {
                     level.file
                 ));
             }
+            level.check().map_err(|e| format!("levels[{k}].{e}"))?;
+        }
+        Ok(())
+    }
+}
+
+/// The range of an ability or a difficulty on the panel's logit scale.
+const LOGITS: (f64, f64) = (
+    -arlpcg_core::statistics::population::MOST_LOGITS,
+    arlpcg_core::statistics::population::MOST_LOGITS,
+);
+/// The range of a share or a success ratio.
+const SHARE: (f64, f64) = (0.0, 1.0);
+
+/// `Err` naming `field` unless `value` is a number within `range`.
+fn within(field: &str, value: f64, (least, most): (f64, f64)) -> Result<(), String> {
+    match (least..=most).contains(&value) {
+        true => Ok(()),
+        false => Err(format!(
+            "{field}: {} is not a number within [{least}, {most}]",
+            arlpcg_core::level::params::show_number(value)
+        )),
+    }
+}
+
+impl CampaignLevel {
+    /// Checks the numbers a campaign file gives a level: shares within [0, 1], b within the
+    /// logit scale's range, λ within [-1, 1]. `Err` names the field.
+    fn check(&self) -> Result<(), String> {
+        within("position", self.position, SHARE)?;
+        within("asked", self.asked, SHARE)?;
+        within("measured", self.measured, SHARE)?;
+        within("ci95[0]", self.ci95[0], SHARE)?;
+        within("ci95[1]", self.ci95[1], SHARE)?;
+        within("b", self.b, LOGITS)?;
+        within("b_ci95[0]", self.b_ci95[0], LOGITS)?;
+        within("b_ci95[1]", self.b_ci95[1], LOGITS)?;
+        if let Some(aux) = self.aux {
+            within("aux", aux, (-1.0, 1.0))?;
+        }
+        let players = &self.players;
+        within("players.reach", players.reach, SHARE)?;
+        within("players.quit", players.quit, SHARE)?;
+        within("players.pass", players.pass, SHARE)?;
+        // Infinite where no player passes the level.
+        if !(1.0..=f64::INFINITY).contains(&players.attempts_per_success) {
+            return Err(format!(
+                "players.attempts_per_success: {} is not a number of at least 1",
+                arlpcg_core::level::params::show_number(players.attempts_per_success)
+            ));
         }
         Ok(())
     }

@@ -37,14 +37,14 @@ pub fn order_by_difficulty(levels: &mut [Level], targets: &[f64], band: f64) {
 
 /// The search `asked` ([`CampaignAsk::request`]): a level whose success for `solver`, over
 /// `trials` runs, is within [`difficulty::BAND`] of `target` ([`difficulty::level_for`]; with a
-/// curve of λ, that curve moved as a whole), with its certificate.
+/// curve of λ, that curve moved as a whole), with its certificate. `stopped` ends the search
+/// ([`difficulty::TargetError::SearchStopped`]).
 pub fn search_level(
-    generator: &GeneratorPolicy,
-    solver: &Solver,
+    (generator, solver): (&GeneratorPolicy, &Solver),
     curve: &difficulty::Curve,
     asked: &LevelRequest,
-    target: f64,
-    trials: u32,
+    (target, trials): (f64, u32),
+    stopped: &(dyn Fn() -> bool + Sync),
 ) -> anyhow::Result<Level> {
     let proof = Proof::Target {
         solver,
@@ -54,11 +54,11 @@ pub fn search_level(
     };
     let watch = Watch {
         on_trial: &|_| {},
-        stop: &|| false,
+        stop: stopped,
     };
     let source = LevelSource::Generator(generator);
     making::verified_level(source, asked, &proof, &watch, &|_| {})?
-        .ok_or_else(|| anyhow::anyhow!("the search was stopped"))
+        .ok_or_else(|| difficulty::TargetError::SearchStopped.into())
 }
 
 /// The panel plays `levels` (each verified by the judge; those it has played keep their plays)
@@ -182,14 +182,15 @@ fn play_all(
 
 /// Level `k` of the campaign in `folder` searched anew from a seed the campaign has not used
 /// (one past its largest), with `generator` and the campaign's judge from the policies folder
-/// `dir`, to its ramp point; then the panel of `dir` rates the campaign again (the levels stay
-/// in their places) and every file of the campaign is rewritten in the formats it has. Returns
-/// the campaign as [`open`] would read it now.
+/// `dir`, to its ramp point (the λ→success curve from `dir` or the cache folder `cache`); then
+/// the panel of `dir` rates the campaign again (the levels stay in their places) and every file
+/// of the campaign is rewritten in the formats it has. Returns the campaign as [`open`] would
+/// read it now.
 pub fn regenerate_level(
     folder: &Path,
     k: usize,
     generator: &GeneratorPolicy,
-    dir: &Path,
+    (dir, cache): (&Path, Option<&Path>),
     stop: &(dyn Fn() -> bool + Sync),
 ) -> anyhow::Result<(PathBuf, Campaign, Vec<Level>)> {
     let (folder, record, mut levels) = open(folder)?;
@@ -198,7 +199,7 @@ pub fn regenerate_level(
     let profile = record.ask().profile;
     let solver = judged.solver(0, profile.as_ref());
     let curve = crate::services::policies::difficulty_curve(
-        dir,
+        (dir, cache),
         generator,
         &solver,
         profile.as_ref(),
@@ -214,7 +215,13 @@ pub fn regenerate_level(
         + 1;
     let target = record.levels[k].asked;
     let asked = record.ask().request(seed);
-    levels[k] = search_level(generator, &solver, &curve, &asked, target, record.trials)?;
+    levels[k] = search_level(
+        (generator, &solver),
+        &curve,
+        &asked,
+        (target, record.trials),
+        stop,
+    )?;
     for level in &mut levels {
         if let Some(stats) = &mut level.stats {
             stats.panel = None;

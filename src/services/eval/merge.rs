@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use arlpcg_core::game::facts::facts;
 use arlpcg_core::level::PolicyRef;
+use arlpcg_core::level::profile::ProfileRecord;
 use arlpcg_core::level::stats::SolverStats;
 
 use super::{AUX_VALUES, Budget, PlayLayout, Results, assemble};
@@ -18,7 +19,8 @@ use super::{AUX_VALUES, Budget, PlayLayout, Results, assemble};
 pub const PART_FILE: &str = "eval-part.json";
 /// What an eval part file says it is.
 const PART_FORMAT: &str = "arlpcg-eval-part";
-const PART_VERSION: u32 = 2;
+/// 3: a part records the profile its levels were made for (a part of version 2 did not say).
+const PART_VERSION: u32 = 3;
 /// The most Solvers an evaluation compares (the paper's four modes, with room to spare).
 const MOST_SOLVERS: usize = 16;
 /// The most levels per table and runs per level a part may claim (ten times `--full`).
@@ -41,6 +43,10 @@ pub struct Part {
     pub layout: PlayLayout,
     /// (play index, its statistics) for this shard's plays.
     pub plays: Vec<(usize, SolverStats)>,
+    /// The game profile every level was made and played for (`eval --profile`; absent: the
+    /// built-in game).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<ProfileRecord>,
 }
 
 impl Part {
@@ -50,8 +56,8 @@ impl Part {
         budget: Budget,
         generator: PolicyRef,
         solvers: Vec<(String, Option<PolicyRef>)>,
-        layout: PlayLayout,
-        plays: Vec<(usize, SolverStats)>,
+        (layout, plays): (PlayLayout, Vec<(usize, SolverStats)>),
+        profile: Option<ProfileRecord>,
     ) -> Self {
         Self {
             format: PART_FORMAT.into(),
@@ -63,6 +69,7 @@ impl Part {
             solvers,
             layout,
             plays,
+            profile,
         }
     }
 
@@ -75,6 +82,11 @@ impl Part {
             self.format,
             self.version
         );
+        if let Some(record) = &self.profile {
+            record
+                .profile(self.layout.game)
+                .map_err(|e| anyhow::anyhow!("profile: {e}"))?;
+        }
         let [index, count] = self.shard;
         ensure!(
             count >= 1 && index < count,
@@ -221,9 +233,10 @@ pub fn merge(parts: Vec<(PathBuf, Part)>) -> Result<Results> {
         .enumerate()
         .map(|(i, s)| s.ok_or_else(|| anyhow::anyhow!("play {i} is missing from its shard's part")))
         .collect::<Result<_>>()?;
-    Ok(assemble(
-        first.budget, &first.generator.path, &first.layout, &stats,
-    ))
+    Ok(Results {
+        profile: first.profile.clone(),
+        ..assemble(first.budget, &first.generator.path, &first.layout, &stats)
+    })
 }
 
 /// What differs between two parts that must come from one evaluation, if anything.
@@ -244,6 +257,8 @@ fn difference(a: &Part, b: &Part) -> Option<&'static str> {
         Some("levels")
     } else if a.shard[1] != b.shard[1] {
         Some("shard count")
+    } else if a.profile.as_ref().map(|p| &p.sha256) != b.profile.as_ref().map(|p| &p.sha256) {
+        Some("profiles")
     } else {
         None
     }
@@ -281,8 +296,8 @@ mod tests {
                         ("rule-pcg".into(), Some(reference("a"))),
                         ("arlpcg".into(), Some(reference("b"))),
                     ],
-                    layout.clone(),
-                    plays,
+                    (layout.clone(), plays),
+                    None,
                 );
                 (PathBuf::from(format!("part{index}")), part)
             })

@@ -199,11 +199,130 @@ fn unread_game() -> Game {
 }
 
 impl Results {
-    /// A game's results.json, as `eval` wrote it.
-    pub fn read(game: Game, json: &[u8]) -> serde_json::Result<Results> {
+    /// A game's results.json, as `eval` wrote it: refused when its tables are another game's,
+    /// or when a number is not finite and within its range (`Err` names the field).
+    pub fn read(game: Game, json: &[u8]) -> anyhow::Result<Results> {
         let mut results: Results = serde_json::from_slice(json)?;
         results.game = game;
+        results.check().map_err(anyhow::Error::msg)?;
         Ok(results)
+    }
+
+    /// Checks tables read from a file: the piece columns of its game, each share within [0, 1],
+    /// each λ within [-1, 1], every other figure finite and not negative.
+    fn check(&self) -> Result<(), String> {
+        let game = facts(self.game);
+        let columns: Vec<&str> = game.piece_columns.iter().map(|(name, _)| *name).collect();
+        if let Some(record) = &self.profile {
+            record
+                .profile(self.game)
+                .map_err(|e| format!("profile: {e}"))?;
+        }
+        // The other game's piece columns: none may stand where this game's do.
+        let foreign: Vec<&str> = Game::ALL
+            .into_iter()
+            .filter(|&g| g != self.game)
+            .flat_map(|g| facts(g).piece_columns.iter().map(|(name, _)| *name))
+            .filter(|name| !columns.contains(name))
+            .collect();
+        for (k, row) in self.controllability.iter().enumerate() {
+            let at = |field: &str| format!("controllability[{k}].{field}");
+            let has = |name: &&str| row.pieces.contains_key(*name);
+            let theirs = foreign.iter().any(has);
+            if theirs
+                || !columns.iter().all(has)
+                || row.air_time.is_some() != game.air_time_step.is_some()
+            {
+                return Err(format!(
+                    "controllability[{k}]: its columns are not the {} game's ({}): another game's results?",
+                    self.game,
+                    columns.join(", ")
+                ));
+            }
+            within(&at("aux"), row.aux, AUX)?;
+            within(&at("success_ratio"), row.success_ratio, SHARE)?;
+            within(&at("success_std"), row.success_std, SHARE)?;
+            within(&at("completed_by_any"), row.completed_by_any, SHARE)?;
+            for name in &columns {
+                within(&at(name), row.pieces[*name], SIZE)?;
+            }
+            if let Some(air) = row.air_time {
+                within(&at("air_time"), air, COUNT)?;
+            }
+            if let Some(f) = row.failures {
+                within(&at("pieces_per_level"), f.pieces_per_level, COUNT)?;
+                for (name, share) in [
+                    ("failures_on_last_piece", f.failures_on_last_piece),
+                    ("failures_on_worst_piece", f.failures_on_worst_piece),
+                ] {
+                    if let Some(share) = share {
+                        within(&at(name), share, SHARE)?;
+                    }
+                }
+            }
+        }
+        for (k, row) in self.generalization.iter().enumerate() {
+            let at = |field: &str| format!("generalization[{k}].{field}");
+            for (name, value) in [
+                ("success_ratio", row.success_ratio),
+                ("success_rule_levels", row.success_rule_levels),
+                ("success_generator_levels", row.success_generator_levels),
+                ("success_std", row.success_std),
+                ("completed_by_any", row.completed_by_any),
+            ] {
+                within(&at(name), value, SHARE)?;
+            }
+            within(&at("avg_steps"), row.avg_steps, COUNT)?;
+        }
+        for (k, row) in self.cross.iter().enumerate() {
+            if row.success_ratio.len() != AUX_VALUES.len() {
+                return Err(format!(
+                    "cross[{k}].success_ratio: {} values, one per λ ({}) expected",
+                    row.success_ratio.len(),
+                    AUX_VALUES.len()
+                ));
+            }
+            for (a, value) in row.success_ratio.iter().enumerate() {
+                within(&format!("cross[{k}].success_ratio[{a}]"), *value, SHARE)?;
+            }
+        }
+        for (k, row) in self.controllability_by_judge.iter().enumerate() {
+            let at = |field: &str| format!("controllability_by_judge[{k}].{field}");
+            within(&at("aux"), row.aux, AUX)?;
+            within(&at("success_ratio"), row.success_ratio, SHARE)?;
+            within(&at("completed_by_any"), row.completed_by_any, SHARE)?;
+        }
+        if let Some(knob) = &self.knob {
+            if knob.aux.len() != knob.success.len() {
+                return Err("knob: aux and success differ in length".into());
+            }
+            for (a, (aux, success)) in knob.aux.iter().zip(&knob.success).enumerate() {
+                within(&format!("knob.aux[{a}]"), *aux, AUX)?;
+                within(&format!("knob.success[{a}]"), *success, SHARE)?;
+            }
+            within("knob.smooth_steps", knob.smooth_steps, SHARE)?;
+        }
+        Ok(())
+    }
+}
+
+/// The range of a share or a success ratio.
+const SHARE: (f64, f64) = (0.0, 1.0);
+/// The range of λ.
+const AUX: (f64, f64) = (-1.0, 1.0);
+/// The range of a piece's mean parameter (metres, degrees), of a size a level has...
+const SIZE: (f64, f64) = (-1e6, 1e6);
+/// ...and of a count or a duration (pieces per level, steps, seconds).
+const COUNT: (f64, f64) = (0.0, 1e9);
+
+/// `Err` naming `field` unless `value` is a number within `range`.
+pub(super) fn within(field: &str, value: f64, (least, most): (f64, f64)) -> Result<(), String> {
+    match (least..=most).contains(&value) {
+        true => Ok(()),
+        false => Err(format!(
+            "{field}: {} is not a number within [{least}, {most}]",
+            arlpcg_core::level::params::show_number(value)
+        )),
     }
 }
 

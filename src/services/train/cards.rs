@@ -172,6 +172,84 @@ pub(super) fn checkpoint_identity(path: &Path) -> Result<(Game, TrainMode)> {
     Ok((card.game, card.training.mode))
 }
 
+/// The policies and cards a run writes into its folder, which a resumed session replaces.
+const RUN_POLICY_FILES: [&str; 4] = [
+    "solver.yaml", "solver.safetensors", "generator.yaml", "generator.safetensors",
+];
+
+/// Refuses to resume from the checkpoint `checkpoint` of the run folder `out` when a policy or
+/// card in the folder, or its Generator's checkpoint, is of another game, or of the same role
+/// with another observation or other actions: the folder then holds files of two runs, and
+/// resuming would replace the other run's policies. Files that do not read as policy cards are
+/// left to the run that wrote them.
+pub(super) fn check_folder_policies(
+    out: &Path,
+    checkpoint: &Path,
+    generator_checkpoint: &Path,
+) -> Result<()> {
+    let read = |path: &Path| -> Option<PolicyCard> {
+        let bytes = fsio::read_limited(path, checkpoint::MAX_POLICY_BYTES, "policy").ok()?;
+        match path.extension().is_some_and(|e| e == "yaml") {
+            true => serde_yaml::from_slice(&bytes).ok(),
+            false => checkpoint::read_card(&bytes).ok(),
+        }
+    };
+    let Some(run) = read(checkpoint) else {
+        return Ok(()); // reading the checkpoint names what is wrong with it
+    };
+    let generator = read(generator_checkpoint);
+    let others = RUN_POLICY_FILES.iter().map(|name| out.join(name));
+    for path in std::iter::once(generator_checkpoint.to_path_buf()).chain(others) {
+        let Some(card) = read(&path) else {
+            continue;
+        };
+        let two_runs = "the folder holds files of two different runs, and resuming would \
+                        replace its policies; resume a folder that one run wrote";
+        if card.game != run.game {
+            bail!(
+                "{}: a {} {}, and {} is a {} run's: {two_runs}",
+                path.display(),
+                card.game,
+                card.role,
+                checkpoint.display(),
+                run.game
+            );
+        }
+        let same_role = match card.role {
+            Role::Solver => Some(&run),
+            Role::Generator => generator.as_ref().filter(|_| path != generator_checkpoint),
+        };
+        if let Some(own) = same_role.filter(|own| !same_layout(own, &card)) {
+            bail!(
+                "{}: a {} of {}, and the run's checkpoint plays {}: {two_runs}",
+                path.display(),
+                card.role,
+                layout(&card),
+                layout(own)
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Whether two cards observe and act alike.
+fn same_layout(a: &PolicyCard, b: &PolicyCard) -> bool {
+    a.role == b.role
+        && a.observation == b.observation
+        && a.continuous_actions == b.continuous_actions
+        && a.binary_actions == b.binary_actions
+}
+
+/// A card's observation size and actions, for a message.
+fn layout(card: &PolicyCard) -> String {
+    let size: usize = card.observation.iter().map(|(_, k)| k).sum();
+    let actions: Vec<&str> = (card.continuous_actions.iter())
+        .chain(&card.binary_actions)
+        .map(String::as_str)
+        .collect();
+    format!("{size} observations and actions {}", actions.join(", "))
+}
+
 /// Reads a checkpoint of `role`, checking that it was trained in `mode`.
 pub(super) fn read_checkpoint(
     path: &Path,

@@ -35,7 +35,7 @@ use arlpcg_core::game::generator::GeneratorGame;
 use arlpcg_core::level::Game;
 use arlpcg_core::level::profile::{Profile, ProfileRecord};
 use arlpcg_core::rl::checkpoint::TrainMode;
-use cards::{checkpoint_identity, solver_shape};
+use cards::{check_folder_policies, checkpoint_identity, solver_shape};
 use config::load_config;
 pub use metrics::write_learning_curve;
 use solver_envs::{SolverEnvs, SourceRecord};
@@ -85,7 +85,9 @@ pub fn open(
         ability_spread,
     } = ask;
     let (game, mode) = if resume {
-        resumed_identity(out, game, mode)?
+        let identity = resumed_identity(out, game, mode)?;
+        check_folder_policies(out, &out.join(CHECKPOINT), &out.join(GENERATOR_CHECKPOINT))?;
+        identity
     } else {
         (game.unwrap_or_default(), mode.unwrap_or(TrainMode::RulePcg))
     };

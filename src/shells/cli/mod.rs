@@ -212,8 +212,9 @@ pub struct EvalArgs {
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
     pub threads: Option<u64>,
     /// Make and play every level for this game profile (`arlpcg profile init`); results.json
-    /// records it.
-    #[arg(long, value_name = "FILE")]
+    /// records it (a shard's part too, which --merge then keeps). Not with --runs, whose seeds
+    /// tables are of the built-in game.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["merge", "runs"])]
     pub profile: Option<PathBuf>,
 }
 
@@ -536,7 +537,7 @@ pub struct CampaignArgs {
     #[arg(long, value_name = "DIR")]
     pub policies: Option<PathBuf>,
     /// How many levels.
-    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=crate::services::campaign::MOST_LEVELS as i64))]
     pub levels: u32,
     /// The success asked for along the campaign: control points `position:success`, position 0
     /// the first level and 1 the last, linear between them ("0:0.95, 1:0.5"; two points at one
@@ -560,7 +561,7 @@ pub struct CampaignArgs {
     #[arg(long, value_name = "NAME", value_parser = Judge::parse)]
     pub judge: Option<Judge>,
     /// Runs per level, for the judge's search and for each judge of the panel.
-    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(10..=100_000))]
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(crate::services::campaign::TRIALS.0 as i64..=crate::services::campaign::TRIALS.1 as i64))]
     pub trials: u32,
     /// Level k is searched from seed SEED + k: the same seed gives the same campaign, byte for
     /// byte.
@@ -585,7 +586,9 @@ pub struct CampaignArgs {
     /// Folder to write into (created if missing).
     #[arg(long)]
     pub out: PathBuf,
-    /// Finish an interrupted campaign in --out: its level files are kept and the rest made.
+    /// Finish an interrupted campaign in --out: its level files are kept and the rest made. The
+    /// same arguments: a level searched for another --ramp or verified with other --trials is
+    /// refused.
     #[arg(long)]
     pub resume: bool,
 }

@@ -113,8 +113,8 @@ pub(super) fn parse_game(s: &str) -> Result<Game, String> {
 
 pub(super) fn parse_aux(s: &str) -> Result<f64, String> {
     let value: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    // -0 is 0: the same level, file name and YAML.
-    params::AUX.check(value + 0.0).map_err(|e| e.to_string())
+    // -0 is 0 (`check` returns it so): the same level, file name and YAML.
+    params::AUX.check(value).map_err(|e| e.to_string())
 }
 
 pub(super) fn parse_point(s: &str) -> Result<[f64; 3], String> {
@@ -141,10 +141,16 @@ pub(super) fn parse_population(s: &str) -> Result<(f64, f64), String> {
         mean.trim().parse().map_err(|_| bad())?,
         sd.trim().parse().map_err(|_| bad())?,
     );
-    match mean.is_finite() && sd.is_finite() && sd >= 0.0 {
-        true => Ok((mean, sd)),
-        false => Err(bad()),
-    }
+    // The limits a campaign file's population meets too.
+    let population = arlpcg_core::statistics::population::Population {
+        theta_mean: mean + 0.0,
+        theta_sd: sd + 0.0,
+        retry: arlpcg_core::statistics::population::DEFAULT_RETRY,
+    };
+    population
+        .check()
+        .map(|()| (population.theta_mean, population.theta_sd))
+        .map_err(|problem| format!("`{s}`: {problem}"))
 }
 
 /// `--retry P`: a chance within [0, 1).

@@ -31,6 +31,13 @@ use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::statistics::population::Population;
 
 pub fn run(args: &CampaignArgs) -> Result<()> {
+    // Ctrl-C from the start stops the campaign at its next safe point: the levels finished
+    // are written for --resume.
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
     if args.out.exists() && !args.out.is_dir() {
         anyhow::bail!("--out {} is not a folder", args.out.display());
     }
@@ -78,17 +85,13 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     let files: Vec<LevelFiles> = (0..n)
         .map(|k| LevelFiles::new(&args.out, &level_stem(k, n), &formats))
         .collect();
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
-    }
     let resumed = match args.resume {
         true => resumed_levels(args, &ask, &files, &solver)?,
         false => vec![None; n],
     };
+    let cache = crate::shells::common::cache_dir();
     let curve = difficulty_curve(
-        &dir,
+        (&dir, cache.as_deref()),
         &generator,
         &solver,
         ask.profile.as_ref(),
@@ -102,7 +105,15 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
             )
         },
         &|| stop.load(Ordering::SeqCst),
-    )?;
+    )
+    .map_err(|e| match e.downcast_ref::<difficulty::TargetError>() {
+        Some(difficulty::TargetError::Stopped) => Interrupted(
+            "interrupted (Ctrl-C) while the λ→success curve was measured; nothing was written"
+                .into(),
+        )
+        .into(),
+        _ => e,
+    })?;
     let built = search_levels(args, &ask, &generator, &solver, &curve, resumed, &stop)?;
     if built.iter().any(Option::is_none) {
         return interrupted(args, &built, &files);
@@ -110,12 +121,11 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     let mut levels: Vec<Level> = built.into_iter().flatten().collect();
     let search = |seed: u64, target: f64| {
         search_level(
-            &generator,
-            &solver,
+            (&generator, &solver),
             &curve,
             &ask.request(seed),
-            target,
-            args.trials,
+            (target, args.trials),
+            &|| stop.load(Ordering::SeqCst),
         )
     };
     let Some(campaign) = rate_levels(&ask, &panel, &mut levels, &stop, Some(&search))? else {
@@ -153,15 +163,18 @@ fn search_levels(
                 return Ok(None);
             }
             let seed = level_seed(args.seed, k)?;
-            let level = search_level(
-                generator,
-                solver,
+            let searched = search_level(
+                (generator, solver),
                 curve,
                 &ask.request(seed),
-                ask.target(k, n),
-                args.trials,
-            )
-            .with_context(|| {
+                (ask.target(k, n), args.trials),
+                &|| stop.load(Ordering::SeqCst),
+            );
+            // A Ctrl-C during the search leaves the level unsearched.
+            if is_search_stopped(&searched) {
+                return Ok(None);
+            }
+            let level = searched.with_context(|| {
                 format!(
                     "level {} of {n} (seed {seed}, success {:.2} asked); nothing was written",
                     k + 1,
@@ -174,6 +187,16 @@ fn search_levels(
         .collect::<Result<_>>()?;
     bar.finish_and_clear();
     Ok(built)
+}
+
+/// Whether `searched` is a search a Ctrl-C ended.
+fn is_search_stopped<T>(searched: &Result<T>) -> bool {
+    searched.as_ref().is_err_and(|e| {
+        matches!(
+            e.downcast_ref(),
+            Some(difficulty::TargetError::SearchStopped)
+        )
+    })
 }
 
 /// Writes the levels, campaign.yaml, campaign.md and campaign.png, all or none, and says so.
@@ -277,6 +300,8 @@ fn resumed_levels(
                 args.seed.saturating_add(n as u64 - 1),
             );
         };
+        // A level searched for another ramp or with other trials is not this campaign's level.
+        check_resumed(&level, &path, ask.target(slot, n), args.trials)?;
         // The panel plays the whole campaign again: its rating is of all the levels together.
         if let Some(stats) = &mut level.stats {
             stats.panel = None;
@@ -284,6 +309,32 @@ fn resumed_levels(
         levels[slot] = Some(level);
     }
     Ok(levels)
+}
+
+/// Refuses a resumed level that the campaign asked for now would not have kept: one whose
+/// judge's success lies off its ramp point (it was searched for another `--ramp`), or that
+/// was verified with another `--trials`.
+fn check_resumed(level: &Level, path: &Path, target: f64, trials: u32) -> Result<()> {
+    let Some(stats) = &level.stats else {
+        return Ok(());
+    };
+    let again = "resume with the arguments it was made with, or choose another --out";
+    if stats.trials != trials {
+        anyhow::bail!(
+            "{}: verified with {} runs, and --trials asks {trials}: {again}",
+            path.display(),
+            stats.trials
+        );
+    }
+    if (stats.success_ratio - target).abs() > difficulty::BAND + 1e-9 {
+        anyhow::bail!(
+            "{}: measured success {:.2}, and --ramp asks {target:.2} ± {} of this level: it was searched for another ramp; {again}",
+            path.display(),
+            stats.success_ratio,
+            difficulty::BAND
+        );
+    }
+    Ok(())
 }
 
 /// After a Ctrl-C: writes the levels finished so far (without the panel's rating, which is of
@@ -340,7 +391,13 @@ fn rate_levels(
                 bar.inc_length(level_runs);
                 search(seed, target)
             };
-            rate_and_mend(ask, panel, levels, &watch, &draw)?.map(|(campaign, kept)| {
+            let mended = rate_and_mend(ask, panel, levels, &watch, &draw);
+            // A Ctrl-C while a level was drawn anew stops the campaign as one during the panel.
+            if is_search_stopped(&mended) {
+                bar.finish_and_clear();
+                return Ok(None);
+            }
+            mended?.map(|(campaign, kept)| {
                 for seed in kept {
                     crate::say!(
                         "drew a level anew from seed {seed} where the panel's b stepped down"
@@ -388,19 +445,29 @@ fn apply_checks(campaign: &Campaign, levels: &[Level]) -> Result<()> {
         (entry.file.clone(), stats, rating)
     });
     let failed = failures(&campaign.checks, evidence);
-    report_checks(&campaign.checks, failed, levels.len())
+    report_checks(&campaign.checks, failed, levels.len(), false)
 }
 
-/// Exit code 3, naming each level and check that failed, when any did.
-pub fn report_checks(checks: &[Check], failed: Vec<(String, String)>, levels: usize) -> Result<()> {
+/// Exit code 3, naming each level and check that failed, when any did. The verdict goes to
+/// standard output, or with `json` to standard error (standard output then carries only JSON).
+pub fn report_checks(
+    checks: &[Check],
+    failed: Vec<(String, String)>,
+    levels: usize,
+    json: bool,
+) -> Result<()> {
+    let tell = |line: String| match json {
+        true => crate::warn!("{line}"),
+        false => crate::say!("{line}"),
+    };
     if failed.is_empty() {
         if !checks.is_empty() {
-            crate::say!("every level passed its checks ({})", checks.len());
+            tell(format!("every level passed its checks ({})", checks.len()));
         }
         return Ok(());
     }
     for (level, why) in &failed {
-        crate::say!("check failed: {level}: {why}");
+        tell(format!("check failed: {level}: {why}"));
     }
     let levels_failed = {
         let mut names: Vec<&String> = failed.iter().map(|(n, _)| n).collect();

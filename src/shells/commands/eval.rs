@@ -22,11 +22,6 @@ pub fn run(args: &EvalArgs) -> Result<()> {
         return merge(args);
     }
     if !args.runs.is_empty() {
-        if args.profile.is_some() {
-            bail!(
-                "--profile with --runs: a seeds table is of the built-in game; evaluate each run with --policies and --profile"
-            );
-        }
         return seeds(args);
     }
     if let Some(missing) = args.policies.iter().find(|dir| !dir.is_dir()) {
@@ -154,8 +149,18 @@ fn load_runs(args: &EvalArgs) -> Result<Vec<LoadedRun<'_>>> {
     }
     let mut loaded: Vec<LoadedRun> = Vec::new();
     for dir in &args.runs {
-        let (solver, card) =
-            load_solver(&dir.join(crate::services::policies::SOLVER_FILE), args.game)?;
+        let solver_file = dir.join(crate::services::policies::SOLVER_FILE);
+        let (solver, card) = load_solver(&solver_file, args.game)?;
+        // A seeds table is of the built-in game: a run trained for a profile is not one more
+        // seed of it.
+        if let Some(profile) = &card.profile {
+            bail!(
+                "--runs: {} was trained for profile `{}` (its card's profile), not the built-in {} game: a seeds table compares runs of one game; evaluate it with --policies and --profile",
+                solver_file.display(),
+                profile.name,
+                args.game
+            );
+        }
         let generator_file = dir.join(GENERATOR_FILE);
         let generator = match generator_file.exists() {
             true => Some(load_generator(&generator_file, args.game)?.0),
@@ -217,13 +222,8 @@ fn seeds(args: &EvalArgs) -> Result<()> {
     let judges = crate::services::policies::load_panel(folder, args.game, Some(&available))?;
     let budget = budget(args);
     let pool = crate::shells::common::thread_pool(args.threads)?;
-    let profile = asked_profile(args)?;
     let validation = pool.install(|| {
-        eval::validation_levels(
-            &validation_generator,
-            budget.validation_tracks,
-            profile.as_ref(),
-        )
+        eval::validation_levels(&validation_generator, budget.validation_tracks, None)
     })?;
     let rule_levels = validation.iter().filter(|l| eval::is_rule_level(l)).count();
     let arlpcg_generators = runs
@@ -242,15 +242,9 @@ fn seeds(args: &EvalArgs) -> Result<()> {
     };
     let bar = crate::shells::common::progress_bar(runs.iter().map(per_run).sum(), "levels played");
     let scores = pool.install(|| {
-        eval::seeds::score_runs(
-            &runs,
-            &judges,
-            &validation,
-            rule_levels,
-            budget,
-            profile.as_ref(),
-            &|| bar.inc(1),
-        )
+        eval::seeds::score_runs(&runs, &judges, &validation, rule_levels, budget, &|| {
+            bar.inc(1)
+        })
     })?;
     bar.finish_and_clear();
     let results = eval::seeds::summarize(budget, &validation_generator.reference.path, scores);
@@ -390,8 +384,8 @@ fn write_shard(
                 .iter()
                 .map(|s| (s.mode.clone(), s.solver.policy_reference()))
                 .collect(),
-            levels.layout,
-            indices.into_iter().zip(stats).collect(),
+            (levels.layout, indices.into_iter().zip(stats).collect()),
+            profile.map(|p| p.record()),
         ))
     })?;
     std::fs::create_dir_all(&args.out)

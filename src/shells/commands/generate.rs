@@ -144,7 +144,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         )
     });
     let failed = checks::failures(&args.checks, named);
-    super::campaign::report_checks(&args.checks, failed, levels.len())
+    super::campaign::report_checks(&args.checks, failed, levels.len(), false)
 }
 
 /// What verification did across the batch: redrawn, unsolved and uncertified levels.
@@ -203,9 +203,15 @@ fn target_curve(
             difficulty::CURVE_TRIALS
         )
     };
-    crate::services::policies::difficulty_curve(dir, generator, solver, profile, announce, &|| {
-        stop.load(Ordering::SeqCst)
-    })
+    let cache = crate::shells::common::cache_dir();
+    crate::services::policies::difficulty_curve(
+        (dir, cache.as_deref()),
+        generator,
+        solver,
+        profile,
+        announce,
+        &|| stop.load(Ordering::SeqCst),
+    )
     .map(Some)
     .map_err(|e| match e.downcast_ref::<difficulty::TargetError>() {
         Some(difficulty::TargetError::Stopped) => crate::shells::common::Interrupted(

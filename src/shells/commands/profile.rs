@@ -10,7 +10,10 @@ use arlpcg_core::level::profile::Profile;
 pub fn run(command: &ProfileCommand) -> Result<()> {
     match command {
         ProfileCommand::Init { game } => {
-            print!("{}", Profile::default_of(*game).to_commented_yaml());
+            crate::shells::common::say(format_args!(
+                "{}",
+                Profile::default_of(*game).to_commented_yaml()
+            ));
             Ok(())
         }
         ProfileCommand::Check { file, trials } => {

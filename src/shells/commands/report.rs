@@ -98,6 +98,22 @@ fn read_game(game: Game, results: &Path, policies: &Path) -> Result<GamePage> {
         .map(|(name, path)| {
             let card: PolicyCard = serde_yaml::from_slice(&read(&path)?)
                 .with_context(|| format!("{}", path.display()))?;
+            if card.game != game {
+                bail!(
+                    "{}: the card of a {} policy in the {game} policies",
+                    path.display(),
+                    card.game
+                );
+            }
+            // The page quotes its time: a number of seconds, not a NaN or a 309-digit one.
+            let wall = card.training.wall_time_s;
+            if !(0.0..=1e9).contains(&wall) {
+                bail!(
+                    "{}: training.wall_time_s: {} is not a number of seconds within [0, 1e9]",
+                    path.display(),
+                    arlpcg_core::level::params::show_number(wall)
+                );
+            }
             Ok((format!("{name}.safetensors"), card))
         })
         .collect::<Result<Vec<_>>>()?;
@@ -108,6 +124,13 @@ fn read_game(game: Game, results: &Path, policies: &Path) -> Result<GamePage> {
         true => Some(crate::services::campaign::read_record(&campaign_file)?),
         false => None,
     };
+    if let Some(other) = campaign.as_ref().filter(|c| c.game != game) {
+        bail!(
+            "{}: a {} campaign in the {game} results",
+            campaign_file.display(),
+            other.game
+        );
+    }
     let mut profiles = Vec::new();
     if dir.join("profiles").is_dir() {
         for folder in subfolders(&dir.join("profiles"))? {
@@ -140,7 +163,7 @@ fn read(path: &Path) -> Result<Vec<u8>> {
 }
 
 fn read_seeds(path: &Path) -> Result<SeedResults> {
-    serde_json::from_slice(&read(path)?).with_context(|| format!("{}", path.display()))
+    SeedResults::read(&read(path)?).with_context(|| format!("{}", path.display()))
 }
 
 /// The folders in `dir`, by name.

@@ -38,6 +38,13 @@ pub fn run(args: &TrainArgs) -> Result<()> {
     if out.exists() && !out.is_dir() {
         return Err(usage(&format!("--out {} is not a folder", out.display())));
     }
+    // The profile is read and checked before anything is made: a bad one leaves no folder.
+    let profile = args
+        .profile
+        .as_deref()
+        .map(crate::services::profile::load)
+        .transpose()?;
+    let pool = crate::shells::common::thread_pool(args.threads)?;
     // One session per run folder: two (two new runs, a resume started twice) would interleave
     // or replace each other's files. The folder is made, if need be, and locked before
     // anything is written in it; a run refused after that takes away the folder it made.
@@ -51,12 +58,6 @@ pub fn run(args: &TrainArgs) -> Result<()> {
             out.display()
         );
     }
-    let profile = args
-        .profile
-        .as_deref()
-        .map(crate::services::profile::load)
-        .transpose()?;
-    let pool = crate::shells::common::thread_pool(args.threads)?;
     pool.install(|| {
         let opened = train::open(
             args.game,

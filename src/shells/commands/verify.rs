@@ -130,7 +130,7 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
             args.levels.len()
         );
     }
-    report_checks(&args.checks, checked, args.levels.len())
+    report_checks(&args.checks, checked, args.levels.len(), args.json)
 }
 
 /// The checks on the arguments alone (exit 2 on a misfit).
@@ -363,7 +363,7 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
             args.levels.len()
         );
     }
-    report_checks(&args.checks, checked, args.levels.len())
+    report_checks(&args.checks, checked, args.levels.len(), args.json)
 }
 
 /// The Solver of each game met so far, resolved from the arguments once per game.

@@ -2,14 +2,44 @@
 
 use std::ffi::{OsStr, OsString};
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 /// Runs the `arlpcg` binary with `args` and waits for it.
 pub fn arlpcg<S: AsRef<OsStr>>(args: impl IntoIterator<Item = S>) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_arlpcg"))
+    test_command().args(args).output().expect("the binary runs")
+}
+
+/// Runs the binary, killed after `limit` (so that a hang fails the test instead of stalling it).
+pub fn arlpcg_within<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S], limit: Duration) -> Output {
+    let mut child = test_command()
         .args(args)
-        .output()
-        .expect("the binary runs")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > limit {
+            child.kill().unwrap();
+            let _ = child.wait();
+            panic!("{args:?} still ran after {limit:?}: it hangs");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// The `arlpcg` binary as the tests run it: measured λ→success curves go to a cache folder
+/// under the build's target folder (`ARLPCG_CACHE`), never into the user's.
+pub fn test_command() -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_arlpcg"));
+    command.env(
+        "ARLPCG_CACHE",
+        Path::new(env!("CARGO_TARGET_TMPDIR")).join("arlpcg-cache"),
+    );
+    command
 }
 
 /// A command line's arguments: the words of `line` (split at white space), each `{}` standing

@@ -22,7 +22,7 @@ impl ParamRange {
         }
     }
 
-    /// Checks that `value` is a number inside the range.
+    /// Checks that `value` is a number inside the range; returns it, -0 as 0.
     pub fn check(&self, value: f64) -> Result<f64, RangeError> {
         if value.is_nan() {
             return Err(RangeError::NotANumber { range: *self });
@@ -33,7 +33,7 @@ impl ParamRange {
                 value,
             });
         }
-        Ok(value)
+        Ok(value + 0.0)
     }
 
     /// Maps `t` in [-1, 1] linearly onto the range (how squashed policy outputs become values).

@@ -28,6 +28,11 @@ const Z90: f64 = 1.281_551_565_545;
 /// one failure in four.
 pub const DEFAULT_RETRY: f64 = 0.75;
 
+/// The largest mean ability (either sign) and spread of a population, logits: far beyond any
+/// judge's θ or level's b (the rating's prior has sd 3), where every player passes or fails
+/// every level alike.
+pub const MOST_LOGITS: f64 = 50.0;
+
 /// Grid points over θ (±8 sd) for the population's integrals.
 const GRID: usize = 2001;
 
@@ -57,18 +62,26 @@ impl Population {
         }
     }
 
-    /// Checks the numbers: finite, sd ≥ 0, retry within [0, 1). `Err` names the field.
+    /// Checks the numbers: the mean within ±[`MOST_LOGITS`], the sd within [0, MOST_LOGITS],
+    /// retry within [0, 1). `Err` names the field. `--population` and a campaign file meet
+    /// the same limits.
     pub fn check(&self) -> Result<(), String> {
-        if !self.theta_mean.is_finite() {
-            return Err(format!("theta_mean {} must be a number", self.theta_mean));
+        if !(-MOST_LOGITS..=MOST_LOGITS).contains(&self.theta_mean) {
+            return Err(format!(
+                "theta_mean {} must be a number within [-{MOST_LOGITS}, {MOST_LOGITS}] (logits)",
+                shown(self.theta_mean)
+            ));
         }
-        if !(self.theta_sd.is_finite() && self.theta_sd >= 0.0) {
-            return Err(format!("theta_sd {} must be a number ≥ 0", self.theta_sd));
+        if !(0.0..=MOST_LOGITS).contains(&self.theta_sd) {
+            return Err(format!(
+                "theta_sd {} must be a number within [0, {MOST_LOGITS}] (logits)",
+                shown(self.theta_sd)
+            ));
         }
         if !(0.0..1.0).contains(&self.retry) {
             return Err(format!(
                 "retry {} must be within [0, 1) (1 would retry forever)",
-                self.retry
+                shown(self.retry)
             ));
         }
         Ok(())
@@ -118,6 +131,14 @@ impl Population {
             .collect();
         let total: f64 = points.iter().map(|p| p.1).sum();
         points.into_iter().map(|(t, w)| (t, w / total)).collect()
+    }
+}
+
+/// `x` for a message: a huge or tiny number in scientific notation (`1e308`, not 309 digits).
+fn shown(x: f64) -> String {
+    match x.is_finite() && (x == 0.0 || (1e-6..1e9).contains(&x.abs())) {
+        true => format!("{x}"),
+        false => format!("{x:e}"),
     }
 }
 

@@ -15,12 +15,12 @@ use crate::services::generation::GeneratorPolicy;
 use crate::services::panel::JudgePanel;
 use crate::services::verify::{Solver, SolverPolicy, verify};
 use arlpcg_core::level::Level;
-use arlpcg_core::level::profile::Profile;
 use arlpcg_core::seed_ranges::EVAL_SEED_BASE;
 use arlpcg_core::statistics::over_seeds::{
     Aggregate, Estimate, estimate, probability_of_improvement,
 };
 
+use super::tables::within;
 use super::{AUX_VALUES, Budget, generator_levels};
 
 pub mod markdown;
@@ -151,6 +151,117 @@ pub struct SeedResults {
     pub arlpcg_beats_on_other_generators: Vec<Improvement>,
 }
 
+impl SeedResults {
+    /// A seeds.json as `eval --runs` wrote it, refused (`Err` naming the field) when a figure
+    /// is not a share within [0, 1], a λ not within [-1, 1], or a curve lacks a value per λ.
+    pub fn read(json: &[u8]) -> anyhow::Result<SeedResults> {
+        let results: SeedResults = serde_json::from_slice(json)?;
+        results.check().map_err(anyhow::Error::msg)?;
+        Ok(results)
+    }
+
+    fn check(&self) -> Result<(), String> {
+        const SHARE: (f64, f64) = (0.0, 1.0);
+        if self.aux.is_empty() || self.aux.len() > AUX_VALUES.len() {
+            return Err(format!("aux: 1 to {} values of λ", AUX_VALUES.len()));
+        }
+        for (a, aux) in self.aux.iter().enumerate() {
+            within(&format!("aux[{a}]"), *aux, (-1.0, 1.0))?;
+        }
+        // Every curve has one value per λ.
+        let curve = |field: &str, values: &[f64]| -> Result<(), String> {
+            if values.len() != self.aux.len() {
+                return Err(format!(
+                    "{field}: {} values, one per λ ({}) expected",
+                    values.len(),
+                    self.aux.len()
+                ));
+            }
+            for (a, value) in values.iter().enumerate() {
+                within(&format!("{field}[{a}]"), *value, SHARE)?;
+            }
+            Ok(())
+        };
+        let estimate = |field: &str, e: &Estimate| -> Result<(), String> {
+            within(&format!("{field}.value"), e.value, SHARE)?;
+            within(&format!("{field}.ci95[0]"), e.ci95[0], SHARE)?;
+            within(&format!("{field}.ci95[1]"), e.ci95[1], SHARE)
+        };
+        for (mode, runs) in &self.seeds {
+            for (k, run) in runs.iter().enumerate() {
+                let at = |field: &str| format!("seeds.{mode}[{k}].{field}");
+                within(&at("validation"), run.validation, SHARE)?;
+                within(
+                    &at("validation_rule_levels"),
+                    run.validation_rule_levels,
+                    SHARE,
+                )?;
+                within(
+                    &at("validation_generator_levels"),
+                    run.validation_generator_levels,
+                    SHARE,
+                )?;
+                if let Some(values) = &run.controllability {
+                    curve(&at("controllability"), values)?;
+                }
+                for (j, judge) in run.controllability_by_judge.iter().enumerate() {
+                    curve(
+                        &at(&format!("controllability_by_judge[{j}].success_ratio")),
+                        &judge.success_ratio,
+                    )?;
+                }
+                if let Some(hard) = run.other_generators_hard {
+                    within(&at("other_generators_hard"), hard, SHARE)?;
+                }
+                for (g, score) in run.on_other_generators.iter().enumerate() {
+                    let field = at(&format!("on_other_generators[{g}].success_ratio"));
+                    within(&field, score.success_ratio, SHARE)?;
+                }
+            }
+        }
+        for (k, mode) in self.modes.iter().enumerate() {
+            let at = |field: &str| format!("modes[{k}].{field}");
+            estimate(&at("validation_iqm"), &mode.validation_iqm)?;
+            estimate(&at("validation_mean"), &mode.validation_mean)?;
+            let curves = mode
+                .controllability
+                .iter()
+                .map(|c| ("controllability".to_string(), c));
+            let judges = mode
+                .controllability_by_judge
+                .iter()
+                .enumerate()
+                .map(|(j, c)| {
+                    (
+                        format!("controllability_by_judge[{j}].success_ratio"),
+                        &c.success_ratio,
+                    )
+                });
+            for (field, estimates) in curves.chain(judges) {
+                if estimates.len() != self.aux.len() {
+                    return Err(format!("{}: one value per λ expected", at(&field)));
+                }
+                for (a, e) in estimates.iter().enumerate() {
+                    estimate(&at(&format!("{field}[{a}]")), e)?;
+                }
+            }
+            if let Some(hard) = &mode.other_generators_hard {
+                estimate(&at("other_generators_hard"), hard)?;
+            }
+        }
+        let beats = self.arlpcg_beats.iter().map(|i| ("arlpcg_beats", i));
+        let others = (self.arlpcg_beats_on_other_generators.iter())
+            .map(|i| ("arlpcg_beats_on_other_generators", i));
+        for (k, (field, improvement)) in beats.chain(others).enumerate() {
+            estimate(
+                &format!("{field}[{k}].probability"),
+                &improvement.probability,
+            )?;
+        }
+        Ok(())
+    }
+}
+
 /// One run to score: its Solver, mode and seed, and its Generator when it has one.
 pub struct SeedRun<'a> {
     pub folder: String,
@@ -163,15 +274,14 @@ pub struct SeedRun<'a> {
 /// Plays the validation set (rule levels first, `rule_levels` of them) with every run's Solver,
 /// each adversarial run's own pair and the `judges` on its controllability levels, and every
 /// Solver on the λ = -1 levels of the ARLPCG Generators other than its run's own
-/// ([`other_generators_plays`] of them); `on_level` after each level played. Generator levels
-/// are made for `profile` (none: the built-in game), as the validation set must be.
+/// ([`other_generators_plays`] of them); `on_level` after each level played. Levels are of the
+/// built-in game, as the runs' are.
 pub fn score_runs(
     runs: &[SeedRun],
     judges: &JudgePanel,
     validation: &[Level],
     rule_levels: usize,
     budget: Budget,
-    profile: Option<&Profile>,
     on_level: &(dyn Fn() + Sync),
 ) -> Result<Vec<RunScores>, candle_core::Error> {
     // Each level's success ratio with `solver`.
@@ -197,7 +307,7 @@ pub fn score_runs(
                     AUX_VALUES
                         .iter()
                         .map(|&aux| {
-                            generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks, profile)
+                            generator_levels(generator, aux, EVAL_SEED_BASE, budget.tracks, None)
                         })
                         .collect::<Result<Vec<_>, _>>()
                 })

@@ -157,7 +157,7 @@ pub fn perform(
             let result = match (ask.success(), ask.aux()) {
                 (Some(target), _) => {
                     let asked = LevelRequest::new(seed, None).goal(goal).profile(profile);
-                    target_level(&shelf[game], &asked, target, trials)
+                    target_level(&shelf[game], &asked, (target, trials), stop)
                 }
                 (None, aux) => {
                     let mut request = LevelRequest::new(seed, None).goal(goal).profile(profile);
@@ -278,8 +278,13 @@ fn regenerate_campaign_level(
         .ok()
         .and_then(|shelf| shelf[game].generator.clone())
         .ok_or_else(|| anyhow::anyhow!("no {game} Generator is loaded (p loads one)"))?;
-    let (folder, record, levels) =
-        crate::services::campaign::regenerate_level(folder, k, &generator, dir, stop)?;
+    let (folder, record, levels) = crate::services::campaign::regenerate_level(
+        folder,
+        k,
+        &generator,
+        (dir, crate::shells::common::cache_dir().as_deref()),
+        stop,
+    )?;
     Ok(Box::new(OpenedCampaign {
         folder,
         record,
@@ -389,12 +394,13 @@ fn sweep_point(
 }
 
 /// The target-success search of `generate --target-success` with the designer's policies: the
-/// λ→success curve is read from (or, the first time, measured into) the Generator's folder.
+/// λ→success curve is read from the Generator's folder or the cache (or, the first time,
+/// measured into the cache). A newer request (`stop`) ends the measurement and the search.
 fn target_level(
     policies: &Policies,
     asked: &LevelRequest,
-    target: f64,
-    trials: u32,
+    (target, trials): (f64, u32),
+    stop: &(dyn Fn() -> bool + Sync),
 ) -> Result<Level, String> {
     let generator = policies
         .generator
@@ -406,13 +412,14 @@ fn target_level(
     let folder = Path::new(&generator.reference.path)
         .parent()
         .unwrap_or(Path::new("."));
+    let cache = crate::shells::common::cache_dir();
     let curve = crate::services::policies::difficulty_curve(
-        folder,
+        (folder, cache.as_deref()),
         generator,
         &Solver::Policy(solver),
         asked.profile.as_ref(),
         || {},
-        &|| false,
+        stop,
     )
     .map_err(|e| format!("{e:#}"))?;
     let proof = Proof::Target {
@@ -423,7 +430,7 @@ fn target_level(
     };
     let watch = verify::Watch {
         on_trial: &|_| {},
-        stop: &|| false,
+        stop,
     };
     making::verified_level(
         LevelSource::Generator(generator),

@@ -119,6 +119,14 @@ pub fn racing_level_draw(
     draw: u32,
 ) -> Result<Level, NoTrack> {
     let (goal, heading, obstacles, mut rng) = goal_and_start(seed, goal, config.obstacles);
+    let no_track = NoTrack {
+        goal,
+        max_segments: config.max_segments,
+    };
+    // A goal no road of these segments can reach fails every attempt: say so at once.
+    if out_of_reach(heading, goal, config, &player.segments()) {
+        return Err(no_track);
+    }
     let mut skip = draw;
     for _ in 0..ATTEMPTS {
         if let Some(mut track) = attempt(
@@ -146,10 +154,40 @@ pub fn racing_level_draw(
             });
         }
     }
-    Err(NoTrack {
-        goal,
-        max_segments: config.max_segments,
-    })
+    Err(no_track)
+}
+
+/// Whether no road from the origin at `heading` of at most `config.max_segments` segments,
+/// each within `ranges` and `config`, can end within reach of `goal`, however they are drawn:
+/// each segment turns the road by at most its largest curve, so the road's end lies in the cone
+/// of headings within the whole turn it may make (when that is under 90°), and no farther than
+/// its segments' whole length. A profile whose roads hardly turn (`max_curve: 0`) would
+/// otherwise spend every attempt on goals off its straight line.
+fn out_of_reach(
+    heading: f64,
+    goal: [f64; 3],
+    config: &RacingRulesConfig,
+    ranges: &SegmentRanges,
+) -> bool {
+    let segments = f64::from(config.max_segments);
+    let distance = goal[0].hypot(goal[2]);
+    let reach = racing::GOAL_REACH_HORIZONTAL;
+    if distance - reach > segments * (ranges.max_length + 1e-3) {
+        return true;
+    }
+    // The largest curve, and the half step of the quantization it may round up by.
+    let turn = segments * (config.max_curve.min(ranges.max_curve) + 1e-3);
+    if turn >= 90.0 {
+        return false;
+    }
+    let off_axis = wrap_degrees(direction_heading(goal[0], goal[2]) - heading).abs();
+    let outside = off_axis - turn;
+    let gap = match outside {
+        ..=0.0 => 0.0,
+        90.0.. => distance,
+        _ => distance * outside.to_radians().sin(),
+    };
+    gap > reach
 }
 
 /// One try at a whole track; `None` when it gets stuck or runs out of segments.
@@ -236,4 +274,47 @@ fn draw(
 
 fn plan_distance(a: [f64; 3], b: [f64; 3]) -> f64 {
     (a[0] - b[0]).hypot(a[2] - b[2])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::level::profile::Pieces;
+
+    /// The early refusal never refuses a goal the rules reach, and refuses the goals a road
+    /// that cannot turn misses.
+    #[test]
+    fn a_goal_out_of_reach_is_refused_at_once_and_only_then() {
+        let config = RacingRulesConfig::default();
+        let ours = Player::of(None);
+        for seed in 0..12 {
+            let (goal, heading, ..) = goal_and_start(seed, None, 0);
+            let built = racing_level(seed, None, None, &config, &ours);
+            assert!(built.is_ok(), "seed {seed}");
+            assert!(!out_of_reach(heading, goal, &config, &ours.segments()));
+        }
+        let straight = SegmentRanges {
+            max_curve: 0.0,
+            ..SegmentRanges::default()
+        };
+        let player = Player::of(None).with_pieces(Some(Pieces::Racing(straight)));
+        let ahead = heading_direction(30.0);
+        let on_axis = [200.0 * ahead[0], 0.0, 200.0 * ahead[1]];
+        assert!(!out_of_reach(30.0, on_axis, &config, &straight));
+        let aside = heading_direction(30.0 + 20.0);
+        let off_axis = [200.0 * aside[0], 0.0, 200.0 * aside[1]];
+        assert!(out_of_reach(30.0, off_axis, &config, &straight));
+        // Most goals lie off a road that cannot turn; those on its line are still built.
+        let refused: Vec<u64> = (0..12)
+            .filter(|&seed| {
+                let (goal, heading, ..) = goal_and_start(seed, None, 0);
+                out_of_reach(heading, goal, &config, &straight)
+            })
+            .collect();
+        assert!(refused.len() >= 6, "{refused:?}");
+        let (_, heading, ..) = goal_and_start(0, None, 0);
+        let [x, z] = heading_direction(heading);
+        let ahead = [quantize(200.0 * x), 0.0, quantize(200.0 * z)];
+        assert!(racing_level(0, None, Some(ahead), &config, &player).is_ok());
+    }
 }

@@ -203,11 +203,11 @@ impl Abilities {
         match (game, character, car) {
             (Game::Platform, Some(c), None) => {
                 c.check().map_err(|e| e.to_string())?;
-                Ok(Abilities::Platform(c))
+                Ok(Abilities::Platform(c.normalized()))
             }
             (Game::Racing, None, Some(c)) => {
                 c.check().map_err(|e| e.to_string())?;
-                Ok(Abilities::Racing(c))
+                Ok(Abilities::Racing(c.normalized()))
             }
             (Game::Platform, _, _) => {
                 Err("a platform profile has `character:` and no `car:`".into())

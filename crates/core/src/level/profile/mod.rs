@@ -113,13 +113,36 @@ trait Fields: Copy {
         Some((self.get(k), Self::FIELDS[k].0))
     }
 
-    /// A copy with the field named `name` at `value`, unchecked.
+    /// A copy with every -0 field at 0: a file's `-0.0` reads as `0.0`, the same profile with
+    /// the same SHA-256 (as `--aux -0` is `--aux 0`).
+    fn normalized(mut self) -> Self {
+        for k in 0..Self::FIELDS.len() {
+            *self.slot(k) += 0.0;
+        }
+        self
+    }
+
+    /// A copy with the field named `name` at `value` (-0 as 0), unchecked.
     fn set(&self, name: &str, value: f64) -> Option<Self> {
         let k = Self::FIELDS.iter().position(|(r, _)| r.name == name)?;
         let mut copy = *self;
-        *copy.slot(k) = value;
+        *copy.slot(k) = value + 0.0;
         Some(copy)
     }
+}
+
+/// Checks a profile's name: 1 to 64 characters of one line, none of them a control character
+/// (a line break or a terminal's escape codes would reach every terminal that shows the name).
+fn check_name(name: &str) -> Result<(), String> {
+    if name.trim().is_empty() || name.len() > 64 {
+        return Err("name: 1 to 64 characters".into());
+    }
+    if name.contains(char::is_control) {
+        return Err(
+            "name: a line of text without control characters (line breaks, escape codes)".into(),
+        );
+    }
+    Ok(())
 }
 
 /// The `n`-th of `values`.
@@ -173,9 +196,7 @@ impl Profile {
                 file.version
             ));
         }
-        if file.name.trim().is_empty() || file.name.len() > 64 {
-            return Err("name: 1 to 64 characters".into());
-        }
+        check_name(&file.name)?;
         let abilities = Abilities::checked(file.game, file.character, file.car)?;
         let pieces = Pieces::checked(file.game, file.blocks, file.segments)?;
         Ok(Self {
@@ -298,6 +319,7 @@ impl ProfileRecord {
     /// The profile a level records, checked: its game's abilities and piece ranges, in range,
     /// and the SHA-256 they hash to.
     pub fn profile(&self, game: Game) -> Result<Profile, String> {
+        check_name(&self.name)?;
         let profile = Profile {
             name: self.name.clone(),
             abilities: Abilities::checked(game, self.character, self.car)?,

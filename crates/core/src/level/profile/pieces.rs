@@ -297,12 +297,12 @@ impl Pieces {
     ) -> Result<Self, String> {
         match (game, blocks, segments) {
             (Game::Platform, blocks, None) => {
-                let blocks = blocks.unwrap_or_default();
+                let blocks = blocks.unwrap_or_default().normalized();
                 blocks.check()?;
                 Ok(Pieces::Platform(blocks))
             }
             (Game::Racing, None, segments) => {
-                let segments = segments.unwrap_or_default();
+                let segments = segments.unwrap_or_default().normalized();
                 segments.check()?;
                 Ok(Pieces::Racing(segments))
             }

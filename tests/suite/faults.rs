@@ -667,26 +667,12 @@ fn a_campaign_resumed_with_another_ramp_is_refused() {
     let done = crate::common::small_campaign(&out, &[]);
     assert!(done.status.success(), "{}", stderr(&done));
     let before = files_of(&out);
-    let other = crate::common::arlpcg([
-        "campaign",
-        "--game",
-        "platform",
-        "--levels",
-        "3",
-        "--ramp",
-        "0:0.2, 1:0.2",
-        "--judge",
-        "scripted-median",
-        "--trials",
-        "20",
-        "--seed",
-        "40",
-        "--format",
-        "yaml",
-        "--resume",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    // small_campaign's command, with another ramp and --resume.
+    let other = crate::common::arlpcg(crate::common::words(
+        "campaign --game platform --levels 3 --ramp {} --judge scripted-median --trials 20 \
+         --seed 40 --format yaml --resume --out {}",
+        &[&"0:0.2, 1:0.2", &out],
+    ));
     crate::common::fails_with(&other, 1, "it was searched for another ramp");
     assert!(stderr(&other).contains("level0"), "{}", stderr(&other));
     assert_eq!(files_of(&out), before, "nothing rewritten");

@@ -4,7 +4,7 @@
 use crate::common::import_glb;
 use arlpcg_core::game::GameSpec;
 use arlpcg_core::game::platform::rules;
-use arlpcg_core::level::Track;
+use arlpcg_core::level::Shape;
 use arlpcg_core::level::platform::BLOCK_THICKNESS;
 use arlpcg_core::level::racing::FINISH_LENGTH;
 use arlpcg_core::level::racing::ROAD_WIDTH;
@@ -453,8 +453,8 @@ fn finish_zone_is_where_the_game_counts_success(
         let l = local(p);
         (0..3).all(|k| l[k].abs() <= 0.5 * size[k] + 1e-4)
     };
-    match &level.track {
-        Track::Platform(track) => {
+    match level.shape() {
+        Shape::Blocks(track) => {
             let goal = track.last();
             assert_eq!(
                 size,
@@ -485,7 +485,7 @@ fn finish_zone_is_where_the_game_counts_success(
                 before.position[2]
             ]));
         }
-        Track::Racing(track) => {
+        Shape::Road(track) => {
             let road = track.road();
             assert_eq!(size, vec![ROAD_WIDTH, 6.0, FINISH_LENGTH]);
             // Points `back` metres before the road's end, `across` from its centre line.

@@ -58,7 +58,7 @@ fn a_weaker_jump_measures_a_shorter_reach_and_its_rule_levels_stay_within_it() {
         (2.0, 1.0),
         "{reach:?}"
     );
-    let player = Player::of(Some(Abilities::Platform(CharacterProfile {
+    let player = Player::of(Some(Abilities::Character(CharacterProfile {
         jump_speed: 0.8 * CharacterProfile::default().jump_speed,
         ..CharacterProfile::default()
     })));

@@ -11,7 +11,7 @@ use arlpcg_core::game::racing::{RacingEnv, RacingRewards, rules};
 use arlpcg_core::level::racing::{RacingRulesConfig, RacingTrack, SegmentParams};
 use arlpcg_core::level::scene::Scene;
 use arlpcg_core::level::stats::Outcome;
-use arlpcg_core::level::{Level, Track, gltf as export, yaml};
+use arlpcg_core::level::{Level, gltf as export, yaml};
 
 fn rule_level(seed: u64, obstacles: u32) -> Level {
     let config = RacingRulesConfig {
@@ -22,10 +22,7 @@ fn rule_level(seed: u64, obstacles: u32) -> Level {
 }
 
 fn track(level: &Level) -> &RacingTrack {
-    match &level.track {
-        Track::Racing(track) => track,
-        Track::Platform(_) => panic!("a racing level"),
-    }
+    level.racing().expect("a racing level")
 }
 
 /// A clone of an environment that has run replays the same run as a fresh one (the same seed

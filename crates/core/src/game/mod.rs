@@ -1,6 +1,8 @@
 //! The games as deterministic simulations over rapier3d: the same level, seed and actions give
 //! the same trajectory, bit for bit. Nothing here prints, reads the clock or uses a global RNG.
 
+#[cfg(feature = "test-game")]
+pub mod ball;
 pub mod facts;
 pub mod generator;
 pub mod platform;
@@ -34,6 +36,11 @@ macro_rules! for_game {
             }
             $crate::level::Game::Racing => {
                 type $G = $crate::game::racing::RacingGame;
+                $body
+            }
+            #[cfg(feature = "test-game")]
+            $crate::level::Game::Ball => {
+                type $G = $crate::game::ball::BallGame;
                 $body
             }
         }

@@ -23,8 +23,9 @@ pub use platform::{BlockParams, Platform, PlatformTrack, Start};
 pub use racing::{Obstacle, RacingTrack, SegmentParams};
 pub use stats::{SolverRef, SolverStats};
 
-/// The two games of the paper; each is a [`GameSpec`](../game/trait.GameSpec.html) in its own
-/// folder under `game/`, and `game::for_game!` turns a `Game` into its type.
+/// The games: the paper's two, and (built with the `test-game` feature, for the tests alone) a
+/// third that proves a game plugs in. Each is a [`GameSpec`](../game/trait.GameSpec.html) in
+/// its own folder under `game/`, and `game::for_game!` turns a `Game` into its type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Game {
@@ -33,16 +34,49 @@ pub enum Game {
     Platform,
     /// Drive a banked road to the goal.
     Racing,
+    /// Roll a ball across blocks to the goal block (tests only).
+    #[cfg(feature = "test-game")]
+    Ball,
 }
 
 impl Game {
     /// Every game, in the order lists and the designer's Tab go through them.
-    pub const ALL: [Game; 2] = [Game::Platform, Game::Racing];
+    pub const ALL: [Game; Game::COUNT] = [
+        Game::Platform,
+        Game::Racing,
+        #[cfg(feature = "test-game")]
+        Game::Ball,
+    ];
+
+    /// How many games there are.
+    pub const COUNT: usize = if cfg!(feature = "test-game") { 3 } else { 2 };
 
     pub fn name(self) -> &'static str {
         match self {
             Game::Platform => "platform",
             Game::Racing => "racing",
+            #[cfg(feature = "test-game")]
+            Game::Ball => "ball",
+        }
+    }
+
+    /// What the game's levels are built from.
+    pub fn shape(self) -> ShapeKind {
+        match self {
+            Game::Platform => ShapeKind::Blocks,
+            Game::Racing => ShapeKind::Road,
+            #[cfg(feature = "test-game")]
+            Game::Ball => ShapeKind::Blocks,
+        }
+    }
+
+    /// Who plays it: what a profile's abilities describe.
+    pub fn player(self) -> PlayerKind {
+        match self {
+            Game::Platform => PlayerKind::Character,
+            Game::Racing => PlayerKind::Car,
+            #[cfg(feature = "test-game")]
+            Game::Ball => PlayerKind::Character,
         }
     }
 
@@ -60,7 +94,7 @@ impl Game {
 
 /// One value per game, indexed by [`Game`] (the designer's loaded policies and profile of each).
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct PerGame<T>([T; Game::ALL.len()]);
+pub struct PerGame<T>([T; Game::COUNT]);
 
 impl<T> PerGame<T> {
     /// Each game's value, made by `make`.
@@ -86,14 +120,15 @@ impl std::str::FromStr for Game {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "platform" => Ok(Game::Platform),
-            "racing" => Ok(Game::Racing),
-            other => Err(format!(
-                "unknown game `{other}`: expected {}",
-                Game::ALL.map(Game::name).join(" or ")
-            )),
-        }
+        Game::ALL
+            .into_iter()
+            .find(|game| game.name() == s)
+            .ok_or_else(|| {
+                format!(
+                    "unknown game `{s}`: expected {}",
+                    Game::ALL.map(Game::name).join(" or ")
+                )
+            })
     }
 }
 
@@ -103,11 +138,80 @@ impl fmt::Display for Game {
     }
 }
 
-/// The pieces of a level, one kind per game.
+/// The pieces of a level, one variant per game: the variant names the game that plays it.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Track {
     Platform(PlatformTrack),
     Racing(RacingTrack),
+    #[cfg(feature = "test-game")]
+    Ball(PlatformTrack),
+}
+
+/// What a level's pieces are, whichever game plays them: what the level's checks, its file,
+/// its scene and the designer's drawing read, so that a game whose levels are built from pieces
+/// another game has needs no more of them than a [`Track`] variant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Shape<'a> {
+    /// Blocks to cross, from a start block to a goal block.
+    Blocks(&'a PlatformTrack),
+    /// A road of segments, with obstacles beside it.
+    Road(&'a RacingTrack),
+}
+
+/// The kind of a [`Shape`]: what a profile's piece ranges describe.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShapeKind {
+    Blocks,
+    Road,
+}
+
+/// Who plays a game: what a profile's abilities describe.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlayerKind {
+    /// Runs and jumps (`character:` in a profile).
+    Character,
+    /// Drives (`car:`).
+    Car,
+}
+
+impl Track {
+    /// What the pieces are.
+    pub fn shape(&self) -> Shape<'_> {
+        match self {
+            Track::Platform(track) => Shape::Blocks(track),
+            Track::Racing(track) => Shape::Road(track),
+            #[cfg(feature = "test-game")]
+            Track::Ball(track) => Shape::Blocks(track),
+        }
+    }
+
+    /// The game that plays it.
+    pub fn game(&self) -> Game {
+        match self {
+            Track::Platform(_) => Game::Platform,
+            Track::Racing(_) => Game::Racing,
+            #[cfg(feature = "test-game")]
+            Track::Ball(_) => Game::Ball,
+        }
+    }
+
+    /// `game`'s track of `blocks`; none for a game of another [`ShapeKind`].
+    pub fn of_blocks(game: Game, blocks: PlatformTrack) -> Option<Track> {
+        match game {
+            Game::Platform => Some(Track::Platform(blocks)),
+            #[cfg(feature = "test-game")]
+            Game::Ball => Some(Track::Ball(blocks)),
+            Game::Racing => None,
+        }
+    }
+
+    /// `game`'s track of `road`; none for a game of another [`ShapeKind`].
+    pub fn of_road(game: Game, road: RacingTrack) -> Option<Track> {
+        match game {
+            Game::Racing => Some(Track::Racing(road)),
+            _ => None,
+        }
+    }
 }
 
 /// A file a level depends on (a trained policy, or the level a prefix was kept from), pinned by
@@ -284,44 +388,46 @@ pub enum InvalidLevel {
 
 impl Level {
     pub fn game(&self) -> Game {
-        match self.track {
-            Track::Platform(_) => Game::Platform,
-            Track::Racing(_) => Game::Racing,
-        }
+        self.track.game()
+    }
+
+    /// What the level's pieces are.
+    pub fn shape(&self) -> Shape<'_> {
+        self.track.shape()
     }
 
     /// The platform track, if this is a platform level.
     pub fn platform(&self) -> Option<&PlatformTrack> {
         match &self.track {
             Track::Platform(track) => Some(track),
-            Track::Racing(_) => None,
+            _ => None,
         }
     }
 
     pub fn racing(&self) -> Option<&racing::RacingTrack> {
         match &self.track {
             Track::Racing(track) => Some(track),
-            Track::Platform(_) => None,
+            _ => None,
         }
     }
 
     /// How many pieces (blocks or segments) the level has.
     pub fn piece_count(&self) -> usize {
-        match &self.track {
-            Track::Platform(track) => track.block_count(),
-            Track::Racing(track) => track.segments.len(),
+        match self.shape() {
+            Shape::Blocks(track) => track.block_count(),
+            Shape::Road(track) => track.segments.len(),
         }
     }
 
     /// Where each piece begins, as the fraction of the start-to-goal distance covered there
     /// (straight-line distances to the goal, 0 at the start): where an aux curve is read.
     pub fn piece_start_fractions(&self) -> Vec<f64> {
-        let starts: Vec<[f64; 3]> = match &self.track {
-            Track::Platform(track) => track.platforms()[..track.block_count()]
+        let starts: Vec<[f64; 3]> = match self.shape() {
+            Shape::Blocks(track) => track.platforms()[..track.block_count()]
                 .iter()
                 .map(|p| p.position)
                 .collect(),
-            Track::Racing(track) => {
+            Shape::Road(track) => {
                 let road = track.road();
                 (0..track.segments.len())
                     .map(|i| match i {
@@ -341,8 +447,8 @@ impl Level {
     /// Checks the rules that span the whole level (ranges and overlaps are checked as pieces are
     /// built): the track reaches its goal and the statistics fit the track.
     pub fn validate(&self) -> Result<(), InvalidLevel> {
-        match &self.track {
-            Track::Platform(track) => {
+        match self.shape() {
+            Shape::Blocks(track) => {
                 if track.block_count() == 0 {
                     return Err(InvalidLevel::NoPieces("blocks"));
                 }
@@ -354,7 +460,7 @@ impl Level {
                     });
                 }
             }
-            Track::Racing(track) => {
+            Shape::Road(track) => {
                 if track.segments.is_empty() {
                     return Err(InvalidLevel::NoPieces("segments"));
                 }
@@ -381,14 +487,14 @@ impl Level {
                 }
             }
         }
-        match (&self.source, self.game()) {
-            (Source::Rules { rules }, Game::Platform) => rules.check(),
-            (Source::RacingRules { rules }, Game::Racing) => rules.check(),
-            (Source::Rules { .. }, Game::Racing) => {
-                Err("kind `rules` is for platform levels; racing levels use `racing-rules`".into())
+        match (&self.source, self.game().shape()) {
+            (Source::Rules { rules }, ShapeKind::Blocks) => rules.check(),
+            (Source::RacingRules { rules }, ShapeKind::Road) => rules.check(),
+            (Source::Rules { .. }, ShapeKind::Road) => {
+                Err("kind `rules` is for platform levels (blocks); racing levels (road) use `racing-rules`".into())
             }
-            (Source::RacingRules { .. }, Game::Platform) => {
-                Err("kind `racing-rules` is for racing levels; platform levels use `rules`".into())
+            (Source::RacingRules { .. }, ShapeKind::Blocks) => {
+                Err("kind `racing-rules` is for racing levels (road); platform levels (blocks) use `rules`".into())
             }
             (Source::Kept { pieces, .. }, _) if *pieces as usize > self.piece_count() => {
                 return Err(InvalidLevel::Source(format!(

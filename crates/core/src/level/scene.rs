@@ -6,7 +6,7 @@ use serde_json::{Value, json};
 use super::platform::{BLOCK_THICKNESS, Platform, PlatformTrack};
 use super::racing::{Obstacle, RacingTrack};
 use super::road::TriangleMesh;
-use super::{Level, Track};
+use super::{Level, Shape};
 
 /// What a node is, which picks its material.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -163,9 +163,9 @@ impl Scene {
 
     /// The scene of a level: every block or piece of road, obstacles, start and goal markers.
     pub fn of_level(level: &Level) -> Scene {
-        let mut scene = match &level.track {
-            Track::Platform(track) => platform_scene(level, track),
-            Track::Racing(track) => racing_scene(level, track),
+        let mut scene = match level.shape() {
+            Shape::Blocks(track) => platform_scene(level, track),
+            Shape::Road(track) => racing_scene(level, track),
         };
         if let Some(pacing) = &level.pacing {
             scene.extras["aux_curve"] = json!(pacing.curve.to_string());
@@ -190,8 +190,8 @@ impl Scene {
 /// within which reaching it counts (docs/spec.md §1: the goal reach of each game).
 fn spawn_and_finish(level: &Level) -> Vec<ScenePoint> {
     let (start, start_heading, finish, finish_heading, horizontal, vertical, finish_kind) =
-        match &level.track {
-            Track::Platform(track) => {
+        match level.shape() {
+            Shape::Blocks(track) => {
                 let start = track.start();
                 let goal_block = track.last();
                 (
@@ -204,7 +204,7 @@ fn spawn_and_finish(level: &Level) -> Vec<ScenePoint> {
                     "on the goal block: stand within reach of the goal",
                 )
             }
-            Track::Racing(track) => {
+            Shape::Road(track) => {
                 let (end, end_heading) = track.road().end();
                 (
                     track.position,
@@ -252,8 +252,8 @@ const RACING_FINISH_ZONE_ABOVE: f64 = 4.0;
 /// character stands on it), or the road's last [`super::racing::FINISH_LENGTH`] metres across its
 /// width (the car on the road there).
 fn finish_zone(level: &Level) -> ScenePoint {
-    let (position, heading, size, rule) = match &level.track {
-        Track::Platform(track) => {
+    let (position, heading, size, rule) = match level.shape() {
+        Shape::Blocks(track) => {
             let goal = track.last();
             let height = PLATFORM_FINISH_ZONE_HEIGHT;
             (
@@ -267,7 +267,7 @@ fn finish_zone(level: &Level) -> ScenePoint {
                 "the character stands on the goal block's top".to_string(),
             )
         }
-        Track::Racing(track) => {
+        Shape::Road(track) => {
             let road = track.road();
             let length = super::racing::FINISH_LENGTH;
             // Back from the road's end along its heading (3 m of road bend by at most 4.5°).

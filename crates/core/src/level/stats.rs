@@ -58,6 +58,30 @@ impl Outcome {
             Outcome::Flipped => "turned over",
         }
     }
+
+    /// The failure a game's ending key names ([`GameFacts::endings`]); none for another key.
+    ///
+    /// [`GameFacts::endings`]: crate::game::facts::GameFacts::endings
+    pub fn of_ending(key: &str) -> Option<Outcome> {
+        match key {
+            "fell" => Some(Outcome::Fell),
+            "timed_out" => Some(Outcome::TimedOut),
+            "off_road" => Some(Outcome::OffRoad),
+            "flipped" => Some(Outcome::Flipped),
+            _ => None,
+        }
+    }
+
+    /// The word a tally of runs that ended this way is headed by.
+    pub fn tally_word(self) -> &'static str {
+        match self {
+            Outcome::Success => "success",
+            Outcome::Fell => "fell",
+            Outcome::TimedOut => "timeout",
+            Outcome::OffRoad => "off road",
+            Outcome::Flipped => "flipped",
+        }
+    }
 }
 
 /// One finished Solver run, as verification records it.

@@ -17,7 +17,7 @@ use super::app::{App, GoalSetting, PolicyInfo, SidePane};
 use super::layout::{Areas, SLIDER_LEFT, SLIDER_RIGHT, fits};
 use crate::services::panel::Judge;
 use arlpcg_core::level::stats::Outcome;
-use arlpcg_core::level::{Game, Level, Track};
+use arlpcg_core::level::{Game, Level, Shape};
 use arlpcg_core::rl::checkpoint::Role;
 
 /// The key map, as the help overlay and the README show it.
@@ -78,12 +78,12 @@ fn draw_screen(app: &App, frame: &mut Frame) {
     header(app, frame, areas.header);
     controls(app, frame, &areas);
     match app.level.as_deref() {
-        Some(level) => match &level.track {
-            Track::Platform(track) => {
+        Some(level) => match level.shape() {
+            Shape::Blocks(track) => {
                 platform::map(app, level, track, frame, areas.map);
                 platform::profile(app, level, track, frame, areas.profile);
             }
-            Track::Racing(track) => {
+            Shape::Road(track) => {
                 let road = track.road();
                 racing::map(app, level, track, &road, frame, areas.map);
                 racing::profile(app, level, &road, frame, areas.profile);
@@ -356,21 +356,15 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
                 None => lines.push(Line::from("success …")),
             }
             if let Some(progress) = t.mean_progress() {
-                lines.push(Line::from(match app.game {
-                    Game::Platform => format!(
-                        "progress {:.2}  fell {}  timeout {}",
-                        progress,
-                        t.count(Outcome::Fell),
-                        t.count(Outcome::TimedOut)
-                    ),
-                    Game::Racing => format!(
-                        "progress {:.2}  off road {}  flipped {}  timeout {}",
-                        progress,
-                        t.count(Outcome::OffRoad),
-                        t.count(Outcome::Flipped),
-                        t.count(Outcome::TimedOut)
-                    ),
-                }));
+                let endings = arlpcg_core::game::facts::facts(app.game).endings;
+                let tallies = endings
+                    .iter()
+                    .filter_map(|(key, _)| Outcome::of_ending(key));
+                let mut line = format!("progress {progress:.2}");
+                for outcome in tallies {
+                    line.push_str(&format!("  {} {}", outcome.tally_word(), t.count(outcome)));
+                }
+                lines.push(Line::from(line));
             }
             if let Some(air) = t.mean_air_seconds(app.game) {
                 lines.push(Line::from(format!("air time {air:.2} s per run")));
@@ -383,10 +377,10 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
     }
     if let Some(level) = &app.level {
         lines.push(Line::from(source_line(level)).dim());
-        if let Some(track) = level.racing() {
+        if let Shape::Road(track) = level.shape() {
             racing::stats(app, track, &mut lines);
         }
-        if let Some(track) = level.platform() {
+        if let Shape::Blocks(track) = level.shape() {
             let blocks = track.block_params();
             let n = blocks.len().max(1) as f64;
             lines.push(Line::from(format!(

@@ -321,7 +321,7 @@ impl GeneratorGame for PlatformGame {
     fn open_env(build: &PlatformBuild, complete: bool) -> PlatformEnv {
         let start = PlatformTrack::new(*build.track.start());
         let mut env = PlatformEnv::open(&start, build.goal, PlatformRewards::default());
-        if let Some(Abilities::Platform(character)) = build.player.abilities {
+        if let Some(Abilities::Character(character)) = build.player.abilities {
             env = env.with_body(character.into());
         }
         env.push_platform(build.track.last(), complete);
@@ -665,8 +665,8 @@ mod tests {
                 max_turn: 30.0,
                 ..Default::default()
             };
-            let player = Player::default()
-                .with_pieces(Some(crate::level::profile::Pieces::Platform(narrow)));
+            let player =
+                Player::default().with_pieces(Some(crate::level::profile::Pieces::Blocks(narrow)));
             let block = block_from_action(&track, goal, &row, (&player, &Reach::default()));
             if let Err(outside) = narrow.check_block(&block) {
                 panic!("{block:?}: {outside}");

@@ -36,7 +36,7 @@ impl GameSpec for PlatformGame {
         let track = level.platform()?;
         let env = PlatformEnv::new(track, level.goal, PlatformRewards::default());
         Some(match abilities {
-            Some(Abilities::Platform(character)) => env.with_body(character.into()),
+            Some(Abilities::Character(character)) => env.with_body(character.into()),
             _ => env,
         })
     }
@@ -64,7 +64,7 @@ impl GameSpec for PlatformGame {
 
     /// The jump's apex, time in the air and length at full speed, and the reach table.
     fn ability_figures(profile: &Profile) -> Vec<String> {
-        let Abilities::Platform(c) = profile.abilities else {
+        let Abilities::Character(c) = profile.abilities else {
             return Vec::new();
         };
         let apex = c.jump_speed * c.jump_speed / (2.0 * c.gravity);

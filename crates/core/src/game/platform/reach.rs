@@ -64,7 +64,7 @@ impl Reach {
     /// same table, so keeping it changes no result.
     pub fn of_player(player: &crate::game::Player) -> Self {
         use std::sync::{Mutex, OnceLock};
-        let Some(Abilities::Platform(character)) = player.abilities else {
+        let Some(Abilities::Character(character)) = player.abilities else {
             return Self::default();
         };
         static MEASURED: OnceLock<Mutex<Vec<(CharacterProfile, Reach)>>> = OnceLock::new();

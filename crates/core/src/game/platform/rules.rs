@@ -223,7 +223,7 @@ mod tests {
             max_height: 1.0,
             max_turn: 45.0,
         };
-        let narrow_player = Player::default().with_pieces(Some(Pieces::Platform(narrow)));
+        let narrow_player = Player::default().with_pieces(Some(Pieces::Blocks(narrow)));
         let players = [
             (Player::default(), BlockRanges::default()),
             (narrow_player, narrow),

@@ -386,7 +386,7 @@ impl GeneratorGame for RacingGame {
     fn open_env(build: &RacingBuild, complete: bool) -> RacingEnv {
         let env = RacingEnv::open(&build.track, build.goal, RacingRewards::default(), complete);
         match build.player.abilities {
-            Some(Abilities::Racing(car)) => env.with_car(car.into()),
+            Some(Abilities::Car(car)) => env.with_car(car.into()),
             _ => env,
         }
     }

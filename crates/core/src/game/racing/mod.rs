@@ -36,7 +36,7 @@ impl GameSpec for RacingGame {
         let track = level.racing()?;
         let env = RacingEnv::new(track, level.goal, RacingRewards::default());
         Some(match abilities {
-            Some(Abilities::Racing(car)) => env.with_car(car.into()),
+            Some(Abilities::Car(car)) => env.with_car(car.into()),
             _ => env,
         })
     }
@@ -72,7 +72,7 @@ impl GameSpec for RacingGame {
     /// The car's top speed and acceleration, the speed it holds through the tightest curves,
     /// and its flight over a crest.
     fn ability_figures(profile: &Profile) -> Vec<String> {
-        let Abilities::Racing(c) = profile.abilities else {
+        let Abilities::Car(c) = profile.abilities else {
             return Vec::new();
         };
         let car = car::Car::from(c);

@@ -297,7 +297,7 @@ mod tests {
             max_curve: 0.0,
             ..SegmentRanges::default()
         };
-        let player = Player::of(None).with_pieces(Some(Pieces::Racing(straight)));
+        let player = Player::of(None).with_pieces(Some(Pieces::Road(straight)));
         let ahead = heading_direction(30.0);
         let on_axis = [200.0 * ahead[0], 0.0, 200.0 * ahead[1]];
         assert!(!out_of_reach(30.0, on_axis, &config, &straight));

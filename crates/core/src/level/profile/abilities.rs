@@ -4,8 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::{Fields, Profile, field, nth};
-use crate::level::Game;
 use crate::level::params::{ParamRange, RangeError};
+use crate::level::{Game, PlayerKind};
 
 /// The platform character's abilities.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -45,11 +45,11 @@ pub struct CarProfile {
     pub damping: f64,
 }
 
-/// One game's abilities.
+/// A player's abilities, of the kind its game has ([`PlayerKind`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Abilities {
-    Platform(CharacterProfile),
-    Racing(CarProfile),
+    Character(CharacterProfile),
+    Car(CarProfile),
 }
 
 impl Default for CharacterProfile {
@@ -97,11 +97,16 @@ pub fn ability_columns(spread: f64) -> usize {
 /// The main abilities of `game`, as a profile file names them: the designer's keys change them,
 /// and an ability-aware Solver observes them and trains over a range of them.
 pub fn main_abilities(game: Game) -> [&'static str; MAIN_ABILITIES] {
-    match game {
-        Game::Platform => [
+    main_of(game.player())
+}
+
+/// The main abilities of a player of `kind`.
+fn main_of(kind: PlayerKind) -> [&'static str; MAIN_ABILITIES] {
+    match kind {
+        PlayerKind::Character => [
             "character.jump_speed", "character.run_speed", "character.gravity",
         ],
-        Game::Racing => ["car.engine_force", "car.grip", "car.max_steer"],
+        PlayerKind::Car => ["car.engine_force", "car.grip", "car.max_steer"],
     }
 }
 
@@ -200,19 +205,21 @@ impl Abilities {
         character: Option<CharacterProfile>,
         car: Option<CarProfile>,
     ) -> Result<Self, String> {
-        match (game, character, car) {
-            (Game::Platform, Some(c), None) => {
+        match (game.player(), character, car) {
+            (PlayerKind::Character, Some(c), None) => {
                 c.check().map_err(|e| e.to_string())?;
-                Ok(Abilities::Platform(c.normalized()))
+                Ok(Abilities::Character(c.normalized()))
             }
-            (Game::Racing, None, Some(c)) => {
+            (PlayerKind::Car, None, Some(c)) => {
                 c.check().map_err(|e| e.to_string())?;
-                Ok(Abilities::Racing(c.normalized()))
+                Ok(Abilities::Car(c.normalized()))
             }
-            (Game::Platform, _, _) => {
-                Err("a platform profile has `character:` and no `car:`".into())
+            (PlayerKind::Character, _, _) => {
+                Err(format!("a {game} profile has `character:` and no `car:`"))
             }
-            (Game::Racing, _, _) => Err("a racing profile has `car:` and no `character:`".into()),
+            (PlayerKind::Car, _, _) => {
+                Err(format!("a {game} profile has `car:` and no `character:`"))
+            }
         }
     }
 
@@ -220,23 +227,23 @@ impl Abilities {
     /// field of the other game.
     pub fn value(&self, field: &str) -> Option<(f64, ParamRange)> {
         match self {
-            Abilities::Platform(c) => c.field(field),
-            Abilities::Racing(c) => c.field(field),
+            Abilities::Character(c) => c.field(field),
+            Abilities::Car(c) => c.field(field),
         }
     }
 
     /// These abilities with `field` at `value`, when they are then valid.
     pub fn with_value(&self, field: &str, value: f64) -> Option<Self> {
         Some(match self {
-            Abilities::Platform(c) => {
+            Abilities::Character(c) => {
                 let c = c.set(field, value)?;
                 c.check().ok()?;
-                Abilities::Platform(c)
+                Abilities::Character(c)
             }
-            Abilities::Racing(c) => {
+            Abilities::Car(c) => {
                 let c = c.set(field, value)?;
                 c.check().ok()?;
-                Abilities::Racing(c)
+                Abilities::Car(c)
             }
         })
     }
@@ -244,8 +251,8 @@ impl Abilities {
     /// Each of the game's [`main_abilities`] relative to the built-in one (0: ours, 0.1: 10%
     /// more): what an ability-aware Solver observes.
     pub fn relative_main(&self) -> [f32; MAIN_ABILITIES] {
-        let ours = Self::default_of(self.game());
-        main_abilities(self.game()).map(|field| {
+        let ours = Self::built_in(self.kind());
+        main_of(self.kind()).map(|field| {
             let value = |a: &Self| a.value(field).expect("a main ability of the game").0;
             (value(self) / value(&ours) - 1.0) as f32
         })
@@ -253,8 +260,8 @@ impl Abilities {
 
     /// Whether each main ability lies within `spread` (a share, 0.2 for ±20%) of `base`'s.
     pub fn within(&self, base: &Self, spread: f64) -> bool {
-        self.game() == base.game()
-            && main_abilities(self.game()).iter().all(|field| {
+        self.kind() == base.kind()
+            && main_of(self.kind()).iter().all(|field| {
                 let (value, _) = self.value(field).expect("a main ability of the game");
                 let (from, _) = base.value(field).expect("a main ability of the game");
                 (value / from - 1.0).abs() <= spread + 1e-9
@@ -268,7 +275,7 @@ impl Abilities {
         use rand::{RngExt, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ VARIATION_STREAM);
         let mut varied = *self;
-        for field in main_abilities(self.game()) {
+        for field in main_of(self.kind()) {
             let (value, range) = varied.value(field).expect("a main ability of the game");
             let scaled =
                 (value * (1.0 + rng.random_range(-spread..=spread))).clamp(range.min, range.max);
@@ -284,16 +291,22 @@ impl Abilities {
 
     /// The built-in abilities of `game`.
     pub fn default_of(game: Game) -> Self {
-        match game {
-            Game::Platform => Abilities::Platform(CharacterProfile::default()),
-            Game::Racing => Abilities::Racing(CarProfile::default()),
+        Self::built_in(game.player())
+    }
+
+    /// The built-in abilities of a player of `kind`.
+    fn built_in(kind: PlayerKind) -> Self {
+        match kind {
+            PlayerKind::Character => Abilities::Character(CharacterProfile::default()),
+            PlayerKind::Car => Abilities::Car(CarProfile::default()),
         }
     }
 
-    pub fn game(&self) -> Game {
+    /// Whose abilities they are.
+    pub fn kind(&self) -> PlayerKind {
         match self {
-            Abilities::Platform(_) => Game::Platform,
-            Abilities::Racing(_) => Game::Racing,
+            Abilities::Character(_) => PlayerKind::Character,
+            Abilities::Car(_) => PlayerKind::Car,
         }
     }
 }

@@ -49,9 +49,13 @@ pub struct ProfileFile {
     pub segments: Option<SegmentRanges>,
 }
 
-/// A checked profile: its name, abilities and piece ranges.
+/// A checked profile: its game, name, abilities (of the game's [`PlayerKind`]) and piece ranges
+/// (of the game's [`ShapeKind`](crate::level::ShapeKind)).
+///
+/// [`PlayerKind`]: crate::level::PlayerKind
 #[derive(Debug, Clone, PartialEq)]
 pub struct Profile {
+    pub game: Game,
     pub name: String,
     pub abilities: Abilities,
     pub pieces: Pieces,
@@ -168,6 +172,7 @@ impl Profile {
     /// The built-in profile of `game`.
     pub fn default_of(game: Game) -> Self {
         Self {
+            game,
             name: DEFAULT_NAME.into(),
             abilities: Abilities::default_of(game),
             pieces: Pieces::default_of(game),
@@ -175,7 +180,7 @@ impl Profile {
     }
 
     pub fn game(&self) -> Game {
-        self.abilities.game()
+        self.game
     }
 
     /// Whether these are the built-in abilities and piece ranges (whatever the name).
@@ -200,6 +205,7 @@ impl Profile {
         let abilities = Abilities::checked(file.game, file.character, file.car)?;
         let pieces = Pieces::checked(file.game, file.blocks, file.segments)?;
         Ok(Self {
+            game: file.game,
             name: file.name,
             abilities,
             pieces,
@@ -210,8 +216,8 @@ impl Profile {
     /// not the built-in ones.
     fn file(&self, full: bool) -> ProfileFile {
         let (character, car) = match self.abilities {
-            Abilities::Platform(c) => (Some(c), None),
-            Abilities::Racing(c) => (None, Some(c)),
+            Abilities::Character(c) => (Some(c), None),
+            Abilities::Car(c) => (None, Some(c)),
         };
         let (blocks, segments) = if full {
             self.pieces.sections()
@@ -239,23 +245,20 @@ impl Profile {
     /// The profile as `profile init` prints it, piece ranges in full: a comment per field with
     /// its range.
     pub fn to_commented_yaml(&self) -> String {
-        let fields: Vec<&(ParamRange, &str)> = match self.abilities {
-            Abilities::Platform(_) => CHARACTER_FIELDS.iter().chain(&BLOCK_FIELDS).collect(),
-            Abilities::Racing(_) => CAR_FIELDS.iter().chain(&SEGMENT_FIELDS).collect(),
+        let (ability_fields, player): (&[_], _) = match self.abilities {
+            Abilities::Character(_) => (&CHARACTER_FIELDS, "character's"),
+            Abilities::Car(_) => (&CAR_FIELDS, "car's"),
         };
+        let (piece_fields, pieces): (&[_], _) = match self.pieces {
+            Pieces::Blocks(_) => (&BLOCK_FIELDS, "blocks"),
+            Pieces::Road(_) => (&SEGMENT_FIELDS, "segments"),
+        };
+        let fields: Vec<&(ParamRange, &str)> = ability_fields.iter().chain(piece_fields).collect();
         let full = serde_yaml::to_string(&self.file(true)).expect("a profile serializes");
         let mut text = format!(
-            "# An arlpcg game profile: the {} abilities levels are made and checked for, and the\n\
-             # ranges of their {}. `arlpcg profile check FILE` measures what it allows; pass it\n\
-             # with --profile FILE.\n",
-            match self.abilities {
-                Abilities::Platform(_) => "character's",
-                Abilities::Racing(_) => "car's",
-            },
-            match self.abilities {
-                Abilities::Platform(_) => "blocks",
-                Abilities::Racing(_) => "segments",
-            }
+            "# An arlpcg game profile: the {player} abilities levels are made and checked for, and the\n\
+             # ranges of their {pieces}. `arlpcg profile check FILE` measures what it allows; pass it\n\
+             # with --profile FILE.\n"
         );
         for line in full.lines() {
             let key = line.trim_start().split(':').next().unwrap_or_default();
@@ -290,6 +293,7 @@ impl Profile {
             None => (self.abilities, self.pieces.with_value(field, value)?),
         };
         Some(Self {
+            game: self.game,
             name: self.name.clone(),
             abilities,
             pieces,
@@ -321,6 +325,7 @@ impl ProfileRecord {
     pub fn profile(&self, game: Game) -> Result<Profile, String> {
         check_name(&self.name)?;
         let profile = Profile {
+            game,
             name: self.name.clone(),
             abilities: Abilities::checked(game, self.character, self.car)?,
             pieces: Pieces::checked(game, self.blocks, self.segments)?,
@@ -353,9 +358,9 @@ mod tests {
                 assert!(a.relative_main().iter().all(|r| r.abs() <= 0.2 + 1e-6));
             }
             // Only the main abilities vary.
-            let fields: &[(ParamRange, &str)] = match game {
-                Game::Platform => &CHARACTER_FIELDS,
-                Game::Racing => &CAR_FIELDS,
+            let fields: &[(ParamRange, &str)] = match game.player() {
+                crate::level::PlayerKind::Character => &CHARACTER_FIELDS,
+                crate::level::PlayerKind::Car => &CAR_FIELDS,
             };
             for (range, _) in fields {
                 if !main_abilities(game).contains(&range.name) {

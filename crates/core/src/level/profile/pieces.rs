@@ -4,9 +4,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::{Fields, field, nth, ordered};
-use crate::level::Game;
 use crate::level::params::{self, ParamRange};
 use crate::level::racing::{self, RoadShape};
+use crate::level::{Game, ShapeKind};
 
 /// The ranges a platform level's blocks are drawn from, by the rules and the Generator; each
 /// within the level format's own (`level::params`).
@@ -55,11 +55,12 @@ fn default_banking() -> f64 {
     racing::BANK_GAIN
 }
 
-/// One game's piece ranges.
+/// The ranges a game's pieces are drawn from, of the kind its levels are built from
+/// ([`ShapeKind`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Pieces {
-    Platform(BlockRanges),
-    Racing(SegmentRanges),
+    Blocks(BlockRanges),
+    Road(SegmentRanges),
 }
 
 impl Default for BlockRanges {
@@ -295,86 +296,99 @@ impl Pieces {
         blocks: Option<BlockRanges>,
         segments: Option<SegmentRanges>,
     ) -> Result<Self, String> {
-        match (game, blocks, segments) {
-            (Game::Platform, blocks, None) => {
-                let blocks = blocks.unwrap_or_default().normalized();
-                blocks.check()?;
-                Ok(Pieces::Platform(blocks))
+        match (game.shape(), blocks, segments) {
+            (ShapeKind::Blocks, blocks, None) => Self::of_blocks(blocks),
+            (ShapeKind::Road, None, segments) => Self::of_road(segments),
+            (ShapeKind::Blocks, _, _) => {
+                Err(format!("a {game} profile has `blocks:`, not `segments:`"))
             }
-            (Game::Racing, None, segments) => {
-                let segments = segments.unwrap_or_default().normalized();
-                segments.check()?;
-                Ok(Pieces::Racing(segments))
+            (ShapeKind::Road, _, _) => {
+                Err(format!("a {game} profile has `segments:`, not `blocks:`"))
             }
-            (Game::Platform, _, _) => {
-                Err("a platform profile has `blocks:`, not `segments:`".into())
-            }
-            (Game::Racing, _, _) => Err("a racing profile has `segments:`, not `blocks:`".into()),
         }
+    }
+
+    fn of_blocks(blocks: Option<BlockRanges>) -> Result<Self, String> {
+        let blocks = blocks.unwrap_or_default().normalized();
+        blocks.check()?;
+        Ok(Pieces::Blocks(blocks))
+    }
+
+    fn of_road(segments: Option<SegmentRanges>) -> Result<Self, String> {
+        let segments = segments.unwrap_or_default().normalized();
+        segments.check()?;
+        Ok(Pieces::Road(segments))
     }
 
     /// The built-in ranges of `game`.
     pub fn default_of(game: Game) -> Self {
-        match game {
-            Game::Platform => Pieces::Platform(BlockRanges::default()),
-            Game::Racing => Pieces::Racing(SegmentRanges::default()),
+        Self::built_in(game.shape())
+    }
+
+    fn built_in(kind: ShapeKind) -> Self {
+        match kind {
+            ShapeKind::Blocks => Pieces::Blocks(BlockRanges::default()),
+            ShapeKind::Road => Pieces::Road(SegmentRanges::default()),
         }
     }
 
-    /// The platform ranges (the built-in ones for a racing profile).
+    /// The block ranges (the built-in ones for a profile of road).
     pub fn blocks(&self) -> BlockRanges {
         match self {
-            Pieces::Platform(b) => *b,
-            Pieces::Racing(_) => BlockRanges::default(),
+            Pieces::Blocks(b) => *b,
+            Pieces::Road(_) => BlockRanges::default(),
         }
     }
 
-    /// The racing ranges (the built-in ones for a platform profile).
+    /// The road ranges (the built-in ones for a profile of blocks).
     pub fn segments(&self) -> SegmentRanges {
         match self {
-            Pieces::Racing(s) => *s,
-            Pieces::Platform(_) => SegmentRanges::default(),
+            Pieces::Road(s) => *s,
+            Pieces::Blocks(_) => SegmentRanges::default(),
         }
     }
 
     /// The field named as in [`BLOCK_FIELDS`] or [`SEGMENT_FIELDS`], with its range.
     pub fn value(&self, field: &str) -> Option<(f64, ParamRange)> {
         match self {
-            Pieces::Platform(b) => b.field(field),
-            Pieces::Racing(s) => s.field(field),
+            Pieces::Blocks(b) => b.field(field),
+            Pieces::Road(s) => s.field(field),
         }
     }
 
     /// These ranges with `field` at `value`, when they are then valid.
     pub fn with_value(&self, field: &str, value: f64) -> Option<Self> {
         let changed = match self {
-            Pieces::Platform(b) => Pieces::Platform(b.set(field, value)?),
-            Pieces::Racing(s) => Pieces::Racing(s.set(field, value)?),
+            Pieces::Blocks(b) => Pieces::Blocks(b.set(field, value)?),
+            Pieces::Road(s) => Pieces::Road(s.set(field, value)?),
         };
-        let game = changed.game();
-        let (blocks, segments) = changed.sections();
-        Pieces::checked(game, blocks, segments).ok()
+        match changed {
+            Pieces::Blocks(b) => Self::of_blocks(Some(b)),
+            Pieces::Road(s) => Self::of_road(Some(s)),
+        }
+        .ok()
     }
 
-    pub fn game(&self) -> Game {
+    /// What the ranges are of.
+    pub fn kind(&self) -> ShapeKind {
         match self {
-            Pieces::Platform(_) => Game::Platform,
-            Pieces::Racing(_) => Game::Racing,
+            Pieces::Blocks(_) => ShapeKind::Blocks,
+            Pieces::Road(_) => ShapeKind::Road,
         }
     }
 
     /// The file's `blocks:` and `segments:`.
     pub(super) fn sections(&self) -> (Option<BlockRanges>, Option<SegmentRanges>) {
         match *self {
-            Pieces::Platform(b) => (Some(b), None),
-            Pieces::Racing(s) => (None, Some(s)),
+            Pieces::Blocks(b) => (Some(b), None),
+            Pieces::Road(s) => (None, Some(s)),
         }
     }
 
     /// The sections a file writes: none for the built-in ranges, so that a profile of
     /// abilities alone keeps its SHA-256.
     pub(super) fn written(&self) -> (Option<BlockRanges>, Option<SegmentRanges>) {
-        if *self == Self::default_of(self.game()) {
+        if *self == Self::built_in(self.kind()) {
             (None, None)
         } else {
             self.sections()

@@ -14,7 +14,7 @@ use crate::level::params::{self, ParamRange};
 use crate::level::platform::{BlockParams, PlatformTrack, Start};
 use crate::level::profile::ProfileRecord;
 use crate::level::racing::{self, Obstacle, RacingTrack, RoadShape, SegmentParams};
-use crate::level::{Game, Level, SolverStats, Source, Track};
+use crate::level::{Game, Level, Shape, ShapeKind, SolverStats, Source, Track};
 
 /// A number that must lie in the range `B` names; checked while parsing, so serde_yaml's error
 /// carries the field path and line.
@@ -176,15 +176,15 @@ impl LevelFile {
                 .and_then(|p| p.piece_aux.get(i).copied().flatten())
                 .map(Bounded::new)
         };
-        let road = match &level.track {
-            Track::Racing(track) if !track.road.is_default() => Some(RoadFile {
+        let road = match level.shape() {
+            Shape::Road(track) if !track.road.is_default() => Some(RoadFile {
                 width: Bounded::new(track.road.width),
                 banking: Bounded::new(track.road.banking),
             }),
             _ => None,
         };
-        let (start, blocks, segments, obstacles) = match &level.track {
-            Track::Platform(track) => {
+        let (start, blocks, segments, obstacles) = match level.shape() {
+            Shape::Blocks(track) => {
                 let s = track.start();
                 let start = StartFile {
                     position: write_point(s.position),
@@ -208,7 +208,7 @@ impl LevelFile {
                     .collect();
                 (start, Some(blocks), None, Vec::new())
             }
-            Track::Racing(track) => {
+            Shape::Road(track) => {
                 let start = StartFile {
                     position: write_point(track.position),
                     heading: Bounded::new(track.heading),
@@ -257,10 +257,23 @@ impl LevelFile {
             ),
             None => None,
         };
-        let (track, default_goal) = match self.game {
-            Game::Platform => self.platform_track(text)?,
-            Game::Racing => self.racing_track(text)?,
+        let (track, default_goal) = match self.game.shape() {
+            ShapeKind::Blocks => {
+                let (blocks, end) = self.platform_track(text)?;
+                (Track::of_blocks(self.game, blocks), end)
+            }
+            ShapeKind::Road => {
+                let (road, end) = self.racing_track(text)?;
+                (Track::of_road(self.game, road), end)
+            }
         };
+        let track = track.ok_or_else(|| {
+            invalid(
+                "game".into(),
+                line_of_key(text, "game"),
+                format!("a {} level cannot hold these pieces", self.game),
+            )
+        })?;
         let level = Level {
             seed: self.seed,
             aux: self.aux.map(|a| a.0),
@@ -300,33 +313,33 @@ impl LevelFile {
 
     /// The platform track the file describes, and where its last block ends (the goal when the
     /// file gives none); each block checked with its line.
-    fn platform_track(&self, text: &str) -> Result<(Track, [f64; 3]), Problem> {
+    fn platform_track(&self, text: &str) -> Result<(PlatformTrack, [f64; 3]), Problem> {
         if self.segments.is_some() {
             return Err(invalid(
                 "segments".into(),
                 line_of_key(text, "segments"),
-                "a platform level has `blocks`, not `segments`".into(),
+                format!("a {} level has `blocks`, not `segments`", self.game),
             ));
         }
         if !self.obstacles.is_empty() {
             return Err(invalid(
                 "obstacles".into(),
                 line_of_key(text, "obstacles"),
-                "a platform level has no obstacles".into(),
+                format!("a {} level has no obstacles", self.game),
             ));
         }
         if self.road.is_some() {
             return Err(invalid(
                 "road".into(),
                 line_of_key(text, "road"),
-                "a platform level has no road".into(),
+                format!("a {} level has no road", self.game),
             ));
         }
         let blocks = self.blocks.as_ref().ok_or_else(|| {
             invalid(
                 "blocks".into(),
                 None,
-                "missing: a platform level needs its blocks".into(),
+                format!("missing: a {} level needs its blocks", self.game),
             )
         })?;
         let start = Start {
@@ -378,31 +391,31 @@ impl LevelFile {
             }
         }
         let last = track.last().position;
-        Ok((Track::Platform(track), last))
+        Ok((track, last))
     }
 
     /// The racing track the file describes, and where its road ends (the goal when the file
     /// gives none); counts and obstacles checked before any road geometry.
-    fn racing_track(&self, text: &str) -> Result<(Track, [f64; 3]), Problem> {
+    fn racing_track(&self, text: &str) -> Result<(RacingTrack, [f64; 3]), Problem> {
         if self.blocks.is_some() {
             return Err(invalid(
                 "blocks".into(),
                 line_of_key(text, "blocks"),
-                "a racing level has `segments`, not `blocks`".into(),
+                format!("a {} level has `segments`, not `blocks`", self.game),
             ));
         }
         if self.start.size.is_some() {
             return Err(invalid(
                 "start.size".into(),
                 None,
-                "a racing level's start has no size".into(),
+                format!("a {} level's start has no size", self.game),
             ));
         }
         let segments = self.segments.as_ref().ok_or_else(|| {
             invalid(
                 "segments".into(),
                 None,
-                "missing: a racing level needs its segments".into(),
+                format!("missing: a {} level needs its segments", self.game),
             )
         })?;
         let segments: Vec<SegmentParams> = segments
@@ -451,7 +464,7 @@ impl LevelFile {
             )
         })?;
         let (end, _) = track.road().end();
-        Ok((Track::Racing(track), end))
+        Ok((track, end))
     }
 }
 

@@ -400,11 +400,8 @@ const GAME_NAMES: &[&str] = &[
 /// `for_game!` and a level's `Shape`, so that a new game touches only these (the tests' ball
 /// game, crates/core/src/game/ball, is the proof).
 const GAME_PLACES: &[&str] = &[
-    "crates/core/src/game/mod.rs",
-    "crates/core/src/level/mod.rs",
-    "crates/core/src/game/platform/",
-    "crates/core/src/game/racing/",
-    "crates/core/src/game/ball/",
+    "crates/core/src/game/mod.rs", "crates/core/src/level/mod.rs",
+    "crates/core/src/game/platform/", "crates/core/src/game/racing/", "crates/core/src/game/ball/",
 ];
 
 #[test]

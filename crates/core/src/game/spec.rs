@@ -11,6 +11,7 @@ use crate::level::stats::Skill;
 /// that costs the failure reward (docs/decisions.md#d18).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Step {
+    /// The step's reward.
     pub reward: f32,
     /// How the run ended, on its last step.
     pub outcome: Option<Outcome>,
@@ -82,7 +83,9 @@ pub(crate) fn coords(v: rapier3d::math::Vector) -> Vec<f64> {
 /// abilities (the platform character's reach) it measures itself, once per process.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Player {
+    /// The player's abilities (none: the built-in ones).
     pub abilities: Option<Abilities>,
+    /// The ranges pieces are drawn from (none: the built-in ones).
     pub pieces: Option<Pieces>,
 }
 
@@ -140,6 +143,7 @@ pub fn observe_solver<G: GameSpec>(env: &G::Env, abilities: Option<&Abilities>, 
 
 /// A scripted player of environment `E`.
 pub trait Scripted<E: SolverEnv> {
+    /// The player's action in the environment's current state.
     fn act(&mut self, env: &E) -> E::Action;
 }
 
@@ -153,10 +157,15 @@ pub struct NoRuleLevel(pub String);
 /// them; `aux` is recorded, not used (the rules know no λ).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RuleAsk {
+    /// The level's seed.
     pub seed: u64,
+    /// The λ recorded in the level (the rules do not use it).
     pub aux: Option<f64>,
+    /// The goal, m (none: drawn from the seed).
     pub goal: Option<[f64; 3]>,
+    /// How many obstacles, where the game has them.
     pub obstacles: u32,
+    /// Which valid level of the seed's stream, from 0.
     pub draw: u32,
 }
 
@@ -167,9 +176,11 @@ pub struct RuleAsk {
 /// [`Game`](crate::level::Game) becomes its type once per entry point, through
 /// [`for_game!`](crate::for_game). Each game implements it in its own folder.
 pub trait GameSpec: Send + Sync + 'static {
+    /// The game, as a runtime value.
     const GAME: crate::level::Game;
     /// What the layers above know of the game as plain data.
     const FACTS: &'static super::facts::GameFacts;
+    /// The Solver's environment.
     type Env: SolverEnv;
     /// The game's scripted (non-learning) player.
     type Scripted: Scripted<Self::Env> + Send + Sync;

@@ -51,6 +51,7 @@ impl Game {
     /// How many games there are.
     pub const COUNT: usize = if cfg!(feature = "test-game") { 3 } else { 2 };
 
+    /// The game's name, as files and the command line write it (`platform`, `racing`).
     pub fn name(self) -> &'static str {
         match self {
             Game::Platform => "platform",
@@ -141,8 +142,11 @@ impl fmt::Display for Game {
 /// The pieces of a level, one variant per game: the variant names the game that plays it.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Track {
+    /// A platform level's blocks.
     Platform(PlatformTrack),
+    /// A racing level's road and obstacles.
     Racing(RacingTrack),
+    /// A ball level's blocks (the tests' third game).
     #[cfg(feature = "test-game")]
     Ball(PlatformTrack),
 }
@@ -161,7 +165,9 @@ pub enum Shape<'a> {
 /// The kind of a [`Shape`]: what a profile's piece ranges describe.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ShapeKind {
+    /// Blocks to land on (platform, ball).
     Blocks,
+    /// A road of segments, with obstacles (racing).
     Road,
 }
 
@@ -219,7 +225,9 @@ impl Track {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PolicyRef {
+    /// The policy file's path, as written.
     pub path: String,
+    /// The SHA-256 of the file's contents, lowercase hex.
     pub sha256: String,
 }
 
@@ -301,17 +309,29 @@ pub enum Source {
     #[default]
     Hand,
     /// Drawn by the rule-based platform generator.
-    Rules { rules: PlatformRulesConfig },
+    Rules {
+        /// The rule generator's settings the level was drawn with.
+        rules: PlatformRulesConfig,
+    },
     /// Drawn by the rule-based racing generator.
     #[serde(rename = "racing-rules")]
-    RacingRules { rules: racing::RacingRulesConfig },
+    RacingRules {
+        /// The rule generator's settings the level was drawn with.
+        rules: racing::RacingRulesConfig,
+    },
     /// Built by a trained Generator policy.
-    Policy { generator: PolicyRef },
+    Policy {
+        /// The Generator policy that built it.
+        generator: PolicyRef,
+    },
     /// The first `pieces` pieces kept from the level file `from`, the rest built by a trained
     /// Generator (`generate --keep`); `aux` or `aux_curve` is the λ of the rest.
     Kept {
+        /// How many pieces were kept from `from`.
         pieces: u32,
+        /// The level file the pieces were kept from.
         from: PolicyRef,
+        /// The Generator policy that built the rest.
         generator: PolicyRef,
     },
 }
@@ -335,7 +355,9 @@ pub struct Level {
     pub aux: Option<f64>,
     /// The point the track leads to.
     pub goal: [f64; 3],
+    /// The level's pieces.
     pub track: Track,
+    /// Where the level came from: by hand, rules or a Generator policy.
     pub source: Source,
     /// What the Solver measured on it, when it has been verified.
     pub stats: Option<SolverStats>,
@@ -354,39 +376,68 @@ pub fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// A level that breaks a rule of its game.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum InvalidLevel {
+    /// The level has no pieces of the named kind (`blocks`, `segments`).
     #[error("the level has no {0}: it needs at least one")]
     NoPieces(&'static str),
+    /// The last block is out of the goal's reach.
     #[error(
         "the last block (at {at:?}) does not reach the goal {goal:?}: it must be within {h} m horizontally and {v} m vertically",
         h = platform::GOAL_REACH_HORIZONTAL,
         v = platform::GOAL_REACH_VERTICAL
     )]
-    GoalNotReached { at: [f64; 3], goal: [f64; 3] },
+    GoalNotReached {
+        /// The last block's position, m.
+        at: [f64; 3],
+        /// The goal, m.
+        goal: [f64; 3],
+    },
+    /// The road ends out of the goal's reach.
     #[error(
         "the road ends at {at:?}, which does not reach the goal {goal:?}: it must end within {h} m horizontally and {v} m vertically",
         h = racing::GOAL_REACH_HORIZONTAL,
         v = racing::GOAL_REACH_VERTICAL
     )]
-    RoadShort { at: [f64; 3], goal: [f64; 3] },
+    RoadShort {
+        /// Where the road ends, m.
+        at: [f64; 3],
+        /// The goal, m.
+        goal: [f64; 3],
+    },
+    /// The road's geometry breaks a rule.
     #[error("{0}")]
     Road(#[from] road::TrackError),
+    /// More pieces of a kind than the game allows.
     #[error("the level has {count} {what}: at most {max} are allowed")]
     TooMany {
+        /// The kind of piece (`segments`, `obstacles`).
         what: &'static str,
+        /// How many the level has.
         count: usize,
+        /// The most allowed.
         max: usize,
     },
+    /// An obstacle breaks a rule.
     #[error("obstacles[{index}].{problem}")]
-    Obstacle { index: usize, problem: String },
+    Obstacle {
+        /// The obstacle's index in the level's list.
+        index: usize,
+        /// Which field is wrong, and why.
+        problem: String,
+    },
+    /// The level's statistics do not fit its track.
     #[error("{0}")]
     Stats(String),
+    /// The level's source does not fit the level (wrong rules kind, more kept pieces than it has,
+    /// bad rule settings).
     #[error("{0}")]
     Source(String),
+    /// The level's aux curve is wrong, or the level has both a λ and a curve.
     #[error("{0}")]
     Pacing(String),
 }
 
 impl Level {
+    /// The game that plays this level.
     pub fn game(&self) -> Game {
         self.track.game()
     }
@@ -404,6 +455,7 @@ impl Level {
         }
     }
 
+    /// The racing track, if this is a racing level.
     pub fn racing(&self) -> Option<&racing::RacingTrack> {
         match &self.track {
             Track::Racing(track) => Some(track),

@@ -6,13 +6,18 @@ use std::fmt;
 /// A closed interval a parameter must lie in, with the name and unit used in error messages.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ParamRange {
+    /// The parameter's name.
     pub name: &'static str,
+    /// The least value allowed.
     pub min: f64,
+    /// The largest value allowed.
     pub max: f64,
+    /// The unit (`m`, `degrees`), or empty.
     pub unit: &'static str,
 }
 
 impl ParamRange {
+    /// The range `[min, max]` of `name`, in `unit`.
     pub const fn new(name: &'static str, min: f64, max: f64, unit: &'static str) -> Self {
         Self {
             name,
@@ -73,12 +78,23 @@ pub fn show_number(value: f64) -> String {
     }
 }
 
+/// A parameter outside its range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RangeError {
+    /// The value is NaN.
     #[error("{} must be a number, not NaN", range.name)]
-    NotANumber { range: ParamRange },
+    NotANumber {
+        /// The range the value had to lie in.
+        range: ParamRange,
+    },
+    /// The value is outside the range.
     #[error("{} {} is out of range {range}", range.name, show_number(*value))]
-    OutOfRange { range: ParamRange, value: f64 },
+    OutOfRange {
+        /// The range the value had to lie in.
+        range: ParamRange,
+        /// The value.
+        value: f64,
+    },
 }
 
 /// Platform game: horizontal centre-to-centre distance from the previous block.

@@ -35,6 +35,7 @@ pub struct RoadSample {
     pub s: f64,
     /// The segment this sample lies in.
     pub segment: usize,
+    /// The point on the centre line, m.
     pub centre: [f64; 3],
     /// Heading, radians.
     pub heading: f64,
@@ -86,22 +87,30 @@ pub struct Road {
 /// A rule of the road broken by a track.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum TrackError {
+    /// Two segments' centre lines come too close.
     #[error(
         "segment {later} crosses segment {earlier}: the road's centre lines come {distance:.1} m apart, less than {min} m"
     )]
     Crosses {
+        /// The earlier segment's index.
         earlier: usize,
+        /// The later segment's index.
         later: usize,
+        /// How close their centre lines come, m.
         distance: f64,
         /// The least distance allowed (the road's width + 3 m).
         min: f64,
     },
+    /// A segment's centre line passes too close to an obstacle.
     #[error(
         "segment {segment} runs into obstacle {obstacle}: its centre line passes {distance:.1} m from it, less than {min} m"
     )]
     HitsObstacle {
+        /// The segment's index.
         segment: usize,
+        /// The obstacle's index.
         obstacle: usize,
+        /// How close the centre line passes, m.
         distance: f64,
         /// The least distance allowed (half the road's width + 1.5 m).
         min: f64,
@@ -216,10 +225,12 @@ impl Road {
         }
     }
 
+    /// The road's cross-sections, from the start.
     pub fn samples(&self) -> &[RoadSample] {
         &self.samples
     }
 
+    /// How many segments the road has.
     pub fn segment_count(&self) -> usize {
         self.banks.len()
     }
@@ -386,9 +397,13 @@ impl Road {
 /// An indexed triangle mesh, in f32 as glTF and rapier store it.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriangleMesh {
+    /// Vertex positions, m.
     pub positions: Vec<[f32; 3]>,
+    /// Vertex normals, unit length.
     pub normals: Vec<[f32; 3]>,
+    /// Vertex texture coordinates.
     pub uvs: Vec<[f32; 2]>,
+    /// Triangles, as three indices into the vertices.
     pub triangles: Vec<[u32; 3]>,
 }
 

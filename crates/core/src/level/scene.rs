@@ -11,17 +11,26 @@ use super::{Level, Shape};
 /// What a node is, which picks its material.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Material {
+    /// A platform block.
     Block,
+    /// The block the player starts on.
     StartBlock,
+    /// The last block, at the goal.
     GoalBlock,
+    /// The marker over the start.
     StartMarker,
+    /// The marker over the goal.
     GoalMarker,
+    /// The road's surface.
     Road,
+    /// The road's skirts along its edges.
     RoadEdge,
+    /// A box or cylinder obstacle on the road.
     Obstacle,
 }
 
 impl Material {
+    /// Every material, in the order files list them.
     pub const ALL: [Material; 8] = [
         Material::Block,
         Material::StartBlock,
@@ -33,6 +42,7 @@ impl Material {
         Material::Obstacle,
     ];
 
+    /// The material's name in files (`block`, `start_block`, ...).
     pub fn name(self) -> &'static str {
         match self {
             Material::Block => "block",
@@ -64,6 +74,7 @@ impl Material {
 /// A box in the world.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneNode {
+    /// The node's name in files (`start_block`, `block_000`, ...).
     pub name: String,
     /// Centre of the box.
     pub centre: [f64; 3],
@@ -71,20 +82,24 @@ pub struct SceneNode {
     pub heading: f64,
     /// Full extents along the box's own x, y, z.
     pub extents: [f64; 3],
+    /// What the box is, which picks its colour.
     pub material: Material,
     /// Metadata carried into the file (the block's generator parameters).
     pub extras: Option<Value>,
+    /// What the box is to an engine's physics.
     pub physics: Physics,
 }
 
 /// A node of its own geometry (a piece of road, a cylinder), in world coordinates.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneMesh {
+    /// The node's name in files (`segment_000`, `obstacle_000`, ...).
     pub name: String,
     /// Its parts, each drawn with one material.
     pub primitives: Vec<(TriangleMesh, Material)>,
     /// Metadata carried into the file (the segment's generator parameters).
     pub extras: Option<Value>,
+    /// What the node is to an engine's physics.
     pub physics: Physics,
 }
 
@@ -92,18 +107,23 @@ pub struct SceneMesh {
 /// `OMI_physics_shape` glTF extensions).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Physics {
-    /// Solid and static: the node's own box (its extents), or its own mesh as a triangle mesh.
+    /// Solid and static: the node's own box (its extents).
     SolidBox,
+    /// Solid and static: the node's own mesh, as a triangle mesh.
     SolidMesh,
     /// Solid and static: an upright cylinder standing on `base`.
     SolidCylinder {
+        /// The centre of the cylinder's base, m.
         base: [f64; 3],
+        /// The cylinder's radius, m.
         radius: f64,
+        /// The cylinder's height, m.
         height: f64,
     },
     /// Not solid: a box (its size in the node's own frame, local +Z along the heading) that an
     /// engine reports entering: the finish, where the game counts a run a success.
     TriggerBox {
+        /// The box's full extents along its own x, y, z, m.
         size: [f64; 3],
     },
     /// Only to look at (markers).
@@ -113,18 +133,23 @@ pub enum Physics {
 /// A place without geometry (where to spawn, where the finish is), in world coordinates.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ScenePoint {
+    /// The point's name in files (`spawn`, `finish`).
     pub name: String,
+    /// Where the point is, m.
     pub position: [f64; 3],
     /// The level's heading there, degrees: the node is turned so that its local +Z (glTF's
     /// forward) points along it.
     pub heading: f64,
+    /// Metadata carried into the file (what the point is, its heading).
     pub extras: Value,
+    /// What the point is to an engine's physics (the finish is a trigger).
     pub physics: Physics,
 }
 
 /// A level ready to export.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
+    /// The scene's name in files (`platform_level`, `racing_level`).
     pub name: String,
     /// Boxes (blocks, markers, box obstacles).
     pub nodes: Vec<SceneNode>,

@@ -13,16 +13,21 @@ pub enum SolverRef {
     /// The game's scripted (non-learning) player, at a skill (files written before skills
     /// existed name none: the expert).
     Scripted {
+        /// How well it plays.
         #[serde(default)]
         skill: Skill,
     },
     /// Uniformly random actions (a baseline).
     Random,
     /// A trained Solver policy.
-    Policy { policy: PolicyRef },
+    Policy {
+        /// The Solver policy file.
+        policy: PolicyRef,
+    },
 }
 
 impl SolverRef {
+    /// The player in words, for reports (`scripted player (expert)`, `random actions`, ...).
     pub fn describe(&self) -> String {
         match self {
             SolverRef::Scripted { skill } => format!("scripted player ({skill})"),
@@ -87,6 +92,7 @@ impl Outcome {
 /// One finished Solver run, as verification records it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrialResult {
+    /// How the run ended.
     pub outcome: Outcome,
     /// Fraction of the track covered, in [0, 1].
     pub progress: f64,
@@ -102,12 +108,17 @@ pub struct TrialResult {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolverStats {
+    /// Who played.
     pub solver: SolverRef,
     /// Seed of the first trial; trial `i` uses `seed + i`.
     pub seed: u64,
+    /// Runs played.
     pub trials: u32,
+    /// Runs that reached the goal.
     pub successes: u32,
+    /// Runs that fell off the track (platform).
     pub fell: u32,
+    /// Runs that ran out of time.
     pub timed_out: u32,
     /// Runs that left the road (racing).
     #[serde(default, skip_serializing_if = "is_zero")]
@@ -149,7 +160,9 @@ pub struct PanelStats {
     pub seed: u64,
     /// Runs per judge.
     pub trials: u32,
+    /// Each judge's runs, in the panel's order.
     pub judges: Vec<JudgeStats>,
+    /// The level's difficulty, when it has been fitted.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rating: Option<Rating>,
 }
@@ -164,7 +177,9 @@ pub struct JudgeStats {
     /// The Solver policy this judge was (none for the scripted player).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub policy: Option<PolicyRef>,
+    /// Runs that reached the goal.
     pub successes: u32,
+    /// `successes / trials`.
     pub success_ratio: f64,
     /// 95% Wilson score interval of the success ratio.
     pub ci95: [f64; 2],
@@ -175,6 +190,7 @@ pub struct JudgeStats {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Rating {
+    /// The level's difficulty b, logits (higher: harder).
     pub b: f64,
     /// 95% interval of b.
     pub ci95: [f64; 2],
@@ -378,8 +394,11 @@ pub fn wilson_interval(successes: u32, trials: u32) -> [f64; 2] {
 )]
 #[serde(rename_all = "lowercase")]
 pub enum Skill {
+    /// The weakest scripted player.
     Novice,
+    /// Between the novice and the expert.
     Median,
+    /// The scripted player as it played before skills existed.
     #[default]
     Expert,
 }
@@ -388,6 +407,7 @@ impl Skill {
     /// Every skill, weakest first.
     pub const ALL: [Skill; 3] = [Skill::Novice, Skill::Median, Skill::Expert];
 
+    /// The skill's name on the command line and in files (`novice`, `median`, `expert`).
     pub fn name(self) -> &'static str {
         match self {
             Skill::Novice => "novice",

@@ -15,6 +15,7 @@ use crate::level::Game;
 
 /// The `format` of every policy card.
 pub const POLICY_FORMAT: &str = "arlpcg-policy";
+/// The `version` of every policy card this build writes and reads.
 pub const POLICY_VERSION: u32 = 1;
 /// The largest policy or checkpoint file read (the paper's 2 × 512 network is 2.3 MB, its
 /// checkpoint with optimizer moments 7 MB).
@@ -28,7 +29,9 @@ const TRAINING_KEY: &str = "training_state";
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Role {
+    /// Plays the levels.
     Solver,
+    /// Builds the levels.
     Generator,
 }
 
@@ -56,6 +59,7 @@ pub enum TrainMode {
 }
 
 impl TrainMode {
+    /// Every mode, in the order tables list them.
     pub const ALL: [TrainMode; 4] = [
         TrainMode::RulePcg,
         TrainMode::FixedTrack,
@@ -68,6 +72,7 @@ impl TrainMode {
         Self::ALL.into_iter().find(|mode| mode.name() == name)
     }
 
+    /// The mode's name on the command line and in files (`rule-pcg`, `fixed-track`, ...).
     pub fn name(self) -> &'static str {
         match self {
             TrainMode::RulePcg => "rule-pcg",
@@ -88,16 +93,25 @@ impl std::fmt::Display for TrainMode {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PolicyCard {
+    /// Always [`POLICY_FORMAT`].
     pub format: String,
+    /// The card's format version ([`POLICY_VERSION`]).
     pub version: u32,
+    /// The game the policy plays.
     pub game: Game,
+    /// Which side of the game it plays.
     pub role: Role,
     /// Named parts of the observation vector and their sizes, in order.
     pub observation: Vec<(String, usize)>,
+    /// The names of its continuous actions, in order.
     pub continuous_actions: Vec<String>,
+    /// The names of its binary actions, in order.
     pub binary_actions: Vec<String>,
+    /// The network's sizes.
     pub network: PolicyShape,
+    /// The observation normalizer's statistics, frozen.
     pub normalizer: RunningNorm,
+    /// How it was trained.
     pub training: TrainingRecord,
     /// Measured results, filled in by evaluation.
     #[serde(default)]
@@ -125,9 +139,13 @@ pub struct PolicyCard {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TrainingRecord {
+    /// How the Solver was trained.
     pub mode: TrainMode,
+    /// Environment steps trained.
     pub steps: u64,
+    /// Wall-clock seconds trained, over all sessions.
     pub wall_time_s: f64,
+    /// The run's seed.
     pub seed: u64,
     /// The commit that trained it, `-dirty` when the tree held uncommitted changes.
     pub commit: String,
@@ -153,13 +171,17 @@ pub struct TrainingRecord {
 /// Everything needed to continue a training run where it stopped.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct TrainingState {
+    /// Environment steps collected so far.
     pub global_step: u64,
+    /// PPO iterations done so far.
     pub iteration: u64,
+    /// Adam's step count, for its bias correction.
     pub adam_step: u64,
     /// Wall-clock seconds trained so far, over all sessions.
     pub wall_time_s: f64,
     /// The run's configuration (game-specific), as it started.
     pub config: serde_json::Value,
+    /// The run's RNG, where it stopped.
     pub rng: rand_chacha::ChaCha8Rng,
     /// Game-specific progress (e.g. the next level seed), opaque here.
     pub source: serde_json::Value,
@@ -198,16 +220,32 @@ impl TrainingState {
 /// Why a policy or checkpoint could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum PolicyError {
+    /// The bytes are not a safetensors file (the reader's words).
     #[error("not a safetensors file: {0}")]
     NotSafetensors(String),
+    /// The file has no policy card in its metadata.
     #[error("no policy card inside: not an arlpcg policy")]
     NoCard,
+    /// The card is unreadable or disagrees with the file or the game.
     #[error("policy card: {0}")]
     Card(String),
+    /// The policy is for another game or role.
     #[error("this is a {found} policy, expected a {expected} one")]
-    WrongKind { found: String, expected: String },
+    WrongKind {
+        /// The file's game and role.
+        found: String,
+        /// The game and role asked for.
+        expected: String,
+    },
+    /// A tensor is missing or has the wrong type or shape.
     #[error("tensor `{name}`: {problem}")]
-    Tensor { name: String, problem: String },
+    Tensor {
+        /// The tensor's name.
+        name: String,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// The file holds no training state: it is not a checkpoint.
     #[error("no training state inside: not a checkpoint")]
     NoTrainingState,
 }
@@ -256,8 +294,11 @@ pub fn checkpoint_bytes(
 
 /// A policy read back, checked against the game and role it must play.
 pub struct LoadedPolicy {
+    /// The network, with the file's weights.
     pub policy: ActorCritic,
+    /// The policy's card.
     pub card: PolicyCard,
+    /// Every tensor in the file, by name.
     pub tensors: HashMap<String, Tensor>,
     training: Option<String>,
 }

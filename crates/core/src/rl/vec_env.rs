@@ -13,6 +13,7 @@ use super::timing::{Clock, InnerTime, Stopwatch, TimeSplit};
 /// What one environment's step led to. Finished episodes are reset by the environment.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Transition {
+    /// The step's reward.
     pub reward: f32,
     /// The episode ended with this step (success, failure or time limit): no bootstrapping.
     pub ended: bool,
@@ -22,7 +23,9 @@ pub struct Transition {
 
 /// A set of environments with automatic reset.
 pub trait VecEnv {
+    /// How many environments there are.
     fn num_envs(&self) -> usize;
+    /// The length of one environment's observation.
     fn observation_size(&self) -> usize;
     /// Writes every environment's current observation, rows of `observation_size`.
     fn observe(&mut self, out: &mut [f32]);
@@ -58,15 +61,20 @@ pub enum Seat {
 /// other policies with their observation normalizers, and the stream their actions are drawn
 /// from (policy after policy, each over its own environments in order).
 pub struct OtherPlayers<'a> {
+    /// Each environment's seat, in order.
     pub seats: Vec<Seat>,
+    /// The other policies, each with its observation normalizer.
     pub policies: Vec<(&'a ActorCritic, &'a RunningNorm)>,
+    /// The stream the other policies' actions are drawn from.
     pub rng: &'a mut ChaCha8Rng,
 }
 
 /// Episode statistics of one rollout.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RolloutStats {
+    /// Environment steps collected.
     pub steps: u64,
+    /// Episodes that ended.
     pub episodes: u32,
     /// Mean undiscounted return of the episodes that ended (NaN when none did).
     pub mean_return: f32,
@@ -76,10 +84,15 @@ pub struct RolloutStats {
 
 /// A PPO learner bound to its environments.
 pub struct Trainer<E: VecEnv> {
+    /// The learner.
     pub ppo: Ppo,
+    /// The environments.
     pub env: E,
+    /// The observation normalizer, updated as the rollout observes.
     pub norm: RunningNorm,
+    /// The stream actions are drawn from.
     pub rng: ChaCha8Rng,
+    /// Environment steps collected so far.
     pub global_step: u64,
     observations: Vec<f32>,
     /// Each environment's return so far in its episode under way (a checkpoint keeps them).
@@ -87,6 +100,7 @@ pub struct Trainer<E: VecEnv> {
 }
 
 impl<E: VecEnv> Trainer<E> {
+    /// A trainer of `ppo` on `env`, with a fresh normalizer and its RNG seeded by `seed`.
     pub fn new(ppo: Ppo, mut env: E, seed: u64) -> Self {
         let (n, d) = (env.num_envs(), env.observation_size());
         let mut observations = vec![0.0; n * d];

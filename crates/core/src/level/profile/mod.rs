@@ -35,16 +35,24 @@ pub const DEFAULT_NAME: &str = "default";
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ProfileFile {
+    /// Always [`FORMAT`].
     pub format: String,
+    /// The file's format version ([`VERSION`]).
     pub version: u32,
+    /// The game the profile is for.
     pub game: Game,
+    /// The profile's name.
     pub name: String,
+    /// The character's abilities (platform).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub character: Option<CharacterProfile>,
+    /// The car's abilities (racing).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub car: Option<CarProfile>,
+    /// The blocks' ranges (platform), when given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub blocks: Option<BlockRanges>,
+    /// The road segments' ranges (racing), when given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub segments: Option<SegmentRanges>,
 }
@@ -55,9 +63,13 @@ pub struct ProfileFile {
 /// [`PlayerKind`]: crate::level::PlayerKind
 #[derive(Debug, Clone, PartialEq)]
 pub struct Profile {
+    /// The game the profile is for.
     pub game: Game,
+    /// The profile's name.
     pub name: String,
+    /// The player's abilities.
     pub abilities: Abilities,
+    /// The ranges its level pieces are drawn from.
     pub pieces: Pieces,
 }
 
@@ -65,16 +77,20 @@ pub struct Profile {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ProfileRecord {
+    /// The profile's name.
     pub name: String,
     /// SHA-256 of the profile's values as [`Profile::to_yaml`] writes them.
     pub sha256: String,
+    /// The character's abilities (platform).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub character: Option<CharacterProfile>,
+    /// The car's abilities (racing).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub car: Option<CarProfile>,
     /// The piece ranges, when they are not the built-in ones.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub blocks: Option<BlockRanges>,
+    /// The road segments' ranges, when they are not the built-in ones.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub segments: Option<SegmentRanges>,
 }
@@ -179,6 +195,7 @@ impl Profile {
         }
     }
 
+    /// The game the profile is for.
     pub fn game(&self) -> Game {
         self.game
     }

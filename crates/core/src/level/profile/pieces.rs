@@ -15,12 +15,15 @@ use crate::level::{Game, ShapeKind};
 pub struct BlockRanges {
     /// Shortest and longest centre-to-centre distance from the previous block, m.
     pub min_distance: f64,
+    /// The longest centre-to-centre distance from the previous block, m.
     pub max_distance: f64,
     /// Smallest and largest side of a block's top, m.
     pub min_size: f64,
+    /// The largest side of a block's top, m.
     pub max_size: f64,
     /// Largest drop (negative) and climb from the previous block, m.
     pub min_height: f64,
+    /// The largest climb from the previous block, m.
     pub max_height: f64,
     /// Sharpest turn off the last jump's direction, degrees (the Generator keeps within
     /// `game::platform::reach::MAX_TURN` as well).
@@ -34,6 +37,7 @@ pub struct BlockRanges {
 pub struct SegmentRanges {
     /// Shortest and longest segment along the centre line, m.
     pub min_length: f64,
+    /// The longest segment along the centre line, m.
     pub max_length: f64,
     /// Sharpest heading change over a segment, either way, degrees.
     pub max_curve: f64,
@@ -59,7 +63,9 @@ fn default_banking() -> f64 {
 /// ([`ShapeKind`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Pieces {
+    /// The blocks' ranges (platform).
     Blocks(BlockRanges),
+    /// The road segments' ranges (racing).
     Road(SegmentRanges),
 }
 
@@ -215,18 +221,22 @@ impl BlockRanges {
         Ok(())
     }
 
+    /// A block's distance from the previous one, m.
     pub fn distance(&self) -> ParamRange {
         ParamRange::new("distance", self.min_distance, self.max_distance, "m")
     }
 
+    /// A block's side, m.
     pub fn size(&self) -> ParamRange {
         ParamRange::new("size", self.min_size, self.max_size, "m")
     }
 
+    /// A block's height over the previous one, m.
     pub fn height(&self) -> ParamRange {
         ParamRange::new("height", self.min_height, self.max_height, "m")
     }
 
+    /// A block's turn off the last jump's direction, either way, degrees (named `angle`).
     pub fn turn(&self) -> ParamRange {
         ParamRange::new("angle", -self.max_turn, self.max_turn, "degrees")
     }
@@ -267,14 +277,17 @@ impl SegmentRanges {
         )
     }
 
+    /// A segment's length, m.
     pub fn length(&self) -> ParamRange {
         ParamRange::new("length", self.min_length, self.max_length, "m")
     }
 
+    /// A segment's heading change, either way, degrees.
     pub fn curve(&self) -> ParamRange {
         ParamRange::new("curve", -self.max_curve, self.max_curve, "degrees")
     }
 
+    /// A segment's height change, either way, m.
     pub fn height(&self) -> ParamRange {
         ParamRange::new("height", -self.max_height, self.max_height, "m")
     }

@@ -26,25 +26,34 @@ const TRANSFORM_TOLERANCE: f64 = 1e-3;
 #[derive(Debug, thiserror::Error)]
 #[error("{}: {problem}", path.display())]
 pub struct LoadError {
+    /// The file.
     pub path: PathBuf,
+    /// What is wrong with it.
     pub problem: Problem,
 }
 
 /// What is wrong with a level file.
 #[derive(Debug, thiserror::Error)]
 pub enum Problem {
+    /// The file could not be read.
     #[error("cannot read the file: {0}")]
     Io(#[from] std::io::Error),
+    /// The file holds nothing.
     #[error("the file is empty")]
     Empty,
+    /// The path is not a regular file.
     #[error("not a regular file (a folder, FIFO, socket or device)")]
     NotAFile,
+    /// The file is over the size limit.
     #[error("the file is larger than {} MiB; a level file is a few kB", MAX_FILE_BYTES >> 20)]
     TooLarge,
+    /// The file is not UTF-8; the byte offset of the first bad byte.
     #[error("not a text file (invalid UTF-8 at byte {0})")]
     NotText(usize),
+    /// The file is not an arlpcg level (no mapping, or a wrong or missing `format` or `version`).
     #[error("not an arlpcg level: {0}")]
     NotALevel(String),
+    /// The file is of a format version this build does not read.
     #[error("format version {0} is not supported: this arlpcg reads version {FORMAT_VERSION}")]
     UnsupportedVersion(String),
     /// A syntax, type or range error found while parsing (serde_yaml names field and line).
@@ -53,8 +62,11 @@ pub enum Problem {
     /// A rule of the level broken by otherwise well-formed values.
     #[error("{field}: {message}{}", line.map(|l| format!(" (line {l})")).unwrap_or_default())]
     Invalid {
+        /// The field, as a path into the file (`segments[2].aux`).
         field: String,
+        /// The field's line in the file, when found.
         line: Option<usize>,
+        /// What is wrong.
         message: String,
     },
 }

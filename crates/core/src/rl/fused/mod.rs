@@ -46,6 +46,7 @@ pub struct ParamLayout {
 }
 
 impl ParamLayout {
+    /// The layout of a network of this shape.
     pub fn new(shape: &PolicyShape) -> Self {
         let mut offset = 0;
         let mut stack = |out: usize| {
@@ -81,6 +82,7 @@ impl ParamLayout {
         self.len
     }
 
+    /// Whether the vector holds no parameters.
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }
@@ -89,28 +91,41 @@ impl ParamLayout {
 /// One minibatch, gathered: rows of observations and actions and one value per row of the rest
 /// (advantages already normalized if they are to be).
 pub struct Minibatch<'a> {
+    /// Observation rows, normalized.
     pub observations: &'a [f32],
+    /// Action rows, as taken.
     pub actions: &'a [f32],
+    /// Each row's log-probability of its action under the policy that took it.
     pub old_log_probs: &'a [f32],
+    /// Each row's advantage.
     pub advantages: &'a [f32],
+    /// Each row's return, the value head's target.
     pub returns: &'a [f32],
 }
 
 /// The loss weights of one update.
 #[derive(Debug, Clone, Copy)]
 pub struct LossWeights {
+    /// PPO's clip range ε on the probability ratio.
     pub clip_coef: f32,
+    /// The entropy bonus's weight.
     pub ent_coef: f32,
+    /// The value loss's weight.
     pub vf_coef: f32,
 }
 
 /// The minibatch's loss terms and CleanRL's diagnostics (means over its rows).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct LossTerms {
+    /// The clipped surrogate loss.
     pub policy_loss: f32,
+    /// The value loss, half the squared error.
     pub value_loss: f32,
+    /// The policy's entropy.
     pub entropy: f32,
+    /// Approximate KL divergence from the old policy, `(ratio − 1) − log ratio`.
     pub approx_kl: f32,
+    /// Fraction of rows whose ratio was clipped, `|ratio − 1| > clip_coef`.
     pub clip_fraction: f32,
 }
 

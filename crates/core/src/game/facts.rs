@@ -10,9 +10,11 @@ use crate::level::{Game, Level};
 /// One game's facts.
 #[derive(Debug)]
 pub struct GameFacts {
+    /// The game.
     pub game: Game,
     /// A piece, and several (`block`/`blocks`, `segment`/`segments`).
     pub piece: &'static str,
+    /// Several pieces (`blocks`, `segments`).
     pub pieces: &'static str,
     /// Where a failed run is counted: "on the way to" a block, "on" a segment.
     pub failed_at: &'static str,
@@ -35,6 +37,7 @@ pub struct GameFacts {
     /// The range of goal distances and heights (m) the rules draw from; a goal set by hand
     /// stays within them.
     pub goal_distance: (f64, f64),
+    /// The range of goal heights the rules draw from, m.
     pub goal_height: (f64, f64),
     /// How far one press of the designer's goal-distance keys moves the goal (m).
     pub goal_distance_step: f64,
@@ -48,13 +51,16 @@ pub struct GameFacts {
     /// The Solver's and the Generator's observations: each part's name and width, and what it
     /// holds (frame, scale, sign, order), for a port of it (an export's sidecar).
     pub solver_observation: ObservationFacts,
+    /// The Generator's observation.
     pub generator_observation: ObservationFacts,
 }
 
 /// An observation's parts in order, and what each holds.
 #[derive(Debug)]
 pub struct ObservationFacts {
+    /// Each part's name and width, in order.
     pub layout: &'static [(&'static str, usize)],
+    /// What each part holds, in the same order.
     pub meanings: &'static [&'static str],
 }
 

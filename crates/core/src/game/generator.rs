@@ -181,6 +181,7 @@ pub trait TrackBuild: Clone + Send + Sync {
 /// observation and actions as a policy card names them, and how the Solver's environment grows
 /// with the track.
 pub trait GeneratorGame: GameSpec {
+    /// The game's track under construction.
     type Build: TrackBuild;
     /// The Generator's observation, named parts in order.
     const GENERATOR_OBSERVATION_LAYOUT: &'static [(&'static str, usize)];
@@ -307,8 +308,11 @@ pub fn observation_size<G: GeneratorGame>() -> usize {
 /// `generate --aux-curve` builds a level).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MatchPacing {
+    /// λ up to `switch`.
     pub before: f32,
+    /// λ from `switch` on.
     pub after: f32,
+    /// The fraction of the start-to-goal distance where λ changes.
     pub switch: f64,
 }
 
@@ -383,10 +387,12 @@ impl<G: GeneratorGame> Match<G> {
         self
     }
 
+    /// The λ curve of a paced match, if it is one.
     pub fn pacing(&self) -> Option<MatchPacing> {
         self.pacing
     }
 
+    /// The track built so far.
     pub fn build(&self) -> &G::Build {
         &self.build
     }

@@ -25,11 +25,15 @@ pub struct AuxCurve {
 /// The words a curve's messages use: what the curve is, its x and y, and examples of a whole
 /// curve, of one point and of a step.
 pub struct CurveWords {
+    /// What the curve is, with its article ("an aux curve").
     pub curve: &'static str,
+    /// The name of a point's x ("fraction").
     pub x: &'static str,
     /// What x is, for the range message: "the fraction of the way to the goal".
     pub x_meaning: &'static str,
+    /// The name of a point's y ("λ").
     pub y: &'static str,
+    /// Examples: a whole curve, one point, a step.
     pub examples: [&'static str; 3],
 }
 

@@ -148,8 +148,15 @@ impl Platform {
 /// Why a block cannot be placed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PlacementError {
+    /// The new block would overlap a platform already placed.
     #[error("block {block} overlaps {}", describe_platform(*other))]
-    Overlap { block: usize, other: usize },
+    Overlap {
+        /// The new block's index in the level's blocks.
+        block: usize,
+        /// The platform it overlaps (0 is the start block, `i + 1` is block `i`).
+        other: usize,
+    },
+    /// The level already holds the most blocks allowed.
     #[error("a level holds at most {MAX_BLOCKS} blocks")]
     TooManyBlocks,
 }
@@ -221,6 +228,7 @@ impl PlatformTrack {
         Ok(())
     }
 
+    /// The start block.
     pub fn start(&self) -> &Start {
         &self.start
     }
@@ -242,6 +250,7 @@ impl PlatformTrack {
             .expect("a track always has its start block")
     }
 
+    /// How many blocks are placed (the start block not counted).
     pub fn block_count(&self) -> usize {
         self.params.len()
     }

@@ -60,6 +60,7 @@ impl RoadShape {
         Ok(())
     }
 
+    /// Whether this is the built-in road (its width and banking).
     pub fn is_default(&self) -> bool {
         *self == Self::default()
     }
@@ -109,14 +110,20 @@ impl SegmentParams {
 pub enum Obstacle {
     /// A box of `size` (x, y, z before turning), turned `heading` degrees about +Y.
     Box {
+        /// The centre of its base, m.
         position: [f64; 3],
+        /// Its full size along x, y, z before turning, m.
         size: [f64; 3],
+        /// Its turn about +Y, degrees.
         heading: f64,
     },
     /// An upright cylinder.
     Cylinder {
+        /// The centre of its base, m.
         position: [f64; 3],
+        /// Its radius, m.
         radius: f64,
+        /// Its height, m.
         height: f64,
     },
 }
@@ -126,6 +133,7 @@ pub const OBSTACLE_SIZE: params::ParamRange =
     params::ParamRange::new("obstacle size", 0.1, 200.0, "m");
 
 impl Obstacle {
+    /// The centre of the obstacle's base, m.
     pub fn position(&self) -> [f64; 3] {
         match *self {
             Obstacle::Box { position, .. } | Obstacle::Cylinder { position, .. } => position,
@@ -259,7 +267,9 @@ pub struct RacingTrack {
     pub position: [f64; 3],
     /// Initial road direction, degrees.
     pub heading: f64,
+    /// The road's segments, from the start.
     pub segments: Vec<SegmentParams>,
+    /// What the road must go around.
     pub obstacles: Vec<Obstacle>,
     /// How wide the road is and how it banks.
     pub road: RoadShape,

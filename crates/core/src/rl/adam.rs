@@ -12,9 +12,13 @@ use super::fused::PARAM_CHUNK;
 /// Adam's state: step count and first and second moments per parameter.
 #[derive(Clone)]
 pub struct Adam {
+    /// Decay of the first moment.
     pub beta1: f64,
+    /// Decay of the second moment.
     pub beta2: f64,
+    /// Added to the second moment's root in the denominator.
     pub eps: f64,
+    /// Updates taken so far, for the bias correction.
     pub step: u64,
     first: Vec<f32>,
     second: Vec<f32>,

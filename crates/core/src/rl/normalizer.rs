@@ -9,12 +9,16 @@ pub const CLIP: f32 = 10.0;
 /// Per-feature running mean and variance.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunningNorm {
+    /// Each feature's running mean.
     pub mean: Vec<f64>,
+    /// Each feature's running variance.
     pub var: Vec<f64>,
+    /// How many rows the statistics hold (starts at 1e-4).
     pub count: f64,
 }
 
 impl RunningNorm {
+    /// A normalizer of `size` features that has seen nothing: mean 0, variance 1.
     pub fn new(size: usize) -> Self {
         Self {
             mean: vec![0.0; size],
@@ -23,6 +27,7 @@ impl RunningNorm {
         }
     }
 
+    /// How many features it normalizes.
     pub fn size(&self) -> usize {
         self.mean.len()
     }

@@ -49,13 +49,18 @@ pub fn rows_where(rows: &[f32], width: usize, keep: &[bool]) -> Vec<f32> {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PolicyShape {
+    /// Observation values.
     pub observation: usize,
+    /// Each hidden layer's width, in order (the actor and the critic alike).
     pub hidden: Vec<usize>,
+    /// Continuous actions (Gaussian).
     pub continuous: usize,
+    /// Binary actions (Bernoulli).
     pub binary: usize,
 }
 
 impl PolicyShape {
+    /// Values in one action row: the continuous actions, then the binary ones.
     pub fn action_size(&self) -> usize {
         self.continuous + self.binary
     }
@@ -86,7 +91,9 @@ impl PolicyShape {
 /// Whether to sample actions or take the most likely ones.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ActMode {
+    /// Draw from the policy's distributions.
     Sample,
+    /// Take the most likely actions.
     Deterministic,
 }
 
@@ -95,7 +102,9 @@ pub enum ActMode {
 pub struct Acted {
     /// Rows of `action_size` values.
     pub actions: Vec<f32>,
+    /// Each row's log-probability of its action.
     pub log_probs: Vec<f32>,
+    /// Each row's value estimate, from the critic.
     pub values: Vec<f32>,
 }
 
@@ -180,6 +189,7 @@ impl ActorCritic {
         })
     }
 
+    /// The network's sizes.
     pub fn shape(&self) -> &PolicyShape {
         &self.shape
     }

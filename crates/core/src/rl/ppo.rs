@@ -89,7 +89,9 @@ impl Default for PpoConfig {
 /// The most environments, steps per rollout and rows per batch a configuration may ask for: a
 /// batch of 2^20 rows of 100 observations is already 400 MB.
 pub const MAX_ENVS: usize = 4096;
+/// The most steps per rollout.
 pub const MAX_STEPS: usize = 65_536;
+/// The most rows per batch.
 pub const MAX_BATCH: usize = 1 << 20;
 
 impl PpoConfig {
@@ -167,10 +169,12 @@ impl PpoConfig {
         }
     }
 
+    /// Rows per rollout: environments × steps.
     pub fn batch_size(&self) -> usize {
         self.num_envs * self.num_steps
     }
 
+    /// Rows per minibatch.
     pub fn minibatch_size(&self) -> usize {
         self.batch_size() / self.num_minibatches.max(1)
     }
@@ -214,21 +218,32 @@ pub fn gae(
 pub struct Batch {
     /// Normalized observations, rows of `observation` values.
     pub observations: Vec<f32>,
+    /// Actions taken, rows of the policy's action size.
     pub actions: Vec<f32>,
+    /// Each row's log-probability of its action when taken.
     pub log_probs: Vec<f32>,
+    /// Each row's advantage (GAE).
     pub advantages: Vec<f32>,
+    /// Each row's return: advantage plus value.
     pub returns: Vec<f32>,
+    /// Each row's value estimate when taken.
     pub values: Vec<f32>,
 }
 
 /// What an update did, CleanRL's diagnostics.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct UpdateStats {
+    /// The clipped surrogate loss.
     pub policy_loss: f32,
+    /// The value loss.
     pub value_loss: f32,
+    /// The policy's entropy.
     pub entropy: f32,
+    /// Approximate KL divergence from the policy that collected the rollout.
     pub approx_kl: f32,
+    /// Fraction of rows whose probability ratio was clipped.
     pub clip_fraction: f32,
+    /// How much of the returns' variance the value estimates explain.
     pub explained_variance: f32,
     /// Minibatch gradient steps taken.
     pub gradient_steps: u32,
@@ -236,14 +251,18 @@ pub struct UpdateStats {
 
 /// A policy and its optimizer.
 pub struct Ppo {
+    /// The hyperparameters.
     pub config: PpoConfig,
+    /// The policy being trained.
     pub policy: ActorCritic,
+    /// Its optimizer.
     pub adam: Adam,
     /// The fused update's buffers, made at the first update for the minibatch size.
     workspace: Option<Workspace>,
 }
 
 impl Ppo {
+    /// PPO on `policy` under `config`, with a fresh optimizer.
     pub fn new(config: PpoConfig, policy: ActorCritic) -> candle_core::Result<Self> {
         let adam = Adam::new(&policy.named_vars());
         Ok(Self {

@@ -124,6 +124,7 @@ pub struct Stopwatch<'a> {
 }
 
 impl<'a> Stopwatch<'a> {
+    /// A stopwatch on `clock`, its first lap starting now.
     pub fn new(clock: Clock<'a>) -> Self {
         Self {
             clock,

@@ -22,13 +22,16 @@ const TIE: f64 = 1e-9;
 /// A point estimate with its 95% interval.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Estimate {
+    /// The point estimate.
     pub value: f64,
+    /// Its 95% interval.
     pub ci95: [f64; 2],
 }
 
 /// How scores are aggregated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Aggregate {
+    /// The mean.
     Mean,
     /// The interquartile mean.
     Iqm,

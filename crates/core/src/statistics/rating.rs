@@ -15,7 +15,9 @@ pub const PRIOR_SD: f64 = 3.0;
 /// Successes out of trials for every judge on every level.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Outcomes {
+    /// How many judges.
     pub judges: usize,
+    /// How many levels.
     pub levels: usize,
     /// `[judge * levels + level]`: runs that succeeded...
     pub successes: Vec<u32>,
@@ -24,6 +26,7 @@ pub struct Outcomes {
 }
 
 impl Outcomes {
+    /// No runs yet: every judge has 0 trials on every level.
     pub fn new(judges: usize, levels: usize) -> Self {
         Self {
             judges,
@@ -33,6 +36,7 @@ impl Outcomes {
         }
     }
 
+    /// Records a judge's runs on a level (successes capped at trials).
     pub fn set(&mut self, judge: usize, level: usize, successes: u32, trials: u32) {
         let k = judge * self.levels + level;
         self.successes[k] = successes.min(trials);

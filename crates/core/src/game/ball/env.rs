@@ -54,7 +54,9 @@ pub const OBSERVATION_SIZE: usize = 13;
 /// One decision: push the ball along the world's x and z (each in [-1, 1]), and hop.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct BallAction {
+    /// The push along the world's x and z, each in [-1, 1].
     pub push: [f32; 2],
+    /// Hop (only from the ground).
     pub hop: bool,
 }
 
@@ -338,6 +340,7 @@ pub struct BallPusher {
 }
 
 impl BallPusher {
+    /// A pusher of this skill, its misjudgements drawn from `seed`.
     pub fn new(seed: u64, skill: Skill) -> Self {
         let error = match skill {
             Skill::Novice => 0.3,

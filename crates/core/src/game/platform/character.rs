@@ -18,7 +18,9 @@ pub struct Body {
     pub jump_speed: f32,
     /// Gravity, m/s².
     pub gravity: f32,
+    /// Horizontal acceleration toward the commanded velocity on the ground, m/s².
     pub ground_accel: f32,
+    /// Horizontal acceleration in the air (air control), m/s².
     pub air_accel: f32,
     /// Fastest turn, degrees per second.
     pub turn_rate_deg: f32,
@@ -97,14 +99,18 @@ impl PlatformAction {
 pub struct Character {
     /// The bottom of the capsule (the feet).
     pub feet: Vector,
+    /// Velocity, m/s.
     pub velocity: Vector,
     /// Facing, radians about +Y (0 along +X).
     pub yaw: f32,
+    /// Whether the character is on the ground.
     pub grounded: bool,
+    /// The abilities it moves with.
     pub body: Body,
 }
 
 impl Character {
+    /// A character standing still at `feet`, facing `yaw` (radians).
     pub fn new(feet: Vector, yaw: f32, body: Body) -> Self {
         Self {
             feet,

@@ -257,10 +257,12 @@ impl PlatformEnv {
         out
     }
 
+    /// The character as it stands now.
     pub fn character(&self) -> &Character {
         &self.character
     }
 
+    /// The blocks the run plays on.
     pub fn world(&self) -> &PlatformWorld {
         &self.world
     }
@@ -275,10 +277,12 @@ impl PlatformEnv {
         self.furthest as f64 / (self.world.platforms().len() - 1).max(1) as f64
     }
 
+    /// Decisions taken so far.
     pub fn steps(&self) -> u32 {
         self.steps
     }
 
+    /// How the run ended, once it has.
     pub fn outcome(&self) -> Option<Outcome> {
         self.outcome
     }

@@ -172,8 +172,11 @@ pub fn observe(
 /// A platform track the Generator is building toward its goal, within its block budget.
 #[derive(Debug, Clone)]
 pub struct PlatformBuild {
+    /// The blocks placed so far.
     pub track: PlatformTrack,
+    /// The goal the track leads to, m.
     pub goal: [f64; 3],
+    /// The block budget: the most blocks the Generator may place.
     pub max_blocks: usize,
     /// Who the track is for: its jumps keep within the player's reach...
     pub player: Player,

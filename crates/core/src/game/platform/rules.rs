@@ -55,7 +55,9 @@ pub fn goal_and_start(seed: u64, goal: Option<[f64; 3]>) -> ([f64; 3], Start, Ch
     "the rules found no valid level toward goal {goal:?} in {ATTEMPTS} attempts of at most {max_blocks} blocks"
 )]
 pub struct NoLevel {
+    /// The goal the rules aimed at, m.
     pub goal: [f64; 3],
+    /// The most blocks a level may have.
     pub max_blocks: u32,
 }
 

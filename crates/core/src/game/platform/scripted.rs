@@ -27,6 +27,7 @@ pub struct ControllerSkill {
 }
 
 impl ControllerSkill {
+    /// What `skill` means to the controller.
     pub fn of(skill: Skill) -> Self {
         let (takeoff_jitter, speed_error) = match skill {
             Skill::Novice => (1.5, 0.3),

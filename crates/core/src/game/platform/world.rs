@@ -28,6 +28,7 @@ pub struct PlatformBox {
     pub top: Vector,
     /// Heading in radians.
     pub heading: f32,
+    /// Side of the top face, m.
     pub size: f32,
 }
 
@@ -109,6 +110,7 @@ impl PlatformWorld {
         self.platforms.push(block);
     }
 
+    /// The blocks, start block first.
     pub fn platforms(&self) -> &[PlatformBox] {
         &self.platforms
     }

@@ -30,7 +30,9 @@ const WHEELS: [[f32; 3]; 4] = [
     [-1.3, -0.2, -0.85],
     [-1.3, -0.2, 0.85],
 ];
+/// Wheel radius, m.
 pub const WHEEL_RADIUS: f32 = 0.35;
+/// Suspension rest length, m.
 pub const SUSPENSION_REST: f32 = 0.35;
 
 /// The car's abilities as the simulation steps with them (from a [`CarProfile`]).
@@ -360,14 +362,17 @@ impl RacingWorld {
         self.body().translation()
     }
 
+    /// The chassis's orientation.
     pub fn rotation(&self) -> Rotation {
         *self.body().rotation()
     }
 
+    /// The chassis's velocity, m/s.
     pub fn velocity(&self) -> Vector {
         self.body().linvel()
     }
 
+    /// The chassis's angular velocity, radians per second.
     pub fn angular_velocity(&self) -> Vector {
         self.body().angvel()
     }

@@ -296,10 +296,12 @@ impl RacingEnv {
         hits
     }
 
+    /// The road the run drives.
     pub fn road(&self) -> &Road {
         &self.road
     }
 
+    /// The physics world: the road, the obstacles and the car.
     pub fn world(&self) -> &RacingWorld {
         &self.world
     }
@@ -319,6 +321,7 @@ impl RacingEnv {
         (self.along / self.road.length()).clamp(0.0, 1.0)
     }
 
+    /// Decisions taken so far.
     pub fn steps(&self) -> u32 {
         self.steps
     }
@@ -328,6 +331,7 @@ impl RacingEnv {
         self.air_steps
     }
 
+    /// How the run ended, once it has.
     pub fn outcome(&self) -> Option<Outcome> {
         self.outcome
     }

@@ -34,6 +34,7 @@ pub fn test_track(lead: usize, middle: &[SegmentParams]) -> RacingTrack {
 /// How one measured run went.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DriveOutcome {
+    /// How the run ended.
     pub outcome: Outcome,
     /// Seconds in the air.
     pub air_s: f32,

@@ -112,9 +112,13 @@ pub fn segment_from_action(
 /// within its segment budget.
 #[derive(Debug, Clone)]
 pub struct RacingBuild {
+    /// The segments and obstacles so far.
     pub track: RacingTrack,
+    /// The road the segments so far make.
     pub road: Road,
+    /// The goal the road leads to, m.
     pub goal: [f64; 3],
+    /// The segment budget: the most segments the Generator may place.
     pub max_segments: usize,
     /// See [`segment_from_action`].
     pub curve_offset: f64,

@@ -33,7 +33,9 @@ const ATTEMPTS: usize = 200;
     "the rules found no valid track toward goal {goal:?} in {ATTEMPTS} attempts of at most {max_segments} segments"
 )]
 pub struct NoTrack {
+    /// The goal the rules aimed at, m.
     pub goal: [f64; 3],
+    /// The most segments a track may have.
     pub max_segments: u32,
 }
 

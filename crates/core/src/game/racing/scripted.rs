@@ -29,6 +29,7 @@ pub struct DriverSkill {
 }
 
 impl DriverSkill {
+    /// What `skill` means to the driver.
     pub fn of(skill: Skill) -> Self {
         let (grip_share, steer_wobble) = match skill {
             Skill::Novice => (1.5, 0.25),

@@ -8,6 +8,7 @@ use crate::level::scene::{Physics, Scene};
 
 /// The glTF physics extensions written (Godot 4 reads them; other tools keep or ignore them).
 pub const OMI_BODY: &str = "OMI_physics_body";
+/// The shapes' extension.
 pub const OMI_SHAPE: &str = "OMI_physics_shape";
 
 /// An `OMI_physics_shape` cylinder: `radiusBottom` and `radiusTop` as the current

@@ -48,7 +48,9 @@ pub struct CarProfile {
 /// A player's abilities, of the kind its game has ([`PlayerKind`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Abilities {
+    /// A platform character's abilities.
     Character(CharacterProfile),
+    /// A racing car's abilities.
     Car(CarProfile),
 }
 

@@ -1,3 +1,6 @@
+//! The `arlpcg` command: checks the arguments are UTF-8, parses them and runs the subcommand
+//! (src/shells), with mimalloc as the allocator.
+
 use std::process::ExitCode;
 
 use clap::Parser;

@@ -16,9 +16,19 @@ use arlpcg_core::level::stats::{Rating, SolverStats};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Check {
     /// The success ratio's 95% interval meets [lo, hi].
-    Success { low: f64, high: f64 },
+    Success {
+        /// The interval's low end.
+        low: f64,
+        /// The interval's high end.
+        high: f64,
+    },
     /// The panel rating's 95% interval of b meets [lo, hi].
-    B { low: f64, high: f64 },
+    B {
+        /// The interval's low end.
+        low: f64,
+        /// The interval's high end.
+        high: f64,
+    },
     /// Some run completed the level.
     Completed,
 }

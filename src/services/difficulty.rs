@@ -33,15 +33,17 @@ pub const SCREEN_TRIALS: u32 = 20;
 pub const CURVE_AUX: [f64; 9] = [1.0, 0.75, 0.5, 0.25, 0.0, -0.25, -0.5, -0.75, -1.0];
 /// Levels per λ and runs per level when measuring the curve.
 pub const CURVE_LEVELS: u32 = 8;
+/// Runs per level when measuring the curve.
 pub const CURVE_TRIALS: u32 = 20;
 
 /// Mean success ratio of a Solver on a Generator's levels at each λ of [`CURVE_AUX`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Curve {
-    /// SHA-256 of the Generator and of the Solver it was measured with (for the scripted
-    /// player, its judge name: `scripted-median`).
+    /// SHA-256 of the Generator.
     pub generator_sha256: String,
+    /// SHA-256 of the Solver it was measured with (for the scripted player, its judge name:
+    /// `scripted-median`).
     pub solver_sha256: String,
     /// SHA-256 of the profile its levels were made for (none: the built-in game).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -80,25 +82,33 @@ impl Curve {
 /// Why no level was found.
 #[derive(Debug, thiserror::Error)]
 pub enum TargetError {
+    /// No candidate came within the band of the target.
     #[error(
         "no level within ±{BAND} of success {target} in {MAX_CANDIDATES} candidates (closest: {closest:.2} at λ {aux:+.2}){}",
         set_aside(*.uncompleted, *.unbuilt)
     )]
     Missed {
+        /// The success asked for.
         target: f64,
+        /// The closest success measured.
         closest: f64,
+        /// The λ of that closest candidate.
         aux: f64,
         /// Candidates within the band that no run completed: never kept.
         uncompleted: u32,
         /// Draws that did not reach the goal within the piece budget.
         unbuilt: u32,
     },
+    /// Stopped while the curve was measured.
     #[error("stopped while the λ→success curve was measured")]
     Stopped,
+    /// Stopped while a level was searched.
     #[error("stopped while a level was searched")]
     SearchStopped,
+    /// The Generator built no level.
     #[error(transparent)]
     Generation(#[from] GenerationError),
+    /// A Solver policy of another game than the level's.
     #[error(transparent)]
     WrongGame(#[from] WrongGame),
 }

@@ -10,7 +10,9 @@ use anyhow::{Context, Result, bail};
 /// Whether an existing file may be replaced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Overwrite {
+    /// Refuse to replace an existing file.
     Never,
+    /// Replace an existing file.
     Allowed,
 }
 
@@ -94,6 +96,7 @@ pub struct FileBatch {
 }
 
 impl FileBatch {
+    /// An empty batch.
     pub fn new() -> Self {
         Self::default()
     }
@@ -113,6 +116,7 @@ impl FileBatch {
         self.staged.len()
     }
 
+    /// Whether nothing is staged.
     pub fn is_empty(&self) -> bool {
         self.staged.is_empty()
     }

@@ -24,7 +24,9 @@ use std::fmt;
 /// pacing).
 #[derive(Debug, Clone, PartialEq)]
 pub enum AuxAsk {
+    /// One λ for the whole level.
     Flat(f64),
+    /// λ along the level.
     Curve(AuxCurve),
 }
 
@@ -57,8 +59,11 @@ impl fmt::Display for AuxAsk {
 /// that `difficulty::level_for` searches λ for.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Ask {
+    /// One λ (`--aux`).
     Aux(f64),
+    /// A curve of λ along the level (`--aux-curve`).
     Curve(AuxCurve),
+    /// A success rate to search λ for (`--target-success`).
     Success(f64),
 }
 
@@ -94,6 +99,7 @@ impl Ask {
 /// what the seed would otherwise draw.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LevelRequest {
+    /// The seed the goal and the Generator's samples are drawn from.
     pub seed: u64,
     /// λ; none for rule levels that record none (a Generator then builds at λ = 0).
     pub aux: Option<AuxAsk>,
@@ -114,8 +120,11 @@ pub struct LevelRequest {
 /// The first `pieces` pieces of `level`, read from the file `from` (`generate --keep`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct KeptPrefix {
+    /// The level the pieces come from.
     pub level: std::sync::Arc<Level>,
+    /// How many pieces to keep.
     pub pieces: usize,
+    /// The level file, pinned by its hash.
     pub from: PolicyRef,
 }
 
@@ -133,18 +142,22 @@ impl LevelRequest {
         }
     }
 
+    /// The same request toward `goal` (none: drawn from the seed).
     pub fn goal(self, goal: Option<[f64; 3]>) -> Self {
         Self { goal, ..self }
     }
 
+    /// The same request with `obstacles` obstacles.
     pub fn obstacles(self, obstacles: u32) -> Self {
         Self { obstacles, ..self }
     }
 
+    /// The same request for valid level `draw` of the seed's stream.
     pub fn draw(self, draw: u32) -> Self {
         Self { draw, ..self }
     }
 
+    /// The same request continuing after `keep`'s pieces.
     pub fn keep(self, keep: KeptPrefix) -> Self {
         Self {
             keep: Some(keep),
@@ -157,6 +170,7 @@ impl LevelRequest {
         Self { profile, ..self }
     }
 
+    /// The same request at `aux`.
     pub fn aux(self, aux: AuxAsk) -> Self {
         Self {
             aux: Some(aux),
@@ -205,8 +219,11 @@ pub const ATTEMPTS: usize = 64;
 pub struct GeneratorPolicy {
     /// The game it builds levels of.
     pub game: Game,
+    /// The network.
     pub policy: ActorCritic,
+    /// Its observation normalizer.
     pub normalizer: RunningNorm,
+    /// The policy file, pinned by its hash.
     pub reference: PolicyRef,
     /// The piece budget and curve offset it was trained with.
     pub limits: BuildLimits,
@@ -215,12 +232,23 @@ pub struct GeneratorPolicy {
 /// Why the Generator built no level.
 #[derive(Debug, thiserror::Error)]
 pub enum GenerationError {
+    /// No attempt built a valid level.
     #[error(
         "the Generator built no valid level toward goal {goal:?} at aux {aux_ask} in {ATTEMPTS} attempts (each overlapped or crossed itself, hit an obstacle or ran out of pieces); try another seed or goal"
     )]
-    NoLevel { goal: [f64; 3], aux_ask: String },
+    NoLevel {
+        /// The goal, m.
+        goal: [f64; 3],
+        /// The λ asked for, in words.
+        aux_ask: String,
+    },
+    /// The kept pieces cannot start this Generator's level.
     #[error("cannot keep that prefix: {problem}")]
-    Keep { problem: String },
+    Keep {
+        /// Why, in words.
+        problem: String,
+    },
+    /// The network failed.
     #[error("the Generator's network failed: {0}")]
     Network(#[from] candle_core::Error),
 }

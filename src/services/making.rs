@@ -66,17 +66,24 @@ pub enum Proof<'a> {
     /// Played `trials` times (runs seeded from the level's seed); a draw that no run completes
     /// is replaced as `redraw` says.
     Played {
+        /// Who plays.
         solver: &'a Solver<'a>,
+        /// Runs per draw.
         trials: u32,
+        /// What happens to a draw that no run completed.
         redraw: Redraw,
     },
     /// Searched until its success for `solver` over `trials` runs lies within
     /// [`difficulty::BAND`] of `target`, from the λ `curve` gives for it
     /// ([`difficulty::level_for`]); needs a Generator.
     Target {
+        /// Whose success is searched for.
         solver: &'a Solver<'a>,
+        /// The Generator's λ→success curve for that Solver.
         curve: &'a Curve,
+        /// The success asked for.
         target: f64,
+        /// Runs per candidate.
         trials: u32,
     },
 }

@@ -34,6 +34,7 @@ impl Judge {
         Judge::Scripted(Skill::Expert),
     ];
 
+    /// The judge's name in files and on the command line (`arlpcg`, `scripted-median`, ...).
     pub fn name(self) -> String {
         match self {
             Judge::Solver(mode) => mode.name().to_string(),
@@ -58,6 +59,7 @@ impl Judge {
 
 /// The judges of a panel, ready to play.
 pub struct JudgePanel {
+    /// Each judge with its Solver policy (none for the scripted player), in order.
     pub judges: Vec<(Judge, Option<SolverPolicy>)>,
     /// The folder's ability-aware Solver, which plays for the ARLPCG judge under a profile whose
     /// abilities that judge's Solver did not train with ([`SolverPolicy::or_aware`]).
@@ -77,6 +79,7 @@ impl JudgePanel {
         }
     }
 
+    /// The judges' names, in order.
     pub fn names(&self) -> Vec<String> {
         self.judges.iter().map(|(j, _)| j.name()).collect()
     }

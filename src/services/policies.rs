@@ -21,6 +21,7 @@ use arlpcg_core::rl::policy::ActorCritic;
 
 /// File names inside a policies folder.
 pub const GENERATOR_FILE: &str = "generator.safetensors";
+/// The Solver's file name inside a policies folder.
 pub const SOLVER_FILE: &str = "solver.safetensors";
 /// An ability-aware Solver beside a folder's Solver: it plays where a profile's abilities differ
 /// from those `solver.safetensors` trained with ([`SolverPolicy::or_aware`]).

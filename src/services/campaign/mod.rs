@@ -106,8 +106,11 @@ pub fn level_stem(k: usize, n: usize) -> String {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Campaign {
+    /// Always [`FORMAT`].
     pub format: String,
+    /// The record's format version.
     pub version: u32,
+    /// The game.
     pub game: Game,
     /// Level `k` is searched from seed `seed + k`.
     pub seed: u64,
@@ -115,6 +118,7 @@ pub struct Campaign {
     pub judge: String,
     /// Runs per level, for the judge and for each judge of the panel.
     pub trials: u32,
+    /// The judge's success asked for along the campaign.
     pub ramp: Ramp,
     /// The shape of λ along each level (pacing), moved as a whole by each level's search.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -125,12 +129,14 @@ pub struct Campaign {
     /// Acceptance checks every level must pass (`verify --campaign` applies them).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub checks: Vec<Check>,
+    /// The player population the levels are judged for.
     pub population: Population,
     /// `scripted judges`: the population's 10th, 50th and 90th percentiles of θ are the
     /// scripted novice's, median's and expert's; `given`: as asked for.
     pub population_from: String,
     /// Each judge's ability θ from the panel's rating of these levels, logits.
     pub judges_theta: Vec<JudgeTheta>,
+    /// The levels, in campaign order.
     pub levels: Vec<CampaignLevel>,
 }
 
@@ -138,7 +144,9 @@ pub struct Campaign {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct JudgeTheta {
+    /// The judge's name.
     pub judge: String,
+    /// Its ability θ, logits.
     pub theta: f64,
 }
 
@@ -151,19 +159,23 @@ pub struct CampaignLevel {
     /// The seed its search and its runs started from (campaign seed + the level's place in the
     /// search, before [`order_by_difficulty`]; seed + n + d for the d-th level drawn anew).
     pub seed: u64,
+    /// Its place in the campaign: 0 the first level, 1 the last.
     pub position: f64,
     /// The judge's success asked for by the ramp.
     pub asked: f64,
     /// The judge's success measured, with its 95% interval.
     pub measured: f64,
+    /// The 95% interval of `measured`.
     pub ci95: [f64; 2],
     /// The λ the level was built at, or its curve of λ (with `pacing`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub aux: Option<f64>,
+    /// The curve of λ the level was built along (with `pacing`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub aux_curve: Option<AuxCurve>,
     /// Difficulty on the panel's scale, logits, with its 95% interval.
     pub b: f64,
+    /// The 95% interval of `b`.
     pub b_ci95: [f64; 2],
     /// How the population fares on it.
     pub players: LevelFlow,
@@ -173,7 +185,10 @@ pub struct CampaignLevel {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum PopulationAsk {
     /// From the scripted judges' θ (10th, 50th, 90th percentiles), with this retry chance.
-    ScriptedJudges { retry: f64 },
+    ScriptedJudges {
+        /// The chance a player tries a failed level again (else quits).
+        retry: f64,
+    },
     /// As given.
     Given(Population),
 }
@@ -181,14 +196,23 @@ pub enum PopulationAsk {
 /// What a campaign was asked for.
 #[derive(Debug, Clone)]
 pub struct CampaignAsk {
+    /// The game.
     pub game: Game,
+    /// Level `k` is searched from seed `seed + k`.
     pub seed: u64,
+    /// The judge whose success the ramp asks for.
     pub judge: String,
+    /// Runs per level, for the judge and for each judge of the panel.
     pub trials: u32,
+    /// The judge's success asked for along the campaign.
     pub ramp: Ramp,
+    /// The shape of λ along each level, if any.
     pub pacing: Option<AuxCurve>,
+    /// The game profile the levels are made for (none: the built-in one).
     pub profile: Option<Profile>,
+    /// Acceptance checks every level must pass.
     pub checks: Vec<Check>,
+    /// How the player population is set.
     pub population: PopulationAsk,
 }
 

@@ -26,16 +26,22 @@ const PALETTE: [[u8; 3]; 6] = [
 /// One named line of points (x, y); NaN points are skipped (the line breaks there).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Series {
+    /// The line's name, in the legend.
     pub name: String,
+    /// Its points.
     pub points: Vec<(f64, f64)>,
 }
 
 /// A line chart.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LineChart {
+    /// The chart's title.
     pub title: String,
+    /// The x axis's label.
     pub x_label: String,
+    /// The y axis's label.
     pub y_label: String,
+    /// The lines.
     pub series: Vec<Series>,
     /// Fixed y range; by default the data's range.
     pub y_range: Option<(f64, f64)>,

@@ -81,10 +81,13 @@ pub fn is_rule_level(level: &Level) -> bool {
 
 /// The levels of an evaluation and its layout.
 pub struct Levels {
+    /// The Generator's levels at each λ of [`AUX_VALUES`].
     pub by_aux: Vec<Vec<Level>>,
     /// The same goals at each λ of [`KNOB_BETWEEN`].
     pub between: Vec<Vec<Level>>,
+    /// The validation set: its rule levels first, then the Generator's.
     pub validation: Vec<Level>,
+    /// The evaluation's layout: what it plays.
     pub layout: PlayLayout,
 }
 

@@ -30,16 +30,21 @@ const MOST_TRIALS: u32 = 10_000;
 /// One shard's raw results: enough to rebuild the tables with the other shards.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Part {
+    /// Always `arlpcg-eval-part`.
     pub format: String,
+    /// The part's format version.
     pub version: u32,
     /// The arlpcg version that played it.
     pub arlpcg: String,
     /// This shard's index and the shard count.
     pub shard: [u64; 2],
+    /// How much the whole evaluation plays.
     pub budget: Budget,
+    /// The Generator whose levels are played.
     pub generator: PolicyRef,
     /// Each judge's name and Solver file (none for the scripted player), in table order.
     pub solvers: Vec<(String, Option<PolicyRef>)>,
+    /// What every shard plays.
     pub layout: PlayLayout,
     /// (play index, its statistics) for this shard's plays.
     pub plays: Vec<(usize, SolverStats)>,

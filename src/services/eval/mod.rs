@@ -79,6 +79,7 @@ impl Budget {
 pub struct NamedSolver<'a> {
     /// The judge's name: a trained Solver's mode, or `scripted-<skill>`.
     pub mode: String,
+    /// The player.
     pub solver: Solver<'a>,
 }
 

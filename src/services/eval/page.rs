@@ -12,6 +12,7 @@ use crate::services::campaign::Campaign;
 
 /// What the page shows of one game.
 pub struct GamePage {
+    /// The game.
     pub game: Game,
     /// The shipped policies' cards, in the order of their table: the ARLPCG Generator first.
     pub cards: Vec<(String, PolicyCard)>,

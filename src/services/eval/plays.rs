@@ -16,6 +16,7 @@ use super::{Budget, Levels, NamedSolver};
 /// evaluation can be played apart and merged.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct PlayLayout {
+    /// The game.
     pub game: Game,
     /// Levels per λ of [`AUX_VALUES`] (the Generator may build fewer than the budget asks).
     pub levels_per_aux: Vec<usize>,
@@ -36,15 +37,33 @@ pub struct PlayLayout {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Play {
     /// The ARLPCG Solver on level `level` at λ number `aux`.
-    Controllability { aux: usize, level: usize },
+    Controllability {
+        /// The λ's index.
+        aux: usize,
+        /// The level's index at that λ.
+        level: usize,
+    },
     /// The ARLPCG Solver on level `level` at λ number `aux` of the knob's in-between values.
-    Knob { aux: usize, level: usize },
+    Knob {
+        /// The λ's index among the in-between values.
+        aux: usize,
+        /// The level's index at that λ.
+        level: usize,
+    },
     /// Solver `solver` on validation level `level`.
-    Generalization { solver: usize, level: usize },
+    Generalization {
+        /// The Solver's index.
+        solver: usize,
+        /// The level's index in the validation set.
+        level: usize,
+    },
     /// Solver `solver` on level `level` at λ number `aux`.
     Cross {
+        /// The Solver's index.
         solver: usize,
+        /// The λ's index.
         aux: usize,
+        /// The level's index at that λ.
         level: usize,
     },
 }

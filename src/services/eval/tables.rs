@@ -11,11 +11,16 @@ use arlpcg_core::level::stats::SolverStats;
 
 use super::{AUX_VALUES, Budget, KNOB_BETWEEN, Play, PlayLayout};
 
+/// One row of the controllability table: the ARLPCG Solver on the Generator's levels at one λ.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct ControllabilityRow {
+    /// λ.
     pub aux: f64,
+    /// Mean over levels of each level's success ratio.
     pub success_ratio: f64,
+    /// Standard deviation over levels of the success ratio.
     pub success_std: f64,
+    /// Fraction of levels completed by at least one run.
     pub completed_by_any: f64,
     /// The pieces' mean parameters, named by the game's piece columns (`avg_block_distance`, ...).
     #[serde(flatten)]
@@ -26,6 +31,7 @@ pub struct ControllabilityRow {
     /// Where the failures are ([`PieceFailures`]; absent from results written before).
     #[serde(default, flatten, skip_serializing_if = "Option::is_none")]
     pub failures: Option<PieceFailures>,
+    /// Levels played at this λ.
     pub tracks: usize,
 }
 
@@ -77,23 +83,31 @@ impl PieceFailures {
     }
 }
 
+/// One row of the generalization table: one Solver on the validation set.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct GeneralizationRow {
+    /// The Solver's training mode.
     pub mode: String,
+    /// Mean over levels of each level's success ratio.
     pub success_ratio: f64,
     /// Mean success on the validation set's rule levels (no Solver trained on these)...
     pub success_rule_levels: f64,
     /// ...and on its Generator levels (the ARLPCG Solver's own training distribution).
     pub success_generator_levels: f64,
+    /// Standard deviation over levels of the success ratio.
     pub success_std: f64,
+    /// Fraction of levels completed by at least one run.
     pub completed_by_any: f64,
     /// Mean decisions of the successful runs.
     pub avg_steps: f64,
+    /// Levels played.
     pub tracks: usize,
 }
 
+/// One row of the cross table: one Solver on the Generator's levels at each λ.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct CrossRow {
+    /// The Solver's training mode.
     pub mode: String,
     /// Success ratio at each λ of [`AUX_VALUES`], in that order.
     pub success_ratio: Vec<f64>,
@@ -177,10 +191,15 @@ pub struct Results {
     /// results.json, whose folder names the game: [`Results::read`] sets it.
     #[serde(skip, default = "unread_game")]
     pub game: Game,
+    /// How much was evaluated.
     pub budget: Budget,
+    /// The Generator's policy file.
     pub generator: String,
+    /// The controllability table, a row per λ.
     pub controllability: Vec<ControllabilityRow>,
+    /// The generalization table, a row per Solver.
     pub generalization: Vec<GeneralizationRow>,
+    /// The cross table, a row per Solver.
     pub cross: Vec<CrossRow>,
     /// Every judge (trained Solvers and the scripted player's skills) at every λ.
     pub controllability_by_judge: Vec<JudgeRow>,

@@ -29,10 +29,15 @@ const GOLDEN_AUX: f32 = -1.0;
 /// A Solver's run, decision by decision.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GoldenEpisode {
+    /// Always `arlpcg-golden-episode`.
     pub format: String,
+    /// The file's format version.
     pub version: u32,
+    /// The game the policy plays.
     pub game: String,
+    /// The policy's role (`solver`, `generator`).
     pub role: String,
+    /// The policy file that played.
     pub policy: PolicyRef,
     /// The level played (a Generator's: the level it built), as its YAML file.
     pub level: String,
@@ -43,6 +48,7 @@ pub struct GoldenEpisode {
     pub run_seed: u64,
     /// How the run ended.
     pub outcome: String,
+    /// Each decision, in order.
     pub frames: Vec<GoldenFrame>,
 }
 

@@ -59,6 +59,7 @@ pub enum Contract {
 }
 
 impl Contract {
+    /// The contract's name on the command line and in sidecars (`plain`, `mlagents`).
     pub fn name(self) -> &'static str {
         match self {
             Contract::Plain => "plain",
@@ -78,37 +79,52 @@ impl Contract {
 /// What the sidecar says about the graph: enough to wire it into a game without this tool.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Sidecar {
+    /// Always `arlpcg-onnx`.
     pub format: String,
+    /// The sidecar's format version.
     pub version: u32,
     /// The contract (the field's name predates the word; files keep it).
     pub profile: Contract,
+    /// The ONNX operator set the graph uses ([`OPSET`]).
     pub opset: i64,
+    /// The game the policy plays.
     pub game: String,
+    /// The policy's role (`solver`, `generator`).
     pub role: String,
     /// The policy file the graph was made from.
     pub policy: PolicyRef,
+    /// How the policy was trained.
     pub training: SidecarTraining,
+    /// The graph's inputs.
     pub inputs: Vec<Port>,
+    /// The graph's outputs.
     pub outputs: Vec<Port>,
     /// Observation rows (raw, as the game produces them) and what this tool computes for them,
     /// output by output.
     pub examples: Examples,
 }
 
+/// How the policy was trained, from its card.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SidecarTraining {
+    /// The training mode (`rule-pcg`, `arlpcg`, ...).
     pub mode: String,
+    /// Environment steps trained.
     pub steps: u64,
+    /// The run's seed.
     pub seed: u64,
+    /// The command that started the run.
     pub command: String,
 }
 
 /// One input or output of the graph.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Port {
+    /// The name in the graph.
     pub name: String,
     /// `"batch"` for the rows, else a size.
     pub shape: Vec<serde_json::Value>,
+    /// What it holds, in words.
     pub meaning: String,
     /// The elements' type where they are not 32-bit floats (`int64`: ML-Agents' discrete
     /// actions).
@@ -122,8 +138,11 @@ pub struct Port {
 /// A named run of columns: `width` of them from `offset`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Columns {
+    /// The part's name.
     pub name: String,
+    /// Its first column.
     pub offset: usize,
+    /// How many columns.
     pub width: usize,
     /// How an observation part is computed (frame, scale, sign, order), for a port of it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -147,15 +166,20 @@ fn columns(named: impl IntoIterator<Item = (String, usize)>) -> Vec<Columns> {
         .collect()
 }
 
+/// Example rows and this tool's outputs for them, to check a runtime against.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Examples {
+    /// Observation rows, raw.
     pub observations: Vec<Vec<f32>>,
+    /// Each output's rows for them, by output name.
     pub outputs: std::collections::BTreeMap<String, Vec<Vec<f32>>>,
 }
 
 /// The graph's bytes and its sidecar.
 pub struct Exported {
+    /// The ONNX model's bytes.
     pub onnx: Vec<u8>,
+    /// Its sidecar.
     pub sidecar: Sidecar,
 }
 

@@ -50,7 +50,9 @@ type ScriptedPlayer<G> = (Skill, <G as arlpcg_core::game::GameSpec>::Scripted);
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Phase {
+    /// The Solver is learning.
     Solver,
+    /// The Generator is learning.
     Generator,
 }
 
@@ -59,6 +61,7 @@ pub enum Phase {
 pub struct AdversarialState {
     /// Matches started so far (each gets its own seed).
     pub episodes_started: u64,
+    /// Which agent is learning.
     pub phase: Phase,
     /// Steps the learning agent has learned from in the current phase.
     pub phase_steps: u64,
@@ -91,9 +94,11 @@ impl Default for AdversarialState {
 pub struct MatchRules {
     /// λ is drawn uniformly from these for each match.
     pub aux_values: Vec<f32>,
+    /// The Generator's piece budget and curve offset.
     pub limits: BuildLimits,
     /// Obstacles drawn into each racing match's scene.
     pub obstacles: u32,
+    /// The Generator's reward terms.
     pub rewards: GeneratorRewards,
     /// The share of matches a snapshot plays (`None`: uniform over the current Solver and the
     /// snapshots).
@@ -110,7 +115,9 @@ pub struct MatchRules {
 
 /// The Generator with its optimizer and normalizer.
 pub struct Generator {
+    /// The Generator's learner.
     pub ppo: Ppo,
+    /// Its observation normalizer.
     pub norm: RunningNorm,
 }
 
@@ -130,21 +137,29 @@ struct Decision {
 /// Episode statistics since they were last taken, split by the sign of λ.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct MatchStats {
+    /// Matches ended.
     pub episodes: u32,
+    /// Matches ended without a valid level.
     pub invalid: u32,
+    /// Sum of the Generator's returns over the ended matches.
     pub generator_return_sum: f64,
     /// [easy (λ > 0), hard (λ < 0)]: finished (valid) matches, Solver successes, pieces placed,
     /// the sums of the pieces' two features (`GeneratorGame::PIECE_FEATURES`), and the Solver's
     /// steps in the air.
     pub judged: [u32; 2],
+    /// [easy, hard]: Solver successes.
     pub successes: [u32; 2],
+    /// [easy, hard]: pieces placed.
     pub pieces: [u32; 2],
+    /// [easy, hard]: the sums of the pieces' two features.
     pub feature_sums: [[f64; 2]; 2],
+    /// [easy, hard]: the Solver's steps in the air.
     pub air_steps: [u64; 2],
     /// [easy, hard]: the matches the scripted opponent finished, and its successes (counted
     /// apart: the finish's stops count the Solver's).
     #[serde(default)]
     pub scripted_judged: [u32; 2],
+    /// [easy, hard]: the scripted opponent's successes.
     #[serde(default)]
     pub scripted_successes: [u32; 2],
 }
@@ -154,14 +169,18 @@ pub struct AdversarialEnvs<G: GeneratorGame> {
     matches: Vec<Match<G>>,
     /// Per match, what it has been through.
     logs: Vec<MatchLog>,
+    /// The Generator, with its optimizer and normalizer.
     pub generator: Generator,
     /// Samples the Generator's actions and shuffles its minibatches.
     pub rng: ChaCha8Rng,
+    /// How matches are set up.
     pub rules: MatchRules,
+    /// Where the run stands: phase and counters.
     pub state: AdversarialState,
     /// Per match, the Generator decisions recorded while it learns (oldest first).
     recorded: Vec<Vec<Decision>>,
     generator_returns: Vec<f32>,
+    /// Match statistics since they were last taken.
     pub stats: MatchStats,
     /// Earlier Solvers, oldest first.
     pub population: Vec<Snapshot>,
@@ -246,6 +265,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         Ok(ended)
     }
 
+    /// Whether the Generator is the one learning.
     pub fn learning(&self) -> bool {
         self.state.phase == Phase::Generator
     }

@@ -46,6 +46,7 @@ pub(super) const CHECKPOINT: &str = "checkpoint.safetensors";
 /// `commands/train.rs`); it does not make a folder a run.
 pub const LOCK_FILE: &str = "train.lock";
 pub(super) const GENERATOR_CHECKPOINT: &str = "generator-checkpoint.safetensors";
+/// The run's metrics file, a row per iteration.
 pub const METRICS: &str = "metrics.csv";
 /// The key under which a checkpoint's `source` holds the episodes or matches under way
 /// ([`SourceRecord`], [`AdversarialRecord`]).
@@ -58,9 +59,13 @@ pub(super) const METRICS_HEADER: &str = "iteration,global_step,wall_time_s,steps
 /// configuration's when given.
 #[derive(Debug, Default, Clone, Copy)]
 pub struct RunAsk<'a> {
+    /// The configuration file (none: the game's defaults).
     pub config: Option<&'a Path>,
+    /// The seed, replacing the configuration's.
     pub seed: Option<u64>,
+    /// The step budget, replacing the configuration's.
     pub steps: Option<u64>,
+    /// The game profile to train for, replacing the configuration's.
     pub profile: Option<&'a Profile>,
     /// The share each main ability varies by (`ability_spread`).
     pub ability_spread: Option<f64>,
@@ -285,8 +290,12 @@ pub trait Training {
     /// `wall` is the clock the shell lends: the run's wall-clock seconds over every session,
     /// for the metrics' time columns.
     fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String>;
+    /// Minutes between checkpoints.
     fn checkpoint_minutes(&self) -> f64;
+    /// Writes the checkpoint, with `wall` the run's wall-clock seconds so far.
     fn save_checkpoint(&self, wall: f64) -> Result<()>;
+    /// Writes the policy files, with `wall` the run's wall-clock seconds so far.
     fn save_policies(&self, wall: f64) -> Result<()>;
+    /// The run's folder.
     fn out(&self) -> &Path;
 }

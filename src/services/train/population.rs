@@ -9,7 +9,9 @@ use arlpcg_core::rl::policy::ActorCritic;
 
 /// An earlier Solver that the Generator plays against.
 pub struct Snapshot {
+    /// The Solver's network.
     pub policy: ActorCritic,
+    /// Its observation normalizer.
     pub norm: RunningNorm,
     /// The Solver's steps when it was taken.
     pub solver_steps: u64,
@@ -38,12 +40,16 @@ impl Snapshot {
 /// `population.K.<variable>`, and this (its training state's `source`) holds the rest.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct PopulationRecord {
+    /// Each snapshot, oldest first.
     pub snapshots: Vec<SnapshotRecord>,
 }
 
+/// One snapshot as a checkpoint records it (its tensors apart).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SnapshotRecord {
+    /// The Solver's steps when it was taken.
     pub solver_steps: u64,
+    /// Its observation normalizer.
     pub norm: RunningNorm,
 }
 

@@ -35,6 +35,7 @@ pub enum SolverMode {
 }
 
 impl SolverMode {
+    /// The mode's name on the command line and in files (`rule-pcg`, `fixed-track`).
     pub fn name(self) -> &'static str {
         match self {
             SolverMode::RulePcg => "rule-pcg",
@@ -56,8 +57,10 @@ pub struct SourceState {
 /// environment, its episode under way (none, in checkpoints from before: episodes start afresh).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct SourceRecord {
+    /// The level source's progress.
     #[serde(flatten)]
     pub state: SourceState,
+    /// Per environment, its episode under way.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub under_way: Vec<EpisodeLog>,
 }
@@ -67,6 +70,7 @@ pub struct SourceRecord {
 pub struct EpisodeLog {
     /// The seed its rule level was made from.
     pub level_seed: u64,
+    /// The seed of the episode's reset.
     pub reset_seed: u64,
     /// The policy's action rows, one per step so far.
     pub rows: Vec<Vec<f32>>,

@@ -79,8 +79,11 @@ impl Solver<'_> {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("the Solver policy {policy} plays the {plays} game, but this is a {level} level")]
 pub struct WrongGame {
+    /// The policy file.
     pub policy: String,
+    /// The game it plays.
     pub plays: Game,
+    /// The level's game.
     pub level: Game,
 }
 
@@ -180,7 +183,9 @@ fn play_all<G: GameSpec>(
 /// One run recorded for display: where the player was at every step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Recording {
+    /// Where the player was at every step.
     pub path: Vec<[f32; 3]>,
+    /// How the run ended.
     pub result: TrialResult,
 }
 

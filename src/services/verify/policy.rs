@@ -10,8 +10,11 @@ use arlpcg_core::rl::policy::ActorCritic;
 pub struct SolverPolicy {
     /// The game it was trained for.
     pub game: Game,
+    /// The network.
     pub policy: ActorCritic,
+    /// Its observation normalizer.
     pub normalizer: RunningNorm,
+    /// The policy file, pinned by its hash.
     pub reference: PolicyRef,
     /// The game profile it trained for (none: the built-in game).
     pub profile: Option<Profile>,

@@ -7,6 +7,7 @@ use arlpcg_core::level::stats::SolverStats;
 /// Aggregates over many levels, as the paper's generalization table does.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Summary {
+    /// Levels summarized.
     pub levels: usize,
     /// Mean over levels of each level's success ratio.
     pub mean_success: f64,
@@ -14,12 +15,14 @@ pub struct Summary {
     pub std_success: f64,
     /// Fraction of levels completed by at least one run.
     pub completed_by_any: f64,
+    /// Mean over levels of the fraction of the track covered.
     pub mean_progress: f64,
     /// Mean decisions of successful runs (over levels with a success).
     pub mean_success_steps: f64,
 }
 
 impl Summary {
+    /// The summary of these levels' statistics.
     pub fn of(stats: &[SolverStats]) -> Self {
         let n = stats.len().max(1) as f64;
         let mean = |f: &dyn Fn(&SolverStats) -> f64| stats.iter().map(f).sum::<f64>() / n;
@@ -79,14 +82,20 @@ impl HalfwaySplit {
 /// stretch harder, as small shares of both.
 #[derive(Debug, Default, Clone, Copy, PartialEq)]
 pub struct FailureConcentration {
+    /// Failed runs, over all levels.
     pub failures: u64,
+    /// Of them, those on their level's last piece.
     pub on_last_piece: u64,
+    /// Of them, those on their level's most-failed piece.
     pub on_worst_piece: u64,
+    /// Levels added.
     pub levels: u64,
+    /// Pieces of those levels.
     pub pieces: u64,
 }
 
 impl FailureConcentration {
+    /// Adds one level's failures.
     pub fn add(&mut self, stats: &SolverStats) {
         let by_piece = &stats.failures_by_piece;
         self.failures += by_piece.iter().map(|&f| u64::from(f)).sum::<u64>();
@@ -103,6 +112,7 @@ impl FailureConcentration {
         })
     }
 
+    /// Mean pieces per level.
     pub fn pieces_per_level(&self) -> f64 {
         self.pieces as f64 / self.levels.max(1) as f64
     }

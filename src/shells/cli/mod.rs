@@ -21,6 +21,7 @@ use arlpcg_core::level::Game;
 use arlpcg_core::level::pacing::AuxCurve;
 use arlpcg_core::rl::checkpoint::TrainMode;
 
+/// The command line.
 #[derive(Debug, Parser)]
 #[command(
     name = "arlpcg",
@@ -42,10 +43,12 @@ use arlpcg_core::rl::checkpoint::TrainMode;
         arlpcg export levels/mine/platform_seed1.yaml --out level.glb"
 )]
 pub struct Cli {
+    /// The subcommand (none: the designer in a terminal, else this help).
     #[command(subcommand)]
     pub command: Option<Command>,
 }
 
+/// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Open the designer (the default without a subcommand): steer λ, generate, watch the
@@ -78,6 +81,7 @@ pub enum Command {
     Profile(ProfileCommand),
 }
 
+/// `profile`'s subcommands.
 #[derive(Debug, Subcommand)]
 #[command(after_help = "Examples:\n  \
     arlpcg profile init --game platform > hero.yaml\n  \
@@ -87,6 +91,7 @@ pub enum Command {
 pub enum ProfileCommand {
     /// Print a game's built-in profile (standard output), a comment per field with its range.
     Init {
+        /// Which game.
         #[arg(long, default_value = "platform", value_parser = parse_game)]
         game: Game,
     },
@@ -94,6 +99,7 @@ pub enum ProfileCommand {
     /// jump and reach table (platform), speed and grip (racing), and how many rule levels it
     /// completes. Exit 1 when the file is wrong or the expert completes under half the levels.
     Check {
+        /// The profile file (.yaml).
         file: PathBuf,
         /// Runs per rule level.
         #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=10_000))]
@@ -101,6 +107,7 @@ pub enum ProfileCommand {
     },
 }
 
+/// `report`'s arguments.
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     arlpcg report                      # writes docs/results.md\n  \
@@ -127,6 +134,7 @@ pub struct ReportArgs {
     pub curves: Vec<PathBuf>,
 }
 
+/// `design`'s arguments.
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     arlpcg design\n  \
@@ -155,6 +163,7 @@ pub struct DesignArgs {
     pub profile: Option<PathBuf>,
 }
 
+/// `eval`'s arguments.
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     arlpcg eval --policies policies/platform --out results/platform\n  \
@@ -229,6 +238,7 @@ pub enum FormatArg {
     Gltf,
 }
 
+/// `generate`'s arguments.
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("source").required(true).args(["rules", "policies"])))]
 pub struct GenerateArgs {
@@ -337,6 +347,7 @@ pub struct GenerateArgs {
     pub shard: Option<Shard>,
 }
 
+/// `export`'s arguments.
 #[derive(Debug, Args)]
 pub struct ExportArgs {
     /// The level file (.yaml).
@@ -354,6 +365,7 @@ pub struct ExportArgs {
     pub force: bool,
 }
 
+/// `export-policy`'s arguments.
 #[derive(Debug, Args)]
 #[command(
     after_help = "The graph takes raw observations (the normalizer is inside) and gives \
@@ -460,6 +472,7 @@ pub fn default_solver(game: Game) -> PathBuf {
     crate::services::policies::shipped_dir(game).join(crate::services::policies::SOLVER_FILE)
 }
 
+/// `verify`'s arguments.
 #[derive(Debug, Args)]
 pub struct VerifyArgs {
     /// Level files (.yaml).
@@ -521,6 +534,7 @@ pub struct VerifyArgs {
     pub campaign: Option<PathBuf>,
 }
 
+/// `campaign`'s arguments.
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     arlpcg campaign --game platform --levels 10 --ramp \"0:0.95, 1:0.5\" --judge scripted-median --out campaigns/first\n  \
@@ -593,6 +607,7 @@ pub struct CampaignArgs {
     pub resume: bool,
 }
 
+/// `train`'s arguments.
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     arlpcg train --game platform --mode arlpcg --seed 1 --out runs/platform-arlpcg-s1\n  \

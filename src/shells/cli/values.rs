@@ -10,7 +10,9 @@ use arlpcg_core::level::params;
 /// One of K equal shares of a batch (`--shard I/K`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Shard {
+    /// The share's index, from 0.
     pub index: u64,
+    /// How many shares.
     pub count: u64,
 }
 
@@ -33,7 +35,9 @@ pub(super) fn parse_target(s: &str) -> Result<f64, String> {
 /// `--keep LEVEL.yaml:K`: the level file and how many of its pieces to keep.
 #[derive(Debug, Clone, PartialEq)]
 pub struct KeepArg {
+    /// The level file.
     pub level: PathBuf,
+    /// How many of its pieces to keep.
     pub pieces: usize,
 }
 

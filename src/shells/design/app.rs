@@ -51,8 +51,11 @@ pub enum GoalSetting {
     /// Set by the designer: horizontal distance (m), height above the start (m), direction
     /// (degrees, the heading convention of level files).
     Custom {
+        /// Horizontal distance from the start, m.
         distance: f64,
+        /// Height above the start, m.
         height: f64,
+        /// Direction, degrees (the heading convention of level files).
         direction: f64,
     },
 }
@@ -77,16 +80,24 @@ impl GoalSetting {
 /// A prompt being typed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PromptKind {
+    /// The seed.
     Seed,
+    /// Solver trials per level.
     Trials,
+    /// A policies folder or policy file to load.
     Policies,
+    /// A target success rate.
     Target,
+    /// An aux curve.
     Curve,
+    /// A campaign folder to open.
     Campaign,
+    /// A game profile file to load.
     Profile,
 }
 
 impl PromptKind {
+    /// What the prompt asks for, in words.
     pub fn label(self) -> &'static str {
         match self {
             PromptKind::Seed => "seed",
@@ -107,12 +118,16 @@ pub enum Loading {
     #[default]
     Idle,
     /// Generation `id` is in flight; an older one's level is dropped when it arrives.
-    Generating { id: u64 },
+    Generating {
+        /// The generation's request number.
+        id: u64,
+    },
 }
 
 /// Whether the designer runs on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Mode {
+    /// The loop goes on.
     #[default]
     Designing,
     /// `q`, Esc or Ctrl-C: the loop ends and the terminal is restored.
@@ -122,16 +137,22 @@ pub enum Mode {
 /// What covers the screen, if anything.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Overlay {
+    /// Nothing: the designer's screen.
     None,
+    /// The keys and what they do (`?`).
     Help,
     /// The loaded policies' cards.
     Cards,
+    /// A prompt being typed.
     Prompt {
+        /// What it asks for.
         kind: PromptKind,
+        /// What has been typed.
         text: String,
     },
     /// Export would overwrite these files.
     ConfirmOverwrite {
+        /// The files that exist.
         paths: Vec<PathBuf>,
     },
     /// The campaign open in [`App::campaign`].
@@ -141,7 +162,9 @@ pub enum Overlay {
 /// What the bottom-right panel shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SidePane {
+    /// The failures on each piece.
     Failures,
+    /// The λ sweep.
     Sweep,
     /// The whole panel of judges on the level on screen.
     Judges,
@@ -150,7 +173,9 @@ pub enum SidePane {
 /// A recorded run being played back.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Replay {
+    /// The run's seed.
     pub seed: u64,
+    /// The run, recorded.
     pub recording: Recording,
     /// Index into the recording's path.
     pub frame: usize,
@@ -159,6 +184,7 @@ pub struct Replay {
 /// Everything the designer shows and remembers.
 #[derive(Debug, Clone, PartialEq)]
 pub struct App {
+    /// The game on screen.
     pub game: Game,
     /// Each game's policies ([`App::policies`]: the game on screen's).
     pub loaded: PerGame<LoadedInfo>,
@@ -171,36 +197,49 @@ pub struct App {
     /// Each game's profile levels are made for, and the ability its keys change ([`profile`];
     /// [`App::profile`]: the game on screen's).
     pub profiles: PerGame<profile::ProfileEdit>,
+    /// The seed levels are generated with.
     pub seed: u64,
+    /// Where the goal comes from.
     pub goal: GoalSetting,
+    /// Solver trials per level.
     pub trials_wanted: u32,
+    /// Where exports go (in a folder per game).
     pub out_dir: PathBuf,
     /// The level on screen.
     pub level: Option<Arc<Level>>,
     /// The generation in flight, if any.
     pub loading: Loading,
+    /// Why the last generation failed, if it did.
     pub generation_error: Option<String>,
+    /// The Solver's trials on the level on screen.
     pub trials: Option<Trials>,
+    /// The run being played back.
     pub replay: Option<Replay>,
     /// The recording asked for (request id, run seed), until it arrives.
     recording: Option<(u64, u64)>,
     replays: u64,
+    /// The λ sweep, once started.
     pub sweep: Option<Sweep>,
+    /// The panel of judges on the level on screen, once started.
     pub judging: Option<judges::Judging>,
     /// The campaign opened last (`o`).
     pub campaign: Option<campaign::CampaignView>,
+    /// What the bottom-right panel shows.
     pub panel: SidePane,
     /// Selected block (index into the level's blocks).
     pub selected: Option<usize>,
+    /// What covers the screen, if anything.
     pub overlay: Overlay,
     /// The latest message for the footer, and whether it reports a problem.
     pub status: Option<(String, bool)>,
+    /// The terminal's size.
     pub size: Rect,
     /// Whether the mouse is dragging the slider.
     dragging: bool,
     next_id: u64,
     /// Whether the screen is drawn in colour (not under `NO_COLOR`).
     pub colour: bool,
+    /// Whether the loop goes on or ends.
     pub mode: Mode,
 }
 
@@ -291,6 +330,7 @@ impl App {
         &self.profiles[self.game]
     }
 
+    /// The profile of the game on screen, to change.
     pub fn profile_mut(&mut self) -> &mut profile::ProfileEdit {
         &mut self.profiles[self.game]
     }

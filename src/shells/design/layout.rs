@@ -7,6 +7,7 @@ use ratatui::layout::{Constraint, Layout, Rect};
 pub const MIN_SIZE: (u16, u16) = (80, 24);
 /// Text left and right of the slider track, on its line.
 pub const SLIDER_LEFT: &str = "hard -1 ";
+/// Text right of the slider track.
 pub const SLIDER_RIGHT: &str = " +1 easy";
 /// Room after the slider for the λ readout.
 pub const SLIDER_READOUT: u16 = 11;
@@ -14,6 +15,7 @@ pub const SLIDER_READOUT: u16 = 11;
 /// The screen's areas.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Areas {
+    /// The title line.
     pub header: Rect,
     /// The controls box (slider, seed, goal), border included.
     pub controls: Rect,
@@ -21,14 +23,20 @@ pub struct Areas {
     pub slider: Rect,
     /// The line under the slider (seed and goal).
     pub settings: Rect,
+    /// The plan of the level.
     pub map: Rect,
+    /// The level's side profile, under the plan.
     pub profile: Rect,
+    /// The Solver's statistics.
     pub stats: Rect,
+    /// The bottom-right panel (failures, sweep or judges).
     pub panel: Rect,
+    /// The footer line: hints and messages.
     pub footer: Rect,
 }
 
 impl Areas {
+    /// The areas of a screen of this size.
     pub fn of(screen: Rect) -> Self {
         let [header, controls, main, footer] = Layout::vertical([
             Constraint::Length(1),

@@ -28,11 +28,14 @@ const TICK: Duration = Duration::from_millis(33);
 
 /// What `arlpcg design` was asked for.
 pub struct DesignOptions {
+    /// The game shown first.
     pub game: Game,
     /// The policies folder; `None`: the shipped ones (`policies/<game>`), or rules and the
     /// scripted controller when they are missing.
     pub policies: Option<PathBuf>,
+    /// Where exports go.
     pub out: PathBuf,
+    /// The seed to start with.
     pub seed: u64,
     /// A campaign folder to open the campaign view on (its game is the one shown).
     pub campaign: Option<PathBuf>,

@@ -35,10 +35,13 @@ pub const DROP_TOLERANCE: f64 = 0.05;
 pub struct RunScores {
     /// The run's folder.
     pub run: String,
+    /// The run's training mode.
     pub mode: String,
+    /// The run's seed.
     pub seed: u64,
-    /// Mean success on the validation set's rule levels and on its Generator levels...
+    /// Mean success on the validation set's rule levels...
     pub validation_rule_levels: f64,
+    /// ...on its Generator levels...
     pub validation_generator_levels: f64,
     /// ...and on all of it.
     pub validation: f64,
@@ -65,13 +68,16 @@ pub struct RunScores {
 pub struct GeneratorScore {
     /// The Generator's run folder.
     pub generator: String,
+    /// The Solver's mean success on them.
     pub success_ratio: f64,
 }
 
 /// One judge's success at each λ of [`AUX_VALUES`].
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct JudgeCurve {
+    /// The judge's name.
     pub judge: String,
+    /// Its success at each λ, in order.
     pub success_ratio: Vec<f64>,
 }
 
@@ -105,10 +111,13 @@ impl RunScores {
 /// One mode over its seeds.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct ModeSummary {
+    /// The training mode.
     pub mode: String,
+    /// The seeds of its runs.
     pub seeds: Vec<u64>,
     /// Validation success: IQM and mean over (half, seed), stratified by half.
     pub validation_iqm: Estimate,
+    /// Validation success: the mean over (half, seed).
     pub validation_mean: Estimate,
     /// Mean controllability success at each λ (adversarial modes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -124,27 +133,35 @@ pub struct ModeSummary {
 /// One judge's mean success at each λ over a mode's seeds.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct JudgeSummary {
+    /// The judge's name.
     pub judge: String,
+    /// Its mean success at each λ, in order.
     pub success_ratio: Vec<Estimate>,
 }
 
 /// P(arlpcg's validation success > the baseline's), over seeds.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct Improvement {
+    /// The baseline's mode.
     pub baseline: String,
+    /// The probability, with its interval.
     pub probability: Estimate,
 }
 
 /// Everything `eval --runs` reports (`seeds.json`).
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct SeedResults {
+    /// How much was evaluated.
     pub budget: Budget,
     /// The Generator whose levels make the validation set's other half.
     pub validation_generator: String,
+    /// The λ values the success curves are measured at, in order.
     pub aux: Vec<f64>,
     /// Each mode's runs, one entry per seed.
     pub seeds: BTreeMap<String, Vec<RunScores>>,
+    /// Each mode over its seeds.
     pub modes: Vec<ModeSummary>,
+    /// P(arlpcg's validation success > each baseline's).
     pub arlpcg_beats: Vec<Improvement>,
     /// P(arlpcg's success > the baseline's) on the other Generators' λ = -1 levels.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -264,10 +281,15 @@ impl SeedResults {
 
 /// One run to score: its Solver, mode and seed, and its Generator when it has one.
 pub struct SeedRun<'a> {
+    /// The run's folder.
     pub folder: String,
+    /// The run's training mode.
     pub mode: String,
+    /// The run's seed.
     pub seed: u64,
+    /// The run's Solver.
     pub solver: &'a SolverPolicy,
+    /// The run's Generator, when it has one.
     pub generator: Option<&'a GeneratorPolicy>,
 }
 

@@ -13,7 +13,9 @@ use arlpcg_core::level::stats::Skill;
 /// What a match has been through since it began: enough to play it again to where it is.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MatchLog {
+    /// The seed the match was made from.
     pub seed: u64,
+    /// What happened, in order.
     pub events: Vec<MatchEvent>,
 }
 
@@ -50,8 +52,10 @@ pub struct MatchesUnderWay {
 /// have held them, the matches under way (none: fresh matches start).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct AdversarialRecord {
+    /// The source's progress.
     #[serde(flatten)]
     pub state: AdversarialState,
+    /// The matches under way, if the checkpoint holds them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub under_way: Option<MatchesUnderWay>,
 }

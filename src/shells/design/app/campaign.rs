@@ -24,8 +24,11 @@ use arlpcg_core::level::Level;
 /// A campaign read back from its folder.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OpenedCampaign {
+    /// The campaign's folder.
     pub folder: PathBuf,
+    /// Its record (campaign.yaml).
     pub record: Campaign,
+    /// Its levels, in order.
     pub levels: Vec<Arc<Level>>,
     /// The level just searched anew (`R`), if that is why it was read.
     pub regenerated: Option<usize>,
@@ -34,7 +37,9 @@ pub struct OpenedCampaign {
 /// The campaign on view, and the level selected in it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CampaignView {
+    /// The campaign.
     pub opened: OpenedCampaign,
+    /// The selected level's index.
     pub selected: usize,
 }
 

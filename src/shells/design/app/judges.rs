@@ -23,13 +23,21 @@ pub const PANEL_SEED: u64 = 0;
 /// One judge's runs, as they come in.
 #[derive(Debug, Clone, PartialEq)]
 pub enum JudgePoint {
+    /// Not played yet.
     Pending,
-    Played { success_ratio: f64, ci95: [f64; 2] },
+    /// Played: its success.
+    Played {
+        /// Runs that reached the goal, as a share.
+        success_ratio: f64,
+        /// 95% Wilson score interval of the share.
+        ci95: [f64; 2],
+    },
 }
 
 /// The panel on one level.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Judging {
+    /// The request's number; answers to an older one are dropped.
     pub id: u64,
     /// The level it measures: a new level is measured afresh.
     pub level: Arc<Level>,
@@ -46,13 +54,18 @@ pub struct Judging {
 pub enum PanelUpdate {
     /// The judges, in the order they play.
     Judges(Vec<String>),
+    /// One judge has played.
     Played {
+        /// The judge's place in the panel's order.
         index: usize,
+        /// Runs that reached the goal, as a share.
         success_ratio: f64,
+        /// 95% Wilson score interval of the share.
         ci95: [f64; 2],
     },
     /// All have played: the panel with the level's rating.
     Rated(Box<PanelStats>),
+    /// The panel could not play, in words.
     Failed(String),
 }
 

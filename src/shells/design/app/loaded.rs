@@ -11,7 +11,9 @@ use arlpcg_core::rl::checkpoint::PolicyCard;
 /// What is known about a loaded policy, for display.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PolicyInfo {
+    /// The policy file.
     pub path: PathBuf,
+    /// Its card.
     pub card: PolicyCard,
 }
 
@@ -19,7 +21,9 @@ pub struct PolicyInfo {
 /// the designer draws rule levels; without a Solver the scripted controller plays).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct LoadedInfo {
+    /// The Generator, if one is loaded.
     pub generator: Option<PolicyInfo>,
+    /// The Solver, if one is loaded.
     pub solver: Option<PolicyInfo>,
     /// The scripted player's skill, when it plays (no Solver).
     pub skill: Skill,
@@ -48,6 +52,8 @@ impl LoadedInfo {
 /// The judge now playing the trials, after `j`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct JudgeSwitch {
+    /// The judge's Solver, if it is a policy.
     pub solver: Option<PolicyInfo>,
+    /// The scripted player's skill, when it plays (no Solver).
     pub skill: Skill,
 }

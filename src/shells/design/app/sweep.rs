@@ -16,16 +16,22 @@ pub const SWEEP_TRIALS: u32 = 40;
 /// One λ of a sweep: its success ratio, or why it has none.
 #[derive(Debug, Clone, PartialEq)]
 pub enum SweepPoint {
+    /// Not measured yet.
     Pending,
+    /// The success ratio measured.
     Success(f64),
+    /// No level to measure, or the trials failed: why.
     NoLevel(String),
 }
 
 /// A λ sweep for the seed and goal it was started with.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sweep {
+    /// The request's number; answers to an older one are dropped.
     pub id: u64,
+    /// The seed the sweep was started with.
     pub seed: u64,
+    /// Each λ with its point, in order.
     pub points: Vec<(f64, SweepPoint)>,
 }
 

@@ -15,8 +15,11 @@ use arlpcg_core::level::stats::{Outcome, SolverStats, TrialResult, wilson_interv
 /// The Solver's trials on the level on screen, as they come in.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Trials {
+    /// The request's number; answers to an older one are dropped.
     pub id: u64,
+    /// How many trials were asked for.
     pub wanted: u32,
+    /// The runs finished so far, in the order they ended.
     pub results: Vec<TrialResult>,
     /// The final statistics (the same as `arlpcg verify` gives), once all trials are in.
     pub stats: Option<SolverStats>,
@@ -25,10 +28,12 @@ pub struct Trials {
 }
 
 impl Trials {
+    /// Trials finished so far.
     pub fn done(&self) -> u32 {
         self.results.len() as u32
     }
 
+    /// Successful trials so far.
     pub fn successes(&self) -> u32 {
         self.results
             .iter()
@@ -45,6 +50,7 @@ impl Trials {
         })
     }
 
+    /// Mean fraction of the track covered so far (`None` before the first trial).
     pub fn mean_progress(&self) -> Option<f64> {
         let n = self.results.len();
         (n > 0).then(|| self.results.iter().map(|r| r.progress).sum::<f64>() / n as f64)
@@ -59,17 +65,18 @@ impl Trials {
             .then(|| dt * air.iter().map(|&a| f64::from(a)).sum::<f64>() / air.len() as f64)
     }
 
+    /// Runs so far that ended as `outcome`.
     pub fn count(&self, outcome: Outcome) -> u32 {
         self.results.iter().filter(|r| r.outcome == outcome).count() as u32
     }
 
-    /// Failed runs per block so far (`blocks` blocks), as `SolverStats::failures_by_piece`.
     /// The piece with the most failures (the first of equals); none before a run fails.
     pub fn most_failed(failures: &[u32]) -> Option<usize> {
         let most = *failures.iter().max()?;
         (most > 0).then(|| failures.iter().position(|&f| f == most))?
     }
 
+    /// Failed runs per block so far (`blocks` blocks), as `SolverStats::failures_by_piece`.
     pub fn failures_by_block(&self, blocks: usize) -> Vec<u32> {
         let mut failures = vec![0; blocks];
         for r in self

@@ -54,6 +54,7 @@ pub const KEYS: [(&str, &str); 22] = [
 
 const HINTS: &str = "←→ λ  ⏎ generate  n seed  r replay  w sweep  x export  p load  ? help  q quit";
 
+/// Draws the designer's screen, in the terminal's own colours under `NO_COLOR`.
 pub fn render(app: &App, frame: &mut Frame) {
     draw_screen(app, frame);
     if !app.colour {

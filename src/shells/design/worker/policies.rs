@@ -20,7 +20,9 @@ use arlpcg_core::rl::checkpoint::{PolicyError, TrainMode};
 /// The policies of one game in use; either may be missing (rule levels; the scripted player).
 #[derive(Default, Clone)]
 pub struct Policies {
+    /// The Generator, if one is loaded (none: rule levels).
     pub generator: Option<Arc<GeneratorPolicy>>,
+    /// The Solver, if one is loaded (none: the scripted player).
     pub solver: Option<Arc<SolverPolicy>>,
     /// The folder's ability-aware Solver, which plays levels made for abilities the Solver did
     /// not train with ([`SolverPolicy::or_aware`]).

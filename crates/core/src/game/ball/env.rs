@@ -69,6 +69,8 @@ pub struct BallEnv {
     abilities: CharacterProfile,
     /// The track grows as a Generator builds it: the last block is not yet the goal.
     open: bool,
+    /// Path length from each block's top centre to the last one's, along the track.
+    path_after: Vec<f32>,
     centre: Vector,
     velocity: Vector,
     grounded: bool,
@@ -90,6 +92,7 @@ impl BallEnv {
             rewards: PlatformRewards::default(),
             abilities,
             open: false,
+            path_after: Vec::new(),
             centre: start,
             velocity: Vector::ZERO,
             grounded: false,
@@ -119,8 +122,14 @@ impl BallEnv {
         self.remaining = self.path_remaining();
     }
 
+    /// Path lengths along the track and the time limit, from the blocks placed so far.
     fn measure(&mut self) {
-        let blocks = (self.world.platforms().len() - 1) as f32;
+        let tops: Vec<Vector> = self.world.platforms().iter().map(|p| p.top).collect();
+        self.path_after = vec![0.0; tops.len()];
+        for i in (0..tops.len() - 1).rev() {
+            self.path_after[i] = self.path_after[i + 1] + tops[i].distance(tops[i + 1]);
+        }
+        let blocks = (tops.len() - 1) as f32;
         let decision = ACTION_REPEAT as f32 * DT;
         self.max_steps = ((TIME_BASE_S + TIME_PER_BLOCK_S * blocks) / decision).ceil() as u32;
     }
@@ -173,11 +182,7 @@ impl BallEnv {
         if self.furthest == platforms.len() - 1 {
             return 0.0;
         }
-        let along: f32 = platforms[next..]
-            .windows(2)
-            .map(|w| w[0].top.distance(w[1].top))
-            .sum();
-        self.bottom().distance(platforms[next].top) + along
+        self.bottom().distance(platforms[next].top) + self.path_after[next]
     }
 
     /// Whether the ball rests on the newest block of a growing track.

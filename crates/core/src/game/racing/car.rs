@@ -2,8 +2,8 @@
 //! over the road's triangle mesh. Its abilities come from the game profile ([`Car`] from a
 //! [`CarProfile`]); the built-in ones are calibrated in docs/racing-physics.md.
 //!
-//! A [`RacingWorld`] is rebuilt for every run from the road's shared shape (the mesh and its
-//! BVH are built once per track), so a run depends only on the track and its actions: the same
+//! A [`RacingWorld`] is rebuilt for every run from the road's shared shape (the mesh, its BVH
+//! and its plan grid are built once per track), so a run depends only on the track and its actions: the same
 //! inputs give a bitwise identical trajectory.
 
 use std::collections::HashMap;

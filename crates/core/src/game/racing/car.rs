@@ -2,13 +2,18 @@
 //! over the road's triangle mesh. Its abilities come from the game profile ([`Car`] from a
 //! [`CarProfile`]); the built-in ones are calibrated in docs/racing-physics.md.
 //!
-//! A [`RacingWorld`] is rebuilt for every run from the road's shared shape (the mesh and its
-//! BVH are built once per track), so a run depends only on the track and its actions: the same
+//! A [`RacingWorld`] is rebuilt for every run from the road's shared shape (the mesh, its BVH
+//! and its plan grid are built once per track), so a run depends only on the track and its actions: the same
 //! inputs give a bitwise identical trajectory.
+
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+use std::sync::Arc;
 
 use rapier3d::control::{DynamicRayCastVehicleController, WheelTuning};
 use rapier3d::math::{Pose, Rotation, Vector};
-use rapier3d::parry::shape::TriMeshFlags;
+use rapier3d::parry::query::RayCast;
+use rapier3d::parry::shape::{TriMesh, TriMeshFlags};
 use rapier3d::prelude::*;
 
 use crate::level::profile::CarProfile;
@@ -103,14 +108,18 @@ impl CarAction {
 #[derive(Clone)]
 pub struct TrackShapes {
     road: SharedShape,
-    obstacles: Vec<(Pose, SharedShape)>,
+    /// The road's triangles by where they lie in plan, for rays cast straight down.
+    plan: Arc<PlanGrid>,
+    obstacles: Arc<[(Pose, SharedShape)]>,
+    /// The obstacles' bounding boxes in plan (x, z), widened by [`PlanGrid::MARGIN`].
+    obstacle_plans: Arc<[[f32; 4]]>,
 }
 
 impl TrackShapes {
     /// The road surface of `road` and the obstacles of `track` as rapier shapes.
     pub fn new(road: &Road, obstacles: &[Obstacle]) -> Self {
-        let road = Self::road_shape(road);
-        let obstacles = obstacles
+        let (road, plan) = Self::road_shape(road);
+        let obstacles: Arc<[(Pose, SharedShape)]> = obstacles
             .iter()
             .map(|o| match *o {
                 Obstacle::Box {
@@ -146,12 +155,30 @@ impl TrackShapes {
                 ),
             })
             .collect();
-        Self { road, obstacles }
+        let margin = PlanGrid::MARGIN as f32;
+        let obstacle_plans = obstacles
+            .iter()
+            .map(|(pose, shape)| {
+                let aabb = shape.compute_aabb(pose);
+                [
+                    aabb.mins.x - margin,
+                    aabb.mins.z - margin,
+                    aabb.maxs.x + margin,
+                    aabb.maxs.z + margin,
+                ]
+            })
+            .collect();
+        Self {
+            road,
+            plan,
+            obstacles,
+            obstacle_plans,
+        }
     }
 
     /// Rebuilds the road's shape after `road` grew.
     pub fn set_road(&mut self, road: &Road) {
-        self.road = Self::road_shape(road);
+        (self.road, self.plan) = Self::road_shape(road);
     }
 
     /// The shapes of a whole track.
@@ -159,16 +186,142 @@ impl TrackShapes {
         Self::new(&track.road(), &track.obstacles)
     }
 
-    /// The road's surface as one triangle mesh.
-    fn road_shape(road: &Road) -> SharedShape {
+    /// The road's surface as one triangle mesh, and its triangles by plan position.
+    fn road_shape(road: &Road) -> (SharedShape, Arc<PlanGrid>) {
         let mesh = road.surface_mesh();
         let vertices = mesh
             .positions
             .iter()
             .map(|p| Vector::new(p[0], p[1], p[2]))
             .collect();
-        SharedShape::trimesh_with_flags(vertices, mesh.triangles, TriMeshFlags::FIX_INTERNAL_EDGES)
-            .expect("a road of at least one segment is a valid triangle mesh")
+        let shape = SharedShape::trimesh_with_flags(
+            vertices,
+            mesh.triangles,
+            TriMeshFlags::FIX_INTERNAL_EDGES,
+        )
+        .expect("a road of at least one segment is a valid triangle mesh");
+        let plan = PlanGrid::new(Self::mesh(&shape));
+        (shape, Arc::new(plan))
+    }
+
+    fn mesh(road: &SharedShape) -> &TriMesh {
+        road.as_trimesh().expect("the road is a triangle mesh")
+    }
+
+    /// Distance down from `origin` to the road or an obstacle, up to `max`: what rapier's scene
+    /// query gives for a ray straight down (the same triangles, obstacles and tests, the nearest
+    /// hit), from only the triangles whose plan covers the ray's.
+    fn cast_down(&self, road_pose: &Pose, origin: Vector, max: f32) -> f32 {
+        let ray = Ray::new(origin, -Vector::Y);
+        let local = ray.inverse_transform_by(road_pose);
+        let mesh = Self::mesh(&self.road);
+        let road = self
+            .plan
+            .under(origin)
+            .iter()
+            .filter_map(|&t| mesh.triangle(t).cast_local_ray(&local, max, true));
+        let obstacles = self
+            .obstacles
+            .iter()
+            .zip(self.obstacle_plans.iter())
+            .filter(|(_, [x0, z0, x1, z1])| {
+                (*x0..=*x1).contains(&origin.x) && (*z0..=*z1).contains(&origin.z)
+            })
+            .filter_map(|((pose, shape), _)| shape.cast_ray(pose, &ray, max, true));
+        road.chain(obstacles).fold(max, f32::min)
+    }
+}
+
+/// A triangle mesh's triangles by the square cells of the horizontal plane that their
+/// footprints (a little widened) overlap: a ray straight down can only hit those of its cell.
+struct PlanGrid {
+    cells: HashMap<(i32, i32), Vec<u32>, BuildHasherDefault<CellHasher>>,
+}
+
+impl PlanGrid {
+    /// Side of a cell, m.
+    const CELL: f64 = 1.5;
+    /// Footprints are widened by this much, m, far more than rounding in a hit test can reach.
+    const MARGIN: f64 = 0.01;
+
+    fn new(mesh: &TriMesh) -> Self {
+        let mut cells: HashMap<_, Vec<u32>, _> = HashMap::default();
+        for t in 0..mesh.num_triangles() as u32 {
+            let triangle = mesh.triangle(t);
+            let plan = [triangle.a, triangle.b, triangle.c].map(|v| [v.x as f64, v.z as f64]);
+            let low = [0, 1].map(|k| plan.iter().map(|v| v[k]).fold(f64::INFINITY, f64::min));
+            let high = [0, 1].map(|k| plan.iter().map(|v| v[k]).fold(f64::NEG_INFINITY, f64::max));
+            let (x0, z0) = Self::cell(low[0] - Self::MARGIN, low[1] - Self::MARGIN);
+            let (x1, z1) = Self::cell(high[0] + Self::MARGIN, high[1] + Self::MARGIN);
+            for x in x0..=x1 {
+                for z in z0..=z1 {
+                    if Self::overlaps(plan, x, z) {
+                        cells.entry((x, z)).or_default().push(t);
+                    }
+                }
+            }
+        }
+        Self { cells }
+    }
+
+    fn cell(x: f64, z: f64) -> (i32, i32) {
+        (
+            (x / Self::CELL).floor() as i32,
+            (z / Self::CELL).floor() as i32,
+        )
+    }
+
+    /// Whether cell `(x, z)` widened by [`Self::MARGIN`] overlaps the triangle `plan` (in
+    /// plan): no edge of it has the whole cell outside (the cell's own axes are the caller's
+    /// range).
+    fn overlaps(plan: [[f64; 2]; 3], x: i32, z: i32) -> bool {
+        let corners = [(0, 0), (1, 0), (0, 1), (1, 1)]
+            .map(|(i, j)| [(x + i) as f64 * Self::CELL, (z + j) as f64 * Self::CELL]);
+        (0..3).all(|e| {
+            let [p, q, r] = [plan[e], plan[(e + 1) % 3], plan[(e + 2) % 3]];
+            // The edge's normal, pointing to the triangle's side.
+            let mut n = [p[1] - q[1], q[0] - p[0]];
+            let side = n[0] * (r[0] - p[0]) + n[1] * (r[1] - p[1]);
+            if side < 0.0 {
+                n = [-n[0], -n[1]];
+            }
+            let reach = -Self::MARGIN * (n[0] * n[0] + n[1] * n[1]).sqrt();
+            side == 0.0
+                || corners
+                    .iter()
+                    .any(|c| n[0] * (c[0] - p[0]) + n[1] * (c[1] - p[1]) >= reach)
+        })
+    }
+
+    /// The triangles a vertical ray through `p` may hit.
+    fn under(&self, p: Vector) -> &[u32] {
+        self.cells
+            .get(&Self::cell(p.x as f64, p.z as f64))
+            .map_or(&[], Vec::as_slice)
+    }
+}
+
+/// Hashes a cell's two coordinates with one multiplication.
+#[derive(Default)]
+struct CellHasher(u64);
+
+impl Hasher for CellHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b.into());
+        }
+    }
+
+    fn write_i32(&mut self, n: i32) {
+        self.write_u64(n as u32 as u64);
+    }
+
+    fn write_u64(&mut self, n: u64) {
+        self.0 = (self.0.rotate_left(29) ^ n).wrapping_mul(0x9E37_79B9_7F4A_7C15);
     }
 }
 
@@ -189,6 +342,7 @@ pub struct RacingWorld {
     vehicle: DynamicRayCastVehicleController,
     chassis: RigidBodyHandle,
     road: ColliderHandle,
+    shapes: TrackShapes,
     car: Car,
 }
 
@@ -200,7 +354,7 @@ impl RacingWorld {
         let mut bodies = RigidBodySet::new();
         let mut colliders = ColliderSet::new();
         let road = colliders.insert(Self::road_collider(shapes));
-        for (pose, shape) in &shapes.obstacles {
+        for (pose, shape) in shapes.obstacles.iter() {
             colliders.insert(ColliderBuilder::new(shape.clone()).position(*pose));
         }
         let ride = SUSPENSION_REST + WHEEL_RADIUS + 0.2 + START_LIFT;
@@ -271,6 +425,7 @@ impl RacingWorld {
             vehicle,
             chassis,
             road,
+            shapes: shapes.clone(),
             car,
         };
         // Queries see the colliders only after collision detection has run once.
@@ -303,6 +458,7 @@ impl RacingWorld {
     /// where it is. The road stays one collider whose shape changes; its bounding box in the
     /// broad phase is refitted at once, so the ray fan sees the new surface before the next step.
     pub fn replace_road(&mut self, shapes: &TrackShapes) {
+        self.shapes = shapes.clone();
         let road = &mut self.colliders[self.road];
         road.set_shape(shapes.road.clone());
         // The scene queries (the Solver's ray fan) see the new shape now, not after the next
@@ -386,18 +542,12 @@ impl RacingWorld {
             .count()
     }
 
-    /// Distance down to the first surface below `origin`, up to `max`.
+    /// Distance down to the first surface (road or obstacle) below each of `origins`, up to
+    /// `max`.
     pub fn cast_down(&self, origins: impl Iterator<Item = Vector>, max: f32, out: &mut [f32]) {
-        let queries = self.broad_phase.as_query_pipeline(
-            self.narrow_phase.query_dispatcher(),
-            &self.bodies,
-            &self.colliders,
-            QueryFilter::exclude_dynamic(),
-        );
+        let road_pose = self.colliders[self.road].position();
         for (origin, slot) in origins.zip(out.iter_mut()) {
-            *slot = queries
-                .cast_ray(&Ray::new(origin, -Vector::Y), max, true)
-                .map_or(max, |(_, distance)| distance);
+            *slot = self.shapes.cast_down(road_pose, origin, max);
         }
     }
 }

@@ -22,7 +22,7 @@ mod recipe;
 pub mod solver_envs;
 mod solver_run;
 
-pub use config::{GeneratorConfig, TrainConfig};
+pub use config::{GeneratorConfig, SOLO_SOLVER_UPDATE_EPOCHS, TrainConfig};
 
 use std::path::Path;
 

@@ -221,7 +221,9 @@ pub fn perform(
             after,
             folder,
         } => send(Response::Judged(
-            next_judge(policies, game, after, &folder).map(Box::new),
+            judges_folder(folder, game)
+                .and_then(|folder| next_judge(policies, game, after, &folder))
+                .map(Box::new),
         )),
         Effect::Load { path, game } => send(Response::Loaded(load_into(policies, &path, game))),
         Effect::OpenCampaign { folder } => send(Response::Campaign(open_campaign(&folder))),
@@ -237,7 +239,11 @@ pub fn perform(
             level,
             policies: dir,
         } => send(Response::Campaign(
-            regenerate_campaign_level(policies, &folder, game, level, &dir, stop)
+            judges_folder(dir, game)
+                .map_err(anyhow::Error::msg)
+                .and_then(|dir| {
+                    regenerate_campaign_level(policies, &folder, game, level, &dir, stop)
+                })
                 .map_err(|e| format!("level {} was not searched anew: {e:#}", level + 1)),
         )),
         Effect::Panel {
@@ -245,9 +251,21 @@ pub fn perform(
             level,
             folder,
             trials,
-        } => play_panel(&level, &folder, trials, stop, &|update| {
-            send(Response::Panel { id, update })
-        }),
+        } => {
+            let send = |update| send(Response::Panel { id, update });
+            match judges_folder(folder, level.game()) {
+                Ok(folder) => play_panel(&level, &folder, trials, stop, &send),
+                Err(e) => send(PanelUpdate::Failed(e)),
+            }
+        }
+    }
+}
+
+/// The folder the judges of `game` come from: `folder`, else the shipped policies.
+fn judges_folder(folder: Option<PathBuf>, game: Game) -> Result<PathBuf, String> {
+    match folder {
+        Some(folder) => Ok(folder),
+        None => crate::shells::common::shipped_dir(game).map_err(|e| format!("{e:#}")),
     }
 }
 

@@ -14,7 +14,7 @@ use crate::services::fsio;
 use crate::services::generation::{Ask, GeneratorPolicy, KeptPrefix, LevelRequest};
 use crate::services::level_files::{Format, LevelFiles, file_stem, render};
 use crate::services::making::{self, LevelSource, Proof, Redraw};
-use crate::services::panel::Judge;
+use crate::services::panel::{Judge, JudgePanel};
 use crate::services::policies::{
     load_folder_solver, load_generator, load_judge_under, load_panel, load_solver, policy_paths,
 };
@@ -42,13 +42,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     if let Some(policy) = &solver {
         crate::shells::common::check_fit(policy, template.profile.as_ref())?;
     }
-    let panel = match args.panel {
-        true => Some(load_panel(&policies_dir(args)?, args.game, None)?),
-        false => None,
-    };
-    if let Some(panel) = &panel {
-        crate::shells::common::check_panel_fit(panel, template.profile.as_ref());
-    }
+    let panel = panel_of(args, template.profile.as_ref())?;
     let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
     let plans: Vec<(u64, LevelFiles)> = seeds
         .iter()
@@ -174,6 +168,17 @@ fn report_verification(levels: &[Level]) {
             "{uncertified} levels have no certificate: no single run succeeded within the search (their success ratio is tiny)"
         );
     }
+}
+
+/// With `--panel`, the panel of judges, having said which of its Solvers never trained with
+/// `profile`'s abilities.
+fn panel_of(args: &GenerateArgs, profile: Option<&Profile>) -> Result<Option<JudgePanel>> {
+    if !args.panel {
+        return Ok(None);
+    }
+    let panel = load_panel(&policies_dir(args)?, args.game, None)?;
+    crate::shells::common::check_panel_fit(&panel, profile);
+    Ok(Some(panel))
 }
 
 /// The folder the judges come from: --policies, else the shipped policies of the game.

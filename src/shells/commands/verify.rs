@@ -1,8 +1,8 @@
 //! `arlpcg verify`: play each level many times and report the Solver's statistics, then a
 //! summary over all the levels.
 
-use std::collections::HashMap;
 use std::collections::hash_map::Entry;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 use anyhow::{Context, Result};
@@ -247,12 +247,22 @@ fn replay_one(level: &arlpcg_core::level::Level) -> Result<String> {
     ))
 }
 
+/// Says what [`panel_fit`] says of `panel` on `level` that this run has not said yet (once a
+/// run, as [`Solvers::check_profile`] says it of the Solver); nothing with `json`.
+fn say_panel_fit(panel: &JudgePanel, level: &Level, json: bool, said: &mut HashSet<String>) {
+    for line in panel_fit(panel, level.profile.as_ref()) {
+        if !json && said.insert(line.clone()) {
+            crate::warn!("{line}");
+        }
+    }
+}
+
 /// `verify --panel`: every level played by every judge, then rated over judges × levels (the
 /// levels of each game together).
 fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
     let mut panels: HashMap<Game, JudgePanel> = HashMap::new();
     let mut rated: Vec<(&Path, Game, PanelStats)> = Vec::new();
-    let mut said: std::collections::HashSet<String> = std::collections::HashSet::new();
+    let mut said = HashSet::new();
     let failed = each_level(
         &args.levels,
         |path| {
@@ -275,12 +285,7 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
                             new.insert(panel)
                         }
                     };
-                    // Said once a run, as the Solver's own (`Solvers::check_profile`).
-                    for line in panel_fit(panel, level.profile.as_ref()) {
-                        if !args.json && said.insert(line.clone()) {
-                            crate::warn!("{line}");
-                        }
-                    }
+                    say_panel_fit(panel, &level, args.json, &mut said);
                     let runs = args.trials as u64 * panel.judges.len() as u64;
                     let bar =
                         crate::shells::common::progress_bar(runs, &path.display().to_string());

@@ -336,11 +336,6 @@ pub fn cached_curve_path(
     ))
 }
 
-/// The folder of the policies shipped for `game`: `policies/<game>`.
-pub fn shipped_dir(game: Game) -> PathBuf {
-    PathBuf::from("policies").join(game.name())
-}
-
 /// The Solver file of `judge` in a policies folder (`solver.safetensors` is the ARLPCG
 /// Solver, `solver-<mode>.safetensors` the others); `None` for the scripted player.
 pub fn judge_file(dir: &Path, judge: Judge) -> Option<PathBuf> {

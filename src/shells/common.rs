@@ -1,6 +1,7 @@
 //! What the shells share (the command layer, training's progress, the designer): usage errors
-//! and interruptions with their exit codes, progress bars, the thread pool and the thread count candle asks for. A leaf module: it
-//! imports nothing of the crate.
+//! and interruptions with their exit codes, progress bars, the thread pool and the thread count candle asks for, where the
+//! shipped policies are ([`policies_root`]) and what is said of Solvers that play under a
+//! profile they never trained with. A leaf module: it imports nothing of the crate.
 
 use anyhow::Result;
 
@@ -234,6 +235,72 @@ pub fn cache_dir() -> Option<std::path::PathBuf> {
         .or_else(|| var("HOME").map(|home| home.join(".cache").join("arlpcg")))
 }
 
+/// The environment variable that names the folder of the shipped policies (the one holding
+/// `platform/` and `racing/`), for a binary run outside its checkout.
+pub const POLICIES_VAR: &str = "ARLPCG_POLICIES";
+
+/// The folder of the shipped policies, whose `platform/` and `racing/` are each game's default
+/// `--policies`: `$ARLPCG_POLICIES` when it is set; else `policies/` in the working folder when
+/// there is one (a checkout); else `policies/` beside the running binary or one or two folders
+/// above it (`target/release/arlpcg` finds its checkout's). An error names every place looked
+/// at.
+pub fn policies_root() -> Result<std::path::PathBuf> {
+    find_policies_root(
+        std::env::var_os(POLICIES_VAR)
+            .filter(|v| !v.is_empty())
+            .map(std::path::PathBuf::from),
+        std::path::Path::new("policies"),
+        std::env::current_exe().ok().as_deref(),
+    )
+}
+
+/// The folder of the shipped policies of `game` (`--policies` when it is not given):
+/// `game`'s folder in [`policies_root`].
+pub fn shipped_dir(game: arlpcg_core::level::Game) -> Result<std::path::PathBuf> {
+    Ok(policies_root()?.join(game.name()))
+}
+
+/// [`policies_root`] from what it reads: the variable's value, the working folder's
+/// `policies/` (`here`) and the running binary.
+fn find_policies_root(
+    var: Option<std::path::PathBuf>,
+    here: &std::path::Path,
+    exe: Option<&std::path::Path>,
+) -> Result<std::path::PathBuf> {
+    if let Some(dir) = var {
+        if dir.is_dir() {
+            return Ok(dir);
+        }
+        anyhow::bail!(
+            "{POLICIES_VAR}={}: no such folder (it names the folder of the shipped policies, which holds platform/ and racing/)",
+            dir.display()
+        );
+    }
+    if here.is_dir() {
+        return Ok(here.to_path_buf());
+    }
+    let beside: Vec<std::path::PathBuf> = exe
+        .and_then(std::path::Path::parent)
+        .map(|bin| {
+            bin.ancestors()
+                .take(3)
+                .map(|d| d.join("policies"))
+                .collect()
+        })
+        .unwrap_or_default();
+    if let Some(found) = beside.iter().find(|dir| dir.is_dir()) {
+        return Ok(found.clone());
+    }
+    let looked: Vec<String> =
+        std::iter::once(format!("{} (in the working folder)", here.display()))
+            .chain(beside.iter().map(|dir| dir.display().to_string()))
+            .collect();
+    anyhow::bail!(
+        "no shipped policies: looked for {}; set {POLICIES_VAR} to the folder that holds platform/ and racing/, or give --policies",
+        looked.join(", ")
+    )
+}
+
 /// Whether `policy` may play under `profile` (none: the built-in game): a warning when it trained
 /// with other abilities, an error when they lie beyond the range it trained over.
 pub fn check_fit(
@@ -248,5 +315,108 @@ pub fn check_fit(
             Ok(())
         }
         ProfileFit::Beyond(problem) => Err(anyhow::anyhow!("{problem}")),
+    }
+}
+
+/// What [`check_fit`] says of each Solver of `panel` that plays under `profile` (none: the
+/// built-in game) though it never trained with its abilities (or beyond the range it trained
+/// over): one line per thing said, naming the judges it is of. Nothing is refused: a panel's
+/// judge plays as it can.
+pub fn panel_fit(
+    panel: &crate::services::panel::JudgePanel,
+    profile: Option<&arlpcg_core::level::profile::Profile>,
+) -> Vec<String> {
+    use crate::services::verify::{ProfileFit, Solver};
+    let mut said: Vec<(String, Vec<String>)> = Vec::new();
+    for (k, (judge, _)) in panel.judges.iter().enumerate() {
+        let Solver::Policy(policy) = panel.solver(k, profile) else {
+            continue;
+        };
+        let (ProfileFit::Untrained(problem) | ProfileFit::Beyond(problem)) = policy.fit(profile)
+        else {
+            continue;
+        };
+        match said.iter_mut().find(|(known, _)| *known == problem) {
+            Some((_, judges)) => judges.push(judge.name()),
+            None => said.push((problem, vec![judge.name()])),
+        }
+    }
+    said.into_iter()
+        .map(|(problem, judges)| {
+            let judge = if judges.len() == 1 { "judge" } else { "judges" };
+            format!("panel {judge} {}: {problem}", judges.join(", "))
+        })
+        .collect()
+}
+
+/// Says [`panel_fit`]'s lines.
+pub fn check_panel_fit(
+    panel: &crate::services::panel::JudgePanel,
+    profile: Option<&arlpcg_core::level::profile::Profile>,
+) {
+    for line in panel_fit(panel, profile) {
+        crate::warn!("{line}");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    #[test]
+    fn the_policies_are_found_by_the_variable_then_here_then_beside_the_binary() {
+        let top = tempfile::tempdir().unwrap();
+        let at = |p: &str| top.path().join(p);
+        for dir in [
+            "var", "checkout/policies", "checkout/target/release", "here",
+        ] {
+            std::fs::create_dir_all(at(dir)).unwrap();
+        }
+        let exe = at("checkout/target/release/arlpcg");
+        let here = at("here/policies");
+        // The binary's checkout, two folders up.
+        let found = find_policies_root(None, &here, Some(&exe)).unwrap();
+        assert_eq!(found, at("checkout/policies"));
+        // The working folder's before it, the variable before both.
+        std::fs::create_dir_all(&here).unwrap();
+        assert_eq!(find_policies_root(None, &here, Some(&exe)).unwrap(), here);
+        let var = Some(at("var"));
+        assert_eq!(
+            find_policies_root(var, &here, Some(&exe)).unwrap(),
+            at("var")
+        );
+        // A variable naming no folder is an error, not a fallback.
+        let missing = find_policies_root(Some(at("nowhere")), &here, Some(&exe)).unwrap_err();
+        assert!(
+            missing.to_string().starts_with("ARLPCG_POLICIES=")
+                && missing.to_string().contains("nowhere"),
+            "{missing}"
+        );
+    }
+
+    #[test]
+    fn without_policies_the_error_names_every_place_looked_at() {
+        let top = tempfile::tempdir().unwrap();
+        let exe = top.path().join("a/b/c/arlpcg");
+        let here = Path::new("no-such-folder/policies");
+        let error = find_policies_root(None, here, Some(&exe))
+            .unwrap_err()
+            .to_string();
+        for place in ["a/b/c/policies", "a/b/policies", "a/policies"] {
+            let place = top.path().join(place);
+            assert!(error.contains(&place.display().to_string()), "{error}");
+        }
+        assert!(
+            error.contains("no-such-folder/policies (in the working folder)"),
+            "{error}"
+        );
+        assert!(
+            error.contains("ARLPCG_POLICIES") && error.contains("--policies"),
+            "{error}"
+        );
+        // Three folders up is not looked at.
+        let above = top.path().join("policies").display().to_string();
+        assert!(!error.contains(&above), "{error}");
     }
 }

@@ -1300,3 +1300,132 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
     fails_with(&campaign, 1, "profile `far` lies beyond the abilities");
     assert!(!Path::new(&path("campaign")).exists());
 }
+
+/// `--threads` on the commands that play: one worker or two, the same bytes.
+#[test]
+fn generate_and_verify_give_the_same_bytes_on_any_thread_count() {
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    for (dir, threads) in [(&a, "1"), (&b, "2")] {
+        let out = generate(
+            dir.path(),
+            &[
+                "--count", "2", "--seed", "4", "--verify", "10", "--format", "yaml", "--threads",
+                threads,
+            ],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let files = files_of(a.path());
+    assert_eq!(files.len(), 2);
+    assert!(
+        files == files_of(b.path()),
+        "--threads 1 and 2 made other files"
+    );
+    let level = a.path().join("platform_seed4.yaml");
+    let verify = |threads: &str| {
+        arlpcg_ok(words(
+            "verify {} --trials 10 --json --threads {}",
+            &[&level, &threads],
+        ))
+        .stdout
+    };
+    assert_eq!(verify("1"), verify("2"));
+    fails_with(
+        &arlpcg(words("verify {} --threads 0", &[&level])),
+        2,
+        "--threads",
+    );
+}
+
+/// The shipped policies without a checkout as working folder: `$ARLPCG_POLICIES`, else
+/// `policies/` beside the binary or above it; else an error that names every place looked at.
+/// `--policies` always wins.
+#[test]
+fn the_shipped_policies_are_found_by_the_variable_or_beside_the_binary_else_named() {
+    let dir = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
+    let at = |p: &str| dir.path().join(p);
+    // A copy of the binary, outside the checkout (a link would lead back to it).
+    let bin = at("opt/bin/arlpcg");
+    std::fs::create_dir_all(at("opt/bin")).unwrap();
+    if std::fs::hard_link(env!("CARGO_BIN_EXE_arlpcg"), &bin).is_err() {
+        std::fs::copy(env!("CARGO_BIN_EXE_arlpcg"), &bin).unwrap();
+    }
+    let checkout = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let shipped = checkout.join("policies");
+    let level = checkout.join("levels/platform/platform_seed7_aux-1.00.yaml");
+    let run = |var: Option<&Path>, args: Vec<std::ffi::OsString>| {
+        let mut command = Command::new(&bin);
+        command
+            .current_dir(dir.path())
+            .env("ARLPCG_CACHE", at("cache"))
+            .env_remove("ARLPCG_POLICIES");
+        if let Some(var) = var {
+            command.env("ARLPCG_POLICIES", var);
+        }
+        command.args(args).output().unwrap()
+    };
+    let verify = || words("verify {} --trials 2", &[&level]);
+
+    // Nowhere: a campaign names every place; verify falls back to the scripted player, saying why.
+    let out = at("campaign");
+    let nowhere = run(
+        None,
+        words("campaign --levels 1 --ramp 0:0.5 --out {}", &[&out]),
+    );
+    fails_with(
+        &nowhere,
+        1,
+        "no shipped policies: looked for policies (in the working folder), ",
+    );
+    for place in ["opt/bin/policies", "opt/policies", "policies"] {
+        assert!(
+            stderr(&nowhere).contains(&at(place).display().to_string()),
+            "{place}: {}",
+            stderr(&nowhere)
+        );
+    }
+    assert!(stderr(&nowhere).contains("set ARLPCG_POLICIES"));
+    assert!(!out.exists());
+    let scripted = run(None, verify());
+    assert!(scripted.status.success(), "{}", stderr(&scripted));
+    assert!(
+        stderr(&scripted)
+            .contains("platform solver: scripted player (no shipped policies: looked for"),
+        "{}",
+        stderr(&scripted)
+    );
+
+    // The variable.
+    let by_var = run(Some(&shipped), verify());
+    assert!(by_var.status.success(), "{}", stderr(&by_var));
+    let solver = shipped.join("platform/solver.safetensors");
+    let said = format!("platform solver: policy {}", solver.display());
+    assert!(stderr(&by_var).contains(&said), "{}", stderr(&by_var));
+    // A variable naming no folder is an error; --policies wins over it.
+    let bad = at("nowhere");
+    let panel = |policies: &[&dyn AsRef<std::ffi::OsStr>]| {
+        let mut args = verify();
+        args.push("--panel".into());
+        if let Some(folder) = policies.first() {
+            args.extend(["--policies".into(), folder.as_ref().to_owned()]);
+        }
+        run(Some(&bad), args)
+    };
+    fails_with(
+        &panel(&[]),
+        1,
+        &format!("ARLPCG_POLICIES={}: no such folder", bad.display()),
+    );
+    let given = panel(&[&shipped.join("platform")]);
+    assert!(given.status.success(), "{}", stderr(&given));
+
+    // Beside the binary, two folders up.
+    std::os::unix::fs::symlink(&shipped, at("opt/policies")).unwrap();
+    let beside = run(None, verify());
+    assert!(beside.status.success(), "{}", stderr(&beside));
+    let said = format!(
+        "platform solver: policy {}",
+        at("opt/policies/platform/solver.safetensors").display()
+    );
+    assert!(stderr(&beside).contains(&said), "{}", stderr(&beside));
+}

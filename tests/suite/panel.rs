@@ -143,6 +143,12 @@ fn a_campaign_follows_its_ramp_and_resumes_to_the_same_bytes() {
     let out = dir.path().join("first");
     let done = small_campaign(&out, &["--check", "completed"]);
     assert!(done.status.success(), "{}", stderr(&done));
+    // Under the built-in abilities every Solver of the panel trained with them.
+    assert!(
+        !stderr(&done).contains("never trained"),
+        "{}",
+        stderr(&done)
+    );
     let record: serde_yaml::Value =
         serde_yaml::from_slice(&std::fs::read(out.join("campaign.yaml")).unwrap()).unwrap();
     assert_eq!(record["format"].as_str(), Some("arlpcg-campaign"));
@@ -171,13 +177,17 @@ fn a_campaign_follows_its_ramp_and_resumes_to_the_same_bytes() {
     let again = small_campaign(&out, &["--check", "completed"]);
     assert!(String::from_utf8_lossy(&again.stdout).contains("already there and identical"));
 
-    // Interrupted after two levels (as a Ctrl-C leaves it): --resume finishes it, the same bytes.
+    // Interrupted after two levels (as a Ctrl-C leaves it): --resume finishes it, the same bytes,
+    // on one worker thread where the first run had every core.
     let resumed = dir.path().join("resumed");
     std::fs::create_dir(&resumed).unwrap();
     for name in ["level01.yaml", "level03.yaml"] {
         std::fs::copy(out.join(name), resumed.join(name)).unwrap();
     }
-    let done = small_campaign(&resumed, &["--check", "completed", "--resume"]);
+    let done = small_campaign(
+        &resumed,
+        &["--check", "completed", "--resume", "--threads", "1"],
+    );
     assert!(done.status.success(), "{}", stderr(&done));
     assert_eq!(files_of(&resumed), first);
 
@@ -234,6 +244,13 @@ fn a_paced_campaign_moves_one_shape_per_level() {
         &["--pacing", "0:0.4, 1:-0.4", "--profile", profile_arg],
     );
     assert!(done.status.success(), "{}", stderr(&done));
+    // The panel's Solvers of one character never trained with the profile's run speed, and the
+    // campaign says so as `verify` does, once, naming them (the ability-aware Solver plays for
+    // arlpcg: its range holds 8.5 m/s).
+    let said = stderr(&done);
+    let never = "panel judges rule-pcg, fixed-track, fixed-aux: the Solver policy trained for the built-in abilities plays under profile `quick`: its statistics are of a player who never trained with them";
+    assert!(said.contains(never), "{said}");
+    assert_eq!(said.matches("never trained").count(), 1, "{said}");
     let level01 = std::fs::read_to_string(out.join("level01.yaml")).unwrap();
     assert!(level01.contains("profile:\n  name: quick"), "{level01}");
     let record: serde_yaml::Value =

@@ -40,7 +40,11 @@ use arlpcg_core::rl::checkpoint::TrainMode;
         arlpcg generate --game platform --rules --count 20 --seed 1 --out levels/mine\n  \
         arlpcg generate --game racing --rules --obstacles 3 --count 20 --out tracks\n  \
         arlpcg verify levels/mine/*.yaml --trials 100\n  \
-        arlpcg export levels/mine/platform_seed1.yaml --out level.glb"
+        arlpcg export levels/mine/platform_seed1.yaml --out level.glb\n\n\
+        The shipped policies (policies/<game>, what commands use without --policies) are found \
+        in $ARLPCG_POLICIES (a folder holding platform/ and racing/) when it is set, else in \
+        policies/ of the working folder, else in policies/ beside the binary or one or two \
+        folders above it (target/release/arlpcg finds its checkout's)."
 )]
 pub struct Cli {
     /// The subcommand (none: the designer in a terminal, else this help).
@@ -144,8 +148,8 @@ pub struct DesignArgs {
     #[arg(long, default_value = "platform", value_parser = parse_game)]
     pub game: Game,
     /// A policies folder (generator.safetensors and/or solver.safetensors) or one policy file.
-    /// Default: the shipped policies/<game>/; without them, rule levels and the scripted
-    /// controller.
+    /// Default: the shipped policies/<game>/ ($ARLPCG_POLICIES, else ./policies, else beside the
+    /// binary: `arlpcg --help`); without them, rule levels and the scripted controller.
     #[arg(long, value_name = "PATH")]
     pub policies: Option<PathBuf>,
     /// Where exports go (into a folder per game).
@@ -161,6 +165,9 @@ pub struct DesignArgs {
     /// generated and played with its character's or car's abilities, and the header names it.
     #[arg(long, value_name = "FILE")]
     pub profile: Option<PathBuf>,
+    /// Worker threads for the trials the designer plays (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
 }
 
 /// `eval`'s arguments.
@@ -345,6 +352,9 @@ pub struct GenerateArgs {
     /// K machines with I = 0..K-1 together write exactly the files of the whole batch.
     #[arg(long, value_name = "I/K", value_parser = parse_shard)]
     pub shard: Option<Shard>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
 }
 
 /// `export`'s arguments.
@@ -467,9 +477,10 @@ impl SolverChoice {
     }
 }
 
-/// Where the shipped Solver of `game` lives.
-pub fn default_solver(game: Game) -> PathBuf {
-    crate::services::policies::shipped_dir(game).join(crate::services::policies::SOLVER_FILE)
+/// Where the shipped Solver of `game` lives (an error names the places looked at for the
+/// shipped policies: [`crate::shells::common::policies_root`]).
+pub fn default_solver(game: Game) -> anyhow::Result<PathBuf> {
+    Ok(crate::shells::common::shipped_dir(game)?.join(crate::services::policies::SOLVER_FILE))
 }
 
 /// `verify`'s arguments.
@@ -512,8 +523,8 @@ pub struct VerifyArgs {
     #[arg(long, value_name = "JUDGES", num_args = 0..=1, default_missing_value = "",
           value_parser = parse_judges, conflicts_with_all = ["solver", "policy", "replay", "chart"])]
     pub panel: Option<Judges>,
-    /// The policies folder the panel's Solvers (and a campaign's judge) come from (default:
-    /// policies/<game>).
+    /// The policies folder the panel's Solvers (and a campaign's judge) come from (default: the
+    /// shipped policies/<game>: $ARLPCG_POLICIES, else ./policies, else beside the binary).
     #[arg(long)]
     pub policies: Option<PathBuf>,
     /// Play under this game profile (`arlpcg profile init`): the character's or car's abilities.
@@ -532,6 +543,9 @@ pub struct VerifyArgs {
     /// nothing.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["solver", "policy", "replay", "chart", "panel", "json", "levels"])]
     pub campaign: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
 }
 
 /// `campaign`'s arguments.
@@ -547,7 +561,8 @@ pub struct CampaignArgs {
     /// Which game.
     #[arg(long, default_value = "platform", value_parser = parse_game)]
     pub game: Game,
-    /// The Generator, the judge and the panel's Solvers (default: the shipped policies/<game>).
+    /// The Generator, the judge and the panel's Solvers (default: the shipped policies/<game>:
+    /// $ARLPCG_POLICIES, else ./policies, else beside the binary; `arlpcg --help`).
     #[arg(long, value_name = "DIR")]
     pub policies: Option<PathBuf>,
     /// How many levels.
@@ -605,6 +620,9 @@ pub struct CampaignArgs {
     /// refused.
     #[arg(long)]
     pub resume: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
 }
 
 /// `train`'s arguments.

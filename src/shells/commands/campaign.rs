@@ -19,13 +19,13 @@ use crate::services::fsio;
 use crate::services::generation::GeneratorPolicy;
 use crate::services::level_files::{Format, LevelFiles, render};
 use crate::services::panel::Judge;
-use crate::services::policies::{
-    difficulty_curve, load_generator, load_panel, policy_paths, shipped_dir,
-};
+use crate::services::policies::{difficulty_curve, load_generator, load_panel, policy_paths};
 use crate::services::profile;
 use crate::services::verify::{self, Solver, Watch};
 use crate::shells::cli::{CampaignArgs, VerifyArgs};
-use crate::shells::common::{ChecksFailed, Interrupted, progress_bar};
+use crate::shells::common::{
+    ChecksFailed, Interrupted, check_panel_fit, progress_bar, shipped_dir,
+};
 use arlpcg_core::level::{Level, yaml};
 use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::statistics::population::Population;
@@ -48,10 +48,10 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         )
         .into());
     }
-    let dir = args
-        .policies
-        .clone()
-        .unwrap_or_else(|| shipped_dir(args.game));
+    let dir = match &args.policies {
+        Some(dir) => dir.clone(),
+        None => shipped_dir(args.game)?,
+    };
     let judge = args.judge.unwrap_or(Judge::Solver(TrainMode::Arlpcg));
     let ask = CampaignAsk {
         game: args.game,
@@ -82,6 +82,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         crate::shells::common::check_fit(policy, ask.profile.as_ref())?;
     }
     let panel = load_panel(&dir, args.game, None)?;
+    check_panel_fit(&panel, ask.profile.as_ref());
     let files: Vec<LevelFiles> = (0..n)
         .map(|k| LevelFiles::new(&args.out, &level_stem(k, n), &formats))
         .collect();
@@ -488,10 +489,10 @@ pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
     let (_, campaign, mut levels) = crate::services::campaign::open(file)?;
     let judge = Judge::parse(&campaign.judge)
         .map_err(|e| anyhow::anyhow!("{}: judge: {e}", file.display()))?;
-    let dir: PathBuf = args
-        .policies
-        .clone()
-        .unwrap_or_else(|| shipped_dir(campaign.game));
+    let dir: PathBuf = match &args.policies {
+        Some(dir) => dir.clone(),
+        None => shipped_dir(campaign.game)?,
+    };
     let judged = load_panel(&dir, campaign.game, Some(&[judge]))?;
     let profile = campaign.ask().profile;
     let solver = judged.solver(0, profile.as_ref());
@@ -499,6 +500,7 @@ pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
         crate::shells::common::check_fit(policy, profile.as_ref())?;
     }
     let panel = load_panel(&dir, campaign.game, None)?;
+    check_panel_fit(&panel, profile.as_ref());
     for (level, entry) in levels.iter_mut().zip(&campaign.levels) {
         level.stats = Some(verify::verify(
             level,

@@ -195,8 +195,10 @@ fn seeds(args: &EvalArgs) -> Result<()> {
     for target in &targets {
         fsio::check_writable(target, overwrite)?;
     }
-    let shipped = crate::services::policies::shipped_dir(args.game);
-    let folder = args.policies.first().unwrap_or(&shipped);
+    let folder = match args.policies.first() {
+        Some(folder) => folder.clone(),
+        None => crate::shells::common::shipped_dir(args.game)?,
+    };
     let (validation_generator, _) = load_generator(&folder.join(GENERATOR_FILE), args.game)?;
     let loaded = load_runs(args)?;
     let runs: Vec<eval::seeds::SeedRun> = loaded
@@ -217,9 +219,9 @@ fn seeds(args: &EvalArgs) -> Result<()> {
     ];
     let available: Vec<Judge> = judges
         .into_iter()
-        .filter(|&j| crate::services::policies::judge_file(folder, j).is_none_or(|p| p.exists()))
+        .filter(|&j| crate::services::policies::judge_file(&folder, j).is_none_or(|p| p.exists()))
         .collect();
-    let judges = crate::services::policies::load_panel(folder, args.game, Some(&available))?;
+    let judges = crate::services::policies::load_panel(&folder, args.game, Some(&available))?;
     let budget = budget(args);
     let pool = crate::shells::common::thread_pool(args.threads)?;
     let validation = pool.install(|| {

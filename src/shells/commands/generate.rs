@@ -14,14 +14,14 @@ use crate::services::fsio;
 use crate::services::generation::{Ask, GeneratorPolicy, KeptPrefix, LevelRequest};
 use crate::services::level_files::{Format, LevelFiles, file_stem, render};
 use crate::services::making::{self, LevelSource, Proof, Redraw};
-use crate::services::panel::Judge;
+use crate::services::panel::{Judge, JudgePanel};
 use crate::services::policies::{
     load_folder_solver, load_generator, load_judge_under, load_panel, load_solver, policy_paths,
-    shipped_dir,
 };
 use crate::services::profile;
 use crate::services::verify::{self, Solver, SolverPolicy};
 use crate::shells::cli::{GenerateArgs, KeepArg, default_solver};
+use crate::shells::common::shipped_dir;
 use arlpcg_core::game::Skill;
 use arlpcg_core::game::facts::facts;
 use arlpcg_core::level::profile::Profile;
@@ -42,10 +42,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     if let Some(policy) = &solver {
         crate::shells::common::check_fit(policy, template.profile.as_ref())?;
     }
-    let panel = match args.panel {
-        true => Some(load_panel(&policies_dir(args), args.game, None)?),
-        false => None,
-    };
+    let panel = panel_of(args, template.profile.as_ref())?;
     let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
     let plans: Vec<(u64, LevelFiles)> = seeds
         .iter()
@@ -173,11 +170,23 @@ fn report_verification(levels: &[Level]) {
     }
 }
 
+/// With `--panel`, the panel of judges, having said which of its Solvers never trained with
+/// `profile`'s abilities.
+fn panel_of(args: &GenerateArgs, profile: Option<&Profile>) -> Result<Option<JudgePanel>> {
+    if !args.panel {
+        return Ok(None);
+    }
+    let panel = load_panel(&policies_dir(args)?, args.game, None)?;
+    crate::shells::common::check_panel_fit(&panel, profile);
+    Ok(Some(panel))
+}
+
 /// The folder the judges come from: --policies, else the shipped policies of the game.
-fn policies_dir(args: &GenerateArgs) -> PathBuf {
-    args.policies
-        .clone()
-        .unwrap_or_else(|| crate::services::policies::shipped_dir(args.game))
+fn policies_dir(args: &GenerateArgs) -> Result<PathBuf> {
+    match &args.policies {
+        Some(dir) => Ok(dir.clone()),
+        None => shipped_dir(args.game),
+    }
 }
 
 /// With `--target-success`: the policies' λ→success curve on levels made for `profile`, read
@@ -400,17 +409,19 @@ fn chosen_solver(
         (None, _, _) => None,
         // A Solver judge's policy; none for the scripted player.
         (Some(_), Some(judge), _) => {
-            load_judge_under(&policies_dir(args), args.game, judge, profile)?
+            load_judge_under(&policies_dir(args)?, args.game, judge, profile)?
         }
         (Some(_), None, Some(path)) => Some(load_solver(path, args.game)?.0),
-        (Some(_), None, None) => match &args.policies {
-            Some(dir) => Some(load_folder_solver(dir, args.game, profile)?),
-            None if shipped.exists() => Some(load_folder_solver(
-                &shipped_dir(args.game),
+        (Some(_), None, None) => match (&args.policies, &shipped) {
+            (Some(dir), _) => Some(load_folder_solver(dir, args.game, profile)?),
+            (None, Ok(solver)) if solver.exists() => Some(load_folder_solver(
+                solver
+                    .parent()
+                    .expect("the Solver file of a policies folder"),
                 args.game,
                 profile,
             )?),
-            None => None,
+            (None, _) => None,
         },
     })
 }

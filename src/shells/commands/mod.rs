@@ -22,11 +22,11 @@ use crate::shells::cli::{Cli, Command};
 /// Runs the parsed command line.
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        Some(Command::Generate(args)) => generate::run(&args),
+        Some(Command::Generate(args)) => in_pool(args.threads, || generate::run(&args)),
         Some(Command::Export(args)) => export::run(&args),
         Some(Command::ExportPolicy(args)) => export_policy::run(&args),
-        Some(Command::Verify(args)) => verify::run(&args),
-        Some(Command::Campaign(args)) => campaign::run(&args),
+        Some(Command::Verify(args)) => in_pool(args.threads, || verify::run(&args)),
+        Some(Command::Campaign(args)) => in_pool(args.threads, || campaign::run(&args)),
         Some(Command::Eval(args)) => eval::run(&args),
         Some(Command::Report(args)) => report::run(&args),
         Some(Command::Profile(command)) => profile::run(&command),
@@ -42,6 +42,7 @@ pub fn run(cli: Cli) -> Result<()> {
                     seed: 1,
                     campaign: None,
                     profile: None,
+                    threads: None,
                 })
             } else {
                 use clap::CommandFactory;
@@ -52,7 +53,19 @@ pub fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// `run` in a pool of `threads` workers (default: one per core), where every trial it plays
+/// runs: results do not depend on the count.
+fn in_pool(threads: Option<u64>, run: impl FnOnce() -> Result<()> + Send) -> Result<()> {
+    crate::shells::common::thread_pool(threads)?.install(run)
+}
+
 fn design(args: crate::shells::cli::DesignArgs) -> Result<()> {
+    // The designer's workers are threads of their own: its trials run in the global pool.
+    if let Some(threads) = args.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads as usize)
+            .build_global()?;
+    }
     crate::shells::design::run(crate::shells::design::DesignOptions {
         game: args.game,
         policies: args.policies,

@@ -1,8 +1,8 @@
 //! `arlpcg verify`: play each level many times and report the Solver's statistics, then a
 //! summary over all the levels.
 
-use std::collections::HashMap;
 use std::collections::hash_map::Entry;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 use anyhow::{Context, Result};
@@ -11,13 +11,14 @@ use serde_json::json;
 use super::campaign::report_checks;
 use crate::services::checks::{Check, failures};
 use crate::services::panel::{JudgePanel, rate};
-use crate::services::policies::{load_aware_solver, load_panel, load_solver, shipped_dir};
+use crate::services::policies::{load_aware_solver, load_panel, load_solver};
 use crate::services::profile;
 use crate::services::verify::{
     FailureConcentration, HalfwaySplit, ProfileFit, Solver, SolverPolicy, Summary, Watch,
     passed_by_piece, verify,
 };
 use crate::shells::cli::{Judges, SolverChoice, VerifyArgs, default_solver};
+use crate::shells::common::{panel_fit, shipped_dir};
 use arlpcg_core::game::Skill;
 use arlpcg_core::game::facts::facts;
 use arlpcg_core::level::profile::Profile;
@@ -246,11 +247,22 @@ fn replay_one(level: &arlpcg_core::level::Level) -> Result<String> {
     ))
 }
 
+/// Says what [`panel_fit`] says of `panel` on `level` that this run has not said yet (once a
+/// run, as [`Solvers::check_profile`] says it of the Solver); nothing with `json`.
+fn say_panel_fit(panel: &JudgePanel, level: &Level, json: bool, said: &mut HashSet<String>) {
+    for line in panel_fit(panel, level.profile.as_ref()) {
+        if !json && said.insert(line.clone()) {
+            crate::warn!("{line}");
+        }
+    }
+}
+
 /// `verify --panel`: every level played by every judge, then rated over judges × levels (the
 /// levels of each game together).
 fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
     let mut panels: HashMap<Game, JudgePanel> = HashMap::new();
     let mut rated: Vec<(&Path, Game, PanelStats)> = Vec::new();
+    let mut said = HashSet::new();
     let failed = each_level(
         &args.levels,
         |path| {
@@ -264,7 +276,7 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
                             let dir = args
                                 .policies
                                 .clone()
-                                .unwrap_or_else(|| crate::services::policies::shipped_dir(game));
+                                .map_or_else(|| shipped_dir(game), Ok)?;
                             let chosen = (!chosen.0.is_empty()).then_some(chosen.0.as_slice());
                             let panel = load_panel(&dir, game, chosen)?;
                             if !args.json {
@@ -273,6 +285,7 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
                             new.insert(panel)
                         }
                     };
+                    say_panel_fit(panel, &level, args.json, &mut said);
                     let runs = args.trials as u64 * panel.judges.len() as u64;
                     let bar =
                         crate::shells::common::progress_bar(runs, &path.display().to_string());
@@ -389,22 +402,24 @@ impl Solvers {
             return Ok(());
         }
         let shipped = default_solver(game);
-        let policy = args.policy.clone().unwrap_or_else(|| shipped.clone());
-        let choice = args
-            .solver
-            .unwrap_or(if args.policy.is_some() || shipped.exists() {
-                SolverChoice::Policy
-            } else {
-                SolverChoice::ScriptedExpert
-            });
+        let found = shipped.as_ref().is_ok_and(|path| path.exists());
+        let choice = args.solver.unwrap_or(if args.policy.is_some() || found {
+            SolverChoice::Policy
+        } else {
+            SolverChoice::ScriptedExpert
+        });
         let resolved = match choice {
-            SolverChoice::Policy => {
-                let aware = match args.policy {
-                    Some(_) => None,
-                    None => load_aware_solver(&shipped_dir(game), game)?.map(Box::new),
-                };
-                Resolved::Policy(Box::new(load_solver(&policy, game)?.0), aware)
-            }
+            SolverChoice::Policy => match &args.policy {
+                Some(policy) => Resolved::Policy(Box::new(load_solver(policy, game)?.0), None),
+                None => {
+                    let policy = shipped.as_ref().map_err(|e| anyhow::anyhow!("{e:#}"))?;
+                    let dir = policy
+                        .parent()
+                        .expect("the Solver file of a policies folder");
+                    let aware = load_aware_solver(dir, game)?.map(Box::new);
+                    Resolved::Policy(Box::new(load_solver(policy, game)?.0), aware)
+                }
+            },
             SolverChoice::Random => Resolved::Random,
             scripted => Resolved::Scripted(scripted.skill().expect("the other choices")),
         };
@@ -415,10 +430,12 @@ impl Solvers {
                     "policy {} (under other abilities, {})",
                     p.reference.path, aware.reference.path
                 ),
-                Resolved::Scripted(_) if args.solver.is_none() => format!(
-                    "scripted player (no trained Solver at {})",
-                    shipped.display()
-                ),
+                Resolved::Scripted(_) if args.solver.is_none() => match &shipped {
+                    Ok(path) => {
+                        format!("scripted player (no trained Solver at {})", path.display())
+                    }
+                    Err(e) => format!("scripted player ({e:#})"),
+                },
                 Resolved::Scripted(skill) => format!("scripted player ({skill})"),
                 Resolved::Random => "random actions".into(),
             };

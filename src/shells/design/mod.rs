@@ -57,8 +57,8 @@ fn starting_policies(
             Ok((policies, info, None))
         }
         None => {
-            let shipped = crate::services::policies::shipped_dir(game);
-            match worker::load(&shipped, game) {
+            let shipped = crate::shells::common::shipped_dir(game);
+            match shipped.and_then(|shipped| worker::load(&shipped, game)) {
                 Ok((policies, info)) => Ok((policies, info, None)),
                 Err(e) => Ok((
                     Policies::default(),

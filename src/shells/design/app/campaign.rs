@@ -134,7 +134,7 @@ impl App {
                     folder,
                     game,
                     level,
-                    policies: self.policies().folder(game),
+                    policies: self.policies().folder(),
                 }];
             }
             KeyCode::Char('o') => {

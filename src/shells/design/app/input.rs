@@ -53,7 +53,7 @@ impl App {
                 vec![Effect::NextJudge {
                     game: self.game,
                     after: self.policies().judge(),
-                    folder: self.policies().folder(self.game),
+                    folder: self.policies().folder(),
                 }]
             }
             KeyCode::Tab => self.switch_game(),

@@ -88,7 +88,7 @@ impl App {
         vec![Effect::Panel {
             id,
             level,
-            folder: self.policies().folder(self.game),
+            folder: self.policies().folder(),
             trials: PANEL_TRIALS,
         }]
     }

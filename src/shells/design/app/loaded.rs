@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 
 use crate::services::panel::Judge;
 use arlpcg_core::game::Skill;
-use arlpcg_core::level::Game;
 use arlpcg_core::rl::checkpoint::PolicyCard;
 
 /// What is known about a loaded policy, for display.
@@ -38,14 +37,13 @@ impl LoadedInfo {
         }
     }
 
-    /// The folder the judges come from: the Solver's, else the Generator's, else the shipped
-    /// policies of `game`.
-    pub fn folder(&self, game: Game) -> PathBuf {
+    /// The folder the judges come from: the Solver's, else the Generator's; none: the shipped
+    /// policies of the game (which the worker finds).
+    pub fn folder(&self) -> Option<PathBuf> {
         [&self.solver, &self.generator]
             .into_iter()
             .flatten()
             .find_map(|p| p.path.parent().map(Path::to_path_buf))
-            .unwrap_or_else(|| crate::services::policies::shipped_dir(game))
     }
 }
 

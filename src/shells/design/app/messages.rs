@@ -196,8 +196,8 @@ pub enum Effect {
         game: Game,
         /// The judge playing now.
         after: Judge,
-        /// The folder of Solvers.
-        folder: PathBuf,
+        /// The folder of Solvers (none: the shipped policies of `game`).
+        folder: Option<PathBuf>,
     },
     /// Read the campaign in `folder` (its campaign.yaml and levels).
     OpenCampaign {
@@ -220,8 +220,9 @@ pub enum Effect {
         game: Game,
         /// The level's index in the campaign, from 0.
         level: usize,
-        /// The folder of the judge's and the panel's policies.
-        policies: PathBuf,
+        /// The folder of the judge's and the panel's policies (none: the shipped policies of
+        /// `game`).
+        policies: Option<PathBuf>,
     },
     /// Every judge whose Solver is in `folder`, and the scripted skills, play `level`.
     Panel {
@@ -229,8 +230,8 @@ pub enum Effect {
         id: u64,
         /// The level to play.
         level: Arc<Level>,
-        /// The folder of the panel's Solvers.
-        folder: PathBuf,
+        /// The folder of the panel's Solvers (none: the shipped policies of the level's game).
+        folder: Option<PathBuf>,
         /// Runs per judge.
         trials: u32,
     },

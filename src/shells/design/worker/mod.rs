@@ -221,7 +221,9 @@ pub fn perform(
             after,
             folder,
         } => send(Response::Judged(
-            next_judge(policies, game, after, &folder).map(Box::new),
+            judges_folder(folder, game)
+                .and_then(|folder| next_judge(policies, game, after, &folder))
+                .map(Box::new),
         )),
         Effect::Load { path, game } => send(Response::Loaded(load_into(policies, &path, game))),
         Effect::OpenCampaign { folder } => send(Response::Campaign(open_campaign(&folder))),
@@ -237,7 +239,7 @@ pub fn perform(
             level,
             policies: dir,
         } => send(Response::Campaign(
-            regenerate_campaign_level(policies, &folder, game, level, &dir, stop)
+            regenerate_campaign_level(policies, &folder, game, level, dir, stop)
                 .map_err(|e| format!("level {} was not searched anew: {e:#}", level + 1)),
         )),
         Effect::Panel {
@@ -245,9 +247,17 @@ pub fn perform(
             level,
             folder,
             trials,
-        } => play_panel(&level, &folder, trials, stop, &|update| {
+        } => play_panel(&level, folder, trials, stop, &|update| {
             send(Response::Panel { id, update })
         }),
+    }
+}
+
+/// The folder the judges of `game` come from: `folder`, else the shipped policies.
+fn judges_folder(folder: Option<PathBuf>, game: Game) -> Result<PathBuf, String> {
+    match folder {
+        Some(folder) => Ok(folder),
+        None => crate::shells::common::shipped_dir(game).map_err(|e| format!("{e:#}")),
     }
 }
 
@@ -264,15 +274,17 @@ fn open_campaign(folder: &Path) -> Result<Box<OpenedCampaign>, String> {
 }
 
 /// Level `k` of the campaign in `folder` searched anew with the Generator on the shelf
-/// ([`crate::services::campaign::regenerate_level`]), read back for the view.
+/// ([`crate::services::campaign::regenerate_level`]) and the judge of the policies folder
+/// `dir` (none: the shipped one), read back for the view.
 fn regenerate_campaign_level(
     policies: &Mutex<GamePolicies>,
     folder: &Path,
     game: Game,
     k: usize,
-    dir: &Path,
+    dir: Option<PathBuf>,
     stop: &(dyn Fn() -> bool + Sync),
 ) -> anyhow::Result<Box<OpenedCampaign>> {
+    let dir = judges_folder(dir, game).map_err(anyhow::Error::msg)?;
     let generator = policies
         .lock()
         .ok()
@@ -282,7 +294,7 @@ fn regenerate_campaign_level(
         folder,
         k,
         &generator,
-        (dir, crate::shells::common::cache_dir().as_deref()),
+        (&dir, crate::shells::common::cache_dir().as_deref()),
         stop,
     )?;
     Ok(Box::new(OpenedCampaign {
@@ -293,18 +305,22 @@ fn regenerate_campaign_level(
     }))
 }
 
-/// Every judge of the panel in `folder` plays `level` `trials` times, each reported as it
-/// ends; then the level is rated. Nothing more once `stop` says so.
+/// Every judge of the panel in `folder` (none: the shipped policies) plays `level` `trials`
+/// times, each reported as it ends; then the level is rated. Nothing more once `stop` says so.
 fn play_panel(
     level: &Level,
-    folder: &Path,
+    folder: Option<PathBuf>,
     trials: u32,
     stop: &(dyn Fn() -> bool + Sync),
     send: &dyn Fn(PanelUpdate),
 ) {
-    let panel = match crate::services::policies::load_panel(folder, level.game(), None) {
+    let panel = judges_folder(folder, level.game()).and_then(|folder| {
+        crate::services::policies::load_panel(&folder, level.game(), None)
+            .map_err(|e| format!("{e:#}"))
+    });
+    let panel = match panel {
         Ok(panel) => panel,
-        Err(e) => return send(PanelUpdate::Failed(format!("{e:#}"))),
+        Err(e) => return send(PanelUpdate::Failed(e)),
     };
     send(PanelUpdate::Judges(panel.names()));
     let watch = Watch {

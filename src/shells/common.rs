@@ -1,7 +1,7 @@
 //! What the shells share (the command layer, training's progress, the designer): usage errors
-//! and interruptions with their exit codes, progress bars, the thread pool and the thread count candle asks for, where the
-//! shipped policies are ([`policies_root`]) and what is said of Solvers that play under a
-//! profile they never trained with. A leaf module: it imports nothing of the crate.
+//! and interruptions with their exit codes, progress bars, the thread pool and the thread count
+//! candle asks for, where the shipped policies are ([`policies_root`]) and what is said of
+//! Solvers that play under a profile they never trained with.
 
 use anyhow::Result;
 

@@ -342,9 +342,37 @@ pub struct RacingWorld {
     vehicle: DynamicRayCastVehicleController,
     chassis: RigidBodyHandle,
     road: ColliderHandle,
+    road_contacts: RoadContacts,
     shapes: TrackShapes,
     car: Car,
 }
+
+/// Leaves the chassis and the road out of collision detection while [`Self::skip`] (the
+/// chassis cannot reach the road this step: [`RacingWorld::chassis_clear`]), so rapier neither
+/// builds their contacts nor sweeps the chassis against the road's triangles for nothing.
+struct RoadContacts {
+    road: ColliderHandle,
+    skip: bool,
+}
+
+impl PhysicsHooks for RoadContacts {
+    fn filter_contact_pair(&self, context: &PairFilterContext) -> Option<SolverFlags> {
+        let road = context.collider1 == self.road || context.collider2 == self.road;
+        (!(road && self.skip)).then_some(SolverFlags::COMPUTE_RIGID_IMPULSES)
+    }
+}
+
+/// The chassis box's bottom face lies this far below the wheels' attachment points, m.
+const BOTTOM_BELOW_WHEELS: f32 = CHASSIS_HALF[1] + WHEELS[0][1];
+/// The box's corners lie beyond the wheels: a corner's height over the road is the wheels'
+/// lowest less this share of their spread (linear extrapolation, along and across).
+const CORNER_SPREAD: f32 = (CHASSIS_HALF[0] - WHEELS[0][0]) / (2.0 * WHEELS[0][0])
+    + (CHASSIS_HALF[2] - WHEELS[1][2]) / (2.0 * WHEELS[1][2]);
+/// A corner's farthest distance from the bottom face under a wheel, m (how far spin moves it).
+const CORNER_LEVER: f32 = 0.71;
+/// Room left for what the wheels cannot see within a step: the road curving under the box and
+/// the step's accelerations, m.
+const CLEARANCE_SLACK: f32 = 0.15;
 
 impl RacingWorld {
     /// A world with `car` standing at `position` (its wheels' height), heading `heading`
@@ -381,7 +409,8 @@ impl RacingWorld {
                     mass,
                     inertia,
                 ))
-                .friction(0.6),
+                .friction(0.6)
+                .active_hooks(ActiveHooks::FILTER_CONTACT_PAIRS),
             chassis,
             &mut bodies,
         );
@@ -425,6 +454,7 @@ impl RacingWorld {
             vehicle,
             chassis,
             road,
+            road_contacts: RoadContacts { road, skip: false },
             shapes: shapes.clone(),
             car,
         };
@@ -487,6 +517,11 @@ impl RacingWorld {
             filter,
         );
         self.vehicle.update_vehicle(self.params.dt, queries);
+        // Rapier sweeps every fast body (CCD): only where the chassis may meet the road or an
+        // obstacle this step.
+        self.road_contacts.skip = self.chassis_clear();
+        self.params.max_ccd_substeps =
+            usize::from(!self.road_contacts.skip || self.obstacle_near());
         self.pipeline.step(
             self.gravity,
             &self.params,
@@ -499,9 +534,47 @@ impl RacingWorld {
             &mut self.multibody_joints,
             &mut self.soft_bodies,
             &mut self.ccd,
-            &(),
+            &self.road_contacts,
             &(),
         );
+    }
+
+    /// Whether the chassis box stays clear of the road this step, by the wheels' ray casts just
+    /// made: all four wheels on the road, and the box's lowest corner (extrapolated from its
+    /// height over the road under each wheel) more than [`CLEARANCE_SLACK`] above it after
+    /// moving towards it at its fastest for a step.
+    fn chassis_clear(&self) -> bool {
+        let body = &self.bodies[self.chassis];
+        let down = body.rotation() * -Vector::Y;
+        let mut low = f32::INFINITY;
+        let mut high = f32::NEG_INFINITY;
+        let mut closing = 0.0f32;
+        for wheel in self.vehicle.wheels() {
+            let info = wheel.raycast_info();
+            if !info.is_in_contact || info.ground_object != Some(self.road) {
+                return false;
+            }
+            let normal = info.contact_normal_ws;
+            let bottom = info.hard_point_ws + down * BOTTOM_BELOW_WHEELS;
+            let height = (bottom - info.contact_point_ws).dot(normal);
+            low = low.min(height);
+            high = high.max(height);
+            closing = closing.max(-body.velocity_at_point(bottom).dot(normal));
+        }
+        let reach = (closing + body.angvel().length() * CORNER_LEVER) * self.params.dt;
+        low - CORNER_SPREAD * (high - low) - reach > CLEARANCE_SLACK
+    }
+
+    /// Whether an obstacle's plan lies within the chassis's reach this step (its bounding
+    /// radius, a step at its speed and half a metre).
+    fn obstacle_near(&self) -> bool {
+        let body = &self.bodies[self.chassis];
+        let p = body.translation();
+        let reach =
+            Vector::from(CHASSIS_HALF).length() + body.linvel().length() * self.params.dt + 0.5;
+        self.shapes.obstacle_plans.iter().any(|[x0, z0, x1, z1]| {
+            p.x > x0 - reach && p.x < x1 + reach && p.z > z0 - reach && p.z < z1 + reach
+        })
     }
 
     /// The car's abilities.

@@ -1037,7 +1037,8 @@ fn a_game_profile_is_checked_recorded_and_played_under() {
 }
 
 /// The shipped Solver never trained with a low jumper's abilities: the shipped ability-aware
-/// Solver plays (its range, ±20%, holds 7.5 m/s). Beyond that range the shipped Solver plays,
+/// Solver plays (its range, ±20%, holds 7.5 m/s). Beyond that range the scripted expert plays
+/// in their place and a line says why; `--solver policy` has the shipped Solver play anyway,
 /// and says that it never trained with them; without a profile it plays as before.
 #[test]
 fn the_shipped_ability_aware_solver_plays_a_profile_within_its_range() {
@@ -1059,7 +1060,13 @@ fn the_shipped_ability_aware_solver_plays_a_profile_within_its_range() {
         "{aware}"
     );
     assert!(!said.contains("never trained"), "{said}");
-    let (shipped, said) = played(&["--profile", &path("lower.yaml")]);
+    let (stand_in, said) = played(&["--profile", &path("lower.yaml")]);
+    assert_eq!(stand_in, "scripted player (expert)");
+    assert!(
+        said.contains("never trained with the abilities of profile `lower-jumper`: the scripted expert, who plays with any abilities, plays in its place"),
+        "{said}"
+    );
+    let (shipped, said) = played(&["--profile", &path("lower.yaml"), "--solver", "policy"]);
     assert!(
         shipped.ends_with("policies/platform/solver.safetensors"),
         "{shipped}"
@@ -1090,6 +1097,29 @@ fn the_shipped_ability_aware_solver_plays_a_profile_within_its_range() {
     let panel = stats.panel.expect("--panel records the panel");
     let arlpcg = panel.judges.iter().find(|j| j.judge == "arlpcg").unwrap();
     assert_eq!(arlpcg.policy.as_ref(), Some(policy));
+    // Beyond both Solvers' abilities, the scripted expert verifies what is generated, and says so.
+    let stood_in = path("stood-in");
+    let out = arlpcg_ok(words(
+        "generate --policies policies/platform --aux 1 --profile {} --count 1 --verify 2 --format yaml --out {}",
+        &[&path("lower.yaml"), &stood_in],
+    ));
+    assert!(
+        stderr(&out)
+            .contains("the scripted expert, who plays with any abilities, plays in its place"),
+        "{}",
+        stderr(&out)
+    );
+    let (_, yaml) = files_of(Path::new(&stood_in)).remove(0);
+    let level = arlpcg_core::level::yaml::parse(std::str::from_utf8(&yaml).unwrap()).unwrap();
+    assert!(
+        matches!(
+            level.stats.unwrap().solver,
+            arlpcg_core::level::SolverRef::Scripted {
+                skill: arlpcg_core::game::Skill::Expert
+            }
+        ),
+        "the scripted expert verifies"
+    );
 }
 
 /// A profile's piece ranges: `init` prints them, levels of both games keep within them, and a
@@ -1294,7 +1324,7 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
     );
     // A campaign judged by it refuses the same profile before it searches.
     let campaign = arlpcg(words(
-        "campaign --policies {} --profile {} --levels 1 --ramp {} --out {}",
+        "campaign --policies {} --judge arlpcg --profile {} --levels 1 --ramp {} --out {}",
         &[&run, &path("far.yaml"), &"0:0.5, 1:0.5", &path("campaign")],
     ));
     fails_with(&campaign, 1, "profile `far` lies beyond the abilities");

@@ -29,7 +29,7 @@ pub const FIRST_POOL: usize = 4;
 
 mod policy;
 mod summary;
-pub use policy::{ProfileFit, SolverPolicy};
+pub use policy::{ProfileFit, SolverPolicy, default_player};
 pub use summary::{FailureConcentration, HalfwaySplit, Summary, pacing_chart, passed_by_piece};
 
 /// Who plays the trials.

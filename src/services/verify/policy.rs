@@ -1,10 +1,14 @@
 //! A trained Solver ready to play, and how it stands to the abilities of a profile it is to play
-//! under (who plays a level made for other abilities: [`SolverPolicy::or_aware`]).
+//! under (who plays a level made for other abilities: [`SolverPolicy::or_aware`], and where no
+//! player was named, [`default_player`]).
 
 use arlpcg_core::level::profile::{Abilities, Profile, main_abilities};
 use arlpcg_core::level::{Game, Level, PolicyRef};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::ActorCritic;
+
+use super::Solver;
+use arlpcg_core::game::Skill;
 
 /// A trained Solver, ready to play.
 pub struct SolverPolicy {
@@ -85,6 +89,38 @@ impl SolverPolicy {
         self.fit(played) != ProfileFit::Fits && aware.fit(played) == ProfileFit::Fits
     }
 
+    /// Who plays in its place under `played` when no player was named
+    /// ([`default_player`]): none where it trained with those abilities, else the scripted
+    /// expert and the line that says why.
+    pub fn stand_in(&self, played: Option<&Profile>) -> Option<(Skill, String)> {
+        let name = |profile: Option<&Profile>| {
+            profile.map_or("the built-in abilities".to_string(), |p| {
+                format!("profile `{}`", p.name)
+            })
+        };
+        let why = match self.fit(played) {
+            ProfileFit::Fits => return None,
+            ProfileFit::Untrained(_) => format!(
+                "the Solver policy {} never trained with the abilities of {}",
+                self.reference.path,
+                name(played)
+            ),
+            ProfileFit::Beyond(_) => format!(
+                "{} lies beyond the abilities the Solver policy {} trained over (within ±{:.0}% of {})",
+                name(played),
+                self.reference.path,
+                100.0 * self.ability_spread.unwrap_or(0.0),
+                name(self.profile.as_ref())
+            ),
+        };
+        Some((
+            Skill::Expert,
+            format!(
+                "{why}: the scripted expert, who plays with any abilities, plays in its place (name a Solver policy to have it play anyway)"
+            ),
+        ))
+    }
+
     /// What it observes after the game's observation on `level`: for an ability-aware Solver
     /// the level's main abilities relative to ours, else nothing.
     pub(super) fn ability_row(&self, level: &Level) -> Vec<f32> {
@@ -93,5 +129,21 @@ impl SolverPolicy {
         }
         let played = Abilities::of(level.profile.as_ref(), level.game());
         played.relative_main().to_vec()
+    }
+}
+
+/// Who plays under `played` when no player was named: `solver`, or `aware` in its place
+/// ([`SolverPolicy::or_aware`]), where it trained with those abilities; else the scripted
+/// expert, who plays with any abilities, and the line that says why (a command says it and
+/// plays on: it never reports a Solver's play of a character it cannot play).
+pub fn default_player<'a>(
+    solver: &'a SolverPolicy,
+    aware: Option<&'a SolverPolicy>,
+    played: Option<&Profile>,
+) -> (Solver<'a>, Option<String>) {
+    let policy = solver.or_aware(aware, played);
+    match policy.stand_in(played) {
+        None => (Solver::Policy(policy), None),
+        Some((skill, why)) => (Solver::Scripted(skill), Some(why)),
     }
 }

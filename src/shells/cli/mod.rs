@@ -304,8 +304,9 @@ pub struct GenerateArgs {
     pub collision_names: bool,
     /// Play each level this many times with the Solver (with --policies the one beside the
     /// Generator, with --rules the shipped one; under a --profile whose abilities it did not
-    /// train with, the folder's solver-aware.safetensors where its range holds them) and store
-    /// the statistics in the YAML.
+    /// train with, the folder's solver-aware.safetensors where its range holds them, else the
+    /// scripted expert, who plays with any abilities, and a line says so) and store the
+    /// statistics in the YAML.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub verify: Option<u32>,
     /// Play --verify and --target-success with this Solver policy (.safetensors) instead of the
@@ -496,7 +497,8 @@ pub struct VerifyArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Who plays (default: the trained Solver of the level's game when one is found, else the
-    /// scripted player).
+    /// scripted player; on a level made for abilities no shipped Solver trained with, the
+    /// scripted expert, and a line says so).
     #[arg(long, value_enum)]
     pub solver: Option<SolverChoice>,
     /// The Solver policy file (.safetensors) for --solver policy (default:
@@ -586,7 +588,8 @@ pub struct CampaignArgs {
     pub profile: Option<PathBuf>,
     /// Whose success the ramp asks for: a Solver of --policies named by its training mode
     /// (arlpcg, rule-pcg, fixed-track, fixed-aux) or the scripted player (scripted-novice,
-    /// scripted-median, scripted-expert). Default: arlpcg.
+    /// scripted-median, scripted-expert). Default: arlpcg, or scripted-expert under a --profile
+    /// whose abilities the folder's Solvers never trained with (a line says so).
     #[arg(long, value_name = "NAME", value_parser = Judge::parse)]
     pub judge: Option<Judge>,
     /// Runs per level, for the judge's search and for each judge of the panel.

@@ -26,6 +26,7 @@ use crate::shells::cli::{CampaignArgs, VerifyArgs};
 use crate::shells::common::{
     ChecksFailed, Interrupted, check_panel_fit, progress_bar, shipped_dir,
 };
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::{Level, yaml};
 use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::statistics::population::Population;
@@ -52,7 +53,11 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         Some(dir) => dir.clone(),
         None => shipped_dir(args.game)?,
     };
-    let judge = args.judge.unwrap_or(Judge::Solver(TrainMode::Arlpcg));
+    let profile = match &args.profile {
+        Some(file) => Some(profile::for_game(profile::load(file)?, args.game, file)?),
+        None => None,
+    };
+    let judge = campaign_judge(args, &dir, profile.as_ref())?;
     let ask = CampaignAsk {
         game: args.game,
         seed: args.seed,
@@ -60,10 +65,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         trials: args.trials,
         ramp: args.ramp.clone(),
         pacing: args.pacing.clone(),
-        profile: match &args.profile {
-            Some(file) => Some(profile::for_game(profile::load(file)?, args.game, file)?),
-            None => None,
-        },
+        profile,
         checks: args.checks.clone(),
         population: match args.population {
             Some((theta_mean, theta_sd)) => PopulationAsk::Given(Population {
@@ -480,6 +482,27 @@ pub fn report_checks(
         failed.len()
     ))
     .into())
+}
+
+/// The judge `--judge` names, else the folder's Solver where it trained with the abilities of
+/// `profile` (or its ability-aware Solver where that one did), else the scripted expert, who
+/// plays with any abilities ([`crate::services::verify::default_player`]; the campaign records the judge that played).
+fn campaign_judge(args: &CampaignArgs, dir: &Path, profile: Option<&Profile>) -> Result<Judge> {
+    if let Some(judge) = args.judge {
+        return Ok(judge);
+    }
+    let solver = Judge::Solver(TrainMode::Arlpcg);
+    let panel = load_panel(dir, args.game, Some(&[solver]))?;
+    let Solver::Policy(policy) = panel.solver(0, profile) else {
+        return Ok(solver);
+    };
+    Ok(match policy.stand_in(profile) {
+        None => solver,
+        Some((skill, why)) => {
+            crate::warn!("{why}");
+            Judge::Scripted(skill)
+        }
+    })
 }
 
 /// `verify --campaign FILE`: the judge and the panel play every level of the campaign again

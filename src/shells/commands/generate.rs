@@ -398,7 +398,8 @@ fn template(args: &GenerateArgs) -> Result<LevelRequest> {
 
 /// The Solver that plays `--verify` and `--target-success`: the judge asked for, the file asked
 /// for, the one beside the Generator, or the shipped one (of a folder, the one that plays under
-/// `profile`); none for the scripted player or when nothing is verified.
+/// `profile`, where one trained with its abilities); none for the scripted player (the expert
+/// where a folder's Solvers cannot play the profile) or when nothing is verified.
 fn chosen_solver(
     args: &GenerateArgs,
     verify_trials: Option<u32>,
@@ -412,17 +413,24 @@ fn chosen_solver(
             load_judge_under(&policies_dir(args)?, args.game, judge, profile)?
         }
         (Some(_), None, Some(path)) => Some(load_solver(path, args.game)?.0),
-        (Some(_), None, None) => match (&args.policies, &shipped) {
-            (Some(dir), _) => Some(load_folder_solver(dir, args.game, profile)?),
-            (None, Ok(solver)) if solver.exists() => Some(load_folder_solver(
-                solver
+        (Some(_), None, None) => {
+            let folder = match (&args.policies, &shipped) {
+                (Some(dir), _) => dir.as_path(),
+                (None, Ok(solver)) if solver.exists() => solver
                     .parent()
                     .expect("the Solver file of a policies folder"),
-                args.game,
-                profile,
-            )?),
-            (None, _) => None,
-        },
+                (None, _) => return Ok(None),
+            };
+            let policy = load_folder_solver(folder, args.game, profile)?;
+            // A folder's Solver that cannot play the character gives way to the scripted expert.
+            match policy.stand_in(profile) {
+                None => Some(policy),
+                Some((_, why)) => {
+                    crate::warn!("{why}");
+                    None
+                }
+            }
+        }
     })
 }
 

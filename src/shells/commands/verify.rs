@@ -15,7 +15,7 @@ use crate::services::policies::{load_aware_solver, load_panel, load_solver};
 use crate::services::profile;
 use crate::services::verify::{
     FailureConcentration, HalfwaySplit, ProfileFit, Solver, SolverPolicy, Summary, Watch,
-    passed_by_piece, verify,
+    default_player, passed_by_piece, verify,
 };
 use crate::shells::cli::{Judges, SolverChoice, VerifyArgs, default_solver};
 use crate::shells::common::{panel_fit, shipped_dir};
@@ -383,14 +383,21 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
 #[derive(Default)]
 struct Solvers {
     resolved: HashMap<Game, Resolved>,
-    /// Whether the run has said that a policy plays under a profile it never trained with.
-    warned_profile: bool,
+    /// What the run has said of a policy that plays, or gives way, under a profile it never
+    /// trained with (each line once).
+    said: HashSet<String>,
 }
 
 enum Resolved {
     /// A Solver policy and, for the shipped one, the shipped ability-aware Solver that plays
-    /// levels made for abilities it did not train with ([`SolverPolicy::or_aware`]).
-    Policy(Box<SolverPolicy>, Option<Box<SolverPolicy>>),
+    /// levels made for abilities it did not train with ([`SolverPolicy::or_aware`]). Unless
+    /// `named` (by --policy or --solver policy), the scripted expert plays levels made for
+    /// abilities neither trained with ([`default_player`]).
+    Policy {
+        policy: Box<SolverPolicy>,
+        aware: Option<Box<SolverPolicy>>,
+        named: bool,
+    },
     Scripted(Skill),
     Random,
 }
@@ -410,14 +417,22 @@ impl Solvers {
         });
         let resolved = match choice {
             SolverChoice::Policy => match &args.policy {
-                Some(policy) => Resolved::Policy(Box::new(load_solver(policy, game)?.0), None),
+                Some(policy) => Resolved::Policy {
+                    policy: Box::new(load_solver(policy, game)?.0),
+                    aware: None,
+                    named: true,
+                },
                 None => {
                     let policy = shipped.as_ref().map_err(|e| anyhow::anyhow!("{e:#}"))?;
                     let dir = policy
                         .parent()
                         .expect("the Solver file of a policies folder");
                     let aware = load_aware_solver(dir, game)?.map(Box::new);
-                    Resolved::Policy(Box::new(load_solver(policy, game)?.0), aware)
+                    Resolved::Policy {
+                        policy: Box::new(load_solver(policy, game)?.0),
+                        aware,
+                        named: args.solver.is_some(),
+                    }
                 }
             },
             SolverChoice::Random => Resolved::Random,
@@ -425,10 +440,18 @@ impl Solvers {
         };
         if !args.json {
             let who = match &resolved {
-                Resolved::Policy(p, None) => format!("policy {}", p.reference.path),
-                Resolved::Policy(p, Some(aware)) => format!(
+                Resolved::Policy {
+                    policy,
+                    aware: None,
+                    ..
+                } => format!("policy {}", policy.reference.path),
+                Resolved::Policy {
+                    policy,
+                    aware: Some(aware),
+                    ..
+                } => format!(
                     "policy {} (under other abilities, {})",
-                    p.reference.path, aware.reference.path
+                    policy.reference.path, aware.reference.path
                 ),
                 Resolved::Scripted(_) if args.solver.is_none() => match &shipped {
                     Ok(path) => {
@@ -446,29 +469,43 @@ impl Solvers {
     }
 
     /// Says once that a Solver policy plays a level made for abilities other than those it
-    /// trained with; refuses a level beyond an ability-aware policy's range.
+    /// trained with, or gives way to the scripted expert there; refuses a level beyond a named
+    /// ability-aware policy's range.
     fn check_profile(&mut self, level: &Level, file: &Path) -> Result<()> {
-        let Solver::Policy(policy) = self.get(level) else {
+        let Resolved::Policy {
+            policy,
+            aware,
+            named,
+        } = &self.resolved[&level.game()]
+        else {
             return Ok(());
         };
-        let fit = policy.fit(level.profile.as_ref());
-        match fit {
-            ProfileFit::Fits => {}
-            ProfileFit::Beyond(problem) => anyhow::bail!("{}: {problem}", file.display()),
-            ProfileFit::Untrained(said) if !self.warned_profile => {
-                self.warned_profile = true;
-                crate::warn!("{said}");
-            }
-            ProfileFit::Untrained(_) => {}
+        let played = level.profile.as_ref();
+        let said = match default_player(policy, aware.as_deref(), played) {
+            (_, Some(gave_way)) if !named => gave_way,
+            _ => match policy.or_aware(aware.as_deref(), played).fit(played) {
+                ProfileFit::Fits => return Ok(()),
+                ProfileFit::Beyond(problem) => anyhow::bail!("{}: {problem}", file.display()),
+                ProfileFit::Untrained(said) => said,
+            },
+        };
+        if self.said.insert(said.clone()) {
+            crate::warn!("{said}");
         }
         Ok(())
     }
 
     /// Who plays `level`.
     fn get(&self, level: &Level) -> Solver<'_> {
+        let played = level.profile.as_ref();
         match &self.resolved[&level.game()] {
-            Resolved::Policy(p, aware) => {
-                Solver::Policy(p.or_aware(aware.as_deref(), level.profile.as_ref()))
+            Resolved::Policy {
+                policy,
+                aware,
+                named: false,
+            } => default_player(policy, aware.as_deref(), played).0,
+            Resolved::Policy { policy, aware, .. } => {
+                Solver::Policy(policy.or_aware(aware.as_deref(), played))
             }
             Resolved::Scripted(skill) => Solver::Scripted(*skill),
             Resolved::Random => Solver::Random,

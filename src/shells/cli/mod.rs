@@ -1,24 +1,21 @@
 //! The command line: one argument struct per subcommand (clap derive), with the help a designer
-//! reads. Parsing only; [`crate::shells::commands`] runs them.
+//! reads. Parsing only; [`crate::shells::commands`] runs them. Here the top level, the designer,
+//! `report`, `eval` and `train`; `making.rs` holds `generate`'s and the exports', `playing.rs`
+//! `verify`'s and `campaign`'s, `values.rs` the parsers of argument values.
 
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+mod making;
+mod playing;
 mod values;
+pub use making::{ExportArgs, ExportPolicyArgs, FormatArg, GenerateArgs};
+pub use playing::{CampaignArgs, SolverChoice, VerifyArgs, default_solver};
 pub use values::{Judges, KeepArg, Shard};
-use values::{
-    parse_ability_spread, parse_aux, parse_contract, parse_game, parse_judges, parse_keep,
-    parse_minutes, parse_point, parse_population, parse_retry, parse_shard, parse_target,
-};
+use values::{parse_ability_spread, parse_game, parse_minutes, parse_shard};
 
-use crate::services::campaign::Ramp;
-use crate::services::checks::Check;
-use crate::services::generation::Ask;
-use crate::services::panel::Judge;
-use arlpcg_core::game::Skill;
 use arlpcg_core::level::Game;
-use arlpcg_core::level::pacing::AuxCurve;
 use arlpcg_core::rl::checkpoint::TrainMode;
 
 /// The command line.
@@ -234,195 +231,6 @@ pub struct EvalArgs {
     pub profile: Option<PathBuf>,
 }
 
-/// Output file formats of `generate`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum FormatArg {
-    /// The level file (source of truth; `arlpcg export` and `verify` read it).
-    Yaml,
-    /// glTF 2.0, one binary file.
-    Glb,
-    /// glTF 2.0 as JSON with a separate .bin buffer.
-    Gltf,
-}
-
-/// `generate`'s arguments.
-#[derive(Debug, Args)]
-#[command(group(clap::ArgGroup::new("source").required(true).args(["rules", "policies"])))]
-pub struct GenerateArgs {
-    /// Which game.
-    #[arg(long, default_value = "platform", value_parser = parse_game)]
-    pub game: Game,
-    /// Use the rule-based generator (random parameters within the game's ranges, kept valid
-    /// and within the character's or the car's ability).
-    #[arg(long)]
-    pub rules: bool,
-    /// Racing: place this many obstacles between the start and the goal, which the road (of the
-    /// rules or of the Generator) goes around. The racing Generator trained with 3, and its
-    /// λ→success curve for --target-success is measured with 3.
-    #[arg(long, value_name = "N", default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=200))]
-    pub obstacles: u32,
-    /// Use the trained Generator in this folder (generator.safetensors; --verify plays the
-    /// solver.safetensors beside it). The shipped one: policies/platform.
-    #[arg(long, value_name = "DIR")]
-    pub policies: Option<PathBuf>,
-    /// How many levels; level i uses seed SEED + i.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
-    pub count: u32,
-    /// Seed of the first level: the same seed gives the same level, byte for byte.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
-    /// The aux input λ in [-1, 1]: +1 easy, -1 hard (required with --policies). The rule-based
-    /// generator only records it.
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_aux)]
-    pub aux: Option<f64>,
-    /// λ along the level instead of one λ (with --policies): control points `fraction:λ`,
-    /// where fraction is the share of the start-to-goal distance covered (0 start, 1 goal),
-    /// linear between points. "0:1, 0.5:1, 0.6:-1, 1:-1" is easy up to halfway, then hard;
-    /// two points at one fraction are a step ("0:1, 0.5:1, 0.5:-1, 1:-1"). Each piece records
-    /// the λ it was built at.
-    #[arg(long, value_name = "CURVE", allow_hyphen_values = true, value_parser = AuxCurve::parse, conflicts_with_all = ["aux", "target_success"])]
-    pub aux_curve: Option<AuxCurve>,
-    /// Keep the first K pieces of an existing level (generated or hand-written) and let the
-    /// Generator build the rest from there, with --aux or --aux-curve and this run's seed. The
-    /// kept pieces are written exactly as they were; the file's `source` names the level kept
-    /// from (path and SHA-256) and how many pieces.
-    #[arg(long, value_name = "LEVEL.yaml:K", value_parser = parse_keep, requires = "policies", conflicts_with_all = ["goal", "target_success"])]
-    pub keep: Option<KeepArg>,
-    /// Goal position x,y,z in metres (default: drawn from the seed).
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_point)]
-    pub goal: Option<[f64; 3]>,
-    /// Folder to write into (created if missing).
-    #[arg(long)]
-    pub out: PathBuf,
-    /// File formats to write, comma-separated.
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "yaml,glb")]
-    pub format: Vec<FormatArg>,
-    /// Name every solid node of the glTF with Godot's `-col` import hint, so that Godot 3 (which
-    /// ignores the physics extension) makes a static body for each. Not for Godot 4.3 and later,
-    /// which read the extension and would make two.
-    #[arg(long)]
-    pub collision_names: bool,
-    /// Play each level this many times with the Solver (with --policies the one beside the
-    /// Generator, with --rules the shipped one; under a --profile whose abilities it did not
-    /// train with, the folder's solver-aware.safetensors where its range holds them, else the
-    /// scripted expert, who plays with any abilities, and a line says so) and store the
-    /// statistics in the YAML.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
-    pub verify: Option<u32>,
-    /// Play --verify and --target-success with this Solver policy (.safetensors) instead of the
-    /// one beside the Generator or the shipped one.
-    #[arg(long, value_name = "FILE")]
-    pub solver_policy: Option<PathBuf>,
-    /// Play --verify and --target-success with this judge instead: a Solver of --policies (or
-    /// policies/<game>) named by its training mode (arlpcg, rule-pcg, fixed-track, fixed-aux),
-    /// or the scripted player (scripted-novice, scripted-median, scripted-expert).
-    #[arg(long, value_name = "NAME", value_parser = Judge::parse, conflicts_with = "solver_policy")]
-    pub judge: Option<Judge>,
-    /// With --verify, also play each level with the panel of judges (every Solver of --policies
-    /// or policies/<game>, and the scripted player at three skills), and record each judge's
-    /// success and the level's difficulty b, rated over the levels of this batch.
-    #[arg(long, requires = "verify")]
-    pub panel: bool,
-    /// Replace files that already exist (by default nothing is overwritten; files identical to
-    /// what this run makes are left as they are, so a re-run finishes an interrupted batch).
-    #[arg(long)]
-    pub force: bool,
-    /// Ask for a success rate instead of λ (0 < P < 1, with --policies): each level is searched
-    /// (λ and draws) until its measured success is within ±0.1 of P; the λ used is recorded.
-    /// Verifies with 100 runs unless --verify says otherwise. The policies' λ→success curve is
-    /// measured once and kept as difficulty-curve.yaml beside them.
-    #[arg(long, value_name = "P", allow_hyphen_values = true, value_parser = parse_target, conflicts_with = "aux")]
-    pub target_success: Option<f64>,
-    /// With --verify, keep a level that no run completed. By default it is redrawn (the next
-    /// level of the seed, toward the same goal; after 10 such draws a Generator's λ is eased by
-    /// 0.25, and the level records the λ it was built at), and each level records one
-    /// successful run's seed as its certificate (`verify --replay` re-runs it).
-    #[arg(long, requires = "verify")]
-    pub allow_unsolved: bool,
-    /// Make the levels for this game profile (`arlpcg profile init`): the character's or car's
-    /// abilities, which --verify plays with; each level records it. Default: the built-in one.
-    #[arg(long, value_name = "FILE")]
-    pub profile: Option<PathBuf>,
-    /// Acceptance check on every level (repeatable): `success LO..HI` (the success ratio),
-    /// `b LO..HI` (the panel's difficulty, with --panel) or `completed`. A level fails a range
-    /// only when its 95% interval lies wholly outside it; any failure ends the run with exit
-    /// code 3 and names each level and check (the files are written all the same).
-    #[arg(long = "check", value_name = "CHECK", value_parser = Check::parse)]
-    pub checks: Vec<Check>,
-    /// Make only shard I of K of the batch (0 <= I < K): level i of the batch when i mod K = I.
-    /// K machines with I = 0..K-1 together write exactly the files of the whole batch.
-    #[arg(long, value_name = "I/K", value_parser = parse_shard)]
-    pub shard: Option<Shard>,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
-    pub threads: Option<u64>,
-}
-
-/// `export`'s arguments.
-#[derive(Debug, Args)]
-pub struct ExportArgs {
-    /// The level file (.yaml).
-    pub level: PathBuf,
-    /// Output file: .glb for binary glTF, .gltf for JSON glTF plus a .bin beside it.
-    #[arg(long)]
-    pub out: PathBuf,
-    /// Name every solid node of the glTF with Godot's `-col` import hint, so that Godot 3 (which
-    /// ignores the physics extension) makes a static body for each. Not for Godot 4.3 and later,
-    /// which read the extension and would make two.
-    #[arg(long)]
-    pub collision_names: bool,
-    /// Replace files that already exist.
-    #[arg(long)]
-    pub force: bool,
-}
-
-/// `export-policy`'s arguments.
-#[derive(Debug, Args)]
-#[command(
-    after_help = "The graph takes raw observations (the normalizer is inside) and gives \
-    the deterministic actions this tool plays with. The sidecar (OUT.json) lists the observation \
-    layout, each output's meaning and example rows with their expected outputs.\n\n\
-    Examples:\n  \
-    arlpcg export-policy policies/racing/solver.safetensors --out racing-solver.onnx\n  \
-    arlpcg export-policy policies/platform/solver.safetensors --contract mlagents --out Platform.onnx"
-)]
-pub struct ExportPolicyArgs {
-    /// The policy file (.safetensors): a Solver or a Generator of either game.
-    pub policy: PathBuf,
-    /// Output file (.onnx); the sidecar goes beside it as OUT.json.
-    #[arg(long)]
-    pub out: PathBuf,
-    /// Whose names the graph uses: `plain` (this tool's) or `mlagents` (ML-Agents' model
-    /// contract, for Unity's Inference Engine). Also accepted as --profile, its former name.
-    #[arg(long, alias = "profile", default_value = "plain", value_parser = parse_contract)]
-    pub contract: crate::services::onnx::Contract,
-    /// Replace files that already exist.
-    #[arg(long)]
-    pub force: bool,
-}
-
-impl GenerateArgs {
-    /// What difficulty is asked for (clap refuses two of `--aux`, `--aux-curve` and
-    /// `--target-success` together); none for rule levels that record no λ.
-    pub fn ask(&self) -> Option<Ask> {
-        match (self.target_success, &self.aux_curve, self.aux) {
-            (Some(target), _, _) => Some(Ask::Success(target)),
-            (None, Some(curve), _) => Some(Ask::Curve(curve.clone())),
-            (None, None, aux) => aux.map(Ask::Aux),
-        }
-    }
-}
-
-impl From<FormatArg> for crate::services::level_files::Format {
-    fn from(format: FormatArg) -> Self {
-        match format {
-            FormatArg::Yaml => Self::Yaml,
-            FormatArg::Glb => Self::Glb,
-            FormatArg::Gltf => Self::Gltf,
-        }
-    }
-}
-
 /// How a Solver is trained (`train --mode`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum TrainModeArg {
@@ -445,187 +253,6 @@ impl From<TrainModeArg> for TrainMode {
             TrainModeArg::Arlpcg => Self::Arlpcg,
         }
     }
-}
-
-/// Who plays the verification trials.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum SolverChoice {
-    /// A trained Solver policy (--policy, default policies/<game>/solver.safetensors).
-    Policy,
-    /// The scripted player (no learning) at its best. Platform: faces the next block, runs,
-    /// jumps at the edge. Racing: pure pursuit of the centre line at the speed the road ahead
-    /// allows.
-    #[value(name = "scripted-expert", alias = "scripted")]
-    ScriptedExpert,
-    /// The scripted player with an average player's mistakes (take-off timing and run-up speed;
-    /// grip misjudged, steering wobble).
-    ScriptedMedian,
-    /// The scripted player with a beginner's mistakes.
-    ScriptedNovice,
-    /// Uniformly random actions (a baseline).
-    Random,
-}
-
-impl SolverChoice {
-    /// The scripted player's skill, for the scripted choices.
-    pub fn skill(self) -> Option<Skill> {
-        match self {
-            SolverChoice::ScriptedExpert => Some(Skill::Expert),
-            SolverChoice::ScriptedMedian => Some(Skill::Median),
-            SolverChoice::ScriptedNovice => Some(Skill::Novice),
-            SolverChoice::Policy | SolverChoice::Random => None,
-        }
-    }
-}
-
-/// Where the shipped Solver of `game` lives (an error names the places looked at for the
-/// shipped policies: [`crate::shells::common::policies_root`]).
-pub fn default_solver(game: Game) -> anyhow::Result<PathBuf> {
-    Ok(crate::shells::common::shipped_dir(game)?.join(crate::services::policies::SOLVER_FILE))
-}
-
-/// `verify`'s arguments.
-#[derive(Debug, Args)]
-pub struct VerifyArgs {
-    /// Level files (.yaml).
-    #[arg(required_unless_present = "campaign")]
-    pub levels: Vec<PathBuf>,
-    /// Runs per level.
-    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
-    pub trials: u32,
-    /// Seed of the first run; run i uses SEED + i.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
-    /// Who plays (default: the trained Solver of the level's game when one is found, else the
-    /// scripted player; on a level made for abilities no shipped Solver trained with, the
-    /// scripted expert, and a line says so).
-    #[arg(long, value_enum)]
-    pub solver: Option<SolverChoice>,
-    /// The Solver policy file (.safetensors) for --solver policy (default:
-    /// policies/<game>/solver.safetensors for each level's game, and on a level made for
-    /// abilities it did not train with policies/<game>/solver-aware.safetensors where that
-    /// file's range holds them).
-    #[arg(long)]
-    pub policy: Option<PathBuf>,
-    /// Print one JSON object per level instead of text.
-    #[arg(long)]
-    pub json: bool,
-    /// Draw the level's difficulty along the way as a PNG: the share of runs that get past
-    /// each piece, and the difficulty its λ asked for (one level only).
-    #[arg(long, value_name = "FILE.png", conflicts_with = "replay")]
-    pub chart: Option<PathBuf>,
-    /// Instead of new trials, re-run each level's certificate (the successful run its
-    /// statistics record) with the Solver that recorded it, and check that it succeeds again.
-    #[arg(long, conflicts_with_all = ["solver", "policy", "trials", "json"])]
-    pub replay: bool,
-    /// Play each level with a panel of judges (comma-separated; alone: every Solver in
-    /// --policies and the scripted player at three skills) and rate its difficulty b over
-    /// judges × levels: P(judge succeeds) = σ(θ_judge − b). Judges: arlpcg, rule-pcg,
-    /// fixed-track, fixed-aux, scripted-novice, scripted-median, scripted-expert.
-    #[arg(long, value_name = "JUDGES", num_args = 0..=1, default_missing_value = "",
-          value_parser = parse_judges, conflicts_with_all = ["solver", "policy", "replay", "chart"])]
-    pub panel: Option<Judges>,
-    /// The policies folder the panel's Solvers (and a campaign's judge) come from (default: the
-    /// shipped policies/<game>: $ARLPCG_POLICIES, else ./policies, else beside the binary).
-    #[arg(long)]
-    pub policies: Option<PathBuf>,
-    /// Play under this game profile (`arlpcg profile init`): the character's or car's abilities.
-    /// Default: the profile each level records, else the built-in one.
-    #[arg(long, value_name = "FILE")]
-    pub profile: Option<PathBuf>,
-    /// Acceptance check on every level (repeatable): `success LO..HI` (the success ratio),
-    /// `b LO..HI` (the panel's difficulty, with --panel) or `completed`. A level fails a range
-    /// only when its 95% interval lies wholly outside it; any failure ends the run with exit
-    /// code 3 and names each level and check .
-    #[arg(long = "check", value_name = "CHECK", value_parser = Check::parse)]
-    pub checks: Vec<Check>,
-    /// Re-play and re-report a campaign (its campaign.yaml, e.g. after editing its levels or
-    /// checks): the judge and the panel play every level again, the population goes through,
-    /// the report goes to standard output and its checks (and --check) are applied. Writes
-    /// nothing.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["solver", "policy", "replay", "chart", "panel", "json", "levels"])]
-    pub campaign: Option<PathBuf>,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
-    pub threads: Option<u64>,
-}
-
-/// `campaign`'s arguments.
-#[derive(Debug, Args)]
-#[command(after_help = "Examples:\n  \
-    arlpcg campaign --game platform --levels 10 --ramp \"0:0.95, 1:0.5\" --judge scripted-median --out campaigns/first\n  \
-    arlpcg campaign --game racing --levels 8 --ramp \"0:0.9, 0.5:0.9, 0.5:0.6, 1:0.6\" --check \"success 0.4..1\" --out campaigns/racing\n  \
-    arlpcg campaign --game platform --levels 10 --ramp \"0:0.95, 1:0.5\" --out campaigns/first --resume\n  \
-    arlpcg verify --campaign campaigns/first/campaign.yaml --check \"b -3..3\"\n\n\
-    Exit codes: 0 done, 1 an error (a file, a policy), 2 arguments that do not fit, 3 a level \
-    failed a --check (the files are written), 130 interrupted (--resume finishes).")]
-pub struct CampaignArgs {
-    /// Which game.
-    #[arg(long, default_value = "platform", value_parser = parse_game)]
-    pub game: Game,
-    /// The Generator, the judge and the panel's Solvers (default: the shipped policies/<game>:
-    /// $ARLPCG_POLICIES, else ./policies, else beside the binary; `arlpcg --help`).
-    #[arg(long, value_name = "DIR")]
-    pub policies: Option<PathBuf>,
-    /// How many levels.
-    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=crate::services::campaign::MOST_LEVELS as i64))]
-    pub levels: u32,
-    /// The success asked for along the campaign: control points `position:success`, position 0
-    /// the first level and 1 the last, linear between them ("0:0.95, 1:0.5"; two points at one
-    /// position are a step). Each level is searched (λ and draws) until the judge's success is
-    /// within ±0.1 of its point; then neighbours trade places where both still fit, so that
-    /// the panel's difficulty b rises along the campaign.
-    #[arg(long, value_name = "CURVE", value_parser = Ramp::parse)]
-    pub ramp: Ramp,
-    /// The shape of λ along every level, an aux curve of `fraction:λ` points ("0:1, 1:-1": easy,
-    /// then hard). Each level's search moves the whole curve up or down (its mean is the λ
-    /// searched) until the judge's success fits the ramp. Default: one λ per level.
-    #[arg(long, value_name = "CURVE", allow_hyphen_values = true, value_parser = AuxCurve::parse)]
-    pub pacing: Option<AuxCurve>,
-    /// Make every level for this game profile (`arlpcg profile init`); campaign.yaml and each
-    /// level record it. Default: the built-in one.
-    #[arg(long, value_name = "FILE")]
-    pub profile: Option<PathBuf>,
-    /// Whose success the ramp asks for: a Solver of --policies named by its training mode
-    /// (arlpcg, rule-pcg, fixed-track, fixed-aux) or the scripted player (scripted-novice,
-    /// scripted-median, scripted-expert). Default: arlpcg, or scripted-expert under a --profile
-    /// whose abilities the folder's Solvers never trained with (a line says so).
-    #[arg(long, value_name = "NAME", value_parser = Judge::parse)]
-    pub judge: Option<Judge>,
-    /// Runs per level, for the judge's search and for each judge of the panel.
-    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(crate::services::campaign::TRIALS.0 as i64..=crate::services::campaign::TRIALS.1 as i64))]
-    pub trials: u32,
-    /// Level k is searched from seed SEED + k: the same seed gives the same campaign, byte for
-    /// byte.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
-    /// The players' ability θ ~ Normal(MEAN, SD) on the panel's logit scale. Default: fitted
-    /// so that the scripted novice, median and expert are its 10th, 50th and 90th percentiles.
-    #[arg(long, value_name = "MEAN,SD", allow_hyphen_values = true, value_parser = parse_population)]
-    pub population: Option<(f64, f64)>,
-    /// The chance that a player tries a level again after failing it (else quits).
-    #[arg(long, value_name = "P", default_value_t = arlpcg_core::statistics::population::DEFAULT_RETRY, value_parser = parse_retry)]
-    pub retry: f64,
-    /// Acceptance check on every level (repeatable): `success LO..HI` (the success ratio),
-    /// `b LO..HI` (the panel's difficulty) or `completed`. A level fails a range
-    /// only when its 95% interval lies wholly outside it; any failure ends the run with exit
-    /// code 3 and names each level and check (the files are written all the same).
-    #[arg(long = "check", value_name = "CHECK", value_parser = Check::parse)]
-    pub checks: Vec<Check>,
-    /// Level file formats, comma-separated.
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "yaml,glb")]
-    pub format: Vec<FormatArg>,
-    /// Folder to write into (created if missing).
-    #[arg(long)]
-    pub out: PathBuf,
-    /// Finish an interrupted campaign in --out: its level files are kept and the rest made. The
-    /// same arguments: a level searched for another --ramp or verified with other --trials is
-    /// refused.
-    #[arg(long)]
-    pub resume: bool,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
-    pub threads: Option<u64>,
 }
 
 /// `train`'s arguments.
@@ -698,6 +325,7 @@ pub struct TrainArgs {
 
 #[cfg(test)]
 mod tests {
+    use super::values::{parse_aux, parse_point};
     use super::*;
 
     #[test]

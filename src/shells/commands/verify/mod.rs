@@ -1,5 +1,7 @@
 //! `arlpcg verify`: play each level many times and report the Solver's statistics, then a
-//! summary over all the levels.
+//! summary over all the levels. Who plays: `players.rs`.
+
+mod players;
 
 use std::collections::hash_map::Entry;
 use std::collections::{HashMap, HashSet};
@@ -11,20 +13,19 @@ use serde_json::json;
 use super::campaign::report_checks;
 use crate::services::checks::{Check, failures};
 use crate::services::panel::{JudgePanel, rate};
-use crate::services::policies::{load_aware_solver, load_panel, load_solver};
+use crate::services::policies::{load_panel, load_solver};
 use crate::services::profile;
 use crate::services::verify::{
-    FailureConcentration, HalfwaySplit, ProfileFit, Solver, SolverPolicy, Summary, Watch,
-    default_player, passed_by_piece, verify,
+    FailureConcentration, HalfwaySplit, Solver, Summary, Watch, passed_by_piece, verify,
 };
-use crate::shells::cli::{Judges, SolverChoice, VerifyArgs, default_solver};
+use crate::shells::cli::{Judges, VerifyArgs};
 use crate::shells::common::{panel_fit, shipped_dir};
-use arlpcg_core::game::Skill;
 use arlpcg_core::game::facts::facts;
 use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::stats::{Outcome, PanelStats, SolverRef, SolverStats};
 use arlpcg_core::level::yaml;
 use arlpcg_core::level::{Game, Level};
+use players::Solvers;
 
 pub fn run(args: &VerifyArgs) -> Result<()> {
     if let Some(file) = &args.campaign {
@@ -377,140 +378,6 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
         );
     }
     report_checks(&args.checks, checked, args.levels.len(), args.json)
-}
-
-/// The Solver of each game met so far, resolved from the arguments once per game.
-#[derive(Default)]
-struct Solvers {
-    resolved: HashMap<Game, Resolved>,
-    /// What the run has said of a policy that plays, or gives way, under a profile it never
-    /// trained with (each line once).
-    said: HashSet<String>,
-}
-
-enum Resolved {
-    /// A Solver policy and, for the shipped one, the shipped ability-aware Solver that plays
-    /// levels made for abilities it did not train with ([`SolverPolicy::or_aware`]). Unless
-    /// `named` (by --policy or --solver policy), the scripted expert plays levels made for
-    /// abilities neither trained with ([`default_player`]).
-    Policy {
-        policy: Box<SolverPolicy>,
-        aware: Option<Box<SolverPolicy>>,
-        named: bool,
-    },
-    Scripted(Skill),
-    Random,
-}
-
-impl Solvers {
-    /// Resolves the Solver for levels of `game` (once), and says who plays.
-    fn resolve(&mut self, game: Game, args: &VerifyArgs) -> Result<()> {
-        if self.resolved.contains_key(&game) {
-            return Ok(());
-        }
-        let shipped = default_solver(game);
-        let found = shipped.as_ref().is_ok_and(|path| path.exists());
-        let choice = args.solver.unwrap_or(if args.policy.is_some() || found {
-            SolverChoice::Policy
-        } else {
-            SolverChoice::ScriptedExpert
-        });
-        let resolved = match choice {
-            SolverChoice::Policy => match &args.policy {
-                Some(policy) => Resolved::Policy {
-                    policy: Box::new(load_solver(policy, game)?.0),
-                    aware: None,
-                    named: true,
-                },
-                None => {
-                    let policy = shipped.as_ref().map_err(|e| anyhow::anyhow!("{e:#}"))?;
-                    let dir = policy
-                        .parent()
-                        .expect("the Solver file of a policies folder");
-                    let aware = load_aware_solver(dir, game)?.map(Box::new);
-                    Resolved::Policy {
-                        policy: Box::new(load_solver(policy, game)?.0),
-                        aware,
-                        named: args.solver.is_some(),
-                    }
-                }
-            },
-            SolverChoice::Random => Resolved::Random,
-            scripted => Resolved::Scripted(scripted.skill().expect("the other choices")),
-        };
-        if !args.json {
-            let who = match &resolved {
-                Resolved::Policy {
-                    policy,
-                    aware: None,
-                    ..
-                } => format!("policy {}", policy.reference.path),
-                Resolved::Policy {
-                    policy,
-                    aware: Some(aware),
-                    ..
-                } => format!(
-                    "policy {} (under other abilities, {})",
-                    policy.reference.path, aware.reference.path
-                ),
-                Resolved::Scripted(_) if args.solver.is_none() => match &shipped {
-                    Ok(path) => {
-                        format!("scripted player (no trained Solver at {})", path.display())
-                    }
-                    Err(e) => format!("scripted player ({e:#})"),
-                },
-                Resolved::Scripted(skill) => format!("scripted player ({skill})"),
-                Resolved::Random => "random actions".into(),
-            };
-            crate::warn!("{game} solver: {who}");
-        }
-        self.resolved.insert(game, resolved);
-        Ok(())
-    }
-
-    /// Says once that a Solver policy plays a level made for abilities other than those it
-    /// trained with, or gives way to the scripted expert there; refuses a level beyond a named
-    /// ability-aware policy's range.
-    fn check_profile(&mut self, level: &Level, file: &Path) -> Result<()> {
-        let Resolved::Policy {
-            policy,
-            aware,
-            named,
-        } = &self.resolved[&level.game()]
-        else {
-            return Ok(());
-        };
-        let played = level.profile.as_ref();
-        let said = match default_player(policy, aware.as_deref(), played) {
-            (_, Some(gave_way)) if !named => gave_way,
-            _ => match policy.or_aware(aware.as_deref(), played).fit(played) {
-                ProfileFit::Fits => return Ok(()),
-                ProfileFit::Beyond(problem) => anyhow::bail!("{}: {problem}", file.display()),
-                ProfileFit::Untrained(said) => said,
-            },
-        };
-        if self.said.insert(said.clone()) {
-            crate::warn!("{said}");
-        }
-        Ok(())
-    }
-
-    /// Who plays `level`.
-    fn get(&self, level: &Level) -> Solver<'_> {
-        let played = level.profile.as_ref();
-        match &self.resolved[&level.game()] {
-            Resolved::Policy {
-                policy,
-                aware,
-                named: false,
-            } => default_player(policy, aware.as_deref(), played).0,
-            Resolved::Policy { policy, aware, .. } => {
-                Solver::Policy(policy.or_aware(aware.as_deref(), played))
-            }
-            Resolved::Scripted(skill) => Solver::Scripted(*skill),
-            Resolved::Random => Solver::Random,
-        }
-    }
 }
 
 fn to_json(path: &Path, level: &Level, s: &SolverStats) -> serde_json::Value {

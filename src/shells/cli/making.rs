@@ -1,0 +1,205 @@
+//! The arguments of the commands that make and export levels: `generate`, `export` and
+//! `export-policy`.
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+
+use super::values::{
+    parse_aux, parse_contract, parse_game, parse_keep, parse_point, parse_shard, parse_target,
+};
+use super::{KeepArg, Shard};
+use crate::services::checks::Check;
+use crate::services::generation::Ask;
+use crate::services::panel::Judge;
+use arlpcg_core::level::Game;
+use arlpcg_core::level::pacing::AuxCurve;
+
+/// Output file formats of `generate`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FormatArg {
+    /// The level file (source of truth; `arlpcg export` and `verify` read it).
+    Yaml,
+    /// glTF 2.0, one binary file.
+    Glb,
+    /// glTF 2.0 as JSON with a separate .bin buffer.
+    Gltf,
+}
+
+/// `generate`'s arguments.
+#[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("source").required(true).args(["rules", "policies"])))]
+pub struct GenerateArgs {
+    /// Which game.
+    #[arg(long, default_value = "platform", value_parser = parse_game)]
+    pub game: Game,
+    /// Use the rule-based generator (random parameters within the game's ranges, kept valid
+    /// and within the character's or the car's ability).
+    #[arg(long)]
+    pub rules: bool,
+    /// Racing: place this many obstacles between the start and the goal, which the road (of the
+    /// rules or of the Generator) goes around. The racing Generator trained with 3, and its
+    /// λ→success curve for --target-success is measured with 3.
+    #[arg(long, value_name = "N", default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=200))]
+    pub obstacles: u32,
+    /// Use the trained Generator in this folder (generator.safetensors; --verify plays the
+    /// solver.safetensors beside it). The shipped one: policies/platform.
+    #[arg(long, value_name = "DIR")]
+    pub policies: Option<PathBuf>,
+    /// How many levels; level i uses seed SEED + i.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub count: u32,
+    /// Seed of the first level: the same seed gives the same level, byte for byte.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// The aux input λ in [-1, 1]: +1 easy, -1 hard (required with --policies). The rule-based
+    /// generator only records it.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_aux)]
+    pub aux: Option<f64>,
+    /// λ along the level instead of one λ (with --policies): control points `fraction:λ`,
+    /// where fraction is the share of the start-to-goal distance covered (0 start, 1 goal),
+    /// linear between points. "0:1, 0.5:1, 0.6:-1, 1:-1" is easy up to halfway, then hard;
+    /// two points at one fraction are a step ("0:1, 0.5:1, 0.5:-1, 1:-1"). Each piece records
+    /// the λ it was built at.
+    #[arg(long, value_name = "CURVE", allow_hyphen_values = true, value_parser = AuxCurve::parse, conflicts_with_all = ["aux", "target_success"])]
+    pub aux_curve: Option<AuxCurve>,
+    /// Keep the first K pieces of an existing level (generated or hand-written) and let the
+    /// Generator build the rest from there, with --aux or --aux-curve and this run's seed. The
+    /// kept pieces are written exactly as they were; the file's `source` names the level kept
+    /// from (path and SHA-256) and how many pieces.
+    #[arg(long, value_name = "LEVEL.yaml:K", value_parser = parse_keep, requires = "policies", conflicts_with_all = ["goal", "target_success"])]
+    pub keep: Option<KeepArg>,
+    /// Goal position x,y,z in metres (default: drawn from the seed).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_point)]
+    pub goal: Option<[f64; 3]>,
+    /// Folder to write into (created if missing).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// File formats to write, comma-separated.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "yaml,glb")]
+    pub format: Vec<FormatArg>,
+    /// Name every solid node of the glTF with Godot's `-col` import hint, so that Godot 3 (which
+    /// ignores the physics extension) makes a static body for each. Not for Godot 4.3 and later,
+    /// which read the extension and would make two.
+    #[arg(long)]
+    pub collision_names: bool,
+    /// Play each level this many times with the Solver (with --policies the one beside the
+    /// Generator, with --rules the shipped one; under a --profile whose abilities it did not
+    /// train with, the folder's solver-aware.safetensors where its range holds them, else the
+    /// scripted expert, who plays with any abilities, and a line says so) and store the
+    /// statistics in the YAML.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub verify: Option<u32>,
+    /// Play --verify and --target-success with this Solver policy (.safetensors) instead of the
+    /// one beside the Generator or the shipped one.
+    #[arg(long, value_name = "FILE")]
+    pub solver_policy: Option<PathBuf>,
+    /// Play --verify and --target-success with this judge instead: a Solver of --policies (or
+    /// policies/<game>) named by its training mode (arlpcg, rule-pcg, fixed-track, fixed-aux),
+    /// or the scripted player (scripted-novice, scripted-median, scripted-expert).
+    #[arg(long, value_name = "NAME", value_parser = Judge::parse, conflicts_with = "solver_policy")]
+    pub judge: Option<Judge>,
+    /// With --verify, also play each level with the panel of judges (every Solver of --policies
+    /// or policies/<game>, and the scripted player at three skills), and record each judge's
+    /// success and the level's difficulty b, rated over the levels of this batch.
+    #[arg(long, requires = "verify")]
+    pub panel: bool,
+    /// Replace files that already exist (by default nothing is overwritten; files identical to
+    /// what this run makes are left as they are, so a re-run finishes an interrupted batch).
+    #[arg(long)]
+    pub force: bool,
+    /// Ask for a success rate instead of λ (0 < P < 1, with --policies): each level is searched
+    /// (λ and draws) until its measured success is within ±0.1 of P; the λ used is recorded.
+    /// Verifies with 100 runs unless --verify says otherwise. The policies' λ→success curve is
+    /// measured once and kept as difficulty-curve.yaml beside them.
+    #[arg(long, value_name = "P", allow_hyphen_values = true, value_parser = parse_target, conflicts_with = "aux")]
+    pub target_success: Option<f64>,
+    /// With --verify, keep a level that no run completed. By default it is redrawn (the next
+    /// level of the seed, toward the same goal; after 10 such draws a Generator's λ is eased by
+    /// 0.25, and the level records the λ it was built at), and each level records one
+    /// successful run's seed as its certificate (`verify --replay` re-runs it).
+    #[arg(long, requires = "verify")]
+    pub allow_unsolved: bool,
+    /// Make the levels for this game profile (`arlpcg profile init`): the character's or car's
+    /// abilities, which --verify plays with; each level records it. Default: the built-in one.
+    #[arg(long, value_name = "FILE")]
+    pub profile: Option<PathBuf>,
+    /// Acceptance check on every level (repeatable): `success LO..HI` (the success ratio),
+    /// `b LO..HI` (the panel's difficulty, with --panel) or `completed`. A level fails a range
+    /// only when its 95% interval lies wholly outside it; any failure ends the run with exit
+    /// code 3 and names each level and check (the files are written all the same).
+    #[arg(long = "check", value_name = "CHECK", value_parser = Check::parse)]
+    pub checks: Vec<Check>,
+    /// Make only shard I of K of the batch (0 <= I < K): level i of the batch when i mod K = I.
+    /// K machines with I = 0..K-1 together write exactly the files of the whole batch.
+    #[arg(long, value_name = "I/K", value_parser = parse_shard)]
+    pub shard: Option<Shard>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
+}
+
+/// `export`'s arguments.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// The level file (.yaml).
+    pub level: PathBuf,
+    /// Output file: .glb for binary glTF, .gltf for JSON glTF plus a .bin beside it.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Name every solid node of the glTF with Godot's `-col` import hint, so that Godot 3 (which
+    /// ignores the physics extension) makes a static body for each. Not for Godot 4.3 and later,
+    /// which read the extension and would make two.
+    #[arg(long)]
+    pub collision_names: bool,
+    /// Replace files that already exist.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// `export-policy`'s arguments.
+#[derive(Debug, Args)]
+#[command(
+    after_help = "The graph takes raw observations (the normalizer is inside) and gives \
+    the deterministic actions this tool plays with. The sidecar (OUT.json) lists the observation \
+    layout, each output's meaning and example rows with their expected outputs.\n\n\
+    Examples:\n  \
+    arlpcg export-policy policies/racing/solver.safetensors --out racing-solver.onnx\n  \
+    arlpcg export-policy policies/platform/solver.safetensors --contract mlagents --out Platform.onnx"
+)]
+pub struct ExportPolicyArgs {
+    /// The policy file (.safetensors): a Solver or a Generator of either game.
+    pub policy: PathBuf,
+    /// Output file (.onnx); the sidecar goes beside it as OUT.json.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Whose names the graph uses: `plain` (this tool's) or `mlagents` (ML-Agents' model
+    /// contract, for Unity's Inference Engine). Also accepted as --profile, its former name.
+    #[arg(long, alias = "profile", default_value = "plain", value_parser = parse_contract)]
+    pub contract: crate::services::onnx::Contract,
+    /// Replace files that already exist.
+    #[arg(long)]
+    pub force: bool,
+}
+
+impl GenerateArgs {
+    /// What difficulty is asked for (clap refuses two of `--aux`, `--aux-curve` and
+    /// `--target-success` together); none for rule levels that record no λ.
+    pub fn ask(&self) -> Option<Ask> {
+        match (self.target_success, &self.aux_curve, self.aux) {
+            (Some(target), _, _) => Some(Ask::Success(target)),
+            (None, Some(curve), _) => Some(Ask::Curve(curve.clone())),
+            (None, None, aux) => aux.map(Ask::Aux),
+        }
+    }
+}
+
+impl From<FormatArg> for crate::services::level_files::Format {
+    fn from(format: FormatArg) -> Self {
+        match format {
+            FormatArg::Yaml => Self::Yaml,
+            FormatArg::Glb => Self::Glb,
+            FormatArg::Gltf => Self::Gltf,
+        }
+    }
+}

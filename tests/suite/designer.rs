@@ -213,10 +213,10 @@ fn a_profile_of_other_abilities_is_played_by_the_shipped_ability_aware_solver() 
     }
 }
 
-/// An ability-aware Solver's trials stop, saying to train for it, when the loaded profile lies
-/// beyond the range it trained over; within it, they play.
+/// Beyond the range an ability-aware Solver trained over, the scripted expert plays the trials in
+/// its place, and the status line and the statistics panel say so; within it, the Solver plays.
 #[test]
-fn trials_refuse_a_profile_beyond_an_ability_aware_solvers_range() {
+fn the_scripted_expert_plays_beyond_an_ability_aware_solvers_range() {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("aware.yaml");
     std::fs::write(&config, "ability_spread: 0.2\n").unwrap();
@@ -228,16 +228,29 @@ fn trials_refuse_a_profile_beyond_an_ability_aware_solvers_range() {
     let (policies, info) = worker::load(&run, Game::Platform).unwrap();
     let mut h = Harness::new(policies, info, dir.path());
     h.settle();
-    for (jump, refused) in [("8.5", false), ("7.0", true)] {
+    for (jump, stood_in) in [("8.5", false), ("7.0", true)] {
         h.load_profile_with_jump(dir.path(), jump);
         let trials = h.app.trials.as_ref().expect("trials of the new level");
-        let said = trials.error.clone().unwrap_or_default();
+        let said = trials.stand_in.clone().unwrap_or_default();
         assert_eq!(
             said.contains("lies beyond the abilities"),
-            refused,
+            stood_in,
             "{said}"
         );
-        assert_eq!(trials.stats.is_some(), !refused);
+        let stats = trials.stats.as_ref().expect("the trials are played");
+        assert_eq!(
+            matches!(
+                stats.solver,
+                arlpcg_core::level::SolverRef::Scripted {
+                    skill: arlpcg_core::game::Skill::Expert
+                }
+            ),
+            stood_in
+        );
+        assert_eq!(
+            h.screen(120, 40).contains("scripted-expert in its place"),
+            stood_in
+        );
     }
 }
 

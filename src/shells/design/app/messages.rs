@@ -58,6 +58,14 @@ pub enum Response {
         /// The trials' statistics.
         stats: Box<SolverStats>,
     },
+    /// The scripted expert plays the trials in the Solver's place: it never trained with the
+    /// level's abilities.
+    StandIn {
+        /// The request's number.
+        id: u64,
+        /// Why, in words.
+        why: String,
+    },
     /// The trials could not be played (the Solver does not fit the level, say).
     TrialsFailed {
         /// The request's number.

@@ -19,6 +19,13 @@ impl App {
                 }
                 Vec::new()
             }
+            Response::StandIn { id, why } => {
+                if let Some(trials) = self.trials.as_mut().filter(|t| t.id == id) {
+                    trials.stand_in = Some(why.clone());
+                    self.say(why);
+                }
+                Vec::new()
+            }
             Response::TrialsFailed { id, problem } => {
                 if let Some(trials) = self.trials.as_mut().filter(|t| t.id == id) {
                     trials.error = Some(problem.clone());

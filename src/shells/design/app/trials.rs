@@ -25,6 +25,8 @@ pub struct Trials {
     pub stats: Option<SolverStats>,
     /// Why the trials stopped before they were all in, if they could not be played.
     pub error: Option<String>,
+    /// Why the scripted expert plays them in the Solver's place, if it does.
+    pub stand_in: Option<String>,
 }
 
 impl Trials {
@@ -105,6 +107,7 @@ impl App {
             results: Vec::new(),
             stats: None,
             error: None,
+            stand_in: None,
         });
         vec![Effect::Trials {
             id,

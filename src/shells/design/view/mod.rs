@@ -333,7 +333,13 @@ fn draw_replay(app: &App, ctx: &mut Context, project: impl Fn(&[f32; 3]) -> [f64
 
 fn stats(app: &App, frame: &mut Frame, area: Rect) {
     let scripted = Judge::Scripted(app.policies().skill).name();
-    let solver = policy_label(&app.policies().solver, &scripted);
+    let solver = match app.trials.as_ref().and_then(|t| t.stand_in.as_ref()) {
+        Some(_) => format!(
+            "{} in its place",
+            Judge::Scripted(arlpcg_core::game::Skill::Expert).name()
+        ),
+        None => policy_label(&app.policies().solver, &scripted),
+    };
     let mut lines = Vec::new();
     match &app.trials {
         Some(t) => {

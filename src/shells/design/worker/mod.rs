@@ -365,10 +365,11 @@ fn play_trials(
         on_trial: &on_trial,
         stop,
     };
-    if let Some(problem) = current.beyond_range(level) {
-        return send(Response::TrialsFailed { id, problem });
+    let (who, stand_in) = current.player(level);
+    if let Some(why) = stand_in {
+        send(Response::StandIn { id, why });
     }
-    match verify::verify_watched(level, &current.solver(level), trials, seed, &watch) {
+    match verify::verify_watched(level, &who, trials, seed, &watch) {
         Ok(Some(stats)) => send(Response::TrialsDone {
             id,
             stats: Box::new(stats),
@@ -395,9 +396,6 @@ fn sweep_point(
         Ok(level) => level,
         Err(problem) => return Some(SweepPoint::NoLevel(problem)),
     };
-    if let Some(problem) = current.beyond_range(&level) {
-        return Some(SweepPoint::NoLevel(problem));
-    }
     let watch = Watch {
         on_trial: &|_| {},
         stop,

@@ -35,30 +35,27 @@ pub struct Policies {
 pub type GamePolicies = PerGame<Policies>;
 
 impl Policies {
-    /// Why the Solver policy may not play `level`: the abilities it is made for lie beyond the
-    /// range the policy trained over (it says to train for them).
-    pub(super) fn beyond_range(&self, level: &Level) -> Option<String> {
-        match self
-            .policy_under(level.profile.as_ref())?
-            .fit(level.profile.as_ref())
-        {
-            verify::ProfileFit::Beyond(problem) => Some(problem),
-            _ => None,
-        }
-    }
-
     /// The Solver policy that plays under `profile` (none: the built-in abilities), if one does.
     pub(super) fn policy_under(&self, profile: Option<&Profile>) -> Option<&SolverPolicy> {
         let solver = self.solver.as_deref()?;
         Some(solver.or_aware(self.aware.as_deref(), profile))
     }
 
-    /// Who plays `level`.
-    pub(super) fn solver(&self, level: &Level) -> Solver<'_> {
-        match self.policy_under(level.profile.as_ref()) {
-            Some(policy) => Solver::Policy(policy),
-            None => Solver::Scripted(self.skill),
+    /// Who plays `level`: the Solver, or the ability-aware one in its place, where it trained
+    /// with the level's abilities; else the scripted expert, and the line that says why
+    /// ([`verify::default_player`]). Without a Solver, the scripted player at its skill.
+    pub(super) fn player(&self, level: &Level) -> (Solver<'_>, Option<String>) {
+        match self.solver.as_deref() {
+            Some(solver) => {
+                verify::default_player(solver, self.aware.as_deref(), level.profile.as_ref())
+            }
+            None => (Solver::Scripted(self.skill), None),
         }
+    }
+
+    /// Who plays `level` ([`Self::player`]).
+    pub(super) fn solver(&self, level: &Level) -> Solver<'_> {
+        self.player(level).0
     }
 
     /// The level of `game` that `request` asks for: the Generator's, or the rules' without

@@ -115,6 +115,9 @@ pub struct LevelRequest {
     pub keep: Option<KeptPrefix>,
     /// The game profile the level is made for (none: the built-in one); the level records it.
     pub profile: Option<Profile>,
+    /// The value of each of the game's style knobs, in order, each in [-1, 1] (missing: 0, no
+    /// preference); read by a Generator with knobs.
+    pub knobs: Vec<f32>,
 }
 
 /// The first `pieces` pieces of `level`, read from the file `from` (`generate --keep`).
@@ -139,6 +142,7 @@ impl LevelRequest {
             draw: 0,
             keep: None,
             profile: None,
+            knobs: Vec::new(),
         }
     }
 
@@ -168,6 +172,11 @@ impl LevelRequest {
     /// Made for `profile` (none: the built-in one).
     pub fn profile(self, profile: Option<Profile>) -> Self {
         Self { profile, ..self }
+    }
+
+    /// The same request with the game's style knobs at `knobs` (in order; missing: 0).
+    pub fn knobs(self, knobs: Vec<f32>) -> Self {
+        Self { knobs, ..self }
     }
 
     /// The same request at `aux`.
@@ -227,6 +236,8 @@ pub struct GeneratorPolicy {
     pub reference: PolicyRef,
     /// The piece budget and curve offset it was trained with.
     pub limits: BuildLimits,
+    /// How many of the game's style knobs it takes (0 or all of them).
+    pub knobs: usize,
 }
 
 /// Why the Generator built no level.
@@ -310,13 +321,16 @@ fn build_level<G: GeneratorGame>(
     let aux_ask = request.aux.as_ref();
     // An ability-aware Generator also observes the abilities of the profile it builds for.
     let mut observation = vec![0.0; generator.policy.shape().observation];
+    let knobs: Vec<f32> = (0..generator.knobs)
+        .map(|k| request.knobs.get(k).copied().unwrap_or(0.0))
+        .collect();
     for _ in 0..ATTEMPTS {
         let mut build = empty.clone();
         let mut piece_auxes = kept_aux.clone();
         while build.piece_count() < generator.limits.max_pieces {
             let aux = piece_aux(aux_ask, &build);
             piece_auxes.push(Some(aux));
-            observe_build::<G>(&build, &[aux as f32], &mut observation);
+            observe_build::<G>(&build, &[aux as f32], &knobs, &mut observation);
             generator.normalizer.normalize(&mut observation);
             let action = generator
                 .policy
@@ -402,6 +416,7 @@ mod tests {
                 sha256: "0".repeat(64),
             },
             limits: BuildLimits::default_for::<arlpcg_core::game::PlatformGame>(),
+            knobs: 0,
         }
     }
 

@@ -149,11 +149,20 @@ pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, Polic
         load_pinned(path, (game, Role::Generator), observation, (actions, &[]))?;
     let card = loaded.card.clone();
     let limits = generator_limits(path, &card)?;
+    let knobs = arlpcg_core::rl::checkpoint::knob_part(&card);
+    let game_knobs = arlpcg_core::for_game!(game, G => G::KNOBS.len());
+    if knobs != 0 && knobs != game_knobs {
+        anyhow::bail!(
+            "{}: card field observation has {knobs} knobs, but the {game} Generator takes {game_knobs} (or none)",
+            path.display()
+        );
+    }
     Ok((
         GeneratorPolicy {
             game,
             policy: loaded.policy,
             limits,
+            knobs,
             normalizer: loaded.card.normalizer,
             reference,
         },

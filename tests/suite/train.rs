@@ -321,6 +321,15 @@ fn out_of_range_training_configs_are_refused_before_anything_is_written() {
         (
             "generator:\n  solver_phase_steps: 0\n", "solver_phase_steps",
         ),
+        (
+            "generator:\n  rewards:\n    knobs: [1]\n",
+            "generator.rewards.knobs",
+        ),
+        (
+            "generator:\n  rewards:\n    knobs: [1, .nan]\n",
+            "generator.rewards",
+        ),
+        ("generator:\n  knob_values: [2]\n", "generator.knob_values"),
     ];
     let deep = format!("seed: {}1{}\n", "[".repeat(100_000), "]".repeat(100_000));
     let aliases = format!(
@@ -1615,4 +1624,31 @@ fn two_new_runs_into_one_folder_leave_one_run_whole() {
         won[0] as u64 + 1,
         "the folder holds the winner's run"
     );
+}
+
+/// A Generator with style knobs: it observes their values after the game's observation (its
+/// card says so), and `generate` plays it with every knob at 0 (no preference).
+#[test]
+fn a_generator_with_knobs_records_them_and_generates() {
+    let (dir, config, out) = scratch("generator:\n  rewards:\n    knobs: [1.0, 0.5]\n");
+    arlpcg_ok(words(
+        "train --mode arlpcg --steps 4096 --threads 1 --config {} --out {}",
+        &[&config, &out],
+    ));
+    let card = std::fs::read_to_string(out.join("generator.yaml")).unwrap();
+    assert!(
+        card.contains("- - aux\n  - 1\n- - knobs\n  - 2\n"),
+        "{card}"
+    );
+    let solver = std::fs::read_to_string(out.join("solver.yaml")).unwrap();
+    assert!(
+        !solver.contains("knobs"),
+        "the Solver takes no knobs: {solver}"
+    );
+    let levels = dir.path().join("levels");
+    arlpcg_ok(words(
+        "generate --policies {} --aux=-1 --count 2 --format yaml --out {}",
+        &[&out, &levels],
+    ));
+    assert_eq!(std::fs::read_dir(&levels).unwrap().count(), 2);
 }

@@ -132,9 +132,11 @@ pub fn generator_golden_episode<G: GeneratorGame>(
     let (mut build, _) = G::new_build(GOLDEN_RUN_SEED, None, limits, obstacles);
     let mut frames = Vec::new();
     let outcome = loop {
-        // An ability-aware Generator also observes the abilities: ours, all 0.
+        // A Generator with knobs observes them, all at 0 (no preference); an ability-aware one
+        // the abilities: ours, all 0.
         let mut observation = vec![0.0; card.network.observation];
-        observe_build::<G>(&build, &[GOLDEN_AUX], &mut observation);
+        let knobs = vec![0.0; arlpcg_core::rl::checkpoint::knob_part(card)];
+        observe_build::<G>(&build, &[GOLDEN_AUX], &knobs, &mut observation);
         let frame = frame(policy, card, build.port_state(), observation)?;
         let placement = build.place(&frame.action);
         frames.push(frame);

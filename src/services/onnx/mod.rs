@@ -234,6 +234,18 @@ fn observation_columns(card: &PolicyCard) -> Vec<Columns> {
             .zip(observation.meanings)
             .find(|((name, width), _)| *name == column.name && *width == column.width)
             .map(|(_, meaning)| meaning.to_string());
+        if column.name == arlpcg_core::game::generator::KNOBS_PART {
+            use arlpcg_core::game::generator::GeneratorGame;
+            let knobs = arlpcg_core::for_game!(card.game, G => G::KNOBS);
+            column.meaning = Some(format!(
+                "the style knobs {}, each in [-1, 1] (0: no preference)",
+                knobs
+                    .iter()
+                    .map(|k| format!("{} ({})", k.name, k.meaning))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ));
+        }
         if column.name == ABILITIES_PART {
             column.meaning = Some(format!(
                 "the profile's {} relative to the built-in ones (value / ours - 1; 0 for ours)",

@@ -49,6 +49,11 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 curve_offset: config.generator.curve_offset,
                 player: config.player(G::GAME),
             },
+            knob_values: config
+                .generator
+                .knob_values
+                .clone()
+                .unwrap_or(super::config::DEFAULT_KNOB_VALUES.to_vec()),
             obstacles: config.generator.obstacles,
             rewards: config.generator.rewards.clone(),
             snapshot_share: config.generator.snapshot_share,

@@ -95,6 +95,9 @@ impl Default for AdversarialState {
 pub struct MatchRules {
     /// λ is drawn uniformly from these for each match.
     pub aux_values: Vec<f32>,
+    /// Each knob of a Generator with knobs (`rewards.knobs`) is drawn uniformly from these for
+    /// each match.
+    pub knob_values: Vec<f32>,
     /// The Generator's piece budget and curve offset.
     pub limits: BuildLimits,
     /// Obstacles drawn into each racing match's scene.
@@ -313,7 +316,11 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         let (build, mut rng) = G::new_build(seed, None, limits, self.rules.obstacles);
         let values = &self.rules.aux_values;
         let aux = values[rng.random_range(0..values.len())];
-        let fresh = Match::new(build, vec![aux], seed);
+        // Drawn only for a Generator with knobs, so that runs without them keep their bytes.
+        let knobs = (0..self.rules.rewards.knobs.len())
+            .map(|_| self.rules.knob_values[rng.random_range(0..self.rules.knob_values.len())])
+            .collect();
+        let fresh = Match::new(build, vec![aux], seed).with_knobs(knobs);
         // Drawn only when pacing is on, so that runs without it keep their bytes.
         if self.rules.paced_share > 0.0 && rng.random_bool(self.rules.paced_share) {
             let pacing = MatchPacing {
@@ -370,6 +377,8 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             if invalid {
                 reward += self.rules.rewards.invalid;
                 ended.push(i);
+            } else {
+                reward += game.placed_style_reward(&self.rules.rewards);
             }
             self.generator_returns[i] += reward;
             if learning {

@@ -9,7 +9,7 @@ use crate::services::fsio;
 use crate::services::fsio::Overwrite;
 use anyhow::{Context, Result, bail};
 use arlpcg_core::game::facts::facts;
-use arlpcg_core::game::generator::GeneratorGame;
+use arlpcg_core::game::generator::{GeneratorGame, KNOBS_PART};
 use arlpcg_core::level::Game;
 use arlpcg_core::level::profile::{ABILITIES_PART, ability_columns};
 use arlpcg_core::rl::checkpoint;
@@ -53,10 +53,20 @@ impl AgentIo {
 pub(super) fn agent_shape(config: &TrainConfig, game: Game, role: Role) -> PolicyShape {
     let io = AgentIo::of(game, role);
     PolicyShape {
-        observation: io.observation_size() + ability_columns(config.ability_spread),
+        observation: io.observation_size()
+            + knob_columns(config, role)
+            + ability_columns(config.ability_spread),
         hidden: config.hidden.clone(),
         continuous: io.continuous.len(),
         binary: io.binary.len(),
+    }
+}
+
+/// The knobs `role`'s agent observes: a Generator's, where its rewards weigh them.
+fn knob_columns(config: &TrainConfig, role: Role) -> usize {
+    match role {
+        Role::Generator => config.generator.rewards.knobs.len(),
+        Role::Solver => 0,
     }
 }
 
@@ -107,7 +117,12 @@ pub(super) fn card(
     };
     let io = AgentIo::of(game, role);
     let mut observation = layout(io.observation);
-    // An ability-aware agent observes the main abilities after the game's observation.
+    // A Generator with knobs observes their values after the game's observation...
+    let knobs = knob_columns(config, role);
+    if knobs > 0 {
+        observation.push((KNOBS_PART.to_string(), knobs));
+    }
+    // ...and an ability-aware agent the main abilities after that.
     let abilities = ability_columns(config.ability_spread);
     if abilities > 0 {
         observation.push((ABILITIES_PART.to_string(), abilities));

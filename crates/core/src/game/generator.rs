@@ -71,6 +71,10 @@ pub struct GeneratorRewards {
     pub piece_failure_weight: f32,
     /// The weights of each aux input (both games use one).
     pub aux: Vec<AuxWeights>,
+    /// The weight of each of the game's style knobs ([`GeneratorGame::KNOBS`], in order); none:
+    /// the Generator has no knobs (it neither observes nor is paid for them).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub knobs: Vec<f32>,
 }
 
 impl Default for GeneratorRewards {
@@ -88,6 +92,7 @@ impl Default for GeneratorRewards {
                 alpha: 1.0,
                 beta: 1.0,
             }],
+            knobs: Vec::new(),
         }
     }
 }
@@ -129,6 +134,18 @@ impl GeneratorRewards {
         self.air_step * self.weighted(aux, |w, l| w.beta * (-l).max(0.0))
     }
 
+    /// The reward for placing a piece whose style measures `measures` (each in [-1, 1]) at knob
+    /// values `knobs`: Σ wᵢ kᵢ mᵢ, so a knob at +1 pays pieces that measure high, at -1 pieces
+    /// that measure low, and at 0 nothing.
+    pub fn per_style(&self, knobs: &[f32], measures: &[f32]) -> f32 {
+        self.knobs
+            .iter()
+            .zip(knobs)
+            .zip(measures)
+            .map(|((w, k), m)| w * k * m)
+            .sum()
+    }
+
     fn weighted(&self, aux: &[f32], term: impl Fn(&AuxWeights, f32) -> f32) -> f32 {
         self.aux.iter().zip(aux).map(|(w, &l)| term(w, l)).sum()
     }
@@ -168,6 +185,9 @@ pub trait TrackBuild: Clone + Send + Sync {
     fn place(&mut self, row: &[f32]) -> Placement;
     /// Distance from where piece `k` leaves the Solver (0: the start) to the goal, m.
     fn distance_to_goal(&self, k: usize) -> f64;
+    /// The style of piece `piece` (0: the first placed), one measure in [-1, 1] per knob of the
+    /// game ([`GeneratorGame::KNOBS`]), into `out`.
+    fn piece_style(&self, piece: usize, out: &mut [f32]);
     /// Two numbers per piece that the training metrics average ([`GeneratorGame::PIECE_FEATURES`]).
     fn piece_features(&self) -> Vec<[f64; 2]>;
     /// The finished track.
@@ -191,6 +211,8 @@ pub trait GeneratorGame: GameSpec {
     const DEFAULT_MAX_PIECES: usize;
     /// The most pieces a level of the game may hold.
     const MAX_PIECES: usize;
+    /// The style knobs a Generator of the game may take beside λ, in order.
+    const KNOBS: &'static [Knob];
     /// The names of the two [`TrackBuild::piece_features`], as the metrics columns call them.
     const PIECE_FEATURES: [&'static str; 2];
     /// The game's training recipe: a training configuration (`train --config`'s YAML) laid
@@ -283,12 +305,48 @@ pub(crate) fn prefix_reaches_goal(pieces: usize) -> String {
     format!("its first {pieces} pieces already reach the goal: keep fewer")
 }
 
-/// Writes the Generator's observation of `build` at aux inputs `aux` into `out`: the game's, then,
-/// for an ability-aware Generator (`out` [`MAIN_ABILITIES`](crate::level::profile::MAIN_ABILITIES)
+/// A style knob of a game's Generator: a value in [-1, 1] asked of a level beside λ (0: no
+/// preference), paid for piece by piece ([`GeneratorRewards::per_style`]) by the piece's own
+/// measure of the style ([`TrackBuild::piece_style`]); a level's measure is the mean over its
+/// pieces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Knob {
+    /// Its name, as `--aux` and the level file write it.
+    pub name: &'static str,
+    /// What -1 and +1 ask for, in words.
+    pub meaning: &'static str,
+}
+
+/// The name of the knobs' part of a Generator's observation (after the game's, before the
+/// abilities of an ability-aware one).
+pub const KNOBS_PART: &str = "knobs";
+
+/// The mean style of a build's pieces, one measure per knob of `G` (zeros for no piece).
+pub fn build_style<G: GeneratorGame>(build: &G::Build) -> Vec<f32> {
+    let mut sums = vec![0.0; G::KNOBS.len()];
+    let mut piece = vec![0.0; G::KNOBS.len()];
+    let n = build.piece_count();
+    for k in 0..n {
+        build.piece_style(k, &mut piece);
+        sums.iter_mut().zip(&piece).for_each(|(s, m)| *s += m);
+    }
+    sums.iter().map(|s| s / n.max(1) as f32).collect()
+}
+
+/// Writes the Generator's observation of `build` at aux inputs `aux` into `out`: the game's, then
+/// the values of the knobs it takes (`knobs`, none for a Generator without knobs), then, for an
+/// ability-aware Generator (`out` [`MAIN_ABILITIES`](crate::level::profile::MAIN_ABILITIES)
 /// longer), the main abilities of the player the track is made for, relative to ours.
-pub fn observe_build<G: GeneratorGame>(build: &G::Build, aux: &[f32], out: &mut [f32]) {
-    let (game, abilities) = out.split_at_mut(observation_size::<G>());
+pub fn observe_build<G: GeneratorGame>(
+    build: &G::Build,
+    aux: &[f32],
+    knobs: &[f32],
+    out: &mut [f32],
+) {
+    let (game, rest) = out.split_at_mut(observation_size::<G>());
     build.observe(aux, game);
+    let (knob_slots, abilities) = rest.split_at_mut(knobs.len());
+    knob_slots.copy_from_slice(knobs);
     if !abilities.is_empty() {
         let played = build
             .player()
@@ -320,6 +378,8 @@ pub struct MatchPacing {
 pub struct Match<G: GeneratorGame> {
     /// λ of the match (a paced match: where it begins).
     pub aux: Vec<f32>,
+    /// The values of the knobs the Generator takes (none: it takes none).
+    pub knobs: Vec<f32>,
     pacing: Option<MatchPacing>,
     /// λ of each piece placed (all `aux` unless paced).
     piece_aux: Vec<f32>,
@@ -346,6 +406,7 @@ impl<G: GeneratorGame> Match<G> {
     pub fn new(build: G::Build, aux: Vec<f32>, solver_seed: u64) -> Self {
         Self {
             aux,
+            knobs: Vec::new(),
             pacing: None,
             piece_aux: Vec::new(),
             build,
@@ -378,6 +439,24 @@ impl<G: GeneratorGame> Match<G> {
         let whole = build.distance_to_goal(0).max(1e-9);
         let next = (piece + 1).min(build.piece_count());
         ((build.distance_to_goal(piece) - build.distance_to_goal(next)) / whole).max(0.0)
+    }
+
+    /// The same match with the Generator's knobs at `knobs`.
+    pub fn with_knobs(mut self, knobs: Vec<f32>) -> Self {
+        self.knobs = knobs;
+        self
+    }
+
+    /// The style reward for the piece placed last ([`GeneratorRewards::per_style`]); 0 for a
+    /// Generator without knobs.
+    pub fn placed_style_reward(&self, rewards: &GeneratorRewards) -> f32 {
+        let n = self.build.piece_count();
+        if self.knobs.is_empty() || n == 0 {
+            return 0.0;
+        }
+        let mut measures = vec![0.0; self.knobs.len()];
+        self.build.piece_style(n - 1, &mut measures);
+        rewards.per_style(&self.knobs, &measures)
     }
 
     /// The same match with λ changing along the track (one aux input).
@@ -453,8 +532,8 @@ impl<G: GeneratorGame> Match<G> {
     /// The Generator's observation, into `out`.
     pub fn observe_generator(&self, out: &mut [f32]) {
         match self.next_paced_aux() {
-            Some(aux) => observe_build::<G>(&self.build, &[aux], out),
-            None => observe_build::<G>(&self.build, &self.aux, out),
+            Some(aux) => observe_build::<G>(&self.build, &[aux], &self.knobs, out),
+            None => observe_build::<G>(&self.build, &self.aux, &self.knobs, out),
         }
     }
 
@@ -570,5 +649,19 @@ mod tests {
             ..GeneratorRewards::default()
         };
         assert_eq!(two.on_failure(&[1.0, -1.0]), -10.0 + 5.0);
+    }
+
+    #[test]
+    fn a_knob_pays_pieces_that_measure_its_way_and_nothing_at_zero() {
+        let none = GeneratorRewards::default();
+        assert_eq!(none.per_style(&[1.0, 1.0], &[1.0, 1.0]), 0.0, "no knobs");
+        let r = GeneratorRewards {
+            knobs: vec![0.5, 2.0],
+            ..GeneratorRewards::default()
+        };
+        assert_eq!(r.per_style(&[1.0, 0.0], &[0.8, 1.0]), 0.4);
+        assert_eq!(r.per_style(&[-1.0, 0.0], &[0.8, 1.0]), -0.4);
+        assert_eq!(r.per_style(&[0.0, -0.5], &[0.8, -1.0]), 1.0);
+        assert_eq!(r.per_style(&[0.0, 0.0], &[1.0, 1.0]), 0.0);
     }
 }

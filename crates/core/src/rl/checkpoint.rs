@@ -426,8 +426,17 @@ fn ability_part(card: &PolicyCard) -> Result<usize, PolicyError> {
     }
 }
 
+/// The size of the knobs' part of a card's observation (0: none): a Generator's style knobs,
+/// after the game's observation (their number is the caller's to check against its game).
+pub fn knob_part(card: &PolicyCard) -> usize {
+    card.observation
+        .iter()
+        .find(|(name, _)| name == crate::game::generator::KNOBS_PART)
+        .map_or(0, |(_, size)| *size)
+}
+
 /// Reads a policy or checkpoint, requiring `game` and `role` and the observation size the game
-/// produces now (a Solver's with the abilities its card names after it).
+/// produces now (with the knobs and abilities its card names after it).
 pub fn load_policy(
     bytes: &[u8],
     game: Game,
@@ -443,7 +452,7 @@ pub fn load_policy(
         });
     }
     // An ability-aware Solver observes the game's main abilities after the game's observation.
-    let observation_size = observation_size + ability_part(&card)?;
+    let observation_size = observation_size + knob_part(&card) + ability_part(&card)?;
     if card.network.observation != observation_size {
         return Err(PolicyError::Card(format!(
             "its network observes {} values but the {game} {role} observes {observation_size}",

@@ -188,6 +188,20 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
     if !(0.0..=1.0).contains(&g.paced_share) {
         return Err("paced_share must be a number in [0, 1]".into());
     }
+    let knobs = arlpcg_core::for_game!(game, G => G::KNOBS.len());
+    if !g.rewards.knobs.is_empty() && g.rewards.knobs.len() != knobs {
+        return Err(format!(
+            "rewards.knobs: the {game} game has {knobs} knobs, so give {knobs} weights (or none), not {}",
+            g.rewards.knobs.len()
+        ));
+    }
+    if let Some(values) = &g.knob_values
+        && (values.is_empty()
+            || values.len() > 1000
+            || values.iter().any(|k| !(-1.0..=1.0).contains(k)))
+    {
+        return Err("knob_values: give 1 to 1000 values, each within [-1, 1]".into());
+    }
     if g.rewards.aux.len() != 1 {
         return Err(format!(
             "rewards.aux: the {game} game has 1 aux input, so give 1 weight pair, not {}",
@@ -202,6 +216,7 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
     ]
     .into_iter()
     .chain(weights)
+    .chain(r.knobs.iter().copied())
     .all(f32::is_finite)
     {
         return Err("rewards: every weight must be a finite number".into());

@@ -65,6 +65,9 @@ fn is_zero(x: &f64) -> bool {
     *x == 0.0
 }
 
+/// The values each style knob of a match is drawn from by default (`knob_values`).
+pub const DEFAULT_KNOB_VALUES: [f32; 5] = [-1.0, -0.5, 0.0, 0.5, 1.0];
+
 /// The Generator's side of an adversarial run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -76,6 +79,10 @@ pub struct GeneratorConfig {
     pub rewards: GeneratorRewards,
     /// λ of each match is drawn uniformly from these (`fixed-aux` holds λ = 1).
     pub aux_values: Vec<f32>,
+    /// With knobs (`rewards.knobs`), each knob of each match is drawn uniformly from these
+    /// (none: [`DEFAULT_KNOB_VALUES`]; 0 is no preference).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub knob_values: Option<Vec<f32>>,
     /// A track that has not reached its goal in this many pieces (blocks, segments) ends as
     /// invalid.
     #[serde(alias = "max_blocks")]
@@ -324,6 +331,7 @@ impl Default for GeneratorConfig {
             },
             rewards: arlpcg_core::for_game!(Game::default(), G => G::default_rewards()),
             aux_values: vec![-1.0, -1.0, -0.5, 0.5, 1.0, 1.0],
+            knob_values: None,
             max_pieces: arlpcg_core::for_game!(Game::default(), G => G::DEFAULT_MAX_PIECES),
             obstacles: 0,
             curve_offset: arlpcg_core::game::generator::DEFAULT_CURVE_OFFSET,

@@ -10,7 +10,7 @@ use rand_chacha::ChaCha8Rng;
 
 use self::env::{BallEnv, BallPusher};
 use super::facts::{GameFacts, ObservationFacts};
-use super::generator::{BuildLimits, GeneratorGame, GeneratorRewards, Placement, TrackBuild};
+use super::generator::{BuildLimits, GeneratorGame, GeneratorRewards, Knob, Placement, TrackBuild};
 use super::platform::PlatformGame;
 use super::platform::generator::PlatformBuild;
 use super::{GameSpec, NoRuleLevel, Player, PortState, RuleAsk};
@@ -105,6 +105,9 @@ impl TrackBuild for BallBuild {
     fn distance_to_goal(&self, k: usize) -> f64 {
         self.0.distance_to_goal(k)
     }
+    fn piece_style(&self, piece: usize, out: &mut [f32]) {
+        self.0.piece_style(piece, out);
+    }
     fn piece_features(&self) -> Vec<[f64; 2]> {
         self.0.piece_features()
     }
@@ -123,6 +126,7 @@ impl GeneratorGame for BallGame {
     const GENERATOR_ACTIONS: &'static [&'static str] = PlatformGame::GENERATOR_ACTIONS;
     const DEFAULT_MAX_PIECES: usize = PlatformGame::DEFAULT_MAX_PIECES;
     const MAX_PIECES: usize = PlatformGame::MAX_PIECES;
+    const KNOBS: &'static [Knob] = PlatformGame::KNOBS;
     const PIECE_FEATURES: [&'static str; 2] = PlatformGame::PIECE_FEATURES;
     const RECIPE: &'static str = "{}";
 

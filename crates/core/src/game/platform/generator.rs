@@ -8,14 +8,16 @@ use rand_chacha::ChaCha8Rng;
 
 use super::env::{PlatformEnv, PlatformRewards};
 use super::reach::{self, Reach};
-use crate::game::generator::{BuildLimits, GeneratorGame, GeneratorRewards, Placement, TrackBuild};
+use crate::game::generator::{
+    BuildLimits, GeneratorGame, GeneratorRewards, Knob, Placement, TrackBuild,
+};
 use crate::game::platform::rules::goal_and_start;
 use crate::game::{PlatformGame, Player};
 use crate::level::Track;
 use crate::level::heading::{direction_heading, wrap_degrees};
 use crate::level::params::{self, quantize};
 use crate::level::platform::{BlockParams, PlatformTrack};
-use crate::level::profile::Abilities;
+use crate::level::profile::{Abilities, BlockRanges};
 
 /// The named parts of the Generator's observation, in order, with their lengths (one aux input).
 pub const GENERATOR_OBSERVATION_LAYOUT: [(&str, usize); 9] = [
@@ -65,6 +67,36 @@ pub const GENERATOR_OBSERVATION_SIZE: usize = {
 pub const GENERATOR_ACTIONS: [&str; 4] = [
     "distance", "turn_from_goal_bearing", "size", "height_from_goal_slope",
 ];
+
+/// The platform Generator's style knobs (docs/decisions.md): how long its jumps are and how
+/// much its blocks step up and down, each measured by [`block_style`].
+pub const KNOBS: [Knob; 2] = [
+    Knob {
+        name: "stride",
+        meaning: "-1 short hops ... +1 long leaps (a block's distance within the profile's range)",
+    },
+    Knob {
+        name: "steps",
+        meaning: "-1 level ... +1 steep steps up and down (a block's height change, either way, within the profile's largest)",
+    },
+];
+
+/// A block's style, one measure in [-1, 1] per [`KNOBS`]: its distance within `ranges`' (-1 the
+/// shortest), and the size of its height change, either way, within the largest `ranges` allow
+/// (-1 level, +1 the largest); 0 where a range is a single value.
+pub fn block_style(block: &BlockParams, ranges: &BlockRanges) -> [f32; 2] {
+    let distance = ranges.distance();
+    let stride = match distance.max > distance.min {
+        true => distance.to_unit(block.distance.clamp(distance.min, distance.max)),
+        false => 0.0,
+    };
+    let largest = ranges.min_height.abs().max(ranges.max_height.abs());
+    let steps = match largest > 0.0 {
+        true => (2.0 * block.height.abs() / largest - 1.0).min(1.0),
+        false => 0.0,
+    };
+    [stride as f32, steps as f32]
+}
 
 /// The block budget of a Generator's track by default: a track that has not reached its goal
 /// within it is invalid (goals are at most 70 m away, blocks 5-10 m apart).
@@ -244,6 +276,13 @@ impl TrackBuild for PlatformBuild {
         crate::level::distance(self.goal, p)
     }
 
+    fn piece_style(&self, piece: usize, out: &mut [f32]) {
+        out.copy_from_slice(&block_style(
+            &self.track.block_params()[piece],
+            &self.player.blocks(),
+        ));
+    }
+
     fn piece_features(&self) -> Vec<[f64; 2]> {
         self.track
             .block_params()
@@ -264,6 +303,7 @@ impl GeneratorGame for PlatformGame {
     const GENERATOR_ACTIONS: &'static [&'static str] = &GENERATOR_ACTIONS;
     const DEFAULT_MAX_PIECES: usize = DEFAULT_MAX_BLOCKS;
     const MAX_PIECES: usize = crate::level::platform::MAX_BLOCKS;
+    const KNOBS: &'static [Knob] = &KNOBS;
     const PIECE_FEATURES: [&'static str; 2] = ["distance", "size"];
     /// The training configuration's defaults are the platform game's recipe.
     const RECIPE: &'static str = "{}";
@@ -417,6 +457,42 @@ mod tests {
             player: Player::default(),
             reach: Reach::default(),
         }
+    }
+
+    #[test]
+    fn a_blocks_style_spans_its_ranges_and_a_match_observes_and_pays_its_knobs() {
+        let ranges = Player::default().blocks();
+        let block = |distance: f64, height: f64| BlockParams {
+            distance,
+            angle: 0.0,
+            size: 5.0,
+            height,
+        };
+        assert_eq!(block_style(&block(5.0, 0.0), &ranges), [-1.0, -1.0]);
+        assert_eq!(block_style(&block(10.0, -2.0), &ranges), [1.0, 1.0]);
+        assert_eq!(block_style(&block(7.5, 1.0), &ranges), [0.0, 0.0]);
+        // Knobs come after the game's observation; a long jump pays at stride +1, costs at -1.
+        let rewards = GeneratorRewards {
+            knobs: vec![1.0, 1.0],
+            ..GeneratorRewards::default()
+        };
+        let long = [1.0, 0.0, 0.0, 0.0];
+        let mut paid = Vec::new();
+        for stride in [1.0, -1.0, 0.0] {
+            let mut game = Match::<PlatformGame>::new(test_build([0.0, 0.0, -60.0]), vec![1.0], 7)
+                .with_knobs(vec![stride, 0.5]);
+            let mut out = vec![0.0; GENERATOR_OBSERVATION_SIZE + 2];
+            game.observe_generator(&mut out);
+            assert_eq!(out[GENERATOR_OBSERVATION_SIZE..], [stride, 0.5]);
+            assert_eq!(game.place(&long), Placement::Placed);
+            let measured = block_style(&game.build().track.block_params()[0], &ranges);
+            assert!(measured[0] > 0.5, "{measured:?}");
+            paid.push(game.placed_style_reward(&rewards) - 0.5 * measured[1]);
+        }
+        assert!(
+            paid[0] > 0.5 && paid[1] < -0.5 && paid[2] == 0.0,
+            "{paid:?}"
+        );
     }
 
     #[test]

@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::env::{RacingEnv, RacingRewards, SIGHT};
 use crate::game::generator::{
-    BuildLimits, DEFAULT_CURVE_OFFSET, GeneratorGame, GeneratorRewards, Placement, TrackBuild,
+    BuildLimits, DEFAULT_CURVE_OFFSET, GeneratorGame, GeneratorRewards, Knob, Placement, TrackBuild,
 };
 use crate::game::{Player, RacingGame};
 use crate::level::Track;
@@ -106,6 +106,33 @@ pub fn segment_from_action(
         curve,
         height,
     }
+}
+
+/// The racing Generator's style knobs (docs/decisions.md): how sharply its road turns and how
+/// much it climbs and falls, each measured by [`segment_style`].
+pub const KNOBS: [Knob; 2] = [
+    Knob {
+        name: "curviness",
+        meaning: "-1 sweeping ... +1 sharp (a segment's heading change, either way, within the profile's largest)",
+    },
+    Knob {
+        name: "elevation",
+        meaning: "-1 flat ... +1 bumpy (a segment's height change, either way, within the profile's largest)",
+    },
+];
+
+/// A segment's style, one measure in [-1, 1] per [`KNOBS`]: the size of its heading change and
+/// of its height change, either way, within the largest `ranges` allow (-1 none, +1 the
+/// largest); 0 where a range allows none.
+pub fn segment_style(segment: &SegmentParams, ranges: &SegmentRanges) -> [f32; 2] {
+    let within = |value: f64, largest: f64| match largest > 0.0 {
+        true => (2.0 * value.abs() / largest - 1.0).min(1.0) as f32,
+        false => 0.0,
+    };
+    [
+        within(segment.curve, ranges.max_curve),
+        within(segment.height, ranges.max_height),
+    ]
 }
 
 /// A racing track the Generator is building toward its goal around the scene's obstacles,
@@ -307,6 +334,13 @@ impl TrackBuild for RacingBuild {
         crate::level::distance(self.goal, p)
     }
 
+    fn piece_style(&self, piece: usize, out: &mut [f32]) {
+        out.copy_from_slice(&segment_style(
+            &self.track.segments[piece],
+            &self.player.segments(),
+        ));
+    }
+
     fn piece_features(&self) -> Vec<[f64; 2]> {
         self.track
             .segments
@@ -327,6 +361,7 @@ impl GeneratorGame for RacingGame {
     const GENERATOR_ACTIONS: &'static [&'static str] = &GENERATOR_ACTIONS;
     const DEFAULT_MAX_PIECES: usize = DEFAULT_MAX_SEGMENTS;
     const MAX_PIECES: usize = racing::MAX_SEGMENTS;
+    const KNOBS: &'static [Knob] = &KNOBS;
     const PIECE_FEATURES: [&'static str; 2] = ["curve", "height"];
     const RECIPE: &'static str = include_str!("recipe.yaml");
 
@@ -431,6 +466,21 @@ mod tests {
     use crate::game::SolverEnv;
     use crate::game::generator::{Match, observation_size};
     use crate::game::racing::{OBSERVATION_SIZE, ScriptedDriver};
+
+    #[test]
+    fn a_segments_style_spans_its_ranges_either_way() {
+        let ranges = SegmentRanges::default();
+        let segment = |curve: f64, height: f64| SegmentParams {
+            length: 20.0,
+            curve,
+            height,
+        };
+        assert_eq!(segment_style(&segment(0.0, 0.0), &ranges), [-1.0, -1.0]);
+        let sharpest = segment(-ranges.max_curve, ranges.max_height);
+        assert_eq!(segment_style(&sharpest, &ranges), [1.0, 1.0]);
+        let halfway = segment(0.5 * ranges.max_curve, -0.5 * ranges.max_height);
+        assert_eq!(segment_style(&halfway, &ranges), [0.0, 0.0]);
+    }
 
     #[test]
     fn a_wider_curve_offset_lets_the_road_bend_away_from_its_goal() {

@@ -378,6 +378,11 @@ fn build_level<G: GeneratorGame>(
                             piece_aux: piece_auxes,
                         }),
                         profile: request.profile.clone(),
+                        knobs: G::KNOBS
+                            .iter()
+                            .zip(&knobs)
+                            .map(|(knob, &value)| (knob.name.to_string(), f64::from(value)))
+                            .collect(),
                     });
                 }
             }

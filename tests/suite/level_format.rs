@@ -45,6 +45,7 @@ fn level() -> impl Strategy<Value = Level> {
                     stats: None,
                     pacing: None,
                     profile: None,
+                    knobs: Default::default(),
                 })
             },
         )

@@ -1627,7 +1627,8 @@ fn two_new_runs_into_one_folder_leave_one_run_whole() {
 }
 
 /// A Generator with style knobs: it observes their values after the game's observation (its
-/// card says so), and `generate` plays it with every knob at 0 (no preference).
+/// card says so); `generate` plays it with every knob at 0 (no preference) or as `--aux` names
+/// them, and each level records them; a knob the game or the Generator lacks is refused.
 #[test]
 fn a_generator_with_knobs_records_them_and_generates() {
     let (dir, config, out) = scratch("generator:\n  rewards:\n    knobs: [1.0, 0.5]\n");
@@ -1651,4 +1652,44 @@ fn a_generator_with_knobs_records_them_and_generates() {
         &[&out, &levels],
     ));
     assert_eq!(std::fs::read_dir(&levels).unwrap().count(), 2);
+    let zero = std::fs::read_to_string(levels.join("platform_seed0_aux-1.00.yaml")).unwrap();
+    assert!(
+        zero.contains("knobs:\n  steps: 0.0\n  stride: 0.0\n"),
+        "{zero}"
+    );
+    let named = dir.path().join("named");
+    arlpcg_ok(words(
+        "generate --policies {} --aux difficulty=-1,stride=1 --format yaml --out {}",
+        &[&out, &named],
+    ));
+    let level =
+        std::fs::read_to_string(named.join("platform_seed0_aux-1.00_stride1.00.yaml")).unwrap();
+    assert!(
+        level.contains("knobs:\n  steps: 0.0\n  stride: 1.0\n"),
+        "{level}"
+    );
+    let refused = |aux: &str, policies: &str| {
+        arlpcg(words(
+            "generate --policies {} --aux {} --out {}",
+            &[&policies, &aux, &dir.path().join("refused")],
+        ))
+    };
+    let shipped = concat!(env!("CARGO_MANIFEST_DIR"), "/policies/platform");
+    let out_s = out.to_str().unwrap();
+    fails_with(
+        &refused("difficulty=1,curviness=1", out_s),
+        2,
+        "knobs are stride, steps",
+    );
+    fails_with(
+        &refused("difficulty=1,stride=1,stride=0", out_s),
+        2,
+        "`stride` is given twice",
+    );
+    fails_with(
+        &refused("difficulty=1,stride=1", shipped),
+        1,
+        "was trained without knobs",
+    );
+    assert!(!dir.path().join("refused").exists());
 }

@@ -155,6 +155,7 @@ pub fn generator_golden_episode<G: GeneratorGame>(
         stats: None,
         pacing: None,
         profile: None,
+        knobs: Default::default(),
     };
     let outcome = format!("{outcome:?}");
     Ok(GoldenEpisode::new(

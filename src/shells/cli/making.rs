@@ -6,9 +6,9 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 
 use super::values::{
-    parse_aux, parse_contract, parse_game, parse_keep, parse_point, parse_shard, parse_target,
+    parse_aux_arg, parse_contract, parse_game, parse_keep, parse_point, parse_shard, parse_target,
 };
-use super::{KeepArg, Shard};
+use super::{AuxArg, KeepArg, Shard};
 use crate::services::checks::Check;
 use crate::services::generation::Ask;
 use crate::services::panel::Judge;
@@ -53,9 +53,11 @@ pub struct GenerateArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// The aux input λ in [-1, 1]: +1 easy, -1 hard (required with --policies). The rule-based
-    /// generator only records it.
-    #[arg(long, allow_hyphen_values = true, value_parser = parse_aux)]
-    pub aux: Option<f64>,
+    /// generator only records it. With a Generator trained with style knobs, named values set
+    /// them too, each in [-1, 1] (0, the default: no preference): `difficulty=-0.5,stride=1`
+    /// (platform: stride, steps; racing: curviness, elevation).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_aux_arg)]
+    pub aux: Option<AuxArg>,
     /// λ along the level instead of one λ (with --policies): control points `fraction:λ`,
     /// where fraction is the share of the start-to-goal distance covered (0 start, 1 goal),
     /// linear between points. "0:1, 0.5:1, 0.6:-1, 1:-1" is easy up to halfway, then hard;
@@ -186,7 +188,8 @@ impl GenerateArgs {
     /// What difficulty is asked for (clap refuses two of `--aux`, `--aux-curve` and
     /// `--target-success` together); none for rule levels that record no λ.
     pub fn ask(&self) -> Option<Ask> {
-        match (self.target_success, &self.aux_curve, self.aux) {
+        let aux = self.aux.as_ref().and_then(|aux| aux.difficulty);
+        match (self.target_success, &self.aux_curve, aux) {
             (Some(target), _, _) => Some(Ask::Success(target)),
             (None, Some(curve), _) => Some(Ask::Curve(curve.clone())),
             (None, None, aux) => aux.map(Ask::Aux),

@@ -12,7 +12,7 @@ mod playing;
 mod values;
 pub use making::{ExportArgs, ExportPolicyArgs, FormatArg, GenerateArgs};
 pub use playing::{CampaignArgs, SolverChoice, VerifyArgs, default_solver};
-pub use values::{Judges, KeepArg, Shard};
+pub use values::{AuxArg, Judges, KeepArg, Shard};
 use values::{parse_ability_spread, parse_game, parse_minutes, parse_shard};
 
 use arlpcg_core::level::Game;
@@ -325,7 +325,7 @@ pub struct TrainArgs {
 
 #[cfg(test)]
 mod tests {
-    use super::values::{parse_aux, parse_point};
+    use super::values::{parse_aux, parse_aux_arg, parse_point};
     use super::*;
 
     #[test]
@@ -341,5 +341,31 @@ mod tests {
         assert!(parse_aux("NaN").unwrap_err().contains("NaN"));
         assert_eq!(parse_point("1,-2, 3.5"), Ok([1.0, -2.0, 3.5]));
         assert!(parse_point("1,2").is_err());
+    }
+
+    #[test]
+    fn aux_takes_a_number_or_named_knobs() {
+        let aux = |d: Option<f64>, knobs: &[(&str, f64)]| AuxArg {
+            difficulty: d,
+            knobs: knobs.iter().map(|(n, v)| (n.to_string(), *v)).collect(),
+        };
+        assert_eq!(parse_aux_arg("-0.5"), Ok(aux(Some(-0.5), &[])));
+        assert_eq!(
+            parse_aux_arg("difficulty=-0.5, stride=1"),
+            Ok(aux(Some(-0.5), &[("stride", 1.0)]))
+        );
+        assert_eq!(parse_aux_arg("steps=0"), Ok(aux(None, &[("steps", 0.0)])));
+        assert!(parse_aux_arg("stride=2").unwrap_err().contains("stride"));
+        assert!(
+            parse_aux_arg("stride=1,5")
+                .unwrap_err()
+                .contains("name=value")
+        );
+        assert!(parse_aux_arg("=1").unwrap_err().contains("without a name"));
+        assert!(
+            parse_aux_arg("difficulty=1,difficulty=0")
+                .unwrap_err()
+                .contains("twice")
+        );
     }
 }

@@ -121,6 +121,45 @@ pub(super) fn parse_aux(s: &str) -> Result<f64, String> {
     params::AUX.check(value).map_err(|e| e.to_string())
 }
 
+/// `--aux`: λ alone (`-0.5`), or named values (`difficulty=-0.5,stride=1`), each in [-1, 1];
+/// names other than `difficulty` are a Generator's style knobs, checked once the game is known.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AuxArg {
+    /// λ: +1 easy, -1 hard.
+    pub difficulty: Option<f64>,
+    /// The knobs asked for, by name, in the order given.
+    pub knobs: Vec<(String, f64)>,
+}
+
+pub(super) fn parse_aux_arg(s: &str) -> Result<AuxArg, String> {
+    if !s.contains('=') {
+        return parse_aux(s.trim()).map(|difficulty| AuxArg {
+            difficulty: Some(difficulty),
+            knobs: Vec::new(),
+        });
+    }
+    let mut arg = AuxArg {
+        difficulty: None,
+        knobs: Vec::new(),
+    };
+    for part in s.split(',') {
+        let (name, value) = part.split_once('=').ok_or_else(|| {
+            format!("`{part}`: give name=value pairs (difficulty=-0.5,stride=1) or one number")
+        })?;
+        let name = name.trim();
+        let value = parse_aux(value.trim()).map_err(|e| format!("{name}: {e}"))?;
+        let given_twice = format!("`{name}` is given twice");
+        match name {
+            "" => return Err(format!("`{part}`: a value without a name")),
+            "difficulty" if arg.difficulty.is_some() => return Err(given_twice),
+            "difficulty" => arg.difficulty = Some(value),
+            _ if arg.knobs.iter().any(|(known, _)| known == name) => return Err(given_twice),
+            _ => arg.knobs.push((name.to_string(), value)),
+        }
+    }
+    Ok(arg)
+}
+
 pub(super) fn parse_point(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').collect();
     let [x, y, z] = parts.as_slice() else {

@@ -38,6 +38,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         Some(dir) => Some(load_generator(&policy_paths(dir).0, args.game)?.0),
         None => None,
     };
+    let template = template.knobs(knob_values(args, generator.as_ref())?);
     let solver = chosen_solver(args, verify_trials, template.profile.as_ref())?;
     if let Some(policy) = &solver {
         crate::shells::common::check_fit(policy, template.profile.as_ref())?;
@@ -325,6 +326,47 @@ fn write_batch(
     )
 }
 
+/// The style knobs `--aux` names, in the game's order (0, no preference, where not named), for
+/// a Generator that takes them; an error for a knob the game or the Generator does not have.
+fn knob_values(args: &GenerateArgs, generator: Option<&GeneratorPolicy>) -> Result<Vec<f32>> {
+    use arlpcg_core::game::generator::GeneratorGame;
+    let asked = args.aux.as_ref().map_or(&[][..], |aux| &aux.knobs[..]);
+    let knobs = arlpcg_core::for_game!(args.game, G => G::KNOBS);
+    let names: Vec<&str> = knobs.iter().map(|k| k.name).collect();
+    for (name, _) in asked {
+        if !names.contains(&name.as_str()) {
+            return Err(crate::shells::common::UsageError(format!(
+                "--aux {name}: the {} game's knobs are {} (and difficulty, λ)",
+                args.game,
+                names.join(", ")
+            ))
+            .into());
+        }
+    }
+    let takes = generator.map_or(0, |g| g.knobs);
+    if let (Some((name, _)), 0) = (asked.first(), takes) {
+        match generator {
+            None => anyhow::bail!(
+                "--aux {name}: the rules take no knobs (a Generator trained with them does)"
+            ),
+            Some(g) => anyhow::bail!(
+                "--aux {name}: the Generator {} was trained without knobs (its config's generator.rewards.knobs)",
+                g.reference.path
+            ),
+        }
+    }
+    Ok(names
+        .iter()
+        .take(takes)
+        .map(|knob| {
+            asked
+                .iter()
+                .find(|(name, _)| name == knob)
+                .map_or(0.0, |(_, value)| *value as f32)
+        })
+        .collect())
+}
+
 /// Runs per candidate of `--target-success` without `--verify`.
 const TARGET_TRIALS: u32 = 100;
 
@@ -361,7 +403,19 @@ fn stem(args: &GenerateArgs, seed: u64) -> String {
         Some(keep) => format!("_keep{}", keep.pieces),
         None => String::new(),
     };
-    stem_of_lambda(args, seed) + &kept
+    stem_of_lambda(args, seed) + &knob_suffix(args) + &kept
+}
+
+/// `_name<value>` for each knob `--aux` names, in the game's order.
+fn knob_suffix(args: &GenerateArgs) -> String {
+    use arlpcg_core::game::generator::GeneratorGame;
+    let asked = args.aux.as_ref().map_or(&[][..], |aux| &aux.knobs[..]);
+    let knobs = arlpcg_core::for_game!(args.game, G => G::KNOBS);
+    knobs
+        .iter()
+        .filter_map(|knob| asked.iter().find(|(name, _)| name == knob.name))
+        .map(|(name, value)| format!("_{name}{value:.2}"))
+        .collect()
 }
 
 fn stem_of_lambda(args: &GenerateArgs, seed: u64) -> String {
@@ -483,7 +537,8 @@ fn build_levels(
             let request = match proof {
                 Proof::Target { .. } => LevelRequest::new(*seed, None)
                     .goal(args.goal)
-                    .profile(template.profile.clone()),
+                    .profile(template.profile.clone())
+                    .knobs(template.knobs.clone()),
                 _ => LevelRequest {
                     seed: *seed,
                     ..template.clone()

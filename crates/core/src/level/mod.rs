@@ -365,6 +365,8 @@ pub struct Level {
     pub pacing: Option<pacing::Pacing>,
     /// The game profile it was made and verified under; none for the built-in one.
     pub profile: Option<crate::level::profile::Profile>,
+    /// The style knobs it was built with, by name, each in [-1, 1] (none: no preference).
+    pub knobs: std::collections::BTreeMap<String, f64>,
 }
 
 /// Straight-line distance between two points, m.

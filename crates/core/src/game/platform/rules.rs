@@ -102,6 +102,7 @@ pub fn platform_level_draw(
                 stats: None,
                 pacing: None,
                 profile: None,
+                knobs: Default::default(),
             });
         }
     }

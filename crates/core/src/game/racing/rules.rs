@@ -153,6 +153,7 @@ pub fn racing_level_draw(
                 stats: None,
                 pacing: None,
                 profile: None,
+                knobs: Default::default(),
             });
         }
     }

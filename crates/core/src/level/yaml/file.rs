@@ -1,6 +1,7 @@
 //! The level file's shape for serde (`LevelFile` and its pieces, numbers bounded while they
 //! are parsed) and its conversion to and from a [`Level`], with the checks serde cannot make.
 
+use std::collections::BTreeMap;
 use std::marker::PhantomData;
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -99,6 +100,9 @@ pub(super) struct LevelFile {
     /// λ along the level (then each block or segment carries its own `aux`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     aux_curve: Option<AuxCurve>,
+    /// The style knobs it was built with, by name (none: no preference).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    knobs: BTreeMap<String, Bounded<Aux>>,
     start: StartFile,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     goal: Option<Point>,
@@ -235,6 +239,11 @@ impl LevelFile {
             seed: level.seed,
             aux: level.aux.map(Bounded::new),
             aux_curve: level.pacing.as_ref().map(|p| p.curve.clone()),
+            knobs: level
+                .knobs
+                .iter()
+                .map(|(name, value)| (name.clone(), Bounded::new(*value)))
+                .collect(),
             start,
             goal: Some(level.goal.map(Bounded::new)),
             blocks,
@@ -286,6 +295,7 @@ impl LevelFile {
             stats: self.stats,
             pacing,
             profile,
+            knobs: self.knobs.iter().map(|(k, v)| (k.clone(), v.0)).collect(),
         };
         level.validate().map_err(|e| {
             let key = |key: &str| (key.to_string(), line_of_key(text, key));

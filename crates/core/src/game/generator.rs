@@ -317,9 +317,7 @@ pub struct Knob {
     pub meaning: &'static str,
 }
 
-/// The name of the knobs' part of a Generator's observation (after the game's, before the
-/// abilities of an ability-aware one).
-pub const KNOBS_PART: &str = "knobs";
+pub use crate::level::KNOBS_PART;
 
 /// The mean style of a build's pieces, one measure per knob of `G` (zeros for no piece).
 pub fn build_style<G: GeneratorGame>(build: &G::Build) -> Vec<f32> {

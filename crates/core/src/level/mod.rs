@@ -346,6 +346,10 @@ impl Source {
     }
 }
 
+/// The name of the knobs' part of a Generator's observation (after the game's, before the
+/// abilities of an ability-aware one), as its card lists it.
+pub const KNOBS_PART: &str = "knobs";
+
 /// A level of either game.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Level {

@@ -431,7 +431,7 @@ fn ability_part(card: &PolicyCard) -> Result<usize, PolicyError> {
 pub fn knob_part(card: &PolicyCard) -> usize {
     card.observation
         .iter()
-        .find(|(name, _)| name == crate::game::generator::KNOBS_PART)
+        .find(|(name, _)| name == crate::level::KNOBS_PART)
         .map_or(0, |(_, size)| *size)
 }
 

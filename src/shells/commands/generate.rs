@@ -329,9 +329,7 @@ fn write_batch(
 /// The style knobs `--aux` names, in the game's order (0, no preference, where not named), for
 /// a Generator that takes them; an error for a knob the game or the Generator does not have.
 fn knob_values(args: &GenerateArgs, generator: Option<&GeneratorPolicy>) -> Result<Vec<f32>> {
-    use arlpcg_core::game::generator::GeneratorGame;
-    let asked = args.aux.as_ref().map_or(&[][..], |aux| &aux.knobs[..]);
-    let knobs = arlpcg_core::for_game!(args.game, G => G::KNOBS);
+    let (asked, knobs) = asked_knobs(args);
     let names: Vec<&str> = knobs.iter().map(|k| k.name).collect();
     for (name, _) in asked {
         if !names.contains(&name.as_str()) {
@@ -406,11 +404,21 @@ fn stem(args: &GenerateArgs, seed: u64) -> String {
     stem_of_lambda(args, seed) + &knob_suffix(args) + &kept
 }
 
-/// `_name<value>` for each knob `--aux` names, in the game's order.
-fn knob_suffix(args: &GenerateArgs) -> String {
+/// The knobs `--aux` names (name, value), and the game's knobs.
+fn asked_knobs(
+    args: &GenerateArgs,
+) -> (
+    &[(String, f64)],
+    &'static [arlpcg_core::game::generator::Knob],
+) {
     use arlpcg_core::game::generator::GeneratorGame;
     let asked = args.aux.as_ref().map_or(&[][..], |aux| &aux.knobs[..]);
-    let knobs = arlpcg_core::for_game!(args.game, G => G::KNOBS);
+    (asked, arlpcg_core::for_game!(args.game, G => G::KNOBS))
+}
+
+/// `_name<value>` for each knob `--aux` names, in the game's order.
+fn knob_suffix(args: &GenerateArgs) -> String {
+    let (asked, knobs) = asked_knobs(args);
     knobs
         .iter()
         .filter_map(|knob| asked.iter().find(|(name, _)| name == knob.name))

@@ -319,18 +319,6 @@ pub struct Knob {
 
 pub use crate::level::KNOBS_PART;
 
-/// The mean style of a build's pieces, one measure per knob of `G` (zeros for no piece).
-pub fn build_style<G: GeneratorGame>(build: &G::Build) -> Vec<f32> {
-    let mut sums = vec![0.0; G::KNOBS.len()];
-    let mut piece = vec![0.0; G::KNOBS.len()];
-    let n = build.piece_count();
-    for k in 0..n {
-        build.piece_style(k, &mut piece);
-        sums.iter_mut().zip(&piece).for_each(|(s, m)| *s += m);
-    }
-    sums.iter().map(|s| s / n.max(1) as f32).collect()
-}
-
 /// Writes the Generator's observation of `build` at aux inputs `aux` into `out`: the game's, then
 /// the values of the knobs it takes (`knobs`, none for a Generator without knobs), then, for an
 /// ability-aware Generator (`out` [`MAIN_ABILITIES`](crate::level::profile::MAIN_ABILITIES)

@@ -37,7 +37,7 @@ fn trainer(shape: &PolicyShape, ppo: PpoConfig) -> Trainer<SolverEnvs<PlatformGa
         ppo.num_envs,
         SourceRecord::default(),
         shape.action_size(),
-        (Default::default(), 0.0),
+        (Default::default(), None),
     )
     .unwrap();
     let ppo = Ppo::new(ppo, ActorCritic::new(shape.clone(), 0).unwrap()).unwrap();

@@ -11,7 +11,7 @@ use crate::services::verify::{ProfileFit, SolverPolicy};
 use arlpcg_core::game::generator::DEFAULT_CURVE_OFFSET;
 use arlpcg_core::game::generator::{BuildLimits, GeneratorGame, observation_size};
 use arlpcg_core::game::{GameSpec, SolverEnv};
-use arlpcg_core::level::profile::{ABILITIES_PART, Profile};
+use arlpcg_core::level::profile::{ABILITIES_PART, Abilities, AbilityRanges, Profile};
 use arlpcg_core::level::{Game, PolicyRef};
 use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::rl::checkpoint::{
@@ -77,9 +77,11 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
         .observation
         .last()
         .is_some_and(|(name, _)| name == ABILITIES_PART);
-    if reads_abilities != card.ability_spread.is_some() {
+    let trained_over = trained_over(&card, profile.as_ref(), game)
+        .map_err(|problem| anyhow::anyhow!("{}: card field {problem}", path.display()))?;
+    if reads_abilities != trained_over.is_some() {
         anyhow::bail!(
-            "{}: card field ability_spread must be given exactly when the observation ends with `{ABILITIES_PART}`",
+            "{}: card field ability_ranges (or ability_spread) must be given exactly when the observation ends with `{ABILITIES_PART}`",
             path.display()
         );
     }
@@ -90,10 +92,34 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
             normalizer: loaded.card.normalizer,
             reference,
             profile,
-            ability_spread: card.ability_spread,
+            trained_over,
         },
         card,
     ))
+}
+
+/// The ranges an ability-aware card's policy trained over: its `ability_ranges`, or for a card
+/// from before them, its `ability_spread` around its profile's abilities (or ours); none for a
+/// policy of one character or car. `Err` names the field.
+fn trained_over(
+    card: &PolicyCard,
+    profile: Option<&Profile>,
+    game: Game,
+) -> Result<Option<AbilityRanges>, String> {
+    if let Some(named) = &card.ability_ranges {
+        return AbilityRanges::from_named(game.player(), named)
+            .map(Some)
+            .map_err(|problem| format!("ability_ranges: {problem}"));
+    }
+    match card.ability_spread {
+        Some(spread) if (0.0..=0.5).contains(&spread) && spread > 0.0 => Ok(Some(
+            AbilityRanges::around(&Abilities::of(profile, game), spread),
+        )),
+        Some(spread) => Err(format!(
+            "ability_spread: {spread} is not a share in (0, 0.5]"
+        )),
+        None => Ok(None),
+    }
 }
 
 /// Loads the ability-aware Solver of the policies folder `dir` ([`AWARE_SOLVER_FILE`]), if it
@@ -104,9 +130,9 @@ pub fn load_aware_solver(dir: &Path, game: Game) -> Result<Option<SolverPolicy>>
         return Ok(None);
     }
     let (policy, _) = load_solver(&path, game)?;
-    if policy.ability_spread.is_none() {
+    if policy.trained_over.is_none() {
         anyhow::bail!(
-            "{}: card field ability_spread is missing: {AWARE_SOLVER_FILE} must be an ability-aware Solver (trained with ability_spread above 0)",
+            "{}: card field ability_ranges is missing: {AWARE_SOLVER_FILE} must be an ability-aware Solver (trained with ability_ranges or ability_spread)",
             path.display()
         );
     }
@@ -568,7 +594,7 @@ mod tests {
             .unwrap()
             .to_string();
         assert!(
-            problem.contains(AWARE_SOLVER_FILE) && problem.contains("card field ability_spread"),
+            problem.contains(AWARE_SOLVER_FILE) && problem.contains("card field ability_ranges"),
             "{problem}"
         );
     }

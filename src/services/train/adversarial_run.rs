@@ -62,7 +62,9 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 TrainMode::FixedAux => 0.0,
                 _ => config.generator.paced_share,
             },
-            ability_spread: config.ability_spread,
+            trained_over: config
+                .trained_over(G::GAME)
+                .expect("the ability ranges were checked with the configuration"),
         }
     }
 

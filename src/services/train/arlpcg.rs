@@ -31,7 +31,7 @@ use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, GeneratorRewards, Match, MatchPacing, TrackBuild,
 };
 use arlpcg_core::game::{Scripted, SolverEnv, observe_solver};
-use arlpcg_core::level::profile::ability_columns;
+use arlpcg_core::level::profile::{AbilityRanges, ability_columns};
 use arlpcg_core::level::stats::{Outcome, Skill};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::ActMode;
@@ -112,9 +112,9 @@ pub struct MatchRules {
     /// The share of matches whose λ changes along the track
     /// ([`GeneratorConfig::paced_share`](super::GeneratorConfig::paced_share)).
     pub paced_share: f64,
-    /// Above 0: each match's Solver plays with the main abilities drawn within this share of
-    /// the player's, and observes them ([`TrainConfig::ability_spread`](super::TrainConfig)).
-    pub ability_spread: f64,
+    /// Some: each match's player has its main abilities drawn within these ranges, and both
+    /// agents observe them ([`TrainConfig::trained_over`](super::TrainConfig::trained_over)).
+    pub trained_over: Option<AbilityRanges>,
 }
 
 /// The Generator with its optimizer and normalizer.
@@ -312,7 +312,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         let mut limits = self.rules.limits;
         limits.player = limits
             .player
-            .varied(G::GAME, self.rules.ability_spread, seed);
+            .drawn(G::GAME, self.rules.trained_over.as_ref(), seed);
         let (build, mut rng) = G::new_build(seed, None, limits, self.rules.obstacles);
         let values = &self.rules.aux_values;
         let aux = values[rng.random_range(0..values.len())];
@@ -444,7 +444,7 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
     }
 
     fn observation_size(&self) -> usize {
-        G::Env::OBSERVATION_SIZE + ability_columns(self.rules.ability_spread)
+        G::Env::OBSERVATION_SIZE + ability_columns(self.rules.trained_over.is_some())
     }
 
     fn observe(&mut self, out: &mut [f32]) {

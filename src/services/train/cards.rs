@@ -55,7 +55,7 @@ pub(super) fn agent_shape(config: &TrainConfig, game: Game, role: Role) -> Polic
     PolicyShape {
         observation: io.observation_size()
             + knob_columns(config, role)
-            + ability_columns(config.ability_spread),
+            + ability_columns(config.ability_aware()),
         hidden: config.hidden.clone(),
         continuous: io.continuous.len(),
         binary: io.binary.len(),
@@ -123,7 +123,7 @@ pub(super) fn card(
         observation.push((KNOBS_PART.to_string(), knobs));
     }
     // ...and an ability-aware agent the main abilities after that.
-    let abilities = ability_columns(config.ability_spread);
+    let abilities = ability_columns(config.ability_aware());
     if abilities > 0 {
         observation.push((ABILITIES_PART.to_string(), abilities));
     }
@@ -155,6 +155,11 @@ pub(super) fn card(
             .then_some(config.generator.curve_offset),
         profile: config.profile.clone(),
         ability_spread: (config.ability_spread > 0.0).then_some(config.ability_spread),
+        ability_ranges: config
+            .trained_over(game)
+            .ok()
+            .flatten()
+            .map(|ranges| ranges.named()),
     }
 }
 

@@ -258,7 +258,10 @@ fn solver_run<G: GameSpec>(
             None => SourceRecord::default(),
         };
         let action_size = solver_shape(config, G::GAME).action_size();
-        let player = (config.player(G::GAME), config.ability_spread);
+        let trained_over = config
+            .trained_over(G::GAME)
+            .map_err(|problem| anyhow::anyhow!("configuration: {problem}"))?;
+        let player = (config.player(G::GAME), trained_over);
         SolverEnvs::<G>::new(source, config.solver.num_envs, record, action_size, player)
             .map_err(|problem| anyhow::anyhow!("level source: {problem}"))
     };

@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 
 use arlpcg_core::game::{GameSpec, Player, SolverEnv, observe_solver};
 use arlpcg_core::level::Level;
-use arlpcg_core::level::profile::{Abilities, ability_columns};
+use arlpcg_core::level::profile::{Abilities, AbilityRanges, ability_columns};
 use arlpcg_core::level::stats::Outcome;
 use arlpcg_core::rl::vec_env::{Transition, VecEnv};
 
@@ -81,9 +81,9 @@ pub struct SolverEnvs<G: GameSpec> {
     mode: SolverMode,
     /// Who the levels are made for and who plays them.
     player: Player,
-    /// Above 0: each episode's main abilities are drawn within this share of the player's, and
-    /// the Solver observes them.
-    spread: f64,
+    /// Some: each episode's main abilities are drawn within these ranges, and the Solver
+    /// observes them.
+    trained_over: Option<AbilityRanges>,
     /// The abilities each environment's episode is played with.
     played: Vec<Option<Abilities>>,
     envs: Vec<G::Env>,
@@ -93,8 +93,8 @@ pub struct SolverEnvs<G: GameSpec> {
 }
 
 impl<G: GameSpec> SolverEnvs<G> {
-    /// `num_envs` environments of `player` (its main abilities drawn within `spread` of its own
-    /// each episode), continuing from `record` (a fresh run starts from the default): its
+    /// `num_envs` environments of `player` (its main abilities drawn within `trained_over`
+    /// each episode, where given), continuing from `record` (a fresh run starts from the default): its
     /// episodes under way are replayed, rows of `action_size`. `Err` says why a record's
     /// episodes cannot be replayed.
     pub fn new(
@@ -102,7 +102,7 @@ impl<G: GameSpec> SolverEnvs<G> {
         num_envs: usize,
         record: SourceRecord,
         action_size: usize,
-        (player, spread): (Player, f64),
+        (player, trained_over): (Player, Option<AbilityRanges>),
     ) -> Result<Self, String> {
         let fixed = match mode {
             SolverMode::RulePcg => Vec::new(),
@@ -113,7 +113,7 @@ impl<G: GameSpec> SolverEnvs<G> {
         let mut this = Self {
             mode,
             player,
-            spread,
+            trained_over,
             played: Vec::new(),
             envs: Vec::with_capacity(num_envs),
             logs: record.under_way,
@@ -166,7 +166,9 @@ impl<G: GameSpec> SolverEnvs<G> {
     /// The abilities the episode of `log` is played with: the player's, varied from the
     /// episode's reset seed when the Solver is ability-aware.
     fn abilities(&self, log: &EpisodeLog) -> Option<Abilities> {
-        let player = self.player.varied(G::GAME, self.spread, log.reset_seed);
+        let player = self
+            .player
+            .drawn(G::GAME, self.trained_over.as_ref(), log.reset_seed);
         player.abilities
     }
 
@@ -231,7 +233,7 @@ impl<G: GameSpec> VecEnv for SolverEnvs<G> {
     }
 
     fn observation_size(&self) -> usize {
-        G::Env::OBSERVATION_SIZE + ability_columns(self.spread)
+        G::Env::OBSERVATION_SIZE + ability_columns(self.trained_over.is_some())
     }
 
     fn observe(&mut self, out: &mut [f32]) {

@@ -2,7 +2,7 @@
 //! under (who plays a level made for other abilities: [`SolverPolicy::or_aware`], and where no
 //! player was named, [`default_player`]).
 
-use arlpcg_core::level::profile::{Abilities, Profile, main_abilities};
+use arlpcg_core::level::profile::{Abilities, AbilityRanges, Profile};
 use arlpcg_core::level::{Game, Level, PolicyRef};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::ActorCritic;
@@ -22,9 +22,9 @@ pub struct SolverPolicy {
     pub reference: PolicyRef,
     /// The game profile it trained for (none: the built-in game).
     pub profile: Option<Profile>,
-    /// An ability-aware Solver: it trained with each main ability within this share of its
-    /// profile's, and observes them (none: it trained with one character or car).
-    pub ability_spread: Option<f64>,
+    /// An ability-aware Solver: it trained with each main ability drawn within these ranges,
+    /// and observes them (none: it trained with one character or car).
+    pub trained_over: Option<AbilityRanges>,
 }
 
 /// How a Solver policy stands to the abilities of a profile it is to play under.
@@ -50,17 +50,13 @@ impl SolverPolicy {
             })
         };
         let trained = self.profile.as_ref();
-        match self.ability_spread {
-            Some(spread) if !abilities(played).within(&abilities(trained), spread) => {
-                ProfileFit::Beyond(format!(
-                    "{} lies beyond the abilities the Solver policy {} trained over (each of {} within ±{:.0}% of {}): train a Solver for it (arlpcg train --profile FILE)",
-                    name(played),
-                    self.reference.path,
-                    main_abilities(self.game).join(", "),
-                    100.0 * spread,
-                    name(trained)
-                ))
-            }
+        match &self.trained_over {
+            Some(ranges) if !ranges.holds(&abilities(played)) => ProfileFit::Beyond(format!(
+                "{} lies beyond the abilities the Solver policy {} trained over ({}): train a Solver for it (arlpcg train --profile FILE)",
+                name(played),
+                self.reference.path,
+                ranges.describe()
+            )),
             None if abilities(played) != abilities(trained) => ProfileFit::Untrained(format!(
                 "the Solver policy trained for {} plays under {}: its statistics are of a player who never trained with them (the scripted player, --solver scripted, plays with them)",
                 name(trained),
@@ -106,11 +102,10 @@ impl SolverPolicy {
                 name(played)
             ),
             ProfileFit::Beyond(_) => format!(
-                "{} lies beyond the abilities the Solver policy {} trained over (within ±{:.0}% of {})",
+                "{} lies beyond the abilities the Solver policy {} trained over ({})",
                 name(played),
                 self.reference.path,
-                100.0 * self.ability_spread.unwrap_or(0.0),
-                name(self.profile.as_ref())
+                self.trained_over.map(|r| r.describe()).unwrap_or_default()
             ),
         };
         Some((
@@ -124,7 +119,7 @@ impl SolverPolicy {
     /// What it observes after the game's observation on `level`: for an ability-aware Solver
     /// the level's main abilities relative to ours, else nothing.
     pub(super) fn ability_row(&self, level: &Level) -> Vec<f32> {
-        if self.ability_spread.is_none() {
+        if self.trained_over.is_none() {
             return Vec::new();
         }
         let played = Abilities::of(level.profile.as_ref(), level.game());

@@ -2,7 +2,7 @@
 //! outputs, rule levels, scripted player and facts), [`SolverEnv`] and one decision's [`Step`],
 //! the [`Player`] a level is made for. Each game implements them in its own folder.
 
-use crate::level::profile::{Abilities, BlockRanges, Pieces, SegmentRanges};
+use crate::level::profile::{Abilities, AbilityRanges, BlockRanges, Pieces, SegmentRanges};
 use crate::level::stats::Outcome;
 use crate::level::stats::Skill;
 
@@ -116,14 +116,19 @@ impl Player {
     }
 
     /// The player of one training episode or match of game `game`: its main abilities drawn
-    /// within `spread` of its own from `seed` (itself when `spread` is 0).
-    pub fn varied(self, game: crate::level::Game, spread: f64, seed: u64) -> Self {
-        if spread <= 0.0 {
+    /// within `ranges` from `seed` (itself when there are none).
+    pub fn drawn(
+        self,
+        game: crate::level::Game,
+        ranges: Option<&AbilityRanges>,
+        seed: u64,
+    ) -> Self {
+        let Some(ranges) = ranges else {
             return self;
-        }
+        };
         let own = self.abilities.unwrap_or(Abilities::default_of(game));
         Self {
-            abilities: Some(own.varied(spread, seed)),
+            abilities: Some(ranges.draw(&own, seed)),
             ..self
         }
     }

@@ -16,10 +16,28 @@ pub const GOAL_REACH_HORIZONTAL: f64 = 3.0;
 /// ...and this close vertically.
 pub const GOAL_REACH_VERTICAL: f64 = 2.0;
 /// Two blocks whose footprints overlap must have tops at least this far apart vertically, so that
-/// the character (1.8 m tall) fits between them. Consecutive blocks are exempt.
+/// the built-in character (1.8 m tall) fits between them: [`headroom_for`] its height.
+/// Consecutive blocks are exempt.
 pub const HEADROOM: f64 = 3.0;
+/// The clearance above a character's head that [`headroom_for`] leaves, m.
+pub const HEAD_CLEARANCE: f64 = 0.2;
 /// The most blocks a level may hold (a guard against absurd files, far above any real level).
 pub const MAX_BLOCKS: usize = 400;
+
+/// How far apart, vertically, the tops of two overlapping blocks must be for a character whose
+/// capsule is `height` tall to fit between them: the upper block's thickness, the character and
+/// [`HEAD_CLEARANCE`] ([`HEADROOM`] for the built-in 1.8 m).
+pub fn headroom_for(height: f64) -> f64 {
+    BLOCK_THICKNESS + height + HEAD_CLEARANCE
+}
+
+/// The headroom of a level made for `abilities` (none, or a car's: the built-in character's).
+pub fn headroom_of(abilities: Option<&crate::level::profile::Abilities>) -> f64 {
+    match abilities {
+        Some(crate::level::profile::Abilities::Character(c)) => headroom_for(c.height),
+        _ => HEADROOM,
+    }
+}
 
 /// The Generator's action for one block, relative to the previous block.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -105,9 +123,9 @@ impl Platform {
         }
     }
 
-    /// Whether the two blocks collide or leave too little headroom between them.
-    pub fn overlaps(&self, other: &Platform) -> bool {
-        (self.position[1] - other.position[1]).abs() < HEADROOM && self.footprint_intersects(other)
+    /// Whether the two blocks collide or leave less than `headroom` between their tops.
+    pub fn overlaps(&self, other: &Platform, headroom: f64) -> bool {
+        (self.position[1] - other.position[1]).abs() < headroom && self.footprint_intersects(other)
     }
 
     /// Separating-axis test of the two square footprints in the horizontal plane.
@@ -176,6 +194,8 @@ pub struct PlatformTrack {
     params: Vec<BlockParams>,
     /// Platform 0 is the start block, platform `i + 1` is `blocks[i]`.
     platforms: Vec<Platform>,
+    /// How far apart the tops of overlapping blocks must be ([`headroom_of`] the character).
+    headroom: f64,
 }
 
 impl PlatformTrack {
@@ -190,7 +210,19 @@ impl PlatformTrack {
             start,
             params: Vec::new(),
             platforms,
+            headroom: HEADROOM,
         }
+    }
+
+    /// This track for a character that needs `headroom` between overlapping blocks
+    /// ([`headroom_of`]); built-in: [`HEADROOM`].
+    pub fn with_headroom(self, headroom: f64) -> Self {
+        Self { headroom, ..self }
+    }
+
+    /// The headroom its blocks keep.
+    pub fn headroom(&self) -> f64 {
+        self.headroom
     }
 
     /// Places every block in turn, failing on the first invalid placement.
@@ -216,7 +248,7 @@ impl PlatformTrack {
         let before_previous = self.platforms.len() - 1;
         if let Some(other) = self.platforms[..before_previous]
             .iter()
-            .position(|p| p.overlaps(&candidate))
+            .position(|p| p.overlaps(&candidate, self.headroom))
         {
             return Err(PlacementError::Overlap {
                 block: self.params.len(),
@@ -304,6 +336,23 @@ mod tests {
     }
 
     #[test]
+    fn the_headroom_is_the_characters_height() {
+        assert_eq!(headroom_for(1.8), HEADROOM, "the built-in character");
+        // Out, then back over the start block 3.1 m up: room for a 1.8 m character, not a 2 m one.
+        let over_the_start = |headroom: f64| {
+            let mut track = PlatformTrack::new(Start::default()).with_headroom(headroom);
+            track.push(block(5.0, 0.0, 6.0, 1.5)).unwrap();
+            track.push(block(5.0, 180.0, 6.0, 1.6))
+        };
+        assert!(over_the_start(headroom_for(1.8)).is_ok());
+        assert_eq!(
+            over_the_start(headroom_for(2.0)),
+            Err(PlacementError::Overlap { block: 1, other: 0 })
+        );
+        assert!(over_the_start(headroom_for(1.2)).is_ok());
+    }
+
+    #[test]
     fn rotated_squares_overlap_only_when_they_touch() {
         let a = Platform {
             position: [0.0; 3],
@@ -316,8 +365,8 @@ mod tests {
             size: 4.0,
         };
         // The diamond's corner reaches 2*sqrt(2) = 2.83 m from its centre.
-        assert!(a.overlaps(&diamond(4.8)));
-        assert!(!a.overlaps(&diamond(4.9)));
+        assert!(a.overlaps(&diamond(4.8), HEADROOM));
+        assert!(!a.overlaps(&diamond(4.9), HEADROOM));
     }
 
     #[test]

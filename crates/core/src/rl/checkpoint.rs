@@ -129,10 +129,15 @@ pub struct PolicyCard {
     /// game).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub profile: Option<crate::level::profile::ProfileRecord>,
-    /// Ability-aware policies: each main ability was drawn within this share (0.2: ±20%) of the
-    /// profile's (or ours) in training; a Solver refuses a profile beyond it.
+    /// Ability-aware policies given as a share: each main ability was drawn within this share
+    /// (0.2: ±20%) of the profile's (or ours) in training; a Solver refuses a profile beyond it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ability_spread: Option<f64>,
+    /// Ability-aware policies: the range each main ability was drawn from in training, by
+    /// field name (written by every ability-aware card since ranges; older cards give only
+    /// `ability_spread`); a Solver refuses a profile beyond them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ability_ranges: Option<std::collections::BTreeMap<String, [f64; 2]>>,
 }
 
 /// How a policy was trained.
@@ -539,6 +544,7 @@ mod tests {
             curve_offset: None,
             profile: None,
             ability_spread: None,
+            ability_ranges: None,
         }
     }
 

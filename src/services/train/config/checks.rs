@@ -42,6 +42,7 @@ pub(in crate::services::train) fn check_resumable_change(
         ),
         ("profile", old.profile == new.profile),
         ("ability_spread", old.ability_spread == new.ability_spread),
+        ("ability_ranges", old.ability_ranges == new.ability_ranges),
     ];
     match fixed.iter().find(|(_, same)| !same) {
         Some((name, _)) => Err(format!(
@@ -157,6 +158,7 @@ pub(in crate::services::train) fn check_config(
     if !(0.0..=0.5).contains(&config.ability_spread) {
         return Err("ability_spread must be a share within [0, 0.5] (0.2: ±20%)".into());
     }
+    config.trained_over(game)?;
     if let Some(record) = &config.profile {
         record
             .profile(game)

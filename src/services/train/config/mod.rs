@@ -2,6 +2,7 @@
 //! the Solver's and the Generator's hyper-parameters with the paper's defaults, and the checks
 //! serde cannot make.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::Result;
@@ -11,7 +12,7 @@ use super::solver_envs::SolverMode;
 use arlpcg_core::game::Player;
 use arlpcg_core::game::generator::{GeneratorGame, GeneratorRewards};
 use arlpcg_core::level::Game;
-use arlpcg_core::level::profile::ProfileRecord;
+use arlpcg_core::level::profile::{Abilities, AbilityRanges, ProfileRecord};
 use arlpcg_core::level::stats::Skill;
 use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::rl::ppo::PpoConfig;
@@ -59,6 +60,11 @@ pub struct TrainConfig {
     /// In [0, 0.5]; 0 (the default): one character or car.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub ability_spread: f64,
+    /// Ability-aware agents over ranges of their own, in place of `ability_spread`: each main
+    /// ability by name, `[least, most]` (`character.jump_speed: [4, 11]`), drawn uniformly per
+    /// episode and match. Empty (the default): `ability_spread` decides.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub ability_ranges: BTreeMap<String, [f64; 2]>,
 }
 
 fn is_zero(x: &f64) -> bool {
@@ -266,6 +272,7 @@ impl Default for TrainConfig {
             generator: GeneratorConfig::default(),
             profile: None,
             ability_spread: 0.0,
+            ability_ranges: BTreeMap::new(),
         }
     }
 }
@@ -395,6 +402,31 @@ pub(super) fn load_config(path: &Path, game: Game) -> Result<TrainConfig> {
 }
 
 impl TrainConfig {
+    /// The ranges its ability-aware agents train over (`ability_ranges`, or `ability_spread`
+    /// around the profile's abilities), none for one character or car; `Err` names the field.
+    pub fn trained_over(&self, game: Game) -> Result<Option<AbilityRanges>, String> {
+        if !self.ability_ranges.is_empty() {
+            if self.ability_spread > 0.0 {
+                return Err("give ability_ranges or ability_spread, not both".into());
+            }
+            return AbilityRanges::from_named(game.player(), &self.ability_ranges)
+                .map(Some)
+                .map_err(|problem| format!("ability_ranges: {problem}"));
+        }
+        Ok((self.ability_spread > 0.0).then(|| {
+            let base = self
+                .player(game)
+                .abilities
+                .unwrap_or(Abilities::default_of(game));
+            AbilityRanges::around(&base, self.ability_spread)
+        }))
+    }
+
+    /// Whether its agents are ability-aware (they observe the abilities they play with).
+    pub fn ability_aware(&self) -> bool {
+        self.ability_spread > 0.0 || !self.ability_ranges.is_empty()
+    }
+
     /// The player the run trains for: its profile's (checked when the configuration was read),
     /// else the built-in one.
     pub fn player(&self, game: Game) -> Player {

@@ -162,3 +162,49 @@ fn out_of_range_generator_fields_are_named() {
         "{err}"
     );
 }
+
+#[test]
+fn ability_ranges_are_read_by_name_and_refused_with_the_field() {
+    let wide = "ability_ranges:\n  character.jump_speed: [4, 11]\n  character.run_speed: [4, 9]\n  character.gravity: [9, 25]\n";
+    let config = TrainConfig::parse_for(wide, Game::Platform).unwrap();
+    assert!(config.ability_aware());
+    let ranges = config.trained_over(Game::Platform).unwrap().unwrap();
+    assert_eq!(ranges.named()["character.gravity"], [9.0, 25.0]);
+    // A share still reads, as ranges around the built-in character.
+    let spread = TrainConfig::parse_for("ability_spread: 0.2\n", Game::Platform).unwrap();
+    let around = spread.trained_over(Game::Platform).unwrap().unwrap();
+    assert_eq!(
+        around.named()["character.jump_speed"],
+        [9.25 * 0.8, 9.25 * 1.2]
+    );
+    for (text, game, says) in [
+        (
+            format!("{wide}ability_spread: 0.2\n"),
+            Game::Platform,
+            "not both",
+        ),
+        (
+            wide.replace("[9, 25]", "[25, 9]"),
+            Game::Platform,
+            "character.gravity: [25, 9] runs backwards",
+        ),
+        (
+            wide.replace("[9, 25]", "[9, .nan]"),
+            Game::Platform,
+            "character.gravity",
+        ),
+        (
+            wide.to_string(),
+            Game::Racing,
+            "not a main ability of a car",
+        ),
+        (
+            wide.replace("  character.gravity: [9, 25]\n", ""),
+            Game::Platform,
+            "character.gravity: missing",
+        ),
+    ] {
+        let problem = TrainConfig::parse_for(&text, game).unwrap_err();
+        assert!(problem.contains(says), "{text}: {problem}");
+    }
+}

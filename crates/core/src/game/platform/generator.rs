@@ -16,7 +16,7 @@ use crate::game::{PlatformGame, Player};
 use crate::level::Track;
 use crate::level::heading::{direction_heading, wrap_degrees};
 use crate::level::params::{self, quantize};
-use crate::level::platform::{BlockParams, PlatformTrack};
+use crate::level::platform::{BlockParams, PlatformTrack, headroom_of};
 use crate::level::profile::{Abilities, BlockRanges};
 
 /// The named parts of the Generator's observation, in order, with their lengths (one aux input).
@@ -326,7 +326,8 @@ impl GeneratorGame for PlatformGame {
     ) -> (PlatformBuild, ChaCha8Rng) {
         let (goal, start, rng) = goal_and_start(seed, goal);
         let build = PlatformBuild {
-            track: PlatformTrack::new(start),
+            track: PlatformTrack::new(start)
+                .with_headroom(headroom_of(limits.player.abilities.as_ref())),
             goal,
             max_blocks: limits.max_pieces,
             player: limits.player,
@@ -346,7 +347,8 @@ impl GeneratorGame for PlatformGame {
         };
         crate::game::generator::check_kept(pieces, kept.block_count(), limits)?;
         let mut build = PlatformBuild {
-            track: PlatformTrack::new(*kept.start()),
+            track: PlatformTrack::new(*kept.start())
+                .with_headroom(headroom_of(limits.player.abilities.as_ref())),
             goal,
             max_blocks: limits.max_pieces,
             player: limits.player,

@@ -10,7 +10,7 @@ use crate::game::Player;
 use crate::game::platform::reach::Reach;
 use crate::level::heading;
 use crate::level::params::quantize;
-use crate::level::platform::{self, BlockParams, Platform, PlatformTrack, Start};
+use crate::level::platform::{self, BlockParams, Platform, PlatformTrack, Start, headroom_of};
 use crate::level::{Level, PlatformRulesConfig, Source, Track};
 
 /// Goals are drawn this far from the start, horizontally, m...
@@ -121,7 +121,7 @@ fn attempt(
     config: &PlatformRulesConfig,
     (player, reach): (&Player, &Reach),
 ) -> Option<PlatformTrack> {
-    let mut track = PlatformTrack::new(start);
+    let mut track = PlatformTrack::new(start).with_headroom(headroom_of(player.abilities.as_ref()));
     while track.block_count() < config.max_blocks as usize {
         let placed = (0..CANDIDATES).any(|_| {
             let candidate = draw(rng, track.last(), goal, config, (player, reach));

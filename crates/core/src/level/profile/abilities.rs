@@ -1,6 +1,8 @@
 //! The abilities of the player's character (platform) or car (racing): the fields a profile
 //! sets, their ranges, and how an ability-aware agent observes and varies the main ones.
 
+use std::collections::BTreeMap;
+
 use serde::{Deserialize, Serialize};
 
 use super::{Fields, Profile, field, nth};
@@ -90,10 +92,10 @@ pub const ABILITIES_PART: &str = "abilities";
 /// How many main abilities each game has.
 pub const MAIN_ABILITIES: usize = 3;
 
-/// How many ability columns an agent trained with `spread` observes after the game's
-/// observation: the main abilities when it is ability-aware (spread above 0), else none.
-pub fn ability_columns(spread: f64) -> usize {
-    if spread > 0.0 { MAIN_ABILITIES } else { 0 }
+/// How many ability columns an agent observes after the game's observation: the main
+/// abilities when it is ability-aware (it trained over [`AbilityRanges`]), else none.
+pub fn ability_columns(aware: bool) -> usize {
+    if aware { MAIN_ABILITIES } else { 0 }
 }
 
 /// The main abilities of `game`, as a profile file names them: the designer's keys change them,
@@ -112,7 +114,11 @@ fn main_of(kind: PlayerKind) -> [&'static str; MAIN_ABILITIES] {
     }
 }
 
-/// The stream [`Abilities::varied`] draws from, apart from every other use of a seed.
+/// How many evenly spaced values of each main ability's range [`AbilityRanges::draw`] draws
+/// from.
+pub const DRAWN_VALUES: usize = 5;
+
+/// The stream [`AbilityRanges::draw`] draws from, apart from every other use of a seed.
 const VARIATION_STREAM: u64 = 0xab11_7135;
 
 /// Each character field.
@@ -260,32 +266,6 @@ impl Abilities {
         })
     }
 
-    /// Whether each main ability lies within `spread` (a share, 0.2 for ±20%) of `base`'s.
-    pub fn within(&self, base: &Self, spread: f64) -> bool {
-        self.kind() == base.kind()
-            && main_of(self.kind()).iter().all(|field| {
-                let (value, _) = self.value(field).expect("a main ability of the game");
-                let (from, _) = base.value(field).expect("a main ability of the game");
-                (value / from - 1.0).abs() <= spread + 1e-9
-            })
-    }
-
-    /// These abilities with each main one scaled by `1 + s`, `s` drawn uniformly within
-    /// `±spread` from a generator seeded by `seed` (kept within the field's range): the
-    /// character or car of one training episode.
-    pub fn varied(&self, spread: f64, seed: u64) -> Self {
-        use rand::{RngExt, SeedableRng};
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ VARIATION_STREAM);
-        let mut varied = *self;
-        for field in main_of(self.kind()) {
-            let (value, range) = varied.value(field).expect("a main ability of the game");
-            let scaled =
-                (value * (1.0 + rng.random_range(-spread..=spread))).clamp(range.min, range.max);
-            varied = varied.with_value(field, scaled).unwrap_or(varied);
-        }
-        varied
-    }
-
     /// The abilities of `profile`, or ours when there is none.
     pub fn of(profile: Option<&Profile>, game: Game) -> Self {
         profile.map_or(Self::default_of(game), |p| p.abilities)
@@ -310,5 +290,126 @@ impl Abilities {
             Abilities::Character(_) => PlayerKind::Character,
             Abilities::Car(_) => PlayerKind::Car,
         }
+    }
+}
+
+/// The ranges an ability-aware agent trained over, one `[least, most]` per main ability of its
+/// game ([`main_abilities`]): each training episode and match drew its main abilities uniformly
+/// within them, and the agent covers exactly the abilities they hold. A file writes them by name
+/// (`ability_ranges:`, [`AbilityRanges::named`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AbilityRanges {
+    kind: PlayerKind,
+    ranges: [[f64; 2]; MAIN_ABILITIES],
+}
+
+impl AbilityRanges {
+    /// Each main ability within `spread` (a share, 0.2 for ±20%) of `base`'s, kept within the
+    /// field's own range.
+    pub fn around(base: &Abilities, spread: f64) -> Self {
+        let ranges = main_of(base.kind()).map(|field| {
+            let (value, range) = base.value(field).expect("a main ability of the game");
+            [
+                (value * (1.0 - spread)).max(range.min),
+                (value * (1.0 + spread)).min(range.max),
+            ]
+        });
+        Self {
+            kind: base.kind(),
+            ranges,
+        }
+    }
+
+    /// The ranges a file names (`character.jump_speed: [4, 11]`, ...): one for every main
+    /// ability of a player of `kind` and none else, each in order and within the field's range.
+    /// `Err` names the field.
+    pub fn from_named(
+        kind: PlayerKind,
+        named: &BTreeMap<String, [f64; 2]>,
+    ) -> Result<Self, String> {
+        let main = main_of(kind);
+        if let Some(other) = named.keys().find(|name| !main.contains(&name.as_str())) {
+            return Err(format!(
+                "{other} is not a main ability of a {} (those are {})",
+                kind_word(kind),
+                main.join(", ")
+            ));
+        }
+        let ours = Abilities::built_in(kind);
+        let mut ranges = [[0.0; 2]; MAIN_ABILITIES];
+        for (slot, field) in ranges.iter_mut().zip(main) {
+            let [least, most] = *named.get(field).ok_or_else(|| {
+                format!(
+                    "{field}: missing (every main ability needs its range: {})",
+                    main.join(", ")
+                )
+            })?;
+            let (_, range) = ours.value(field).expect("a main ability of the game");
+            for end in [least, most] {
+                range.check(end).map_err(|e| e.to_string())?;
+            }
+            if least > most {
+                return Err(format!(
+                    "{field}: [{least}, {most}] runs backwards (least first)"
+                ));
+            }
+            *slot = [least + 0.0, most + 0.0];
+        }
+        Ok(Self { kind, ranges })
+    }
+
+    /// The ranges by field name, as a file writes them.
+    pub fn named(&self) -> BTreeMap<String, [f64; 2]> {
+        main_of(self.kind)
+            .iter()
+            .zip(self.ranges)
+            .map(|(field, range)| (field.to_string(), range))
+            .collect()
+    }
+
+    /// Whether every main ability of `abilities` lies within its range.
+    pub fn holds(&self, abilities: &Abilities) -> bool {
+        abilities.kind() == self.kind
+            && main_of(self.kind)
+                .iter()
+                .zip(self.ranges)
+                .all(|(field, [least, most])| {
+                    let (value, _) = abilities.value(field).expect("a main ability of the game");
+                    (least - 1e-9..=most + 1e-9).contains(&value)
+                })
+    }
+
+    /// `base` with each main ability drawn from a generator seeded by `seed` among
+    /// [`DRAWN_VALUES`] evenly spaced values of its range, ends included: the character or car
+    /// of one training episode or match. A run thus plays at most 125 characters, and measures
+    /// each one's reach once (about a second each), however many matches it plays.
+    pub fn draw(&self, base: &Abilities, seed: u64) -> Abilities {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ VARIATION_STREAM);
+        let mut drawn = *base;
+        for (field, [least, most]) in main_of(self.kind).iter().zip(self.ranges) {
+            let step = rng.random_range(0..DRAWN_VALUES) as f64 / (DRAWN_VALUES - 1) as f64;
+            let value = least + (most - least) * step;
+            drawn = drawn.with_value(field, value).unwrap_or(drawn);
+        }
+        drawn
+    }
+
+    /// The ranges in words: `character.jump_speed 4-11, character.run_speed 4-9, ...`.
+    pub fn describe(&self) -> String {
+        main_of(self.kind)
+            .iter()
+            .zip(self.ranges)
+            .map(|(field, [least, most])| format!("{field} {least}-{most}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// A player of `kind` in words.
+fn kind_word(kind: PlayerKind) -> &'static str {
+    match kind {
+        PlayerKind::Character => "character",
+        PlayerKind::Car => "car",
     }
 }

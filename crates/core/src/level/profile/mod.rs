@@ -18,8 +18,8 @@ use crate::level::params::{self, ParamRange, RangeError};
 mod abilities;
 mod pieces;
 pub use abilities::{
-    ABILITIES_PART, Abilities, CAR_FIELDS, CHARACTER_FIELDS, CarProfile, CharacterProfile,
-    MAIN_ABILITIES, ability_columns, main_abilities,
+    ABILITIES_PART, Abilities, AbilityRanges, CAR_FIELDS, CHARACTER_FIELDS, CarProfile,
+    CharacterProfile, MAIN_ABILITIES, ability_columns, main_abilities,
 };
 pub use pieces::{BLOCK_FIELDS, BlockRanges, Pieces, SEGMENT_FIELDS, SegmentRanges};
 
@@ -363,15 +363,18 @@ mod tests {
     use super::*;
 
     #[test]
-    fn varied_abilities_stay_within_their_spread_and_follow_their_seed() {
+    fn drawn_abilities_stay_within_their_ranges_and_follow_their_seed() {
         for game in [Game::Platform, Game::Racing] {
             let ours = Abilities::default_of(game);
             assert_eq!(ours.relative_main(), [0.0; MAIN_ABILITIES]);
-            let varied: Vec<Abilities> = (0..50).map(|seed| ours.varied(0.2, seed)).collect();
-            assert_eq!(varied[7], ours.varied(0.2, 7), "seeded");
-            assert!(varied.iter().all(|a| a.within(&ours, 0.2)));
-            assert!(varied.iter().any(|a| !a.within(&ours, 0.1)), "it spreads");
-            for a in &varied {
+            let around = AbilityRanges::around(&ours, 0.2);
+            let narrow = AbilityRanges::around(&ours, 0.1);
+            assert!(around.holds(&ours));
+            let drawn: Vec<Abilities> = (0..50).map(|seed| around.draw(&ours, seed)).collect();
+            assert_eq!(drawn[7], around.draw(&ours, 7), "seeded");
+            assert!(drawn.iter().all(|a| around.holds(a)));
+            assert!(drawn.iter().any(|a| !narrow.holds(a)), "it spreads");
+            for a in &drawn {
                 assert!(a.relative_main().iter().all(|r| r.abs() <= 0.2 + 1e-6));
             }
             // Only the main abilities vary.
@@ -381,10 +384,50 @@ mod tests {
             };
             for (range, _) in fields {
                 if !main_abilities(game).contains(&range.name) {
-                    assert_eq!(varied[3].value(range.name), ours.value(range.name));
+                    assert_eq!(drawn[3].value(range.name), ours.value(range.name));
                 }
             }
+            // A file's names read back to the same ranges.
+            assert_eq!(
+                AbilityRanges::from_named(game.player(), &around.named()),
+                Ok(around)
+            );
         }
+    }
+
+    #[test]
+    fn ability_ranges_from_a_file_name_the_field_that_is_wrong() {
+        let kind = crate::level::PlayerKind::Character;
+        let wide = |jump: [f64; 2]| {
+            std::collections::BTreeMap::from([
+                ("character.jump_speed".to_string(), jump),
+                ("character.run_speed".to_string(), [4.0, 9.0]),
+                ("character.gravity".to_string(), [9.0, 25.0]),
+            ])
+        };
+        let ranges = AbilityRanges::from_named(kind, &wide([4.0, 11.0])).unwrap();
+        let godot = Abilities::Character(CharacterProfile {
+            run_speed: 5.0,
+            jump_speed: 4.5,
+            gravity: 9.8,
+            ..CharacterProfile::default()
+        });
+        assert!(ranges.holds(&godot) && ranges.holds(&Abilities::default_of(Game::Platform)));
+        let error = AbilityRanges::from_named(kind, &wide([11.0, 4.0])).unwrap_err();
+        assert!(
+            error.contains("character.jump_speed") && error.contains("backwards"),
+            "{error}"
+        );
+        let error = AbilityRanges::from_named(kind, &wide([1.0, 4.0])).unwrap_err();
+        assert!(error.contains("character.jump_speed"), "{error}");
+        let mut missing = wide([4.0, 11.0]);
+        missing.remove("character.gravity");
+        let error = AbilityRanges::from_named(kind, &missing).unwrap_err();
+        assert!(error.contains("character.gravity: missing"), "{error}");
+        let mut other = wide([4.0, 11.0]);
+        other.insert("car.grip".into(), [0.5, 1.0]);
+        let error = AbilityRanges::from_named(kind, &other).unwrap_err();
+        assert!(error.contains("car.grip is not a main ability"), "{error}");
     }
 
     #[test]

@@ -12,7 +12,7 @@ use super::{
 use crate::level::heading;
 use crate::level::pacing::{AuxCurve, Pacing};
 use crate::level::params::{self, ParamRange};
-use crate::level::platform::{BlockParams, PlatformTrack, Start};
+use crate::level::platform::{BlockParams, PlatformTrack, Start, headroom_of};
 use crate::level::profile::ProfileRecord;
 use crate::level::racing::{self, Obstacle, RacingTrack, RoadShape, SegmentParams};
 use crate::level::{Game, Level, Shape, ShapeKind, SolverStats, Source, Track};
@@ -268,7 +268,8 @@ impl LevelFile {
         };
         let (track, default_goal) = match self.game.shape() {
             ShapeKind::Blocks => {
-                let (blocks, end) = self.platform_track(text)?;
+                let headroom = headroom_of(profile.as_ref().map(|p| &p.abilities));
+                let (blocks, end) = self.platform_track(text, headroom)?;
                 (Track::of_blocks(self.game, blocks), end)
             }
             ShapeKind::Road => {
@@ -323,7 +324,13 @@ impl LevelFile {
 
     /// The platform track the file describes, and where its last block ends (the goal when the
     /// file gives none); each block checked with its line.
-    fn platform_track(&self, text: &str) -> Result<(PlatformTrack, [f64; 3]), Problem> {
+    /// The blocks of a platform level, each placed with `headroom` ([`headroom_of`] its
+    /// character).
+    fn platform_track(
+        &self,
+        text: &str,
+        headroom: f64,
+    ) -> Result<(PlatformTrack, [f64; 3]), Problem> {
         if self.segments.is_some() {
             return Err(invalid(
                 "segments".into(),
@@ -357,7 +364,7 @@ impl LevelFile {
             heading: self.start.heading.0,
             size: self.start.size.map_or(Start::default().size, |s| s.0),
         };
-        let mut track = PlatformTrack::new(start);
+        let mut track = PlatformTrack::new(start).with_headroom(headroom);
         for (i, block) in blocks.iter().enumerate() {
             let field = format!("blocks[{i}]");
             let line = || line_of_item(text, "blocks", i);

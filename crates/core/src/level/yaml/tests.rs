@@ -134,3 +134,32 @@ segments:
     let msg = problem(&format!("{HAND_MADE}road: {{width: 7, banking: 0}}\n"));
     assert!(msg.contains("a platform level has no road"), "{msg}");
 }
+
+#[test]
+fn a_level_keeps_the_headroom_of_the_character_it_was_made_for() {
+    // Out, then back over the start block 3.1 m up: room for the built-in 1.8 m character...
+    let over_the_start = "\
+format: arlpcg-level
+version: 1
+game: platform
+start: {position: [0, 0, 0], heading: 0, size: 6}
+blocks:
+- {distance: 5, angle: 0, size: 6, height: 1.5}
+- {distance: 5, angle: 180, size: 6, height: 1.6}
+";
+    assert!(parse(over_the_start).is_ok());
+    // ...but not for a 2 m one, whose profile the level records.
+    let tall = crate::level::profile::Profile::default_of(crate::level::Game::Platform)
+        .with_value("character.height", 2.0)
+        .unwrap();
+    let record = serde_yaml::to_string(&serde_yaml::Mapping::from_iter([(
+        "profile".into(),
+        serde_yaml::to_value(tall.record()).unwrap(),
+    )]))
+    .unwrap();
+    let msg = problem(&format!("{over_the_start}{record}"));
+    assert!(
+        msg.contains("blocks[1]: block 1 overlaps the start block"),
+        "{msg}"
+    );
+}

@@ -29,7 +29,12 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Campaign(args)) => in_pool(args.threads, || campaign::run(&args)),
         Some(Command::Eval(args)) => eval::run(&args),
         Some(Command::Report(args)) => report::run(&args),
-        Some(Command::Profile(command)) => profile::run(&command),
+        Some(Command::Profile(command)) => match command {
+            crate::shells::cli::ProfileCommand::Check { threads, .. } => {
+                in_pool(threads, || profile::run(&command))
+            }
+            _ => profile::run(&command),
+        },
         Some(Command::Train(args)) => train::run(&args),
         Some(Command::Design(args)) => design(args),
         None => {

@@ -16,7 +16,7 @@ pub fn run(command: &ProfileCommand) -> Result<()> {
             ));
             Ok(())
         }
-        ProfileCommand::Check { file, trials } => {
+        ProfileCommand::Check { file, trials, .. } => {
             let profile = load(file)?;
             crate::say!(
                 "{}: the {} profile `{}` (sha256 {})",

@@ -171,6 +171,17 @@ pub enum ShapeKind {
     Road,
 }
 
+impl ShapeKind {
+    /// The style knobs a level of this shape may record (`knobs:`), as its games' Generators
+    /// name them (`GeneratorGame::KNOBS`).
+    pub fn knobs(self) -> &'static [&'static str] {
+        match self {
+            ShapeKind::Blocks => &platform::BLOCK_KNOBS,
+            ShapeKind::Road => &racing::ROAD_KNOBS,
+        }
+    }
+}
+
 /// Who plays a game: what a profile's abilities describe.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PlayerKind {
@@ -440,6 +451,16 @@ pub enum InvalidLevel {
     /// The level's aux curve is wrong, or the level has both a λ and a curve.
     #[error("{0}")]
     Pacing(String),
+    /// The level records a knob its game's Generators do not take.
+    #[error("`{name}` is not a knob of a {game} level (its knobs: {known})")]
+    UnknownKnob {
+        /// The name recorded.
+        name: String,
+        /// The level's game.
+        game: Game,
+        /// The knobs it may record.
+        known: String,
+    },
 }
 
 impl Level {
@@ -577,6 +598,14 @@ impl Level {
             pacing
                 .check(self.piece_count(), self.source.kept_pieces())
                 .map_err(InvalidLevel::Pacing)?;
+        }
+        let known = self.game().shape().knobs();
+        if let Some(name) = self.knobs.keys().find(|k| !known.contains(&k.as_str())) {
+            return Err(InvalidLevel::UnknownKnob {
+                name: name.clone(),
+                game: self.game(),
+                known: known.join(", "),
+            });
         }
         Ok(())
     }

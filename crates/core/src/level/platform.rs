@@ -39,6 +39,10 @@ pub fn headroom_of(abilities: Option<&crate::level::profile::Abilities>) -> f64 
     }
 }
 
+/// The style knobs a blocks level may record, as the Generators name them
+/// (`crates/core/src/game/platform/generator.rs`, `KNOBS`).
+pub const BLOCK_KNOBS: [&str; 2] = ["stride", "steps"];
+
 /// The Generator's action for one block, relative to the previous block.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct BlockParams {

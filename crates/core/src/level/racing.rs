@@ -9,6 +9,9 @@ use super::params::{self, ParamRange, RangeError};
 
 /// The most segments a track may have (a 10 km road).
 pub const MAX_SEGMENTS: usize = 400;
+/// The style knobs a road level may record, as the Generators name them
+/// (`crates/core/src/game/racing/generator.rs`, `KNOBS`).
+pub const ROAD_KNOBS: [&str; 2] = ["curviness", "elevation"];
 /// The most obstacles a track may have.
 pub const MAX_OBSTACLES: usize = 200;
 /// The road's end must come this close to the goal, horizontally, m...

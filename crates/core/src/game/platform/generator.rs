@@ -72,11 +72,11 @@ pub const GENERATOR_ACTIONS: [&str; 4] = [
 /// much its blocks step up and down, each measured by [`block_style`].
 pub const KNOBS: [Knob; 2] = [
     Knob {
-        name: "stride",
+        name: crate::level::platform::BLOCK_KNOBS[0],
         meaning: "-1 short hops ... +1 long leaps (a block's distance within the profile's range)",
     },
     Knob {
-        name: "steps",
+        name: crate::level::platform::BLOCK_KNOBS[1],
         meaning: "-1 level ... +1 steep steps up and down (a block's height change, either way, within the profile's largest)",
     },
 ];

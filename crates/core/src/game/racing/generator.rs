@@ -112,11 +112,11 @@ pub fn segment_from_action(
 /// much it climbs and falls, each measured by [`segment_style`].
 pub const KNOBS: [Knob; 2] = [
     Knob {
-        name: "curviness",
+        name: crate::level::racing::ROAD_KNOBS[0],
         meaning: "-1 sweeping ... +1 sharp (a segment's heading change, either way, within the profile's largest)",
     },
     Knob {
-        name: "elevation",
+        name: crate::level::racing::ROAD_KNOBS[1],
         meaning: "-1 flat ... +1 bumpy (a segment's height change, either way, within the profile's largest)",
     },
 ];

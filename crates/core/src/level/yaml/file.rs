@@ -309,6 +309,7 @@ impl LevelFile {
                 | crate::level::InvalidLevel::RoadShort { .. } => key("goal"),
                 crate::level::InvalidLevel::Road(_) => key("segments"),
                 crate::level::InvalidLevel::Pacing(_) => key("aux_curve"),
+                crate::level::InvalidLevel::UnknownKnob { .. } => key("knobs"),
                 crate::level::InvalidLevel::Obstacle { index, problem } => {
                     return invalid(
                         format!("obstacles[{index}]"),
@@ -323,9 +324,8 @@ impl LevelFile {
     }
 
     /// The platform track the file describes, and where its last block ends (the goal when the
-    /// file gives none); each block checked with its line.
-    /// The blocks of a platform level, each placed with `headroom` ([`headroom_of`] its
-    /// character).
+    /// file gives none); each block checked with its line and placed with `headroom`
+    /// ([`headroom_of`] its character).
     fn platform_track(
         &self,
         text: &str,

@@ -163,3 +163,18 @@ blocks:
         "{msg}"
     );
 }
+
+#[test]
+fn a_level_records_only_its_games_knobs() {
+    let knobs = |names: &str| format!("{HAND_MADE}knobs: {{{names}}}\n");
+    let level = parse(&knobs("stride: 1, steps: -0.5")).unwrap();
+    assert_eq!(level.knobs["steps"], -0.5);
+    let msg = problem(&knobs("stride: 1, curviness: 0.5"));
+    assert!(
+        msg.contains("knobs")
+            && msg.contains(
+                "`curviness` is not a knob of a platform level (its knobs: stride, steps)"
+            ),
+        "{msg}"
+    );
+}

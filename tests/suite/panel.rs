@@ -100,6 +100,35 @@ fn verify_panel_reports_every_judge_and_rates_the_levels_together() {
 
     let bad = arlpcg(words("verify {} --panel scripted-wizard", &[&levels[0]]));
     fails_with(&bad, 2, "scripted-expert");
+
+    // Under --profile the panel plays the profile's character: a low jumper cannot climb the
+    // hand-made staircase the built-in character climbs.
+    let dir = tempfile::tempdir().unwrap();
+    let low = dir.path().join("low.yaml");
+    let init = arlpcg_ok(words("profile init --game platform", &[]));
+    let text = String::from_utf8(init.stdout).unwrap();
+    std::fs::write(
+        &low,
+        text.replace("name: default", "name: low")
+            .replace("jump_speed: 9.25", "jump_speed: 5.0"),
+    )
+    .unwrap();
+    let staircase = concat!(env!("CARGO_MANIFEST_DIR"), "/levels/hand/staircase.yaml");
+    let expert = |profile: &[&str]| {
+        let mut args = vec![
+            staircase, "--panel", "scripted-expert", "--trials", "4", "--json",
+        ];
+        args.extend_from_slice(profile);
+        let out = arlpcg_ok(&[&["verify"], args.as_slice()].concat());
+        let row: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        row["panel"]["scripted-expert"].clone()
+    };
+    let low = low.to_str().unwrap();
+    assert_ne!(
+        expert(&[]),
+        expert(&["--profile", low]),
+        "--profile plays the low jumper"
+    );
 }
 
 #[test]

@@ -264,48 +264,46 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
     let mut panels: HashMap<Game, JudgePanel> = HashMap::new();
     let mut rated: Vec<(&Path, Game, PanelStats)> = Vec::new();
     let mut said = HashSet::new();
+    let profile = args.profile.as_deref().map(profile::load).transpose()?;
     let failed = each_level(
         &args.levels,
         |path| {
-            yaml::load(path)
-                .map_err(anyhow::Error::from)
-                .and_then(|level| {
-                    let game = level.game();
-                    let panel = match panels.entry(game) {
-                        Entry::Occupied(known) => known.into_mut(),
-                        Entry::Vacant(new) => {
-                            let dir = args
-                                .policies
-                                .clone()
-                                .map_or_else(|| shipped_dir(game), Ok)?;
-                            let chosen = (!chosen.0.is_empty()).then_some(chosen.0.as_slice());
-                            let panel = load_panel(&dir, game, chosen)?;
-                            if !args.json {
-                                crate::warn!("{game} panel: {}", panel.names().join(", "));
-                            }
-                            new.insert(panel)
+            load_under(path, profile.as_ref(), args.profile.as_deref()).and_then(|level| {
+                let game = level.game();
+                let panel = match panels.entry(game) {
+                    Entry::Occupied(known) => known.into_mut(),
+                    Entry::Vacant(new) => {
+                        let dir = args
+                            .policies
+                            .clone()
+                            .map_or_else(|| shipped_dir(game), Ok)?;
+                        let chosen = (!chosen.0.is_empty()).then_some(chosen.0.as_slice());
+                        let panel = load_panel(&dir, game, chosen)?;
+                        if !args.json {
+                            crate::warn!("{game} panel: {}", panel.names().join(", "));
                         }
-                    };
-                    say_panel_fit(panel, &level, args.json, &mut said);
-                    let runs = args.trials as u64 * panel.judges.len() as u64;
-                    let bar =
-                        crate::shells::common::progress_bar(runs, &path.display().to_string());
-                    let watch = Watch {
-                        on_trial: &|_| bar.inc(1),
-                        stop: &|| false,
-                    };
-                    let played = crate::services::panel::play(
-                        panel,
-                        &level,
-                        args.trials,
-                        args.seed,
-                        &watch,
-                        &|_, _| {},
-                    )?
-                    .expect("a panel without a stop condition plays to the end");
-                    bar.finish_and_clear();
-                    Ok((game, played))
-                })
+                        new.insert(panel)
+                    }
+                };
+                say_panel_fit(panel, &level, args.json, &mut said);
+                let runs = args.trials as u64 * panel.judges.len() as u64;
+                let bar = crate::shells::common::progress_bar(runs, &path.display().to_string());
+                let watch = Watch {
+                    on_trial: &|_| bar.inc(1),
+                    stop: &|| false,
+                };
+                let played = crate::services::panel::play(
+                    panel,
+                    &level,
+                    args.trials,
+                    args.seed,
+                    &watch,
+                    &|_, _| {},
+                )?
+                .expect("a panel without a stop condition plays to the end");
+                bar.finish_and_clear();
+                Ok((game, played))
+            })
         },
         |path, (game, stats)| {
             rated.push((path, game, stats));

@@ -16,3 +16,4 @@ pub mod policies;
 pub mod profile;
 pub mod train;
 pub mod verify;
+pub mod view;

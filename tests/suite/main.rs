@@ -21,3 +21,4 @@ mod racing_game;
 mod report;
 mod shipped;
 mod train;
+mod view;

@@ -119,7 +119,7 @@ fn verify_panel_reports_every_judge_and_rates_the_levels_together() {
             staircase, "--panel", "scripted-expert", "--trials", "4", "--json",
         ];
         args.extend_from_slice(profile);
-        let out = arlpcg_ok(&[&["verify"], args.as_slice()].concat());
+        let out = arlpcg_ok([&["verify"], args.as_slice()].concat());
         let row: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         row["panel"]["scripted-expert"].clone()
     };

@@ -159,6 +159,22 @@ pub struct ExportArgs {
     pub force: bool,
 }
 
+/// `view`'s arguments.
+#[derive(Debug, Args)]
+#[command(after_help = "Examples:\n  \
+    arlpcg view levels/platform/platform_seed7_aux-1.00.yaml\n  \
+    arlpcg view levels            # the newest level the designer or generate writes there\n  \
+    arlpcg view my-levels --port 8080\n\n\
+    In the page: drag to orbit, the wheel to zoom, f to look from the start toward the goal. \
+    Pieces are tinted red by their share of the failures the level's statistics record.")]
+pub struct ViewArgs {
+    /// A level file (.yaml), or a folder: the page shows its newest level file and follows it.
+    pub level: PathBuf,
+    /// The port to serve on, on 127.0.0.1 (0: any free one; the address is printed).
+    #[arg(long, default_value_t = 0)]
+    pub port: u16,
+}
+
 /// `export-policy`'s arguments.
 #[derive(Debug, Args)]
 #[command(

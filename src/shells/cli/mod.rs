@@ -10,7 +10,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 mod making;
 mod playing;
 mod values;
-pub use making::{ExportArgs, ExportPolicyArgs, FormatArg, GenerateArgs};
+pub use making::{ExportArgs, ExportPolicyArgs, FormatArg, GenerateArgs, ViewArgs};
 pub use playing::{CampaignArgs, SolverChoice, VerifyArgs, default_solver};
 pub use values::{AuxArg, Judges, KeepArg, Shard};
 use values::{parse_ability_spread, parse_game, parse_minutes, parse_shard};
@@ -61,6 +61,9 @@ pub enum Command {
     Export(ExportArgs),
     /// Write a trained policy's actor as ONNX (with a JSON sidecar), to run it in an engine.
     ExportPolicy(ExportPolicyArgs),
+    /// Show a level in 3D in a web browser: a page served on this machine (127.0.0.1), offline,
+    /// that follows the level file, or the newest level of a folder, as it changes.
+    View(ViewArgs),
     /// Play levels many times and report how often the Solver gets through.
     Verify(VerifyArgs),
     /// Generate a sequence of levels on a difficulty ramp, rate them with the panel of judges,

@@ -11,6 +11,7 @@ mod profile;
 mod report;
 mod train;
 mod verify;
+mod view;
 
 pub use crate::shells::common::{ChecksFailed, Interrupted, UsageError, exit_code};
 pub use verify::one_line;
@@ -25,6 +26,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Generate(args)) => in_pool(args.threads, || generate::run(&args)),
         Some(Command::Export(args)) => export::run(&args),
         Some(Command::ExportPolicy(args)) => export_policy::run(&args),
+        Some(Command::View(args)) => view::run(&args),
         Some(Command::Verify(args)) => in_pool(args.threads, || verify::run(&args)),
         Some(Command::Campaign(args)) => in_pool(args.threads, || campaign::run(&args)),
         Some(Command::Eval(args)) => eval::run(&args),

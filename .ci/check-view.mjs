@@ -1,0 +1,74 @@
+// `arlpcg view` in a real browser (headless Chromium, driven by puppeteer-core): the page draws
+// the level (not a blank canvas) within 2 s of opening, a new level written to the folder it
+// follows changes the picture within 1 s, and the page's console has no errors.
+// Usage: node .ci/check-view.mjs ARLPCG_BINARY CHROMIUM LEVEL_A LEVEL_B SCREENSHOT_DIR
+import { spawn } from "node:child_process";
+import { copyFileSync, mkdtempSync, mkdirSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
+import puppeteer from "puppeteer-core";
+
+const [binary, chromium, levelA, levelB, shots] = process.argv.slice(2);
+const fail = (message) => { console.error(`check-view: ${message}`); failed = true; };
+let failed = false;
+const folder = mkdtempSync(join(tmpdir(), "arlpcg-view-"));
+mkdirSync(shots, { recursive: true });
+copyFileSync(levelA, join(folder, "a.yaml"));
+
+const server = spawn(binary, ["view", folder], { stdio: ["ignore", "pipe", "inherit"] });
+const address = await new Promise((resolve, reject) => {
+  let seen = "";
+  server.stdout.on("data", (chunk) => {
+    seen += chunk;
+    const found = seen.match(/http:\/\/[0-9.:]+\//);
+    if (found) resolve(found[0]);
+  });
+  server.on("exit", (code) => reject(new Error(`arlpcg view exited with ${code}`)));
+});
+
+const browser = await puppeteer.launch({
+  executablePath: chromium,
+  headless: true,
+  args: ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"],
+});
+const errors = [];
+try {
+  const page = await browser.newPage();
+  await page.setViewport({ width: 1024, height: 640 });
+  page.on("console", (message) => { if (message.type() === "error") errors.push(message.text()); });
+  page.on("pageerror", (error) => errors.push(String(error)));
+  // Offline: the page may ask only the server it came from.
+  await page.setRequestInterception(true);
+  page.on("request", (request) => {
+    if (request.url().startsWith(address)) request.continue();
+    else { errors.push(`asked the network for ${request.url()}`); request.abort(); }
+  });
+
+  const opened = Date.now();
+  await page.goto(address);
+  await page.waitForFunction(() => Number(document.body.dataset.drawn) > 2000, { timeout: 2000 });
+  const first = await page.evaluate(() => ({ ...document.body.dataset }));
+  console.log(`first picture after ${Date.now() - opened} ms: ${first.drawn} pixels drawn`);
+  await page.screenshot({ path: join(shots, "view-first.png") });
+
+  const written = Date.now();
+  copyFileSync(levelB, join(folder, "b.yaml"));
+  await page.waitForFunction((version) => document.body.dataset.version !== version, { timeout: 1000 }, first.version);
+  await page.waitForFunction(() => Number(document.body.dataset.drawn) > 2000, { timeout: 1000 });
+  const second = await page.evaluate(() => ({ ...document.body.dataset }));
+  console.log(`new level shown ${Date.now() - written} ms after it was written: ${second.drawn} pixels drawn`);
+  await page.screenshot({ path: join(shots, "view-second.png") });
+  if (second.drawn === first.drawn) fail("the new level did not change the picture");
+  if (first.errors || second.errors) fail(`the page reported errors: ${first.errors}${second.errors}`);
+  if (errors.length) fail(`console errors: ${errors.join("; ")}`);
+} catch (error) {
+  fail(`${error.message}${errors.length ? ` (console: ${errors.join("; ")})` : ""}`);
+} finally {
+  server.kill();
+  // Closing a headless Chromium can hang on some machines: give it 5 s.
+  await Promise.race([browser.close(), new Promise((resolve) => setTimeout(resolve, 5000))]);
+  browser.process()?.kill("SIGKILL");
+}
+if (failed) process.exit(1);
+console.log("check-view: ok");
+process.exit(0);

@@ -1,0 +1,123 @@
+//! `arlpcg view`: the page, the scene and the version it serves on 127.0.0.1, following a
+//! folder's newest level. (The page's drawing in a real browser is checked by `.ci/run`, with
+//! headless Chromium: `.ci/check-view.sh`.)
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::process::{Child, Stdio};
+
+use crate::common::{arlpcg, fails_with, test_command};
+
+/// A running `arlpcg view`, stopped when dropped.
+struct Viewer {
+    child: Child,
+    address: String,
+}
+
+impl Drop for Viewer {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn view(path: &std::path::Path) -> Viewer {
+    let mut child = test_command()
+        .args(["view", path.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let address = line
+        .split("http://")
+        .nth(1)
+        .and_then(|rest| rest.split('/').next())
+        .unwrap_or_else(|| panic!("no address in {line:?}"))
+        .to_string();
+    Viewer { child, address }
+}
+
+/// The body of `GET path`, with its status code.
+fn get(viewer: &Viewer, path: &str) -> (u16, String) {
+    let mut stream = TcpStream::connect(&viewer.address).unwrap();
+    write!(
+        stream,
+        "GET {path} HTTP/1.0\r\nHost: {}\r\n\r\n",
+        viewer.address
+    )
+    .unwrap();
+    let mut answer = String::new();
+    stream.read_to_string(&mut answer).unwrap();
+    let status = answer[9..12].parse().unwrap();
+    let body = answer.split_once("\r\n\r\n").unwrap().1.to_string();
+    (status, body)
+}
+
+fn pieces(viewer: &Viewer) -> (String, u64) {
+    let (status, body) = get(viewer, "/scene.json");
+    assert_eq!(status, 200, "{body}");
+    let json: serde_json::Value = serde_json::from_str(&body).unwrap();
+    let version = json["version"].as_str().unwrap().to_string();
+    (version, json["scene"]["pieces"].as_u64().unwrap())
+}
+
+#[test]
+fn the_view_serves_the_newest_level_of_a_folder_and_follows_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let shipped = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("levels");
+    let easy = shipped.join("platform/platform_seed7_aux+1.00.yaml");
+    let track = shipped.join("racing/racing_seed7_aux+0.00.yaml");
+    std::fs::copy(&easy, dir.path().join("a.yaml")).unwrap();
+    let viewer = view(dir.path());
+
+    let (status, page) = get(&viewer, "/");
+    assert_eq!(status, 200);
+    assert!(
+        page.contains("<canvas") && page.contains("\"boxes\""),
+        "the first scene is in the page"
+    );
+    assert!(!page.contains("/*SCENE*/"));
+    assert!(
+        !page.contains("http://") && !page.contains("https://"),
+        "nothing from the network"
+    );
+    let (first, blocks) = pieces(&viewer);
+    let level = arlpcg_core::level::yaml::load(&easy).unwrap();
+    assert_eq!(blocks, level.piece_count() as u64);
+    assert_eq!(get(&viewer, "/version").1, first);
+
+    // A newer level in the folder is what the page shows next.
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    std::fs::copy(&track, dir.path().join("b.yaml")).unwrap();
+    let (second, segments) = pieces(&viewer);
+    assert_ne!(second, first);
+    let road = arlpcg_core::level::yaml::load(&track).unwrap();
+    assert_eq!(segments, road.piece_count() as u64);
+    assert_eq!(get(&viewer, "/nothing").0, 404);
+
+    // A broken newest file is an error the page is told of; the server keeps serving.
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    std::fs::write(
+        dir.path().join("c.yaml"),
+        "format: arlpcg-level\nversion: 1\ngame: chess\n",
+    )
+    .unwrap();
+    let (status, problem) = get(&viewer, "/scene.json");
+    assert_eq!(status, 500);
+    assert!(problem.contains("c.yaml"), "{problem}");
+    std::fs::remove_file(dir.path().join("c.yaml")).unwrap();
+    assert_eq!(pieces(&viewer).1, segments);
+}
+
+#[test]
+fn a_missing_level_or_an_empty_folder_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = arlpcg(["view", dir.path().join("none.yaml").to_str().unwrap()]);
+    fails_with(&out, 1, "no such level file or folder");
+    let out = arlpcg(["view", dir.path().to_str().unwrap()]);
+    fails_with(&out, 1, "holds no level file");
+}

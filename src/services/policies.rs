@@ -77,8 +77,13 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
         .observation
         .last()
         .is_some_and(|(name, _)| name == ABILITIES_PART);
-    let trained_over = trained_over(&card, profile.as_ref(), game)
-        .map_err(|problem| anyhow::anyhow!("{}: card field {problem}", path.display()))?;
+    // A card from before ranges gives only its share, around its profile's abilities.
+    let trained_over = AbilityRanges::given(
+        card.ability_ranges.as_ref(),
+        card.ability_spread,
+        &Abilities::of(profile.as_ref(), game),
+    )
+    .map_err(|problem| anyhow::anyhow!("{}: card field {problem}", path.display()))?;
     if reads_abilities != trained_over.is_some() {
         anyhow::bail!(
             "{}: card field ability_ranges (or ability_spread) must be given exactly when the observation ends with `{ABILITIES_PART}`",
@@ -96,30 +101,6 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
         },
         card,
     ))
-}
-
-/// The ranges an ability-aware card's policy trained over: its `ability_ranges`, or for a card
-/// from before them, its `ability_spread` around its profile's abilities (or ours); none for a
-/// policy of one character or car. `Err` names the field.
-fn trained_over(
-    card: &PolicyCard,
-    profile: Option<&Profile>,
-    game: Game,
-) -> Result<Option<AbilityRanges>, String> {
-    if let Some(named) = &card.ability_ranges {
-        return AbilityRanges::from_named(game.player(), named)
-            .map(Some)
-            .map_err(|problem| format!("ability_ranges: {problem}"));
-    }
-    match card.ability_spread {
-        Some(spread) if (0.0..=0.5).contains(&spread) && spread > 0.0 => Ok(Some(
-            AbilityRanges::around(&Abilities::of(profile, game), spread),
-        )),
-        Some(spread) => Err(format!(
-            "ability_spread: {spread} is not a share in (0, 0.5]"
-        )),
-        None => Ok(None),
-    }
 }
 
 /// Loads the ability-aware Solver of the policies folder `dir` ([`AWARE_SOLVER_FILE`]), if it

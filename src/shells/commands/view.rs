@@ -44,8 +44,8 @@ pub fn run(args: &ViewArgs) -> Result<()> {
                 reply(body.to_string(), "application/json")
             }),
             "/version" => shown
-                .version()
-                .map(|version| reply(version, "text/plain; charset=utf-8")),
+                .version_and_file()
+                .map(|(version, _)| reply(version, "text/plain; charset=utf-8")),
             _ => Ok(tiny_http::Response::from_string("not found").with_status_code(404)),
         };
         let response = answer.unwrap_or_else(|problem| {
@@ -111,19 +111,18 @@ impl Shown {
         Ok((path, when))
     }
 
-    /// A string that changes whenever the shown level does.
-    fn version(&self) -> Result<String> {
+    /// A string that changes whenever the shown level does, and the level's file.
+    fn version_and_file(&self) -> Result<(String, PathBuf)> {
         let (path, modified) = self.file()?;
         let nanos = modified
             .duration_since(SystemTime::UNIX_EPOCH)
             .map_or(0, |d| d.as_nanos());
-        Ok(format!("{}@{nanos}", path.display()))
+        Ok((format!("{}@{nanos}", path.display()), path))
     }
 
     /// The version and the scene of the level shown now.
     fn current(&self) -> Result<(String, serde_json::Value)> {
-        let version = self.version()?;
-        let (path, _) = self.file()?;
+        let (version, path) = self.version_and_file()?;
         let level = yaml::load(&path)?;
         let title = path.file_name().map_or_else(
             || path.display().to_string(),

@@ -61,8 +61,9 @@ pub struct TrainConfig {
     #[serde(default, skip_serializing_if = "is_zero")]
     pub ability_spread: f64,
     /// Ability-aware agents over ranges of their own, in place of `ability_spread`: each main
-    /// ability by name, `[least, most]` (`character.jump_speed: [4, 11]`), drawn uniformly per
-    /// episode and match. Empty (the default): `ability_spread` decides.
+    /// ability by name, `[least, most]` (`character.jump_speed: [4, 11]`), drawn per episode and
+    /// match among evenly spaced values (`AbilityRanges::draw`). Empty (the default):
+    /// `ability_spread` decides.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub ability_ranges: BTreeMap<String, [f64; 2]>,
 }
@@ -405,21 +406,16 @@ impl TrainConfig {
     /// The ranges its ability-aware agents train over (`ability_ranges`, or `ability_spread`
     /// around the profile's abilities), none for one character or car; `Err` names the field.
     pub fn trained_over(&self, game: Game) -> Result<Option<AbilityRanges>, String> {
-        if !self.ability_ranges.is_empty() {
-            if self.ability_spread > 0.0 {
-                return Err("give ability_ranges or ability_spread, not both".into());
-            }
-            return AbilityRanges::from_named(game.player(), &self.ability_ranges)
-                .map(Some)
-                .map_err(|problem| format!("ability_ranges: {problem}"));
+        let named = (!self.ability_ranges.is_empty()).then_some(&self.ability_ranges);
+        let spread = (self.ability_spread > 0.0).then_some(self.ability_spread);
+        if named.is_some() && spread.is_some() {
+            return Err("give ability_ranges or ability_spread, not both".into());
         }
-        Ok((self.ability_spread > 0.0).then(|| {
-            let base = self
-                .player(game)
-                .abilities
-                .unwrap_or(Abilities::default_of(game));
-            AbilityRanges::around(&base, self.ability_spread)
-        }))
+        let base = self
+            .player(game)
+            .abilities
+            .unwrap_or(Abilities::default_of(game));
+        AbilityRanges::given(named, spread, &base)
     }
 
     /// Whether its agents are ability-aware (they observe the abilities they play with).

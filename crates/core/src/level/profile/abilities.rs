@@ -358,6 +358,28 @@ impl AbilityRanges {
         Ok(Self { kind, ranges })
     }
 
+    /// The ranges a configuration or a card gives: its `ability_ranges` by name, else its
+    /// `ability_spread` (a share in (0, 0.5]) around `base`; none when it gives neither. `Err`
+    /// names the field.
+    pub fn given(
+        named: Option<&BTreeMap<String, [f64; 2]>>,
+        spread: Option<f64>,
+        base: &Abilities,
+    ) -> Result<Option<Self>, String> {
+        if let Some(named) = named {
+            return Self::from_named(base.kind(), named)
+                .map(Some)
+                .map_err(|problem| format!("ability_ranges: {problem}"));
+        }
+        match spread {
+            Some(spread) if spread > 0.0 && spread <= 0.5 => Ok(Some(Self::around(base, spread))),
+            Some(spread) => Err(format!(
+                "ability_spread: {spread} is not a share in (0, 0.5]"
+            )),
+            None => Ok(None),
+        }
+    }
+
     /// The ranges by field name, as a file writes them.
     pub fn named(&self) -> BTreeMap<String, [f64; 2]> {
         main_of(self.kind)

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use crate::common::{arlpcg, arlpcg_ok, fails_with, files_of, stderr, words};
+use crate::common::{FIVE_JUMPERS, arlpcg, arlpcg_ok, fails_with, files_of, stderr, words};
 
 fn generate(dir: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
@@ -1285,15 +1285,19 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
         "`0.7` is not a share within [0, 0.5]",
     );
     assert!(!Path::new(&run).exists());
+    // Five characters (jumps 8-9.5 m/s, ours otherwise): each one's reach is measured once.
+    let config = path("aware.yaml");
+    std::fs::write(&config, FIVE_JUMPERS).unwrap();
     arlpcg_ok(words(
-        "train --mode arlpcg --ability-spread 0.2 --steps 8192 --threads 1 --out {}",
-        &[&run],
+        "train --mode arlpcg --config {} --steps 8192 --threads 1 --out {}",
+        &[&config, &run],
     ));
-    // Both agents observe the abilities, and their cards say over which range.
+    // Both agents observe the abilities, and their cards say over which ranges.
     for card in ["solver.yaml", "generator.yaml"] {
         let card = std::fs::read_to_string(dir.path().join("run").join(card)).unwrap();
         assert!(
-            card.contains("- - abilities\n  - 3") && card.contains("ability_spread: 0.2"),
+            card.contains("- - abilities\n  - 3")
+                && card.contains("character.jump_speed:\n  - 8.0\n  - 9.5"),
             "{card}"
         );
     }

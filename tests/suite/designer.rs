@@ -219,7 +219,7 @@ fn a_profile_of_other_abilities_is_played_by_the_shipped_ability_aware_solver() 
 fn the_scripted_expert_plays_beyond_an_ability_aware_solvers_range() {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("aware.yaml");
-    std::fs::write(&config, "ability_spread: 0.2\n").unwrap();
+    std::fs::write(&config, crate::common::FIVE_JUMPERS).unwrap();
     let run = dir.path().join("run");
     crate::common::arlpcg_ok(crate::common::words(
         "train --mode arlpcg --config {} --steps 8192 --threads 1 --out {}",

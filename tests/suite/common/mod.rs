@@ -5,6 +5,15 @@ use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+/// A training configuration over five characters: ours with jumps of 8, 8.375, ..., 9.5 m/s.
+/// An ability-aware run measures each drawn character's reach once (seconds in a test build),
+/// so a test's run draws from few.
+pub const FIVE_JUMPERS: &str = "ability_ranges:
+  character.jump_speed: [8.0, 9.5]
+  character.run_speed: [8.0, 8.0]
+  character.gravity: [20.0, 20.0]
+";
+
 /// Runs the `arlpcg` binary with `args` and waits for it.
 pub fn arlpcg<S: AsRef<OsStr>>(args: impl IntoIterator<Item = S>) -> Output {
     test_command().args(args).output().expect("the binary runs")

@@ -254,6 +254,58 @@ fn the_scripted_expert_plays_beyond_an_ability_aware_solvers_range() {
     }
 }
 
+/// With a Generator trained with style knobs, `m` picks the slider the arrows move: a knob's
+/// value reaches the level (its file records it) and the screen shows it beside the style the
+/// level measures; without knobs, `m` says there are none and λ stays on the arrows.
+#[test]
+fn the_arrows_move_a_style_knob_that_m_picks() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rules = Harness::rules(dir.path());
+    rules.settle();
+    rules.key(KeyCode::Char('m'));
+    assert!(rules.pending.is_empty() && rules.app.slider == 0);
+    let (said, problem) = rules.app.status.clone().unwrap();
+    assert!(problem && said.contains("no style knobs"), "{said}");
+
+    let config = dir.path().join("knobs.yaml");
+    std::fs::write(&config, "generator:\n  rewards:\n    knobs: [1.0, 0.5]\n").unwrap();
+    let run = dir.path().join("run");
+    crate::common::arlpcg_ok(crate::common::words(
+        "train --mode arlpcg --config {} --steps 4096 --threads 1 --out {}",
+        &[&config, &run],
+    ));
+    let (policies, info) = worker::load(&run, Game::Platform).unwrap();
+    let mut h = Harness::new(policies, info, dir.path());
+    h.settle();
+    assert_eq!(h.app.knobs, vec![0.0, 0.0]);
+    let screen = h.screen(120, 40);
+    assert!(
+        screen.contains("λ +1.00  stride +0.00  steps +0.00"),
+        "{screen}"
+    );
+    assert!(screen.contains("measured stride"), "{screen}");
+    h.key(KeyCode::Char('m'));
+    assert_eq!(h.app.slider, 1);
+    h.key(KeyCode::End);
+    assert!(
+        matches!(&h.pending[..], [Effect::Generate { knobs, ask: Ask::Aux(aux), .. }]
+            if knobs == &[1.0, 0.0] && *aux == 1.0)
+    );
+    h.settle();
+    let level = h.app.level.clone().unwrap();
+    assert_eq!(level.knobs.get("stride"), Some(&1.0));
+    assert!(h.screen(120, 40).contains("stride +1.00"));
+    // Round to λ again: the arrows move λ, the knob keeps its value.
+    h.key(KeyCode::Char('m'));
+    h.key(KeyCode::Char('m'));
+    assert_eq!(h.app.slider, 0);
+    h.key(KeyCode::Left);
+    assert!(
+        matches!(&h.pending[..], [Effect::Generate { knobs, ask: Ask::Aux(aux), .. }]
+            if knobs == &[1.0, 0.0] && (*aux - 0.9).abs() < 1e-9)
+    );
+}
+
 #[test]
 fn whole_screen_at_80x24() {
     let dir = tempfile::tempdir().unwrap();
@@ -586,6 +638,7 @@ fn newer_requests_supersede_older_ones() {
         keep: None,
         trials: 100,
         profile: None,
+        knobs: Vec::new(),
     };
     workers.submit(generate(101));
     loop {

@@ -192,6 +192,11 @@ pub struct App {
     pub aux: f64,
     /// What difficulty is asked for: the slider's λ, a success rate, or λ along the level.
     pub ask: Ask,
+    /// The style knobs of a Generator trained with them, in its game's order, each in
+    /// [-1, 1] (0: no preference); empty for one without.
+    pub knobs: Vec<f64>,
+    /// Which slider the arrow keys and the mouse move: 0 λ, k the k-th knob (`m` cycles).
+    pub slider: usize,
     /// The prefix every regeneration keeps.
     pub kept: Option<crate::services::generation::KeptPrefix>,
     /// Each game's profile levels are made for, and the ability its keys change ([`profile`];
@@ -255,6 +260,8 @@ impl App {
             },
             aux: 1.0,
             ask: Ask::Aux(1.0),
+            knobs: Vec::new(),
+            slider: 0,
             kept: None,
             profiles: PerGame::default(),
             seed,
@@ -300,6 +307,7 @@ impl App {
     }
 
     fn generate(&mut self) -> Vec<Effect> {
+        self.fit_knobs();
         let id = self.id();
         self.loading = Loading::Generating { id };
         self.replay = None;
@@ -313,7 +321,78 @@ impl App {
             keep: self.kept.clone(),
             trials: self.trials_wanted,
             profile: self.profile().profile.clone(),
+            knobs: self.knob_values(),
         }]
+    }
+
+    /// The knobs the game on screen's Generator takes: none for the rules or a Generator
+    /// trained without them, else each of its game's.
+    pub fn knob_names(&self) -> &'static [&'static str] {
+        match &self.policies().generator {
+            Some(g) if arlpcg_core::rl::checkpoint::knob_part(&g.card) > 0 => {
+                self.game.shape().knobs()
+            }
+            _ => &[],
+        }
+    }
+
+    /// Keeps one value per knob of the Generator on screen (new ones at 0, no preference),
+    /// and the slider on one that exists.
+    fn fit_knobs(&mut self) {
+        let count = self.knob_names().len();
+        self.knobs.resize(count, 0.0);
+        if self.slider > count {
+            self.slider = 0;
+        }
+    }
+
+    /// The knobs as a request takes them.
+    pub(super) fn knob_values(&self) -> Vec<f32> {
+        self.knobs.iter().map(|&v| v as f32).collect()
+    }
+
+    /// The value of the slider the keys move: λ, or the selected knob's.
+    fn slider_value(&self) -> f64 {
+        match self.slider {
+            0 => self.aux,
+            k => self.knobs[k - 1],
+        }
+    }
+
+    /// Moves the slider the keys move (λ or the selected knob) to `value`.
+    fn set_slider(&mut self, value: f64) -> Vec<Effect> {
+        match self.slider {
+            0 => self.set_aux(value),
+            k => self.set_knob(k - 1, value),
+        }
+    }
+
+    /// `m`: the next slider for the arrow keys (λ, then each knob), for a Generator with knobs.
+    pub(super) fn next_slider(&mut self) -> Vec<Effect> {
+        self.fit_knobs();
+        let names = self.knob_names();
+        if names.is_empty() {
+            self.complain(
+                "this Generator takes no style knobs (train one with generator.rewards.knobs)",
+            );
+            return Vec::new();
+        }
+        self.slider = (self.slider + 1) % (names.len() + 1);
+        let name = match self.slider {
+            0 => "λ",
+            k => names[k - 1],
+        };
+        self.say(format!("the arrows move {name} (m: the next slider)"));
+        Vec::new()
+    }
+
+    fn set_knob(&mut self, k: usize, value: f64) -> Vec<Effect> {
+        let value = (value.clamp(-1.0, 1.0) * 100.0).round() / 100.0;
+        if self.knobs[k] == value {
+            return Vec::new();
+        }
+        self.knobs[k] = value;
+        self.generate()
     }
 
     /// The policies of the game on screen.

@@ -9,8 +9,10 @@ pub const MIN_SIZE: (u16, u16) = (80, 24);
 pub const SLIDER_LEFT: &str = "hard -1 ";
 /// Text right of the slider track.
 pub const SLIDER_RIGHT: &str = " +1 easy";
-/// Room after the slider for the λ readout.
+/// Room after the slider for the λ readout...
 pub const SLIDER_READOUT: u16 = 11;
+/// ...and for each style knob's, beside its name.
+const KNOB_READOUT: u16 = 8;
 
 /// The screen's areas.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -38,6 +40,17 @@ pub struct Areas {
 impl Areas {
     /// The areas of a screen of this size.
     pub fn of(screen: Rect) -> Self {
+        Self::with_knobs(screen, &[])
+    }
+
+    /// The areas of a screen of this size whose slider line also reads out the style knobs
+    /// `knobs` (their names), after λ.
+    pub fn with_knobs(screen: Rect, knobs: &[&str]) -> Self {
+        let readout = SLIDER_READOUT
+            + knobs
+                .iter()
+                .map(|name| name.chars().count() as u16 + KNOB_READOUT)
+                .sum::<u16>();
         let [header, controls, main, footer] = Layout::vertical([
             Constraint::Length(1),
             Constraint::Length(4),
@@ -56,9 +69,7 @@ impl Areas {
         let slider = Rect {
             x: inner.x + left_text,
             y: inner.y,
-            width: inner
-                .width
-                .saturating_sub(left_text + right_text + SLIDER_READOUT),
+            width: inner.width.saturating_sub(left_text + right_text + readout),
             height: 1.min(inner.height),
         };
         let settings = Rect {

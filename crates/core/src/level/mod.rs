@@ -474,6 +474,17 @@ impl Level {
         self.track.shape()
     }
 
+    /// The level's style, one value in [-1, 1] per knob of its shape ([`ShapeKind::knobs`]),
+    /// measured within the piece ranges of the profile it was made under (its game's built-in
+    /// ones without one): see [`profile::Pieces::style`].
+    pub fn style(&self) -> Vec<f64> {
+        let pieces = self.profile.as_ref().map_or_else(
+            || profile::Pieces::default_of(self.game()),
+            |profile| profile.pieces,
+        );
+        pieces.style(self.shape())
+    }
+
     /// The platform track, if this is a platform level.
     pub fn platform(&self) -> Option<&PlatformTrack> {
         match &self.track {

@@ -1,5 +1,5 @@
-//! The designer's input: keys (with the prompts they open) and the mouse on the λ slider, as
-//! changes of [`App`] and the effects they ask for.
+//! The designer's input: keys (with the prompts they open) and the mouse on the slider (λ or a
+//! style knob), as changes of [`App`] and the effects they ask for.
 
 use ratatui::crossterm::event::{
     KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEvent, MouseEventKind,
@@ -57,10 +57,11 @@ impl App {
                 }]
             }
             KeyCode::Tab => self.switch_game(),
-            KeyCode::Left => self.set_aux(self.aux - AUX_STEP),
-            KeyCode::Right => self.set_aux(self.aux + AUX_STEP),
-            KeyCode::Home => self.set_aux(-1.0),
-            KeyCode::End => self.set_aux(1.0),
+            KeyCode::Left => self.set_slider(self.slider_value() - AUX_STEP),
+            KeyCode::Right => self.set_slider(self.slider_value() + AUX_STEP),
+            KeyCode::Home => self.set_slider(-1.0),
+            KeyCode::End => self.set_slider(1.0),
+            KeyCode::Char('m') => self.next_slider(),
             KeyCode::Enter | KeyCode::Char(' ') => self.generate(),
             KeyCode::Char('n') => {
                 self.seed = next_seed(self.seed);
@@ -199,22 +200,26 @@ impl App {
         if self.overlay != Overlay::None {
             return Vec::new();
         }
-        let slider = Areas::of(self.size).slider;
+        let slider = Areas::with_knobs(self.size, self.knob_names()).slider;
         let at = Position::new(mouse.column, mouse.row);
         match mouse.kind {
             MouseEventKind::Down(MouseButton::Left) if slider.contains(at) => {
                 self.dragging = true;
-                self.set_aux(slider_aux(slider, mouse.column))
+                self.set_slider(slider_aux(slider, mouse.column))
             }
             MouseEventKind::Drag(MouseButton::Left) if self.dragging => {
-                self.set_aux(slider_aux(slider, mouse.column))
+                self.set_slider(slider_aux(slider, mouse.column))
             }
             MouseEventKind::Up(_) => {
                 self.dragging = false;
                 Vec::new()
             }
-            MouseEventKind::ScrollUp if slider.contains(at) => self.set_aux(self.aux + AUX_STEP),
-            MouseEventKind::ScrollDown if slider.contains(at) => self.set_aux(self.aux - AUX_STEP),
+            MouseEventKind::ScrollUp if slider.contains(at) => {
+                self.set_slider(self.slider_value() + AUX_STEP)
+            }
+            MouseEventKind::ScrollDown if slider.contains(at) => {
+                self.set_slider(self.slider_value() - AUX_STEP)
+            }
             _ => Vec::new(),
         }
     }

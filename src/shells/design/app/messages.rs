@@ -142,6 +142,8 @@ pub enum Effect {
         trials: u32,
         /// The game profile the level is made for (none: the built-in one).
         profile: Option<Profile>,
+        /// The Generator's style knobs, in its game's order (empty: none).
+        knobs: Vec<f32>,
     },
     /// Play `trials` runs of `level` with the game's current player, from `seed`.
     Trials {
@@ -179,6 +181,8 @@ pub enum Effect {
         trials: u32,
         /// The game profile the levels are made for (none: the built-in one).
         profile: Option<Profile>,
+        /// The Generator's style knobs, in its game's order (empty: none).
+        knobs: Vec<f32>,
     },
     /// Write the level's YAML and .glb files into `dir` as `stem.*`.
     Export {

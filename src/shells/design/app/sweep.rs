@@ -56,6 +56,7 @@ impl App {
             auxes: SWEEP_AUX.to_vec(),
             trials: SWEEP_TRIALS,
             profile: self.profile().profile.clone(),
+            knobs: self.knob_values(),
         }]
     }
 

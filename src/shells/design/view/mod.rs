@@ -24,9 +24,12 @@ use arlpcg_core::rl::checkpoint::Role;
 pub const KEYS: [(&str, &str); 22] = [
     (
         "← →  (mouse: click/drag)",
-        "λ down/up by 0.1 (-1 hard ... +1 easy)",
+        "λ down/up by 0.1 (-1 hard ... +1 easy), or a knob",
     ),
-    ("Home End", "λ = -1 / λ = +1"),
+    (
+        "Home End  m",
+        "-1 / +1 / the next slider: λ, each style knob",
+    ),
     ("Enter, Space", "generate again (same settings: same level)"),
     ("n s", "draw a new seed / type a seed"),
     ("g", "goal: from the seed / set by hand"),
@@ -75,7 +78,7 @@ fn draw_screen(app: &App, frame: &mut Frame) {
         frame.render_widget(Paragraph::new(text).wrap(Wrap { trim: true }), screen);
         return;
     }
-    let areas = Areas::of(screen);
+    let areas = Areas::with_knobs(screen, app.knob_names());
     header(app, frame, areas.header);
     controls(app, frame, &areas);
     match app.level.as_deref() {
@@ -194,17 +197,30 @@ fn header(app: &App, frame: &mut Frame, area: Rect) {
 }
 
 fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
-    frame.render_widget(
-        Block::bordered().title(" λ (aux): how hard the Generator builds "),
-        areas.controls,
-    );
+    let names = app.knob_names();
+    let title = match names.is_empty() {
+        true => " λ (aux): how hard the Generator builds ",
+        false => " λ (aux): how hard the Generator builds; style knobs (m: which the arrows move) ",
+    };
+    frame.render_widget(Block::bordered().title(title), areas.controls);
     let width = areas.slider.width as usize;
-    let mut slider = match app.ask.curve() {
+    // The slider the keys move: λ, or a knob (its value; λ's curve while paced).
+    // (A knob's ends take as many columns as λ's, so the mouse maps the same way.)
+    let (value, ends) = match app.slider {
+        0 => (app.aux, (SLIDER_LEFT.to_string(), SLIDER_RIGHT.to_string())),
+        k => (
+            app.knobs.get(k - 1).copied().unwrap_or(0.0),
+            (
+                format!("{:>w$}", "-1 ", w = SLIDER_LEFT.chars().count()),
+                format!("{:<w$}", " +1", w = SLIDER_RIGHT.chars().count()),
+            ),
+        ),
+    };
+    let mut slider = match app.ask.curve().filter(|_| app.slider == 0) {
         // The curve from start to goal, taller where it is harder.
         Some(curve) => super::app::pacing::curve_line(curve, width),
         None => {
-            let knob =
-                (((app.aux + 1.0) / 2.0) * (width.saturating_sub(1)) as f64).round() as usize;
+            let knob = (((value + 1.0) / 2.0) * (width.saturating_sub(1)) as f64).round() as usize;
             let track: String = (0..width)
                 .map(|i| match i.cmp(&knob) {
                     std::cmp::Ordering::Less => '━',
@@ -212,12 +228,22 @@ fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
                     std::cmp::Ordering::Greater => '─',
                 })
                 .collect();
-            Line::from(vec![
-                Span::raw(SLIDER_LEFT).red(),
+            let mut line = Line::from(vec![
+                Span::raw(ends.0).red(),
                 Span::styled(track, Style::new().fg(Color::Cyan)),
-                Span::raw(SLIDER_RIGHT).green(),
-                Span::styled(format!("  λ {:+.2}", app.aux), Style::new().bold()),
-            ])
+                Span::raw(ends.1).green(),
+            ]);
+            // λ and each knob's value, the one the keys move in bold.
+            let values = std::iter::once(("λ", app.aux))
+                .chain(names.iter().copied().zip(app.knobs.iter().copied()));
+            for (k, (name, v)) in values.enumerate() {
+                let style = match k == app.slider {
+                    true => Style::new().bold(),
+                    false => Style::new().dim(),
+                };
+                line.push_span(Span::styled(format!("  {name} {v:+.2}"), style));
+            }
+            line
         }
     };
     if let Some(kept) = &app.kept {
@@ -256,6 +282,18 @@ fn controls(app: &App, frame: &mut Frame, areas: &Areas) {
         settings.push_span(Span::styled(
             format!("   {}: {curve}", super::app::pacing::preset_name(curve)),
             Style::new().fg(Color::Magenta),
+        ));
+    }
+    // With knobs, the style the level on screen measures (what each knob asks for).
+    if let (false, Some(level)) = (names.is_empty(), app.level.as_deref()) {
+        let measured: Vec<String> = names
+            .iter()
+            .zip(level.style())
+            .map(|(name, v)| format!("{name} {v:+.2}"))
+            .collect();
+        settings.push_span(Span::styled(
+            format!("   measured {}", measured.join(" ")),
+            Style::new().fg(Color::Yellow),
         ));
     }
     frame.render_widget(Paragraph::new(settings), areas.settings);

@@ -153,14 +153,21 @@ pub fn perform(
             keep,
             trials,
             profile,
+            knobs,
         } => {
             let result = match (ask.success(), ask.aux()) {
                 (Some(target), _) => {
-                    let asked = LevelRequest::new(seed, None).goal(goal).profile(profile);
+                    let asked = LevelRequest::new(seed, None)
+                        .goal(goal)
+                        .profile(profile)
+                        .knobs(knobs);
                     target_level(&shelf[game], &asked, (target, trials), stop)
                 }
                 (None, aux) => {
-                    let mut request = LevelRequest::new(seed, None).goal(goal).profile(profile);
+                    let mut request = LevelRequest::new(seed, None)
+                        .goal(goal)
+                        .profile(profile)
+                        .knobs(knobs);
                     if let Some(aux) = aux {
                         request = request.aux(aux);
                     }
@@ -195,6 +202,7 @@ pub fn perform(
             auxes,
             trials,
             profile,
+            knobs,
         } => {
             let current = &shelf[game];
             for (index, aux) in auxes.into_iter().enumerate() {
@@ -203,7 +211,8 @@ pub fn perform(
                 }
                 let request = LevelRequest::new(seed, Some(aux))
                     .goal(goal)
-                    .profile(profile.clone());
+                    .profile(profile.clone())
+                    .knobs(knobs.clone());
                 let Some(point) = sweep_point(current, game, request, trials, stop) else {
                     return;
                 };

@@ -17,7 +17,7 @@ use crate::level::Track;
 use crate::level::heading::{direction_heading, wrap_degrees};
 use crate::level::params::{self, quantize};
 use crate::level::platform::{BlockParams, PlatformTrack, headroom_of};
-use crate::level::profile::{Abilities, BlockRanges};
+use crate::level::profile::Abilities;
 
 /// The named parts of the Generator's observation, in order, with their lengths (one aux input).
 pub const GENERATOR_OBSERVATION_LAYOUT: [(&str, usize); 9] = [
@@ -69,7 +69,7 @@ pub const GENERATOR_ACTIONS: [&str; 4] = [
 ];
 
 /// The platform Generator's style knobs (docs/decisions.md): how long its jumps are and how
-/// much its blocks step up and down, each measured by [`block_style`].
+/// much its blocks step up and down, each measured by `BlockRanges::style`.
 pub const KNOBS: [Knob; 2] = [
     Knob {
         name: crate::level::platform::BLOCK_KNOBS[0],
@@ -80,23 +80,6 @@ pub const KNOBS: [Knob; 2] = [
         meaning: "-1 level ... +1 steep steps up and down (a block's height change, either way, within the profile's largest)",
     },
 ];
-
-/// A block's style, one measure in [-1, 1] per [`KNOBS`]: its distance within `ranges`' (-1 the
-/// shortest), and the size of its height change, either way, within the largest `ranges` allow
-/// (-1 level, +1 the largest); 0 where a range is a single value.
-pub fn block_style(block: &BlockParams, ranges: &BlockRanges) -> [f32; 2] {
-    let distance = ranges.distance();
-    let stride = match distance.max > distance.min {
-        true => distance.to_unit(block.distance.clamp(distance.min, distance.max)),
-        false => 0.0,
-    };
-    let largest = ranges.min_height.abs().max(ranges.max_height.abs());
-    let steps = match largest > 0.0 {
-        true => (2.0 * block.height.abs() / largest - 1.0).min(1.0),
-        false => 0.0,
-    };
-    [stride as f32, steps as f32]
-}
 
 /// The block budget of a Generator's track by default: a track that has not reached its goal
 /// within it is invalid (goals are at most 70 m away, blocks 5-10 m apart).
@@ -277,10 +260,12 @@ impl TrackBuild for PlatformBuild {
     }
 
     fn piece_style(&self, piece: usize, out: &mut [f32]) {
-        out.copy_from_slice(&block_style(
-            &self.track.block_params()[piece],
-            &self.player.blocks(),
-        ));
+        out.copy_from_slice(
+            &self
+                .player
+                .blocks()
+                .style(&self.track.block_params()[piece]),
+        );
     }
 
     fn piece_features(&self) -> Vec<[f64; 2]> {
@@ -470,9 +455,9 @@ mod tests {
             size: 5.0,
             height,
         };
-        assert_eq!(block_style(&block(5.0, 0.0), &ranges), [-1.0, -1.0]);
-        assert_eq!(block_style(&block(10.0, -2.0), &ranges), [1.0, 1.0]);
-        assert_eq!(block_style(&block(7.5, 1.0), &ranges), [0.0, 0.0]);
+        assert_eq!(ranges.style(&block(5.0, 0.0)), [-1.0, -1.0]);
+        assert_eq!(ranges.style(&block(10.0, -2.0)), [1.0, 1.0]);
+        assert_eq!(ranges.style(&block(7.5, 1.0)), [0.0, 0.0]);
         // Knobs come after the game's observation; a long jump pays at stride +1, costs at -1.
         let rewards = GeneratorRewards {
             knobs: vec![1.0, 1.0],
@@ -487,7 +472,7 @@ mod tests {
             game.observe_generator(&mut out);
             assert_eq!(out[GENERATOR_OBSERVATION_SIZE..], [stride, 0.5]);
             assert_eq!(game.place(&long), Placement::Placed);
-            let measured = block_style(&game.build().track.block_params()[0], &ranges);
+            let measured = ranges.style(&game.build().track.block_params()[0]);
             assert!(measured[0] > 0.5, "{measured:?}");
             paid.push(game.placed_style_reward(&rewards) - 0.5 * measured[1]);
         }

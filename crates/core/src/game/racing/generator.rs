@@ -109,7 +109,7 @@ pub fn segment_from_action(
 }
 
 /// The racing Generator's style knobs (docs/decisions.md): how sharply its road turns and how
-/// much it climbs and falls, each measured by [`segment_style`].
+/// much it climbs and falls, each measured by `SegmentRanges::style`.
 pub const KNOBS: [Knob; 2] = [
     Knob {
         name: crate::level::racing::ROAD_KNOBS[0],
@@ -120,20 +120,6 @@ pub const KNOBS: [Knob; 2] = [
         meaning: "-1 flat ... +1 bumpy (a segment's height change, either way, within the profile's largest)",
     },
 ];
-
-/// A segment's style, one measure in [-1, 1] per [`KNOBS`]: the size of its heading change and
-/// of its height change, either way, within the largest `ranges` allow (-1 none, +1 the
-/// largest); 0 where a range allows none.
-pub fn segment_style(segment: &SegmentParams, ranges: &SegmentRanges) -> [f32; 2] {
-    let within = |value: f64, largest: f64| match largest > 0.0 {
-        true => (2.0 * value.abs() / largest - 1.0).min(1.0) as f32,
-        false => 0.0,
-    };
-    [
-        within(segment.curve, ranges.max_curve),
-        within(segment.height, ranges.max_height),
-    ]
-}
 
 /// A racing track the Generator is building toward its goal around the scene's obstacles,
 /// within its segment budget.
@@ -335,10 +321,7 @@ impl TrackBuild for RacingBuild {
     }
 
     fn piece_style(&self, piece: usize, out: &mut [f32]) {
-        out.copy_from_slice(&segment_style(
-            &self.track.segments[piece],
-            &self.player.segments(),
-        ));
+        out.copy_from_slice(&self.player.segments().style(&self.track.segments[piece]));
     }
 
     fn piece_features(&self) -> Vec<[f64; 2]> {
@@ -475,11 +458,11 @@ mod tests {
             curve,
             height,
         };
-        assert_eq!(segment_style(&segment(0.0, 0.0), &ranges), [-1.0, -1.0]);
+        assert_eq!(ranges.style(&segment(0.0, 0.0)), [-1.0, -1.0]);
         let sharpest = segment(-ranges.max_curve, ranges.max_height);
-        assert_eq!(segment_style(&sharpest, &ranges), [1.0, 1.0]);
+        assert_eq!(ranges.style(&sharpest), [1.0, 1.0]);
         let halfway = segment(0.5 * ranges.max_curve, -0.5 * ranges.max_height);
-        assert_eq!(segment_style(&halfway, &ranges), [0.0, 0.0]);
+        assert_eq!(ranges.style(&halfway), [0.0, 0.0]);
     }
 
     #[test]

@@ -363,6 +363,24 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_levels_style_is_the_mean_of_its_pieces_measures() {
+        use crate::level::Shape;
+        use crate::level::platform::{BlockParams, PlatformTrack, Start};
+        let ranges = Pieces::default_of(Game::Platform);
+        // The shortest jump, level, then the longest, 2 m up: stride -1 and +1, steps -1 and +1.
+        let blocks = [
+            BlockParams::new(5.0, 0.0, 5.0, 0.0).unwrap(),
+            BlockParams::new(10.0, 0.0, 5.0, 2.0).unwrap(),
+        ];
+        let track = PlatformTrack::from_params(Start::default(), &blocks).unwrap();
+        assert_eq!(ranges.style(Shape::Blocks(&track)), vec![0.0, 0.0]);
+        let track = PlatformTrack::from_params(Start::default(), &blocks[1..]).unwrap();
+        assert_eq!(ranges.style(Shape::Blocks(&track)), vec![1.0, 1.0]);
+        let empty = PlatformTrack::new(Start::default());
+        assert_eq!(ranges.style(Shape::Blocks(&empty)), vec![0.0, 0.0]);
+    }
+
+    #[test]
     fn drawn_abilities_stay_within_their_ranges_and_follow_their_seed() {
         for game in [Game::Platform, Game::Racing] {
             let ours = Abilities::default_of(game);

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use super::{Fields, field, nth, ordered};
 use crate::level::params::{self, ParamRange};
 use crate::level::racing::{self, RoadShape};
-use crate::level::{Game, ShapeKind};
+use crate::level::{Game, Shape, ShapeKind};
 
 /// The ranges a platform level's blocks are drawn from, by the rules and the Generator; each
 /// within the level format's own (`level::params`).
@@ -241,6 +241,21 @@ impl BlockRanges {
         ParamRange::new("angle", -self.max_turn, self.max_turn, "degrees")
     }
 
+    /// A block's style, one measure in [-1, 1] per knob of a blocks level
+    /// ([`crate::level::platform::BLOCK_KNOBS`]): its distance within these ranges' (-1 the
+    /// shortest), and the size of its height change, either way, within the largest they allow
+    /// (-1 level, +1 the largest); 0 where a range is a single value. What a Generator's
+    /// knob pays and a level's style measures.
+    pub fn style(&self, block: &crate::level::platform::BlockParams) -> [f32; 2] {
+        let distance = self.distance();
+        let stride = match distance.max > distance.min {
+            true => distance.to_unit(block.distance.clamp(distance.min, distance.max)),
+            false => 0.0,
+        };
+        let largest = self.min_height.abs().max(self.max_height.abs());
+        [stride as f32, within_largest(block.height, largest)]
+    }
+
     /// Checks that each of `block`'s parameters lies within these ranges.
     #[cfg(test)]
     pub(crate) fn check_block(
@@ -275,6 +290,17 @@ impl SegmentRanges {
             (SEGMENT_FIELDS[0].0.name, self.min_length),
             (SEGMENT_FIELDS[1].0.name, self.max_length),
         )
+    }
+
+    /// A segment's style, one measure in [-1, 1] per knob of a road level
+    /// ([`crate::level::racing::ROAD_KNOBS`]): the size of its heading change and of its
+    /// height change, either way, within the largest these ranges allow (-1 none, +1 the
+    /// largest); 0 where a range allows none.
+    pub fn style(&self, segment: &crate::level::racing::SegmentParams) -> [f32; 2] {
+        [
+            within_largest(segment.curve, self.max_curve),
+            within_largest(segment.height, self.max_height),
+        ]
     }
 
     /// A segment's length, m.
@@ -345,6 +371,31 @@ impl Pieces {
         }
     }
 
+    /// The style of the level `shape`, one value per knob of its shape
+    /// ([`ShapeKind::knobs`]): each the mean over its pieces of their measure within these
+    /// ranges (`BlockRanges::style`, `SegmentRanges::style`; the ranges of the level's own
+    /// shape), 0 for a level of no pieces. The same measure a Generator's knob pays per piece.
+    pub fn style(&self, shape: Shape<'_>) -> Vec<f64> {
+        let measures: Vec<[f32; 2]> = match shape {
+            Shape::Blocks(track) => {
+                let ranges = self.blocks();
+                track
+                    .block_params()
+                    .iter()
+                    .map(|b| ranges.style(b))
+                    .collect()
+            }
+            Shape::Road(track) => {
+                let ranges = self.segments();
+                track.segments.iter().map(|s| ranges.style(s)).collect()
+            }
+        };
+        let count = measures.len().max(1) as f64;
+        (0..2)
+            .map(|k| measures.iter().map(|m| f64::from(m[k])).sum::<f64>() / count)
+            .collect()
+    }
+
     /// The block ranges (the built-in ones for a profile of road).
     pub fn blocks(&self) -> BlockRanges {
         match self {
@@ -406,5 +457,14 @@ impl Pieces {
         } else {
             self.sections()
         }
+    }
+}
+
+/// The size of `value`, either way, within `largest` as a measure in [-1, 1] (-1 none, +1
+/// `largest` or more); 0 where `largest` is 0.
+fn within_largest(value: f64, largest: f64) -> f32 {
+    match largest > 0.0 {
+        true => (2.0 * value.abs() / largest - 1.0).min(1.0) as f32,
+        false => 0.0,
     }
 }

@@ -1692,4 +1692,17 @@ fn a_generator_with_knobs_records_them_and_generates() {
         "was trained without knobs",
     );
     assert!(!dir.path().join("refused").exists());
+    // `eval` adds a table per knob: nine settings, the style measured and the Solver's success.
+    let evaluated = dir.path().join("eval");
+    arlpcg_ok(words(
+        "eval --policies {} --tracks 2 --trials 2 --validation-tracks 2 --threads 1 --out {}",
+        &[&out, &evaluated],
+    ));
+    let md = std::fs::read_to_string(evaluated.join("results.md")).unwrap();
+    for knob in ["stride", "steps"] {
+        assert!(md.contains(&format!("### Style knob `{knob}`")), "{md}");
+    }
+    assert!(md.contains("| -1.00 |") && md.contains("| +1.00 |"), "{md}");
+    let json = std::fs::read_to_string(evaluated.join("results.json")).unwrap();
+    assert!(json.contains("\"spearman\""), "{json}");
 }

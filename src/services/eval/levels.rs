@@ -7,6 +7,7 @@ use arlpcg_core::level::Level;
 use arlpcg_core::level::profile::Profile;
 use arlpcg_core::seed_ranges::{EVAL_SEED_BASE, VALIDATION_AUX_STRIDE, VALIDATION_SEED_BASE};
 
+use super::styles::{KNOB_SETTINGS, KnobLayout};
 use super::{AUX_VALUES, Budget, KNOB_BETWEEN, NamedSolver, PlayLayout};
 
 /// Seeds tried per wanted level before the table notes a shortfall (the Generator may fail to
@@ -23,6 +24,18 @@ pub fn generator_levels(
     count: u32,
     profile: Option<&Profile>,
 ) -> Result<Vec<Level>, candle_core::Error> {
+    styled_levels(generator, (aux, &[]), base, count, profile)
+}
+
+/// [`generator_levels`] with the Generator's style knobs at `knobs` (in its game's order;
+/// missing: 0).
+fn styled_levels(
+    generator: &GeneratorPolicy,
+    (aux, knobs): (f64, &[f32]),
+    base: u64,
+    count: u32,
+    profile: Option<&Profile>,
+) -> Result<Vec<Level>, candle_core::Error> {
     let mut levels = Vec::with_capacity(count as usize);
     for seed in base..base + count as u64 * SEED_TRIES {
         if levels.len() == count as usize {
@@ -30,7 +43,8 @@ pub fn generator_levels(
         }
         let request = LevelRequest::new(seed, Some(aux))
             .obstacles(facts(generator.game).scene_obstacles)
-            .profile(profile.cloned());
+            .profile(profile.cloned())
+            .knobs(knobs.to_vec());
         match generation::generator_level(generator, &request) {
             Ok(level) => levels.push(level),
             // (No prefix is kept here, so `Keep` does not occur.)
@@ -87,6 +101,9 @@ pub struct Levels {
     pub between: Vec<Vec<Level>>,
     /// The validation set: its rule levels first, then the Generator's.
     pub validation: Vec<Level>,
+    /// Per style knob, the same goals at each setting of [`KNOB_SETTINGS`] (λ and the other
+    /// knobs at 0; none for a Generator without knobs).
+    pub by_knob: Vec<Vec<Vec<Level>>>,
     /// The evaluation's layout: what it plays.
     pub layout: PlayLayout,
 }
@@ -109,6 +126,30 @@ pub fn levels(
         .collect::<Result<_, _>>()?;
     let validation = validation_levels(generator, budget.validation_tracks, profile)?;
     let game = generator.game;
+    let by_knob: Vec<Vec<Vec<Level>>> = (0..generator.knobs)
+        .map(|k| {
+            KNOB_SETTINGS
+                .iter()
+                .map(|&value| {
+                    let mut knobs = vec![0.0; generator.knobs];
+                    knobs[k] = value as f32;
+                    styled_levels(
+                        generator,
+                        (0.0, &knobs),
+                        EVAL_SEED_BASE,
+                        budget.tracks,
+                        profile,
+                    )
+                })
+                .collect::<Result<_, _>>()
+        })
+        .collect::<Result<_, _>>()?;
+    let knobs = by_knob
+        .iter()
+        .zip(game.shape().knobs())
+        .enumerate()
+        .map(|(k, (levels, name))| KnobLayout::of(name, k, levels))
+        .collect();
     let piece_means = by_aux
         .iter()
         .map(|levels| {
@@ -128,11 +169,13 @@ pub fn levels(
         validation_levels: validation.len(),
         validation_rule_levels: validation.iter().filter(|l| is_rule_level(l)).count(),
         solvers: solvers.iter().map(|s| s.mode.clone()).collect(),
+        knobs,
     };
     Ok(Levels {
         by_aux,
         between,
         validation,
+        by_knob,
         layout,
     })
 }

@@ -12,6 +12,8 @@
 //!   of successful runs.
 //! - **Cross**: every Solver on the controllability levels, success ratio at each λ.
 //! - **Knob**: the ARLPCG Solver on the same goals every 0.25 of λ, how far success moves a step.
+//! - **Style knobs** (a Generator trained with them): each knob at nine settings, the others and
+//!   λ at 0, the style its levels measure and the ARLPCG Solver's success ([`styles`]).
 //!
 //! In parts, as an evaluation flows: [`levels`] builds every level and the [`PlayLayout`] of the
 //! tables; [`plays`] numbers the plays (one Solver on one level) and plays any subset of them,
@@ -25,6 +27,7 @@ pub mod page;
 mod plays;
 mod report;
 pub mod seeds;
+pub mod styles;
 pub(crate) mod tables;
 
 pub use levels::{Levels, generator_levels, is_rule_level, levels, validation_levels};
@@ -102,9 +105,10 @@ pub fn evaluate(
     })
 }
 
-/// Levels `evaluate` plays in all (for a progress bar).
-pub fn levels_to_play(budget: Budget, solvers: usize) -> u64 {
+/// Levels `evaluate` plays in all (for a progress bar), for a Generator of `knobs` style knobs.
+pub fn levels_to_play(budget: Budget, solvers: usize, knobs: usize) -> u64 {
     let per_table = AUX_VALUES.len() as u64 * budget.tracks as u64;
     let between = KNOB_BETWEEN.len() as u64 * budget.tracks as u64;
-    per_table + between + solvers as u64 * (budget.validation_tracks as u64 + per_table)
+    let styles = (knobs * styles::KNOB_SETTINGS.len()) as u64 * budget.tracks as u64;
+    per_table + between + styles + solvers as u64 * (budget.validation_tracks as u64 + per_table)
 }

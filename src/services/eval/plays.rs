@@ -8,6 +8,7 @@ use crate::services::verify::verify;
 use arlpcg_core::level::Game;
 use arlpcg_core::level::stats::SolverStats;
 
+use super::styles::KnobLayout;
 use super::{Budget, Levels, NamedSolver};
 
 /// What the tables are made of, without the levels themselves: the game, how many levels each
@@ -31,6 +32,9 @@ pub struct PlayLayout {
     pub validation_rule_levels: usize,
     /// The Solvers' training modes, in table order.
     pub solvers: Vec<String>,
+    /// The style knobs' tables, one per knob of a Generator trained with them (none before).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub knobs: Vec<KnobLayout>,
 }
 
 /// One play of one level by one Solver: which table, which Solver and λ, which level.
@@ -57,6 +61,16 @@ pub enum Play {
         /// The level's index in the validation set.
         level: usize,
     },
+    /// The ARLPCG Solver on level `level` of style knob `knob` at its setting number `setting`
+    /// ([`KNOB_SETTINGS`](super::styles::KNOB_SETTINGS)).
+    Style {
+        /// The knob's index.
+        knob: usize,
+        /// The setting's index.
+        setting: usize,
+        /// The level's index at that setting.
+        level: usize,
+    },
     /// Solver `solver` on level `level` at λ number `aux`.
     Cross {
         /// The Solver's index.
@@ -73,7 +87,13 @@ impl PlayLayout {
     pub fn play_count(&self) -> usize {
         let per_table: usize = self.levels_per_aux.iter().sum();
         let between: usize = self.levels_between.iter().sum();
-        per_table + between + self.solvers.len() * (self.validation_levels + per_table)
+        let styles: usize = self
+            .knobs
+            .iter()
+            .flat_map(|k| &k.measured)
+            .map(Vec::len)
+            .sum();
+        per_table + between + styles + self.solvers.len() * (self.validation_levels + per_table)
     }
 
     /// Every play of the evaluation, in a fixed order; shard I of K plays those whose index
@@ -92,6 +112,16 @@ impl PlayLayout {
             );
             for (aux, &n) in self.levels_per_aux.iter().enumerate() {
                 plays.extend((0..n).map(|level| Play::Cross { solver, aux, level }));
+            }
+        }
+        // Last, so that evaluations without knobs number their plays as before.
+        for (knob, layout) in self.knobs.iter().enumerate() {
+            for (setting, at) in layout.measured.iter().enumerate() {
+                plays.extend((0..at.len()).map(|level| Play::Style {
+                    knob,
+                    setting,
+                    level,
+                }));
             }
         }
         plays
@@ -124,6 +154,11 @@ pub fn play(
                     (main, &levels.by_aux[aux][level], budget.trials)
                 }
                 Play::Knob { aux, level } => (main, &levels.between[aux][level], budget.trials),
+                Play::Style {
+                    knob,
+                    setting,
+                    level,
+                } => (main, &levels.by_knob[knob][setting][level], budget.trials),
                 Play::Generalization { solver, level } => {
                     (solver, &levels.validation[level], budget.validation_trials)
                 }

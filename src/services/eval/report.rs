@@ -61,6 +61,26 @@ pub fn markdown(results: &Results) -> String {
             knob.steps
         );
     }
+    for table in &results.knobs {
+        md += &format!(
+            "\n### Style knob `{}` (λ and the other knobs 0): measured style and ARLPCG success\n\n| {} | measured (mean ± std over levels) | success | levels |\n|---|---|---|---|\n",
+            table.knob, table.knob
+        );
+        for row in &table.rows {
+            md += &format!(
+                "| {:+.2} | {} | {} | {} |\n",
+                row.value,
+                ratio_and_std(row.measured, row.measured_std),
+                num(row.success_ratio, 3),
+                row.tracks
+            );
+        }
+        md += &format!(
+            "\nSpearman's rank correlation of the setting and each level's measure: {}; success moves by at most {} across the settings.\n",
+            num(table.spearman, 3),
+            num(table.success_spread, 3)
+        );
+    }
     md += "\n## Solver generalization (held-out validation levels)\n\n";
     md += "| mode | success ratio | on rule levels | on Generator levels | completed by any | avg steps | paper |\n|---|---|---|---|---|---|---|\n";
     for row in &results.generalization {

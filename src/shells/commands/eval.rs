@@ -89,7 +89,7 @@ pub fn run(args: &EvalArgs) -> Result<()> {
             .join(", ")
     );
     let bar = crate::shells::common::progress_bar(
-        eval::levels_to_play(budget, named.len()),
+        eval::levels_to_play(budget, named.len(), generator.knobs),
         "levels played",
     );
     let results = pool

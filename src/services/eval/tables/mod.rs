@@ -210,6 +210,9 @@ pub struct Results {
     /// built-in game).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub profile: Option<arlpcg_core::level::profile::ProfileRecord>,
+    /// Each style knob's table (a Generator trained with knobs; absent otherwise).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub knobs: Vec<super::styles::KnobTable>,
 }
 
 /// What a [`Results`] read from JSON holds until [`Results::read`] sets the game.
@@ -320,6 +323,18 @@ impl Results {
                 within(&format!("knob.success[{a}]"), *success, SHARE)?;
             }
             within("knob.smooth_steps", knob.smooth_steps, SHARE)?;
+        }
+        for (k, table) in self.knobs.iter().enumerate() {
+            let at = |field: &str| format!("knobs[{k}].{field}");
+            within(&at("spearman"), table.spearman, AUX)?;
+            within(&at("success_spread"), table.success_spread, SHARE)?;
+            for (r, row) in table.rows.iter().enumerate() {
+                let at = |field: &str| format!("knobs[{k}].rows[{r}].{field}");
+                within(&at("value"), row.value, AUX)?;
+                within(&at("measured"), row.measured, AUX)?;
+                within(&at("measured_std"), row.measured_std, SHARE)?;
+                within(&at("success_ratio"), row.success_ratio, SHARE)?;
+            }
         }
         Ok(())
     }
@@ -481,6 +496,7 @@ pub fn assemble(
         controllability_by_judge,
         knob: Knob::of(&plays, stats),
         profile: None,
+        knobs: super::styles::knob_tables(&layout.knobs, &plays, stats),
     }
 }
 

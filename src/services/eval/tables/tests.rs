@@ -52,6 +52,7 @@ pub(in crate::services::eval) fn layout(game: Game) -> PlayLayout {
         validation_levels: 3,
         validation_rule_levels: 1,
         solvers: vec!["rule-pcg".into(), "arlpcg".into()],
+        knobs: Vec::new(),
     }
 }
 
@@ -74,6 +75,7 @@ fn outcomes(layout: &PlayLayout) -> Vec<SolverStats> {
             }
             Play::Cross { solver, .. } => stats(solver as u32 + 1, 4),
             Play::Knob { .. } => stats(3, 4),
+            Play::Style { setting, .. } => stats(setting as u32 % 5, 4),
         })
         .collect()
 }

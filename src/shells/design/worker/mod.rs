@@ -155,19 +155,14 @@ pub fn perform(
             profile,
             knobs,
         } => {
+            let request = LevelRequest::new(seed, None)
+                .goal(goal)
+                .profile(profile)
+                .knobs(knobs);
             let result = match (ask.success(), ask.aux()) {
-                (Some(target), _) => {
-                    let asked = LevelRequest::new(seed, None)
-                        .goal(goal)
-                        .profile(profile)
-                        .knobs(knobs);
-                    target_level(&shelf[game], &asked, (target, trials), stop)
-                }
+                (Some(target), _) => target_level(&shelf[game], &request, (target, trials), stop),
                 (None, aux) => {
-                    let mut request = LevelRequest::new(seed, None)
-                        .goal(goal)
-                        .profile(profile)
-                        .knobs(knobs);
+                    let mut request = request;
                     if let Some(aux) = aux {
                         request = request.aux(aux);
                     }

@@ -1063,7 +1063,9 @@ fn the_shipped_ability_aware_solver_plays_a_profile_within_its_range() {
     let (stand_in, said) = played(&["--profile", &path("lower.yaml")]);
     assert_eq!(stand_in, "scripted player (expert)");
     assert!(
-        said.contains("never trained with the abilities of profile `lower-jumper`: the scripted expert, who plays with any abilities, plays in its place"),
+        said.contains("never trained with the abilities of profile `lower-jumper`, nor within the abilities the ability-aware Solver policy")
+            && said.contains("solver-aware.safetensors trained over (character.jump_speed 7.4-11.1")
+            && said.contains("): the scripted expert, who plays with any abilities, plays in its place"),
         "{said}"
     );
     let (shipped, said) = played(&["--profile", &path("lower.yaml"), "--solver", "policy"]);
@@ -1422,6 +1424,17 @@ fn the_shipped_policies_are_found_by_the_variable_or_beside_the_binary_else_name
     assert!(!out.exists());
     let scripted = run(None, verify());
     assert!(scripted.status.success(), "{}", stderr(&scripted));
+    let rules = run(
+        None,
+        words("generate --rules --verify 2 --out {}", &[&at("rules")]),
+    );
+    assert!(rules.status.success(), "{}", stderr(&rules));
+    assert!(
+        stderr(&rules).contains("no shipped policies: looked for")
+            && stderr(&rules).contains("the scripted expert verifies"),
+        "{}",
+        stderr(&rules)
+    );
     assert!(
         stderr(&scripted)
             .contains("platform solver: scripted player (no shipped policies: looked for"),

@@ -89,6 +89,16 @@ impl SolverPolicy {
     /// ([`default_player`]): none where it trained with those abilities, else the scripted
     /// expert and the line that says why.
     pub fn stand_in(&self, played: Option<&Profile>) -> Option<(Skill, String)> {
+        self.stand_in_beside(None, played)
+    }
+
+    /// [`Self::stand_in`], naming the range of the folder's ability-aware Solver `aware` too
+    /// where it does not hold the abilities either.
+    pub fn stand_in_beside(
+        &self,
+        aware: Option<&SolverPolicy>,
+        played: Option<&Profile>,
+    ) -> Option<(Skill, String)> {
         let name = |profile: Option<&Profile>| {
             profile.map_or("the built-in abilities".to_string(), |p| {
                 format!("profile `{}`", p.name)
@@ -108,10 +118,22 @@ impl SolverPolicy {
                 self.trained_over.map(|r| r.describe()).unwrap_or_default()
             ),
         };
+        let nor = aware
+            .filter(|aware| !std::ptr::eq(*aware, self))
+            .and_then(|aware| {
+                aware.trained_over.map(|range| {
+                    format!(
+                        ", nor within the abilities the ability-aware Solver policy {} trained over ({})",
+                        aware.reference.path,
+                        range.describe()
+                    )
+                })
+            })
+            .unwrap_or_default();
         Some((
             Skill::Expert,
             format!(
-                "{why}: the scripted expert, who plays with any abilities, plays in its place (name a Solver policy to have it play anyway)"
+                "{why}{nor}: the scripted expert, who plays with any abilities, plays in its place (name a Solver policy to have it play anyway)"
             ),
         ))
     }
@@ -137,7 +159,7 @@ pub fn default_player<'a>(
     played: Option<&Profile>,
 ) -> (Solver<'a>, Option<String>) {
     let policy = solver.or_aware(aware, played);
-    match policy.stand_in(played) {
+    match policy.stand_in_beside(aware, played) {
         None => (Solver::Policy(policy), None),
         Some((skill, why)) => (Solver::Scripted(skill), Some(why)),
     }

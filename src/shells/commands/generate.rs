@@ -16,7 +16,8 @@ use crate::services::level_files::{Format, LevelFiles, file_stem, render};
 use crate::services::making::{self, LevelSource, Proof, Redraw};
 use crate::services::panel::{Judge, JudgePanel};
 use crate::services::policies::{
-    load_folder_solver, load_generator, load_judge_under, load_panel, load_solver, policy_paths,
+    load_aware_solver, load_folder_solver, load_generator, load_judge_under, load_panel,
+    load_solver, policy_paths,
 };
 use crate::services::profile;
 use crate::services::verify::{self, Solver, SolverPolicy};
@@ -481,11 +482,22 @@ fn chosen_solver(
                 (None, Ok(solver)) if solver.exists() => solver
                     .parent()
                     .expect("the Solver file of a policies folder"),
-                (None, _) => return Ok(None),
+                (None, Err(e)) => {
+                    crate::warn!("{e:#}: the scripted expert verifies");
+                    return Ok(None);
+                }
+                (None, Ok(solver)) => {
+                    crate::warn!(
+                        "{}: no such Solver policy: the scripted expert verifies",
+                        solver.display()
+                    );
+                    return Ok(None);
+                }
             };
             let policy = load_folder_solver(folder, args.game, profile)?;
+            let aware = load_aware_solver(folder, args.game)?;
             // A folder's Solver that cannot play the character gives way to the scripted expert.
-            match policy.stand_in(profile) {
+            match policy.stand_in_beside(aware.as_ref(), profile) {
                 None => Some(policy),
                 Some((_, why)) => {
                     crate::warn!("{why}");

@@ -1,9 +1,12 @@
 //! Golden episodes: a real run of a policy, each decision's state ([`SolverEnv::port_state`],
 //! [`TrackBuild::port_state`]), the raw observation computed from it and the deterministic
 //! action the policy (and so its ONNX graph) chose. A Solver plays a rule level of its game; a
-//! Generator builds a level at λ = [`GOLDEN_AUX`] toward the goal of a seed. An engine's port
-//! of the observation recomputes each frame's observation from its state and runs the graph on
-//! it; `.ci/port-check.py` is such a port, written from docs/engines.md alone.
+//! Generator builds a level at λ = [`GOLDEN_AUX`] toward the goal of a seed, and each of its
+//! frames also holds the piece its action stood for, with what the action → piece mapping
+//! reads besides the state in the episode's `piece_rules` ([`GoldenPieces`]). An
+//! ability-aware agent's state holds the abilities it played with. An engine's port recomputes
+//! each frame's observation from its state, runs the graph on it, and rebuilds each piece from
+//! the action; `.ci/port-check.py` is such a port, written from docs/engines.md alone.
 
 use std::collections::BTreeMap;
 
@@ -14,8 +17,11 @@ use serde::{Deserialize, Serialize};
 use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, Placement, TrackBuild, observe_build,
 };
-use arlpcg_core::game::{GameSpec, PortState, SolverEnv, observe_solver};
+use arlpcg_core::game::platform::generator::block_from_action;
+use arlpcg_core::game::racing::generator::segment_from_action;
+use arlpcg_core::game::{GameSpec, PlatformGame, PortState, RacingGame, SolverEnv, observe_solver};
 use arlpcg_core::level::PolicyRef;
+use arlpcg_core::level::profile::{ABILITIES_PART, Abilities, main_abilities};
 use arlpcg_core::rl::checkpoint::PolicyCard;
 use arlpcg_core::rl::policy::{ActMode, ActorCritic};
 
@@ -25,6 +31,10 @@ const GOLDEN_LEVEL_SEED: u64 = 1;
 const GOLDEN_RUN_SEED: u64 = 0;
 /// λ of a Generator's golden episode.
 const GOLDEN_AUX: f32 = -1.0;
+
+/// The golden episodes' format version: 2 added each Generator frame's `piece`, the episode's
+/// `piece_rules`, and an ability-aware agent's `abilities` and `abilities_built_in` state.
+const GOLDEN_VERSION: u32 = 2;
 
 /// A Solver's run, decision by decision.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -46,6 +56,10 @@ pub struct GoldenEpisode {
     pub aux: Option<f32>,
     /// The run's reset seed.
     pub run_seed: u64,
+    /// A Generator's: what its action → piece mapping reads besides each frame's state (the
+    /// player's piece ranges; platform: the reach table; racing: the curve offset), by name.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub piece_rules: BTreeMap<String, Vec<f64>>,
     /// How the run ended.
     pub outcome: String,
     /// Each decision, in order.
@@ -58,18 +72,20 @@ impl GoldenEpisode {
         policy: PolicyRef,
         level: &arlpcg_core::level::Level,
         aux: Option<f32>,
+        piece_rules: BTreeMap<String, Vec<f64>>,
         outcome: String,
         frames: Vec<GoldenFrame>,
     ) -> Self {
         Self {
             format: "arlpcg-golden-episode".into(),
-            version: 1,
+            version: GOLDEN_VERSION,
             game: card.game.to_string(),
             role: card.role.to_string(),
             policy,
             level: arlpcg_core::level::yaml::to_string(level),
             aux,
             run_seed: GOLDEN_RUN_SEED,
+            piece_rules,
             outcome,
             frames,
         }
@@ -85,6 +101,11 @@ pub struct GoldenFrame {
     pub observation: Vec<f32>,
     /// The deterministic action: continuous actions clipped to [-1, 1], binary ones 0 or 1.
     pub action: Vec<f32>,
+    /// A Generator's: the piece the action stood for, by parameter name as the level file
+    /// names them, as placing it computed it (also when the placement was then refused as
+    /// invalid); none when the track had no piece left to place.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub piece: Option<BTreeMap<String, f64>>,
 }
 
 /// The golden episode of Solver `policy` (with its `card`) of game `G`.
@@ -103,7 +124,8 @@ pub fn golden_episode<G: GameSpec>(
         // An ability-aware Solver also observes the abilities: ours, all 0.
         let mut observation = vec![0.0; card.network.observation];
         observe_solver::<G>(&env, None, &mut observation);
-        let frame = frame(policy, card, env.port_state(), observation)?;
+        let mut frame = frame(policy, card, env.port_state(), observation)?;
+        record_abilities::<G>(card, None, &mut frame);
         let action = G::Env::action_from_policy_row(&frame.action);
         frames.push(frame);
         if let Some(outcome) = env.step(action).outcome {
@@ -115,6 +137,7 @@ pub fn golden_episode<G: GameSpec>(
         reference,
         &level,
         None,
+        BTreeMap::new(),
         format!("{outcome:?}"),
         frames,
     ))
@@ -122,7 +145,7 @@ pub fn golden_episode<G: GameSpec>(
 
 /// The golden episode of Generator `policy` (with its `card` and `limits`) of game `G`: each
 /// piece it places, until the track reaches its goal or ends.
-pub fn generator_golden_episode<G: GeneratorGame>(
+pub fn generator_golden_episode<G: GoldenPieces>(
     policy: &ActorCritic,
     card: &PolicyCard,
     reference: PolicyRef,
@@ -130,6 +153,7 @@ pub fn generator_golden_episode<G: GeneratorGame>(
 ) -> candle_core::Result<GoldenEpisode> {
     let obstacles = arlpcg_core::game::facts::facts(G::GAME).scene_obstacles;
     let (mut build, _) = G::new_build(GOLDEN_RUN_SEED, None, limits, obstacles);
+    let piece_rules = G::piece_rules(&build);
     let mut frames = Vec::new();
     let outcome = loop {
         // A Generator with knobs observes them, all at 0 (no preference); an ability-aware one
@@ -137,8 +161,14 @@ pub fn generator_golden_episode<G: GeneratorGame>(
         let mut observation = vec![0.0; card.network.observation];
         let knobs = vec![0.0; arlpcg_core::rl::checkpoint::knob_part(card)];
         observe_build::<G>(&build, &[GOLDEN_AUX], &knobs, &mut observation);
-        let frame = frame(policy, card, build.port_state(), observation)?;
+        let mut frame = frame(policy, card, build.port_state(), observation)?;
+        if !knobs.is_empty() {
+            frame.state.insert("knobs".into(), vec![0.0; knobs.len()]);
+        }
+        record_abilities::<G>(card, build.player().abilities, &mut frame);
+        let piece = G::piece(&build, &frame.action);
         let placement = build.place(&frame.action);
+        frame.piece = piece.filter(|_| placement != Placement::OutOfPieces);
         frames.push(frame);
         if placement != Placement::Placed {
             break placement;
@@ -163,6 +193,7 @@ pub fn generator_golden_episode<G: GeneratorGame>(
         reference,
         &level,
         Some(GOLDEN_AUX),
+        piece_rules,
         outcome,
         frames,
     ))
@@ -191,12 +222,194 @@ fn frame(
             .collect(),
         observation,
         action,
+        piece: None,
     })
 }
+
+/// An ability-aware agent's (its card's observation ends with [`ABILITIES_PART`]) state gains
+/// the main abilities it played with (`played`; none: ours), in [`main_abilities`]' order, and
+/// ours (`abilities_built_in`): its `abilities` columns are each value / ours - 1.
+fn record_abilities<G: GameSpec>(
+    card: &PolicyCard,
+    played: Option<Abilities>,
+    frame: &mut GoldenFrame,
+) {
+    if card.observation.last().map(|(name, _)| name.as_str()) != Some(ABILITIES_PART) {
+        return;
+    }
+    let ours = Abilities::default_of(G::GAME);
+    let values = |abilities: &Abilities| -> Vec<f64> {
+        main_abilities(G::GAME)
+            .iter()
+            .map(|field| {
+                abilities
+                    .value(field)
+                    .expect("a main ability of the game")
+                    .0
+            })
+            .collect()
+    };
+    let state = &mut frame.state;
+    state.insert("abilities".into(), values(&played.unwrap_or(ours)));
+    state.insert("abilities_built_in".into(), values(&ours));
+}
+
+/// What a Generator's golden episode records of its pieces, so that a port of the action →
+/// piece mapping (docs/engines.md) can be checked: each game's own mapping, called as placing a
+/// piece calls it. A game without one (the tests' ball) records none.
+pub trait GoldenPieces: GeneratorGame {
+    /// What the mapping reads besides a frame's state, by name.
+    fn piece_rules(_build: &Self::Build) -> BTreeMap<String, Vec<f64>> {
+        BTreeMap::new()
+    }
+
+    /// The piece action `row` stands for on `build`, by the level file's parameter names.
+    fn piece(_build: &Self::Build, _row: &[f32]) -> Option<BTreeMap<String, f64>> {
+        None
+    }
+}
+
+/// Names and values, as the golden file writes them.
+fn named<const N: usize, T: Clone>(pairs: [(&str, T); N]) -> BTreeMap<String, T> {
+    pairs
+        .into_iter()
+        .map(|(name, value)| (name.to_string(), value))
+        .collect()
+}
+
+impl GoldenPieces for PlatformGame {
+    /// The player's block ranges and its reach table (by `REACH_HEIGHTS`).
+    fn piece_rules(build: &Self::Build) -> BTreeMap<String, Vec<f64>> {
+        let r = build.player.blocks();
+        named([
+            ("min_distance", vec![r.min_distance]),
+            ("max_distance", vec![r.max_distance]),
+            ("min_size", vec![r.min_size]),
+            ("max_size", vec![r.max_size]),
+            ("min_height", vec![r.min_height]),
+            ("max_height", vec![r.max_height]),
+            ("max_turn", vec![r.max_turn]),
+            ("reach_table", build.reach.0.to_vec()),
+        ])
+    }
+
+    fn piece(build: &Self::Build, row: &[f32]) -> Option<BTreeMap<String, f64>> {
+        let block = block_from_action(&build.track, build.goal, row, (&build.player, &build.reach));
+        Some(named([
+            ("distance", block.distance),
+            ("angle", block.angle),
+            ("size", block.size),
+            ("height", block.height),
+        ]))
+    }
+}
+
+impl GoldenPieces for RacingGame {
+    /// The player's segment ranges and the card's curve offset.
+    fn piece_rules(build: &Self::Build) -> BTreeMap<String, Vec<f64>> {
+        let r = build.player.segments();
+        named([
+            ("min_length", vec![r.min_length]),
+            ("max_length", vec![r.max_length]),
+            ("max_curve", vec![r.max_curve]),
+            ("max_height", vec![r.max_height]),
+            ("curve_offset", vec![build.curve_offset]),
+        ])
+    }
+
+    fn piece(build: &Self::Build, row: &[f32]) -> Option<BTreeMap<String, f64>> {
+        let segment = segment_from_action(
+            &build.road,
+            build.goal,
+            row,
+            build.curve_offset,
+            &build.player.segments(),
+        );
+        Some(named([
+            ("length", segment.length),
+            ("curve", segment.curve),
+            ("height", segment.height),
+        ]))
+    }
+}
+
+#[cfg(feature = "test-game")]
+impl GoldenPieces for arlpcg_core::game::ball::BallGame {}
 
 /// Where the golden episode of the graph at `onnx` goes: the same name with `.golden.json`.
 pub fn golden_path(onnx: &std::path::Path) -> std::path::PathBuf {
     let mut name = onnx.as_os_str().to_owned();
     name.push(".golden.json");
     name.into()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::services::policies::{generator_limits, load_any};
+
+    fn shipped(name: &str) -> std::path::PathBuf {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("policies/{name}"))
+    }
+
+    /// Each frame of a shipped Generator's golden episode holds the piece it placed, the very
+    /// piece of the level it built, and the episode what the mapping read.
+    #[test]
+    fn a_generators_golden_frames_hold_the_pieces_of_its_level() {
+        for game in ["platform", "racing"] {
+            let path = shipped(&format!("{game}/generator.safetensors"));
+            let (policy, card, reference) = load_any(&path).unwrap();
+            let limits = generator_limits(&path, &card).unwrap();
+            let episode = arlpcg_core::for_game!(card.game, G => {
+                generator_golden_episode::<G>(&policy, &card, reference, limits)
+            })
+            .unwrap();
+            assert_eq!(episode.version, GOLDEN_VERSION);
+            let level = arlpcg_core::level::yaml::parse(&episode.level).unwrap();
+            let pieces: Vec<Vec<f64>> = match (level.platform(), level.racing()) {
+                (Some(track), _) => track
+                    .block_params()
+                    .iter()
+                    .map(|b| vec![b.angle, b.distance, b.height, b.size])
+                    .collect(),
+                (_, Some(track)) => track
+                    .segments
+                    .iter()
+                    .map(|s| vec![s.curve, s.height, s.length])
+                    .collect(),
+                _ => unreachable!("a level of the Generator's game"),
+            };
+            let recorded: Vec<Vec<f64>> = episode
+                .frames
+                .iter()
+                .map(|f| f.piece.clone().unwrap().into_values().collect())
+                .collect();
+            assert_eq!(recorded, pieces, "{game}");
+            let rules = match game {
+                "platform" => {
+                    "max_distance max_height max_size max_turn min_distance min_height min_size reach_table"
+                }
+                _ => "curve_offset max_curve max_height max_length min_length",
+            };
+            let names: Vec<&str> = episode.piece_rules.keys().map(String::as_str).collect();
+            assert_eq!(names.join(" "), rules);
+        }
+    }
+
+    /// An ability-aware Solver's golden state holds the abilities it played with (ours) and
+    /// ours; a Solver that is not aware has neither.
+    #[test]
+    fn an_ability_aware_solvers_golden_state_holds_its_abilities() {
+        for (name, aware) in [("solver-aware", true), ("solver", false)] {
+            let path = shipped(&format!("platform/{name}.safetensors"));
+            let (policy, card, reference) = load_any(&path).unwrap();
+            let episode = golden_episode::<PlatformGame>(&policy, &card, reference).unwrap();
+            let state = &episode.frames[0].state;
+            assert_eq!(state.contains_key("abilities"), aware, "{name}");
+            if aware {
+                assert_eq!(state["abilities"], [9.25, 8.0, 20.0]);
+                assert_eq!(state["abilities"], state["abilities_built_in"]);
+            }
+        }
+    }
 }

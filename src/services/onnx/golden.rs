@@ -3,7 +3,7 @@
 //! action the policy (and so its ONNX graph) chose. A Solver plays a rule level of its game; a
 //! Generator builds a level at λ = [`GOLDEN_AUX`] toward the goal of a seed, and each of its
 //! frames also holds the piece its action stood for, with what the action → piece mapping
-//! reads besides the state in the episode's `piece_rules` ([`GoldenPieces`]). An
+//! reads besides the state in the episode's `piece_rules` ([`TrackBuild::port_piece`]). An
 //! ability-aware agent's state holds the abilities it played with. An engine's port recomputes
 //! each frame's observation from its state, runs the graph on it, and rebuilds each piece from
 //! the action; `.ci/port-check.py` is such a port, written from docs/engines.md alone.
@@ -17,9 +17,7 @@ use serde::{Deserialize, Serialize};
 use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, Placement, TrackBuild, observe_build,
 };
-use arlpcg_core::game::platform::generator::block_from_action;
-use arlpcg_core::game::racing::generator::segment_from_action;
-use arlpcg_core::game::{GameSpec, PlatformGame, PortState, RacingGame, SolverEnv, observe_solver};
+use arlpcg_core::game::{GameSpec, PortState, SolverEnv, observe_solver};
 use arlpcg_core::level::PolicyRef;
 use arlpcg_core::level::profile::{ABILITIES_PART, Abilities, main_abilities};
 use arlpcg_core::rl::checkpoint::PolicyCard;
@@ -145,7 +143,7 @@ pub fn golden_episode<G: GameSpec>(
 
 /// The golden episode of Generator `policy` (with its `card` and `limits`) of game `G`: each
 /// piece it places, until the track reaches its goal or ends.
-pub fn generator_golden_episode<G: GoldenPieces>(
+pub fn generator_golden_episode<G: GeneratorGame>(
     policy: &ActorCritic,
     card: &PolicyCard,
     reference: PolicyRef,
@@ -153,7 +151,7 @@ pub fn generator_golden_episode<G: GoldenPieces>(
 ) -> candle_core::Result<GoldenEpisode> {
     let obstacles = arlpcg_core::game::facts::facts(G::GAME).scene_obstacles;
     let (mut build, _) = G::new_build(GOLDEN_RUN_SEED, None, limits, obstacles);
-    let piece_rules = G::piece_rules(&build);
+    let piece_rules = build.port_piece_rules();
     let mut frames = Vec::new();
     let outcome = loop {
         // A Generator with knobs observes them, all at 0 (no preference); an ability-aware one
@@ -166,7 +164,7 @@ pub fn generator_golden_episode<G: GoldenPieces>(
             frame.state.insert("knobs".into(), vec![0.0; knobs.len()]);
         }
         record_abilities::<G>(card, build.player().abilities, &mut frame);
-        let piece = G::piece(&build, &frame.action);
+        let piece = build.port_piece(&frame.action);
         let placement = build.place(&frame.action);
         frame.piece = piece.filter(|_| placement != Placement::OutOfPieces);
         frames.push(frame);
@@ -254,88 +252,6 @@ fn record_abilities<G: GameSpec>(
     state.insert("abilities_built_in".into(), values(&ours));
 }
 
-/// What a Generator's golden episode records of its pieces, so that a port of the action →
-/// piece mapping (docs/engines.md) can be checked: each game's own mapping, called as placing a
-/// piece calls it. A game without one (the tests' ball) records none.
-pub trait GoldenPieces: GeneratorGame {
-    /// What the mapping reads besides a frame's state, by name.
-    fn piece_rules(_build: &Self::Build) -> BTreeMap<String, Vec<f64>> {
-        BTreeMap::new()
-    }
-
-    /// The piece action `row` stands for on `build`, by the level file's parameter names.
-    fn piece(_build: &Self::Build, _row: &[f32]) -> Option<BTreeMap<String, f64>> {
-        None
-    }
-}
-
-/// Names and values, as the golden file writes them.
-fn named<const N: usize, T: Clone>(pairs: [(&str, T); N]) -> BTreeMap<String, T> {
-    pairs
-        .into_iter()
-        .map(|(name, value)| (name.to_string(), value))
-        .collect()
-}
-
-impl GoldenPieces for PlatformGame {
-    /// The player's block ranges and its reach table (by `REACH_HEIGHTS`).
-    fn piece_rules(build: &Self::Build) -> BTreeMap<String, Vec<f64>> {
-        let r = build.player.blocks();
-        named([
-            ("min_distance", vec![r.min_distance]),
-            ("max_distance", vec![r.max_distance]),
-            ("min_size", vec![r.min_size]),
-            ("max_size", vec![r.max_size]),
-            ("min_height", vec![r.min_height]),
-            ("max_height", vec![r.max_height]),
-            ("max_turn", vec![r.max_turn]),
-            ("reach_table", build.reach.0.to_vec()),
-        ])
-    }
-
-    fn piece(build: &Self::Build, row: &[f32]) -> Option<BTreeMap<String, f64>> {
-        let block = block_from_action(&build.track, build.goal, row, (&build.player, &build.reach));
-        Some(named([
-            ("distance", block.distance),
-            ("angle", block.angle),
-            ("size", block.size),
-            ("height", block.height),
-        ]))
-    }
-}
-
-impl GoldenPieces for RacingGame {
-    /// The player's segment ranges and the card's curve offset.
-    fn piece_rules(build: &Self::Build) -> BTreeMap<String, Vec<f64>> {
-        let r = build.player.segments();
-        named([
-            ("min_length", vec![r.min_length]),
-            ("max_length", vec![r.max_length]),
-            ("max_curve", vec![r.max_curve]),
-            ("max_height", vec![r.max_height]),
-            ("curve_offset", vec![build.curve_offset]),
-        ])
-    }
-
-    fn piece(build: &Self::Build, row: &[f32]) -> Option<BTreeMap<String, f64>> {
-        let segment = segment_from_action(
-            &build.road,
-            build.goal,
-            row,
-            build.curve_offset,
-            &build.player.segments(),
-        );
-        Some(named([
-            ("length", segment.length),
-            ("curve", segment.curve),
-            ("height", segment.height),
-        ]))
-    }
-}
-
-#[cfg(feature = "test-game")]
-impl GoldenPieces for arlpcg_core::game::ball::BallGame {}
-
 /// Where the golden episode of the graph at `onnx` goes: the same name with `.golden.json`.
 pub fn golden_path(onnx: &std::path::Path) -> std::path::PathBuf {
     let mut name = onnx.as_os_str().to_owned();
@@ -347,6 +263,7 @@ pub fn golden_path(onnx: &std::path::Path) -> std::path::PathBuf {
 mod tests {
     use super::*;
     use crate::services::policies::{generator_limits, load_any};
+    use arlpcg_core::game::PlatformGame;
 
     fn shipped(name: &str) -> std::path::PathBuf {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("policies/{name}"))

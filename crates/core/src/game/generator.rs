@@ -195,6 +195,26 @@ pub trait TrackBuild: Clone + Send + Sync {
     /// The state the Generator's observation is computed from, by name (the golden episodes of
     /// docs/engines.md): positions and headings in the world, and what each plan-view ray found.
     fn port_state(&self) -> super::PortState;
+    /// What the action → piece mapping reads besides [`Self::port_state`], by name (the golden
+    /// episodes' `piece_rules`; none for a game whose golden episodes record no pieces).
+    fn port_piece_rules(&self) -> std::collections::BTreeMap<String, Vec<f64>> {
+        Default::default()
+    }
+    /// The piece the action `row` stands for on this track, by the level file's parameter
+    /// names, as placing it computes it (none: not recorded).
+    fn port_piece(&self, _row: &[f32]) -> Option<std::collections::BTreeMap<String, f64>> {
+        None
+    }
+}
+
+/// Names and values, as a port's records write them.
+pub fn named<const N: usize, T: Clone>(
+    pairs: [(&str, T); N],
+) -> std::collections::BTreeMap<String, T> {
+    pairs
+        .into_iter()
+        .map(|(name, value)| (name.to_string(), value))
+        .collect()
 }
 
 /// A game whose levels a Generator builds: its track under construction, the Generator's

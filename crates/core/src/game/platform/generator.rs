@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use super::env::{PlatformEnv, PlatformRewards};
 use super::reach::{self, Reach};
 use crate::game::generator::{
-    BuildLimits, GeneratorGame, GeneratorRewards, Knob, Placement, TrackBuild,
+    BuildLimits, GeneratorGame, GeneratorRewards, Knob, Placement, TrackBuild, named,
 };
 use crate::game::platform::rules::goal_and_start;
 use crate::game::{PlatformGame, Player};
@@ -40,7 +40,7 @@ pub const GENERATOR_OBSERVATION_MEANINGS: [&str; 9] = [
     "the last block's side / 6 m",
     "the block before the last, minus the last's top centre, same frame, / 10 m (0 when the last is the start)",
     "its side / 6 m (0 at the start)",
-    "sin, cos of the turn the last block was placed with (0 at the start)",
+    "sin, cos of the turn the last block was placed with (a turn of 0 at the start: (0, 1))",
     "1 - blocks placed / the piece budget",
     "λ: +1 easy, -1 hard",
 ];
@@ -237,6 +237,31 @@ impl TrackBuild for PlatformBuild {
             ("blocks", vec![self.track.block_count() as f64]),
             ("max_blocks", vec![self.max_blocks as f64]),
         ]
+    }
+
+    /// The player's block ranges and its reach table (by `REACH_HEIGHTS`).
+    fn port_piece_rules(&self) -> std::collections::BTreeMap<String, Vec<f64>> {
+        let r = self.player.blocks();
+        named([
+            ("min_distance", vec![r.min_distance]),
+            ("max_distance", vec![r.max_distance]),
+            ("min_size", vec![r.min_size]),
+            ("max_size", vec![r.max_size]),
+            ("min_height", vec![r.min_height]),
+            ("max_height", vec![r.max_height]),
+            ("max_turn", vec![r.max_turn]),
+            ("reach_table", self.reach.0.to_vec()),
+        ])
+    }
+
+    fn port_piece(&self, row: &[f32]) -> Option<std::collections::BTreeMap<String, f64>> {
+        let block = block_from_action(&self.track, self.goal, row, (&self.player, &self.reach));
+        Some(named([
+            ("distance", block.distance),
+            ("angle", block.angle),
+            ("size", block.size),
+            ("height", block.height),
+        ]))
     }
 
     fn place(&mut self, row: &[f32]) -> Placement {

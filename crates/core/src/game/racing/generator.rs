@@ -9,7 +9,8 @@ use rand_chacha::ChaCha8Rng;
 
 use super::env::{RacingEnv, RacingRewards, SIGHT};
 use crate::game::generator::{
-    BuildLimits, DEFAULT_CURVE_OFFSET, GeneratorGame, GeneratorRewards, Knob, Placement, TrackBuild,
+    BuildLimits, DEFAULT_CURVE_OFFSET, GeneratorGame, GeneratorRewards, Knob, Placement,
+    TrackBuild, named,
 };
 use crate::game::{Player, RacingGame};
 use crate::level::Track;
@@ -281,6 +282,33 @@ impl TrackBuild for RacingBuild {
             ("obstacle_rays", obstacle_rays.map(f64::from).to_vec()),
             ("road_rays", road_rays.map(f64::from).to_vec()),
         ]
+    }
+
+    /// The player's segment ranges and the curve offset.
+    fn port_piece_rules(&self) -> std::collections::BTreeMap<String, Vec<f64>> {
+        let r = self.player.segments();
+        named([
+            ("min_length", vec![r.min_length]),
+            ("max_length", vec![r.max_length]),
+            ("max_curve", vec![r.max_curve]),
+            ("max_height", vec![r.max_height]),
+            ("curve_offset", vec![self.curve_offset]),
+        ])
+    }
+
+    fn port_piece(&self, row: &[f32]) -> Option<std::collections::BTreeMap<String, f64>> {
+        let segment = segment_from_action(
+            &self.road,
+            self.goal,
+            row,
+            self.curve_offset,
+            &self.player.segments(),
+        );
+        Some(named([
+            ("length", segment.length),
+            ("curve", segment.curve),
+            ("height", segment.height),
+        ]))
     }
 
     fn place(&mut self, row: &[f32]) -> Placement {

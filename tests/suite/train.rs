@@ -1018,6 +1018,22 @@ fn a_finish_with_a_scripted_opponent_changes_the_finish_alone_and_resumes_to_the
             .iter()
             .all(|(_, s)| !played(s))
     );
+    // `easy_only`: it plays easy matches alone, leaving every hard one to the final Solver.
+    let easy_dir = dir.path().join("easy");
+    std::fs::create_dir(&easy_dir).unwrap();
+    let easy_only =
+        format!("{finish}\nscripted_opponent: {{skill: median, share: 0.5, easy_only: true}}");
+    let easy = train_tiny_to_640(&easy_dir, &tiny_with_finish(&easy_only));
+    let easy_finish: Vec<[f64; 2]> = opponent_success(&easy)
+        .into_iter()
+        .filter(|r| r.0 >= 640)
+        .map(|r| r.1)
+        .collect();
+    assert!(
+        easy_finish.iter().all(|s| !s[1].is_finite())
+            && easy_finish.iter().any(|s| s[0].is_finite()),
+        "{easy_finish:?}"
+    );
 
     let config = dir.path().join("scripted.yaml");
     std::fs::write(&config, tiny_with_finish(&scripted)).unwrap();

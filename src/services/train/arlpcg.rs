@@ -298,7 +298,11 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         };
         // Drawn only with a scripted opponent, so that runs without one keep their bytes.
         let scripted = match self.rules.scripted_opponent {
-            Some(o) if opponent.is_none() && rng.random_bool(o.share) => {
+            Some(o)
+                if opponent.is_none()
+                    && (!o.easy_only || fresh.aux[0] > 0.0)
+                    && rng.random_bool(o.share) =>
+            {
                 Some((o.skill, G::scripted(seed, o.skill)))
             }
             _ => None,

@@ -82,6 +82,7 @@ mod tests {
                 scripted_opponent: Some(ScriptedOpponent {
                     skill: Skill::Median,
                     share: 0.5,
+                    easy_only: false,
                 }),
                 ..Finish::NONE
             }

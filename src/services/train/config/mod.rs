@@ -201,6 +201,9 @@ pub struct ScriptedOpponent {
     pub skill: Skill,
     /// The share of matches it plays, in (0, 1].
     pub share: f64,
+    /// Whether it plays only easy matches (λ > 0), leaving every hard one to the final Solver.
+    #[serde(default)]
+    pub easy_only: bool,
 }
 
 /// The default of [`Finish::hard_match_block`].
@@ -384,6 +387,7 @@ pub const PLATFORM_FINISH: Finish = Finish {
     scripted_opponent: Some(ScriptedOpponent {
         skill: Skill::Median,
         share: 0.5,
+        easy_only: false,
     }),
     ..Finish::NONE
 };

@@ -420,6 +420,9 @@ impl App {
         self.game = self.game.next();
         self.goal = GoalSetting::FromSeed;
         self.kept = None;
+        // The knobs are the other game's: back to no preference, the arrows on λ.
+        self.knobs.clear();
+        self.slider = 0;
         if self.policies().generator.is_none() && self.ask.curve().is_some() {
             self.ask = Ask::Aux(self.aux);
         }

@@ -210,6 +210,19 @@ impl RacingBuild {
     }
 }
 
+impl RacingBuild {
+    /// The segment the action `row` stands for at the road's end ([`segment_from_action`]).
+    fn next_segment(&self, row: &[f32]) -> SegmentParams {
+        segment_from_action(
+            &self.road,
+            self.goal,
+            row,
+            self.curve_offset,
+            &self.player.segments(),
+        )
+    }
+}
+
 impl TrackBuild for RacingBuild {
     fn player(&self) -> &Player {
         &self.player
@@ -297,13 +310,7 @@ impl TrackBuild for RacingBuild {
     }
 
     fn port_piece(&self, row: &[f32]) -> Option<std::collections::BTreeMap<String, f64>> {
-        let segment = segment_from_action(
-            &self.road,
-            self.goal,
-            row,
-            self.curve_offset,
-            &self.player.segments(),
-        );
+        let segment = self.next_segment(row);
         Some(named([
             ("length", segment.length),
             ("curve", segment.curve),
@@ -316,13 +323,7 @@ impl TrackBuild for RacingBuild {
         if index >= self.max_segments {
             return Placement::OutOfPieces;
         }
-        let segment = segment_from_action(
-            &self.road,
-            self.goal,
-            row,
-            self.curve_offset,
-            &self.player.segments(),
-        );
+        let segment = self.next_segment(row);
         self.road.push(segment);
         self.track.segments.push(segment);
         if self.road.first_crossing(index).is_some()

@@ -495,15 +495,16 @@ fn chosen_solver(
                 }
             };
             let policy = load_folder_solver(folder, args.game, profile)?;
-            let aware = load_aware_solver(folder, args.game)?;
-            // A folder's Solver that cannot play the character gives way to the scripted expert.
-            match policy.stand_in_beside(aware.as_ref(), profile) {
-                None => Some(policy),
-                Some((_, why)) => {
-                    crate::warn!("{why}");
-                    None
-                }
+            // A folder's Solver that cannot play the character gives way to the scripted expert
+            // (the line names the ability-aware one's range too, read only then).
+            if policy.stand_in(profile).is_none() {
+                return Ok(Some(policy));
             }
+            let aware = load_aware_solver(folder, args.game)?;
+            if let Some((_, why)) = policy.stand_in_beside(aware.as_ref(), profile) {
+                crate::warn!("{why}");
+            }
+            None
         }
     })
 }

@@ -351,50 +351,6 @@ impl App {
         self.knobs.iter().map(|&v| v as f32).collect()
     }
 
-    /// The value of the slider the keys move: λ, or the selected knob's.
-    fn slider_value(&self) -> f64 {
-        match self.slider {
-            0 => self.aux,
-            k => self.knobs[k - 1],
-        }
-    }
-
-    /// Moves the slider the keys move (λ or the selected knob) to `value`.
-    fn set_slider(&mut self, value: f64) -> Vec<Effect> {
-        match self.slider {
-            0 => self.set_aux(value),
-            k => self.set_knob(k - 1, value),
-        }
-    }
-
-    /// `m`: the next slider for the arrow keys (λ, then each knob), for a Generator with knobs.
-    pub(super) fn next_slider(&mut self) -> Vec<Effect> {
-        self.fit_knobs();
-        let names = self.knob_names();
-        if names.is_empty() {
-            self.complain(
-                "this Generator takes no style knobs (train one with generator.rewards.knobs)",
-            );
-            return Vec::new();
-        }
-        self.slider = (self.slider + 1) % (names.len() + 1);
-        let name = match self.slider {
-            0 => "λ",
-            k => names[k - 1],
-        };
-        self.say(format!("the arrows move {name} (m: the next slider)"));
-        Vec::new()
-    }
-
-    fn set_knob(&mut self, k: usize, value: f64) -> Vec<Effect> {
-        let value = (value.clamp(-1.0, 1.0) * 100.0).round() / 100.0;
-        if self.knobs[k] == value {
-            return Vec::new();
-        }
-        self.knobs[k] = value;
-        self.generate()
-    }
-
     /// The policies of the game on screen.
     pub fn policies(&self) -> &LoadedInfo {
         &self.loaded[self.game]

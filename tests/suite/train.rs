@@ -411,6 +411,38 @@ fn a_fixed_aux_run_refuses_a_finish_that_waits_for_hard_matches() {
     assert_eq!(defaults.adversarial_budget(), defaults.steps);
 }
 
+/// A configuration file is laid over its mode's defaults, not arlpcg's: a rule-pcg Solver
+/// keeps its four update passes beside the file's width, and `--print-config --config` shows
+/// just that.
+#[test]
+fn a_configuration_file_lies_over_its_modes_defaults() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("wide.yaml");
+    std::fs::write(&config, "hidden: [32, 32]\n").unwrap();
+    let printed = arlpcg_ok(words(
+        "train --game platform --mode rule-pcg --config {} --print-config",
+        &[&config],
+    ))
+    .stdout;
+    let printed: arlpcg::services::train::TrainConfig = serde_yaml::from_slice(&printed).unwrap();
+    assert_eq!(printed.hidden, vec![32, 32]);
+    assert_eq!(
+        printed.solver.update_epochs,
+        arlpcg::services::train::SOLO_SOLVER_UPDATE_EPOCHS
+    );
+    let adversarial = arlpcg_ok(words(
+        "train --game platform --mode arlpcg --config {} --print-config",
+        &[&config],
+    ))
+    .stdout;
+    let adversarial: arlpcg::services::train::TrainConfig =
+        serde_yaml::from_slice(&adversarial).unwrap();
+    assert_ne!(
+        adversarial.solver.update_epochs,
+        arlpcg::services::train::SOLO_SOLVER_UPDATE_EPOCHS
+    );
+}
+
 /// Ctrl-C, and SIGTERM as Slurm and Kubernetes stop a job, save a checkpoint and the policy,
 /// then exit 130.
 #[test]

@@ -36,7 +36,7 @@ use arlpcg_core::level::Game;
 use arlpcg_core::level::profile::{Profile, ProfileRecord};
 use arlpcg_core::rl::checkpoint::TrainMode;
 use cards::{check_folder_policies, checkpoint_identity, solver_shape};
-use config::load_config;
+pub use config::load_config;
 pub use metrics::write_learning_curve;
 use solver_envs::{SolverEnvs, SourceRecord};
 use solver_run::SolverRun;
@@ -104,7 +104,9 @@ pub fn open(
     }
     let config = if resume {
         Start::Resume(ConfigChange {
-            config: config.map(|path| load_config(path, game)).transpose()?,
+            config: config
+                .map(|path| load_config(path, game, mode))
+                .transpose()?,
             seed,
             steps,
             profile: profile.map(|p| Box::new(p.record())),
@@ -128,7 +130,7 @@ pub fn open(
         }
         let mut config = match config {
             Some(path) => {
-                let config = load_config(path, game)?;
+                let config = load_config(path, game, mode)?;
                 // fixed-aux plays no hard match, so a finish that waits for them never ends.
                 let finish = config.generator.finish;
                 if mode == TrainMode::FixedAux

@@ -321,7 +321,8 @@ pub struct TrainArgs {
     /// A resumed run keeps its own.
     #[arg(long, value_name = "SHARE", value_parser = parse_ability_spread)]
     pub ability_spread: Option<f64>,
-    /// Print the default configuration as YAML and exit.
+    /// Print the configuration a new run with these --game, --mode and --config would train
+    /// with (the defaults, or the file laid over them) as YAML, and exit.
     #[arg(long)]
     pub print_config: bool,
     /// Worker threads for environments and networks (default: all cores).

@@ -14,14 +14,16 @@ use crate::shells::common::{Interrupted, UsageError};
 
 pub fn run(args: &TrainArgs) -> Result<()> {
     if args.print_config {
-        crate::shells::common::say(format_args!(
-            "{}",
-            serde_yaml::to_string(&TrainConfig::for_run(
-                args.game.unwrap_or_default(),
-                args.mode
-                    .map_or(arlpcg_core::rl::checkpoint::TrainMode::RulePcg, Into::into)
-            ))?
-        ));
+        // What a new run with these --game, --mode and --config would train with.
+        let game = args.game.unwrap_or_default();
+        let mode = args
+            .mode
+            .map_or(arlpcg_core::rl::checkpoint::TrainMode::RulePcg, Into::into);
+        let config = match &args.config {
+            Some(path) => train::load_config(path, game, mode)?,
+            None => TrainConfig::for_run(game, mode),
+        };
+        crate::shells::common::say(format_args!("{}", serde_yaml::to_string(&config)?));
         return Ok(());
     }
     let usage = |message: &str| anyhow::Error::from(UsageError(message.into()));

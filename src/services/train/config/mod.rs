@@ -392,7 +392,10 @@ pub const PLATFORM_FINISH: Finish = Finish {
     ..Finish::NONE
 };
 
-pub(super) fn load_config(path: &Path, game: Game) -> Result<TrainConfig> {
+/// The configuration file at `path` laid over the defaults of `game` in `mode`
+/// ([`TrainConfig::for_run`]: a baseline's Solver keeps its four update passes unless the file
+/// says otherwise).
+pub fn load_config(path: &Path, game: Game, mode: TrainMode) -> Result<TrainConfig> {
     let bytes =
         crate::services::fsio::read_limited(path, MAX_CONFIG_BYTES, "training configuration")?;
     let text = String::from_utf8(bytes).map_err(|e| {
@@ -402,7 +405,7 @@ pub(super) fn load_config(path: &Path, game: Game) -> Result<TrainConfig> {
             e.utf8_error().valid_up_to()
         )
     })?;
-    TrainConfig::parse_for(&text, game)
+    TrainConfig::parse_over(&text, TrainConfig::for_run(game, mode), game)
         .map_err(|problem| anyhow::anyhow!("{}: {problem}", path.display()))
 }
 
@@ -475,6 +478,11 @@ impl TrainConfig {
     /// out take that game's defaults ([`TrainConfig::for_game`]); `Err` names the field (and,
     /// for syntax and type errors, the line).
     pub fn parse_for(text: &str, game: Game) -> Result<TrainConfig, String> {
+        Self::parse_over(text, Self::for_game(game), game)
+    }
+
+    /// `text` laid over `defaults` (a game's, or a mode's), checked for `game`.
+    fn parse_over(text: &str, defaults: TrainConfig, game: Game) -> Result<TrainConfig, String> {
         arlpcg_core::level::yaml_limits::check(text)?;
         // Parsed once as written, for errors with their line...
         let _: TrainConfig = serde_yaml::from_str(text).map_err(|e| e.to_string())?;
@@ -485,7 +493,7 @@ impl TrainConfig {
             other => other,
         };
         rename_aliases(&mut given);
-        let defaults = serde_yaml::to_value(Self::for_game(game)).map_err(|e| e.to_string())?;
+        let defaults = serde_yaml::to_value(defaults).map_err(|e| e.to_string())?;
         let config: TrainConfig =
             serde_yaml::from_value(overlay(defaults, given)).map_err(|e| e.to_string())?;
         check_config(&config, game)?;

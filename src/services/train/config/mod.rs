@@ -152,9 +152,11 @@ pub struct GeneratorConfig {
 /// `steps`, so an annealed Generator learning rate is refused with a finish.
 /// Its optional fields are written out even when none (`null`): a configuration file's
 /// missing fields take the game's defaults (`TrainConfig::parse_for`), so a printed or saved
-/// configuration with a field left out would read back as that game's value.
+/// configuration with a field left out would read back as that game's value. A file may give
+/// some of its fields only (`serde(default)` lets it read as written; the recipe's values then
+/// fill the rest).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct Finish {
     /// Solver steps played in the finish (0: no finish).
     pub solver_steps: u64,
@@ -194,9 +196,10 @@ pub struct Finish {
     pub scripted_opponent: Option<ScriptedOpponent>,
 }
 
-/// The scripted player as the Generator's opponent in a finish ([`Finish::scripted_opponent`]).
+/// The scripted player as the Generator's opponent in a finish ([`Finish::scripted_opponent`]);
+/// a file may give some of its fields only, as for [`Finish`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct ScriptedOpponent {
     pub skill: Skill,
     /// The share of matches it plays, in (0, 1].
@@ -215,6 +218,17 @@ fn hard_match_block() -> u32 {
 
 fn one_iteration() -> u64 {
     1
+}
+
+/// The median player in half the matches, easy and hard: the platform recipe's.
+impl Default for ScriptedOpponent {
+    fn default() -> Self {
+        ScriptedOpponent {
+            skill: Skill::Median,
+            share: 0.5,
+            easy_only: false,
+        }
+    }
 }
 
 impl Default for Finish {

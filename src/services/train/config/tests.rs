@@ -26,6 +26,28 @@ fn a_partial_file_takes_its_games_defaults_and_old_names_still_read() {
     );
 }
 
+/// A file may name one field of the finish, or of its scripted opponent: the recipe's values
+/// fill the rest (docs/training.md).
+#[test]
+fn a_partial_finish_keeps_the_recipes_other_fields() {
+    let text = "generator:\n  finish:\n    scripted_opponent:\n      easy_only: true\n";
+    let racing = TrainConfig::parse_for(text, Game::Racing).unwrap();
+    let mut expected = TrainConfig::for_game(Game::Racing);
+    let opponent = expected
+        .generator
+        .finish
+        .scripted_opponent
+        .as_mut()
+        .unwrap();
+    opponent.easy_only = true;
+    assert_eq!(racing, expected);
+    let entropy = "generator:\n  finish:\n    generator_entropy: 0.02\n";
+    let platform = TrainConfig::parse_for(entropy, Game::Platform).unwrap();
+    let mut expected = TrainConfig::for_game(Game::Platform);
+    expected.generator.finish.generator_entropy = Some(0.02);
+    assert_eq!(platform, expected);
+}
+
 #[test]
 fn the_platform_finish_follows_the_budget_and_stages_apply_from_their_step() {
     // The platform recipe's finish starts where its Solver's 8M end (racing's: recipe.rs).

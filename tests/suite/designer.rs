@@ -306,6 +306,53 @@ fn the_arrows_move_a_style_knob_that_m_picks() {
     );
 }
 
+/// `V` serves the level on screen in 3D (the page of `arlpcg view`), and the page follows the
+/// designer: a new level is a new version of the scene, with its own pieces.
+#[test]
+fn v_serves_the_level_on_screen_in_3d_and_follows_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    h.key(KeyCode::Char('V'));
+    assert!(
+        !h.pending.iter().any(|e| matches!(e, Effect::OpenView)),
+        "no level yet"
+    );
+    h.settle();
+    h.key(KeyCode::Char('V'));
+    assert!(matches!(h.pending.as_slice(), [Effect::OpenView]));
+    h.pending.clear();
+
+    let mut browser = arlpcg::shells::design::browser::Browser::default();
+    let url = browser.serve(&h.app).unwrap();
+    let address = url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
+    let scene = |address: &str| {
+        let (status, body) = crate::view::get(address, "/scene.json");
+        assert_eq!(status, 200, "{body}");
+        let json: serde_json::Value = serde_json::from_str(&body).unwrap();
+        let pieces = json["scene"]["pieces"].as_u64().unwrap() as usize;
+        (json["version"].as_str().unwrap().to_string(), pieces)
+    };
+    let first_level = h.app.level.clone().unwrap();
+    let (first, pieces) = scene(&address);
+    assert_eq!(pieces, first_level.piece_count());
+    browser.follow(&h.app);
+    assert_eq!(scene(&address).0, first, "nothing changed, nothing new");
+    assert_eq!(browser.serve(&h.app).unwrap(), url, "one server");
+
+    h.key(KeyCode::Char('n'));
+    h.settle();
+    let second_level = h.app.level.clone().unwrap();
+    assert_ne!(second_level.seed, first_level.seed);
+    browser.follow(&h.app);
+    let (second, pieces) = scene(&address);
+    assert_ne!(second, first);
+    assert_eq!(pieces, second_level.piece_count());
+    assert_eq!(crate::view::get(&address, "/version").1, second);
+}
+
 #[test]
 fn whole_screen_at_80x24() {
     let dir = tempfile::tempdir().unwrap();

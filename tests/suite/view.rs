@@ -41,15 +41,10 @@ fn view(path: &std::path::Path) -> Viewer {
     Viewer { child, address }
 }
 
-/// The body of `GET path`, with its status code.
-fn get(viewer: &Viewer, path: &str) -> (u16, String) {
-    let mut stream = TcpStream::connect(&viewer.address).unwrap();
-    write!(
-        stream,
-        "GET {path} HTTP/1.0\r\nHost: {}\r\n\r\n",
-        viewer.address
-    )
-    .unwrap();
+/// The body of `GET path` from the view at `address` (host:port), with its status code.
+pub fn get(address: &str, path: &str) -> (u16, String) {
+    let mut stream = TcpStream::connect(address).unwrap();
+    write!(stream, "GET {path} HTTP/1.0\r\nHost: {address}\r\n\r\n").unwrap();
     let mut answer = String::new();
     stream.read_to_string(&mut answer).unwrap();
     let status = answer[9..12].parse().unwrap();
@@ -58,7 +53,7 @@ fn get(viewer: &Viewer, path: &str) -> (u16, String) {
 }
 
 fn pieces(viewer: &Viewer) -> (String, u64) {
-    let (status, body) = get(viewer, "/scene.json");
+    let (status, body) = get(&viewer.address, "/scene.json");
     assert_eq!(status, 200, "{body}");
     let json: serde_json::Value = serde_json::from_str(&body).unwrap();
     let version = json["version"].as_str().unwrap().to_string();
@@ -74,7 +69,7 @@ fn the_view_serves_the_newest_level_of_a_folder_and_follows_it() {
     std::fs::copy(&easy, dir.path().join("a.yaml")).unwrap();
     let viewer = view(dir.path());
 
-    let (status, page) = get(&viewer, "/");
+    let (status, page) = get(&viewer.address, "/");
     assert_eq!(status, 200);
     assert!(
         page.contains("<canvas") && page.contains("\"boxes\""),
@@ -88,7 +83,7 @@ fn the_view_serves_the_newest_level_of_a_folder_and_follows_it() {
     let (first, blocks) = pieces(&viewer);
     let level = arlpcg_core::level::yaml::load(&easy).unwrap();
     assert_eq!(blocks, level.piece_count() as u64);
-    assert_eq!(get(&viewer, "/version").1, first);
+    assert_eq!(get(&viewer.address, "/version").1, first);
 
     // A newer level in the folder is what the page shows next.
     std::thread::sleep(std::time::Duration::from_millis(20));
@@ -97,7 +92,7 @@ fn the_view_serves_the_newest_level_of_a_folder_and_follows_it() {
     assert_ne!(second, first);
     let road = arlpcg_core::level::yaml::load(&track).unwrap();
     assert_eq!(segments, road.piece_count() as u64);
-    assert_eq!(get(&viewer, "/nothing").0, 404);
+    assert_eq!(get(&viewer.address, "/nothing").0, 404);
 
     // A broken newest file is an error the page is told of; the server keeps serving.
     std::thread::sleep(std::time::Duration::from_millis(20));
@@ -106,7 +101,7 @@ fn the_view_serves_the_newest_level_of_a_folder_and_follows_it() {
         "format: arlpcg-level\nversion: 1\ngame: chess\n",
     )
     .unwrap();
-    let (status, problem) = get(&viewer, "/scene.json");
+    let (status, problem) = get(&viewer.address, "/scene.json");
     assert_eq!(status, 500);
     assert!(problem.contains("c.yaml"), "{problem}");
     std::fs::remove_file(dir.path().join("c.yaml")).unwrap();

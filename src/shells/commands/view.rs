@@ -1,7 +1,5 @@
-//! `arlpcg view`: a level in 3D in a web browser. The binary serves one page on 127.0.0.1
-//! (`src/shells/view/page.html`, WebGL with no library, so it works offline) with the level's
-//! scene inside ([`crate::services::view`]); the page asks for `/version` a few times a second
-//! and fetches `/scene.json` again when the file, or a folder's newest level, changes.
+//! `arlpcg view`: a level in 3D in a web browser, served by [`crate::shells::view`]: a level
+//! file, or the newest level file of a folder, followed as it changes.
 
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
@@ -10,65 +8,27 @@ use anyhow::{Context, Result};
 
 use crate::services::view::scene_json;
 use crate::shells::cli::ViewArgs;
+use crate::shells::view::{self, Shown};
 use arlpcg_core::level::yaml;
 
-/// The page, with `/*SCENE*/` where the first scene goes.
-const PAGE: &str = include_str!("../view/page.html");
-
 pub fn run(args: &ViewArgs) -> Result<()> {
-    let shown = Shown::new(&args.level)?;
+    let shown = ShownFile::new(&args.level)?;
     shown.current()?;
-    let server = tiny_http::Server::http(("127.0.0.1", args.port))
-        .map_err(|e| anyhow::anyhow!("cannot serve on 127.0.0.1:{}: {e}", args.port))?;
-    let address = server
-        .server_addr()
-        .to_ip()
-        .context("the server has no IP address")?;
+    let (server, address) = view::bind(args.port)?;
     crate::say!(
         "showing {} at http://{address}/ (Ctrl-C stops)",
         args.level.display()
     );
-    for request in server.incoming_requests() {
-        let answer = match request.url().split('?').next().unwrap_or("") {
-            "/" => shown.current().map(|(version, scene)| {
-                let first = serde_json::json!({"version": version, "scene": scene});
-                // Inside a <script> element "</" would end it early.
-                let inline = first.to_string().replace("</", "<\\/");
-                reply(
-                    PAGE.replace("/*SCENE*/", &inline),
-                    "text/html; charset=utf-8",
-                )
-            }),
-            "/scene.json" => shown.current().map(|(version, scene)| {
-                let body = serde_json::json!({"version": version, "scene": scene});
-                reply(body.to_string(), "application/json")
-            }),
-            "/version" => shown
-                .version_and_file()
-                .map(|(version, _)| reply(version, "text/plain; charset=utf-8")),
-            _ => Ok(tiny_http::Response::from_string("not found").with_status_code(404)),
-        };
-        let response = answer.unwrap_or_else(|problem| {
-            crate::warn!("{problem:#}");
-            tiny_http::Response::from_string(format!("{problem:#}")).with_status_code(500)
-        });
-        // A browser that went away is no reason to stop serving.
-        let _ = request.respond(response);
-    }
+    view::serve(&server, &shown);
     Ok(())
 }
 
-fn reply(body: String, kind: &str) -> tiny_http::Response<std::io::Cursor<Vec<u8>>> {
-    let header = tiny_http::Header::from_bytes("Content-Type", kind).expect("a valid header");
-    tiny_http::Response::from_string(body).with_header(header)
-}
-
 /// What the page shows: a level file, or the newest level file of a folder.
-struct Shown {
+struct ShownFile {
     path: PathBuf,
 }
 
-impl Shown {
+impl ShownFile {
     fn new(path: &Path) -> Result<Self> {
         anyhow::ensure!(
             path.exists(),
@@ -119,8 +79,13 @@ impl Shown {
             .map_or(0, |d| d.as_nanos());
         Ok((format!("{}@{nanos}", path.display()), path))
     }
+}
 
-    /// The version and the scene of the level shown now.
+impl Shown for ShownFile {
+    fn version(&self) -> Result<String> {
+        Ok(self.version_and_file()?.0)
+    }
+
     fn current(&self) -> Result<(String, serde_json::Value)> {
         let (version, path) = self.version_and_file()?;
         let level = yaml::load(&path)?;

@@ -456,16 +456,24 @@ impl App {
         stem
     }
 
+    /// The level on screen with its Solver statistics and panel, once the trials are in: what
+    /// `x` exports and the 3D view shows.
+    pub fn level_with_stats(&self) -> Option<Level> {
+        let mut level = Level::clone(self.level.as_ref()?);
+        level.stats = self.trials.as_ref().and_then(|t| t.stats.clone());
+        if let Some(stats) = &mut level.stats {
+            stats.panel = self.panel_on_screen();
+        }
+        Some(level)
+    }
+
     fn export(&mut self, overwrite: bool) -> Vec<Effect> {
-        let Some(level) = &self.level else {
+        let Some(level) = self.level_with_stats() else {
             self.complain("no level to export yet");
             return Vec::new();
         };
-        let mut level = Level::clone(level);
-        level.stats = self.trials.as_ref().and_then(|t| t.stats.clone());
-        match &mut level.stats {
-            Some(stats) => stats.panel = self.panel_on_screen(),
-            None => self.say("exporting without Solver statistics (trials still running)"),
+        if level.stats.is_none() {
+            self.say("exporting without Solver statistics (trials still running)");
         }
         vec![Effect::Export {
             level: Box::new(level),

@@ -3,9 +3,11 @@
 //! Three parts, as docs/architecture.md asks: the state and its pure `update` ([`app`]), the drawing
 //! that only reads it ([`view`], on the areas of [`layout`]), and this thin shell, which owns
 //! the terminal, turns terminal events and worker answers into messages, and hands the effects
-//! to the worker threads ([`worker`]).
+//! to the worker threads ([`worker`]), but for the 3D view in the browser, which it serves
+//! itself ([`browser`]).
 
 pub mod app;
+pub mod browser;
 pub mod layout;
 pub mod view;
 pub mod worker;
@@ -19,8 +21,9 @@ use ratatui::DefaultTerminal;
 use ratatui::crossterm::event::{self, DisableMouseCapture, EnableMouseCapture, Event};
 use ratatui::crossterm::execute;
 
-use app::{App, LoadedInfo, Message, Mode, Response};
+use app::{App, Effect, LoadedInfo, Message, Mode, Response};
 use arlpcg_core::level::Game;
+use browser::Browser;
 use worker::{GamePolicies, Policies, Workers};
 
 /// Time between animation ticks.
@@ -142,6 +145,7 @@ fn event_loop(
             height: size.height,
         },
     );
+    let mut browser = Browser::default();
     for effect in app.start() {
         workers.submit(effect);
     }
@@ -162,8 +166,12 @@ fn event_loop(
             effects.extend(app::update(app, Message::Worker(response)));
         }
         for effect in effects {
-            workers.submit(effect);
+            match effect {
+                Effect::OpenView => browser.open(app),
+                effect => workers.submit(effect),
+            }
         }
+        browser.follow(app);
     }
     Ok(())
 }

@@ -96,6 +96,7 @@ impl App {
                 };
                 self.judge_if_shown()
             }
+            KeyCode::Char('V') => self.open_view(),
             KeyCode::Char('J') => self.judge_level(),
             KeyCode::Char('x') => self.export(false),
             KeyCode::Char('P') => self.next_pacing(),
@@ -228,6 +229,15 @@ impl App {
         };
         self.say(format!("the arrows move {name} (m: the next slider)"));
         Vec::new()
+    }
+
+    /// `V`: the level on screen in 3D in the web browser (the shell serves it).
+    fn open_view(&mut self) -> Vec<Effect> {
+        if self.level.is_none() {
+            self.complain("no level to show yet");
+            return Vec::new();
+        }
+        vec![Effect::OpenView]
     }
 
     fn set_knob(&mut self, k: usize, value: f64) -> Vec<Effect> {

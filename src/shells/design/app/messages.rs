@@ -247,4 +247,7 @@ pub enum Effect {
         /// Runs per judge.
         trials: u32,
     },
+    /// Show the level on screen in 3D in the web browser, and follow it from now on: the
+    /// shell's, not the workers' (it serves the page itself).
+    OpenView,
 }

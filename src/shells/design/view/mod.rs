@@ -41,7 +41,7 @@ pub const KEYS: [(&str, &str); 22] = [
     ("T", "target success rate: λ is searched for it"),
     ("r", "replay one Solver run on the map"),
     ("w", "λ sweep: success against λ for this seed and goal"),
-    ("v", "bottom-right panel: failures / λ sweep / judges"),
+    ("v V", "panel: failures / λ sweep / judges / 3D in browser"),
     ("P C", "pacing: next preset / type a curve fraction:λ, ..."),
     ("k K", "keep pieces up to the selected one / let go"),
     ("x", "export YAML (with the Solver statistics) + .glb"),

@@ -48,7 +48,8 @@ fn slot(effect: &Effect) -> (Slot, u64) {
         | Effect::NextJudge { .. }
         | Effect::OpenCampaign { .. }
         | Effect::LoadProfile { .. }
-        | Effect::RegenerateCampaignLevel { .. } => (Slot::Always, 0),
+        | Effect::RegenerateCampaignLevel { .. }
+        | Effect::OpenView => (Slot::Always, 0),
     }
 }
 
@@ -254,6 +255,8 @@ pub fn perform(
         } => play_panel(&level, folder, trials, stop, &|update| {
             send(Response::Panel { id, update })
         }),
+        // The shell serves the view itself (design/browser.rs); a worker has nothing to do.
+        Effect::OpenView => {}
     }
 }
 

@@ -1,0 +1,118 @@
+//! The 3D view's web server, shared by `arlpcg view` (a level file, or a folder's newest) and
+//! the designer (`V`: the level on screen). It serves one page on 127.0.0.1 (`page.html`:
+//! WebGL with no library, so it works offline) with the first scene inside
+//! ([`crate::services::view::scene_json`]); the page asks for `/version` a few times a second
+//! and fetches `/scene.json` again when it changes.
+
+use std::net::SocketAddr;
+use std::sync::{Arc, Mutex, PoisonError};
+
+use anyhow::{Context, Result};
+use serde_json::Value;
+
+/// The page, with `/*SCENE*/` where the first scene goes.
+const PAGE: &str = include_str!("page.html");
+
+/// What the page shows.
+pub trait Shown: Send + Sync {
+    /// A string that changes whenever the scene does.
+    fn version(&self) -> Result<String>;
+    /// The version and the scene shown now.
+    fn current(&self) -> Result<(String, Value)>;
+}
+
+/// A server on 127.0.0.1:`port` (0: any free port) and the address it listens on.
+pub fn bind(port: u16) -> Result<(tiny_http::Server, SocketAddr)> {
+    let server = tiny_http::Server::http(("127.0.0.1", port))
+        .map_err(|e| anyhow::anyhow!("cannot serve on 127.0.0.1:{port}: {e}"))?;
+    let address = server
+        .server_addr()
+        .to_ip()
+        .context("the server has no IP address")?;
+    Ok((server, address))
+}
+
+/// Answers the page's requests for `shown`, for as long as the server lives.
+pub fn serve(server: &tiny_http::Server, shown: &dyn Shown) {
+    for request in server.incoming_requests() {
+        let answer = match request.url().split('?').next().unwrap_or("") {
+            "/" => shown.current().map(|(version, scene)| {
+                let first = serde_json::json!({"version": version, "scene": scene});
+                // Inside a <script> element "</" would end it early.
+                let inline = first.to_string().replace("</", "<\\/");
+                reply(
+                    PAGE.replace("/*SCENE*/", &inline),
+                    "text/html; charset=utf-8",
+                )
+            }),
+            "/scene.json" => shown.current().map(|(version, scene)| {
+                let body = serde_json::json!({"version": version, "scene": scene});
+                reply(body.to_string(), "application/json")
+            }),
+            "/version" => shown
+                .version()
+                .map(|version| reply(version, "text/plain; charset=utf-8")),
+            _ => Ok(tiny_http::Response::from_string("not found").with_status_code(404)),
+        };
+        let response = answer.unwrap_or_else(|problem| {
+            crate::warn!("{problem:#}");
+            tiny_http::Response::from_string(format!("{problem:#}")).with_status_code(500)
+        });
+        // A browser that went away is no reason to stop serving.
+        let _ = request.respond(response);
+    }
+}
+
+fn reply(body: String, kind: &str) -> tiny_http::Response<std::io::Cursor<Vec<u8>>> {
+    let header = tiny_http::Header::from_bytes("Content-Type", kind).expect("a valid header");
+    tiny_http::Response::from_string(body).with_header(header)
+}
+
+/// A scene held in memory and served from a thread of its own: the designer's view, which
+/// [`LiveView::show`] moves on to each new level.
+pub struct LiveView {
+    /// The scene's version (1, 2, …) and the scene.
+    scene: Mutex<(u64, Value)>,
+    /// Where the page is served.
+    pub address: SocketAddr,
+}
+
+impl LiveView {
+    /// Serves `scene` on a free port of 127.0.0.1 until the process ends.
+    pub fn start(scene: Value) -> Result<Arc<LiveView>> {
+        let (server, address) = bind(0)?;
+        let live = Arc::new(LiveView {
+            scene: Mutex::new((1, scene)),
+            address,
+        });
+        let shown = live.clone();
+        std::thread::Builder::new()
+            .name("view".into())
+            .spawn(move || serve(&server, shown.as_ref()))
+            .context("cannot start the view's server")?;
+        Ok(live)
+    }
+
+    /// Shows `scene` from now on: the page fetches it within a second.
+    pub fn show(&self, scene: Value) {
+        let mut held = self.scene.lock().unwrap_or_else(PoisonError::into_inner);
+        *held = (held.0 + 1, scene);
+    }
+
+    /// The page's address.
+    pub fn url(&self) -> String {
+        format!("http://{}/", self.address)
+    }
+}
+
+impl Shown for LiveView {
+    fn version(&self) -> Result<String> {
+        let held = self.scene.lock().unwrap_or_else(PoisonError::into_inner);
+        Ok(held.0.to_string())
+    }
+
+    fn current(&self) -> Result<(String, Value)> {
+        let held = self.scene.lock().unwrap_or_else(PoisonError::into_inner);
+        Ok((held.0.to_string(), held.1.clone()))
+    }
+}

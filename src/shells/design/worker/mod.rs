@@ -14,7 +14,7 @@ use super::app::campaign::OpenedCampaign;
 use super::app::judges::{PANEL_SEED, PanelUpdate};
 use super::app::{Effect, ExportOutcome, Response, SweepPoint};
 use crate::services::fsio::Overwrite;
-use crate::services::generation::LevelRequest;
+use crate::services::generation::{Ask, KeptPrefix, LevelRequest};
 use crate::services::level_files::{Format, LevelFiles, write_level_files};
 use crate::services::making::{self, LevelSource, Proof};
 use crate::services::panel::rate;
@@ -160,22 +160,10 @@ pub fn perform(
                 .goal(goal)
                 .profile(profile)
                 .knobs(knobs);
-            let result = match (ask.success(), ask.aux()) {
-                (Some(target), _) => target_level(&shelf[game], &request, (target, trials), stop),
-                (None, aux) => {
-                    let mut request = request;
-                    if let Some(aux) = aux {
-                        request = request.aux(aux);
-                    }
-                    if let Some(keep) = keep {
-                        request = request.keep(keep);
-                    }
-                    shelf[game].level(game, request)
-                }
-            };
             send(Response::Level {
                 id,
-                result: result.map(Arc::new),
+                result: make_level(&shelf[game], game, request, ask, keep, trials, stop)
+                    .map(Arc::new),
             })
         }
         Effect::Trials {
@@ -257,6 +245,32 @@ pub fn perform(
         }),
         // The shell serves the view itself (design/browser.rs); a worker has nothing to do.
         Effect::OpenView => {}
+    }
+}
+
+/// The level `ask` wants: one that meets its success target over `trials` runs, else the
+/// Generator's (or the rules') level at its λ, continuing `keep` where one is given.
+fn make_level(
+    policies: &Policies,
+    game: Game,
+    request: LevelRequest,
+    ask: Ask,
+    keep: Option<KeptPrefix>,
+    trials: u32,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Level, String> {
+    match (ask.success(), ask.aux()) {
+        (Some(target), _) => target_level(policies, &request, (target, trials), stop),
+        (None, aux) => {
+            let mut request = request;
+            if let Some(aux) = aux {
+                request = request.aux(aux);
+            }
+            if let Some(keep) = keep {
+                request = request.keep(keep);
+            }
+            policies.level(game, request)
+        }
     }
 }
 

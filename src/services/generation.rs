@@ -383,6 +383,7 @@ fn build_level<G: GeneratorGame>(
                             .zip(&knobs)
                             .map(|(knob, &value)| (knob.name.to_string(), f64::from(value)))
                             .collect(),
+                        want: None,
                     });
                 }
             }

@@ -3,7 +3,6 @@
 
 pub mod campaign;
 pub mod chart;
-pub mod checks;
 pub mod difficulty;
 pub mod eval;
 pub mod fsio;
@@ -17,3 +16,4 @@ pub mod profile;
 pub mod train;
 pub mod verify;
 pub mod view;
+pub mod wish;

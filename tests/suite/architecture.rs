@@ -16,8 +16,8 @@ fn root() -> &'static Path {
 /// The pure parts, from the repository's root: the core crate and the services that compute.
 const PURE: &[&str] = &[
     "crates/core/src", "src/services/train", "src/services/eval", "src/services/onnx",
-    "src/services/verify", "src/services/generation.rs", "src/services/making.rs",
-    "src/services/difficulty.rs", "src/services/panel.rs",
+    "src/services/verify", "src/services/generation.rs", "src/services/making",
+    "src/services/difficulty.rs", "src/services/panel.rs", "src/services/wish",
 ];
 
 /// What the pure parts may not name, and why.

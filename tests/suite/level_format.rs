@@ -46,6 +46,7 @@ fn level() -> impl Strategy<Value = Level> {
                     pacing: None,
                     profile: None,
                     knobs: Default::default(),
+                    want: None,
                 })
             },
         )

@@ -22,3 +22,4 @@ mod report;
 mod shipped;
 mod train;
 mod view;
+mod wish;

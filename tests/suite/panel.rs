@@ -325,15 +325,28 @@ fn checks_fail_a_batch_with_exit_code_3_and_bad_checks_are_usage_errors() {
         "{}",
         String::from_utf8_lossy(&failed.stdout)
     );
-    fails_with(&verify(&["speed 1..2"]), 2, "`speed` is not a check");
-    fails_with(&verify(&["success 0.6..0.4"]), 2, "LO ≤ HI");
+    fails_with(&verify(&["speed 1..2"]), 2, "`speed` is not an attribute");
+    fails_with(&verify(&["success 0.6..0.4"]), 2, "is empty");
     fails_with(
         &verify(&["b -1..1"]),
         2,
-        "--check b reads the panel's rating",
+        "--check b -1..1 reads the panel's runs",
     );
     let panel = arlpcg(words("verify {} --panel --check completed", &[&LEVEL]));
-    fails_with(&panel, 2, "with --panel, a check is `b LO..HI`");
+    fails_with(
+        &panel,
+        2,
+        "with --panel, `completed` has no one player's runs",
+    );
+    // A check on the pieces reads the same level file: the shipped level has 11 blocks.
+    assert!(verify(&["pieces 11", "jump 5..10"]).status.success());
+    let pieces = verify(&["pieces >= 20"]);
+    fails_with(&pieces, 3, "1 of 1 levels failed their checks");
+    assert!(
+        String::from_utf8_lossy(&pieces.stdout).contains("pieces >= 20: measured 11"),
+        "{}",
+        String::from_utf8_lossy(&pieces.stdout)
+    );
 
     // generate writes its files, then fails the batch.
     let dir = tempfile::tempdir().unwrap();
@@ -348,5 +361,11 @@ fn checks_fail_a_batch_with_exit_code_3_and_bad_checks_are_usage_errors() {
         "generate --rules --check completed --out {}",
         &[&out],
     ));
-    fails_with(&unverified, 2, "--check reads the levels' statistics");
+    fails_with(&unverified, 2, "--check completed reads the levels' runs");
+    // A check on the pieces needs no runs; one of the other game's is refused before any.
+    let racing = arlpcg(words(
+        "generate --rules --check {} --out {}",
+        &[&"curve <= 30", &out],
+    ));
+    fails_with(&racing, 2, "`curve` is not an attribute of these levels");
 }

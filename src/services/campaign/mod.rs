@@ -17,9 +17,9 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::services::chart::stacked_png;
-use crate::services::checks::Check;
 use crate::services::generation::{AuxAsk, LevelRequest};
 use crate::services::level_files::{Format, LevelFiles, render};
+use crate::services::wish::Constraint;
 use arlpcg_core::level::pacing::{AuxCurve, CurveWords, parse_points, show_points, value_at};
 use arlpcg_core::level::profile::{Profile, ProfileRecord};
 use arlpcg_core::level::{Game, Level};
@@ -128,7 +128,7 @@ pub struct Campaign {
     pub profile: Option<ProfileRecord>,
     /// Acceptance checks every level must pass (`verify --campaign` applies them).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub checks: Vec<Check>,
+    pub checks: Vec<Constraint>,
     /// The player population the levels are judged for.
     pub population: Population,
     /// `scripted judges`: the population's 10th, 50th and 90th percentiles of θ are the
@@ -211,7 +211,7 @@ pub struct CampaignAsk {
     /// The game profile the levels are made for (none: the built-in one).
     pub profile: Option<Profile>,
     /// Acceptance checks every level must pass.
-    pub checks: Vec<Check>,
+    pub checks: Vec<Constraint>,
     /// How the player population is set.
     pub population: PopulationAsk,
 }

@@ -1,8 +1,11 @@
 //! A verified level for a request, made in one place for `generate`, campaigns and the designer:
 //! drawn from a [`LevelSource`] (the rules or a Generator) as a [`LevelRequest`] asks, then
 //! proved as a [`Proof`] says: left unplayed, played with a draw that no run completes replaced
-//! (and λ eased after [`Redraw::max_draws`] such draws), or searched to a success rate. A level
-//! that was played carries its certificate: a recorded run that reaches the goal.
+//! (and λ eased after [`Redraw::max_draws`] such draws), searched to a success rate, or
+//! searched over λ and draws until it meets a wish list ([`wanted`]). A level that was played
+//! carries its certificate: a recorded run that reaches the goal.
+
+pub mod wanted;
 
 use crate::services::difficulty::{self, Curve};
 use crate::services::generation::{self, GeneratorPolicy, LevelRequest};
@@ -86,6 +89,9 @@ pub enum Proof<'a> {
         /// Runs per candidate.
         trials: u32,
     },
+    /// Searched over λ (or curves of λ) and draws until it meets every constraint of a wish
+    /// list ([`wanted::Search`]); played where the wish list reads runs or `solver` is given.
+    Wanted(wanted::Search<'a>),
 }
 
 /// The level `request` asks of `source`, proved as `proof` says, with its certificate where it
@@ -128,6 +134,7 @@ pub fn verified_level(
             trials,
             redraw,
         } => played_level(source, request, (solver, trials, redraw), watch, eased),
+        Proof::Wanted(ref search) => search.level(source, request, watch),
     }
 }
 

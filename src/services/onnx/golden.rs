@@ -184,6 +184,7 @@ pub fn generator_golden_episode<G: GeneratorGame>(
         pacing: None,
         profile: None,
         knobs: Default::default(),
+        want: None,
     };
     let outcome = format!("{outcome:?}");
     Ok(GoldenEpisode::new(

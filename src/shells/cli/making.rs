@@ -9,9 +9,9 @@ use super::values::{
     parse_aux_arg, parse_contract, parse_game, parse_keep, parse_point, parse_shard, parse_target,
 };
 use super::{AuxArg, KeepArg, Shard};
-use crate::services::checks::Check;
 use crate::services::generation::Ask;
 use crate::services::panel::Judge;
+use crate::services::wish::{Constraint, Want};
 use arlpcg_core::level::Game;
 use arlpcg_core::level::pacing::AuxCurve;
 
@@ -126,12 +126,35 @@ pub struct GenerateArgs {
     /// abilities, which --verify plays with; each level records it. Default: the built-in one.
     #[arg(long, value_name = "FILE")]
     pub profile: Option<PathBuf>,
-    /// Acceptance check on every level (repeatable): `success LO..HI` (the success ratio),
-    /// `b LO..HI` (the panel's difficulty, with --panel) or `completed`. A level fails a range
-    /// only when its 95% interval lies wholly outside it; any failure ends the run with exit
-    /// code 3 and names each level and check (the files are written all the same).
-    #[arg(long = "check", value_name = "CHECK", value_parser = Check::parse)]
-    pub checks: Vec<Check>,
+    /// Search each level until it meets every constraint of this wish list (docs/wish.md):
+    /// `"pieces 8..12, climb >= 6, hardest 0.66..1, success 0.4..0.8"`. With --policies, λ
+    /// (unless --aux gives it), a curve of λ and the seed's draws are searched; constraints on
+    /// runs are played (--verify N runs, else 20). Each level records its want, the draw and
+    /// each constraint's measured value; a want no candidate meets is named (exit 1, nothing
+    /// written), a contradictory one refused (exit 2).
+    #[arg(long, value_name = "WISHES", value_parser = Want::parse, conflicts_with_all = ["target_success", "want_file", "sentence"])]
+    pub want: Option<Want>,
+    /// The wish list from a file: YAML, `want: "pieces 8..12, climb >= 6"` or a list of
+    /// constraints under `want:`.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["target_success", "sentence"])]
+    pub want_file: Option<PathBuf>,
+    /// The wish list in plain words: "a long, easy level that climbs, with one hard jump near
+    /// the end". Read offline by a vocabulary (docs/wish.md), printed as the wish list it
+    /// reads as, with every word it did not use named; then searched as --want.
+    #[arg(
+        long = "ask",
+        value_name = "SENTENCE",
+        conflicts_with = "target_success"
+    )]
+    pub sentence: Option<String>,
+    /// Acceptance check on every level (repeatable), in the wish-list language (docs/wish.md):
+    /// `success LO..HI` (the success ratio), `b LO..HI` (the panel's difficulty, with
+    /// --panel), `completed`, or any attribute of the pieces (`pieces 8..12`). A level fails a
+    /// success or b range only when its 95% interval lies wholly outside it; any failure ends
+    /// the run with exit code 3 and names each level and check (the files are written all the
+    /// same).
+    #[arg(long = "check", value_name = "CHECK", value_parser = Constraint::parse)]
+    pub checks: Vec<Constraint>,
     /// Make only shard I of K of the batch (0 <= I < K): level i of the batch when i mod K = I.
     /// K machines with I = 0..K-1 together write exactly the files of the whole batch.
     #[arg(long, value_name = "I/K", value_parser = parse_shard)]

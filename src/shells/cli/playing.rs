@@ -7,8 +7,8 @@ use clap::{Args, ValueEnum};
 use super::values::{parse_game, parse_judges, parse_population, parse_retry};
 use super::{FormatArg, Judges};
 use crate::services::campaign::Ramp;
-use crate::services::checks::Check;
 use crate::services::panel::Judge;
+use crate::services::wish::Constraint;
 use arlpcg_core::game::Skill;
 use arlpcg_core::level::Game;
 use arlpcg_core::level::pacing::AuxCurve;
@@ -99,12 +99,14 @@ pub struct VerifyArgs {
     /// Default: the profile each level records, else the built-in one.
     #[arg(long, value_name = "FILE")]
     pub profile: Option<PathBuf>,
-    /// Acceptance check on every level (repeatable): `success LO..HI` (the success ratio),
-    /// `b LO..HI` (the panel's difficulty, with --panel) or `completed`. A level fails a range
-    /// only when its 95% interval lies wholly outside it; any failure ends the run with exit
-    /// code 3 and names each level and check .
-    #[arg(long = "check", value_name = "CHECK", value_parser = Check::parse)]
-    pub checks: Vec<Check>,
+    /// Acceptance check on every level (repeatable), in the wish-list language (docs/wish.md):
+    /// `success LO..HI` (the success ratio), `b LO..HI` (the panel's difficulty, with
+    /// --panel), `completed`, or any attribute of the pieces or runs (`pieces 8..12`,
+    /// `hardest 0.6..1`). A level fails a success or b range only when its 95% interval lies
+    /// wholly outside it; any failure ends the run with exit code 3 and names each level and
+    /// check.
+    #[arg(long = "check", value_name = "CHECK", value_parser = Constraint::parse)]
+    pub checks: Vec<Constraint>,
     /// Re-play and re-report a campaign (its campaign.yaml, e.g. after editing its levels or
     /// checks): the judge and the panel play every level again, the population goes through,
     /// the report goes to standard output and its checks (and --check) are applied. Writes
@@ -172,12 +174,14 @@ pub struct CampaignArgs {
     /// The chance that a player tries a level again after failing it (else quits).
     #[arg(long, value_name = "P", default_value_t = arlpcg_core::statistics::population::DEFAULT_RETRY, value_parser = parse_retry)]
     pub retry: f64,
-    /// Acceptance check on every level (repeatable): `success LO..HI` (the success ratio),
-    /// `b LO..HI` (the panel's difficulty) or `completed`. A level fails a range
-    /// only when its 95% interval lies wholly outside it; any failure ends the run with exit
-    /// code 3 and names each level and check (the files are written all the same).
-    #[arg(long = "check", value_name = "CHECK", value_parser = Check::parse)]
-    pub checks: Vec<Check>,
+    /// Acceptance check on every level (repeatable), in the wish-list language (docs/wish.md):
+    /// `success LO..HI` (the success ratio), `b LO..HI` (the panel's difficulty),
+    /// `completed`, or any attribute of the pieces or runs (`pieces 8..12`). A level fails a
+    /// success or b range only when its 95% interval lies wholly outside it; any failure ends
+    /// the run with exit code 3 and names each level and check (the files are written all the
+    /// same).
+    #[arg(long = "check", value_name = "CHECK", value_parser = Constraint::parse)]
+    pub checks: Vec<Constraint>,
     /// Level file formats, comma-separated.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "yaml,glb")]
     pub format: Vec<FormatArg>,

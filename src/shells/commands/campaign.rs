@@ -13,7 +13,6 @@ use crate::services::campaign::{
     Campaign, CampaignAsk, CampaignLevel, PopulationAsk, REDRAWS, campaign_files, level_stem, rate,
     rate_and_mend, search_level,
 };
-use crate::services::checks::{Check, evidence, failures};
 use crate::services::difficulty;
 use crate::services::fsio;
 use crate::services::generation::GeneratorPolicy;
@@ -22,6 +21,7 @@ use crate::services::panel::Judge;
 use crate::services::policies::{difficulty_curve, load_generator, load_panel, policy_paths};
 use crate::services::profile;
 use crate::services::verify::{self, Solver, Watch};
+use crate::services::wish::{Constraint, Evidence, failures};
 use crate::shells::cli::{CampaignArgs, VerifyArgs};
 use crate::shells::common::{
     ChecksFailed, Interrupted, check_panel_fit, progress_bar, shipped_dir,
@@ -42,6 +42,8 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     if args.out.exists() && !args.out.is_dir() {
         anyhow::bail!("--out {} is not a folder", args.out.display());
     }
+    crate::services::wish::fit_checks(&args.checks, args.game)
+        .map_err(crate::shells::common::UsageError)?;
     let formats: Vec<Format> = args.format.iter().map(|&f| f.into()).collect();
     if !formats.contains(&Format::Yaml) {
         return Err(crate::shells::common::UsageError(
@@ -443,10 +445,11 @@ fn report(campaign: &Campaign) {
 
 /// The campaign's checks on its levels (named by their files), exit code 3 on a failure.
 fn apply_checks(campaign: &Campaign, levels: &[Level]) -> Result<()> {
-    let evidence = campaign.levels.iter().zip(levels).map(|(entry, level)| {
-        let (stats, rating) = evidence(level);
-        (entry.file.clone(), stats, rating)
-    });
+    let evidence = campaign
+        .levels
+        .iter()
+        .zip(levels)
+        .map(|(entry, level)| (entry.file.clone(), level, Evidence::of(level)));
     let failed = failures(&campaign.checks, evidence);
     report_checks(&campaign.checks, failed, levels.len(), false)
 }
@@ -454,7 +457,7 @@ fn apply_checks(campaign: &Campaign, levels: &[Level]) -> Result<()> {
 /// Exit code 3, naming each level and check that failed, when any did. The verdict goes to
 /// standard output, or with `json` to standard error (standard output then carries only JSON).
 pub fn report_checks(
-    checks: &[Check],
+    checks: &[Constraint],
     failed: Vec<(String, String)>,
     levels: usize,
     json: bool,

@@ -8,7 +8,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Context, Result};
 use rayon::prelude::*;
 
-use crate::services::checks;
 use crate::services::difficulty;
 use crate::services::fsio;
 use crate::services::generation::{Ask, GeneratorPolicy, KeptPrefix, LevelRequest};
@@ -21,6 +20,7 @@ use crate::services::policies::{
 };
 use crate::services::profile;
 use crate::services::verify::{self, Solver, SolverPolicy};
+use crate::services::wish::{self, Evidence, Reads, Want};
 use crate::shells::cli::{GenerateArgs, KeepArg, default_solver};
 use crate::shells::common::shipped_dir;
 use arlpcg_core::game::Skill;
@@ -30,11 +30,14 @@ use arlpcg_core::level::{Game, Level};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
     let seeds = check_arguments(args)?;
+    let want = wanted(args)?;
     let template = template(args)?;
     let ask = args.ask();
+    let reads_runs = want.as_ref().is_some_and(|w| w.reads() > Reads::Pieces);
     let verify_trials = args
         .verify
-        .or(ask.as_ref().and_then(Ask::success).map(|_| TARGET_TRIALS));
+        .or(ask.as_ref().and_then(Ask::success).map(|_| TARGET_TRIALS))
+        .or(reads_runs.then_some(WANT_TRIALS));
     let generator = match &args.policies {
         Some(dir) => Some(load_generator(&policy_paths(dir).0, args.game)?.0),
         None => None,
@@ -80,6 +83,14 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         template.profile.as_ref(),
         &stop,
     )?;
+    let judges = match &want {
+        Some(want) => want_judges(args, want, template.profile.as_ref())?,
+        None => Vec::new(),
+    };
+    let players: Vec<(Judge, Solver)> = judges
+        .iter()
+        .map(|(judge, policy)| (*judge, judge_player(*judge, policy.as_ref())))
+        .collect();
     let mut levels = build_levels(
         args,
         &plans,
@@ -88,18 +99,12 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         &who,
         curve.as_ref(),
         verify_trials,
+        want.as_ref().map(|w| (w, players.as_slice())),
         &stop,
     )?;
     if let Some(panel) = &panel {
         let trials = verify_trials.unwrap_or(TARGET_TRIALS);
-        let runs = (levels.len() * panel.judges.len()) as u64 * trials as u64;
-        let bar = crate::shells::common::progress_bar(runs, "panel runs");
-        let watch = verify::Watch {
-            on_trial: &|_| bar.inc(1),
-            stop: &|| stop.load(Ordering::SeqCst),
-        };
-        crate::services::panel::play_and_rate(panel, &mut levels, trials, &watch);
-        bar.finish_and_clear();
+        play_panel(panel, &mut levels, trials, &stop);
     }
     // The folder is made only now, and removed again if the batch fails.
     let made_folder = !args.out.exists();
@@ -134,16 +139,33 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         args.out.display()
     );
     report_verification(&levels);
-    let named = levels.iter().zip(&plans).map(|(level, (seed, _))| {
-        let (stats, rating) = checks::evidence(level);
+    apply_checks(args, &levels, &plans)
+}
+
+/// `--check` on the batch's levels: exit code 3, naming each level and check, on a failure.
+fn apply_checks(args: &GenerateArgs, levels: &[Level], plans: &[(u64, LevelFiles)]) -> Result<()> {
+    let named = levels.iter().zip(plans).map(|(level, (seed, _))| {
         (
             format!("{} (seed {seed})", stem(args, *seed)),
-            stats,
-            rating,
+            level,
+            Evidence::of(level),
         )
     });
-    let failed = checks::failures(&args.checks, named);
+    let failed = wish::failures(&args.checks, named);
     super::campaign::report_checks(&args.checks, failed, levels.len(), false)
+}
+
+/// The panel's runs on every level, rated together, with a progress bar; Ctrl-C in `stop`
+/// cuts them short.
+fn play_panel(panel: &JudgePanel, levels: &mut Vec<Level>, trials: u32, stop: &AtomicBool) {
+    let runs = (levels.len() * panel.judges.len()) as u64 * trials as u64;
+    let bar = crate::shells::common::progress_bar(runs, "panel runs");
+    let watch = verify::Watch {
+        on_trial: &|_| bar.inc(1),
+        stop: &|| stop.load(Ordering::SeqCst),
+    };
+    crate::services::panel::play_and_rate(panel, levels, trials, &watch);
+    bar.finish_and_clear();
 }
 
 /// What verification did across the batch: redrawn, unsolved and uncertified levels.
@@ -263,21 +285,38 @@ fn check_arguments(args: &GenerateArgs) -> Result<Vec<u64>> {
             "--obstacles with --keep: the kept level's scene (start, goal, obstacles) stays",
         );
     }
-    if args.policies.is_some() && ask.is_none() {
+    let wants = args.want.is_some() || args.want_file.is_some() || args.sentence.is_some();
+    if args.policies.is_some() && ask.is_none() && !wants {
         return usage(
-            "--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard), --aux-curve CURVE or --target-success P",
+            "--policies needs --aux λ in [-1, 1] (+1 easy, -1 hard), --aux-curve CURVE, --target-success P or a wish list (--want, --want-file, --ask)",
         );
     }
+    if let Some(want) = &args.want {
+        want.fit(args.game)
+            .map_err(crate::shells::common::UsageError)?;
+    }
+    wish::fit_checks(&args.checks, args.game).map_err(crate::shells::common::UsageError)?;
     if args.solver_policy.is_some() && args.verify.is_none() && success.is_none() {
         return usage("--solver-policy plays --verify N or --target-success P; give one of them");
     }
-    if !args.checks.is_empty() && args.verify.is_none() && success.is_none() {
-        return usage(
-            "--check reads the levels' statistics: give --verify N or --target-success P",
-        );
+    if let Some(check) = args
+        .checks
+        .iter()
+        .find(|c| c.attribute.reads() > Reads::Pieces)
+        && args.verify.is_none()
+        && success.is_none()
+        && !wants
+    {
+        return usage(&format!(
+            "--check {check} reads the levels' runs: give --verify N, --target-success P or a wish list"
+        ));
     }
-    if args.checks.iter().any(|c| c.needs_panel()) && !args.panel {
-        return usage("--check b reads the panel's rating: give --panel too");
+    if let Some(check) = args.checks.iter().find(|c| c.needs_panel())
+        && !args.panel
+    {
+        return usage(&format!(
+            "--check {check} reads the panel's runs: give --panel too"
+        ));
     }
     if args.judge.is_some() && args.verify.is_none() && success.is_none() {
         return usage("--judge plays --verify N or --target-success P; give one of them");
@@ -369,6 +408,68 @@ fn knob_values(args: &GenerateArgs, generator: Option<&GeneratorPolicy>) -> Resu
 /// Runs per candidate of `--target-success` without `--verify`.
 const TARGET_TRIALS: u32 = 100;
 
+/// Runs per played candidate of a wish list that reads runs, without `--verify`.
+const WANT_TRIALS: u32 = 20;
+
+/// The wish list of --want, --want-file or --ask (said as read, with each word it did not
+/// use), checked against the game's attributes; none without one.
+fn wanted(args: &GenerateArgs) -> Result<Option<Want>> {
+    let usage = |message: String| crate::shells::common::UsageError(message);
+    let want = match (&args.want, &args.want_file, &args.sentence) {
+        (Some(want), _, _) => want.clone(),
+        (None, Some(file), _) => wish::load(file).map_err(usage)?,
+        (None, None, Some(sentence)) => {
+            let reading = wish::words::read(sentence, args.game).map_err(usage)?;
+            crate::warn!("read as: {}", reading.want);
+            if !reading.unknown.is_empty() {
+                crate::warn!(
+                    "not used (not in the vocabulary, docs/wish.md): {}",
+                    reading.unknown.join(", ")
+                );
+            }
+            if !reading.other_game.is_empty() {
+                crate::warn!(
+                    "not used (nothing of {} levels): {}",
+                    args.game,
+                    reading.other_game.join(", ")
+                );
+            }
+            reading.want
+        }
+        (None, None, None) => return Ok(None),
+    };
+    want.fit(args.game).map_err(usage)?;
+    Ok(Some(want))
+}
+
+/// The policy of each judge `want` asks the success of (none for the scripted player).
+fn want_judges(
+    args: &GenerateArgs,
+    want: &Want,
+    profile: Option<&Profile>,
+) -> Result<Vec<(Judge, Option<SolverPolicy>)>> {
+    want.judges()
+        .into_iter()
+        .map(|judge| match judge {
+            Judge::Scripted(_) => Ok((judge, None)),
+            Judge::Solver(_) => Ok((
+                judge,
+                load_judge_under(&policies_dir(args)?, args.game, judge, profile)?,
+            )),
+        })
+        .collect()
+}
+
+/// Who plays for `judge`: its policy, else the scripted player at its skill (the expert for a
+/// Solver judge that cannot play the profile).
+fn judge_player(judge: Judge, policy: Option<&SolverPolicy>) -> Solver<'_> {
+    match (policy, judge) {
+        (Some(policy), _) => Solver::Policy(policy),
+        (None, Judge::Scripted(skill)) => Solver::Scripted(skill),
+        (None, Judge::Solver(_)) => Solver::Scripted(Skill::Expert),
+    }
+}
+
 /// The level `--keep` names, read and checked, and the pieces to keep of it.
 fn kept_prefix(keep: &KeepArg, game: Game) -> Result<KeptPrefix> {
     let (level, from) = arlpcg_core::level::yaml::load_pinned(&keep.level)?;
@@ -402,7 +503,19 @@ fn stem(args: &GenerateArgs, seed: u64) -> String {
         Some(keep) => format!("_keep{}", keep.pieces),
         None => String::new(),
     };
-    stem_of_lambda(args, seed) + &knob_suffix(args) + &kept
+    stem_of_lambda(args, seed) + &knob_suffix(args) + &want_suffix(args) + &kept
+}
+
+/// `_want-` and a short hash of the wish list as asked (the file records it).
+fn want_suffix(args: &GenerateArgs) -> String {
+    let asked = match (&args.want, &args.want_file, &args.sentence) {
+        (Some(want), _, _) => want.to_string(),
+        (_, Some(file), _) => file.display().to_string(),
+        (_, _, Some(sentence)) => sentence.clone(),
+        _ => return String::new(),
+    };
+    let hash = arlpcg_core::level::sha256_hex(asked.as_bytes());
+    format!("_want-{}", &hash[..8])
 }
 
 /// The knobs `--aux` names (name, value), and the game's knobs.
@@ -521,18 +634,25 @@ fn build_levels(
     who: &Solver,
     curve: Option<&difficulty::Curve>,
     verify_trials: Option<u32>,
+    want: Option<(&Want, &[(Judge, Solver)])>,
     stop: &AtomicBool,
 ) -> Result<Vec<Level>> {
     let source = generator.map_or(LevelSource::Rules(args.game), LevelSource::Generator);
     let target = args.ask().as_ref().and_then(Ask::success);
-    let proof = match (target, curve, verify_trials) {
-        (Some(target), Some(curve), _) => Proof::Target {
+    let proof = match (want, target, curve, verify_trials) {
+        (Some((want, judges)), ..) => Proof::Wanted(making::wanted::Search {
+            want,
+            solver: verify_trials.map(|_| who),
+            judges,
+            trials: verify_trials.unwrap_or(WANT_TRIALS),
+        }),
+        (None, Some(target), Some(curve), _) => Proof::Target {
             solver: who,
             curve,
             target,
             trials: verify_trials.unwrap_or(TARGET_TRIALS),
         },
-        (_, _, Some(trials)) if args.verify.is_some() => Proof::Played {
+        (None, _, _, Some(trials)) if args.verify.is_some() => Proof::Played {
             solver: who,
             trials,
             redraw: Redraw {

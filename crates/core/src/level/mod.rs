@@ -382,6 +382,34 @@ pub struct Level {
     pub profile: Option<crate::level::profile::Profile>,
     /// The style knobs it was built with, by name, each in [-1, 1] (none: no preference).
     pub knobs: std::collections::BTreeMap<String, f64>,
+    /// The wish list it was searched to meet (`generate --want`), with what was measured.
+    pub want: Option<WantRecord>,
+}
+
+/// What a level was searched to meet (`generate --want`, `--ask`): the wish list as it was
+/// read, the draw of its seed that met it, how many candidates were tried, and the value each
+/// constraint measured on the kept level (src/services/wish defines the attributes).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WantRecord {
+    /// The wish list, in the form `generate --want` reads.
+    pub asked: String,
+    /// The draw of the level's seed that was kept.
+    pub draw: u32,
+    /// Candidates built (draws × λ) before this one met every constraint, this one included.
+    pub tried: u32,
+    /// Each constraint with the value it measured.
+    pub measured: Vec<MeasuredConstraint>,
+}
+
+/// One constraint of a [`WantRecord`] and its value on the level.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeasuredConstraint {
+    /// The constraint, as written (`climb >= 6`).
+    pub constraint: String,
+    /// Its attribute's value on the level.
+    pub value: f64,
 }
 
 /// Straight-line distance between two points, m.
@@ -444,6 +472,9 @@ pub enum InvalidLevel {
     /// The level's statistics do not fit its track.
     #[error("{0}")]
     Stats(String),
+    /// The level's wish-list record holds a value that is not a number.
+    #[error("{0}")]
+    Want(String),
     /// The level's source does not fit the level (wrong rules kind, more kept pieces than it has,
     /// bad rule settings).
     #[error("{0}")]
@@ -599,6 +630,14 @@ impl Level {
             stats
                 .check(self.piece_count())
                 .map_err(InvalidLevel::Stats)?;
+        }
+        if let Some(want) = &self.want
+            && let Some(bad) = want.measured.iter().find(|m| !m.value.is_finite())
+        {
+            return Err(InvalidLevel::Want(format!(
+                "`{}` measured {}: a measured value must be a finite number",
+                bad.constraint, bad.value
+            )));
         }
         if let Some(pacing) = &self.pacing {
             if self.aux.is_some() {

@@ -11,13 +11,13 @@ use anyhow::{Context, Result};
 use serde_json::json;
 
 use super::campaign::report_checks;
-use crate::services::checks::{Check, failures};
 use crate::services::panel::{JudgePanel, rate};
 use crate::services::policies::{load_panel, load_solver};
 use crate::services::profile;
 use crate::services::verify::{
     FailureConcentration, HalfwaySplit, Solver, Summary, Watch, passed_by_piece, verify,
 };
+use crate::services::wish::{Evidence, Reads, failures};
 use crate::shells::cli::{Judges, VerifyArgs};
 use crate::shells::common::{panel_fit, shipped_dir};
 use arlpcg_core::game::facts::facts;
@@ -78,7 +78,14 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
             concentration.add(&stats);
             checked.extend(failures(
                 &args.checks,
-                [(path.display().to_string(), Some(&stats), None)],
+                [(
+                    path.display().to_string(),
+                    &level,
+                    Evidence {
+                        stats: Some(&stats),
+                        ..Evidence::default()
+                    },
+                )],
             ));
             if let Some(chart) = &args.chart {
                 let name = path.file_stem().unwrap_or_default().to_string_lossy();
@@ -135,6 +142,29 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
     report_checks(&args.checks, checked, args.levels.len(), args.json)
 }
 
+/// Rates the levels of each game together (the judges' abilities come from all of them),
+/// saying each judge's ability unless `json`.
+fn rate_each_game(rated: &mut [(&Path, Level, PanelStats)], json: bool) {
+    for game in Game::ALL {
+        let mut of_game: Vec<&mut PanelStats> = rated
+            .iter_mut()
+            .filter(|(_, level, _)| level.game() == game)
+            .map(|(_, _, s)| s)
+            .collect();
+        if of_game.is_empty() {
+            continue;
+        }
+        let abilities = rate(&mut of_game);
+        if !json {
+            let shown: Vec<String> = abilities
+                .iter()
+                .map(|(name, theta)| format!("{name} {theta:+.2}"))
+                .collect();
+            crate::say!("{game} judges' ability θ (logits): {}", shown.join(", "));
+        }
+    }
+}
+
 /// The checks on the arguments alone (exit 2 on a misfit).
 fn check_arguments(args: &VerifyArgs) -> Result<()> {
     let usage = |message: &str| Err(crate::shells::common::UsageError(message.into()).into());
@@ -144,13 +174,22 @@ fn check_arguments(args: &VerifyArgs) -> Result<()> {
     if args.replay && !args.checks.is_empty() {
         return usage("--check reads new trials; --replay plays none");
     }
-    if args.panel.is_some() && args.checks.iter().any(|c| !c.needs_panel()) {
-        return usage(
-            "with --panel, a check is `b LO..HI`; `success` and `completed` read one Solver's runs (verify without --panel)",
-        );
+    let one_players = |c: &&crate::services::wish::Constraint| {
+        c.attribute.reads() == Reads::Runs && !c.needs_panel()
+    };
+    if args.panel.is_some()
+        && let Some(check) = args.checks.iter().find(one_players)
+    {
+        return usage(&format!(
+            "with --panel, `{check}` has no one player's runs to read: a check reads the pieces, `b LO..HI` or `success LO..HI for JUDGE` (or verify without --panel)"
+        ));
     }
-    if args.panel.is_none() && args.checks.iter().any(Check::needs_panel) {
-        return usage("--check b reads the panel's rating: give --panel too");
+    if args.panel.is_none()
+        && let Some(check) = args.checks.iter().find(|c| c.needs_panel())
+    {
+        return usage(&format!(
+            "--check {check} reads the panel's runs: give --panel too"
+        ));
     }
     if args.chart.is_some() && args.levels.len() != 1 {
         return usage("--chart draws one level: give one level file");
@@ -262,7 +301,7 @@ fn say_panel_fit(panel: &JudgePanel, level: &Level, json: bool, said: &mut HashS
 /// levels of each game together).
 fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
     let mut panels: HashMap<Game, JudgePanel> = HashMap::new();
-    let mut rated: Vec<(&Path, Game, PanelStats)> = Vec::new();
+    let mut rated: Vec<(&Path, Level, PanelStats)> = Vec::new();
     let mut said = HashSet::new();
     let profile = args.profile.as_deref().map(profile::load).transpose()?;
     let failed = each_level(
@@ -302,37 +341,24 @@ fn panel(args: &VerifyArgs, chosen: &Judges) -> Result<()> {
                 )?
                 .expect("a panel without a stop condition plays to the end");
                 bar.finish_and_clear();
-                Ok((game, played))
+                Ok((level, played))
             })
         },
-        |path, (game, stats)| {
-            rated.push((path, game, stats));
+        |path, (level, stats)| {
+            rated.push((path, level, stats));
             Ok(())
         },
     )?;
-    for game in Game::ALL {
-        let mut of_game: Vec<&mut PanelStats> = rated
-            .iter_mut()
-            .filter(|(_, g, _)| *g == game)
-            .map(|(_, _, s)| s)
-            .collect();
-        if of_game.is_empty() {
-            continue;
-        }
-        let abilities = rate(&mut of_game);
-        if !args.json {
-            let shown: Vec<String> = abilities
-                .iter()
-                .map(|(name, theta)| format!("{name} {theta:+.2}"))
-                .collect();
-            crate::say!("{game} judges' ability θ (logits): {}", shown.join(", "));
-        }
-    }
+    rate_each_game(&mut rated, args.json);
     let checked = failures(
         &args.checks,
-        rated
-            .iter()
-            .map(|(path, _, stats)| (path.display().to_string(), None, stats.rating)),
+        rated.iter().map(|(path, level, stats)| {
+            let evidence = Evidence {
+                panel: Some(stats),
+                ..Evidence::default()
+            };
+            (path.display().to_string(), level, evidence)
+        }),
     );
     for (path, _, stats) in &rated {
         let rating = stats.rating.expect("rated above");

@@ -103,6 +103,7 @@ pub fn platform_level_draw(
                 pacing: None,
                 profile: None,
                 knobs: Default::default(),
+                want: None,
             });
         }
     }

@@ -154,6 +154,7 @@ pub fn racing_level_draw(
                 pacing: None,
                 profile: None,
                 knobs: Default::default(),
+                want: None,
             });
         }
     }

@@ -15,7 +15,7 @@ use crate::level::params::{self, ParamRange};
 use crate::level::platform::{BlockParams, PlatformTrack, Start, headroom_of};
 use crate::level::profile::ProfileRecord;
 use crate::level::racing::{self, Obstacle, RacingTrack, RoadShape, SegmentParams};
-use crate::level::{Game, Level, Shape, ShapeKind, SolverStats, Source, Track};
+use crate::level::{Game, Level, Shape, ShapeKind, SolverStats, Source, Track, WantRecord};
 
 /// A number that must lie in the range `B` names; checked while parsing, so serde_yaml's error
 /// carries the field path and line.
@@ -123,6 +123,9 @@ pub(super) struct LevelFile {
     profile: Option<ProfileRecord>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     stats: Option<SolverStats>,
+    /// The wish list it was searched to meet, with each constraint's measured value.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    want: Option<WantRecord>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -253,6 +256,7 @@ impl LevelFile {
             source: level.source.clone(),
             profile: level.profile.as_ref().map(|p| p.record()),
             stats: level.stats.clone(),
+            want: level.want.clone(),
         }
     }
 
@@ -297,11 +301,13 @@ impl LevelFile {
             pacing,
             profile,
             knobs: self.knobs.iter().map(|(k, v)| (k.clone(), v.0)).collect(),
+            want: self.want,
         };
         level.validate().map_err(|e| {
             let key = |key: &str| (key.to_string(), line_of_key(text, key));
             let (field, line) = match &e {
                 crate::level::InvalidLevel::Stats(_) => key("stats"),
+                crate::level::InvalidLevel::Want(_) => key("want"),
                 crate::level::InvalidLevel::Source(_) => key("source"),
                 crate::level::InvalidLevel::NoPieces(what)
                 | crate::level::InvalidLevel::TooMany { what, .. } => key(what),

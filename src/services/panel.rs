@@ -42,6 +42,17 @@ impl Judge {
         }
     }
 
+    /// Who plays for the judge: `policy` (its Solver's, where one was loaded), else the
+    /// scripted player at its skill (the expert for a Solver judge without a policy, one that
+    /// cannot play the profile).
+    pub fn player(self, policy: Option<&SolverPolicy>) -> Solver<'_> {
+        match (policy, self) {
+            (Some(policy), _) => Solver::Policy(policy),
+            (None, Judge::Scripted(skill)) => Solver::Scripted(skill),
+            (None, Judge::Solver(_)) => Solver::Scripted(Skill::Expert),
+        }
+    }
+
     /// The judge called `name`, or an error listing the names.
     pub fn parse(name: &str) -> Result<Judge, String> {
         Judge::ALL

@@ -152,3 +152,45 @@ fn contradictory_or_unmeetable_wants_are_named_and_write_nothing() {
     assert!(stderr(&unmet).contains("never met: pieces >= 200: measured"));
     assert!(!out.exists());
 }
+
+#[test]
+fn bench_scores_an_ask_set_and_names_a_bad_ask() {
+    let dir = tempfile::tempdir().unwrap();
+    let asks = dir.path().join("asks.yaml");
+    std::fs::write(
+        &asks,
+        "asks:\n- want: pieces 6..9\n- ask: a short, easy level\n- want: pieces >= 200\n",
+    )
+    .unwrap();
+    let out = dir.path().join("score.json");
+    let output = arlpcg_ok(words(
+        "bench --game platform --asks {} --levels 2 --trials 10 --out {}",
+        &[&asks, &out],
+    ));
+    let said = String::from_utf8_lossy(&output.stdout).to_string();
+    assert!(
+        said.contains("3 asks (1 sentences) × 2 seeds = 6 levels"),
+        "{said}"
+    );
+    let score: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    // The third ask cannot be met: two of six searches keep no level.
+    let controllability = score["controllability"].as_f64().unwrap();
+    assert!((controllability - 4.0 / 6.0).abs() < 1e-9, "{score}");
+    assert!(score["quality"].as_f64().unwrap() <= controllability + 1e-9);
+    assert!(score["diversity"].as_f64().unwrap() > 0.0);
+    assert!(score["by_attribute"]["pieces"].as_f64().unwrap() < 1.0);
+    assert!(score["by_attribute"]["success"].as_f64().unwrap() > 0.0);
+    // Nothing is overwritten without --force; a bad ask is named by its place.
+    fails_with(
+        &arlpcg(words("bench --asks {} --out {}", &[&asks, &out])),
+        1,
+        "already exists",
+    );
+    std::fs::write(&asks, "asks:\n- want: pieces 6..9\n- ask: purple\n").unwrap();
+    fails_with(
+        &arlpcg(words("bench --asks {}", &[&asks])),
+        2,
+        "asks[1]: `purple` says nothing",
+    );
+}

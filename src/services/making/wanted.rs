@@ -44,6 +44,8 @@ pub struct Search<'a> {
     "no level met `{want}` in {tried} candidates ({played} played): {closest}; ask for less, or give more room (--aux, another --seed)"
 )]
 pub struct Unmet {
+    /// The constraints (by index) the closest candidate missed or could not be measured on.
+    pub missed: Vec<usize>,
     want: String,
     tried: u32,
     played: u32,
@@ -55,8 +57,8 @@ pub struct Unmet {
 struct Closest {
     each: Vec<Option<Miss>>,
     met_somewhere: Vec<bool>,
-    /// (how far it missed in all, what it was, why it missed).
-    best: Option<(f64, String, Vec<String>)>,
+    /// (how far it missed in all, what it was, why it missed, which it missed).
+    best: Option<(f64, String, Vec<String>, Vec<usize>)>,
 }
 
 impl Closest {
@@ -72,6 +74,7 @@ impl Closest {
     /// reading at most `measured`).
     fn note(&mut self, want: &Want, what: String, misses: &[(usize, Miss)], measured: Reads) {
         let mut far = 0.0;
+        let mut unmeasured = Vec::new();
         for (index, constraint) in want.constraints.iter().enumerate() {
             let missed = misses.iter().find(|(i, _)| *i == index).map(|(_, m)| m);
             match missed {
@@ -89,12 +92,16 @@ impl Closest {
                     self.met_somewhere[index] = true
                 }
                 // Not measured: as far as a miss that could not be measured.
-                None => far += 1.0,
+                None => {
+                    far += 1.0;
+                    unmeasured.push(index);
+                }
             }
         }
         if self.best.as_ref().is_none_or(|(best, ..)| far < *best) {
             let whys = misses.iter().map(|(_, m)| m.why.clone()).collect();
-            self.best = Some((far, what, whys));
+            let which = misses.iter().map(|(i, _)| *i).chain(unmeasured).collect();
+            self.best = Some((far, what, whys, which));
         }
     }
 
@@ -107,7 +114,7 @@ impl Closest {
             .filter(|(_, met)| !**met)
             .filter_map(|(miss, _)| miss.as_ref().map(|m| format!("never met: {}", m.why)))
             .collect();
-        let best = self.best.as_ref().map(|(_, what, whys)| {
+        let best = self.best.as_ref().map(|(_, what, whys, _)| {
             format!("the closest candidate ({what}) missed {}", whys.join("; "))
         });
         never.into_iter().chain(best).collect::<Vec<_>>().join("; ")
@@ -192,6 +199,7 @@ impl Search<'_> {
             return Err(last_error.unwrap_or_else(|| anyhow::anyhow!("no candidate was built")));
         }
         Err(Unmet {
+            missed: closest.best.as_ref().map_or(Vec::new(), |b| b.3.clone()),
             want: self.want.to_string(),
             tried,
             played,

@@ -6,6 +6,7 @@
 //! `checks:` check levels with the same constraints. docs/wish.md is the language's manual.
 
 pub mod attributes;
+pub mod score;
 pub mod words;
 
 use std::fmt;

@@ -164,6 +164,42 @@ pub struct GenerateArgs {
     pub threads: Option<u64>,
 }
 
+/// `bench`'s arguments.
+#[derive(Debug, Args)]
+#[command(after_help = "Examples:\n  \
+    arlpcg bench --game platform --asks results/platform/wish/asks.yaml\n  \
+    arlpcg bench --game racing --asks results/racing/wish/asks.yaml --levels 2 --out results/racing/wish/score.json\n\n\
+    Quality: the share of levels certified (a recorded run completes them). Controllability: \
+    the share meeting every constraint of their ask, and per attribute. Diversity: the mean \
+    distance between the levels over pairs (docs/wish.md), beside plain levels of the \
+    Generator at λ = 0. A search that meets no candidate counts as a miss.")]
+pub struct BenchArgs {
+    /// Which game.
+    #[arg(long, default_value = "platform", value_parser = parse_game)]
+    pub game: Game,
+    /// The ask set: YAML, `asks:` a list, each `want: WISHES` or `ask: SENTENCE` (docs/wish.md).
+    #[arg(long, value_name = "FILE")]
+    pub asks: PathBuf,
+    /// The Generator and Solver (default: the shipped policies/<game>).
+    #[arg(long, value_name = "DIR")]
+    pub policies: Option<PathBuf>,
+    /// Levels searched for each ask, from seeds 0, 1, ...
+    #[arg(long, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
+    pub levels: u32,
+    /// Runs per played candidate.
+    #[arg(long, value_name = "N", default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub trials: u32,
+    /// Write the score as JSON here (an existing file is replaced only with --force).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Replace --out if it exists.
+    #[arg(long)]
+    pub force: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
+    pub threads: Option<u64>,
+}
+
 /// `export`'s arguments.
 #[derive(Debug, Args)]
 pub struct ExportArgs {

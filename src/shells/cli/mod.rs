@@ -10,7 +10,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 mod making;
 mod playing;
 mod values;
-pub use making::{ExportArgs, ExportPolicyArgs, FormatArg, GenerateArgs, ViewArgs};
+pub use making::{BenchArgs, ExportArgs, ExportPolicyArgs, FormatArg, GenerateArgs, ViewArgs};
 pub use playing::{CampaignArgs, SolverChoice, VerifyArgs, default_solver};
 pub use values::{AuxArg, Judges, KeepArg, Shard};
 use values::{parse_ability_spread, parse_game, parse_minutes, parse_shard};
@@ -66,6 +66,9 @@ pub enum Command {
     View(ViewArgs),
     /// Play levels many times and report how often the Solver gets through.
     Verify(VerifyArgs),
+    /// Score wish lists the way the PCG Benchmark does: a set of asks, levels searched for
+    /// each, and their quality, controllability, diversity and time per level.
+    Bench(BenchArgs),
     /// Generate a sequence of levels on a difficulty ramp, rate them with the panel of judges,
     /// and report the players it keeps and loses (campaign.yaml, campaign.md, campaign.png).
     Campaign(CampaignArgs),

@@ -89,7 +89,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     };
     let players: Vec<(Judge, Solver)> = judges
         .iter()
-        .map(|(judge, policy)| (*judge, judge_player(*judge, policy.as_ref())))
+        .map(|(judge, policy)| (*judge, judge.player(policy.as_ref())))
         .collect();
     let mut levels = build_levels(
         args,
@@ -458,16 +458,6 @@ fn want_judges(
             )),
         })
         .collect()
-}
-
-/// Who plays for `judge`: its policy, else the scripted player at its skill (the expert for a
-/// Solver judge that cannot play the profile).
-fn judge_player(judge: Judge, policy: Option<&SolverPolicy>) -> Solver<'_> {
-    match (policy, judge) {
-        (Some(policy), _) => Solver::Policy(policy),
-        (None, Judge::Scripted(skill)) => Solver::Scripted(skill),
-        (None, Judge::Solver(_)) => Solver::Scripted(Skill::Expert),
-    }
 }
 
 /// The level `--keep` names, read and checked, and the pieces to keep of it.

@@ -2,6 +2,7 @@
 //! Errors come back as `anyhow` errors with the file and field named; `main` turns them into
 //! one line and a non-zero exit code.
 
+mod bench;
 pub(crate) mod campaign;
 mod eval;
 mod export;
@@ -28,6 +29,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::ExportPolicy(args)) => export_policy::run(&args),
         Some(Command::View(args)) => view::run(&args),
         Some(Command::Verify(args)) => in_pool(args.threads, || verify::run(&args)),
+        Some(Command::Bench(args)) => in_pool(args.threads, || bench::run(&args)),
         Some(Command::Campaign(args)) => in_pool(args.threads, || campaign::run(&args)),
         Some(Command::Eval(args)) => eval::run(&args),
         Some(Command::Report(args)) => report::run(&args),

@@ -147,6 +147,21 @@ fn read_game(game: Game, results: &Path, policies: &Path) -> Result<GamePage> {
             }
         }
     }
+    let wish_file = dir.join("wish").join("score.json");
+    let wish = match wish_file.is_file() {
+        true => Some(
+            serde_json::from_slice::<crate::services::wish::score::Score>(&read(&wish_file)?)
+                .with_context(|| format!("{}", wish_file.display()))?,
+        ),
+        false => None,
+    };
+    if let Some(other) = wish.as_ref().filter(|w| w.game != game) {
+        bail!(
+            "{}: the score of {} asks in the {game} results",
+            wish_file.display(),
+            other.game
+        );
+    }
     Ok(GamePage {
         game,
         cards,
@@ -155,6 +170,7 @@ fn read_game(game: Game, results: &Path, policies: &Path) -> Result<GamePage> {
         more_seeds,
         campaign,
         profiles,
+        wish,
     })
 }
 

@@ -91,25 +91,27 @@ fn game_section(page: &GamePage) -> String {
     md
 }
 
-/// The wish-list bench: quality, controllability (per attribute too), diversity and time.
+/// The wish-list bench: quality, controllability (and per attribute), diversity and time.
 fn wish_section(name: &str, s: &crate::services::wish::score::Score) -> String {
     let pct = |x: f64| format!("{:.0}%", 100.0 * x);
-    let mut md = format!(
-        "\n### Wish lists\n\nThe shipped policies asked for levels by wish lists and sentences ([wish.md](wish.md)): `arlpcg bench --game {name} --asks results/{name}/wish/asks.yaml --levels {} --out results/{name}/wish/score.json`. {} asks ({} of them sentences), {} levels.\n\n| quality (certified) | controllability (every constraint) | diversity (plain levels at λ = 0) | median time per level |\n|---|---|---|---|\n| {} | {} | {:.3} ({:.3}) | {:.1} s |\n\n| attribute | constraints met |\n|---|---|\n",
-        s.levels_per_ask,
+    let attributes: Vec<String> = s
+        .by_attribute
+        .iter()
+        .map(|(attribute, share)| format!("`{attribute}` {}", pct(*share)))
+        .collect();
+    format!(
+        "\n**Wish lists** ([wish.md](wish.md)), {} asks ({} of them sentences), {} levels: `arlpcg bench --game {name} --asks results/{name}/wish/asks.yaml --levels {} --out results/{name}/wish/score.json`\n\n| quality (certified) | controllability (every constraint; per attribute) | diversity (plain levels at λ = 0) | median time per level |\n|---|---|---|---|\n| {} | {}; {} | {:.3} ({:.3}) | {:.1} s |\n",
         s.asks,
         s.sentences,
         s.searched,
+        s.levels_per_ask,
         pct(s.quality),
         pct(s.controllability),
+        attributes.join(", "),
         s.diversity,
         s.plain_diversity,
         s.median_seconds
-    );
-    for (attribute, share) in &s.by_attribute {
-        md += &format!("| `{attribute}` | {} |\n", pct(*share));
-    }
-    md
+    )
 }
 
 /// The Solvers under each profile: validation success (on rule and Generator levels made for

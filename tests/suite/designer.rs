@@ -686,6 +686,7 @@ fn newer_requests_supersede_older_ones() {
         trials: 100,
         profile: None,
         knobs: Vec::new(),
+        want: None,
     };
     workers.submit(generate(101));
     loop {
@@ -792,6 +793,61 @@ fn target_success_mode_finds_a_level_in_band() {
     h.key(KeyCode::Right);
     assert_eq!(h.app.ask.success(), None, "the slider leaves target mode");
     assert!(matches!(h.pending[..], [Effect::Generate { .. }]));
+}
+
+/// `W` takes a wish list or a sentence: each level is searched to meet it, the slider shows
+/// the λ found, and the statistics show each constraint ✓ or ✗ with its value; a constraint the
+/// game does not have is a message; empty lets it go.
+#[test]
+fn a_typed_wish_list_is_searched_for_and_checked_on_screen() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::shipped(dir.path());
+    h.settle();
+    h.key(KeyCode::Char('W'));
+    h.keys("a short level that climbs, purple");
+    h.key(KeyCode::Enter);
+    let (said, _) = h.app.status.clone().unwrap();
+    assert!(
+        said.contains("wish list: pieces <= 7, climb >= 5") && said.contains("not used: purple"),
+        "{said}"
+    );
+    assert!(matches!(
+        &h.pending[..],
+        [Effect::Generate { want: Some(_), .. }]
+    ));
+    h.settle();
+    let level = h
+        .app
+        .level
+        .clone()
+        .expect("a level that meets the wish list");
+    assert!(level.piece_count() <= 7);
+    let record = level.want.as_ref().expect("the level records its want");
+    assert_eq!(record.asked, "pieces <= 7, climb >= 5");
+    assert_eq!(
+        h.app.aux,
+        level.aux.unwrap(),
+        "the slider shows the λ found"
+    );
+    let screen = h.screen(100, 40);
+    assert!(
+        screen.contains("✓ pieces <= 7") && screen.contains("✓ climb >= 5"),
+        "{screen}"
+    );
+    h.key(KeyCode::Char('W'));
+    for _ in 0..40 {
+        h.key(KeyCode::Backspace);
+    }
+    h.keys("curviness >= 0.5");
+    h.key(KeyCode::Enter);
+    let (said, is_error) = h.app.status.clone().unwrap();
+    assert!(is_error && said.contains("`curviness`"), "{said}");
+    h.key(KeyCode::Char('W'));
+    for _ in 0..40 {
+        h.key(KeyCode::Backspace);
+    }
+    h.key(KeyCode::Enter);
+    assert!(h.app.want.is_none());
 }
 
 /// Trials that cannot be played (here a racing Solver put on the platform game) say why, on the

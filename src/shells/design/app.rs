@@ -88,6 +88,8 @@ pub enum PromptKind {
     Policies,
     /// A target success rate.
     Target,
+    /// A wish list, or a sentence in plain words.
+    Want,
     /// An aux curve.
     Curve,
     /// A campaign folder to open.
@@ -103,6 +105,7 @@ impl PromptKind {
             PromptKind::Seed => "seed",
             PromptKind::Trials => "Solver trials per level",
             PromptKind::Target => "target success rate, 0.05-0.95 (empty: back to the λ slider)",
+            PromptKind::Want => "wish list or plain words, docs/wish.md (empty: none)",
             PromptKind::Policies => "policies folder, or a Generator/Solver .safetensors file",
             PromptKind::Curve => "aux curve, fraction:λ, ... (e.g. 0:1, 0.5:1, 0.6:-1, 1:-1)",
             PromptKind::Campaign => "campaign folder (what `arlpcg campaign` wrote)",
@@ -199,6 +202,8 @@ pub struct App {
     pub slider: usize,
     /// The prefix every regeneration keeps.
     pub kept: Option<crate::services::generation::KeptPrefix>,
+    /// The wish list each level is searched to meet (`W`; none: λ alone).
+    pub want: Option<crate::services::wish::Want>,
     /// Each game's profile levels are made for, and the ability its keys change ([`profile`];
     /// [`App::profile`]: the game on screen's).
     pub profiles: PerGame<profile::ProfileEdit>,
@@ -263,6 +268,7 @@ impl App {
             knobs: Vec::new(),
             slider: 0,
             kept: None,
+            want: None,
             profiles: PerGame::default(),
             seed,
             goal: GoalSetting::FromSeed,
@@ -322,6 +328,7 @@ impl App {
             trials: self.trials_wanted,
             profile: self.profile().profile.clone(),
             knobs: self.knob_values(),
+            want: self.want.clone(),
         }]
     }
 

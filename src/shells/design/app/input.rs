@@ -70,6 +70,7 @@ impl App {
             KeyCode::Char('s') => self.open_prompt(PromptKind::Seed),
             KeyCode::Char('t') => self.open_prompt(PromptKind::Trials),
             KeyCode::Char('T') => self.open_prompt(PromptKind::Target),
+            KeyCode::Char('W') => self.open_prompt(PromptKind::Want),
             KeyCode::Char('p') => self.open_prompt(PromptKind::Policies),
             KeyCode::Char('g') => self.toggle_goal(),
             KeyCode::Char('d') => self.adjust_goal(-1.0, 0.0, 0.0),
@@ -119,6 +120,10 @@ impl App {
             PromptKind::Target => self.ask.success().map_or(String::new(), |t| format!("{t}")),
             PromptKind::Policies => String::new(),
             PromptKind::Curve => self.ask.curve().map_or(String::new(), ToString::to_string),
+            PromptKind::Want => self
+                .want
+                .as_ref()
+                .map_or(String::new(), ToString::to_string),
             PromptKind::Campaign | PromptKind::Profile => String::new(),
         };
         self.overlay = Overlay::Prompt { kind, text };
@@ -183,6 +188,7 @@ impl App {
                     Vec::new()
                 }
             },
+            PromptKind::Want => self.submit_want(text),
             PromptKind::Curve if text.is_empty() => Vec::new(),
             PromptKind::Curve => self.submit_curve(text),
             PromptKind::Policies if text.is_empty() => Vec::new(),
@@ -192,6 +198,49 @@ impl App {
                     path: PathBuf::from(text),
                     game: self.game,
                 }]
+            }
+        }
+    }
+
+    /// A wish list typed at `W` (or a sentence, read as one): each level is searched to meet
+    /// it, the statistics show each constraint ✓ or ✗; empty: none.
+    fn submit_want(&mut self, text: &str) -> Vec<Effect> {
+        use crate::services::panel::Judge;
+        use crate::services::wish::{Want, words};
+        if text.is_empty() {
+            if self.want.take().is_some() {
+                self.say("no wish list: λ alone");
+                return self.generate();
+            }
+            return Vec::new();
+        }
+        let read = match Want::parse(text) {
+            Ok(want) => Ok((want, String::new())),
+            Err(_) => words::read(text, self.game).map(|r| {
+                let unused: Vec<String> = r.unknown.into_iter().chain(r.other_game).collect();
+                let unused = match unused.is_empty() {
+                    true => String::new(),
+                    false => format!(" (not used: {})", unused.join(", ")),
+                };
+                (r.want, unused)
+            }),
+        };
+        let checked = read.and_then(|(want, unused)| {
+            want.fit(self.game)?;
+            match want.judges().iter().any(|j| matches!(j, Judge::Solver(_))) {
+                true => Err("the designer plays the scripted judges; a Solver judge's success: arlpcg generate --want".into()),
+                false => Ok((want, unused)),
+            }
+        });
+        match checked {
+            Ok((want, unused)) => {
+                self.say(format!("wish list: {want}{unused}"));
+                self.want = Some(want);
+                self.generate()
+            }
+            Err(e) => {
+                self.complain(format!("wish list: {e}"));
+                Vec::new()
             }
         }
     }

@@ -144,6 +144,8 @@ pub enum Effect {
         profile: Option<Profile>,
         /// The Generator's style knobs, in its game's order (empty: none).
         knobs: Vec<f32>,
+        /// The wish list the level is searched to meet (none: the ask alone).
+        want: Option<crate::services::wish::Want>,
     },
     /// Play `trials` runs of `level` with the game's current player, from `seed`.
     Trials {

@@ -89,8 +89,9 @@ impl App {
             Ok(level) => {
                 self.generation_error = None;
                 self.selected = self.selected.filter(|&i| i < level.piece_count());
-                // In target-success mode the slider shows the λ the search found.
-                if let (Some(_), Some(aux)) = (self.ask.success(), level.aux) {
+                // With a success target or a wish list the slider shows the λ the search found.
+                let searched = self.ask.success().is_some() || self.want.is_some();
+                if let (true, Some(aux)) = (searched, level.aux) {
                     self.aux = aux;
                 }
                 self.level = Some(level);

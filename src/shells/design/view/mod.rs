@@ -38,7 +38,7 @@ pub const KEYS: [(&str, &str); 22] = [
     ("a A", "goal direction -15° / +15°"),
     ("↑ ↓", "select a block/segment: its parameters in stats"),
     ("t", "Solver trials per level (default 100)"),
-    ("T", "target success rate: λ is searched for it"),
+    ("T W", "target success / wish list or words: searched for"),
     ("r", "replay one Solver run on the map"),
     ("w", "λ sweep: success against λ for this seed and goal"),
     ("v V", "panel: failures / λ sweep / judges / 3D in browser"),
@@ -420,6 +420,14 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
         }
         None => lines.push(Line::from("no trials yet")),
     }
+    if let (Some(want), Some(level)) = (&app.want, &app.level) {
+        wish_lines(
+            want,
+            level,
+            app.trials.as_ref().and_then(|t| t.stats.as_ref()),
+            &mut lines,
+        );
+    }
     if let Some(level) = &app.level {
         lines.push(Line::from(source_line(level)).dim());
         if let Shape::Road(track) = level.shape() {
@@ -463,6 +471,48 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
         Paragraph::new(lines).block(Block::bordered().title(format!(" Solver: {solver} "))),
         area,
     );
+}
+
+/// Each constraint of the wish list: ✓ or ✗ with its value on the level, measured on the
+/// trials once they are done (a judge's success as the search measured it), … before.
+fn wish_lines(
+    want: &crate::services::wish::Want,
+    level: &Level,
+    stats: Option<&arlpcg_core::level::SolverStats>,
+    lines: &mut Vec<Line>,
+) {
+    use crate::services::wish::{Attribute, Evidence, Reads, Strictness};
+    let evidence = Evidence {
+        stats,
+        ..Evidence::default()
+    };
+    for constraint in &want.constraints {
+        let text = constraint.to_string();
+        let recorded = level
+            .want
+            .as_ref()
+            .and_then(|w| w.measured.iter().find(|m| m.constraint == text))
+            .map(|m| m.value);
+        let line = match constraint.attribute {
+            Attribute::Success(Some(_)) => {
+                recorded.map(|v| (constraint.low <= v && v <= constraint.high, v))
+            }
+            a if a.reads() > Reads::Pieces && stats.is_none() => None,
+            a => a.value(level, &evidence).ok().map(|v| {
+                (
+                    constraint
+                        .miss(level, &evidence, Strictness::Value)
+                        .is_none(),
+                    v,
+                )
+            }),
+        };
+        lines.push(match line {
+            Some((true, v)) => Line::from(format!("✓ {text}  ({v:.2})")).green(),
+            Some((false, v)) => Line::from(format!("✗ {text}  ({v:.2})")).red(),
+            None => Line::from(format!("… {text}")).dim(),
+        });
+    }
 }
 
 /// The piece (of `pieces`) on which most of the Solver's runs so far failed; the maps mark it.

@@ -19,6 +19,7 @@ use crate::services::level_files::{Format, LevelFiles, write_level_files};
 use crate::services::making::{self, LevelSource, Proof};
 use crate::services::panel::rate;
 use crate::services::verify::{self, Solver, Watch};
+use crate::services::wish::Want;
 use arlpcg_core::level::{Game, Level};
 
 mod policies;
@@ -155,15 +156,16 @@ pub fn perform(
             trials,
             profile,
             knobs,
+            want,
         } => {
             let request = LevelRequest::new(seed, None)
                 .goal(goal)
                 .profile(profile)
                 .knobs(knobs);
+            let asked = (ask, keep, want);
             send(Response::Level {
                 id,
-                result: make_level(&shelf[game], game, request, ask, keep, trials, stop)
-                    .map(Arc::new),
+                result: make_level(&shelf[game], game, request, asked, trials, stop).map(Arc::new),
             })
         }
         Effect::Trials {
@@ -248,17 +250,24 @@ pub fn perform(
     }
 }
 
-/// The level `ask` wants: one that meets its success target over `trials` runs, else the
-/// Generator's (or the rules') level at its λ, continuing `keep` where one is given.
+/// The level asked for: one that meets the wish list (its λ searched), else one that meets
+/// the success target over `trials` runs, else the Generator's (or the rules') level at its λ;
+/// continuing the kept prefix where one is given.
 fn make_level(
     policies: &Policies,
     game: Game,
     request: LevelRequest,
-    ask: Ask,
-    keep: Option<KeptPrefix>,
+    (ask, keep, want): (Ask, Option<KeptPrefix>, Option<Want>),
     trials: u32,
     stop: &(dyn Fn() -> bool + Sync),
 ) -> Result<Level, String> {
+    if let Some(want) = want {
+        let mut request = request;
+        if let Some(keep) = keep {
+            request = request.keep(keep);
+        }
+        return wanted_level(policies, game, request, &want, stop);
+    }
     match (ask.success(), ask.aux()) {
         (Some(target), _) => target_level(policies, &request, (target, trials), stop),
         (None, aux) => {
@@ -271,6 +280,49 @@ fn make_level(
             }
             policies.level(game, request)
         }
+    }
+}
+
+/// Runs per candidate of a wish list's search in the designer (`generate --want`'s default).
+const WANT_TRIALS: u32 = 20;
+
+/// A level of `request`'s seed that meets `want` ([`making::wanted`]): played by the Solver
+/// that plays under its profile (else the scripted player), the scripted judges for theirs.
+fn wanted_level(
+    policies: &Policies,
+    game: Game,
+    request: LevelRequest,
+    want: &Want,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Level, String> {
+    let request = request.obstacles(arlpcg_core::game::facts::facts(game).scene_obstacles);
+    let source = policies
+        .generator
+        .as_deref()
+        .map_or(LevelSource::Rules(game), LevelSource::Generator);
+    let solver = match policies.policy_under(request.profile.as_ref()) {
+        Some(policy) => Solver::Policy(policy),
+        None => Solver::Scripted(policies.skill),
+    };
+    let judges: Vec<_> = want
+        .judges()
+        .into_iter()
+        .map(|j| (j, j.player(None)))
+        .collect();
+    let search = making::wanted::Search {
+        want,
+        solver: Some(&solver),
+        judges: &judges,
+        trials: WANT_TRIALS,
+    };
+    let watch = verify::Watch {
+        on_trial: &|_| {},
+        stop,
+    };
+    match making::verified_level(source, &request, &Proof::Wanted(search), &watch, &|_| {}) {
+        Ok(Some(level)) => Ok(level),
+        Ok(None) => Err("stopped".into()),
+        Err(e) => Err(format!("{e:#}")),
     }
 }
 

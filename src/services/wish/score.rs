@@ -30,6 +30,9 @@ pub struct AskEntry {
     /// A sentence in plain words.
     #[serde(default)]
     pub ask: Option<String>,
+    /// The wish list the sentence reads as, where the set says (checked when it is read).
+    #[serde(default)]
+    pub reads_as: Option<String>,
 }
 
 impl AskSet {
@@ -52,13 +55,24 @@ impl AskSet {
             .enumerate()
             .map(|(i, entry)| {
                 let (text, want, sentence) = match (&entry.want, &entry.ask) {
-                    (Some(text), None) => (text.clone(), Want::parse(text), false),
+                    (Some(text), None) if entry.reads_as.is_none() => {
+                        (text.clone(), Want::parse(text), false)
+                    }
                     (None, Some(text)) => {
-                        (text.clone(), words::read(text, game).map(|r| r.want), true)
+                        let want =
+                            words::read(text, game).map(|r| r.want).and_then(|w| {
+                                match &entry.reads_as {
+                                    Some(said) if *said != w.to_string() => Err(format!(
+                                        "`{text}` reads as `{w}`, not as `{said}` (reads_as)"
+                                    )),
+                                    _ => Ok(w),
+                                }
+                            });
+                        (text.clone(), want, true)
                     }
                     _ => (
                         String::new(),
-                        Err("give `want:` or `ask:`, one of them".to_string()),
+                        Err("give `want:` or `ask:` (with `reads_as:`), one of them".to_string()),
                         false,
                     ),
                 };

@@ -144,3 +144,32 @@ fn the_documented_vocabulary_and_examples_are_what_the_reader_reads() {
     }
     assert!(read >= 10, "{read} examples");
 }
+
+/// The shipped ask sets read whole: every wish list parses and fits its game, every sentence
+/// reads as the wish list the set gives for it.
+#[test]
+fn the_shipped_ask_sets_read_as_they_say() {
+    for (game, asks, sentences) in [(Game::Platform, 43, 15), (Game::Racing, 41, 15)] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("results/{game}/wish/asks.yaml"));
+        let set = score::AskSet::load(&path, game).unwrap();
+        assert_eq!(set.len(), asks, "{game}");
+        assert_eq!(
+            set.iter().filter(|(_, _, s)| *s).count(),
+            sentences,
+            "{game}"
+        );
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("asks.yaml");
+    std::fs::write(
+        &file,
+        "asks:\n- ask: a short level\n  reads_as: pieces <= 9\n",
+    )
+    .unwrap();
+    let err = score::AskSet::load(&file, Game::Platform).unwrap_err();
+    assert!(
+        err.contains("asks[0]") && err.contains("reads as `pieces <= 7`"),
+        "{err}"
+    );
+}

@@ -842,6 +842,22 @@ fn a_typed_wish_list_is_searched_for_and_checked_on_screen() {
     h.key(KeyCode::Enter);
     let (said, is_error) = h.app.status.clone().unwrap();
     assert!(is_error && said.contains("`curviness`"), "{said}");
+    // Tab to racing lets go of a wish list racing levels cannot meet (`climb` they have).
+    h.key(KeyCode::Char('W'));
+    for _ in 0..40 {
+        h.key(KeyCode::Backspace);
+    }
+    h.keys("stride >= 0");
+    h.key(KeyCode::Enter);
+    assert!(h.app.want.is_some());
+    h.key(KeyCode::Tab);
+    assert!(h.app.want.is_none());
+    let (said, _) = h.app.status.clone().unwrap();
+    assert!(
+        said.contains("wish list let go") && said.contains("`stride`"),
+        "{said}"
+    );
+    h.key(KeyCode::Tab);
     h.key(KeyCode::Char('W'));
     for _ in 0..40 {
         h.key(KeyCode::Backspace);

@@ -389,6 +389,11 @@ impl App {
         if self.policies().generator.is_none() && self.ask.curve().is_some() {
             self.ask = Ask::Aux(self.aux);
         }
+        // A wish list that speaks of what the other game's levels do not have is let go.
+        if let Some(Err(why)) = self.want.as_ref().map(|w| w.fit(self.game)) {
+            self.want = None;
+            self.complain(format!("wish list let go: {why}"));
+        }
         self.level = None;
         self.trials = None;
         self.sweep = None;

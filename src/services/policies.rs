@@ -436,6 +436,23 @@ pub fn load_judge_under(
     }))
 }
 
+/// Each of `judges` with the policy that plays for it under `profile` ([`load_judge_under`]:
+/// none for the scripted player, whose folder is never read).
+pub fn load_judges_under(
+    dir: impl Fn() -> Result<PathBuf>,
+    game: Game,
+    judges: &[Judge],
+    profile: Option<&Profile>,
+) -> Result<Vec<(Judge, Option<SolverPolicy>)>> {
+    judges
+        .iter()
+        .map(|&judge| match judge {
+            Judge::Scripted(_) => Ok((judge, None)),
+            Judge::Solver(_) => Ok((judge, load_judge_under(&dir()?, game, judge, profile)?)),
+        })
+        .collect()
+}
+
 /// The paths of the Generator and the Solver in a policies folder.
 pub fn policy_paths(dir: &Path) -> (PathBuf, PathBuf) {
     (dir.join(GENERATOR_FILE), dir.join(SOLVER_FILE))

@@ -15,9 +15,9 @@ use crate::services::making::wanted::{Search, Unmet};
 use crate::services::making::{self, LevelSource, Proof};
 use crate::services::panel::Judge;
 use crate::services::policies::{
-    load_folder_solver, load_generator, load_judge_under, policy_paths,
+    load_folder_solver, load_generator, load_judges_under, policy_paths,
 };
-use crate::services::verify::{Solver, SolverPolicy, Watch};
+use crate::services::verify::{Solver, Watch};
 use crate::services::wish::score::{AskSet, Outcome, Score, score};
 use crate::shells::cli::BenchArgs;
 use crate::shells::common::{UsageError, shipped_dir};
@@ -37,14 +37,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let generator = load_generator(&policy_paths(&dir).0, args.game)?.0;
     let solver = load_folder_solver(&dir, args.game, None)?;
     let who = Solver::Policy(&solver);
-    let mut judges: Vec<(Judge, Option<SolverPolicy>)> = Vec::new();
-    for (_, want, _) in &asks {
-        for judge in want.judges() {
-            if !judges.iter().any(|(j, _)| *j == judge) {
-                judges.push((judge, load_judge_under(&dir, args.game, judge, None)?));
-            }
+    let mut asked: Vec<Judge> = Vec::new();
+    for judge in asks.iter().flat_map(|(_, want, _)| want.judges()) {
+        if !asked.contains(&judge) {
+            asked.push(judge);
         }
     }
+    let judges = load_judges_under(|| Ok(dir.clone()), args.game, &asked, None)?;
     let stop = AtomicBool::new(false);
     let jobs: Vec<(usize, u64)> = (0..asks.len())
         .flat_map(|a| (0..u64::from(args.levels)).map(move |seed| (a, seed)))

@@ -328,3 +328,40 @@ impl App {
         }
     }
 }
+
+/// A prompt being typed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PromptKind {
+    /// The seed.
+    Seed,
+    /// Solver trials per level.
+    Trials,
+    /// A policies folder or policy file to load.
+    Policies,
+    /// A target success rate.
+    Target,
+    /// A wish list, or a sentence in plain words.
+    Want,
+    /// An aux curve.
+    Curve,
+    /// A campaign folder to open.
+    Campaign,
+    /// A game profile file to load.
+    Profile,
+}
+
+impl PromptKind {
+    /// What the prompt asks for, in words.
+    pub fn label(self) -> &'static str {
+        match self {
+            PromptKind::Seed => "seed",
+            PromptKind::Trials => "Solver trials per level",
+            PromptKind::Target => "target success rate, 0.05-0.95 (empty: back to the λ slider)",
+            PromptKind::Want => "wish list or plain words, docs/wish.md (empty: none)",
+            PromptKind::Policies => "policies folder, or a Generator/Solver .safetensors file",
+            PromptKind::Curve => "aux curve, fraction:λ, ... (e.g. 0:1, 0.5:1, 0.6:-1, 1:-1)",
+            PromptKind::Campaign => "campaign folder (what `arlpcg campaign` wrote)",
+            PromptKind::Profile => "game profile file (`arlpcg profile init` writes one)",
+        }
+    }
+}

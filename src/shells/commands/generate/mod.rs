@@ -15,8 +15,8 @@ use crate::services::level_files::{Format, LevelFiles, file_stem, render};
 use crate::services::making::{self, LevelSource, Proof, Redraw};
 use crate::services::panel::{Judge, JudgePanel};
 use crate::services::policies::{
-    load_aware_solver, load_folder_solver, load_generator, load_judge_under, load_panel,
-    load_solver, policy_paths,
+    load_aware_solver, load_folder_solver, load_generator, load_judge_under, load_judges_under,
+    load_panel, load_solver, policy_paths,
 };
 use crate::services::profile;
 use crate::services::verify::{self, Solver, SolverPolicy};
@@ -27,6 +27,9 @@ use arlpcg_core::game::Skill;
 use arlpcg_core::game::facts::facts;
 use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::{Game, Level};
+
+mod asking;
+use asking::{knob_suffix, knob_values, want_suffix, wanted};
 
 pub fn run(args: &GenerateArgs) -> Result<()> {
     let seeds = check_arguments(args)?;
@@ -84,7 +87,12 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         &stop,
     )?;
     let judges = match &want {
-        Some(want) => want_judges(args, want, template.profile.as_ref())?,
+        Some(want) => load_judges_under(
+            || policies_dir(args),
+            args.game,
+            &want.judges(),
+            template.profile.as_ref(),
+        )?,
         None => Vec::new(),
     };
     let players: Vec<(Judge, Solver)> = judges
@@ -366,99 +374,11 @@ fn write_batch(
     )
 }
 
-/// The style knobs `--aux` names, in the game's order (0, no preference, where not named), for
-/// a Generator that takes them; an error for a knob the game or the Generator does not have.
-fn knob_values(args: &GenerateArgs, generator: Option<&GeneratorPolicy>) -> Result<Vec<f32>> {
-    let (asked, knobs) = asked_knobs(args);
-    let names: Vec<&str> = knobs.iter().map(|k| k.name).collect();
-    for (name, _) in asked {
-        if !names.contains(&name.as_str()) {
-            return Err(crate::shells::common::UsageError(format!(
-                "--aux {name}: the {} game's knobs are {} (and difficulty, λ)",
-                args.game,
-                names.join(", ")
-            ))
-            .into());
-        }
-    }
-    let takes = generator.map_or(0, |g| g.knobs);
-    if let (Some((name, _)), 0) = (asked.first(), takes) {
-        match generator {
-            None => anyhow::bail!(
-                "--aux {name}: the rules take no knobs (a Generator trained with them does)"
-            ),
-            Some(g) => anyhow::bail!(
-                "--aux {name}: the Generator {} was trained without knobs (its config's generator.rewards.knobs)",
-                g.reference.path
-            ),
-        }
-    }
-    Ok(names
-        .iter()
-        .take(takes)
-        .map(|knob| {
-            asked
-                .iter()
-                .find(|(name, _)| name == knob)
-                .map_or(0.0, |(_, value)| *value as f32)
-        })
-        .collect())
-}
-
 /// Runs per candidate of `--target-success` without `--verify`.
 const TARGET_TRIALS: u32 = 100;
 
 /// Runs per played candidate of a wish list that reads runs, without `--verify`.
 const WANT_TRIALS: u32 = 20;
-
-/// The wish list of --want, --want-file or --ask (said as read, with each word it did not
-/// use), checked against the game's attributes; none without one.
-fn wanted(args: &GenerateArgs) -> Result<Option<Want>> {
-    let usage = |message: String| crate::shells::common::UsageError(message);
-    let want = match (&args.want, &args.want_file, &args.sentence) {
-        (Some(want), _, _) => want.clone(),
-        (None, Some(file), _) => wish::load(file).map_err(usage)?,
-        (None, None, Some(sentence)) => {
-            let reading = wish::words::read(sentence, args.game).map_err(usage)?;
-            crate::warn!("read as: {}", reading.want);
-            if !reading.unknown.is_empty() {
-                crate::warn!(
-                    "not used (not in the vocabulary, docs/wish.md): {}",
-                    reading.unknown.join(", ")
-                );
-            }
-            if !reading.other_game.is_empty() {
-                crate::warn!(
-                    "not used (nothing of {} levels): {}",
-                    args.game,
-                    reading.other_game.join(", ")
-                );
-            }
-            reading.want
-        }
-        (None, None, None) => return Ok(None),
-    };
-    want.fit(args.game).map_err(usage)?;
-    Ok(Some(want))
-}
-
-/// The policy of each judge `want` asks the success of (none for the scripted player).
-fn want_judges(
-    args: &GenerateArgs,
-    want: &Want,
-    profile: Option<&Profile>,
-) -> Result<Vec<(Judge, Option<SolverPolicy>)>> {
-    want.judges()
-        .into_iter()
-        .map(|judge| match judge {
-            Judge::Scripted(_) => Ok((judge, None)),
-            Judge::Solver(_) => Ok((
-                judge,
-                load_judge_under(&policies_dir(args)?, args.game, judge, profile)?,
-            )),
-        })
-        .collect()
-}
 
 /// The level `--keep` names, read and checked, and the pieces to keep of it.
 fn kept_prefix(keep: &KeepArg, game: Game) -> Result<KeptPrefix> {
@@ -494,40 +414,6 @@ fn stem(args: &GenerateArgs, seed: u64) -> String {
         None => String::new(),
     };
     stem_of_lambda(args, seed) + &knob_suffix(args) + &want_suffix(args) + &kept
-}
-
-/// `_want-` and a short hash of the wish list as asked (the file records it).
-fn want_suffix(args: &GenerateArgs) -> String {
-    let asked = match (&args.want, &args.want_file, &args.sentence) {
-        (Some(want), _, _) => want.to_string(),
-        (_, Some(file), _) => file.display().to_string(),
-        (_, _, Some(sentence)) => sentence.clone(),
-        _ => return String::new(),
-    };
-    let hash = arlpcg_core::level::sha256_hex(asked.as_bytes());
-    format!("_want-{}", &hash[..8])
-}
-
-/// The knobs `--aux` names (name, value), and the game's knobs.
-fn asked_knobs(
-    args: &GenerateArgs,
-) -> (
-    &[(String, f64)],
-    &'static [arlpcg_core::game::generator::Knob],
-) {
-    use arlpcg_core::game::generator::GeneratorGame;
-    let asked = args.aux.as_ref().map_or(&[][..], |aux| &aux.knobs[..]);
-    (asked, arlpcg_core::for_game!(args.game, G => G::KNOBS))
-}
-
-/// `_name<value>` for each knob `--aux` names, in the game's order.
-fn knob_suffix(args: &GenerateArgs) -> String {
-    let (asked, knobs) = asked_knobs(args);
-    knobs
-        .iter()
-        .filter_map(|knob| asked.iter().find(|(name, _)| name == knob.name))
-        .map(|(name, value)| format!("_{name}{value:.2}"))
-        .collect()
 }
 
 fn stem_of_lambda(args: &GenerateArgs, seed: u64) -> String {

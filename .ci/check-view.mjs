@@ -1,6 +1,7 @@
 // `arlpcg view` in a real browser (headless Chromium, driven by puppeteer-core): the page draws
-// the level (not a blank canvas) within 2 s of opening, a new level written to the folder it
-// follows changes the picture within 1 s, and the page's console has no errors.
+// the level (not a blank canvas) and its certificate run within 2 s of opening, a new level
+// written to the folder it follows changes the picture within 1 s, and the page's console has
+// no errors.
 // Usage: node .ci/check-view.mjs ARLPCG_BINARY CHROMIUM LEVEL_A LEVEL_B SCREENSHOT_DIR
 import { spawn } from "node:child_process";
 import { copyFileSync, mkdtempSync, mkdirSync } from "node:fs";
@@ -50,6 +51,7 @@ try {
   const first = await page.evaluate(() => ({ ...document.body.dataset }));
   console.log(`first picture after ${Date.now() - opened} ms: ${first.drawn} pixels drawn`);
   await page.screenshot({ path: join(shots, "view-first.png") });
+  if (!(Number(first.trail) > 10)) fail(`the certificate run is not drawn (${first.trail} points)`);
 
   const written = Date.now();
   copyFileSync(levelB, join(folder, "b.yaml"));

@@ -1,19 +1,65 @@
 //! What `arlpcg view` draws: a level's scene (the same boxes, road and markers the glTF export
 //! writes, `crates/core/src/level/scene.rs`) as flat JSON a browser turns into triangles, each
-//! piece tinted toward red by its share of the recorded failures.
+//! piece tinted toward red by its share of the recorded failures, and the certificate's run
+//! (the recorded run that reaches the goal) as a trail over it.
 
 use serde_json::{Value, json};
 
+use crate::services::verify;
 use arlpcg_core::level::Level;
 use arlpcg_core::level::scene::{Material, Scene};
+use arlpcg_core::level::stats::Outcome;
+
+/// The run drawn over a level.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Trail {
+    /// The certificate run, played again.
+    Run {
+        /// The run's seed.
+        seed: u64,
+        /// Where the player was at every step.
+        path: Vec<[f32; 3]>,
+        /// Whether it reached the goal again.
+        succeeded: bool,
+    },
+    /// No trail, and why (an unplayed level, no certificate, its Solver's file missing).
+    None(String),
+}
+
+impl Trail {
+    /// The certificate run of `level`, played again with the Solver that recorded it
+    /// ([`verify::certificate_run`]).
+    pub fn of_certificate(level: &Level) -> Trail {
+        match verify::certificate_run(level) {
+            Ok((seed, run)) => Trail::Run {
+                seed,
+                succeeded: run.result.outcome == Outcome::Success,
+                path: run.path,
+            },
+            Err(why) => Trail::None(format!("{why:#}")),
+        }
+    }
+
+    fn json(&self) -> Value {
+        match self {
+            Trail::Run {
+                seed,
+                path,
+                succeeded,
+            } => json!({"seed": seed, "succeeded": succeeded, "points": path.concat()}),
+            Trail::None(why) => json!({"none": why}),
+        }
+    }
+}
 
 /// The colour a piece that holds every recorded failure is tinted to.
 const FAILURE_RED: [f32; 4] = [0.9, 0.12, 0.1, 1.0];
 
 /// The scene of `level` as the view page reads it: `boxes` (centre, heading in degrees,
 /// extents, colour), `meshes` (world positions, normals and triangle indices, colour),
-/// `points` (spawn, finish) and a `title`. Pure: the same level gives the same bytes.
-pub fn scene_json(level: &Level, title: &str) -> Value {
+/// `points` (spawn, finish), the `trail` (flat world positions, or why there is none) and a
+/// `title`. Pure: the same level and trail give the same bytes.
+pub fn scene_json(level: &Level, title: &str, trail: &Trail) -> Value {
     let scene = Scene::of_level(level);
     let failures = failure_shares(level);
     let colour = |name: &str, material: Material| {
@@ -63,6 +109,7 @@ pub fn scene_json(level: &Level, title: &str) -> Value {
         "boxes": boxes,
         "meshes": meshes,
         "points": points,
+        "trail": trail.json(),
     })
 }
 
@@ -106,6 +153,10 @@ mod tests {
         yaml::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).unwrap()
     }
 
+    fn none() -> Trail {
+        Trail::None("not played".into())
+    }
+
     fn names<'a>(scene: &'a Value, part: &str) -> Vec<&'a str> {
         scene[part]
             .as_array()
@@ -120,7 +171,7 @@ mod tests {
         let mut level = shipped("levels/platform/platform_seed7_aux-1.00.yaml");
         let failures = level.stats.as_ref().unwrap().failures_by_piece.clone();
         let blocks = level.piece_count();
-        let scene = scene_json(&level, "a level");
+        let scene = scene_json(&level, "a level", &none());
         let boxes = names(&scene, "boxes");
         assert!(boxes.contains(&"start_block"), "{boxes:?}");
         assert_eq!(
@@ -128,7 +179,7 @@ mod tests {
             blocks
         );
         assert_eq!(names(&scene, "points"), ["spawn", "finish", "finish_zone"]);
-        assert_eq!(scene, scene_json(&level, "a level"), "pure");
+        assert_eq!(scene, scene_json(&level, "a level", &none()), "pure");
 
         let rgba = |scene: &Value, name: &str| {
             let boxes = scene["boxes"].as_array().unwrap();
@@ -139,7 +190,7 @@ mod tests {
             .position(|&n| n == *failures.iter().max().unwrap())
             .unwrap();
         level.stats = None;
-        let unplayed = scene_json(&level, "a level");
+        let unplayed = scene_json(&level, "a level", &none());
         let block = format!("block_{most:03}");
         assert_ne!(
             rgba(&scene, &block),
@@ -151,6 +202,7 @@ mod tests {
         let track = scene_json(
             &shipped("levels/racing/racing_seed7_aux+0.00.yaml"),
             "a track",
+            &none(),
         );
         let meshes = track["meshes"].as_array().unwrap();
         assert!(names(&track, "meshes").contains(&"segment_000"));
@@ -163,5 +215,45 @@ mod tests {
                 .iter()
                 .all(|i| (i.as_u64().unwrap() as usize) < vertices)
         );
+    }
+
+    /// The certificate run is played again with the Solver that recorded it: its trail leaves
+    /// the spawn and ends at the finish; a level with no certificate says why it has none.
+    #[test]
+    fn the_certificate_run_is_drawn_as_a_trail_from_spawn_to_finish() {
+        // The shipped level names its Solver by a path from the repository's root, where
+        // cargo runs the tests.
+        let level = shipped("levels/platform/platform_seed7_aux-1.00.yaml");
+        let trail = Trail::of_certificate(&level);
+        let Trail::Run {
+            seed,
+            path,
+            succeeded,
+        } = &trail
+        else {
+            panic!("{trail:?}");
+        };
+        assert_eq!(Some(*seed), level.stats.as_ref().unwrap().certificate);
+        assert!(*succeeded && path.len() > 10, "{} steps", path.len());
+        let scene = scene_json(&level, "a level", &trail);
+        let point = |name: &str| {
+            let points = scene["points"].as_array().unwrap();
+            let p = &points.iter().find(|p| p["name"] == name).unwrap()["position"];
+            [0, 1, 2].map(|k| p[k].as_f64().unwrap() as f32)
+        };
+        let far = |a: [f32; 3], b: [f32; 3]| ((a[0] - b[0]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+        assert!(far(path[0], point("spawn")) < 1.0, "{:?}", path[0]);
+        assert!(far(*path.last().unwrap(), point("finish")) < 4.0);
+        let flat = scene["trail"]["points"].as_array().unwrap();
+        assert_eq!(flat.len(), 3 * path.len());
+
+        let mut unplayed = level.clone();
+        unplayed.stats = None;
+        let Trail::None(why) = Trail::of_certificate(&unplayed) else {
+            panic!("no statistics, no run");
+        };
+        assert!(why.contains("no statistics"), "{why}");
+        let scene = scene_json(&unplayed, "a level", &Trail::None(why.clone()));
+        assert_eq!(scene["trail"]["none"], why.as_str());
     }
 }

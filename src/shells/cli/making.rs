@@ -225,7 +225,9 @@ pub struct ExportArgs {
     arlpcg view levels            # the newest level the designer or generate writes there\n  \
     arlpcg view my-levels --port 8080\n\n\
     In the page: drag to orbit, the wheel to zoom, f to look from the start toward the goal. \
-    Pieces are tinted red by their share of the failures the level's statistics record.")]
+    Pieces are tinted red by their share of the failures the level's statistics record; the \
+    certificate's run (the recorded run that reaches the goal) is drawn in blue, played again \
+    with the Solver its statistics name.")]
 pub struct ViewArgs {
     /// A level file (.yaml), or a folder: the page shows its newest level file and follows it.
     pub level: PathBuf,

@@ -6,7 +6,7 @@ use std::time::SystemTime;
 
 use anyhow::{Context, Result};
 
-use crate::services::view::scene_json;
+use crate::services::view::{Trail, scene_json};
 use crate::shells::cli::ViewArgs;
 use crate::shells::view::{self, Shown};
 use arlpcg_core::level::yaml;
@@ -93,6 +93,9 @@ impl Shown for ShownFile {
             || path.display().to_string(),
             |n| n.to_string_lossy().into_owned(),
         );
-        Ok((version, scene_json(&level, &title)))
+        Ok((
+            version,
+            scene_json(&level, &title, &Trail::of_certificate(&level)),
+        ))
     }
 }

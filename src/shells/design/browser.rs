@@ -6,7 +6,7 @@ use std::process::{Command, Stdio};
 use std::sync::Arc;
 
 use super::app::App;
-use crate::services::view::scene_json;
+use crate::services::view::{Trail, scene_json};
 use crate::shells::view::LiveView;
 
 /// The view once opened, and which state of the level it shows.
@@ -76,7 +76,12 @@ fn key(app: &App) -> Option<(usize, bool)> {
 
 fn scene(app: &App) -> Option<serde_json::Value> {
     let level = app.level_with_stats()?;
-    Some(scene_json(&level, &format!("{}.yaml", app.export_stem())))
+    let trail = Trail::of_certificate(&level);
+    Some(scene_json(
+        &level,
+        &format!("{}.yaml", app.export_stem()),
+        &trail,
+    ))
 }
 
 /// Asks the system to open `url` in the default browser, with nothing printed on the

@@ -7,22 +7,22 @@ use std::collections::hash_map::Entry;
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde_json::json;
 
 use super::campaign::report_checks;
 use crate::services::panel::{JudgePanel, rate};
-use crate::services::policies::{load_panel, load_solver};
+use crate::services::policies::load_panel;
 use crate::services::profile;
 use crate::services::verify::{
-    FailureConcentration, HalfwaySplit, Solver, Summary, Watch, passed_by_piece, verify,
+    FailureConcentration, HalfwaySplit, Summary, Watch, passed_by_piece, verify,
 };
 use crate::services::wish::{Evidence, Reads, failures};
 use crate::shells::cli::{Judges, VerifyArgs};
 use crate::shells::common::{panel_fit, shipped_dir};
 use arlpcg_core::game::facts::facts;
 use arlpcg_core::level::profile::Profile;
-use arlpcg_core::level::stats::{Outcome, PanelStats, SolverRef, SolverStats};
+use arlpcg_core::level::stats::{Outcome, PanelStats, SolverStats};
 use arlpcg_core::level::yaml;
 use arlpcg_core::level::{Game, Level};
 use players::Solvers;
@@ -250,39 +250,17 @@ fn replay(args: &VerifyArgs) -> Result<()> {
 }
 
 fn replay_one(level: &arlpcg_core::level::Level) -> Result<String> {
-    let stats = level
-        .stats
-        .as_ref()
-        .context("no statistics: verify the level first (generate --verify N)")?;
-    let seed = stats
-        .certificate
-        .context("its statistics record no certificate (no successful run was found)")?;
-    let loaded;
-    let solver = match &stats.solver {
-        SolverRef::Scripted { skill } => Solver::Scripted(*skill),
-        SolverRef::Random => Solver::Random,
-        SolverRef::Policy { policy } => {
-            loaded = load_solver(Path::new(&policy.path), level.game())?.0;
-            if loaded.reference.sha256 != policy.sha256 {
-                anyhow::bail!(
-                    "{} is not the policy that recorded the certificate (its SHA-256 differs)",
-                    policy.path
-                );
-            }
-            Solver::Policy(&loaded)
-        }
-    };
-    let run = crate::services::verify::record(level, &solver, seed)?;
+    let (seed, run) = crate::services::verify::certificate_run(level)?;
+    let solver = level.stats.as_ref().map(|s| s.solver.describe());
+    let solver = solver.unwrap_or_default();
     if run.result.outcome != Outcome::Success {
         anyhow::bail!(
-            "the certificate run (seed {seed}) did not succeed with the {}: it {}",
-            stats.solver.describe(),
+            "the certificate run (seed {seed}) did not succeed with the {solver}: it {}",
             run.result.outcome.describe()
         );
     }
     Ok(format!(
-        "the certificate run (seed {seed}) succeeds again with the {} in {} decisions",
-        stats.solver.describe(),
+        "the certificate run (seed {seed}) succeeds again with the {solver} in {} decisions",
         run.result.steps
     ))
 }

@@ -159,6 +159,16 @@ pub(in crate::services::train) fn check_config(
         return Err("ability_spread must be a share within [0, 0.5] (0.2: ±20%)".into());
     }
     config.trained_over(game)?;
+    let finish = &config.generator.finish;
+    if finish.by_ability_half
+        && finish.solver_steps > 0
+        && (!config.ability_aware() || finish.generator_until_hard_success.is_none())
+    {
+        return Err("generator.finish.by_ability_half counts the stop of \
+             generator_until_hard_success in the halves of the ability ranges: give both \
+             ability_ranges (or ability_spread) and generator_until_hard_success"
+            .into());
+    }
     if let Some(record) = &config.profile {
         record
             .profile(game)

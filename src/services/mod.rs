@@ -2,6 +2,7 @@
 //! files it is told to read or write.
 
 pub mod campaign;
+pub mod certificate;
 pub mod chart;
 pub mod difficulty;
 pub mod eval;

@@ -5,7 +5,7 @@
 
 use serde_json::{Value, json};
 
-use crate::services::verify;
+use crate::services::certificate;
 use arlpcg_core::level::Level;
 use arlpcg_core::level::scene::{Material, Scene};
 use arlpcg_core::level::stats::Outcome;
@@ -28,9 +28,9 @@ pub enum Trail {
 
 impl Trail {
     /// The certificate run of `level`, played again with the Solver that recorded it
-    /// ([`verify::certificate_run`]).
+    /// ([`certificate::run`]).
     pub fn of_certificate(level: &Level) -> Trail {
-        match verify::certificate_run(level) {
+        match certificate::run(level) {
             Ok((seed, run)) => Trail::Run {
                 seed,
                 succeeded: run.result.outcome == Outcome::Success,

@@ -260,38 +260,6 @@ pub fn certify(
     Ok(None)
 }
 
-/// The certificate run `level`'s statistics record, played again with the Solver that recorded
-/// it (its policy file checked by SHA-256): its seed and the run. `Err` says why it cannot be
-/// (no statistics, no certificate, the policy missing or changed); whether the run succeeds
-/// again is the caller's to read.
-pub fn certificate_run(level: &Level) -> anyhow::Result<(u64, Recording)> {
-    use anyhow::Context;
-    let stats = level
-        .stats
-        .as_ref()
-        .context("no statistics: verify the level first (generate --verify N)")?;
-    let seed = stats
-        .certificate
-        .context("its statistics record no certificate (no successful run was found)")?;
-    let loaded;
-    let solver = match &stats.solver {
-        SolverRef::Scripted { skill } => Solver::Scripted(*skill),
-        SolverRef::Random => Solver::Random,
-        SolverRef::Policy { policy } => {
-            let path = std::path::Path::new(&policy.path);
-            loaded = crate::services::policies::load_solver(path, level.game())?.0;
-            if loaded.reference.sha256 != policy.sha256 {
-                anyhow::bail!(
-                    "{} is not the policy that recorded the certificate (its SHA-256 differs)",
-                    policy.path
-                );
-            }
-            Solver::Policy(&loaded)
-        }
-    };
-    Ok((seed, record(level, &solver, seed)?))
-}
-
 /// `level` with a certificate in its statistics: single runs from the trials' seeds on, so a
 /// level some trial completed is certified within a few runs unless its success ratio is tiny.
 pub fn certified(mut level: Level, solver: &Solver, seed: u64) -> Result<Level, WrongGame> {

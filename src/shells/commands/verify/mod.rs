@@ -250,7 +250,7 @@ fn replay(args: &VerifyArgs) -> Result<()> {
 }
 
 fn replay_one(level: &arlpcg_core::level::Level) -> Result<String> {
-    let (seed, run) = crate::services::verify::certificate_run(level)?;
+    let (seed, run) = crate::services::certificate::run(level)?;
     let solver = level.stats.as_ref().map(|s| s.solver.describe());
     let solver = solver.unwrap_or_default();
     if run.result.outcome != Outcome::Success {

@@ -58,6 +58,7 @@ generator:
   solver_warmup_steps: 128
   solver_phase_steps: 128
   generator_phase_steps: 8
+  own_check: {levels: 1, trials: 2}
   finish:
     solver_steps: 128
     generator_phase_steps: 8

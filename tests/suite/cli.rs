@@ -1290,16 +1290,31 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
     // Five characters (jumps 8-9.5 m/s, ours otherwise): each one's reach is measured once.
     let config = path("aware.yaml");
     std::fs::write(&config, FIVE_JUMPERS).unwrap();
-    arlpcg_ok(words(
+    let trained = arlpcg_ok(words(
         "train --mode arlpcg --config {} --steps 8192 --threads 1 --out {}",
         &[&config, &run],
     ));
-    // Both agents observe the abilities, and their cards say over which ranges.
+    // The finished pair checks its own knob (2 levels × 2 runs at each end here), says how it
+    // fared on its last line...
+    let said = String::from_utf8_lossy(&trained.stdout);
+    assert!(
+        said.contains("own check (2 levels × 2 runs at each end): its Solver succeeds")
+            && said.contains("bars: ≥ 0.95, ≤ 0.7, ≥ 0.95"),
+        "{said}"
+    );
+    // ...and both agents observe the abilities; their cards say over which ranges, and carry
+    // the check's figures.
     for card in ["solver.yaml", "generator.yaml"] {
         let card = std::fs::read_to_string(dir.path().join("run").join(card)).unwrap();
         assert!(
             card.contains("- - abilities\n  - 3")
                 && card.contains("character.jump_speed:\n  - 8.0\n  - 9.5"),
+            "{card}"
+        );
+        assert!(
+            card.contains("own_success_at_+1:")
+                && card.contains("own_success_at_-1:")
+                && card.contains("own_completed_least:"),
             "{card}"
         );
     }

@@ -535,6 +535,7 @@ generator:
   generator_phase_steps: 16
   population: 2
   population_every_steps: 256
+  own_check: {levels: 1, trials: 2}
   stages:
   - from_steps: 768
     solver_learning_rate: 0.0

@@ -13,6 +13,7 @@ use super::metrics::{
     check_metrics_header, generator_metrics_header, generator_row, open_append, scripted_columns,
     time_columns, truncate_metrics, update_columns,
 };
+use super::own_check;
 use super::population::{PopulationRecord, Snapshot, population_from, population_record};
 use super::solver_run::SolverRun;
 use super::{CHECKPOINT, ConfigChange, GENERATOR_CHECKPOINT, GENERATOR_METRICS, Training};
@@ -192,6 +193,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         card.training.population = envs.population.iter().map(|s| s.solver_steps).collect();
         record_commands(&mut card, &self.solver.commands, &self.solver.commit);
         self.solver.record_time(&mut card);
+        card.results = self.solver.results.clone();
         card
     }
 
@@ -449,5 +451,26 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
 
     fn out(&self) -> &Path {
         &self.solver.out
+    }
+
+    fn check_own_control(&mut self, wall: f64, starting: &dyn Fn()) -> Result<Option<String>> {
+        let config = &self.solver.config;
+        let profile = config
+            .profile
+            .as_ref()
+            .map(|record| record.profile(G::GAME))
+            .transpose()
+            .map_err(|problem| anyhow::anyhow!("the run's profile: {problem}"))?;
+        let check = config.generator.own_check;
+        let out = self.solver.out.clone();
+        if check.levels > 0 && check.trials > 0 {
+            starting();
+        }
+        let Some(control) = own_check::own_control(&out, G::GAME, profile.as_ref(), check)? else {
+            return Ok(None);
+        };
+        self.solver.results = control.results();
+        self.save_policies(wall)?;
+        Ok(Some(control.describe()))
     }
 }

@@ -17,6 +17,7 @@ pub mod arlpcg;
 mod cards;
 mod config;
 mod metrics;
+pub mod own_check;
 pub mod population;
 mod recipe;
 pub mod solver_envs;
@@ -303,4 +304,11 @@ pub trait Training {
     fn save_policies(&self, wall: f64) -> Result<()>;
     /// The run's folder.
     fn out(&self) -> &Path;
+    /// For a finished run with a Generator: plays its own check ([`own_check`]; `starting`
+    /// hears when it begins), writes the figures into its cards' `results` (the policies
+    /// again, `wall` as in [`Training::save_policies`]) and returns them in words; none for a
+    /// run without a Generator or a check of 0 levels.
+    fn check_own_control(&mut self, _wall: f64, _starting: &dyn Fn()) -> Result<Option<String>> {
+        Ok(None)
+    }
 }

@@ -67,6 +67,9 @@ pub(super) struct SolverRun<E: Resumable> {
     pub(super) time: TimeSplit,
     /// This session's matrix-product peak in FLOP/s ([`Training::set_matmul_peak`]; 0: none).
     pub(super) matmul_peak: f64,
+    /// What the finished run measured of itself, for its cards' `results`
+    /// ([`Training::check_own_control`]).
+    pub(super) results: std::collections::HashMap<String, f64>,
 }
 
 impl<E: Resumable> SolverRun<E> {
@@ -103,6 +106,7 @@ impl<E: Resumable> SolverRun<E> {
             commit: String::new(),
             time: TimeSplit::default(),
             matmul_peak: 0.0,
+            results: Default::default(),
         })
     }
 
@@ -188,6 +192,7 @@ impl<E: Resumable> SolverRun<E> {
             commit: loaded.card.training.commit.clone(),
             time: state.time_split,
             matmul_peak: 0.0,
+            results: Default::default(),
         })
     }
 
@@ -229,6 +234,7 @@ impl<E: Resumable> SolverRun<E> {
         );
         record_commands(&mut card, &self.commands, &self.commit);
         self.record_time(&mut card);
+        card.results = self.results.clone();
         card
     }
 

@@ -188,8 +188,15 @@ fn train_loop(
     }
     if run.solver_steps() < run.budget() {
         crate::say!("paused {summary} (--resume goes on)");
-    } else {
-        crate::say!("finished {summary}");
+        return Ok(());
+    }
+    // A finished run with a Generator checks its own knob; its cards carry the figures.
+    let starting = || {
+        crate::say!("checking the finished pair's knob (its own Solver on its λ = ±1 levels)...")
+    };
+    match run.check_own_control(wall, &starting)? {
+        Some(control) => crate::say!("finished {summary}; {control}"),
+        None => crate::say!("finished {summary}"),
     }
     Ok(())
 }

@@ -12,6 +12,8 @@ pub const FIVE_JUMPERS: &str = "ability_ranges:
   character.jump_speed: [8.0, 9.5]
   character.run_speed: [8.0, 8.0]
   character.gravity: [20.0, 20.0]
+generator:
+  own_check: {levels: 2, trials: 2}
 ";
 
 /// Runs the `arlpcg` binary with `args` and waits for it.

@@ -17,6 +17,8 @@ const MAX_POPULATION: usize = 16;
 const MAX_PHASE_STEPS: u64 = 1_000_000_000_000;
 /// Hard matches in a finish's block (a Generator phase plays a few hundred a minute).
 const MAX_HARD_MATCH_BLOCK: u32 = 100_000;
+/// The most levels, and runs per level, a finished run's own check plays at each end of λ.
+const MAX_OWN_CHECK: u32 = 1000;
 /// The most retries a Solver gets on one piece of a match.
 const MAX_RETRIES: u32 = 10;
 
@@ -159,6 +161,12 @@ pub(in crate::services::train) fn check_config(
         return Err("ability_spread must be a share within [0, 0.5] (0.2: ±20%)".into());
     }
     config.trained_over(game)?;
+    let own = config.generator.own_check;
+    if own.levels > MAX_OWN_CHECK || own.trials > MAX_OWN_CHECK {
+        return Err(format!(
+            "generator.own_check: levels and trials must be within [0, {MAX_OWN_CHECK}]"
+        ));
+    }
     let finish = &config.generator.finish;
     if finish.by_ability_half
         && finish.solver_steps > 0

@@ -141,6 +141,31 @@ pub struct GeneratorConfig {
     /// After the Solver's budget, the Generator's finish against the Solver frozen and alone.
     #[serde(default)]
     pub finish: Finish,
+    /// The check a finished run makes of its own knob ([`OwnCheck`]).
+    #[serde(default)]
+    pub own_check: OwnCheck,
+}
+
+/// What a finished adversarial run plays to say whether its knob works: `levels` of its
+/// Generator's levels at λ = +1 and at λ = -1, each played `trials` times by its own Solver
+/// (`services/train/own_check.rs`); 0 of either: no check. A file may give one field only.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OwnCheck {
+    /// Levels at each end of λ.
+    pub levels: u32,
+    /// Runs per level.
+    pub trials: u32,
+}
+
+impl Default for OwnCheck {
+    /// 20 levels × 20 runs at each end: a few seconds to a minute on two cores.
+    fn default() -> Self {
+        Self {
+            levels: 20,
+            trials: 20,
+        }
+    }
 }
 
 /// The last stretch of an adversarial run, after the Solver's `steps`: the Generator learns
@@ -379,6 +404,7 @@ impl Default for GeneratorConfig {
             paced_share: 0.0,
             stages: Vec::new(),
             finish: PLATFORM_FINISH,
+            own_check: OwnCheck::default(),
         }
     }
 }

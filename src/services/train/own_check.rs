@@ -1,0 +1,152 @@
+//! The check a finished adversarial run makes of its own knob: its Generator's levels at
+//! λ = +1 and at λ = -1, played by its own Solver. A knob that works leaves easy levels easy
+//! (success at least [`EASY_BAR`]), makes hard ones hard (at most [`HARD_BAR`]) and builds no
+//! level that none of the runs completes (at least [`COMPLETED_BAR`] of them completed at each
+//! end); a run that misses any says so on its cards (`results`) and in `train`'s last line, so that a seed
+//! whose Generator never learned to make hard levels does not pass for a pair.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use anyhow::Result;
+
+use super::config::OwnCheck;
+use crate::services::eval::generator_levels;
+use crate::services::policies::{load_generator, load_solver};
+use crate::services::verify::{self, Solver};
+use arlpcg_core::level::Game;
+use arlpcg_core::level::profile::Profile;
+use arlpcg_core::seed_ranges::EVAL_SEED_BASE;
+
+/// Own success at λ = +1 at or above this: easy levels stay easy.
+pub const EASY_BAR: f64 = 0.95;
+/// Own success at λ = -1 at or below this: hard levels are hard.
+pub const HARD_BAR: f64 = 0.70;
+/// The share of levels that some run completes, at each end, at or above this: hard, not
+/// impossible.
+pub const COMPLETED_BAR: f64 = 0.95;
+
+/// What the check measured.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OwnControl {
+    /// Mean success of the run's Solver on its Generator's λ = +1 levels...
+    pub easy: f64,
+    /// ...and on its λ = -1 levels.
+    pub hard: f64,
+    /// The smaller of the two ends' shares of levels that at least one run completed.
+    pub completed: f64,
+    /// What was played.
+    pub check: OwnCheck,
+}
+
+impl OwnControl {
+    /// Whether the knob works by both bars.
+    pub fn meets(&self) -> bool {
+        self.easy >= EASY_BAR && self.hard <= HARD_BAR && self.completed >= COMPLETED_BAR
+    }
+
+    /// The figures as a card's `results`.
+    pub fn results(&self) -> HashMap<String, f64> {
+        HashMap::from([
+            ("own_success_at_+1".to_string(), round3(self.easy)),
+            ("own_success_at_-1".to_string(), round3(self.hard)),
+            ("own_completed_least".to_string(), round3(self.completed)),
+        ])
+    }
+
+    /// In words, with the verdict.
+    pub fn describe(&self) -> String {
+        let verdict = if self.meets() {
+            "its knob works"
+        } else {
+            "its knob does NOT work"
+        };
+        format!(
+            "own check ({} levels × {} runs at each end): its Solver succeeds {:.3} at λ = +1 \
+             and {:.3} at λ = -1, and completes at least {:.3} of the levels at each end: \
+             {verdict} (bars: ≥ {EASY_BAR}, ≤ {HARD_BAR}, ≥ {COMPLETED_BAR})",
+            self.check.levels, self.check.trials, self.easy, self.hard, self.completed
+        )
+    }
+}
+
+fn round3(x: f64) -> f64 {
+    (x * 1000.0).round() / 1000.0
+}
+
+/// Plays the check on the policies of the run folder `out` (its `generator.safetensors` and
+/// `solver.safetensors`), for `profile` (the run's own; none: ours). None when `check` plays
+/// nothing. Seeded: the same policies give the same figures on any number of threads.
+pub fn own_control(
+    out: &Path,
+    game: Game,
+    profile: Option<&Profile>,
+    check: OwnCheck,
+) -> Result<Option<OwnControl>> {
+    if check.levels == 0 || check.trials == 0 {
+        return Ok(None);
+    }
+    let (generator, _) = load_generator(&out.join("generator.safetensors"), game)?;
+    let (solver, _) = load_solver(&out.join("solver.safetensors"), game)?;
+    let solver = Solver::Policy(&solver);
+    // The mean success and the share of levels some run completed.
+    let play = |aux: f64| -> Result<(f64, f64)> {
+        let levels = generator_levels(&generator, aux, EVAL_SEED_BASE, check.levels, profile)?;
+        let (mut total, mut completed) = (0.0, 0);
+        for level in &levels {
+            let seed = level.seed.unwrap_or(EVAL_SEED_BASE);
+            let stats = verify::verify(level, &solver, check.trials, seed, &|| {})?;
+            total += stats.success_ratio;
+            completed += usize::from(stats.successes > 0);
+        }
+        // A seed the Generator could not build counts as neither easy nor hard.
+        let built = levels.len().max(1) as f64;
+        Ok((total / built, completed as f64 / built))
+    };
+    let (easy, easy_completed) = play(1.0)?;
+    let (hard, hard_completed) = play(-1.0)?;
+    Ok(Some(OwnControl {
+        easy,
+        hard,
+        completed: easy_completed.min(hard_completed),
+        check,
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn control(easy: f64, hard: f64, completed: f64) -> OwnControl {
+        let check = OwnCheck {
+            levels: 20,
+            trials: 20,
+        };
+        OwnControl {
+            easy,
+            hard,
+            completed,
+            check,
+        }
+    }
+
+    #[test]
+    fn a_knob_works_only_when_easy_is_easy_hard_is_hard_and_hard_is_not_impossible() {
+        assert!(control(0.97, 0.55, 1.0).meets());
+        assert!(!control(0.90, 0.55, 1.0).meets(), "easy levels too hard");
+        assert!(!control(0.97, 0.82, 1.0).meets(), "hard levels too easy");
+        assert!(
+            !control(0.98, 0.30, 0.40).meets(),
+            "hard by being impossible"
+        );
+        let said = control(0.98, 0.30, 0.40).describe();
+        assert!(
+            said.contains("0.300 at λ = -1") && said.contains("does NOT work"),
+            "{said}"
+        );
+        assert_eq!(
+            control(0.9876, 0.5, 1.0).results()["own_success_at_+1"],
+            0.988
+        );
+    }
+}

@@ -382,15 +382,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
                     self.generator_iteration(lr_scale, schedule.generator_entropy, wall)?;
                 let envs = self.envs();
                 // In the finish, the phase may end early once the Solver fails enough.
-                let mut message = message;
                 let hard_enough = match finish.generator_until_hard_success {
-                    Some(target) if in_finish && finish.by_ability_half => {
-                        let halves = envs.rules.trained_over.map_or(0, |r| r.halved());
-                        let block = finish.hard_match_block;
-                        let met = envs.state.count_hard_halves(&stats, block, target);
-                        message += &format!(", ability halves hard {met}/{halves}");
-                        met == halves
-                    }
                     Some(target) if in_finish => envs
                         .count_hard_block(&stats, finish.hard_match_block)
                         .is_some_and(|s| s <= target),

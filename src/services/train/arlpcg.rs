@@ -31,7 +31,7 @@ use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, GeneratorRewards, Match, MatchPacing, TrackBuild,
 };
 use arlpcg_core::game::{Scripted, SolverEnv, observe_solver};
-use arlpcg_core::level::profile::{AbilityRanges, MAIN_ABILITIES, ability_columns};
+use arlpcg_core::level::profile::{AbilityRanges, ability_columns};
 use arlpcg_core::level::stats::{Outcome, Skill};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::ActMode;
@@ -75,35 +75,6 @@ pub struct AdversarialState {
     /// ...and the Solver steps where the catch-up ended the finish (none: it has not).
     #[serde(default)]
     pub finish_ended_at: Option<u64>,
-    /// With `Finish::by_ability_half`: the block being counted for each main ability's lower
-    /// and upper half ([successes, finished hard matches])...
-    #[serde(default)]
-    pub half_blocks: [[[u32; 2]; 2]; MAIN_ABILITIES],
-    /// ...and whether each half's latest block fell to the target.
-    #[serde(default)]
-    pub halves_met: [[bool; 2]; MAIN_ABILITIES],
-}
-
-impl AdversarialState {
-    /// Adds the hard matches of `stats` to each ability half's block
-    /// (`Finish::by_ability_half`); a half whose block holds `block_size` matches records
-    /// whether the Solver's success over it was at most `target`, and begins a new block.
-    /// Returns how many halves are met now.
-    pub fn count_hard_halves(&mut self, stats: &MatchStats, block_size: u32, target: f64) -> usize {
-        for (ability, halves) in stats.hard_by_half.iter().enumerate() {
-            for (half, [successes, finished]) in halves.iter().enumerate() {
-                let block = &mut self.half_blocks[ability][half];
-                block[0] += successes;
-                block[1] += finished;
-                if block[1] >= block_size {
-                    let ratio = f64::from(block[0]) / f64::from(block[1]);
-                    self.halves_met[ability][half] = ratio <= target;
-                    *block = [0, 0];
-                }
-            }
-        }
-        self.halves_met.iter().flatten().filter(|met| **met).count()
-    }
 }
 
 impl Default for AdversarialState {
@@ -115,8 +86,6 @@ impl Default for AdversarialState {
             generator_steps: 0,
             hard_block: [0, 0],
             finish_ended_at: None,
-            half_blocks: Default::default(),
-            halves_met: Default::default(),
         }
     }
 }
@@ -197,10 +166,6 @@ pub struct MatchStats {
     /// [easy, hard]: the scripted opponent's successes.
     #[serde(default)]
     pub scripted_successes: [u32; 2],
-    /// In a run over ability ranges: the Solver's hard matches by each main ability's half of
-    /// its range ([`AbilityRanges::halves`]), [successes, finished].
-    #[serde(default)]
-    pub hard_by_half: [[[u32; 2]; 2]; MAIN_ABILITIES],
 }
 
 /// Many matches of the Generator against the Solver, as the Solver's environments.
@@ -314,8 +279,6 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         self.state.phase = phase;
         self.state.phase_steps = 0;
         self.state.hard_block = [0, 0];
-        self.state.half_blocks = Default::default();
-        self.state.halves_met = Default::default();
         for recorded in &mut self.recorded {
             recorded.clear();
         }
@@ -462,19 +425,6 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
                     stats.feature_sums[side][1] += features[1];
                 }
                 stats.air_steps[side] += u64::from(G::air_steps(game.env()));
-                if let (true, Some(ranges), Some(abilities)) = (
-                    side == 1,
-                    &self.rules.trained_over,
-                    game.build().player().abilities,
-                ) {
-                    for (ability, half) in ranges.halves(&abilities).into_iter().enumerate() {
-                        if let Some(half) = half {
-                            let count = &mut stats.hard_by_half[ability][half];
-                            count[0] += u32::from(outcome == Outcome::Success);
-                            count[1] += 1;
-                        }
-                    }
-                }
             }
             Some(_) => {}
         }
@@ -605,37 +555,5 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
         InnerTime {
             generator_s: clock() - generator_start,
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Each half keeps its own block: a half is met once its block of hard matches has the
-    /// Solver at or under the target, and stays as its latest block left it.
-    #[test]
-    fn each_ability_half_counts_its_own_block_of_hard_matches() {
-        let mut state = AdversarialState::default();
-        let mut stats = MatchStats::default();
-        // Jump's lower half: 1 success in 4 (met at 0.4); its upper half: 3 in 4 (not met);
-        // run's lower half: 1 in 3 (block not yet full).
-        stats.hard_by_half[0] = [[1, 4], [3, 4]];
-        stats.hard_by_half[1][0] = [1, 3];
-        assert_eq!(state.count_hard_halves(&stats, 4, 0.4), 1);
-        assert_eq!(state.halves_met[0], [true, false]);
-        assert_eq!(state.half_blocks[1][0], [1, 3], "counted on");
-        // The next block: jump's upper half now fails enough, its lower half no longer does.
-        let mut next = MatchStats::default();
-        next.hard_by_half[0] = [[4, 4], [0, 4]];
-        next.hard_by_half[1][0] = [0, 1];
-        assert_eq!(state.count_hard_halves(&next, 4, 0.4), 2);
-        assert_eq!(state.halves_met[0], [false, true]);
-        assert_eq!(
-            state.halves_met[1],
-            [true, false],
-            "1 in 4 over two batches"
-        );
-        assert_eq!(state.half_blocks, AdversarialState::default().half_blocks);
     }
 }

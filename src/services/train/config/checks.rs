@@ -167,16 +167,6 @@ pub(in crate::services::train) fn check_config(
             "generator.own_check: levels and trials must be within [0, {MAX_OWN_CHECK}]"
         ));
     }
-    let finish = &config.generator.finish;
-    if finish.by_ability_half
-        && finish.solver_steps > 0
-        && (!config.ability_aware() || finish.generator_until_hard_success.is_none())
-    {
-        return Err("generator.finish.by_ability_half counts the stop of \
-             generator_until_hard_success in the halves of the ability ranges: give both \
-             ability_ranges (or ability_spread) and generator_until_hard_success"
-            .into());
-    }
     if let Some(record) = &config.profile {
         record
             .profile(game)

@@ -219,14 +219,6 @@ pub struct Finish {
     /// Solver plays every match). The stops above count the final Solver's matches only.
     #[serde(default)]
     pub scripted_opponent: Option<ScriptedOpponent>,
-    /// For a run over ability ranges: `generator_until_hard_success` counts the hard matches
-    /// in groups, each main ability's lower and upper half of its range
-    /// ([`AbilityRanges::halves`](arlpcg_core::level::profile::AbilityRanges::halves)), each
-    /// over its own blocks of `hard_match_block`, and ends the phase only once every group's
-    /// latest block has fallen to the target: the Generator has made hard levels for slow and
-    /// fast, light and heavy players alike, not on average.
-    #[serde(default)]
-    pub by_ability_half: bool,
 }
 
 /// The scripted player as the Generator's opponent in a finish ([`Finish::scripted_opponent`]);
@@ -284,7 +276,6 @@ impl Finish {
         hard_match_block: HARD_MATCH_BLOCK,
         generator_entropy: None,
         scripted_opponent: None,
-        by_ability_half: false,
     };
 }
 

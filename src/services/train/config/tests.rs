@@ -230,21 +230,3 @@ fn ability_ranges_are_read_by_name_and_refused_with_the_field() {
         assert!(problem.contains(says), "{text}: {problem}");
     }
 }
-
-/// `finish.by_ability_half` splits the stop of `generator_until_hard_success` over ability
-/// ranges: without either, the file is refused by name.
-#[test]
-fn a_finish_by_ability_half_needs_ability_ranges_and_a_stop() {
-    let finish = "generator:\n  finish:\n    by_ability_half: true\n";
-    let problem = TrainConfig::parse_for(finish, Game::Platform).unwrap_err();
-    assert!(problem.contains("by_ability_half"), "{problem}");
-    let ranged = format!("ability_spread: 0.2\n{finish}");
-    let config = TrainConfig::parse_for(&ranged, Game::Platform).unwrap();
-    assert!(config.generator.finish.by_ability_half);
-    let no_stop = format!("{ranged}    generator_until_hard_success: null\n");
-    let problem = TrainConfig::parse_for(&no_stop, Game::Platform).unwrap_err();
-    assert!(
-        problem.contains("generator_until_hard_success"),
-        "{problem}"
-    );
-}

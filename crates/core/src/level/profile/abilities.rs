@@ -401,34 +401,6 @@ impl AbilityRanges {
                 })
     }
 
-    /// Which half of its range each main ability of `abilities` lies in: `Some(0)` below the
-    /// middle, `Some(1)` above, none at the middle itself (or for a range of one value): the
-    /// groups a training finish's `by_ability_half` stop counts apart.
-    pub fn halves(&self, abilities: &Abilities) -> [Option<usize>; MAIN_ABILITIES] {
-        let fields = main_of(self.kind);
-        std::array::from_fn(|i| {
-            let [least, most] = self.ranges[i];
-            let value = abilities.value(fields[i])?.0;
-            let middle = 0.5 * (least + most);
-            let tolerance = 1e-9 * (most - least).abs().max(1.0);
-            match value - middle {
-                d if d < -tolerance => Some(0),
-                d if d > tolerance => Some(1),
-                _ => None,
-            }
-        })
-    }
-
-    /// How many halves [`AbilityRanges::halves`] tells apart: two for each main ability whose
-    /// range holds more than one value.
-    pub fn halved(&self) -> usize {
-        2 * self
-            .ranges
-            .iter()
-            .filter(|[least, most]| most > least)
-            .count()
-    }
-
     /// `base` with each main ability drawn from a generator seeded by `seed` among
     /// [`DRAWN_VALUES`] evenly spaced values of its range, ends included: the character or car
     /// of one training episode or match. A run thus plays at most 125 characters, and measures

@@ -414,36 +414,6 @@ mod tests {
     }
 
     #[test]
-    fn ability_halves_split_each_range_at_its_middle() {
-        for game in [Game::Platform, Game::Racing] {
-            let ours = Abilities::default_of(game);
-            let around = AbilityRanges::around(&ours, 0.2);
-            assert_eq!(around.halved(), 2 * MAIN_ABILITIES);
-            // Ours lies at the middle of ranges drawn around it: in no half.
-            assert_eq!(around.halves(&ours), [None; MAIN_ABILITIES]);
-            let fields = main_abilities(game);
-            let value = |a: &Abilities, i: usize| a.value(fields[i]).unwrap().0;
-            let mut seen = [[false; 2]; MAIN_ABILITIES];
-            for seed in 0..200 {
-                let drawn = around.draw(&ours, seed);
-                for (i, half) in around.halves(&drawn).into_iter().enumerate() {
-                    let above = value(&drawn, i) - value(&ours, i);
-                    match half {
-                        Some(0) => assert!(above < 0.0),
-                        Some(1) => assert!(above > 0.0),
-                        None => assert!(above.abs() < 1e-9),
-                        Some(_) => panic!("two halves"),
-                    }
-                    if let Some(h) = half {
-                        seen[i][h] = true;
-                    }
-                }
-            }
-            assert_eq!(seen, [[true; 2]; MAIN_ABILITIES], "every half is drawn");
-        }
-    }
-
-    #[test]
     fn ability_ranges_from_a_file_name_the_field_that_is_wrong() {
         let kind = crate::level::PlayerKind::Character;
         let wide = |jump: [f64; 2]| {

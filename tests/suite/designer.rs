@@ -842,28 +842,34 @@ fn a_typed_wish_list_is_searched_for_and_checked_on_screen() {
     h.key(KeyCode::Enter);
     let (said, is_error) = h.app.status.clone().unwrap();
     assert!(is_error && said.contains("`curviness`"), "{said}");
-    // Tab to racing lets go of a wish list racing levels cannot meet (`climb` they have).
+    // Each game keeps its own wish list: Tab to racing finds none (`stride` racing levels do not
+    // have), and Tab back finds platform's as it was left.
     h.key(KeyCode::Char('W'));
     for _ in 0..40 {
         h.key(KeyCode::Backspace);
     }
     h.keys("stride >= 0");
     h.key(KeyCode::Enter);
-    assert!(h.app.want.is_some());
-    h.key(KeyCode::Tab);
-    assert!(h.app.want.is_none());
-    let (said, _) = h.app.status.clone().unwrap();
-    assert!(
-        said.contains("wish list let go") && said.contains("`stride`"),
-        "{said}"
+    assert_eq!(
+        h.app.want().map(ToString::to_string).as_deref(),
+        Some("stride >= 0")
     );
     h.key(KeyCode::Tab);
+    assert_eq!(h.app.game, Game::Racing);
+    assert!(h.app.want().is_none());
+    h.key(KeyCode::Tab);
+    let (said, _) = h.app.status.clone().unwrap();
+    assert!(said.contains("platform's wish list: stride >= 0"), "{said}");
+    assert_eq!(
+        h.app.want().map(ToString::to_string).as_deref(),
+        Some("stride >= 0")
+    );
     h.key(KeyCode::Char('W'));
     for _ in 0..40 {
         h.key(KeyCode::Backspace);
     }
     h.key(KeyCode::Enter);
-    assert!(h.app.want.is_none());
+    assert!(h.app.want().is_none());
 }
 
 /// Trials that cannot be played (here a racing Solver put on the platform game) say why, on the

@@ -166,8 +166,9 @@ pub struct App {
     pub slider: usize,
     /// The prefix every regeneration keeps.
     pub kept: Option<crate::services::generation::KeptPrefix>,
-    /// The wish list each level is searched to meet (`W`; none: λ alone).
-    pub want: Option<crate::services::wish::Want>,
+    /// Each game's wish list its levels are searched to meet (`W`; none: λ alone;
+    /// [`App::want`]: the game on screen's).
+    pub wants: PerGame<Option<crate::services::wish::Want>>,
     /// Each game's profile levels are made for, and the ability its keys change ([`profile`];
     /// [`App::profile`]: the game on screen's).
     pub profiles: PerGame<profile::ProfileEdit>,
@@ -232,7 +233,7 @@ impl App {
             knobs: Vec::new(),
             slider: 0,
             kept: None,
-            want: None,
+            wants: PerGame::default(),
             profiles: PerGame::default(),
             seed,
             goal: GoalSetting::FromSeed,
@@ -292,7 +293,7 @@ impl App {
             trials: self.trials_wanted,
             profile: self.profile().profile.clone(),
             knobs: self.knob_values(),
-            want: self.want.clone(),
+            want: self.want().cloned(),
         }]
     }
 
@@ -331,6 +332,11 @@ impl App {
         &mut self.loaded[self.game]
     }
 
+    /// The wish list of the game on screen, if it has one.
+    pub fn want(&self) -> Option<&crate::services::wish::Want> {
+        self.wants[self.game].as_ref()
+    }
+
     /// The profile of the game on screen.
     pub fn profile(&self) -> &profile::ProfileEdit {
         &self.profiles[self.game]
@@ -353,10 +359,9 @@ impl App {
         if self.policies().generator.is_none() && self.ask.curve().is_some() {
             self.ask = Ask::Aux(self.aux);
         }
-        // A wish list that speaks of what the other game's levels do not have is let go.
-        if let Some(Err(why)) = self.want.as_ref().map(|w| w.fit(self.game)) {
-            self.want = None;
-            self.complain(format!("wish list let go: {why}"));
+        // Each game keeps its own wish list: say which one now holds.
+        if let Some(want) = self.want() {
+            self.say(format!("{}'s wish list: {want}", self.game));
         }
         self.level = None;
         self.trials = None;

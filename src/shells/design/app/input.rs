@@ -120,10 +120,7 @@ impl App {
             PromptKind::Target => self.ask.success().map_or(String::new(), |t| format!("{t}")),
             PromptKind::Policies => String::new(),
             PromptKind::Curve => self.ask.curve().map_or(String::new(), ToString::to_string),
-            PromptKind::Want => self
-                .want
-                .as_ref()
-                .map_or(String::new(), ToString::to_string),
+            PromptKind::Want => self.want().map_or(String::new(), ToString::to_string),
             PromptKind::Campaign | PromptKind::Profile => String::new(),
         };
         self.overlay = Overlay::Prompt { kind, text };
@@ -208,7 +205,7 @@ impl App {
         use crate::services::panel::Judge;
         use crate::services::wish::{Want, words};
         if text.is_empty() {
-            if self.want.take().is_some() {
+            if self.wants[self.game].take().is_some() {
                 self.say("no wish list: λ alone");
                 return self.generate();
             }
@@ -235,7 +232,7 @@ impl App {
         match checked {
             Ok((want, unused)) => {
                 self.say(format!("wish list: {want}{unused}"));
-                self.want = Some(want);
+                self.wants[self.game] = Some(want);
                 self.generate()
             }
             Err(e) => {

@@ -90,7 +90,7 @@ impl App {
                 self.generation_error = None;
                 self.selected = self.selected.filter(|&i| i < level.piece_count());
                 // With a success target or a wish list the slider shows the λ the search found.
-                let searched = self.ask.success().is_some() || self.want.is_some();
+                let searched = self.ask.success().is_some() || self.want().is_some();
                 if let (true, Some(aux)) = (searched, level.aux) {
                     self.aux = aux;
                 }

@@ -420,7 +420,7 @@ fn stats(app: &App, frame: &mut Frame, area: Rect) {
         }
         None => lines.push(Line::from("no trials yet")),
     }
-    if let (Some(want), Some(level)) = (&app.want, &app.level) {
+    if let (Some(want), Some(level)) = (app.want(), &app.level) {
         wish_lines(
             want,
             level,

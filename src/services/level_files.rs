@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 
 use crate::services::fsio::{self, Overwrite};
-use arlpcg_core::level::scene::Scene;
+use arlpcg_core::level::scene::{PhysicsExtensions, Scene};
 use arlpcg_core::level::{Game, Level, gltf, yaml};
 
 /// A level's file formats.
@@ -29,6 +29,8 @@ pub struct LevelFiles {
     formats: Vec<Format>,
     /// glTF files name their solid nodes for Godot's import hints ([`Scene::with_collision_names`]).
     collision_names: bool,
+    /// The glTF physics extensions written ([`Scene::with_physics_extensions`]).
+    physics: PhysicsExtensions,
 }
 
 impl LevelFiles {
@@ -45,12 +47,19 @@ impl LevelFiles {
             stem: stem.to_string(),
             formats: unique,
             collision_names: false,
+            physics: PhysicsExtensions::Omi,
         }
     }
 
     /// The same files, their glTF naming solid nodes for Godot's import hints or not.
     pub fn with_collision_names(mut self, on: bool) -> Self {
         self.collision_names = on;
+        self
+    }
+
+    /// The same files, their glTF writing colliders in these physics extensions.
+    pub fn with_physics(mut self, physics: PhysicsExtensions) -> Self {
+        self.physics = physics;
         self
     }
 
@@ -81,9 +90,12 @@ impl LevelFiles {
 /// The bytes of each file of `files` for `level`, in [`LevelFiles::paths`] order (the same
 /// level always gives the same bytes).
 pub fn render(level: &Level, files: &LevelFiles) -> Vec<(PathBuf, Vec<u8>)> {
-    let scene = || match files.collision_names {
-        true => Scene::of_level(level).with_collision_names(),
-        false => Scene::of_level(level),
+    let scene = || {
+        let scene = Scene::of_level(level).with_physics_extensions(files.physics);
+        match files.collision_names {
+            true => scene.with_collision_names(),
+            false => scene,
+        }
     };
     let mut out = Vec::new();
     for format in &files.formats {

@@ -1,6 +1,8 @@
 //! glTF export read back with the `gltf` crate: one node per block plus start block and
 //! markers, names, extras, and world bounds that match the level.
 
+use std::collections::BTreeMap;
+
 use crate::common::import_glb;
 use arlpcg_core::game::GameSpec;
 use arlpcg_core::game::platform::rules;
@@ -8,7 +10,7 @@ use arlpcg_core::level::Shape;
 use arlpcg_core::level::platform::BLOCK_THICKNESS;
 use arlpcg_core::level::racing::FINISH_LENGTH;
 use arlpcg_core::level::racing::ROAD_WIDTH;
-use arlpcg_core::level::scene::Scene;
+use arlpcg_core::level::scene::{PhysicsExtensions, Scene};
 use arlpcg_core::level::{Level, PlatformRulesConfig, gltf as export};
 
 fn level(seed: u64) -> Level {
@@ -574,5 +576,181 @@ fn collision_names_mark_exactly_the_solid_meshes() {
                 "{game}: {marker}"
             );
         }
+    }
+}
+
+/// The document of `level`'s `.gltf` export with its colliders in `physics`.
+fn document_with(level: &Level, physics: PhysicsExtensions) -> serde_json::Value {
+    let scene = Scene::of_level(level).with_physics_extensions(physics);
+    serde_json::from_slice(&export::to_gltf(&scene, "level.bin").main).unwrap()
+}
+
+/// Each node's extension `name` by the node's name, for the nodes that carry it.
+fn by_node(root: &serde_json::Value, name: &str) -> BTreeMap<String, serde_json::Value> {
+    let nodes = root["nodes"].as_array().unwrap();
+    nodes
+        .iter()
+        .filter(|n| !n["extensions"][name].is_null())
+        .map(|n| {
+            (
+                n["name"].as_str().unwrap().into(),
+                n["extensions"][name].clone(),
+            )
+        })
+        .collect()
+}
+
+/// `--physics khr`: the same colliders and trigger as the OMI export, on the same nodes, in the
+/// Khronos drafts' terms: a `KHR_implicit_shapes` box of the same size, a cylinder of the same
+/// height and radius (`radiusBottom`, `radiusTop`), each road segment's mesh as
+/// `geometry.node`, the segment's own node; `finish_zone` a box trigger where the game counts
+/// success. Every index points at a shape or a node with a mesh, and each shape is used once.
+/// Nothing of OMI's is written, and the extensions are used, not required.
+#[test]
+fn khr_physics_has_one_collider_per_solid_piece_and_the_finish_a_trigger() {
+    use arlpcg_core::game::{GameSpec, RacingGame};
+    let levels = (1..=5)
+        .map(level)
+        .chain((1..=5).filter_map(|seed| RacingGame::rule_level(seed, &Default::default())))
+        .chain([racing_with_obstacles()]);
+    let mut cylinders = 0;
+    for level in levels {
+        let game = level.game();
+        let omi = document_with(&level, PhysicsExtensions::Omi);
+        let root = document_with(&level, PhysicsExtensions::Khr);
+        assert_eq!(
+            root["extensionsUsed"],
+            serde_json::json!([export::KHR_SHAPES, export::KHR_BODY])
+        );
+        assert!(
+            root.get("extensionsRequired").is_none(),
+            "used, not required"
+        );
+        assert!(
+            !root.to_string().contains("OMI_"),
+            "{game}: no OMI with khr"
+        );
+        let shapes = root["extensions"][export::KHR_SHAPES]["shapes"]
+            .as_array()
+            .unwrap();
+        let nodes = root["nodes"].as_array().unwrap();
+        let omi_shapes = omi["extensions"]["OMI_physics_shape"]["shapes"]
+            .as_array()
+            .unwrap();
+        let omi_bodies = by_node(&omi, "OMI_physics_body");
+        let bodies = by_node(&root, export::KHR_BODY);
+        assert_eq!(
+            bodies.keys().collect::<Vec<_>>(),
+            omi_bodies.keys().collect::<Vec<_>>(),
+            "{game}: the same nodes carry a body"
+        );
+        let mut used = vec![0; shapes.len()];
+        for (name, body) in &bodies {
+            let (role, omi_role) = match name.as_str() {
+                "finish_zone" => ("trigger", &omi_bodies[name]["trigger"]),
+                _ => ("collider", &omi_bodies[name]["collider"]),
+            };
+            assert_eq!(body.as_object().unwrap().len(), 1, "{game}: {name}: {body}");
+            let geometry = body[role]["geometry"].as_object().unwrap();
+            assert_eq!(geometry.len(), 1, "{game}: {name}: shape or node, not both");
+            let omi_shape = &omi_shapes[omi_role["shape"].as_u64().unwrap() as usize];
+            match (geometry.get("shape"), geometry.get("node")) {
+                (Some(index), None) => {
+                    let index = index.as_u64().unwrap() as usize;
+                    assert!(index < shapes.len(), "{game}: {name}: shape {index}");
+                    used[index] += 1;
+                    let shape = &shapes[index];
+                    assert_eq!(shape["type"], omi_shape["type"], "{game}: {name}");
+                    match shape["type"].as_str().unwrap() {
+                        "box" => assert_eq!(shape["box"], omi_shape["box"], "{game}: {name}"),
+                        "cylinder" => {
+                            let (c, o) = (&shape["cylinder"], &omi_shape["cylinder"]);
+                            assert_eq!(c.as_object().unwrap().len(), 3, "{game}: {name}: {c}");
+                            assert_eq!(c["height"], o["height"]);
+                            assert!(o["radius"].as_f64().unwrap() > 0.0);
+                            assert_eq!(c["radiusBottom"], o["radius"]);
+                            assert_eq!(c["radiusTop"], o["radius"]);
+                            cylinders += 1;
+                        }
+                        other => panic!("{game}: {name}: a {other}"),
+                    }
+                }
+                (None, Some(node)) => {
+                    assert_eq!(omi_shape["type"], "trimesh", "{game}: {name}");
+                    let node = &nodes[node.as_u64().unwrap() as usize];
+                    assert_eq!(node["mesh"], omi_shape["trimesh"]["mesh"], "{game}: {name}");
+                    assert_eq!(
+                        format!("{}_collider", node["name"].as_str().unwrap()),
+                        *name
+                    );
+                }
+                _ => panic!("{game}: {name}: {body}"),
+            }
+        }
+        assert_eq!(used, vec![1; shapes.len()], "{game}: each shape used once");
+        let solid = bodies.keys().filter(|n| n.ends_with("_collider")).count();
+        assert!(solid >= level.piece_count(), "{game}: {solid} colliders");
+        let trigger = nodes.iter().find(|n| n["name"] == "finish_zone").unwrap();
+        let index = trigger["extensions"][export::KHR_BODY]["trigger"]["geometry"]["shape"]
+            .as_u64()
+            .unwrap();
+        let shape = &shapes[index as usize];
+        assert_eq!(shape["type"], "box");
+        finish_zone_is_where_the_game_counts_success(&level, trigger, &shape["box"]["size"]);
+        for marker in ["start", "goal"] {
+            let node = nodes.iter().find(|n| n["name"] == marker).unwrap();
+            assert!(node.get("extensions").is_none(), "{game}: {marker}");
+        }
+    }
+    assert!(cylinders > 0, "the obstacle course has cylinders");
+}
+
+/// `--physics both`: every node carries the OMI body exactly as the default export writes it
+/// and the KHR body exactly as `khr` does, the document both sets of shapes; the default writes
+/// OMI alone, as before.
+#[test]
+fn both_physics_writes_omi_and_khr_on_the_same_nodes_and_the_default_omi_only() {
+    for level in [level(3), racing_with_obstacles()] {
+        let game = level.game();
+        let omi = document_with(&level, PhysicsExtensions::Omi);
+        let khr = document_with(&level, PhysicsExtensions::Khr);
+        let both = document_with(&level, PhysicsExtensions::Both);
+        assert_eq!(
+            both["extensionsUsed"],
+            serde_json::json!([
+                "OMI_physics_body",
+                "OMI_physics_shape",
+                export::KHR_SHAPES,
+                export::KHR_BODY
+            ])
+        );
+        for (name, alone) in [("OMI_physics_body", &omi), (export::KHR_BODY, &khr)] {
+            assert_eq!(by_node(&both, name), by_node(alone, name), "{game}: {name}");
+        }
+        for name in ["OMI_physics_shape", export::KHR_SHAPES] {
+            let alone = if name == export::KHR_SHAPES {
+                &khr
+            } else {
+                &omi
+            };
+            assert_eq!(
+                both["extensions"][name], alone["extensions"][name],
+                "{game}"
+            );
+        }
+        assert_eq!(
+            both["nodes"].as_array().unwrap().len(),
+            omi["nodes"].as_array().unwrap().len()
+        );
+        let default = export::to_gltf(&Scene::of_level(&level), "level.bin").main;
+        let default_text = String::from_utf8(default).unwrap();
+        assert!(
+            !default_text.contains("KHR_"),
+            "{game}: OMI only by default"
+        );
+        assert_eq!(
+            serde_json::from_str::<serde_json::Value>(&default_text).unwrap(),
+            omi
+        );
     }
 }

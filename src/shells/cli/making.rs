@@ -26,6 +26,18 @@ pub enum FormatArg {
     Gltf,
 }
 
+/// The glTF physics extensions of `generate` and `export` (`--physics`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PhysicsArg {
+    /// `OMI_physics_shape` and `OMI_physics_body` (Godot 4.3 and later read them).
+    Omi,
+    /// The Khronos drafts `KHR_implicit_shapes` and `KHR_physics_rigid_bodies` (three.js with
+    /// Rapier, Babylon.js with Havok, the Khronos sample viewer; docs/engines.md).
+    Khr,
+    /// Both, on the same collider nodes.
+    Both,
+}
+
 /// `generate`'s arguments.
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("source").required(true).args(["rules", "policies"])))]
@@ -85,6 +97,11 @@ pub struct GenerateArgs {
     /// which read the extension and would make two.
     #[arg(long)]
     pub collision_names: bool,
+    /// The glTF physics extensions that carry the colliders and the finish trigger: omi
+    /// (`OMI_physics_shape`/`OMI_physics_body`, as Godot 4 reads them), khr (the Khronos drafts
+    /// `KHR_implicit_shapes`/`KHR_physics_rigid_bodies`) or both on the same collider nodes.
+    #[arg(long, value_enum, value_name = "EXTENSIONS", default_value = "omi")]
+    pub physics: PhysicsArg,
     /// Play each level this many times with the Solver (with --policies the one beside the
     /// Generator, with --rules the shipped one; under a --profile whose abilities it did not
     /// train with, the folder's solver-aware.safetensors where its range holds them, else the
@@ -213,6 +230,11 @@ pub struct ExportArgs {
     /// which read the extension and would make two.
     #[arg(long)]
     pub collision_names: bool,
+    /// The glTF physics extensions that carry the colliders and the finish trigger: omi
+    /// (`OMI_physics_shape`/`OMI_physics_body`, as Godot 4 reads them), khr (the Khronos drafts
+    /// `KHR_implicit_shapes`/`KHR_physics_rigid_bodies`) or both on the same collider nodes.
+    #[arg(long, value_enum, value_name = "EXTENSIONS", default_value = "omi")]
+    pub physics: PhysicsArg,
     /// Replace files that already exist.
     #[arg(long)]
     pub force: bool,
@@ -280,6 +302,16 @@ impl From<FormatArg> for crate::services::level_files::Format {
             FormatArg::Yaml => Self::Yaml,
             FormatArg::Glb => Self::Glb,
             FormatArg::Gltf => Self::Gltf,
+        }
+    }
+}
+
+impl From<PhysicsArg> for arlpcg_core::level::scene::PhysicsExtensions {
+    fn from(physics: PhysicsArg) -> Self {
+        match physics {
+            PhysicsArg::Omi => Self::Omi,
+            PhysicsArg::Khr => Self::Khr,
+            PhysicsArg::Both => Self::Both,
         }
     }
 }

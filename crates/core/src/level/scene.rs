@@ -103,8 +103,8 @@ pub struct SceneMesh {
     pub physics: Physics,
 }
 
-/// What a node is to an engine's physics (written as the `OMI_physics_body` and
-/// `OMI_physics_shape` glTF extensions).
+/// What a node is to an engine's physics (written as the glTF physics extensions that
+/// [`PhysicsExtensions`] names).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Physics {
     /// Solid and static: the node's own box (its extents).
@@ -146,6 +146,19 @@ pub struct ScenePoint {
     pub physics: Physics,
 }
 
+/// Which glTF physics extensions an export writes its colliders and trigger in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PhysicsExtensions {
+    /// `OMI_physics_shape` and `OMI_physics_body` (Godot 4 reads them).
+    #[default]
+    Omi,
+    /// The Khronos drafts `KHR_implicit_shapes` and `KHR_physics_rigid_bodies` (three.js with
+    /// Rapier, Babylon.js with Havok, the Khronos sample viewer).
+    Khr,
+    /// Both, on the same collider nodes.
+    Both,
+}
+
 /// A level ready to export.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
@@ -159,6 +172,8 @@ pub struct Scene {
     pub points: Vec<ScenePoint>,
     /// Metadata of the whole level (game, seed, aux).
     pub extras: Value,
+    /// The glTF physics extensions the export writes (OMI unless asked).
+    pub physics_extensions: PhysicsExtensions,
 }
 
 /// The suffix Godot's import hints read as "this mesh also collides" (a static body with the
@@ -183,6 +198,12 @@ impl Scene {
                 mesh.name.push_str(COLLISION_SUFFIX);
             }
         }
+        self
+    }
+
+    /// The scene with its colliders and trigger written in `extensions` (`--physics`).
+    pub fn with_physics_extensions(mut self, extensions: PhysicsExtensions) -> Scene {
+        self.physics_extensions = extensions;
         self
     }
 
@@ -486,6 +507,7 @@ fn level_scene(
         meshes,
         points: Vec::new(),
         extras,
+        physics_extensions: PhysicsExtensions::Omi,
     }
 }
 

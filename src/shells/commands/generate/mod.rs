@@ -58,7 +58,8 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
             (
                 seed,
                 LevelFiles::new(&args.out, &stem(args, seed), &formats)
-                    .with_collision_names(args.collision_names),
+                    .with_collision_names(args.collision_names)
+                    .with_physics(args.physics.into()),
             )
         })
         .collect();

@@ -11,7 +11,7 @@ mod physics;
 
 use super::scene::{Material, Scene};
 use physics::physics;
-pub use physics::{OMI_BODY, OMI_SHAPE};
+pub use physics::{KHR_BODY, KHR_SHAPES, OMI_BODY, OMI_SHAPE};
 
 /// A `.gltf` document and the `.bin` buffer it refers to.
 #[derive(Debug, Clone, PartialEq)]

@@ -33,7 +33,7 @@ enum Geometry {
 /// Where a collider or the trigger goes.
 enum Target {
     /// A `<name>_collider` node of its own, pushed after the scene's nodes.
-    New(json::Node),
+    New(Box<json::Node>),
     /// A node that is already there (`finish_zone`).
     Existing(json::Index<json::Node>),
 }
@@ -101,10 +101,10 @@ fn bodies(
     point_nodes: &[json::Index<json::Node>],
 ) -> Vec<Body> {
     let collider = |name: &str, node: json::Node, geometry| Body {
-        target: Target::New(json::Node {
+        target: Target::New(Box::new(json::Node {
             name: Some(format!("{name}_collider")),
             ..node
-        }),
+        })),
         role: "collider",
         geometry,
     };
@@ -200,7 +200,7 @@ pub(super) fn physics(
         match body.target {
             Target::New(node) => nodes.push(root.push(json::Node {
                 extensions: Some(extensions),
-                ..node
+                ..*node
             })),
             Target::Existing(node) => root.nodes[node.value()].extensions = Some(extensions),
         }

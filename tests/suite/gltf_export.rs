@@ -341,17 +341,23 @@ fn racing_with_obstacles() -> Level {
     .unwrap()
 }
 
+/// The levels the physics tests export: rule levels of seeds 1 ..= `seeds` of each game, and
+/// a racing level among obstacles.
+fn physics_levels(seeds: u64) -> impl Iterator<Item = Level> {
+    use arlpcg_core::game::{GameSpec, RacingGame};
+    (1..=seeds)
+        .map(level)
+        .chain((1..=seeds).filter_map(|seed| RacingGame::rule_level(seed, &Default::default())))
+        .chain([racing_with_obstacles()])
+}
+
 /// Colliders an engine imports (`OMI_physics_body` / `OMI_physics_shape`): an unscaled box beside
 /// every block and box obstacle with the block's size, a cylinder beside every cylinder, each
 /// road segment's own mesh as a triangle mesh, and a trigger at the finish; markers collide with
 /// nothing. On 20 rule levels of each game and a racing level among obstacles.
 #[test]
 fn every_solid_piece_has_a_collider_and_the_finish_a_trigger() {
-    use arlpcg_core::game::{GameSpec, RacingGame};
-    let levels = (1..=20)
-        .map(level)
-        .chain((1..=20).filter_map(|seed| RacingGame::rule_level(seed, &Default::default())))
-        .chain([racing_with_obstacles()]);
+    let levels = physics_levels(20);
     for level in levels {
         let game = level.game();
         let out = export::to_gltf(&Scene::of_level(&level), "level.bin");
@@ -608,11 +614,7 @@ fn by_node(root: &serde_json::Value, name: &str) -> BTreeMap<String, serde_json:
 /// Nothing of OMI's is written, and the extensions are used, not required.
 #[test]
 fn khr_physics_has_one_collider_per_solid_piece_and_the_finish_a_trigger() {
-    use arlpcg_core::game::{GameSpec, RacingGame};
-    let levels = (1..=5)
-        .map(level)
-        .chain((1..=5).filter_map(|seed| RacingGame::rule_level(seed, &Default::default())))
-        .chain([racing_with_obstacles()]);
+    let levels = physics_levels(5);
     let mut cylinders = 0;
     for level in levels {
         let game = level.game();

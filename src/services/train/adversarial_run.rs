@@ -455,7 +455,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
             .map_err(|problem| anyhow::anyhow!("the run's profile: {problem}"))?;
         let check = config.generator.own_check;
         let out = self.solver.out.clone();
-        if check.levels > 0 && check.trials > 0 {
+        if check.plays() {
             starting();
         }
         let Some(control) = own_check::own_control(&out, G::GAME, profile.as_ref(), check)? else {

@@ -83,7 +83,7 @@ pub fn own_control(
     profile: Option<&Profile>,
     check: OwnCheck,
 ) -> Result<Option<OwnControl>> {
-    if check.levels == 0 || check.trials == 0 {
+    if !check.plays() {
         return Ok(None);
     }
     let (generator, _) = load_generator(&out.join("generator.safetensors"), game)?;

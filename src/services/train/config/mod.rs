@@ -158,6 +158,13 @@ pub struct OwnCheck {
     pub trials: u32,
 }
 
+impl OwnCheck {
+    /// Whether the check plays anything (0 levels or 0 runs: no check).
+    pub fn plays(&self) -> bool {
+        self.levels > 0 && self.trials > 0
+    }
+}
+
 impl Default for OwnCheck {
     /// 20 levels × 20 runs at each end: a few seconds to a minute on two cores.
     fn default() -> Self {

@@ -27,10 +27,25 @@ pub struct LevelFiles {
     dir: PathBuf,
     stem: String,
     formats: Vec<Format>,
-    /// glTF files name their solid nodes for Godot's import hints ([`Scene::with_collision_names`]).
-    collision_names: bool,
-    /// The glTF physics extensions written ([`Scene::with_physics_extensions`]).
-    physics: PhysicsExtensions,
+    gltf: GltfOptions,
+}
+
+/// How a level's glTF files carry their colliders; `generate`, `export`, `campaign` and the
+/// designer take the same two options, and a campaign's record keeps them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GltfOptions {
+    /// Name the solid nodes for Godot's import hints ([`Scene::with_collision_names`]).
+    pub collision_names: bool,
+    /// The physics extensions written ([`Scene::with_physics_extensions`]; OMI by default).
+    pub physics: PhysicsExtensions,
+}
+
+impl GltfOptions {
+    /// OMI extensions and no import hints: what a file gets unless asked otherwise.
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
 }
 
 impl LevelFiles {
@@ -46,20 +61,13 @@ impl LevelFiles {
             dir: dir.to_path_buf(),
             stem: stem.to_string(),
             formats: unique,
-            collision_names: false,
-            physics: PhysicsExtensions::Omi,
+            gltf: GltfOptions::default(),
         }
     }
 
-    /// The same files, their glTF naming solid nodes for Godot's import hints or not.
-    pub fn with_collision_names(mut self, on: bool) -> Self {
-        self.collision_names = on;
-        self
-    }
-
-    /// The same files, their glTF writing colliders in these physics extensions.
-    pub fn with_physics(mut self, physics: PhysicsExtensions) -> Self {
-        self.physics = physics;
+    /// The same files, their glTF carrying colliders as `gltf` says.
+    pub fn with_gltf(mut self, gltf: GltfOptions) -> Self {
+        self.gltf = gltf;
         self
     }
 
@@ -91,8 +99,8 @@ impl LevelFiles {
 /// level always gives the same bytes).
 pub fn render(level: &Level, files: &LevelFiles) -> Vec<(PathBuf, Vec<u8>)> {
     let scene = || {
-        let scene = Scene::of_level(level).with_physics_extensions(files.physics);
-        match files.collision_names {
+        let scene = Scene::of_level(level).with_physics_extensions(files.gltf.physics);
+        match files.gltf.collision_names {
             true => scene.with_collision_names(),
             false => scene,
         }

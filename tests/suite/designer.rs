@@ -7,12 +7,14 @@ use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use arlpcg::services::generation::{Ask, LevelRequest};
+use arlpcg::services::level_files::GltfOptions;
 use arlpcg::shells::design::app::{
     self, App, Effect, GoalSetting, LoadedInfo, Loading, Message, Mode, Overlay, Response,
 };
 use arlpcg::shells::design::layout::Areas;
 use arlpcg::shells::design::view;
 use arlpcg::shells::design::worker::{self, GamePolicies, Policies, Workers};
+use arlpcg_core::level::scene::PhysicsExtensions;
 use arlpcg_core::level::{Game, yaml};
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
@@ -569,6 +571,25 @@ fn export_asks_before_overwriting() {
     assert!(overwrite);
     h.settle();
     assert!(h.app.status.as_ref().unwrap().0.contains("exported"));
+}
+
+/// `design --physics both --collision-names`: the designer's export writes its glTF so.
+#[test]
+fn export_writes_the_gltf_physics_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::rules(dir.path());
+    h.app.gltf = GltfOptions {
+        collision_names: true,
+        physics: PhysicsExtensions::Both,
+    };
+    h.settle();
+    h.key(KeyCode::Char('x'));
+    h.settle();
+    let glb = dir.path().join("platform/platform_seed1_aux+1.00.glb");
+    let bytes = String::from_utf8_lossy(&std::fs::read(glb).unwrap()).into_owned();
+    for name in ["OMI_physics_body", "KHR_physics_rigid_bodies", "-col"] {
+        assert!(bytes.contains(name), "{name}");
+    }
 }
 
 #[test]

@@ -270,7 +270,10 @@ fn a_paced_campaign_moves_one_shape_per_level() {
     let profile_arg = profile_file.to_str().unwrap();
     let done = small_campaign(
         &out,
-        &["--pacing", "0:0.4, 1:-0.4", "--profile", profile_arg],
+        &[
+            "--pacing", "0:0.4, 1:-0.4", "--profile", profile_arg, "--physics", "khr", "--format",
+            "glb",
+        ],
     );
     assert!(done.status.success(), "{}", stderr(&done));
     // The panel's Solvers of one character never trained with the profile's run speed, and the
@@ -286,6 +289,12 @@ fn a_paced_campaign_moves_one_shape_per_level() {
         serde_yaml::from_slice(&std::fs::read(out.join("campaign.yaml")).unwrap()).unwrap();
     assert_eq!(record["pacing"].as_str(), Some("0:0.4, 1:-0.4"));
     assert_eq!(record["profile"]["name"].as_str(), Some("quick"));
+    // --physics khr: the record keeps it (a level searched anew is written the same way) and
+    // the levels' glTF carries the Khronos drafts, not OMI.
+    assert_eq!(record["gltf"]["physics"].as_str(), Some("khr"));
+    let glb =
+        String::from_utf8_lossy(&std::fs::read(out.join("level01.glb")).unwrap()).into_owned();
+    assert!(glb.contains("KHR_physics_rigid_bodies") && !glb.contains("OMI_physics_body"));
     for level in record["levels"].as_sequence().unwrap() {
         assert!(level.get("aux").is_none(), "{level:?}");
         let curve = level["aux_curve"].as_str().unwrap();

@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::services::chart::stacked_png;
 use crate::services::generation::{AuxAsk, LevelRequest};
-use crate::services::level_files::{Format, LevelFiles, render};
+use crate::services::level_files::{Format, GltfOptions, LevelFiles, render};
 use crate::services::wish::Constraint;
 use arlpcg_core::level::pacing::{AuxCurve, CurveWords, parse_points, show_points, value_at};
 use arlpcg_core::level::profile::{Profile, ProfileRecord};
@@ -129,6 +129,10 @@ pub struct Campaign {
     /// Acceptance checks every level must pass (`verify --campaign` applies them).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub checks: Vec<Constraint>,
+    /// How the levels' glTF files carry their colliders (absent: OMI, no import hints); a
+    /// level searched anew is written the same way.
+    #[serde(default, skip_serializing_if = "GltfOptions::is_default")]
+    pub gltf: GltfOptions,
     /// The player population the levels are judged for.
     pub population: Population,
     /// `scripted judges`: the population's 10th, 50th and 90th percentiles of θ are the
@@ -212,6 +216,8 @@ pub struct CampaignAsk {
     pub profile: Option<Profile>,
     /// Acceptance checks every level must pass.
     pub checks: Vec<Constraint>,
+    /// How the levels' glTF files carry their colliders.
+    pub gltf: GltfOptions,
     /// How the player population is set.
     pub population: PopulationAsk,
 }
@@ -319,6 +325,7 @@ impl CampaignAsk {
             pacing: self.pacing.clone(),
             profile: self.profile.as_ref().map(Profile::record),
             checks: self.checks.clone(),
+            gltf: self.gltf,
             population: Population {
                 theta_mean: round4(population.theta_mean),
                 theta_sd: round4(population.theta_sd),
@@ -356,6 +363,7 @@ impl Campaign {
                 .as_ref()
                 .and_then(|record| record.profile(self.game).ok()),
             checks: self.checks.clone(),
+            gltf: self.gltf,
             population: match self.population_from.as_str() {
                 "given" => PopulationAsk::Given(self.population),
                 _ => PopulationAsk::ScriptedJudges {
@@ -478,7 +486,7 @@ pub fn campaign_files(
         .iter()
         .enumerate()
         .flat_map(|(k, level)| {
-            let names = LevelFiles::new(dir, &level_stem(k, n), formats);
+            let names = LevelFiles::new(dir, &level_stem(k, n), formats).with_gltf(campaign.gltf);
             render(level, &names).into_iter().rev()
         })
         .collect();

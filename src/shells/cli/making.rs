@@ -26,10 +26,36 @@ pub enum FormatArg {
     Gltf,
 }
 
-/// The glTF physics extensions of `generate` and `export` (`--physics`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+/// How the glTF files carry their colliders: `generate`, `export`, `campaign` and `design` take
+/// the same two options.
+#[derive(Debug, Clone, Copy, Default, Args)]
+pub struct GltfArgs {
+    /// Name every solid node of the glTF with Godot's `-col` import hint, so that Godot 3 (which
+    /// ignores the physics extension) makes a static body for each. Not for Godot 4.3 and later,
+    /// which read the extension and would make two.
+    #[arg(long)]
+    pub collision_names: bool,
+    /// The glTF physics extensions that carry the colliders and the finish trigger: omi
+    /// (`OMI_physics_shape`/`OMI_physics_body`, as Godot 4 reads them), khr (the Khronos drafts
+    /// `KHR_implicit_shapes`/`KHR_physics_rigid_bodies`) or both on the same collider nodes.
+    #[arg(long, value_enum, value_name = "EXTENSIONS", default_value = "omi")]
+    pub physics: PhysicsArg,
+}
+
+impl From<GltfArgs> for crate::services::level_files::GltfOptions {
+    fn from(args: GltfArgs) -> Self {
+        Self {
+            collision_names: args.collision_names,
+            physics: args.physics.into(),
+        }
+    }
+}
+
+/// The glTF physics extensions (`--physics`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
 pub enum PhysicsArg {
     /// `OMI_physics_shape` and `OMI_physics_body` (Godot 4.3 and later read them).
+    #[default]
     Omi,
     /// The Khronos drafts `KHR_implicit_shapes` and `KHR_physics_rigid_bodies` (three.js with
     /// Rapier, Babylon.js with Havok, the Khronos sample viewer; docs/engines.md).
@@ -92,16 +118,9 @@ pub struct GenerateArgs {
     /// File formats to write, comma-separated.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "yaml,glb")]
     pub format: Vec<FormatArg>,
-    /// Name every solid node of the glTF with Godot's `-col` import hint, so that Godot 3 (which
-    /// ignores the physics extension) makes a static body for each. Not for Godot 4.3 and later,
-    /// which read the extension and would make two.
-    #[arg(long)]
-    pub collision_names: bool,
-    /// The glTF physics extensions that carry the colliders and the finish trigger: omi
-    /// (`OMI_physics_shape`/`OMI_physics_body`, as Godot 4 reads them), khr (the Khronos drafts
-    /// `KHR_implicit_shapes`/`KHR_physics_rigid_bodies`) or both on the same collider nodes.
-    #[arg(long, value_enum, value_name = "EXTENSIONS", default_value = "omi")]
-    pub physics: PhysicsArg,
+    /// How the glTF files carry their colliders (`--collision-names`, `--physics`).
+    #[command(flatten)]
+    pub gltf: GltfArgs,
     /// Play each level this many times with the Solver (with --policies the one beside the
     /// Generator, with --rules the shipped one; under a --profile whose abilities it did not
     /// train with, the folder's solver-aware.safetensors where its range holds them, else the
@@ -225,16 +244,9 @@ pub struct ExportArgs {
     /// Output file: .glb for binary glTF, .gltf for JSON glTF plus a .bin beside it.
     #[arg(long)]
     pub out: PathBuf,
-    /// Name every solid node of the glTF with Godot's `-col` import hint, so that Godot 3 (which
-    /// ignores the physics extension) makes a static body for each. Not for Godot 4.3 and later,
-    /// which read the extension and would make two.
-    #[arg(long)]
-    pub collision_names: bool,
-    /// The glTF physics extensions that carry the colliders and the finish trigger: omi
-    /// (`OMI_physics_shape`/`OMI_physics_body`, as Godot 4 reads them), khr (the Khronos drafts
-    /// `KHR_implicit_shapes`/`KHR_physics_rigid_bodies`) or both on the same collider nodes.
-    #[arg(long, value_enum, value_name = "EXTENSIONS", default_value = "omi")]
-    pub physics: PhysicsArg,
+    /// How the glTF files carry their colliders (`--collision-names`, `--physics`).
+    #[command(flatten)]
+    pub gltf: GltfArgs,
     /// Replace files that already exist.
     #[arg(long)]
     pub force: bool,

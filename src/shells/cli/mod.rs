@@ -10,7 +10,9 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 mod making;
 mod playing;
 mod values;
-pub use making::{BenchArgs, ExportArgs, ExportPolicyArgs, FormatArg, GenerateArgs, ViewArgs};
+pub use making::{
+    BenchArgs, ExportArgs, ExportPolicyArgs, FormatArg, GenerateArgs, GltfArgs, ViewArgs,
+};
 pub use playing::{CampaignArgs, SolverChoice, VerifyArgs, default_solver};
 pub use values::{AuxArg, Judges, KeepArg, Shard};
 use values::{parse_ability_spread, parse_game, parse_minutes, parse_shard};
@@ -171,6 +173,9 @@ pub struct DesignArgs {
     /// generated and played with its character's or car's abilities, and the header names it.
     #[arg(long, value_name = "FILE")]
     pub profile: Option<PathBuf>,
+    /// How the glTF files carry their colliders (`--collision-names`, `--physics`).
+    #[command(flatten)]
+    pub gltf: GltfArgs,
     /// Worker threads for the trials the designer plays (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
     pub threads: Option<u64>,

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 
 use super::values::{parse_game, parse_judges, parse_population, parse_retry};
-use super::{FormatArg, Judges};
+use super::{FormatArg, GltfArgs, Judges};
 use crate::services::campaign::Ramp;
 use crate::services::panel::Judge;
 use crate::services::wish::Constraint;
@@ -185,6 +185,9 @@ pub struct CampaignArgs {
     /// Level file formats, comma-separated.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "yaml,glb")]
     pub format: Vec<FormatArg>,
+    /// How the glTF files carry their colliders (`--collision-names`, `--physics`).
+    #[command(flatten)]
+    pub gltf: GltfArgs,
     /// Folder to write into (created if missing).
     #[arg(long)]
     pub out: PathBuf,

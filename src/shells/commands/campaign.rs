@@ -69,6 +69,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
         pacing: args.pacing.clone(),
         profile,
         checks: args.checks.clone(),
+        gltf: args.gltf.into(),
         population: match args.population {
             Some((theta_mean, theta_sd)) => PopulationAsk::Given(Population {
                 theta_mean,
@@ -88,7 +89,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     let panel = load_panel(&dir, args.game, None)?;
     check_panel_fit(&panel, ask.profile.as_ref());
     let files: Vec<LevelFiles> = (0..n)
-        .map(|k| LevelFiles::new(&args.out, &level_stem(k, n), &formats))
+        .map(|k| LevelFiles::new(&args.out, &level_stem(k, n), &formats).with_gltf(ask.gltf))
         .collect();
     let resumed = match args.resume {
         true => resumed_levels(args, &ask, &files, &solver)?,

@@ -37,9 +37,7 @@ pub fn run(args: &ExportArgs) -> Result<()> {
     } else {
         Overwrite::Never
     };
-    let files = LevelFiles::new(dir, stem, &[format])
-        .with_collision_names(args.collision_names)
-        .with_physics(args.physics.into());
+    let files = LevelFiles::new(dir, stem, &[format]).with_gltf(args.gltf.into());
     files.check_writable(overwrite)?;
     write_level_files(&level, &files, overwrite)?;
     for path in files.paths() {

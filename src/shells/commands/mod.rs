@@ -51,6 +51,7 @@ pub fn run(cli: Cli) -> Result<()> {
                     seed: 1,
                     campaign: None,
                     profile: None,
+                    gltf: crate::shells::cli::GltfArgs::default(),
                     threads: None,
                 })
             } else {
@@ -82,5 +83,6 @@ fn design(args: crate::shells::cli::DesignArgs) -> Result<()> {
         seed: args.seed,
         campaign: args.campaign,
         profile: args.profile,
+        gltf: args.gltf.into(),
     })
 }

@@ -12,6 +12,7 @@ use arlpcg_core::level::heading::{direction_heading, heading_direction, wrap_deg
 use arlpcg_core::level::params::quantize;
 
 pub use crate::services::generation::Ask;
+use crate::services::level_files::GltfOptions;
 use crate::services::verify::Recording;
 use arlpcg_core::level::{Game, Level, PerGame};
 
@@ -180,6 +181,8 @@ pub struct App {
     pub trials_wanted: u32,
     /// Where exports go (in a folder per game).
     pub out_dir: PathBuf,
+    /// How the exported glTF carries its colliders (`design --physics`, `--collision-names`).
+    pub gltf: GltfOptions,
     /// The level on screen.
     pub level: Option<Arc<Level>>,
     /// The generation in flight, if any.
@@ -239,6 +242,7 @@ impl App {
             goal: GoalSetting::FromSeed,
             trials_wanted: DEFAULT_TRIALS,
             out_dir,
+            gltf: GltfOptions::default(),
             level: None,
             loading: Loading::Idle,
             generation_error: None,
@@ -461,6 +465,7 @@ impl App {
             dir: self.out_dir.join(self.game.name()),
             stem: self.export_stem(),
             overwrite,
+            gltf: self.gltf,
         }]
     }
 

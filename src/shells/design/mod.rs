@@ -44,6 +44,8 @@ pub struct DesignOptions {
     pub campaign: Option<PathBuf>,
     /// A game profile the levels of the game opened on are made for.
     pub profile: Option<PathBuf>,
+    /// How exported glTF files carry their colliders.
+    pub gltf: crate::services::level_files::GltfOptions,
 }
 
 /// The policies the designer starts on for `game`, and a note when it falls back to rules and
@@ -101,6 +103,7 @@ pub fn run(mut options: DesignOptions) -> Result<()> {
     let (answers, responses) = channel();
     let workers = Workers::start(shelf, answers);
     let mut app = App::new(options.game, info, options.seed, options.out);
+    app.gltf = options.gltf;
     app.profile_mut().profile = profile;
     for (game, info) in others {
         app.loaded[game] = info;

@@ -147,7 +147,8 @@ pub struct ScenePoint {
 }
 
 /// Which glTF physics extensions an export writes its colliders and trigger in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum PhysicsExtensions {
     /// `OMI_physics_shape` and `OMI_physics_body` (Godot 4 reads them).
     #[default]

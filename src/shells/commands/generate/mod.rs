@@ -57,9 +57,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         .map(|&seed| {
             (
                 seed,
-                LevelFiles::new(&args.out, &stem(args, seed), &formats)
-                    .with_collision_names(args.collision_names)
-                    .with_physics(args.physics.into()),
+                LevelFiles::new(&args.out, &stem(args, seed), &formats).with_gltf(args.gltf.into()),
             )
         })
         .collect();

@@ -8,6 +8,7 @@ use ratatui::crossterm::event::{KeyEvent, MouseEvent};
 
 use super::judges;
 use super::{JudgeSwitch, LoadedInfo, SweepPoint};
+use crate::services::level_files::GltfOptions;
 use crate::services::panel::Judge;
 use crate::services::verify::Recording;
 use arlpcg_core::level::profile::Profile;
@@ -196,6 +197,8 @@ pub enum Effect {
         stem: String,
         /// Whether to replace files that exist.
         overwrite: bool,
+        /// How the .glb carries its colliders.
+        gltf: GltfOptions,
     },
     /// Policies of `game` from a folder or one file.
     Load {

@@ -15,7 +15,7 @@ use super::app::judges::{PANEL_SEED, PanelUpdate};
 use super::app::{Effect, ExportOutcome, Response, SweepPoint};
 use crate::services::fsio::Overwrite;
 use crate::services::generation::{Ask, KeptPrefix, LevelRequest};
-use crate::services::level_files::{Format, LevelFiles, write_level_files};
+use crate::services::level_files::{Format, GltfOptions, LevelFiles, write_level_files};
 use crate::services::making::{self, LevelSource, Proof};
 use crate::services::panel::rate;
 use crate::services::verify::{self, Solver, Watch};
@@ -210,7 +210,13 @@ pub fn perform(
             dir,
             stem,
             overwrite,
-        } => send(Response::Exported(export(&level, &dir, &stem, overwrite))),
+            gltf,
+        } => send(Response::Exported(export(
+            &level,
+            (&dir, &stem),
+            gltf,
+            overwrite,
+        ))),
         Effect::NextJudge {
             game,
             after,
@@ -530,10 +536,15 @@ fn target_level(
     .ok_or_else(|| "the search was stopped".to_string())
 }
 
-/// Writes the level's YAML and `.glb` into `dir` as `stem.*`, unless one exists and `overwrite`
-/// is false.
-fn export(level: &Level, dir: &Path, stem: &str, overwrite: bool) -> ExportOutcome {
-    let files = LevelFiles::new(dir, stem, &[Format::Yaml, Format::Glb]);
+/// Writes the level's YAML and `.glb` (its colliders as `gltf` says) into `dir` as `stem.*`,
+/// unless one exists and `overwrite` is false.
+fn export(
+    level: &Level,
+    (dir, stem): (&Path, &str),
+    gltf: GltfOptions,
+    overwrite: bool,
+) -> ExportOutcome {
+    let files = LevelFiles::new(dir, stem, &[Format::Yaml, Format::Glb]).with_gltf(gltf);
     let paths = files.paths();
     let existing: Vec<PathBuf> = paths.iter().filter(|p| p.exists()).cloned().collect();
     if !existing.is_empty() && !overwrite {

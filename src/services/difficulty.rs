@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::services::generation::{self, AuxAsk, GenerationError, GeneratorPolicy, LevelRequest};
 use crate::services::verify::{Solver, Watch, WrongGame, stats_of, trial_results, verify};
+use crate::services::wish::{Constraint, Evidence, Reads, Strictness};
 use arlpcg_core::level::Level;
 #[cfg(doc)]
 use arlpcg_core::level::pacing::AuxCurve;
@@ -85,7 +86,7 @@ pub enum TargetError {
     /// No candidate came within the band of the target.
     #[error(
         "no level within ±{BAND} of success {target} in {MAX_CANDIDATES} candidates (closest: {closest:.2} at λ {aux:+.2}){}",
-        set_aside(*.uncompleted, *.unbuilt)
+        set_aside(*.uncompleted, *.unbuilt, *.off_checks)
     )]
     Missed {
         /// The success asked for.
@@ -98,6 +99,8 @@ pub enum TargetError {
         uncompleted: u32,
         /// Draws that did not reach the goal within the piece budget.
         unbuilt: u32,
+        /// Draws whose pieces missed a check, never played.
+        off_checks: u32,
     },
     /// Stopped while the curve was measured.
     #[error("stopped while the λ→success curve was measured")]
@@ -115,7 +118,7 @@ pub enum TargetError {
 
 /// What a missed search set aside, for its message: a target near 0 is missed because a level
 /// that no run completes is never kept.
-fn set_aside(uncompleted: u32, unbuilt: u32) -> String {
+fn set_aside(uncompleted: u32, unbuilt: u32, off_checks: u32) -> String {
     let mut parts = Vec::new();
     if uncompleted > 0 {
         parts.push(format!(
@@ -126,6 +129,11 @@ fn set_aside(uncompleted: u32, unbuilt: u32) -> String {
     if unbuilt > 0 {
         parts.push(format!(
             "{unbuilt} draws did not reach the goal within the piece budget"
+        ));
+    }
+    if off_checks > 0 {
+        parts.push(format!(
+            "{off_checks} draws missed a check on their pieces and were not played"
         ));
     }
     match parts.is_empty() {
@@ -214,7 +222,9 @@ impl Curve {
 /// a new draw of the seed, or of another seed after [`OWN_SCENE_CANDIDATES`] (unless
 /// `asked.goal` is given). When `asked` has a curve of λ (pacing), the search moves the whole
 /// curve, its mean at the λ searched ([`AuxCurve::shifted`]). A candidate that no run completed
-/// is never kept. The level is made for `asked.profile`. `stopped` is asked before each
+/// is never kept, nor one whose pieces miss a constraint of `checks` on the pieces alone (it is
+/// not played: those constraints are met by search, the others checked afterwards). The level
+/// is made for `asked.profile`. `stopped` is asked before each
 /// candidate and between the runs it plays (a Ctrl-C ends the search with
 /// [`TargetError::SearchStopped`]).
 pub fn level_for(
@@ -223,6 +233,7 @@ pub fn level_for(
     curve: &Curve,
     asked: &LevelRequest,
     (target, trials): (f64, u32),
+    checks: &[Constraint],
     stopped: &(dyn Fn() -> bool + Sync),
 ) -> Result<Level, TargetError> {
     let (seed, goal) = (asked.seed, asked.goal);
@@ -232,7 +243,11 @@ pub fn level_for(
     };
     let mut aux = curve.aux_for(target);
     let mut closest = (f64::INFINITY, f64::NAN, aux);
-    let (mut uncompleted, mut unbuilt) = (0, 0);
+    let (mut uncompleted, mut unbuilt, mut off_checks) = (0, 0, 0);
+    let on_pieces: Vec<&Constraint> = checks
+        .iter()
+        .filter(|c| c.attribute.reads() <= Reads::Pieces)
+        .collect();
     let obstacles = arlpcg_core::game::facts::facts(generator.game).scene_obstacles;
     for draw in 0..MAX_CANDIDATES {
         if stopped() {
@@ -263,6 +278,14 @@ pub fn level_for(
             }
             Err(e) => return Err(e.into()),
         };
+        let unplayed = Evidence::default();
+        if on_pieces
+            .iter()
+            .any(|c| c.miss(&level, &unplayed, Strictness::Value).is_some())
+        {
+            off_checks += 1;
+            continue;
+        }
         let stats = screened_stats(&level, solver, (trials, seed), target, stopped)?
             .ok_or(TargetError::SearchStopped)?;
         let miss = stats.success_ratio - target;
@@ -285,6 +308,7 @@ pub fn level_for(
         aux: closest.2,
         uncompleted,
         unbuilt,
+        off_checks,
     })
 }
 
@@ -336,11 +360,15 @@ mod tests {
                 aux: -1.0,
                 uncompleted,
                 unbuilt,
+                off_checks: unbuilt + 1,
             }
             .to_string()
         };
         let plain = missed(0, 0);
-        assert!(plain.ends_with("(closest: 0.00 at λ -1.00)"), "{plain}");
+        assert!(
+            plain.ends_with("(closest: 0.00 at λ -1.00); 1 draws missed a check on their pieces and were not played"),
+            "{plain}"
+        );
         let redrawn = missed(7, 2);
         assert!(
             redrawn.contains("7 candidates within it were set aside because no run completed them")

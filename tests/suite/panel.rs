@@ -378,3 +378,18 @@ fn checks_fail_a_batch_with_exit_code_3_and_bad_checks_are_usage_errors() {
     ));
     fails_with(&racing, 2, "`curve` is not an attribute of these levels");
 }
+
+/// A campaign's checks on the pieces are met by search, not only checked: levels 1 and 2 of
+/// this campaign have 7 and 6 blocks when searched for their ramp point alone.
+#[test]
+fn a_campaign_searches_for_its_checks_on_the_pieces() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("campaign");
+    let done = small_campaign(&out, &["--check", "pieces 10..11"]);
+    assert!(done.status.success(), "{}", stderr(&done));
+    for k in 1..=3 {
+        let level = arlpcg_core::level::yaml::load(&out.join(format!("level0{k}.yaml"))).unwrap();
+        let blocks = level.platform().unwrap().block_count();
+        assert!((10..=11).contains(&blocks), "level {k}: {blocks} blocks");
+    }
+}

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use super::{Campaign, CampaignAsk, campaign_files, level_stem, open};
 use crate::services::difficulty;
-use crate::services::generation::{GeneratorPolicy, LevelRequest};
+use crate::services::generation::GeneratorPolicy;
 use crate::services::level_files::Format;
 use crate::services::making::{self, LevelSource, Proof};
 use crate::services::panel::{Judge, JudgePanel, play_and_rate};
@@ -35,23 +35,26 @@ pub fn order_by_difficulty(levels: &mut [Level], targets: &[f64], band: f64) {
     }
 }
 
-/// The search `asked` ([`CampaignAsk::request`]): a level whose success for `solver`, over
-/// `trials` runs, is within [`difficulty::BAND`] of `target` ([`difficulty::level_for`]; with a
-/// curve of λ, that curve moved as a whole), with its certificate. `stopped` ends the search
+/// The search of level `seed` of the campaign `ask` ([`CampaignAsk::request`]): a level whose
+/// success for `solver`, over the campaign's runs, is within [`difficulty::BAND`] of `target`
+/// ([`difficulty::level_for`]; with a curve of λ, that curve moved as a whole) and whose pieces
+/// meet the campaign's checks on pieces, with its certificate. `stopped` ends the search
 /// ([`difficulty::TargetError::SearchStopped`]).
 pub fn search_level(
     (generator, solver): (&GeneratorPolicy, &Solver),
     curve: &difficulty::Curve,
-    asked: &LevelRequest,
-    (target, trials): (f64, u32),
+    ask: &CampaignAsk,
+    (seed, target): (u64, f64),
     stopped: &(dyn Fn() -> bool + Sync),
 ) -> anyhow::Result<Level> {
     let proof = Proof::Target {
         solver,
         curve,
         target,
-        trials,
+        trials: ask.trials,
+        checks: &ask.checks,
     };
+    let asked = &ask.request(seed);
     let watch = Watch {
         on_trial: &|_| {},
         stop: stopped,
@@ -214,12 +217,11 @@ pub fn regenerate_level(
         .unwrap_or(record.seed)
         + 1;
     let target = record.levels[k].asked;
-    let asked = record.ask().request(seed);
     levels[k] = search_level(
         (generator, &solver),
         &curve,
-        &asked,
-        (target, record.trials),
+        &record.ask(),
+        (seed, target),
         stop,
     )?;
     for level in &mut levels {

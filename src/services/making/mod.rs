@@ -10,6 +10,7 @@ pub mod wanted;
 use crate::services::difficulty::{self, Curve};
 use crate::services::generation::{self, GeneratorPolicy, LevelRequest};
 use crate::services::verify::{self, Solver, Watch};
+use crate::services::wish::Constraint;
 use arlpcg_core::level::{Game, Level};
 
 /// Where levels come from.
@@ -88,6 +89,9 @@ pub enum Proof<'a> {
         target: f64,
         /// Runs per candidate.
         trials: u32,
+        /// Constraints a candidate's pieces must meet before it is played (a campaign's or
+        /// `generate`'s checks; those reading runs are checked afterwards).
+        checks: &'a [Constraint],
     },
     /// Searched over λ (or curves of λ) and draws until it meets every constraint of a wish
     /// list ([`wanted::Search`]); played where the wish list reads runs or `solver` is given.
@@ -112,6 +116,7 @@ pub fn verified_level(
             curve,
             target,
             trials,
+            checks,
         } => {
             let LevelSource::Generator(generator) = source else {
                 anyhow::bail!("a success target needs a Generator: the rules know no λ");
@@ -122,6 +127,7 @@ pub fn verified_level(
                 curve,
                 request,
                 (target, trials),
+                checks,
                 watch.stop,
             ) {
                 Err(difficulty::TargetError::SearchStopped) => return Ok(None),

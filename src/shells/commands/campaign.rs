@@ -126,13 +126,9 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     }
     let mut levels: Vec<Level> = built.into_iter().flatten().collect();
     let search = |seed: u64, target: f64| {
-        search_level(
-            (&generator, &solver),
-            &curve,
-            &ask.request(seed),
-            (target, args.trials),
-            &|| stop.load(Ordering::SeqCst),
-        )
+        search_level((&generator, &solver), &curve, &ask, (seed, target), &|| {
+            stop.load(Ordering::SeqCst)
+        })
     };
     let Some(campaign) = rate_levels(&ask, &panel, &mut levels, &stop, Some(&search))? else {
         let searched: Vec<Option<Level>> = levels.into_iter().map(Some).collect();
@@ -172,8 +168,8 @@ fn search_levels(
             let searched = search_level(
                 (generator, solver),
                 curve,
-                &ask.request(seed),
-                (ask.target(k, n), args.trials),
+                ask,
+                (seed, ask.target(k, n)),
                 &|| stop.load(Ordering::SeqCst),
             );
             // A Ctrl-C during the search leaves the level unsearched.

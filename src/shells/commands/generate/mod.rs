@@ -526,6 +526,7 @@ fn build_levels(
             curve,
             target,
             trials: verify_trials.unwrap_or(TARGET_TRIALS),
+            checks: &args.checks,
         },
         (None, _, _, Some(trials)) if args.verify.is_some() => Proof::Played {
             solver: who,

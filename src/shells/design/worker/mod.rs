@@ -520,6 +520,7 @@ fn target_level(
         curve: &curve,
         target,
         trials,
+        checks: &[],
     };
     let watch = verify::Watch {
         on_trial: &|_| {},

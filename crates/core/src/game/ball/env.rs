@@ -7,6 +7,7 @@ use rapier3d::math::Vector;
 use rapier3d::parry::shape::Ball;
 
 use crate::game::platform::PlatformRewards;
+use crate::game::platform::course::Course;
 use crate::game::platform::world::{PlatformBox, PlatformWorld};
 use crate::game::{Scripted, Skill, SolverEnv, Step};
 use crate::level::PlatformTrack;
@@ -18,11 +19,8 @@ use crate::level::stats::{Outcome, TrialResult};
 const PHYSICS_HZ: f32 = 60.0;
 const ACTION_REPEAT: u32 = 2;
 const DT: f32 = 1.0 / PHYSICS_HZ;
-/// Seconds allowed: this many, plus [`TIME_PER_BLOCK_S`] per block.
-const TIME_BASE_S: f32 = 10.0;
-const TIME_PER_BLOCK_S: f32 = 4.0;
-/// A run has fallen when the ball is this far below the lowest block.
-const FALL_MARGIN: f32 = 5.0;
+/// Seconds between decisions.
+const DECISION_DT: f32 = ACTION_REPEAT as f32 * DT;
 /// Share of its horizontal speed a rolling ball loses per second when not pushed.
 const ROLLING_LOSS: f32 = 0.8;
 
@@ -67,18 +65,11 @@ pub struct BallEnv {
     rewards: PlatformRewards,
     /// Its abilities: top speed, hop speed, gravity, push (ground and air) and radius.
     abilities: CharacterProfile,
-    /// The track grows as a Generator builds it: the last block is not yet the goal.
-    open: bool,
-    /// Path length from each block's top centre to the last one's, along the track.
-    path_after: Vec<f32>,
+    /// The run's way along the blocks (the platform game's, time limit and fall included).
+    course: Course,
     centre: Vector,
     velocity: Vector,
     grounded: bool,
-    furthest: usize,
-    steps: u32,
-    max_steps: u32,
-    remaining: f32,
-    outcome: Option<Outcome>,
 }
 
 impl BallEnv {
@@ -91,18 +82,12 @@ impl BallEnv {
             goal: Vector::new(goal[0] as f32, goal[1] as f32, goal[2] as f32),
             rewards: PlatformRewards::default(),
             abilities,
-            open: false,
-            path_after: Vec::new(),
+            course: Course::default(),
             centre: start,
             velocity: Vector::ZERO,
             grounded: false,
-            furthest: 0,
-            steps: 0,
-            max_steps: 0,
-            remaining: 0.0,
-            outcome: None,
         };
-        env.measure();
+        env.course = Course::new(&env.world, DECISION_DT);
         env.reset_on(0, 0);
         env
     }
@@ -110,28 +95,15 @@ impl BallEnv {
     /// The environment of a track still being built from its start block.
     pub fn open(start: &PlatformTrack, goal: [f64; 3], abilities: CharacterProfile) -> Self {
         let mut env = Self::new(start, goal, abilities);
-        env.open = true;
+        env.course = env.course.opened();
         env
     }
 
     /// Adds the Generator's newest block; `closes`: it is the last.
     pub fn push_platform(&mut self, platform: &Platform, closes: bool) {
         self.world.push(platform);
-        self.open = !closes;
-        self.measure();
-        self.remaining = self.path_remaining();
-    }
-
-    /// Path lengths along the track and the time limit, from the blocks placed so far.
-    fn measure(&mut self) {
-        let tops: Vec<Vector> = self.world.platforms().iter().map(|p| p.top).collect();
-        self.path_after = vec![0.0; tops.len()];
-        for i in (0..tops.len() - 1).rev() {
-            self.path_after[i] = self.path_after[i + 1] + tops[i].distance(tops[i + 1]);
-        }
-        let blocks = (tops.len() - 1) as f32;
-        let decision = ACTION_REPEAT as f32 * DT;
-        self.max_steps = ((TIME_BASE_S + TIME_PER_BLOCK_S * blocks) / decision).ceil() as u32;
+        let bottom = self.bottom();
+        self.course.grown(&self.world, closes, bottom, DECISION_DT);
     }
 
     /// Starts a run on block `block`, the ball within a metre of its centre (seeded).
@@ -148,10 +120,8 @@ impl BallEnv {
         self.centre = top + offset + Vector::Y * lift;
         self.velocity = Vector::ZERO;
         self.grounded = false;
-        self.furthest = block;
-        self.steps = 0;
-        self.outcome = None;
-        self.remaining = self.path_remaining();
+        let bottom = self.bottom();
+        self.course.restart(&self.world, block, bottom);
     }
 
     /// The ball's lowest point.
@@ -160,8 +130,7 @@ impl BallEnv {
     }
 
     fn next_block(&self) -> PlatformBox {
-        let platforms = self.world.platforms();
-        platforms[(self.furthest + 1).min(platforms.len() - 1)]
+        self.world.platforms()[self.course.next_index(&self.world)]
     }
 
     fn standing_on(&self) -> Option<usize> {
@@ -176,23 +145,14 @@ impl BallEnv {
             .flatten()
     }
 
-    fn path_remaining(&self) -> f32 {
-        let platforms = self.world.platforms();
-        let next = (self.furthest + 1).min(platforms.len() - 1);
-        if self.furthest == platforms.len() - 1 {
-            return 0.0;
-        }
-        self.bottom().distance(platforms[next].top) + self.path_after[next]
-    }
-
     /// Whether the ball rests on the newest block of a growing track.
     pub fn awaits_platform(&self) -> bool {
-        self.open && self.outcome.is_none() && self.furthest == self.world.platforms().len() - 1
+        self.course.awaits_platform(&self.world)
     }
 
     /// The furthest block rolled onto (0: the start block).
     pub fn furthest(&self) -> usize {
-        self.furthest
+        self.course.furthest()
     }
 
     /// One physics step: push, gravity, the hop, and rapier's controller through the blocks.
@@ -238,31 +198,14 @@ impl SolverEnv for BallEnv {
     }
 
     fn step(&mut self, action: BallAction) -> Step {
-        if let Some(outcome) = self.outcome {
-            return Step::finished(outcome, 0.0);
+        if let Some(finished) = self.course.finished() {
+            return finished;
         }
         for _ in 0..ACTION_REPEAT {
             self.physics_step(action);
         }
-        self.steps += 1;
-        if let Some(index) = self.standing_on() {
-            self.furthest = self.furthest.max(index);
-        }
-        let remaining = self.path_remaining();
-        let reward = self.rewards.progress_per_metre * (self.remaining - remaining);
-        self.remaining = remaining;
-        let last = self.world.platforms().len() - 1;
-        let outcome = if self.furthest == last && !self.open {
-            Some(Outcome::Success)
-        } else if self.bottom().y < self.world.lowest_top() - FALL_MARGIN {
-            Some(Outcome::Fell)
-        } else if self.steps >= self.max_steps {
-            Some(Outcome::TimedOut)
-        } else {
-            None
-        };
-        self.outcome = outcome;
-        Step::after(outcome, reward, self.rewards.success, self.rewards.failure)
+        let now = (self.bottom(), self.standing_on());
+        self.course.after_decision(&self.world, now, &self.rewards)
     }
 
     fn observe(&self, out: &mut [f32]) {
@@ -278,7 +221,7 @@ impl SolverEnv for BallEnv {
             .chain([next.size / 6.0])
             .chain((self.velocity / 10.0).to_array())
             .chain([f32::from(u8::from(self.grounded))])
-            .chain([1.0 - self.steps as f32 / self.max_steps as f32]);
+            .chain([self.course.time_left()]);
         for (slot, value) in out.iter_mut().zip(values) {
             *slot = value;
         }
@@ -308,9 +251,9 @@ impl SolverEnv for BallEnv {
     fn trial_result(&self, outcome: Outcome) -> TrialResult {
         TrialResult {
             outcome,
-            progress: self.furthest as f64 / (self.world.platforms().len() - 1).max(1) as f64,
-            target_piece: self.furthest,
-            steps: self.steps,
+            progress: self.course.progress(&self.world),
+            target_piece: self.course.furthest(),
+            steps: self.course.steps(),
             air_steps: None,
         }
     }
@@ -325,8 +268,8 @@ impl SolverEnv for BallEnv {
             ("centre", crate::game::spec::coords(self.centre)),
             ("velocity", crate::game::spec::coords(self.velocity)),
             ("grounded", vec![f64::from(u8::from(self.grounded))]),
-            ("steps", vec![f64::from(self.steps)]),
-            ("max_steps", vec![f64::from(self.max_steps)]),
+            ("steps", vec![f64::from(self.course.steps())]),
+            ("max_steps", vec![f64::from(self.course.max_steps())]),
             ("goal", crate::game::spec::coords(self.goal)),
             ("next_block_top", crate::game::spec::coords(next.top)),
             ("next_block_size", vec![f64::from(next.size)]),

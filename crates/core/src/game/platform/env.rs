@@ -6,6 +6,7 @@ use rand_chacha::ChaCha8Rng;
 use rapier3d::math::Vector;
 
 use super::character::{Body, Character, DECISION_DT, PlatformAction};
+use super::course::Course;
 use super::world::PlatformWorld;
 use crate::game::SolverEnv;
 use crate::game::Step;
@@ -23,12 +24,7 @@ const HEIGHT_MAP_LEFT: [f32; HEIGHT_MAP_SIDE] = [-3.0, -1.5, 0.0, 1.5, 3.0];
 const RAY_START_HEIGHT: f32 = 2.2;
 /// ...and see this far down.
 const RAY_LENGTH: f32 = 8.0;
-/// A run has fallen when its feet are this far below the lowest block.
-pub const FALL_MARGIN: f32 = 5.0;
-/// Time allowed for a level: this many seconds...
-const TIME_BASE_S: f32 = 10.0;
-/// ...plus this many per block.
-const TIME_PER_BLOCK_S: f32 = 4.0;
+pub use super::course::FALL_MARGIN;
 
 /// The named parts of the observation vector, in order, with their lengths.
 pub const OBSERVATION_LAYOUT: [(&str, usize); 9] = [
@@ -100,20 +96,11 @@ pub struct PlatformEnv {
     world: PlatformWorld,
     goal: Vector,
     rewards: PlatformRewards,
-    /// Path length from each platform's top centre to the last one's, along the track.
-    path_after: Vec<f32>,
-    max_steps: u32,
-    /// The track is still growing (the Generator places blocks as the Solver advances): reaching
-    /// the last block is not yet success.
-    open: bool,
+    /// The run's way along the blocks.
+    course: Course,
     character: Character,
     /// The character's abilities (the game profile's).
     body: Body,
-    /// Highest platform index the character has stood on (0 is the start block).
-    furthest: usize,
-    steps: u32,
-    remaining: f32,
-    outcome: Option<Outcome>,
 }
 
 impl PlatformEnv {
@@ -125,17 +112,11 @@ impl PlatformEnv {
             world,
             goal: Vector::new(goal[0] as f32, goal[1] as f32, goal[2] as f32),
             rewards,
-            path_after: Vec::new(),
-            max_steps: 0,
-            open: false,
+            course: Course::default(),
             character: Character::new(start.top, start.heading, Body::default()),
             body: Body::default(),
-            furthest: 0,
-            steps: 0,
-            remaining: 0.0,
-            outcome: None,
         };
-        env.measure_track();
+        env.course = Course::new(&env.world, DECISION_DT);
         env.reset(0);
         env
     }
@@ -151,7 +132,7 @@ impl PlatformEnv {
     /// (often just the start block) and grows with [`PlatformEnv::push_platform`].
     pub fn open(track: &PlatformTrack, goal: [f64; 3], rewards: PlatformRewards) -> Self {
         let mut env = Self::new(track, goal, rewards);
-        env.open = true;
+        env.course = env.course.opened();
         env
     }
 
@@ -159,26 +140,14 @@ impl PlatformEnv {
     /// standing on it is success. The run goes on where it was; its time limit grows.
     pub fn push_platform(&mut self, platform: &Platform, closes: bool) {
         self.world.push(platform);
-        self.open = !closes;
-        self.measure_track();
-        self.remaining = self.path_remaining();
-    }
-
-    /// Path lengths along the track and the time limit, from the platforms placed so far.
-    fn measure_track(&mut self) {
-        let tops: Vec<Vector> = self.world.platforms().iter().map(|p| p.top).collect();
-        self.path_after = vec![0.0; tops.len()];
-        for i in (0..tops.len() - 1).rev() {
-            self.path_after[i] = self.path_after[i + 1] + tops[i].distance(tops[i + 1]);
-        }
-        let blocks = (tops.len() - 1) as f32;
-        self.max_steps = ((TIME_BASE_S + TIME_PER_BLOCK_S * blocks) / DECISION_DT).ceil() as u32;
+        let feet = self.character.feet;
+        self.course.grown(&self.world, closes, feet, DECISION_DT);
     }
 
     /// Whether the character stands on the newest block of a growing track: the Generator's
     /// turn to place the next one.
     pub fn awaits_platform(&self) -> bool {
-        self.open && self.outcome.is_none() && self.furthest == self.world.platforms().len() - 1
+        self.course.awaits_platform(&self.world)
     }
 
     /// Starts a new run on block `block` (0: the start block), as [`PlatformEnv::reset`] does on
@@ -196,10 +165,8 @@ impl PlatformEnv {
         let offset = rapier3d::math::Rotation::from_rotation_y(start.heading) * local;
         let yaw = start.heading + rng.random_range(-90.0f32..=90.0).to_radians();
         self.character = Character::new(start.top + offset, yaw, self.body);
-        self.furthest = block;
-        self.steps = 0;
-        self.outcome = None;
-        self.remaining = self.path_remaining();
+        let feet = self.character.feet;
+        self.course.restart(&self.world, block, feet);
     }
 
     /// The platform the character stands on, if grounded on one.
@@ -216,20 +183,7 @@ impl PlatformEnv {
 
     /// Index of the next platform to reach (the last one once the run has succeeded).
     fn next_index(&self) -> usize {
-        (self.furthest + 1).min(self.world.platforms().len() - 1)
-    }
-
-    fn path_remaining(&self) -> f32 {
-        let last = self.world.platforms().len() - 1;
-        if self.furthest == last {
-            // Done, or waiting for the Generator's next block.
-            return 0.0;
-        }
-        let next = self.next_index();
-        self.character
-            .feet
-            .distance(self.world.platforms()[next].top)
-            + self.path_after[next]
+        self.course.next_index(&self.world)
     }
 
     /// How far each height-map ray travels down before it hits something ([`RAY_LENGTH`] where
@@ -269,22 +223,22 @@ impl PlatformEnv {
 
     /// Highest platform index stood on so far (0 is the start block).
     pub fn furthest(&self) -> usize {
-        self.furthest
+        self.course.furthest()
     }
 
     /// Fraction of the blocks reached, in [0, 1].
     pub fn progress(&self) -> f64 {
-        self.furthest as f64 / (self.world.platforms().len() - 1).max(1) as f64
+        self.course.progress(&self.world)
     }
 
     /// Decisions taken so far.
     pub fn steps(&self) -> u32 {
-        self.steps
+        self.course.steps()
     }
 
     /// How the run ended, once it has.
     pub fn outcome(&self) -> Option<Outcome> {
-        self.outcome
+        self.course.outcome()
     }
 }
 
@@ -300,30 +254,12 @@ impl crate::game::SolverEnv for PlatformEnv {
 
     /// Advances one decision.
     fn step(&mut self, action: PlatformAction) -> Step {
-        if let Some(outcome) = self.outcome {
-            // A finished run stays finished.
-            return Step::finished(outcome, 0.0);
+        if let Some(finished) = self.course.finished() {
+            return finished;
         }
         self.character.step(&self.world, action);
-        self.steps += 1;
-        if let Some(index) = self.standing_on() {
-            self.furthest = self.furthest.max(index);
-        }
-        let remaining = self.path_remaining();
-        let reward = self.rewards.progress_per_metre * (self.remaining - remaining);
-        self.remaining = remaining;
-        let last = self.world.platforms().len() - 1;
-        let outcome = if self.furthest == last && !self.open {
-            Some(Outcome::Success)
-        } else if self.character.feet.y < self.world.lowest_top() - FALL_MARGIN {
-            Some(Outcome::Fell)
-        } else if self.steps >= self.max_steps {
-            Some(Outcome::TimedOut)
-        } else {
-            None
-        };
-        self.outcome = outcome;
-        Step::after(outcome, reward, self.rewards.success, self.rewards.failure)
+        let now = (self.character.feet, self.standing_on());
+        self.course.after_decision(&self.world, now, &self.rewards)
     }
 
     /// Writes the observation (see [`OBSERVATION_LAYOUT`]) into `out`.
@@ -350,7 +286,7 @@ impl crate::game::SolverEnv for PlatformEnv {
             .chain(local(c.velocity).map(|x| x / 10.0))
             .chain([bearing.sin(), bearing.cos()])
             .chain([if c.grounded { 1.0 } else { 0.0 }])
-            .chain([1.0 - self.steps as f32 / self.max_steps as f32]);
+            .chain([self.course.time_left()]);
         let (state_out, map) = out.split_at_mut(STATE_SIZE);
         for (slot, value) in state_out.iter_mut().zip(state) {
             *slot = value;
@@ -395,8 +331,8 @@ impl crate::game::SolverEnv for PlatformEnv {
             ("yaw", vec![f64::from(c.yaw)]),
             ("velocity", crate::game::spec::coords(c.velocity)),
             ("grounded", vec![f64::from(u8::from(c.grounded))]),
-            ("steps", vec![f64::from(self.steps)]),
-            ("max_steps", vec![f64::from(self.max_steps)]),
+            ("steps", vec![f64::from(self.course.steps())]),
+            ("max_steps", vec![f64::from(self.course.max_steps())]),
             ("goal", crate::game::spec::coords(self.goal)),
             ("next_block_top", crate::game::spec::coords(next.top)),
             ("next_block_size", vec![f64::from(next.size)]),

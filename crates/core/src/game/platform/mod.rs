@@ -3,6 +3,7 @@
 //! non-learning controller, and [`reach`] the calibrated jumping range.
 
 pub mod character;
+pub mod course;
 pub mod env;
 pub mod generator;
 pub mod reach;

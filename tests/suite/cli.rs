@@ -560,6 +560,15 @@ fn a_batch_that_fails_writes_nothing_and_overwrites_nothing() {
     );
     fails_with(&failed, 1, "nothing was written");
     assert_eq!(files_of(dir.path()), before);
+    // A verified batch whose level cannot be built fails before any level is played.
+    let unbuildable = generate(
+        dir.path(),
+        &[
+            "--count", "1", "--format", "yaml", "--force", "--goal", "0,300,5", "--verify", "20",
+        ],
+    );
+    fails_with(&unbuildable, 1, "seed 0 (nothing was played or written)");
+    assert_eq!(files_of(dir.path()), before);
 }
 
 /// Ctrl-C in a batch writes the levels finished so far, complete, leaves no temporary file,

@@ -543,11 +543,27 @@ fn build_levels(
         on_trial: &|_| {},
         stop: &|| stop.load(Ordering::SeqCst),
     };
+    // A seed whose level cannot be built fails the batch before any level is played: each
+    // seed's first draw is built, unplayed, first (milliseconds beside the runs).
+    if let Proof::Played { .. } = proof {
+        plans.par_iter().try_for_each(|(seed, _)| {
+            let request = LevelRequest {
+                seed: *seed,
+                ..template.clone()
+            };
+            source
+                .level(&request)
+                .map(drop)
+                .with_context(|| format!("seed {seed} (nothing was played or written)"))
+        })?;
+    }
+    // The first seed that fails ends the batch: the seeds not yet started are not played.
+    let failed = AtomicBool::new(false);
     let bar = crate::shells::common::progress_bar(plans.len() as u64, "generating");
     let built: Vec<Option<Result<Level>>> = plans
         .par_iter()
         .map(|(seed, _)| {
-            if stop.load(Ordering::SeqCst) {
+            if stop.load(Ordering::SeqCst) || failed.load(Ordering::SeqCst) {
                 return None;
             }
             // A success target searches its own draws, λ and (without a goal) seeds.
@@ -565,12 +581,23 @@ fn build_levels(
                 crate::warn!("{eased}")
             });
             bar.inc(1);
+            if level.is_err() {
+                failed.store(true, Ordering::SeqCst);
+            }
             level
                 .with_context(|| format!("seed {seed} (nothing was written)"))
                 .transpose()
         })
         .collect();
     bar.finish_and_clear();
+    let mut built = built;
+    let first_error = built.iter_mut().find_map(|level| match level {
+        Some(Err(_)) => level.take()?.err(),
+        _ => None,
+    });
+    if let Some(error) = first_error {
+        return Err(error);
+    }
     // The levels finished before a Ctrl-C: a prefix of the batch, so that a re-run resumes it.
     let mut levels = Vec::with_capacity(plans.len());
     for level in built {

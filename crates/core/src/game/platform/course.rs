@@ -1,14 +1,38 @@
 //! A run's way along a track of blocks, whoever runs it: the path still to go, the furthest
-//! block stood on, the decisions taken and the time allowed, and how the run ends. The platform
-//! character's environment keeps one, and so does any game played on the platform game's
-//! blocks (the test game's ball).
+//! block stood on, the decisions taken and the time allowed, how the run ends and what it pays
+//! (the Solver's rewards). The platform character's environment keeps one, and so does any game
+//! played on the platform game's blocks (the test game's ball).
 
 use rapier3d::math::Vector;
 
-use super::env::PlatformRewards;
 use super::world::PlatformWorld;
 use crate::game::Step;
 use crate::level::stats::Outcome;
+
+/// The Solver's reward weights (docs/spec.md §2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlatformRewards {
+    /// Per metre of progress along the track toward the goal (negative when moving back).
+    pub progress_per_metre: f32,
+    /// On reaching the goal block.
+    pub success: f32,
+    /// On falling or running out of time.
+    pub failure: f32,
+}
+
+impl Default for PlatformRewards {
+    fn default() -> Self {
+        // A jump of a typical 7 m block pays about +7 and a fall costs 5, so attempting a jump
+        // pays once it succeeds about 40% of the time. (At 0.1 per metre the Solver learned to
+        // wait on the start block: a jump had to succeed 88% of the time to be worth a fall, and
+        // the time-out's penalty is discounted to nothing 1000 steps ahead.)
+        Self {
+            progress_per_metre: 1.0,
+            success: 10.0,
+            failure: -5.0,
+        }
+    }
+}
 
 /// A run has fallen when its lowest point is this far below the lowest block.
 pub const FALL_MARGIN: f32 = 5.0;

@@ -7,6 +7,7 @@ use rapier3d::math::Vector;
 
 use super::character::{Body, Character, DECISION_DT, PlatformAction};
 use super::course::Course;
+pub use super::course::{FALL_MARGIN, PlatformRewards};
 use super::world::PlatformWorld;
 use crate::game::SolverEnv;
 use crate::game::Step;
@@ -24,7 +25,6 @@ const HEIGHT_MAP_LEFT: [f32; HEIGHT_MAP_SIDE] = [-3.0, -1.5, 0.0, 1.5, 3.0];
 const RAY_START_HEIGHT: f32 = 2.2;
 /// ...and see this far down.
 const RAY_LENGTH: f32 = 8.0;
-pub use super::course::FALL_MARGIN;
 
 /// The named parts of the observation vector, in order, with their lengths.
 pub const OBSERVATION_LAYOUT: [(&str, usize); 9] = [
@@ -65,31 +65,6 @@ pub const OBSERVATION_SIZE: usize = {
     }
     total
 };
-
-/// The Solver's reward weights (docs/spec.md §2).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PlatformRewards {
-    /// Per metre of progress along the track toward the goal (negative when moving back).
-    pub progress_per_metre: f32,
-    /// On reaching the goal block.
-    pub success: f32,
-    /// On falling or running out of time.
-    pub failure: f32,
-}
-
-impl Default for PlatformRewards {
-    fn default() -> Self {
-        // A jump of a typical 7 m block pays about +7 and a fall costs 5, so attempting a jump
-        // pays once it succeeds about 40% of the time. (At 0.1 per metre the Solver learned to
-        // wait on the start block: a jump had to succeed 88% of the time to be worth a fall, and
-        // the time-out's penalty is discounted to nothing 1000 steps ahead.)
-        Self {
-            progress_per_metre: 1.0,
-            success: 10.0,
-            failure: -5.0,
-        }
-    }
-}
 
 /// One Solver run on one platform level.
 pub struct PlatformEnv {

@@ -353,23 +353,25 @@ mod tests {
     /// target near 0 is missed), and says nothing of them when there were none.
     #[test]
     fn a_missed_target_names_the_candidates_no_run_completed() {
-        let missed = |uncompleted, unbuilt| {
+        let missed = |uncompleted, unbuilt, off_checks| {
             TargetError::Missed {
                 target: 0.02,
                 closest: 0.0,
                 aux: -1.0,
                 uncompleted,
                 unbuilt,
-                off_checks: unbuilt + 1,
+                off_checks,
             }
             .to_string()
         };
-        let plain = missed(0, 0);
+        let plain = missed(0, 0, 0);
+        assert!(plain.ends_with("(closest: 0.00 at λ -1.00)"), "{plain}");
+        let checked = missed(0, 0, 3);
         assert!(
-            plain.ends_with("(closest: 0.00 at λ -1.00); 1 draws missed a check on their pieces and were not played"),
-            "{plain}"
+            checked.ends_with("; 3 draws missed a check on their pieces and were not played"),
+            "{checked}"
         );
-        let redrawn = missed(7, 2);
+        let redrawn = missed(7, 2, 0);
         assert!(
             redrawn.contains("7 candidates within it were set aside because no run completed them")
                 && redrawn.contains("ask for a higher success")

@@ -560,7 +560,7 @@ fn build_levels(
     // The first seed that fails ends the batch: the seeds not yet started are not played.
     let failed = AtomicBool::new(false);
     let bar = crate::shells::common::progress_bar(plans.len() as u64, "generating");
-    let built: Vec<Option<Result<Level>>> = plans
+    let mut built: Vec<Option<Result<Level>>> = plans
         .par_iter()
         .map(|(seed, _)| {
             if stop.load(Ordering::SeqCst) || failed.load(Ordering::SeqCst) {
@@ -590,7 +590,6 @@ fn build_levels(
         })
         .collect();
     bar.finish_and_clear();
-    let mut built = built;
     let first_error = built.iter_mut().find_map(|level| match level {
         Some(Err(_)) => level.take()?.err(),
         _ => None,

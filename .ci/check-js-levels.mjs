@@ -7,14 +7,13 @@
 // (or, with --min-exact and --drift, beyond those bars; below).
 //
 //   node .ci/check-js-levels.mjs ARLPCG_BINARY [SEEDS (100)] [FIRST_SEED (0)] [--aux=-1,0,1]
-//       [--min-exact=N --drift=D]
+//       [--min-exact=N --drift=D] [--ort=MODULE]
 
 import { execFileSync } from "node:child_process";
 import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
-import { fileURLToPath } from "node:url";
-import * as ort from "onnxruntime-node";
+import { fileURLToPath, pathToFileURL } from "node:url";
 import { PlatformGenerator } from "../web/levels.mjs";
 import { ChaCha8Rng } from "../web/rng.mjs";
 
@@ -23,7 +22,7 @@ const args = process.argv.slice(2);
 const flag = (name) => args.find((a) => a.startsWith(`--${name}=`))?.split("=")[1];
 const [binary, seedsArg = "100", firstArg = "0"] = args.filter((a) => !a.startsWith("--"));
 if (!binary) {
-  console.error("usage: node .ci/check-js-levels.mjs ARLPCG_BINARY [SEEDS] [FIRST_SEED] [--aux=-1,0,1] [--min-exact=N --drift=D]");
+  console.error("usage: node .ci/check-js-levels.mjs ARLPCG_BINARY [SEEDS] [FIRST_SEED] [--aux=-1,0,1] [--min-exact=N --drift=D] [--ort=MODULE]");
   process.exit(2);
 }
 const seeds = Number(seedsArg);
@@ -37,6 +36,11 @@ const TOLERANCE = 1e-3 + 1e-9;
 // observe that and drift a little. `--min-exact=N` passes when at least N levels are within the
 // rounding in every value and every other level within `--drift=D` (degrees or metres) in every
 // block value; the goal, the start and the number of blocks are always held to the rounding.
+// The runtime: onnxruntime-node (pinned in .ci/package.json) unless `--ort=` names another
+// module (a path to onnxruntime-web's ESM entry, say: the same module runs in a page).
+const ortModule = flag("ort") ?? "onnxruntime-node";
+const ort = await import(ortModule.startsWith("/") ? pathToFileURL(ortModule).href : ortModule);
+if (ort.env?.wasm) ort.env.wasm.numThreads = 1;
 const minExact = flag("min-exact") === undefined ? null : Number(flag("min-exact"));
 const AUXES = (flag("aux") ?? "-1,0,1").split(",").map(Number);
 const DRIFT = (flag("drift") === undefined ? 1e-3 : Number(flag("drift"))) + 1e-9;
@@ -175,7 +179,7 @@ console.log(
     `with the same goal, start and number of blocks, their block values at most ` +
     `${worstDrift.toFixed(4)} off; ${mismatches} failed the check; ` +
     `${mean.toFixed(2)} ms per level on average, median ${median.toFixed(2)}, slowest ` +
-    `${(times[times.length - 1] ?? 0).toFixed(2)} (onnxruntime-node)`,
+    `${(times[times.length - 1] ?? 0).toFixed(2)} (${ortModule})`,
 );
 const enough = minExact === null ? exact === levels : exact >= minExact;
 if (!enough) console.log(`${exact} levels within the rounding in every value: fewer than ${minExact ?? levels}`);

@@ -7,7 +7,7 @@
 // (or, with --min-exact and --drift, beyond those bars; below).
 //
 //   node .ci/check-js-levels.mjs ARLPCG_BINARY [SEEDS (100)] [FIRST_SEED (0)] [--aux=-1,0,1]
-//       [--min-exact=N --drift=D] [--ort=MODULE]
+//       [--min-exact=N --drift=D] [--ort=MODULE] [--game=racing --obstacles=N]
 
 import { execFileSync } from "node:child_process";
 import fs from "node:fs";
@@ -15,6 +15,7 @@ import os from "node:os";
 import path from "node:path";
 import { fileURLToPath, pathToFileURL } from "node:url";
 import { PlatformGenerator } from "../web/levels.mjs";
+import { RacingGenerator } from "../web/racing.mjs";
 import { ChaCha8Rng } from "../web/rng.mjs";
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), "..");
@@ -22,7 +23,7 @@ const args = process.argv.slice(2);
 const flag = (name) => args.find((a) => a.startsWith(`--${name}=`))?.split("=")[1];
 const [binary, seedsArg = "100", firstArg = "0"] = args.filter((a) => !a.startsWith("--"));
 if (!binary) {
-  console.error("usage: node .ci/check-js-levels.mjs ARLPCG_BINARY [SEEDS] [FIRST_SEED] [--aux=-1,0,1] [--min-exact=N --drift=D] [--ort=MODULE]");
+  console.error("usage: node .ci/check-js-levels.mjs ARLPCG_BINARY [SEEDS] [FIRST_SEED] [--game=racing --obstacles=N] [--aux=-1,0,1] [--min-exact=N --drift=D] [--ort=MODULE]");
   process.exit(2);
 }
 const seeds = Number(seedsArg);
@@ -35,12 +36,19 @@ const TOLERANCE = 1e-3 + 1e-9;
 // quantized twice, so it can land a thousandth or two of a degree off, and the blocks after it
 // observe that and drift a little. `--min-exact=N` passes when at least N levels are within the
 // rounding in every value and every other level within `--drift=D` (degrees or metres) in every
-// block value; the goal, the start and the number of blocks are always held to the rounding.
+// block value; the goal, the start and the number of blocks are always held to the rounding
+// (and a racing level's obstacles).
 // The runtime: onnxruntime-node (pinned in .ci/package.json) unless `--ort=` names another
 // module (a path to onnxruntime-web's ESM entry, say: the same module runs in a page).
 const ortModule = flag("ort") ?? "onnxruntime-node";
 const ort = await import(ortModule.startsWith("/") ? pathToFileURL(ortModule).href : ortModule);
 if (ort.env?.wasm) ort.env.wasm.numThreads = 1;
+// The game (`--game=racing`: web/racing.mjs and the racing Generator), and for racing the
+// obstacles drawn from each seed (`--obstacles=N`, generate's flag).
+const GAME = flag("game") ?? "platform";
+const OBSTACLES = Number(flag("obstacles") ?? 0);
+const PIECES = GAME === "racing" ? "segments" : "blocks";
+const FIELDS = GAME === "racing" ? ["length", "curve", "height"] : ["distance", "angle", "size", "height"];
 const minExact = flag("min-exact") === undefined ? null : Number(flag("min-exact"));
 const AUXES = (flag("aux") ?? "-1,0,1").split(",").map(Number);
 const DRIFT = (flag("drift") === undefined ? 1e-3 : Number(flag("drift"))) + 1e-9;
@@ -76,14 +84,20 @@ const DRIFT = (flag("drift") === undefined ? 1e-3 : Number(flag("drift"))) + 1e-
 const arlpcg = (...args) => execFileSync(path.resolve(binary), args, { cwd: root, stdio: ["ignore", "pipe", "inherit"] });
 const tmp = fs.mkdtempSync(path.join(os.tmpdir(), "js-levels-"));
 const onnxPath = path.join(tmp, "generator.onnx");
-arlpcg("export-policy", "policies/platform/generator.safetensors", "--out", onnxPath);
+arlpcg("export-policy", `policies/${GAME}/generator.safetensors`, "--out", onnxPath);
 const sidecar = JSON.parse(fs.readFileSync(`${onnxPath}.json`, "utf8"));
-const generator = await PlatformGenerator.load(ort, fs.readFileSync(onnxPath), sidecar);
+const Generator = GAME === "racing" ? RacingGenerator : PlatformGenerator;
+const generator = await Generator.load(ort, fs.readFileSync(onnxPath), sidecar);
 
-/** The goal, start heading and blocks of a level file (the fields this check compares). */
+/** An obstacle's numbers in the level file's order. */
+function obstacleNumbers(o) {
+  return o.kind === "box" ? [...o.position, ...o.size, o.heading] : [...o.position, o.radius, o.height];
+}
+
+/** The goal, start heading, obstacles' numbers and pieces of a level file (what is compared). */
 function readLevel(text) {
   const lines = text.split("\n");
-  const level = { seed: null, goal: [], heading: null, blocks: [] };
+  const level = { seed: null, goal: [], heading: null, obstacles: [], pieces: [] };
   let section = null;
   for (const line of lines) {
     const top = line.match(/^([a-z_]+):\s*(.*)$/);
@@ -98,12 +112,16 @@ function readLevel(text) {
     } else if (section === "start") {
       const m = line.match(/^ {2}heading: (\S+)$/);
       if (m) level.heading = Number(m[1]);
-    } else if (section === "blocks") {
-      const m = line.match(/^(- | {2})(distance|angle|size|height): (\S+)$/);
-      if (m) {
-        if (m[1] === "- ") level.blocks.push({});
-        level.blocks[level.blocks.length - 1][m[2]] = Number(m[3]);
+    } else if (section === PIECES) {
+      const m = line.match(/^(- | {2})([a-z]+): (\S+)$/);
+      if (m && FIELDS.includes(m[2])) {
+        if (m[1] === "- ") level.pieces.push({});
+        level.pieces[level.pieces.length - 1][m[2]] = Number(m[3]);
       }
+    } else if (section === "obstacles") {
+      if (line.startsWith("- kind:")) level.obstacles.push([]);
+      const m = line.match(/^ {2}(?:- |[a-z]+: )(-?[0-9.]+)$/);
+      if (m) level.obstacles[level.obstacles.length - 1].push(Number(m[1]));
     }
   }
   return level;
@@ -118,8 +136,9 @@ const times = [];
 for (const aux of AUXES) {
   const out = path.join(tmp, `aux${aux}`);
   arlpcg(
-    "generate", "--policies", "policies/platform", `--aux=${aux}`, "--seed", String(first),
-    "--count", String(seeds), "--out", out, "--format", "yaml",
+    "generate", "--game", GAME, "--policies", `policies/${GAME}`, `--aux=${aux}`, "--seed",
+    String(first), "--count", String(seeds), "--out", out, "--format", "yaml",
+    ...(GAME === "racing" ? ["--obstacles", String(OBSTACLES)] : []),
   );
   const files = fs.readdirSync(out).filter((f) => f.endsWith(".yaml"));
   if (files.length !== seeds) {
@@ -131,7 +150,7 @@ for (const aux of AUXES) {
     const began = performance.now();
     let got;
     try {
-      got = await generator.build({ seed: want.seed, aux });
+      got = await generator.build({ seed: want.seed, aux, obstacles: OBSTACLES });
     } catch (error) {
       console.log(`${file}: the module built no level: ${error.message}`);
       mismatches++;
@@ -144,15 +163,21 @@ for (const aux of AUXES) {
     const near = (a, b) => Math.abs(a - b) <= TOLERANCE;
     want.goal.forEach((g, i) => near(g, got.goal[i]) || problems.push(`goal[${i}] ${g} vs ${got.goal[i]}`));
     if (!near(want.heading, got.start.heading)) problems.push(`start heading ${want.heading} vs ${got.start.heading}`);
-    if (want.blocks.length !== got.blocks.length) {
-      problems.push(`${want.blocks.length} blocks vs ${got.blocks.length} (attempt ${got.attempt})`);
+    const gotObstacles = (got.obstacles ?? []).map(obstacleNumbers).flat();
+    const wantObstacles = want.obstacles.flat();
+    if (gotObstacles.length !== wantObstacles.length || wantObstacles.some((v, i) => !near(v, gotObstacles[i]))) {
+      problems.push(`obstacles ${wantObstacles} vs ${gotObstacles}`);
     }
-    const n = Math.min(want.blocks.length, got.blocks.length);
+    const gotPieces = got[PIECES];
+    if (want.pieces.length !== gotPieces.length) {
+      problems.push(`${want.pieces.length} ${PIECES} vs ${gotPieces.length} (attempt ${got.attempt})`);
+    }
+    const n = Math.min(want.pieces.length, gotPieces.length);
     const offs = [];
     for (let i = 0; i < n; i++) {
-      for (const key of ["distance", "angle", "size", "height"]) {
-        const off = Math.abs(want.blocks[i][key] - got.blocks[i][key]);
-        if (off > TOLERANCE) offs.push({ off, text: `block ${i} ${key} ${want.blocks[i][key]} vs ${got.blocks[i][key]}` });
+      for (const key of FIELDS) {
+        const off = Math.abs(want.pieces[i][key] - gotPieces[i][key]);
+        if (off > TOLERANCE) offs.push({ off, text: `${PIECES} ${i} ${key} ${want.pieces[i][key]} vs ${gotPieces[i][key]}` });
       }
     }
     const drift = Math.max(0, ...offs.map((o) => o.off));
@@ -174,9 +199,9 @@ const mean = times.reduce((a, b) => a + b, 0) / Math.max(times.length, 1);
 const median = times[Math.floor(times.length / 2)] ?? 0;
 if (minExact !== null) for (const line of drifted) console.log(`drifted: ${line}`);
 console.log(
-  `js levels (${seeds} seeds from ${first} at λ = ${AUXES.join(", ")}): ${exact} of ${levels} levels rebuilt ` +
+  `js levels, ${GAME}${GAME === "racing" ? ` with ${OBSTACLES} obstacles` : ""} (${seeds} seeds from ${first} at λ = ${AUXES.join(", ")}): ${exact} of ${levels} levels rebuilt ` +
     `to every value arlpcg generate wrote within its rounding (1e-3); ${drifted.length} more ` +
-    `with the same goal, start and number of blocks, their block values at most ` +
+    `with the same goal, start${GAME === "racing" ? ", obstacles" : ""} and number of ${PIECES}, their values at most ` +
     `${worstDrift.toFixed(4)} off; ${mismatches} failed the check; ` +
     `${mean.toFixed(2)} ms per level on average, median ${median.toFixed(2)}, slowest ` +
     `${(times[times.length - 1] ?? 0).toFixed(2)} (${ortModule})`,

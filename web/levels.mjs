@@ -23,7 +23,7 @@
 // starts the next attempt on the same stream, a block within reach of the goal completes the
 // level. The random streams are in rng.mjs.
 //
-// Limits: the platform game only (not racing); one λ for the whole level (no λ curve, no kept
+// Limits: the platform game here (racing: racing.mjs); one λ for the whole level (no λ curve, no kept
 // prefix, no `--draw`, no `--target-success`); the built-in character unless the caller gives
 // a profile's piece rules *with its measured reach table* (arlpcg measures a profile's reach
 // by simulation, which this module does not do); style knobs and an ability-aware Generator's
@@ -73,22 +73,22 @@ export function wrapDegrees(angle) {
 }
 
 /** The plan direction (x, z) of a heading in degrees (`heading_direction`). */
-function headingDirection(heading) {
+export function headingDirection(heading) {
   const h = heading * RADIANS_PER_DEGREE;
   return [Math.cos(h), -Math.sin(h)];
 }
 
 /** The heading in degrees of the plan direction (x, z) (`direction_heading`). */
-function directionHeading(x, z) {
+export function directionHeading(x, z) {
   return Math.atan2(-z, x) * DEGREES_PER_RADIAN;
 }
 
-function clamp(x, lo, hi) {
+export function clamp(x, lo, hi) {
   return x < lo ? lo : x > hi ? hi : x;
 }
 
 /** `ParamRange::from_unit`: -1 the least, +1 the most, linearly. */
-function fromUnit(t, lo, hi) {
+export function fromUnit(t, lo, hi) {
   const u = clamp(t, -1.0, 1.0);
   return lo + (u + 1.0) * 0.5 * (hi - lo);
 }
@@ -280,17 +280,21 @@ export function blockFromAction(track, goal, row, rules, reach) {
   return block;
 }
 
-/** A loaded platform Generator. */
-export class PlatformGenerator {
+/**
+ * An exported Generator's network and sampling, for either game: the graph with its unclipped
+ * means exposed, and `choose`, which samples an action row as `ActorCritic::choose` does.
+ */
+export class GeneratorNetwork {
   /**
    * @param {object} ort an onnxruntime module (onnxruntime-node or onnxruntime-web)
    * @param {Uint8Array} onnx the graph's bytes (`arlpcg export-policy`, contract plain)
    * @param {object} sidecar the parsed sidecar (G.onnx.json); needs `sampling` and `generator`
+   * @param {string} game the game the Generator must build for
    * @param {object} [options] `sessionOptions` for onnxruntime
    */
-  static async load(ort, onnx, sidecar, options = {}) {
-    if (sidecar.format !== "arlpcg-onnx" || sidecar.game !== "platform" || sidecar.role !== "generator") {
-      throw new Error(`not a platform Generator's sidecar: ${sidecar.game} ${sidecar.role}`);
+  static async load(ort, onnx, sidecar, game, options = {}) {
+    if (sidecar.format !== "arlpcg-onnx" || sidecar.game !== game || sidecar.role !== "generator") {
+      throw new Error(`not a ${game} Generator's sidecar: ${sidecar.game} ${sidecar.role}`);
     }
     if (sidecar.profile !== "plain") throw new Error("export the Generator with --contract plain");
     if (!sidecar.sampling || !sidecar.generator) {
@@ -298,7 +302,7 @@ export class PlatformGenerator {
     }
     const { bytes, meanOutput } = exposeMeans(onnx);
     const session = await ort.InferenceSession.create(bytes, options.sessionOptions ?? {});
-    return new PlatformGenerator(ort, session, meanOutput, sidecar);
+    return new GeneratorNetwork(ort, session, meanOutput, sidecar);
   }
 
   constructor(ort, session, meanOutput, sidecar) {
@@ -325,6 +329,23 @@ export class PlatformGenerator {
     }
     return action;
   }
+}
+
+/** A loaded platform Generator. */
+export class PlatformGenerator {
+  /**
+   * @param {object} ort an onnxruntime module (onnxruntime-node or onnxruntime-web)
+   * @param {Uint8Array} onnx the graph's bytes (`arlpcg export-policy`, contract plain)
+   * @param {object} sidecar the parsed sidecar (G.onnx.json); needs `sampling` and `generator`
+   * @param {object} [options] `sessionOptions` for onnxruntime
+   */
+  static async load(ort, onnx, sidecar, options = {}) {
+    return new PlatformGenerator(await GeneratorNetwork.load(ort, onnx, sidecar, "platform", options));
+  }
+
+  constructor(network) {
+    this.network = network;
+  }
 
   /**
    * The level of `seed` at λ `aux`: its goal, start and blocks as `arlpcg generate` writes
@@ -334,20 +355,21 @@ export class PlatformGenerator {
    *          `generator.piece_rules` names, its measured `reach_table` and `headroom`)
    */
   async build({ seed, aux = 0.0, knobs = [], abilities = [], rules = null }) {
-    const pieceRules = rules ? flatRules(rules) : this.builtIn;
+    const net = this.network;
+    const pieceRules = rules ? flatRules(rules) : net.builtIn;
     const reach = new Reach(pieceRules.reach_table);
     const headroom = pieceRules.headroom ?? HEADROOM;
     const { goal, start, rng } = goalAndStart(seed);
-    const observation = new Float32Array(this.observationSize);
+    const observation = new Float32Array(net.observationSize);
     const extra = [...knobs, ...abilities];
-    for (let attempt = 0; attempt < this.attempts; attempt++) {
+    for (let attempt = 0; attempt < net.attempts; attempt++) {
       const track = new Track(start, headroom);
-      while (track.blocks.length < this.maxPieces) {
-        observe(track, goal, aux, this.maxPieces, observation);
-        for (let i = PLATFORM_OBSERVATION_SIZE; i < this.observationSize; i++) {
+      while (track.blocks.length < net.maxPieces) {
+        observe(track, goal, aux, net.maxPieces, observation);
+        for (let i = PLATFORM_OBSERVATION_SIZE; i < net.observationSize; i++) {
           observation[i] = Math.fround(extra[i - PLATFORM_OBSERVATION_SIZE] ?? 0.0);
         }
-        const action = await this.choose(observation, rng);
+        const action = await net.choose(observation, rng);
         const block = blockFromAction(track, goal, action, pieceRules, reach);
         if (!track.push(block)) break;
         if (reaches(track.last, goal)) {
@@ -366,12 +388,12 @@ export class PlatformGenerator {
         }
       }
     }
-    throw new Error(`the Generator built no valid level toward goal ${goal} at λ = ${aux} in ${this.attempts} attempts`);
+    throw new Error(`the Generator built no valid level toward goal ${goal} at λ = ${aux} in ${net.attempts} attempts`);
   }
 }
 
 /** Piece rules with each one-value list as its value (the sidecar's lists). */
-function flatRules(rules) {
+export function flatRules(rules) {
   const out = {};
   for (const [name, value] of Object.entries(rules)) {
     out[name] = name === "reach_table" ? value : Array.isArray(value) ? value[0] : value;

@@ -183,6 +183,9 @@ fn export_policy_writes_the_graph_and_its_sidecar_once() {
     assert_eq!(sidecar["game"], "racing");
     assert_eq!(sidecar["inputs"][0]["name"], "observation");
     assert_eq!(sidecar["outputs"][0]["columns"][1]["name"], "steer");
+    // A Solver's sidecar says how its actions are sampled, and holds no Generator's rules.
+    assert_eq!(sidecar["sampling"]["std"].as_array().unwrap().len(), 2);
+    assert!(sidecar.get("generator").is_none());
 
     // Existing files stay unless --force; the same policy gives the same bytes.
     let again = arlpcg(words("export-policy {} --out {}", &[&policy, &out_arg]));
@@ -302,6 +305,29 @@ fn a_policys_golden_episode_replays_from_its_level_and_actions() {
             level.piece_count(),
             "one frame per piece placed"
         );
+        // The sidecar holds what `generate` reads besides the graph: the sampling's standard
+        // deviations, the piece budget and attempts, and the golden's piece rules.
+        let sidecar: serde_json::Value = serde_json::from_slice(
+            &std::fs::read(dir.path().join(format!("{game}-generator.onnx.json"))).unwrap(),
+        )
+        .unwrap();
+        let rules = &sidecar["generator"];
+        assert_eq!(rules["piece_rules"], episode["piece_rules"], "{game}");
+        assert_eq!(rules["attempts"], 64);
+        let budget = frames[0]["state"]
+            .get("max_blocks")
+            .or(frames[0]["state"].get("max_segments"))
+            .unwrap_or_else(|| panic!("{game}: no piece budget in the state"));
+        assert_eq!(rules["max_pieces"].as_f64(), budget[0].as_f64(), "{game}");
+        let log_std: Vec<f32> =
+            serde_json::from_value(sidecar["sampling"]["log_std"].clone()).unwrap();
+        let std: Vec<f32> = serde_json::from_value(sidecar["sampling"]["std"].clone()).unwrap();
+        let actions = sidecar["outputs"][0]["columns"].as_array().unwrap().len();
+        assert_eq!((log_std.len(), std.len()), (actions, actions), "{game}");
+        for (l, s) in log_std.iter().zip(&std) {
+            assert_eq!(l.exp(), *s, "{game}");
+            assert!(*s > 0.0 && *s < 2.0, "{game}: a trained std, {s}");
+        }
     }
 }
 

@@ -305,7 +305,7 @@ mod tests {
             assert_eq!(recorded, pieces, "{game}");
             let rules = match game {
                 "platform" => {
-                    "max_distance max_height max_size max_turn min_distance min_height min_size reach_table"
+                    "headroom max_distance max_height max_size max_turn min_distance min_height min_size reach_table"
                 }
                 _ => "curve_offset max_curve max_height max_length min_length",
             };

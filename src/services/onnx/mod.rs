@@ -102,6 +102,61 @@ pub struct Sidecar {
     /// Observation rows (raw, as the game produces them) and what this tool computes for them,
     /// output by output.
     pub examples: Examples,
+    /// How this tool samples the continuous actions where it does not act deterministically
+    /// (a Generator building a level); none for a policy without continuous actions.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampling: Option<Sampling>,
+    /// What a Generator's builds read besides the graph (none for a Solver): the piece budget,
+    /// the attempts and the built-in player's piece rules.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub generator: Option<GeneratorRules>,
+}
+
+/// The Gaussian each continuous action is sampled from: its mean is the actor's output before
+/// the graph's clip to [-1, 1]; its standard deviation is a trained constant per action.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Sampling {
+    /// How a sample is drawn, in words.
+    pub meaning: String,
+    /// The log standard deviation of each continuous action, in order.
+    pub log_std: Vec<f32>,
+    /// `exp(log_std)` as this tool computes it (float32), in order.
+    pub std: Vec<f32>,
+}
+
+/// A Generator's build rules, as `generate` reads them (`build_level` in
+/// `src/services/generation.rs`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GeneratorRules {
+    /// The piece budget of a level (the card's `max_pieces`).
+    pub max_pieces: usize,
+    /// Attempts at a level before `generate` gives up.
+    pub attempts: usize,
+    /// The built-in player's piece rules, as a golden episode's `piece_rules`.
+    pub piece_rules: std::collections::BTreeMap<String, Vec<f64>>,
+}
+
+/// The sampling of `policy`'s continuous actions; none when it has none.
+fn sampling(policy: &ActorCritic) -> candle_core::Result<Option<Sampling>> {
+    if policy.shape().continuous == 0 {
+        return Ok(None);
+    }
+    let log_std = policy
+        .named_vars()
+        .into_iter()
+        .find(|(name, _)| name == "log_std")
+        .map(|(_, var)| var.as_tensor().flatten_all()?.to_vec1::<f32>())
+        .transpose()?
+        .unwrap_or_default();
+    let std = log_std.iter().map(|l| l.exp()).collect();
+    Ok(Some(Sampling {
+        meaning: "action k = mean_k + std_k * n_k (float32), mean_k the actor's output before \
+            the clip that gives continuous_actions, n_k a standard normal draw, the columns in \
+            order; the game then clips each to [-1, 1]"
+            .into(),
+        log_std,
+        std,
+    }))
 }
 
 /// How the policy was trained, from its card.
@@ -377,6 +432,8 @@ pub fn export(
                 })
                 .collect(),
             examples,
+            sampling: sampling(policy)?,
+            generator: None,
         },
     })
 }

@@ -28,9 +28,8 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
     }
     // Loaded through the game's own loader: game, role, shape and normalizer all checked.
     let (policy, card, reference) = crate::services::policies::load_any(&args.policy)?;
-    let exported = crate::services::onnx::export(&policy, &card, reference, args.contract)
+    let mut exported = crate::services::onnx::export(&policy, &card, reference, args.contract)
         .with_context(|| format!("{}: exporting the actor", args.policy.display()))?;
-    let sidecar = serde_json::to_string_pretty(&exported.sidecar)? + "\n";
     // The policy's golden episode, for a port of its observation (docs/engines.md).
     let golden = match card.role {
         Role::Solver => {
@@ -47,9 +46,16 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
                 generator_golden_episode::<G>(&policy, &card, reference, limits)
             })
             .with_context(|| format!("{}: building its golden episode", args.policy.display()))?;
+            // What `generate` reads besides the graph, for a port that builds levels.
+            exported.sidecar.generator = Some(crate::services::onnx::GeneratorRules {
+                max_pieces: limits.max_pieces,
+                attempts: crate::services::generation::ATTEMPTS,
+                piece_rules: episode.piece_rules.clone(),
+            });
             Some(serde_json::to_string(&episode)? + "\n")
         }
     };
+    let sidecar = serde_json::to_string_pretty(&exported.sidecar)? + "\n";
     let mut batch = FileBatch::new();
     batch.stage(&args.out, &exported.onnx, overwrite)?;
     batch.stage(&sidecar_path, sidecar.as_bytes(), overwrite)?;

@@ -239,10 +239,12 @@ impl TrackBuild for PlatformBuild {
         ]
     }
 
-    /// The player's block ranges and its reach table (by `REACH_HEIGHTS`).
+    /// The player's block ranges, its reach table (by `REACH_HEIGHTS`) and the headroom a
+    /// block keeps from any but the last (`PlatformTrack::push`).
     fn port_piece_rules(&self) -> std::collections::BTreeMap<String, Vec<f64>> {
         let r = self.player.blocks();
         named([
+            ("headroom", vec![self.track.headroom()]),
             ("min_distance", vec![r.min_distance]),
             ("max_distance", vec![r.max_distance]),
             ("min_size", vec![r.min_size]),

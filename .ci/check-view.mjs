@@ -1,7 +1,8 @@
 // `arlpcg view` in a real browser (headless Chromium, driven by puppeteer-core): the page draws
 // the level (not a blank canvas) and its certificate run within 2 s of opening, a new level
-// written to the folder it follows changes the picture within 1 s, and the page's console has
-// no errors.
+// written to the folder it follows changes the picture within 1 s, moving the page's λ slider
+// shows that level rebuilt at the new λ (by the shipped Generator) within 1 s, and the page's
+// console has no errors.
 // Usage: node .ci/check-view.mjs ARLPCG_BINARY CHROMIUM LEVEL_A LEVEL_B SCREENSHOT_DIR
 import { spawn } from "node:child_process";
 import { copyFileSync, mkdtempSync, mkdirSync } from "node:fs";
@@ -61,6 +62,25 @@ try {
   console.log(`new level shown ${Date.now() - written} ms after it was written: ${second.drawn} pixels drawn`);
   await page.screenshot({ path: join(shots, "view-second.png") });
   if (second.drawn === first.drawn) fail("the new level did not change the picture");
+
+  // The λ slider: the shipped Generator rebuilds the level shown at λ = -1, then +1.
+  if (await page.evaluate(() => document.getElementById("slider").hidden)) fail("no λ slider");
+  let before = second;
+  for (const aux of ["-1", "1"]) {
+    const moved = Date.now();
+    await page.evaluate((aux) => {
+      const input = document.getElementById("aux");
+      input.value = aux;
+      input.dispatchEvent(new Event("input"));
+    }, aux);
+    await page.waitForFunction((aux) => document.body.dataset.aux === aux, { timeout: 1000 }, aux);
+    const rebuilt = await page.evaluate(() => ({ ...document.body.dataset, caption: document.getElementById("caption").textContent }));
+    console.log(`λ = ${aux} shown ${Date.now() - moved} ms after the slider moved: ${rebuilt.drawn} pixels drawn (${rebuilt.caption})`);
+    await page.screenshot({ path: join(shots, `view-aux${aux}.png`) });
+    if (rebuilt.drawn === before.drawn) fail(`λ = ${aux} did not change the picture`);
+    if (rebuilt.errors) fail(`the page reported errors: ${rebuilt.errors}`);
+    before = rebuilt;
+  }
   if (first.errors || second.errors) fail(`the page reported errors: ${first.errors}${second.errors}`);
   if (errors.length) fail(`console errors: ${errors.join("; ")}`);
 } catch (error) {

@@ -1,14 +1,18 @@
 //! What `arlpcg view` draws: a level's scene (the same boxes, road and markers the glTF export
 //! writes, `crates/core/src/level/scene.rs`) as flat JSON a browser turns into triangles, each
 //! piece tinted toward red by its share of the recorded failures, and the certificate's run
-//! (the recorded run that reaches the goal) as a trail over it.
+//! (the recorded run that reaches the goal) as a trail over it; and the request that builds a
+//! level's scene again at another λ (the page's slider).
+
+use std::sync::Arc;
 
 use serde_json::{Value, json};
 
 use crate::services::certificate;
-use arlpcg_core::level::Level;
+use crate::services::generation::{KeptPrefix, LevelRequest};
 use arlpcg_core::level::scene::{Material, Scene};
 use arlpcg_core::level::stats::Outcome;
+use arlpcg_core::level::{Level, PolicyRef, Shape};
 
 /// The run drawn over a level.
 #[derive(Debug, Clone, PartialEq)]
@@ -111,6 +115,33 @@ pub fn scene_json(level: &Level, title: &str, trail: &Trail) -> Value {
         "points": points,
         "trail": trail.json(),
     })
+}
+
+/// The request that builds `level`'s scene again at λ `aux` (the view's slider): its start,
+/// goal and obstacles kept (a kept prefix of no pieces, read from the file `from`), its seed
+/// (0 for a hand-made level), its profile and its style knobs. The seed's first draw: rebuilt at
+/// the λ a Generator made it with, a level that was its seed's first draw comes back as it was.
+pub fn rebuild_request(level: Arc<Level>, from: PolicyRef, aux: f64) -> LevelRequest {
+    let obstacles = match level.track.shape() {
+        Shape::Road(road) => road.obstacles.len() as u32,
+        Shape::Blocks(_) => 0,
+    };
+    let knobs = level
+        .game()
+        .shape()
+        .knobs()
+        .iter()
+        .map(|name| level.knobs.get(*name).copied().unwrap_or(0.0) as f32)
+        .collect();
+    LevelRequest::new(level.seed.unwrap_or(0), Some(aux))
+        .obstacles(obstacles)
+        .profile(level.profile.clone())
+        .knobs(knobs)
+        .keep(KeptPrefix {
+            level,
+            pieces: 0,
+            from,
+        })
 }
 
 /// Each piece's share of the failures the level's statistics record, scaled so that the most
@@ -255,5 +286,60 @@ mod tests {
         assert!(why.contains("no statistics"), "{why}");
         let scene = scene_json(&unplayed, "a level", &Trail::None(why.clone()));
         assert_eq!(scene["trail"]["none"], why.as_str());
+    }
+
+    /// The slider's rebuild keeps the level's scene and seed: at the λ the shipped Generator
+    /// made a shipped level with, it is that level's track again; at another λ it is another
+    /// track from the same start toward the same goal, past the same obstacles.
+    #[test]
+    fn a_level_rebuilt_at_its_own_aux_is_itself_and_at_another_another_over_the_same_scene() {
+        use crate::services::making::LevelSource;
+        use crate::services::policies::load_generator;
+        for (file, game) in [
+            ("levels/platform/platform_seed7_aux-1.00.yaml", "platform"),
+            ("levels/racing/racing_seed7_aux+0.00.yaml", "racing"),
+        ] {
+            let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+            let (level, from) = yaml::load_pinned(&root.join(file)).unwrap();
+            let (generator, _) = load_generator(
+                &root.join(format!("policies/{game}/generator.safetensors")),
+                level.game(),
+            )
+            .unwrap();
+            let level = Arc::new(level);
+            let at = |aux: f64| {
+                let request = rebuild_request(level.clone(), from.clone(), aux);
+                LevelSource::Generator(&generator).level(&request).unwrap()
+            };
+            let own = level.aux.unwrap();
+            let again = at(own);
+            assert_eq!(again.track, level.track, "{file}");
+            assert_eq!((again.seed, again.goal), (level.seed, level.goal));
+            let other = at(if own > 0.0 { -1.0 } else { 1.0 });
+            assert_ne!(other.track, level.track, "{file}");
+            assert_eq!(other.goal, level.goal);
+            // The spawn, the start block, the goal's marker and any obstacle (the finish
+            // lies on the last piece, which moves).
+            let scene = |l: &Level| {
+                let scene = scene_json(l, "", &none());
+                let fixed = |part: &str| {
+                    let all = scene[part].as_array().unwrap().iter();
+                    all.filter(|v| {
+                        let name = v["name"].as_str().unwrap();
+                        !["block_", "segment_", "finish"]
+                            .iter()
+                            .any(|p| name.starts_with(p))
+                    })
+                    .cloned()
+                    .collect::<Vec<_>>()
+                };
+                (fixed("points"), fixed("boxes"))
+            };
+            assert_eq!(
+                scene(&other),
+                scene(&level),
+                "{file}: start, goal and obstacles kept"
+            );
+        }
     }
 }

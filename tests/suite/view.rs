@@ -22,8 +22,13 @@ impl Drop for Viewer {
 }
 
 fn view(path: &std::path::Path) -> Viewer {
+    view_with(path, &[])
+}
+
+fn view_with(path: &std::path::Path, more: &[&str]) -> Viewer {
     let mut child = test_command()
         .args(["view", path.to_str().unwrap()])
+        .args(more)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -106,6 +111,79 @@ fn the_view_serves_the_newest_level_of_a_folder_and_follows_it() {
     assert!(problem.contains("c.yaml"), "{problem}");
     std::fs::remove_file(dir.path().join("c.yaml")).unwrap();
     assert_eq!(pieces(&viewer).1, segments);
+}
+
+/// The page's λ slider: `/scene.json?aux=λ` is the level shown rebuilt at λ by the Generator
+/// of `--policies` (unplayed), a λ outside [-1, 1] is refused, and without a Generator for the
+/// level's game the scene says why there is no slider.
+#[test]
+fn the_slider_rebuilds_the_level_shown_at_another_aux() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let hard = root.join("levels/platform/platform_seed7_aux-1.00.yaml");
+    let viewer = view_with(
+        &hard,
+        &[
+            "--policies",
+            root.join("policies/platform").to_str().unwrap(),
+        ],
+    );
+    let scene = |query: &str| {
+        let (status, body) = get(&viewer.address, &format!("/scene.json{query}"));
+        assert_eq!(status, 200, "{body}");
+        serde_json::from_str::<serde_json::Value>(&body).unwrap()["scene"].clone()
+    };
+    let file = scene("");
+    assert_eq!(file["slider"]["aux"], -1.0);
+    assert!(
+        file["slider"]["generator"]
+            .as_str()
+            .unwrap()
+            .ends_with("generator.safetensors")
+    );
+    let again = scene("?aux=-1");
+    // (Colours aside: the file's pieces are tinted by its recorded failures.)
+    let centres = |scene: &serde_json::Value| -> Vec<serde_json::Value> {
+        let boxes = scene["boxes"].as_array().unwrap();
+        boxes.iter().map(|b| b["centre"].clone()).collect()
+    };
+    assert_eq!(
+        centres(&again),
+        centres(&file),
+        "its own λ: the file's level, seed 7's first draw"
+    );
+    let easy = scene("?aux=1");
+    assert!(
+        easy["title"].as_str().unwrap().ends_with("at λ = +1.00"),
+        "{}",
+        easy["title"]
+    );
+    assert!(
+        easy["trail"]["none"]
+            .as_str()
+            .unwrap()
+            .contains("not played")
+    );
+    assert_ne!(easy["pieces"], file["pieces"]);
+    for bad in ["?aux=1.5", "?aux=nan", "?aux=easy"] {
+        let (status, body) = get(&viewer.address, &format!("/scene.json{bad}"));
+        assert_eq!(status, 400, "{bad}: {body}");
+        assert!(body.contains("not a λ in [-1, 1]"), "{body}");
+    }
+    drop(viewer);
+
+    // A folder with no Generator: no slider, and why.
+    let empty = tempfile::tempdir().unwrap();
+    let viewer = view_with(&hard, &["--policies", empty.path().to_str().unwrap()]);
+    let (_, body) = get(&viewer.address, "/scene.json");
+    let none = serde_json::from_str::<serde_json::Value>(&body).unwrap()["scene"]["slider"]["none"]
+        .clone();
+    assert!(
+        none.as_str().unwrap().contains("generator.safetensors"),
+        "{none}"
+    );
+    let (status, body) = get(&viewer.address, "/scene.json?aux=0");
+    assert_eq!(status, 500);
+    assert!(body.contains("generator.safetensors"), "{body}");
 }
 
 #[test]

@@ -257,8 +257,12 @@ pub struct ExportArgs {
 #[command(after_help = "Examples:\n  \
     arlpcg view levels/platform/platform_seed7_aux-1.00.yaml\n  \
     arlpcg view levels            # the newest level the designer or generate writes there\n  \
-    arlpcg view my-levels --port 8080\n\n\
-    In the page: drag to orbit, the wheel to zoom, f to look from the start toward the goal. \
+    arlpcg view my-levels --port 8080\n  \
+    arlpcg view levels/racing/racing_seed7_aux+0.00.yaml --policies runs/my-racing\n\n\
+    In the page: drag to orbit, the wheel to zoom, f to look from the start toward the goal; \
+    the λ slider (or [ and ]) rebuilds the level's seed, start, goal and obstacles at another λ \
+    with the Generator of --policies, unplayed (back at the file's own λ it is the file's level \
+    when that was its seed's first draw). \
     Pieces are tinted red by their share of the failures the level's statistics record; the \
     certificate's run (the recorded run that reaches the goal) is drawn in blue, played again \
     with the Solver its statistics name.")]
@@ -268,6 +272,11 @@ pub struct ViewArgs {
     /// The port to serve on, on 127.0.0.1 (0: any free one; the address is printed).
     #[arg(long, default_value_t = 0)]
     pub port: u16,
+    /// The Generator the page's λ slider rebuilds levels with: a policies folder (its
+    /// generator.safetensors) or a Generator's file. Default: the shipped policies/<game>/ of
+    /// the level shown ($ARLPCG_POLICIES, else ./policies, else beside the binary).
+    #[arg(long, value_name = "PATH")]
+    pub policies: Option<PathBuf>,
 }
 
 /// `export-policy`'s arguments.

@@ -1,18 +1,25 @@
 //! `arlpcg view`: a level in 3D in a web browser, served by [`crate::shells::view`]: a level
-//! file, or the newest level file of a folder, followed as it changes.
+//! file, or the newest level file of a folder, followed as it changes; its scene rebuilt at
+//! another λ by a Generator when the page's slider moves.
 
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, PoisonError};
 use std::time::SystemTime;
 
 use anyhow::{Context, Result};
+use serde_json::{Value, json};
 
-use crate::services::view::{Trail, scene_json};
+use crate::services::generation::GeneratorPolicy;
+use crate::services::making::LevelSource;
+use crate::services::policies::{GENERATOR_FILE, load_generator};
+use crate::services::view::{Trail, rebuild_request, scene_json};
 use crate::shells::cli::ViewArgs;
+use crate::shells::common::shipped_dir;
 use crate::shells::view::{self, Shown};
-use arlpcg_core::level::yaml;
+use arlpcg_core::level::{Game, yaml};
 
 pub fn run(args: &ViewArgs) -> Result<()> {
-    let shown = ShownFile::new(&args.level)?;
+    let shown = ShownFile::new(&args.level, args.policies.clone())?;
     shown.current()?;
     let (server, address) = view::bind(args.port)?;
     crate::say!(
@@ -23,13 +30,19 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     Ok(())
 }
 
-/// What the page shows: a level file, or the newest level file of a folder.
+/// What the page shows: a level file, or the newest level file of a folder, and the Generators
+/// that rebuild it at another λ.
 struct ShownFile {
     path: PathBuf,
+    /// `--policies`: a folder holding generator.safetensors, or a Generator's file; none: the
+    /// shipped policies of the shown level's game.
+    policies: Option<PathBuf>,
+    /// Each game's Generator once loaded, or why it could not be.
+    generators: Mutex<Vec<(Game, Loaded)>>,
 }
 
 impl ShownFile {
-    fn new(path: &Path) -> Result<Self> {
+    fn new(path: &Path, policies: Option<PathBuf>) -> Result<Self> {
         anyhow::ensure!(
             path.exists(),
             "{}: no such level file or folder",
@@ -37,7 +50,43 @@ impl ShownFile {
         );
         Ok(Self {
             path: path.to_path_buf(),
+            policies,
+            generators: Mutex::default(),
         })
+    }
+
+    /// The Generator that rebuilds `game`'s levels, and its file; loaded once.
+    fn generator(&self, game: Game) -> Loaded {
+        let mut loaded = self
+            .generators
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner);
+        let load = || -> Result<Arc<(GeneratorPolicy, PathBuf)>> {
+            let path = match &self.policies {
+                Some(path) if path.is_dir() => path.join(GENERATOR_FILE),
+                Some(path) => path.clone(),
+                None => shipped_dir(game)?.join(GENERATOR_FILE),
+            };
+            let (generator, _card) = load_generator(&path, game)?;
+            Ok(Arc::new((generator, path)))
+        };
+        if let Some((_, known)) = loaded.iter().find(|(g, _)| *g == game) {
+            return known.clone();
+        }
+        let known = load().map_err(|e| format!("{e:#}"));
+        loaded.push((game, known.clone()));
+        known
+    }
+
+    /// What the page's λ slider needs for `level`: the λ it was made at and the Generator that
+    /// rebuilds it, or why there is none.
+    fn slider(&self, level: &arlpcg_core::level::Level) -> Value {
+        match self.generator(level.game()) {
+            Ok(generator) => {
+                json!({"aux": level.aux, "generator": generator.1.display().to_string()})
+            }
+            Err(why) => json!({"none": why}),
+        }
     }
 
     /// The level file shown now, and when it last changed.
@@ -86,16 +135,38 @@ impl Shown for ShownFile {
         Ok(self.version_and_file()?.0)
     }
 
-    fn current(&self) -> Result<(String, serde_json::Value)> {
+    fn current(&self) -> Result<(String, Value)> {
         let (version, path) = self.version_and_file()?;
         let level = yaml::load(&path)?;
-        let title = path.file_name().map_or_else(
-            || path.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
-        Ok((
-            version,
-            scene_json(&level, &title, &Trail::of_certificate(&level)),
-        ))
+        let mut scene = scene_json(&level, &title(&path), &Trail::of_certificate(&level));
+        scene["slider"] = self.slider(&level);
+        Ok((version, scene))
     }
+
+    fn rebuilt(&self, aux: f64) -> Result<(String, Value)> {
+        let (version, path) = self.version_and_file()?;
+        let (level, from) = yaml::load_pinned(&path)?;
+        let generator = self.generator(level.game()).map_err(anyhow::Error::msg)?;
+        let request = rebuild_request(Arc::new(level), from, aux);
+        let rebuilt = LevelSource::Generator(&generator.0).level(&request)?;
+        let title = format!("{} at λ = {aux:+.2}", title(&path));
+        let unplayed = Trail::None(format!(
+            "rebuilt by {} (its seed's first draw, not played)",
+            generator.1.display()
+        ));
+        let mut scene = scene_json(&rebuilt, &title, &unplayed);
+        scene["slider"] = self.slider(&rebuilt);
+        Ok((version, scene))
+    }
+}
+
+/// A game's Generator and its file, or why it could not be loaded.
+type Loaded = Result<Arc<(GeneratorPolicy, PathBuf)>, String>;
+
+/// A level file's name as the page's caption gives it.
+fn title(path: &Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
 }

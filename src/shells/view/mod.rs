@@ -2,7 +2,8 @@
 //! the designer (`V`: the level on screen). It serves one page on 127.0.0.1 (`page.html`:
 //! WebGL with no library, so it works offline) with the first scene inside
 //! ([`crate::services::view::scene_json`]); the page asks for `/version` a few times a second
-//! and fetches `/scene.json` again when it changes.
+//! and fetches `/scene.json` again when it changes, and `/scene.json?aux=λ` when its λ slider
+//! moves (a [`Shown`] that can rebuild its level: `arlpcg view`'s file).
 
 use std::net::SocketAddr;
 use std::sync::{Arc, Mutex, PoisonError};
@@ -19,6 +20,10 @@ pub trait Shown: Send + Sync {
     fn version(&self) -> Result<String>;
     /// The version and the scene shown now.
     fn current(&self) -> Result<(String, Value)>;
+    /// The version and the scene shown now, rebuilt at λ `aux` by a Generator.
+    fn rebuilt(&self, aux: f64) -> Result<(String, Value)> {
+        anyhow::bail!("this view cannot rebuild its level at λ = {aux}: it has no Generator")
+    }
 }
 
 /// A server on 127.0.0.1:`port` (0: any free port) and the address it listens on.
@@ -45,10 +50,19 @@ pub fn serve(server: &tiny_http::Server, shown: &dyn Shown) {
                     "text/html; charset=utf-8",
                 )
             }),
-            "/scene.json" => shown.current().map(|(version, scene)| {
-                let body = serde_json::json!({"version": version, "scene": scene});
-                reply(body.to_string(), "application/json")
-            }),
+            "/scene.json" => match asked_aux(request.url()) {
+                Err(problem) => {
+                    let answer = tiny_http::Response::from_string(problem).with_status_code(400);
+                    let _ = request.respond(answer);
+                    continue;
+                }
+                Ok(aux) => aux
+                    .map_or_else(|| shown.current(), |aux| shown.rebuilt(aux))
+                    .map(|(version, scene)| {
+                        let body = serde_json::json!({"version": version, "scene": scene});
+                        reply(body.to_string(), "application/json")
+                    }),
+            },
             "/version" => shown
                 .version()
                 .map(|version| reply(version, "text/plain; charset=utf-8")),
@@ -60,6 +74,20 @@ pub fn serve(server: &tiny_http::Server, shown: &dyn Shown) {
         });
         // A browser that went away is no reason to stop serving.
         let _ = request.respond(response);
+    }
+}
+
+/// The λ a `/scene.json?aux=λ` request asks for (none without `aux`), or why it is refused.
+fn asked_aux(url: &str) -> Result<Option<f64>, String> {
+    let Some((_, query)) = url.split_once('?') else {
+        return Ok(None);
+    };
+    let Some(text) = query.split('&').find_map(|pair| pair.strip_prefix("aux=")) else {
+        return Ok(None);
+    };
+    match text.parse::<f64>() {
+        Ok(aux) if (-1.0..=1.0).contains(&aux) => Ok(Some(aux)),
+        _ => Err(format!("aux: {text:?} is not a λ in [-1, 1]")),
     }
 }
 

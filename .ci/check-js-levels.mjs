@@ -6,8 +6,12 @@
 // rounding (1e-3). Prints each mismatch and the milliseconds per level; exits 1 on any mismatch
 // (or, with --min-exact and --drift, beyond those bars; below).
 //
+// With --browser=CHROMIUM the module runs in a page of headless Chromium (driven by
+// puppeteer-core) on onnxruntime-web's WebAssembly build, served with the module from memory:
+// the page asks nothing of the network.
+//
 //   node .ci/check-js-levels.mjs ARLPCG_BINARY [SEEDS (100)] [FIRST_SEED (0)] [--aux=-1,0,1]
-//       [--min-exact=N --drift=D] [--ort=MODULE] [--game=racing --obstacles=N]
+//       [--min-exact=N --drift=D] [--ort=MODULE | --browser=CHROMIUM] [--game=racing --obstacles=N]
 
 import { execFileSync } from "node:child_process";
 import fs from "node:fs";
@@ -40,9 +44,10 @@ const TOLERANCE = 1e-3 + 1e-9;
 // (and a racing level's obstacles).
 // The runtime: onnxruntime-node (pinned in .ci/package.json) unless `--ort=` names another
 // module (a path to onnxruntime-web's ESM entry, say: the same module runs in a page).
-const ortModule = flag("ort") ?? "onnxruntime-node";
-const ort = await import(ortModule.startsWith("/") ? pathToFileURL(ortModule).href : ortModule);
-if (ort.env?.wasm) ort.env.wasm.numThreads = 1;
+const browserPath = flag("browser");
+const ortModule = browserPath ? "onnxruntime-web in headless Chromium" : flag("ort") ?? "onnxruntime-node";
+const ort = browserPath ? null : await import(ortModule.startsWith("/") ? pathToFileURL(ortModule).href : ortModule);
+if (ort?.env?.wasm) ort.env.wasm.numThreads = 1;
 // The game (`--game=racing`: web/racing.mjs and the racing Generator), and for racing the
 // obstacles drawn from each seed (`--obstacles=N`, generate's flag).
 const GAME = flag("game") ?? "platform";
@@ -87,7 +92,86 @@ const onnxPath = path.join(tmp, "generator.onnx");
 arlpcg("export-policy", `policies/${GAME}/generator.safetensors`, "--out", onnxPath);
 const sidecar = JSON.parse(fs.readFileSync(`${onnxPath}.json`, "utf8"));
 const Generator = GAME === "racing" ? RacingGenerator : PlatformGenerator;
-const generator = await Generator.load(ort, fs.readFileSync(onnxPath), sidecar);
+// `build(request)`: the level and the milliseconds it took, under node or in the page.
+const { build, close } = browserPath
+  ? await inPage(browserPath)
+  : await (async () => {
+    const generator = await Generator.load(ort, fs.readFileSync(onnxPath), sidecar);
+    return {
+      build: async (request) => {
+        const began = performance.now();
+        const level = await generator.build(request);
+        return { level, ms: performance.now() - began };
+      },
+      close: async () => {},
+    };
+  })();
+
+/** The module in a page of headless Chromium, on onnxruntime-web (one WebAssembly thread). */
+async function inPage(chromium) {
+  const { default: puppeteer } = await import("puppeteer-core");
+  const ortDist = path.join(root, ".ci/node_modules/onnxruntime-web/dist");
+  const origin = "http://levels.test";
+  const files = {
+    "/generator.onnx": [fs.readFileSync(onnxPath), "application/octet-stream"],
+    "/generator.onnx.json": [JSON.stringify(sidecar), "application/json"],
+    "/": ['<!doctype html><title>web/levels.mjs</title><link rel="icon" href="data:,">', "text/html"],
+  };
+  const served = (url) => {
+    const at = new URL(url).pathname;
+    if (files[at]) return files[at];
+    const [dir, kind] = at.startsWith("/web/") ? [path.join(root, "web"), "/web/"] : [ortDist, "/ort/"];
+    if (!at.startsWith(kind)) return null;
+    const file = path.join(dir, at.slice(kind.length));
+    if (!file.startsWith(dir) || !fs.existsSync(file)) return null;
+    const type = file.endsWith(".wasm") ? "application/wasm" : "text/javascript";
+    return [fs.readFileSync(file), type];
+  };
+  const browser = await puppeteer.launch({ executablePath: chromium, headless: true, args: ["--no-sandbox"] });
+  const page = await browser.newPage();
+  const errors = [];
+  page.on("pageerror", (e) => errors.push(String(e)));
+  await page.setRequestInterception(true);
+  page.on("request", (request) => {
+    const found = request.url().startsWith(origin) ? served(request.url()) : null;
+    if (!found) {
+      errors.push(`asked for ${request.url()}`);
+      request.respond({ status: 404, body: "" });
+      return;
+    }
+    request.respond({ status: 200, contentType: found[1], body: found[0], headers: { "Access-Control-Allow-Origin": "*" } });
+  });
+  await page.goto(`${origin}/`);
+  await page.evaluate(async (game) => {
+    const ort = await import("/ort/ort.wasm.min.mjs");
+    ort.env.wasm.numThreads = 1;
+    ort.env.wasm.wasmPaths = "/ort/";
+    const { PlatformGenerator } = await import("/web/levels.mjs");
+    const { RacingGenerator } = await import("/web/racing.mjs");
+    const onnx = new Uint8Array(await (await fetch("/generator.onnx")).arrayBuffer());
+    const sidecar = await (await fetch("/generator.onnx.json")).json();
+    const Generator = game === "racing" ? RacingGenerator : PlatformGenerator;
+    const generator = await Generator.load(ort, onnx, sidecar);
+    window.buildLevel = async (request) => {
+      const began = performance.now();
+      const level = await generator.build(request);
+      return { level, ms: performance.now() - began };
+    };
+  }, GAME);
+  const version = await browser.version();
+  console.log(`in ${version}: the module loaded onnxruntime-web and the Generator in a page`);
+  return {
+    build: async (request) => {
+      const answer = await page.evaluate((r) => window.buildLevel(r), request);
+      if (errors.length) throw new Error(errors.join("; "));
+      return answer;
+    },
+    close: async () => {
+      await Promise.race([browser.close(), new Promise((resolve) => setTimeout(resolve, 5000))]);
+      browser.process()?.kill("SIGKILL");
+    },
+  };
+}
 
 /** An obstacle's numbers in the level file's order. */
 function obstacleNumbers(o) {
@@ -147,17 +231,17 @@ for (const aux of AUXES) {
   }
   for (const file of files.sort()) {
     const want = readLevel(fs.readFileSync(path.join(out, file), "utf8"));
-    const began = performance.now();
     let got;
     try {
-      got = await generator.build({ seed: want.seed, aux, obstacles: OBSTACLES });
+      const built = await build({ seed: want.seed, aux, obstacles: OBSTACLES });
+      got = built.level;
+      times.push(built.ms);
     } catch (error) {
       console.log(`${file}: the module built no level: ${error.message}`);
       mismatches++;
       levels++;
       continue;
     }
-    times.push(performance.now() - began);
     levels++;
     const problems = [];
     const near = (a, b) => Math.abs(a - b) <= TOLERANCE;
@@ -193,6 +277,7 @@ for (const aux of AUXES) {
     }
   }
 }
+await close();
 fs.rmSync(tmp, { recursive: true, force: true });
 times.sort((a, b) => a - b);
 const mean = times.reduce((a, b) => a + b, 0) / Math.max(times.length, 1);

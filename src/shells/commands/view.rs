@@ -61,6 +61,9 @@ impl ShownFile {
             .generators
             .lock()
             .unwrap_or_else(PoisonError::into_inner);
+        if let Some((_, known)) = loaded.iter().find(|(g, _)| *g == game) {
+            return known.clone();
+        }
         let load = || -> Result<Arc<(GeneratorPolicy, PathBuf)>> {
             let path = match &self.policies {
                 Some(path) if path.is_dir() => path.join(GENERATOR_FILE),
@@ -70,9 +73,6 @@ impl ShownFile {
             let (generator, _card) = load_generator(&path, game)?;
             Ok(Arc::new((generator, path)))
         };
-        if let Some((_, known)) = loaded.iter().find(|(g, _)| *g == game) {
-            return known.clone();
-        }
         let known = load().map_err(|e| format!("{e:#}"));
         loaded.push((game, known.clone()));
         known

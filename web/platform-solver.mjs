@@ -545,6 +545,7 @@ export class PlatformSolver {
     let next = 0;
     let playing = [];
     let decisions = 0;
+    let networkMs = 0;
     const started = performance.now();
     for (;;) {
       while (playing.length < pool && next < trials) {
@@ -554,7 +555,9 @@ export class PlatformSolver {
       }
       if (playing.length === 0) break;
       playing.forEach((p, r) => course.observe(p.run, rows.subarray(r * n, (r + 1) * n)));
+      const before = performance.now();
       const actions = await this.act(rows, playing.length, playing.map((p) => p.rng), { deterministic });
+      networkMs += performance.now() - before;
       decisions += playing.length;
       playing = playing.filter((p, r) => {
         if (onDecision) onDecision(p, rows.subarray(r * n, (r + 1) * n), actions[r]);
@@ -571,7 +574,8 @@ export class PlatformSolver {
         return false;
       });
     }
-    this.lastTiming = { decisions, ms: performance.now() - started };
+    // The time the runs took, and how much of it the graph (onnxruntime) and the draws took.
+    this.lastTiming = { decisions, ms: performance.now() - started, networkMs };
     return results;
   }
 }

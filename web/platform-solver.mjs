@@ -45,7 +45,7 @@
 
 import { ChaCha8Rng } from "./rng.mjs";
 import { exposeMeans } from "./onnx-means.mjs";
-import { headingDirection, wrapDegrees } from "./levels.mjs";
+import { headingDirection, quantize, wrapDegrees } from "./levels.mjs";
 
 const f32 = Math.fround;
 
@@ -124,21 +124,51 @@ function rotate(q, v) {
 // Levels.
 
 /**
- * The few fields of an arlpcg platform level file (YAML, block style, as `arlpcg generate`
- * writes it) that a run needs: `start` (position, heading, size), `goal` and each block's
- * `distance`, `angle`, `size` and `height`. Other keys are skipped. Not a YAML parser: a level
- * written by hand in flow style or with anchors needs a real one (then pass the parsed object).
+ * The few fields of an arlpcg platform level file that a run needs: `start` (position, heading,
+ * size), `goal` and each block's `distance`, `angle`, `size` and `height`. Reads the YAML
+ * arlpcg writes (block style) and hand-written levels like levels/hand/staircase.yaml (comments,
+ * one-line flow collections such as `{distance: 7, angle: 0, size: 5, height: 0}`). Not a YAML
+ * parser: anchors, multi-line flow collections or block scalars need a real one (then pass the
+ * parsed object to `platformLevel`).
  * @param {string} text
  */
 export function parsePlatformLevel(text) {
-  const lines = text.split(/\r?\n/).map((l) => l.replace(/\s+#.*$/, "")).filter((l) => l.trim() !== "");
+  const lines = text
+    .split(/\r?\n/)
+    .map((l) => l.replace(/(^|\s)#.*$/, "").replace(/\s+$/, ""))
+    .filter((l) => l.trim() !== "");
   let pos = 0;
   const indent = (l) => l.length - l.trimStart().length;
-  const scalar = (s) => {
+  // A one-line value: a flow collection, a number or a string.
+  const value = (s) => {
     const t = s.trim();
+    if (t.startsWith("{") || t.startsWith("[")) return flow(t);
     if (/^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/.test(t)) return Number(t);
     return t.replace(/^(['"])(.*)\1$/, "$2");
   };
+  // `{a: 1, b: [1, 2]}` or `[1, 2]`: split at the top level's commas.
+  function flow(t) {
+    const inner = t.slice(1, -1);
+    const parts = [];
+    let depth = 0;
+    let from = 0;
+    for (let i = 0; i <= inner.length; i++) {
+      const c = inner[i];
+      if (c === "{" || c === "[") depth++;
+      if (c === "}" || c === "]") depth--;
+      if ((c === "," && depth === 0) || i === inner.length) {
+        if (inner.slice(from, i).trim() !== "") parts.push(inner.slice(from, i).trim());
+        from = i + 1;
+      }
+    }
+    if (t.startsWith("[")) return parts.map(value);
+    return Object.fromEntries(
+      parts.map((p) => {
+        const at = p.indexOf(":");
+        return [p.slice(0, at).trim(), value(p.slice(at + 1))];
+      }),
+    );
+  }
   // A node whose lines are indented at least `min` (a mapping or a sequence).
   function node(min) {
     if (pos >= lines.length || indent(lines[pos]) < min) return null;
@@ -150,13 +180,13 @@ export function parsePlatformLevel(text) {
         if (rest.trim() === "") {
           pos++;
           out.push(node(at + 1));
-        } else if (/^\s*[^\s:]+:(\s|$)/.test(rest)) {
+        } else if (/^\s*[^\s:{[]+:(\s|$)/.test(rest)) {
           // A mapping inside the item: its first key on the dash's line.
           lines[pos] = " ".repeat(at + 1 + (rest.length - rest.trimStart().length)) + rest.trimStart();
           out.push(node(at + 1));
         } else {
           pos++;
-          out.push(scalar(rest));
+          out.push(value(rest));
         }
       }
       return out;
@@ -167,7 +197,7 @@ export function parsePlatformLevel(text) {
       if (!m) throw new Error(`level file: cannot read line "${lines[pos].trim()}"`);
       pos++;
       if (m[2] !== undefined && m[2] !== "") {
-        out[m[1]] = scalar(m[2]);
+        out[m[1]] = value(m[2]);
       } else {
         // A nested node: deeper lines, or a sequence at the same indentation (YAML allows it).
         const next = pos < lines.length ? lines[pos] : "";
@@ -189,14 +219,13 @@ export function platformLevel(doc) {
     if (v === undefined || v === null) throw new Error(`level: missing ${what}`);
     return v;
   };
-  const goal = need(doc.goal, "goal (arlpcg writes it; this module does not derive it)").map(Number);
-  return {
+  const level = {
     start: {
       position: need(start.position, "start.position").map(Number),
       heading: Number(need(start.heading, "start.heading")),
       size: Number(start.size ?? START_SIZE),
     },
-    goal,
+    goal: doc.goal?.map(Number),
     blocks: need(doc.blocks, "blocks").map((b, i) => ({
       distance: Number(need(b.distance, `blocks[${i}].distance`)),
       angle: Number(need(b.angle, `blocks[${i}].angle`)),
@@ -204,6 +233,10 @@ export function platformLevel(doc) {
       height: Number(need(b.height, `blocks[${i}].height`)),
     })),
   };
+  // No goal written: the last block's top, to the file's 1 mm (`into_level`,
+  // crates/core/src/level/yaml/file.rs).
+  if (!level.goal) level.goal = placePlatforms(level).at(-1).position.map(quantize);
+  return level;
 }
 
 /**

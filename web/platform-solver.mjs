@@ -45,6 +45,7 @@
 
 import { ChaCha8Rng } from "./rng.mjs";
 import { headingDirection, quantize, wrapDegrees } from "./levels.mjs";
+import { readLevelYaml } from "./level-file.mjs";
 import {
   SolverNetwork,
   add,
@@ -113,88 +114,13 @@ const F32_RADIANS_PER_DEGREE = f32(f32(Math.PI) / 180.0);
 /**
  * The few fields of an arlpcg platform level file that a run needs: `start` (position, heading,
  * size), `goal` and each block's `distance`, `angle`, `size` and `height`. Reads the YAML
- * arlpcg writes (block style) and hand-written levels like levels/hand/staircase.yaml (comments,
- * one-line flow collections such as `{distance: 7, angle: 0, size: 5, height: 0}`). Not a YAML
- * parser: anchors, multi-line flow collections or block scalars need a real one (then pass the
- * parsed object to `platformLevel`).
+ * arlpcg writes (block style) and hand-written levels like levels/hand/staircase.yaml
+ * (`readLevelYaml`, level-file.mjs: not YAML at large; pass a parsed object to `platformLevel`
+ * otherwise).
  * @param {string} text
  */
 export function parsePlatformLevel(text) {
-  const lines = text
-    .split(/\r?\n/)
-    .map((l) => l.replace(/(^|\s)#.*$/, "").replace(/\s+$/, ""))
-    .filter((l) => l.trim() !== "");
-  let pos = 0;
-  const indent = (l) => l.length - l.trimStart().length;
-  // A one-line value: a flow collection, a number or a string.
-  const value = (s) => {
-    const t = s.trim();
-    if (t.startsWith("{") || t.startsWith("[")) return flow(t);
-    if (/^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/.test(t)) return Number(t);
-    return t.replace(/^(['"])(.*)\1$/, "$2");
-  };
-  // `{a: 1, b: [1, 2]}` or `[1, 2]`: split at the top level's commas.
-  function flow(t) {
-    const inner = t.slice(1, -1);
-    const parts = [];
-    let depth = 0;
-    let from = 0;
-    for (let i = 0; i <= inner.length; i++) {
-      const c = inner[i];
-      if (c === "{" || c === "[") depth++;
-      if (c === "}" || c === "]") depth--;
-      if ((c === "," && depth === 0) || i === inner.length) {
-        if (inner.slice(from, i).trim() !== "") parts.push(inner.slice(from, i).trim());
-        from = i + 1;
-      }
-    }
-    if (t.startsWith("[")) return parts.map(value);
-    return Object.fromEntries(
-      parts.map((p) => {
-        const at = p.indexOf(":");
-        return [p.slice(0, at).trim(), value(p.slice(at + 1))];
-      }),
-    );
-  }
-  // A node whose lines are indented at least `min` (a mapping or a sequence).
-  function node(min) {
-    if (pos >= lines.length || indent(lines[pos]) < min) return null;
-    const at = indent(lines[pos]);
-    if (lines[pos].trimStart().startsWith("- ") || lines[pos].trim() === "-") {
-      const out = [];
-      while (pos < lines.length && indent(lines[pos]) === at && lines[pos].trimStart().startsWith("-")) {
-        const rest = lines[pos].trimStart().slice(1);
-        if (rest.trim() === "") {
-          pos++;
-          out.push(node(at + 1));
-        } else if (/^\s*[^\s:{[]+:(\s|$)/.test(rest)) {
-          // A mapping inside the item: its first key on the dash's line.
-          lines[pos] = " ".repeat(at + 1 + (rest.length - rest.trimStart().length)) + rest.trimStart();
-          out.push(node(at + 1));
-        } else {
-          pos++;
-          out.push(value(rest));
-        }
-      }
-      return out;
-    }
-    const out = {};
-    while (pos < lines.length && indent(lines[pos]) === at) {
-      const m = lines[pos].trim().match(/^([^:]+):(?:\s+(.*))?$/);
-      if (!m) throw new Error(`level file: cannot read line "${lines[pos].trim()}"`);
-      pos++;
-      if (m[2] !== undefined && m[2] !== "") {
-        out[m[1]] = value(m[2]);
-      } else {
-        // A nested node: deeper lines, or a sequence at the same indentation (YAML allows it).
-        const next = pos < lines.length ? lines[pos] : "";
-        const sameIndentSeq = indent(next) === at && next.trimStart().startsWith("-");
-        out[m[1]] = node(sameIndentSeq ? at : at + 1);
-      }
-    }
-    return out;
-  }
-  const doc = node(0);
+  const doc = readLevelYaml(text);
   if (doc?.game !== undefined && doc.game !== "platform") throw new Error(`not a platform level: game ${doc.game}`);
   return platformLevel(doc);
 }
@@ -411,6 +337,29 @@ export class PlatformCourse {
     };
   }
 
+  /**
+   * A run in a recorded state (a golden episode's `state`, `steps` decisions in): the feet,
+   * yaw, velocity and grounded flag as recorded, `furthest` the block before the recorded next
+   * block.
+   */
+  runFromState(state, steps) {
+    const next = this.platforms.findIndex((p) => p.top.every((v, k) => Math.abs(v - state.next_block_top[k]) < 1e-4));
+    return {
+      feet: state.feet.map(f32),
+      velocity: state.velocity.map(f32),
+      yaw: f32(state.yaw[0]),
+      grounded: state.grounded[0] === 1,
+      steps,
+      furthest: next - 1,
+      outcome: null,
+    };
+  }
+
+  /** The feet, as a golden episode records the run's position. */
+  position(run) {
+    return run.feet;
+  }
+
   /** What a run's result reports beside its seed and outcome. */
   summary(run) {
     const last = this.platforms.length - 1;
@@ -512,9 +461,13 @@ export class PlatformSolver {
    * means and p ≥ 1/2, as the graph's `continuous_actions` and `binary_actions` give them).
    */
   async act(rows, count, rngs, options = {}) {
-    // PlatformAction::from_policy_row: clipped to [-1, 1], NaN as 0; the jump on at 1.
     const raw = await this.network.act(rows, count, rngs, options);
-    return raw.map((row) => ({ forward: clipAction(row[0]), turn: clipAction(row[1]), jump: row[2] === 1.0 }));
+    return raw.map((row) => this.decode(row));
+  }
+
+  /** The action a row (forward, turn, jump) stands for (`PlatformAction::from_policy_row`: clipped to [-1, 1], NaN as 0; the jump on at 1). */
+  decode(row) {
+    return { forward: clipAction(row[0]), turn: clipAction(row[1]), jump: row[2] === 1.0 };
   }
 
   /**

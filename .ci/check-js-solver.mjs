@@ -1,21 +1,27 @@
-// Checks web/platform-solver.mjs against arlpcg itself: the exported platform Solver playing
-// levels in rapier.js (@dimforge/rapier3d-compat, pinned in .ci/package.json) under
-// onnxruntime-node, against `arlpcg verify` playing the same levels in rapier3d.
+// Checks the JS Solvers against arlpcg itself: the exported Solver of a game playing levels in
+// rapier.js (@dimforge/rapier3d-compat, pinned in .ci/package.json) under onnxruntime-node,
+// against `arlpcg verify` playing the same levels in rapier3d. `--game=platform` (the default):
+// web/platform-solver.mjs; `--game=racing`: web/racing-solver.mjs.
 //
-// 1. Exports policies/platform/solver.safetensors (`arlpcg export-policy`) and checks the port on
-//    its golden episode: every observation recomputed from the recorded state within 1e-5, and
-//    the episode replayed from its reset with the graph's deterministic actions (the feet's
-//    largest distance from the recorded ones and the outcome are printed; the outcome must match).
-// 2. Has `arlpcg generate` build SEEDS platform levels at each λ in --aux (the shipped
-//    Generator; λ = -1 hard, +1 easy), runs `arlpcg verify --json --threads 1 --trials N --seed 0`
-//    on them and plays each level N times in the module with the same seeds (run i resets with
-//    seed i and draws its actions from a stream seeded i, as verify does).
-// 3. Prints each level's two success ratios (and falls and time-outs), the overall success
-//    ratios, the milliseconds per decision and the time it took; exits 1 when the overall
-//    ratios are more than --bar apart (0.05 by default) or the golden episode is not reproduced.
+// 1. Exports policies/GAME/solver.safetensors (`arlpcg export-policy`) and checks the port on
+//    its golden episode: every observation recomputed from the recorded state within 1e-5; one
+//    decision stepped from each recorded state with the recorded action, against the next
+//    recorded state (how many land within 1e-6 m, and the farthest, are printed); and the
+//    episode replayed from its reset with the graph's deterministic actions (the position's
+//    largest distance from the recorded one and the outcome are printed; the outcome must
+//    match, and for platform the number of decisions too).
+// 2. Has `arlpcg generate` build SEEDS levels of the game at each λ in --aux (the shipped
+//    Generator; λ = -1 hard, +1 easy; racing: among --obstacles=N obstacles, 0 by default as
+//    in levels/racing/), runs `arlpcg verify --json --threads 1 --trials N --seed 0` on them and
+//    plays each level N times in the module with the same seeds (run i resets with seed i and
+//    draws its actions from a stream seeded i, as verify does).
+// 3. Prints each level's two success ratios (and how the other runs ended), the overall
+//    success ratios, the milliseconds per decision and the time it took; exits 1 when the
+//    overall ratios are more than --bar apart (0.05 by default) or the golden episode is not
+//    reproduced.
 //
-//   node .ci/check-js-solver.mjs ARLPCG_BINARY [--seeds=5] [--aux=-1,-0.5,0,1] [--trials=20]
-//       [--bar=0.05] [--keep=DIR]
+//   node .ci/check-js-solver.mjs ARLPCG_BINARY [--game=platform|racing] [--seeds=5]
+//       [--aux=-1,-0.5,0,1] [--trials=20] [--obstacles=0] [--bar=0.05] [--keep=DIR]
 
 import { execFileSync } from "node:child_process";
 import fs from "node:fs";
@@ -25,6 +31,7 @@ import { fileURLToPath } from "node:url";
 import * as ort from "onnxruntime-node";
 import RAPIER from "@dimforge/rapier3d-compat";
 import { PlatformCourse, PlatformSolver, parsePlatformLevel } from "../web/platform-solver.mjs";
+import { RacingCourse, RacingSolver, parseRacingLevel } from "../web/racing-solver.mjs";
 
 const started = performance.now();
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), "..");
@@ -32,7 +39,9 @@ const args = process.argv.slice(2);
 const flag = (name) => args.find((a) => a.startsWith(`--${name}=`))?.split("=")[1];
 const [binaryArg] = args.filter((a) => !a.startsWith("--"));
 if (!binaryArg) {
-  console.error("usage: node .ci/check-js-solver.mjs ARLPCG_BINARY [--seeds=5] [--aux=-1,-0.5,0,1] [--trials=20] [--bar=0.05] [--keep=DIR]");
+  console.error(
+    "usage: node .ci/check-js-solver.mjs ARLPCG_BINARY [--game=platform|racing] [--seeds=5] [--aux=-1,-0.5,0,1] [--trials=20] [--obstacles=0] [--bar=0.05] [--keep=DIR]",
+  );
   process.exit(2);
 }
 const binary = path.resolve(binaryArg);
@@ -40,19 +49,54 @@ const SEEDS = Number(flag("seeds") ?? 5);
 const AUXES = (flag("aux") ?? "-1,-0.5,0,1").split(",").map(Number);
 const TRIALS = Number(flag("trials") ?? 20);
 const BAR = Number(flag("bar") ?? 0.05);
+const GAME = flag("game") ?? "platform";
+const OBSTACLES = Number(flag("obstacles") ?? 0);
+// What differs between the games: the module, the golden state's position, how runs fail.
+const GAMES = {
+  platform: {
+    Solver: PlatformSolver,
+    Course: PlatformCourse,
+    parse: parsePlatformLevel,
+    observationSize: 40,
+    position: (state) => state.feet,
+    sameSteps: true,
+    failures: [
+      ["fell", "Fell", "fell"],
+      ["timed out", "TimedOut", "timed_out"],
+    ],
+  },
+  racing: {
+    Solver: RacingSolver,
+    Course: RacingCourse,
+    parse: parseRacingLevel,
+    observationSize: 47,
+    position: (state) => state.position,
+    // A racing episode runs ~600 decisions through the chassis's chaotic contacts with the road:
+    // the replay ends alike, not on the same decision (docs/engines.md).
+    sameSteps: false,
+    failures: [
+      ["off road", "OffRoad", "off_road"],
+      ["flipped", "Flipped", "flipped"],
+      ["timed out", "TimedOut", "timed_out"],
+    ],
+  },
+};
+const game = GAMES[GAME];
+if (!game) throw new Error(`--game=${GAME}: platform or racing`);
+if (OBSTACLES && GAME !== "racing") throw new Error("--obstacles is racing's");
 // Observations recomputed from a golden episode's state: the port kit's bar (docs/engines.md).
 const OBSERVATION_BAR = 1e-5;
 
 const dir = flag("keep") ? path.resolve(flag("keep")) : fs.mkdtempSync(path.join(os.tmpdir(), "arlpcg-js-solver-"));
 fs.mkdirSync(dir, { recursive: true });
-const policy = path.join(root, "policies/platform/solver.safetensors");
+const policy = path.join(root, `policies/${GAME}/solver.safetensors`);
 const arlpcg = (...a) => execFileSync(binary, a, { cwd: root, encoding: "utf8", maxBuffer: 1 << 26 });
 
 await RAPIER.init();
 const onnxPath = path.join(dir, "solver.onnx");
 arlpcg("export-policy", policy, "--out", onnxPath, "--force");
 const sidecar = JSON.parse(fs.readFileSync(`${onnxPath}.json`, "utf8"));
-const solver = await PlatformSolver.load(ort, new Uint8Array(fs.readFileSync(onnxPath)), sidecar, {
+const solver = await game.Solver.load(ort, new Uint8Array(fs.readFileSync(onnxPath)), sidecar, {
   sessionOptions: { intraOpNumThreads: 1, interOpNumThreads: 1 },
 });
 let failed = false;
@@ -60,43 +104,46 @@ let failed = false;
 // 1. The golden episode.
 {
   const golden = JSON.parse(fs.readFileSync(`${onnxPath}.golden.json`, "utf8"));
-  const course = new PlatformCourse(RAPIER, parsePlatformLevel(golden.level));
-  const observation = new Float32Array(40);
+  const course = new game.Course(RAPIER, game.parse(golden.level));
+  const observation = new Float32Array(game.observationSize);
   let worst = 0;
-  for (const frame of golden.frames) {
-    const s = frame.state;
-    // The recorded state as a run: `furthest` is the platform before the recorded next block.
-    const next = course.platforms.findIndex((p) => p.top.every((v, k) => Math.abs(v - s.next_block_top[k]) < 1e-4));
-    const run = {
-      feet: s.feet.map(Math.fround),
-      velocity: s.velocity.map(Math.fround),
-      yaw: Math.fround(s.yaw[0]),
-      grounded: s.grounded[0] === 1,
-      steps: s.steps[0],
-      furthest: next - 1,
-    };
+  golden.frames.forEach((frame, i) => {
+    const run = course.runFromState(frame.state, i);
     course.observe(run, observation);
     frame.observation.forEach((want, k) => (worst = Math.max(worst, Math.abs(observation[k] - want))));
+    course.release?.(run);
+  });
+  // One decision from each recorded state with the recorded action (the golden's actions are
+  // the graph's deterministic ones, clipped), against the next recorded state.
+  const stepped = [];
+  for (let i = 0; i + 1 < golden.frames.length; i++) {
+    const run = course.runFromState(golden.frames[i].state, i);
+    course.step(run, solver.decode(golden.frames[i].action));
+    const want = game.position(golden.frames[i + 1].state);
+    stepped.push(Math.hypot(...course.position(run).map((v, k) => v - want[k])));
+    course.release?.(run);
   }
-  // Replayed from the reset, deterministically (the golden episode's actions are the means).
+  // Replayed from the reset, deterministically.
   let feetOff = 0;
   const frames = [];
   const [replayed] = await solver.play(course, {
     trials: 1,
     seed: golden.run_seed,
     deterministic: true,
-    onDecision: (p) => frames.push(p.run.feet.slice()),
+    onDecision: (p) => frames.push(course.position(p.run).slice()),
   });
-  frames.forEach((feet, i) => {
-    const want = golden.frames[i]?.state.feet;
-    if (want) feetOff = Math.max(feetOff, Math.hypot(...feet.map((v, k) => v - want[k])));
+  frames.forEach((position, i) => {
+    const want = golden.frames[i] && game.position(golden.frames[i].state);
+    if (want) feetOff = Math.max(feetOff, Math.hypot(...position.map((v, k) => v - want[k])));
   });
   course.free();
-  const same = replayed.outcome === golden.outcome && replayed.steps === golden.frames.length;
+  const same = replayed.outcome === golden.outcome && (!game.sameSteps || replayed.steps === golden.frames.length);
   console.log(
     `golden episode: observations from the recorded state within ${worst.toExponential(2)} (bar ${OBSERVATION_BAR}); ` +
+      `one decision from each recorded state: ${stepped.filter((d) => d <= 1e-6).length} of ${stepped.length} within 1e-6 m ` +
+      `of the next recorded state, the farthest ${Math.max(...stepped).toExponential(2)} m; ` +
       `replayed: ${replayed.outcome} in ${replayed.steps} decisions (recorded: ${golden.outcome} in ${golden.frames.length}), ` +
-      `feet at most ${(feetOff * 1000).toFixed(2)} mm from the recorded ones`,
+      `at most ${(feetOff * 1000).toFixed(2)} mm from the recorded positions`,
   );
   if (!(worst <= OBSERVATION_BAR) || !same) failed = true;
 }
@@ -105,7 +152,8 @@ let failed = false;
 const levelsDir = path.join(dir, "levels");
 fs.rmSync(levelsDir, { recursive: true, force: true });
 for (const aux of AUXES) {
-  arlpcg("generate", "--game", "platform", "--policies", "policies/platform", `--aux=${aux}`, "--seed", "0", "--count", String(SEEDS), "--out", levelsDir);
+  const obstacles = GAME === "racing" && OBSTACLES ? ["--obstacles", String(OBSTACLES)] : [];
+  arlpcg("generate", "--game", GAME, "--policies", `policies/${GAME}`, `--aux=${aux}`, "--seed", "0", "--count", String(SEEDS), ...obstacles, "--out", levelsDir);
 }
 const files = fs.readdirSync(levelsDir).filter((f) => f.endsWith(".yaml")).sort().map((f) => path.join(levelsDir, f));
 const verifyStarted = performance.now();
@@ -125,27 +173,26 @@ let decisions = 0;
 let playMs = 0;
 let networkMs = 0;
 const gaps = [];
-console.log(`${files.length} levels × ${TRIALS} runs (λ ${AUXES.join(", ")}; seeds 0-${SEEDS - 1}); success verify → JS (and how runs failed):`);
+console.log(
+  `${files.length} ${GAME} levels × ${TRIALS} runs (λ ${AUXES.join(", ")}; seeds 0-${SEEDS - 1}` +
+    `${GAME === "racing" ? `; ${OBSTACLES} obstacles` : ""}); success verify → JS (and how runs failed):`,
+);
 for (const file of files) {
   const v = verified.get(file);
   if (!v) throw new Error(`verify gave no line for ${file}`);
-  const course = new PlatformCourse(RAPIER, parsePlatformLevel(fs.readFileSync(file, "utf8")));
+  const course = new game.Course(RAPIER, game.parse(fs.readFileSync(file, "utf8")));
   const results = await solver.play(course, { trials: TRIALS, seed: 0 });
   course.free();
   decisions += solver.lastTiming.decisions;
   playMs += solver.lastTiming.ms;
   networkMs += solver.lastTiming.networkMs;
   const js = results.filter((r) => r.outcome === "Success").length;
-  const fell = results.filter((r) => r.outcome === "Fell").length;
-  const timedOut = results.filter((r) => r.outcome === "TimedOut").length;
   rustSuccesses += v.successes;
   jsSuccesses += js;
   runs += TRIALS;
   gaps.push(js / TRIALS - v.success_ratio);
-  console.log(
-    `  ${path.basename(file).padEnd(30)} ${v.success_ratio.toFixed(2)} → ${(js / TRIALS).toFixed(2)}` +
-      `   (fell ${v.fell} → ${fell}, timed out ${v.timed_out} → ${timedOut})`,
-  );
+  const failures = game.failures.map(([words, outcome, key]) => `${words} ${v[key]} → ${results.filter((r) => r.outcome === outcome).length}`);
+  console.log(`  ${path.basename(file).padEnd(30)} ${v.success_ratio.toFixed(2)} → ${(js / TRIALS).toFixed(2)}   (${failures.join(", ")})`);
 }
 const rust = rustSuccesses / runs;
 const js = jsSuccesses / runs;

@@ -44,10 +44,25 @@
 // "Playing a Solver in rapier.js".
 
 import { ChaCha8Rng } from "./rng.mjs";
-import { exposeMeans } from "./onnx-means.mjs";
 import { headingDirection, quantize, wrapDegrees } from "./levels.mjs";
+import { readLevelYaml } from "./level-file.mjs";
+import {
+  SolverNetwork,
+  add,
+  clipAction,
+  dot,
+  f32,
+  length,
+  playRuns,
+  randomRangeF32,
+  rotate,
+  rotationY,
+  scale,
+  sub,
+} from "./solver.mjs";
 
-const f32 = Math.fround;
+// Kept here for callers of this module's earlier versions.
+export { randomF32, randomRangeF32 } from "./solver.mjs";
 
 /** The built-in character (`CharacterProfile::default`, crates/core/src/level/profile/abilities.rs). */
 export const BUILT_IN_CHARACTER = Object.freeze({
@@ -94,120 +109,18 @@ const STAND_HEIGHT = f32(0.2);
 const F32_RADIANS_PER_DEGREE = f32(f32(Math.PI) / 180.0);
 
 // ---------------------------------------------------------------------------------------------
-// float32 vectors as glam computes them (rapier's math): [x, y, z] arrays of float32 values.
-
-const add = (a, b) => [f32(a[0] + b[0]), f32(a[1] + b[1]), f32(a[2] + b[2])];
-const sub = (a, b) => [f32(a[0] - b[0]), f32(a[1] - b[1]), f32(a[2] - b[2])];
-const scale = (a, s) => [f32(a[0] * s), f32(a[1] * s), f32(a[2] * s)];
-const dot = (a, b) => f32(f32(f32(a[0] * b[0]) + f32(a[1] * b[1])) + f32(a[2] * b[2]));
-const length = (a) => f32(Math.sqrt(dot(a, a)));
-
-/** `Quat::from_rotation_y(angle)` as [x, y, z, w]. */
-function rotationY(angle) {
-  const half = f32(angle * 0.5);
-  return [0.0, f32(Math.sin(half)), 0.0, f32(Math.cos(half))];
-}
-
-/** `Quat * Vec3` (glam's mul_vec3a: v(w² - b·b) + b(2 v·b) + (b × v)(2w)). */
-function rotate(q, v) {
-  const b = [q[0], q[1], q[2]];
-  const w = q[3];
-  const cross = [
-    f32(f32(b[1] * v[2]) - f32(b[2] * v[1])),
-    f32(f32(b[2] * v[0]) - f32(b[0] * v[2])),
-    f32(f32(b[0] * v[1]) - f32(b[1] * v[0])),
-  ];
-  return add(add(scale(v, f32(f32(w * w) - dot(b, b))), scale(b, f32(dot(v, b) * 2.0))), scale(cross, f32(w * 2.0)));
-}
-
-// ---------------------------------------------------------------------------------------------
 // Levels.
 
 /**
  * The few fields of an arlpcg platform level file that a run needs: `start` (position, heading,
  * size), `goal` and each block's `distance`, `angle`, `size` and `height`. Reads the YAML
- * arlpcg writes (block style) and hand-written levels like levels/hand/staircase.yaml (comments,
- * one-line flow collections such as `{distance: 7, angle: 0, size: 5, height: 0}`). Not a YAML
- * parser: anchors, multi-line flow collections or block scalars need a real one (then pass the
- * parsed object to `platformLevel`).
+ * arlpcg writes (block style) and hand-written levels like levels/hand/staircase.yaml
+ * (`readLevelYaml`, level-file.mjs: not YAML at large; pass a parsed object to `platformLevel`
+ * otherwise).
  * @param {string} text
  */
 export function parsePlatformLevel(text) {
-  const lines = text
-    .split(/\r?\n/)
-    .map((l) => l.replace(/(^|\s)#.*$/, "").replace(/\s+$/, ""))
-    .filter((l) => l.trim() !== "");
-  let pos = 0;
-  const indent = (l) => l.length - l.trimStart().length;
-  // A one-line value: a flow collection, a number or a string.
-  const value = (s) => {
-    const t = s.trim();
-    if (t.startsWith("{") || t.startsWith("[")) return flow(t);
-    if (/^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/.test(t)) return Number(t);
-    return t.replace(/^(['"])(.*)\1$/, "$2");
-  };
-  // `{a: 1, b: [1, 2]}` or `[1, 2]`: split at the top level's commas.
-  function flow(t) {
-    const inner = t.slice(1, -1);
-    const parts = [];
-    let depth = 0;
-    let from = 0;
-    for (let i = 0; i <= inner.length; i++) {
-      const c = inner[i];
-      if (c === "{" || c === "[") depth++;
-      if (c === "}" || c === "]") depth--;
-      if ((c === "," && depth === 0) || i === inner.length) {
-        if (inner.slice(from, i).trim() !== "") parts.push(inner.slice(from, i).trim());
-        from = i + 1;
-      }
-    }
-    if (t.startsWith("[")) return parts.map(value);
-    return Object.fromEntries(
-      parts.map((p) => {
-        const at = p.indexOf(":");
-        return [p.slice(0, at).trim(), value(p.slice(at + 1))];
-      }),
-    );
-  }
-  // A node whose lines are indented at least `min` (a mapping or a sequence).
-  function node(min) {
-    if (pos >= lines.length || indent(lines[pos]) < min) return null;
-    const at = indent(lines[pos]);
-    if (lines[pos].trimStart().startsWith("- ") || lines[pos].trim() === "-") {
-      const out = [];
-      while (pos < lines.length && indent(lines[pos]) === at && lines[pos].trimStart().startsWith("-")) {
-        const rest = lines[pos].trimStart().slice(1);
-        if (rest.trim() === "") {
-          pos++;
-          out.push(node(at + 1));
-        } else if (/^\s*[^\s:{[]+:(\s|$)/.test(rest)) {
-          // A mapping inside the item: its first key on the dash's line.
-          lines[pos] = " ".repeat(at + 1 + (rest.length - rest.trimStart().length)) + rest.trimStart();
-          out.push(node(at + 1));
-        } else {
-          pos++;
-          out.push(value(rest));
-        }
-      }
-      return out;
-    }
-    const out = {};
-    while (pos < lines.length && indent(lines[pos]) === at) {
-      const m = lines[pos].trim().match(/^([^:]+):(?:\s+(.*))?$/);
-      if (!m) throw new Error(`level file: cannot read line "${lines[pos].trim()}"`);
-      pos++;
-      if (m[2] !== undefined && m[2] !== "") {
-        out[m[1]] = value(m[2]);
-      } else {
-        // A nested node: deeper lines, or a sequence at the same indentation (YAML allows it).
-        const next = pos < lines.length ? lines[pos] : "";
-        const sameIndentSeq = indent(next) === at && next.trimStart().startsWith("-");
-        out[m[1]] = node(sameIndentSeq ? at : at + 1);
-      }
-    }
-    return out;
-  }
-  const doc = node(0);
+  const doc = readLevelYaml(text);
   if (doc?.game !== undefined && doc.game !== "platform") throw new Error(`not a platform level: game ${doc.game}`);
   return platformLevel(doc);
 }
@@ -424,6 +337,35 @@ export class PlatformCourse {
     };
   }
 
+  /**
+   * A run in a recorded state (a golden episode's `state`, `steps` decisions in): the feet,
+   * yaw, velocity and grounded flag as recorded, `furthest` the block before the recorded next
+   * block.
+   */
+  runFromState(state, steps) {
+    const next = this.platforms.findIndex((p) => p.top.every((v, k) => Math.abs(v - state.next_block_top[k]) < 1e-4));
+    return {
+      feet: state.feet.map(f32),
+      velocity: state.velocity.map(f32),
+      yaw: f32(state.yaw[0]),
+      grounded: state.grounded[0] === 1,
+      steps,
+      furthest: next - 1,
+      outcome: null,
+    };
+  }
+
+  /** The feet, as a golden episode records the run's position. */
+  position(run) {
+    return run.feet;
+  }
+
+  /** What a run's result reports beside its seed and outcome. */
+  summary(run) {
+    const last = this.platforms.length - 1;
+    return { steps: run.steps, furthest: run.furthest, progress: run.furthest / Math.max(last, 1) };
+  }
+
   /** Moves the capsule (centred at `centre`) by `desired` through the blocks (`move_character`). */
   move(centre, desired) {
     this.character.setTranslation({ x: centre[0], y: centre[1], z: centre[2] });
@@ -489,20 +431,6 @@ function facing(yaw) {
   return [f32(Math.cos(yaw)), 0.0, f32(-Math.sin(yaw))];
 }
 
-/** rand's `random_range(low..=high)` for f32: a u32's top 23 bits as [1, 2), minus 1, times the span, plus low. */
-export function randomRangeF32(rng, low, high) {
-  const bits = (rng.nextU32() >>> 9) | 0x3f800000;
-  const view = new DataView(new ArrayBuffer(4));
-  view.setUint32(0, bits);
-  const value01 = f32(view.getFloat32(0) - 1.0);
-  return f32(f32(value01 * f32(high - low)) + low);
-}
-
-/** rand's `random::<f32>()`: a u32's top 24 bits times 2⁻²⁴. */
-export function randomF32(rng) {
-  return (rng.nextU32() >>> 8) * 5.9604644775390625e-8;
-}
-
 // ---------------------------------------------------------------------------------------------
 // The policy.
 
@@ -515,100 +443,42 @@ export class PlatformSolver {
    * @param {object} [options] `sessionOptions` for onnxruntime
    */
   static async load(ort, onnx, sidecar, options = {}) {
-    if (sidecar.game !== "platform" || sidecar.role !== "solver") {
-      throw new Error(`not a platform Solver's export: ${sidecar.game} ${sidecar.role}`);
-    }
-    if (sidecar.profile !== "plain") throw new Error("export the Solver with --contract plain");
-    if (!sidecar.sampling) throw new Error("the sidecar has no `sampling`: export it again with a newer arlpcg");
-    const size = sidecar.inputs[0].shape[1];
-    if (size !== PLATFORM_SOLVER_OBSERVATION_SIZE) {
-      // An ability-aware Solver (43 columns) observes the abilities too; not supported here.
-      throw new Error(`this module plays the 40-column platform Solver; this one observes ${size}`);
-    }
-    const { bytes, meanOutput } = exposeMeans(onnx);
-    const session = await ort.InferenceSession.create(bytes, options.sessionOptions ?? {});
-    return new PlatformSolver(ort, session, meanOutput, sidecar);
+    const network = await SolverNetwork.load(ort, onnx, sidecar, {
+      game: "platform",
+      observationSize: PLATFORM_SOLVER_OBSERVATION_SIZE,
+      sessionOptions: options.sessionOptions,
+    });
+    return new PlatformSolver(network);
   }
 
-  constructor(ort, session, meanOutput, sidecar) {
-    this.ort = ort;
-    this.session = session;
-    this.meanOutput = meanOutput;
-    this.input = sidecar.inputs[0].name;
-    this.std = sidecar.sampling.std.map(f32);
+  constructor(network) {
+    this.network = network;
   }
 
   /**
    * The actions of a batch of observations (rows of 40), each row's draws from its own stream
-   * (`choose_per_row`, ActMode::Sample; `deterministic`: the means and p ≥ 1/2, as the graph's
-   * `continuous_actions` and `binary_actions` give them, drawing nothing).
+   * (`choose_per_row`, ActMode::Sample: forward, turn, then the jump; `deterministic`: the
+   * means and p ≥ 1/2, as the graph's `continuous_actions` and `binary_actions` give them).
    */
-  async act(rows, count, rngs, { deterministic = false } = {}) {
-    const n = PLATFORM_SOLVER_OBSERVATION_SIZE;
-    const tensor = new this.ort.Tensor("float32", rows.subarray(0, count * n), [count, n]);
-    const result = await this.session.run({ [this.input]: tensor }, [this.meanOutput, "binary_probabilities"]);
-    const means = result[this.meanOutput].data;
-    const probabilities = result.binary_probabilities.data;
-    const actions = [];
-    for (let r = 0; r < count; r++) {
-      const row = [0.0, 0.0];
-      for (let k = 0; k < 2; k++) {
-        const mean = means[2 * r + k];
-        row[k] = deterministic ? mean : f32(mean + f32(this.std[k] * rngs[r].standardNormalF32()));
-      }
-      const p = probabilities[r];
-      const jump = deterministic ? p >= 0.5 : randomF32(rngs[r]) < p;
-      // PlatformAction::from_policy_row: clipped to [-1, 1], NaN as 0.
-      const clean = (v) => (Number.isNaN(v) ? 0.0 : Math.min(Math.max(v, -1.0), 1.0));
-      actions.push({ forward: clean(row[0]), turn: clean(row[1]), jump });
-    }
-    return actions;
+  async act(rows, count, rngs, options = {}) {
+    const raw = await this.network.act(rows, count, rngs, options);
+    return raw.map((row) => this.decode(row));
+  }
+
+  /** The action a row (forward, turn, jump) stands for (`PlatformAction::from_policy_row`: clipped to [-1, 1], NaN as 0; the jump on at 1). */
+  decode(row) {
+    return { forward: clipAction(row[0]), turn: clipAction(row[1]), jump: row[2] === 1.0 };
   }
 
   /**
-   * Plays `trials` runs of a course as `arlpcg verify --seed SEED --trials N` does: run i resets
-   * with SEED + i and draws its actions from a ChaCha8 stream seeded SEED + i. The runs go side
-   * by side (`pool` at a time, one batched graph run per decision), which changes no run.
+   * Plays `trials` runs of a course as `arlpcg verify --seed SEED --trials N` does (`playRuns`
+   * in solver.mjs: run i resets with SEED + i and draws from a stream seeded SEED + i; `pool`
+   * runs side by side, which changes no run).
    * @returns {Promise<{seed: number, outcome: string, steps: number, furthest: number, progress: number}[]>}
    */
-  async play(course, { trials = 100, seed = 0, pool = 32, deterministic = false, onDecision = null } = {}) {
-    const n = PLATFORM_SOLVER_OBSERVATION_SIZE;
-    const results = new Array(trials);
-    const rows = new Float32Array(pool * n);
-    let next = 0;
-    let playing = [];
-    let decisions = 0;
-    let networkMs = 0;
-    const started = performance.now();
-    for (;;) {
-      while (playing.length < pool && next < trials) {
-        const s = seed + next;
-        playing.push({ index: next, seed: s, run: course.reset(s), rng: ChaCha8Rng.seedFromU64(s) });
-        next++;
-      }
-      if (playing.length === 0) break;
-      playing.forEach((p, r) => course.observe(p.run, rows.subarray(r * n, (r + 1) * n)));
-      const before = performance.now();
-      const actions = await this.act(rows, playing.length, playing.map((p) => p.rng), { deterministic });
-      networkMs += performance.now() - before;
-      decisions += playing.length;
-      playing = playing.filter((p, r) => {
-        if (onDecision) onDecision(p, rows.subarray(r * n, (r + 1) * n), actions[r]);
-        const outcome = course.step(p.run, actions[r]);
-        if (!outcome) return true;
-        const last = course.platforms.length - 1;
-        results[p.index] = {
-          seed: p.seed,
-          outcome,
-          steps: p.run.steps,
-          furthest: p.run.furthest,
-          progress: p.run.furthest / Math.max(last, 1),
-        };
-        return false;
-      });
-    }
-    // The time the runs took, and how much of it the graph (onnxruntime) and the draws took.
-    this.lastTiming = { decisions, ms: performance.now() - started, networkMs };
+  async play(course, options = {}) {
+    const { results, timing } = await playRuns(this, course, PLATFORM_SOLVER_OBSERVATION_SIZE, options);
+    this.lastTiming = timing;
     return results;
   }
 }

@@ -136,14 +136,28 @@ function along(origin, heading, curvature, rise, length, s) {
   }
   const t = s / length;
   const y = rise * t * t * (3.0 - 2.0 * t);
-  return [[origin[0] + dx, origin[1] + y, origin[2] + dz], h];
+  const slope = (rise * 6.0 * t * (1.0 - t)) / length;
+  return [[origin[0] + dx, origin[1] + y, origin[2] + dz], h, slope];
 }
 
-/** The road's centre line as `Road` keeps it (the plan only: no banks, no mesh). */
-class Road {
-  constructor(position, headingDegrees) {
+/** The built-in road (`RoadShape::default`, crates/core/src/level/racing.rs): 9 m wide, banking 10° per °/m. */
+export const ROAD_SHAPE = Object.freeze({ width: ROAD_WIDTH, banking: 10.0 });
+/** The steepest banking, degrees, and the blend either side of a join, m (`MAX_BANK_DEGREES`, `BANK_BLEND`). */
+const MAX_BANK_DEGREES = 15.0;
+const BANK_BLEND = 6.0;
+
+/**
+ * The road as `Road` keeps it (crates/core/src/level/road.rs): its cross-sections (`samples`:
+ * s, segment, centre, heading in radians, slope, bank in radians), where each segment starts
+ * and the end's pose. The Generator's checks use the plan; the Solver's world (racing-solver.mjs)
+ * the banks and slopes too.
+ */
+export class Road {
+  constructor(position, headingDegrees, shape = ROAD_SHAPE) {
+    this.shape = shape;
     this.samples = [];
     this.starts = [0.0];
+    this.banks = [];
     this.segments = 0;
     this.endPoint = position.slice();
     this.endHeading = headingDegrees * RADIANS_PER_DEGREE;
@@ -158,12 +172,15 @@ class Road {
     return this.starts[this.starts.length - 1];
   }
 
+  /** Appends a segment (`Road::push`); the samples its join's bank blend reaches are re-banked. */
   push(params) {
     const index = this.segments;
     const origin = this.endPoint;
     const heading = this.endHeading;
     const length = params.length;
     const curvature = (params.curve * RADIANS_PER_DEGREE) / length;
+    const bank = clamp((this.shape.banking * params.curve) / length, -MAX_BANK_DEGREES, MAX_BANK_DEGREES) * RADIANS_PER_DEGREE;
+    this.banks.push(bank);
     const startS = this.starts[this.starts.length - 1];
     this.starts.push(startS + length);
     this.segments++;
@@ -171,12 +188,77 @@ class Road {
     const steps = Math.ceil(length / SAMPLE_SPACING);
     for (let k = 0; k <= steps; k++) {
       const s = (length * k) / steps;
-      const [centre, h] = along(origin, heading, curvature, params.height, length, s);
-      this.samples.push({ s: startS + s, segment: index, centre, heading: h });
+      const [centre, h, slope] = along(origin, heading, curvature, params.height, length, s);
+      this.samples.push({ s: startS + s, segment: index, centre, heading: h, slope, bank: 0.0 });
     }
     const [end, endHeading] = along(origin, heading, curvature, params.height, length, length);
     this.endPoint = end;
     this.endHeading = endHeading;
+    const from = startS - BANK_BLEND;
+    for (let i = this.samples.length - 1; i >= 0; i--) {
+      if (this.samples[i].s < from) break;
+      this.samples[i].bank = this.bankAt(this.samples[i].s);
+    }
+  }
+
+  /** The segment at distance s along the road, clamped to the first and last (`segment_at`). */
+  segmentAt(s) {
+    for (let i = 1; i < this.starts.length; i++) if (s < this.starts[i]) return i - 1;
+    return Math.max(this.banks.length - 1, 0);
+  }
+
+  /** The bank at distance s along the road, radians, blended over a join's 6 m (`bank_at`). */
+  bankAt(s) {
+    const segment = this.segmentAt(s);
+    const own = this.banks[segment];
+    const start = this.starts[segment];
+    const end = this.starts[segment + 1];
+    if (segment > 0 && s - start < BANK_BLEND) {
+      const t = (s - start + BANK_BLEND) / (2.0 * BANK_BLEND);
+      return this.banks[segment - 1] + t * (own - this.banks[segment - 1]);
+    }
+    if (segment + 1 < this.banks.length && end - s < BANK_BLEND) {
+      const t = (s - end + BANK_BLEND) / (2.0 * BANK_BLEND);
+      return own + t * (this.banks[segment + 1] - own);
+    }
+    return own;
+  }
+
+  /**
+   * The sample nearest `point` horizontally among `window` either side of `hint` (the whole road
+   * without a hint), the first of equal distances (`Road::nearest`).
+   */
+  nearest(point, hint = null, window = 0) {
+    const lo = hint === null ? 0 : Math.max(hint - window, 0);
+    const hi = hint === null ? this.samples.length : Math.min(hint + window + 1, this.samples.length);
+    let best = lo;
+    let bestD = Infinity;
+    for (let i = lo; i < hi; i++) {
+      const c = this.samples[i].centre;
+      const dx = c[0] - point[0];
+      const dz = c[2] - point[2];
+      const d = dx * dx + dz * dz;
+      if (d < bestD) {
+        bestD = d;
+        best = i;
+      }
+    }
+    return best;
+  }
+
+  /** The sample nearest distance s along the road, clamped to its ends (`Road::nearest_along`). */
+  nearestAlong(s) {
+    let lo = 0;
+    let hi = this.samples.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >> 1;
+      if (this.samples[mid].s < s) lo = mid + 1;
+      else hi = mid;
+    }
+    const after = lo;
+    if (after === 0) return 0;
+    if (after === this.samples.length) return after - 1;
+    return s - this.samples[after - 1].s < this.samples[after].s - s ? after - 1 : after;
   }
 
   /** Whether the samples of segment `from` on come within the clearance of an earlier part. */

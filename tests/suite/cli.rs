@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use crate::common::{FIVE_JUMPERS, arlpcg, arlpcg_ok, fails_with, files_of, stderr, words};
+use crate::common::{arlpcg, arlpcg_ok, fails_with, files_of, stderr, words};
 
 fn generate(dir: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
@@ -1288,21 +1288,17 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
     for (name, jump) in [("near", "8.5"), ("far", "7.0")] {
         write_platform_profile(&path(&format!("{name}.yaml")), name, jump);
     }
-    let run = path("run");
+    let refused = path("refused");
     // A share beyond ±50% is refused before anything is made.
     fails_with(
-        &arlpcg(words("train --ability-spread 0.7 --out {}", &[&run])),
+        &arlpcg(words("train --ability-spread 0.7 --out {}", &[&refused])),
         2,
         "`0.7` is not a share within [0, 0.5]",
     );
-    assert!(!Path::new(&run).exists());
+    assert!(!Path::new(&refused).exists());
     // Five characters (jumps 8-9.5 m/s, ours otherwise): each one's reach is measured once.
-    let config = path("aware.yaml");
-    std::fs::write(&config, FIVE_JUMPERS).unwrap();
-    let trained = arlpcg_ok(words(
-        "train --mode arlpcg --config {} --steps 8192 --threads 1 --out {}",
-        &[&config, &run],
-    ));
+    let (run, trained) = crate::common::five_jumpers_pair();
+    let run = run.to_str().unwrap().to_string();
     // The finished pair checks its own knob (2 levels × 2 runs at each end here), says how it
     // fared on its last line...
     let said = String::from_utf8_lossy(&trained.stdout);
@@ -1314,7 +1310,7 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
     // ...and both agents observe the abilities; their cards say over which ranges, and carry
     // the check's figures.
     for card in ["solver.yaml", "generator.yaml"] {
-        let card = std::fs::read_to_string(dir.path().join("run").join(card)).unwrap();
+        let card = std::fs::read_to_string(Path::new(&run).join(card)).unwrap();
         assert!(
             card.contains("- - abilities\n  - 3")
                 && card.contains("character.jump_speed:\n  - 8.0\n  - 9.5"),

@@ -220,14 +220,8 @@ fn a_profile_of_other_abilities_is_played_by_the_shipped_ability_aware_solver() 
 #[test]
 fn the_scripted_expert_plays_beyond_an_ability_aware_solvers_range() {
     let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("aware.yaml");
-    std::fs::write(&config, crate::common::FIVE_JUMPERS).unwrap();
-    let run = dir.path().join("run");
-    crate::common::arlpcg_ok(crate::common::words(
-        "train --mode arlpcg --config {} --steps 8192 --threads 1 --out {}",
-        &[&config, &run],
-    ));
-    let (policies, info) = worker::load(&run, Game::Platform).unwrap();
+    let (run, _) = crate::common::five_jumpers_pair();
+    let (policies, info) = worker::load(run, Game::Platform).unwrap();
     let mut h = Harness::new(policies, info, dir.path());
     h.settle();
     for (jump, stood_in) in [("8.5", false), ("7.0", true)] {
@@ -269,14 +263,8 @@ fn the_arrows_move_a_style_knob_that_m_picks() {
     let (said, problem) = rules.app.status.clone().unwrap();
     assert!(problem && said.contains("no style knobs"), "{said}");
 
-    let config = dir.path().join("knobs.yaml");
-    std::fs::write(&config, "generator:\n  rewards:\n    knobs: [1.0, 0.5]\n").unwrap();
-    let run = dir.path().join("run");
-    crate::common::arlpcg_ok(crate::common::words(
-        "train --mode arlpcg --config {} --steps 4096 --threads 1 --out {}",
-        &[&config, &run],
-    ));
-    let (policies, info) = worker::load(&run, Game::Platform).unwrap();
+    let (run, _) = crate::common::knob_pair();
+    let (policies, info) = worker::load(run, Game::Platform).unwrap();
     let mut h = Harness::new(policies, info, dir.path());
     h.settle();
     assert_eq!(h.app.knobs, vec![0.0, 0.0]);

@@ -1680,11 +1680,8 @@ fn two_new_runs_into_one_folder_leave_one_run_whole() {
 /// them, and each level records them; a knob the game or the Generator lacks is refused.
 #[test]
 fn a_generator_with_knobs_records_them_and_generates() {
-    let (dir, config, out) = scratch("generator:\n  rewards:\n    knobs: [1.0, 0.5]\n");
-    arlpcg_ok(words(
-        "train --mode arlpcg --steps 4096 --threads 1 --config {} --out {}",
-        &[&config, &out],
-    ));
+    let dir = tempfile::tempdir().unwrap();
+    let (out, _) = crate::common::knob_pair();
     let card = std::fs::read_to_string(out.join("generator.yaml")).unwrap();
     assert!(
         card.contains("- - aux\n  - 1\n- - knobs\n  - 2\n"),

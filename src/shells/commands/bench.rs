@@ -53,7 +53,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         on_trial: &|_| {},
         stop: &|| stop.load(Ordering::SeqCst),
     };
-    let outcomes: Vec<Outcome> = jobs
+    // Each search's outcome, and for a search that met nothing why (the closest it came).
+    let searched: Vec<(Outcome, Option<String>)> = jobs
         .par_iter()
         .map(|&(ask, seed)| {
             let want = &asks[ask].1;
@@ -79,23 +80,37 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             bar.inc(1);
             let seconds = started.elapsed().as_secs_f64();
             match made {
-                Ok(level) => Ok(Outcome {
-                    level,
-                    missed: Vec::new(),
-                    seconds,
-                }),
-                Err(e) => match e.downcast::<Unmet>() {
-                    Ok(unmet) => Ok(Outcome {
-                        level: None,
-                        missed: unmet.missed,
+                Ok(level) => Ok((
+                    Outcome {
+                        level,
+                        missed: Vec::new(),
                         seconds,
-                    }),
+                    },
+                    None,
+                )),
+                Err(e) => match e.downcast::<Unmet>() {
+                    Ok(unmet) => {
+                        let why = format!("ask {}, seed {seed}: {unmet}", ask + 1);
+                        let missed = unmet.missed;
+                        Ok((
+                            Outcome {
+                                level: None,
+                                missed,
+                                seconds,
+                            },
+                            Some(why),
+                        ))
+                    }
                     Err(e) => Err(e.context(format!("ask {}, seed {seed}", ask + 1))),
                 },
             }
         })
         .collect::<Result<_>>()?;
     bar.finish_and_clear();
+    for why in searched.iter().filter_map(|(_, why)| why.as_ref()) {
+        crate::warn!("{why}");
+    }
+    let outcomes: Vec<Outcome> = searched.into_iter().map(|(outcome, _)| outcome).collect();
     let plain: Vec<_> = (0..(jobs.len() as u64).min(MAX_PLAIN))
         .map(|seed| LevelSource::Generator(&generator).level(&LevelRequest::new(seed, Some(0.0))))
         .collect::<Result<_>>()?;

@@ -1,20 +1,57 @@
 //! What the integration tests share: running the binary, reading its output and its files.
 
 use std::ffi::{OsStr, OsString};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 /// A training configuration over five characters: ours with jumps of 8, 8.375, ..., 9.5 m/s.
 /// An ability-aware run measures each drawn character's reach once (seconds in a test build),
 /// so a test's run draws from few.
-pub const FIVE_JUMPERS: &str = "ability_ranges:
+const FIVE_JUMPERS: &str = "ability_ranges:
   character.jump_speed: [8.0, 9.5]
   character.run_speed: [8.0, 8.0]
   character.gravity: [20.0, 20.0]
 generator:
   own_check: {levels: 2, trials: 2}
 ";
+
+/// A tiny ability-aware platform pair over [`FIVE_JUMPERS`] (8192 steps), shared ([`shared_pair`]).
+pub fn five_jumpers_pair() -> &'static (PathBuf, Output) {
+    static PAIR: OnceLock<(PathBuf, Output)> = OnceLock::new();
+    PAIR.get_or_init(|| shared_pair("five-jumpers", FIVE_JUMPERS, 8192))
+}
+
+/// A tiny platform pair whose Generator takes the two style knobs (rewards 1.0 and 0.5; 4096
+/// steps), shared ([`shared_pair`]).
+pub fn knob_pair() -> &'static (PathBuf, Output) {
+    static PAIR: OnceLock<(PathBuf, Output)> = OnceLock::new();
+    PAIR.get_or_init(|| {
+        shared_pair(
+            "style-pair",
+            "generator:\n  rewards:\n    knobs: [1.0, 0.5]\n",
+            4096,
+        )
+    })
+}
+
+/// `train --mode arlpcg --config CONFIG --steps STEPS --threads 1` into the build's temporary
+/// folder `name/run`, for the tests that play a trained pair and only read it: trained once per
+/// test process (each caller keeps it in its own `OnceLock`), its folder and what `train` printed.
+fn shared_pair(name: &str, config: &str, steps: u32) -> (PathBuf, Output) {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let config_file = dir.join("config.yaml");
+    std::fs::write(&config_file, config).unwrap();
+    let run = dir.join("run");
+    let trained = arlpcg_ok(words(
+        "train --mode arlpcg --config {} --steps {} --threads 1 --out {}",
+        &[&config_file, &steps.to_string(), &run],
+    ));
+    (run, trained)
+}
 
 /// Runs the `arlpcg` binary with `args` and waits for it.
 pub fn arlpcg<S: AsRef<OsStr>>(args: impl IntoIterator<Item = S>) -> Output {

@@ -181,6 +181,15 @@ fn bench_scores_an_ask_set_and_names_a_bad_ask() {
     assert!(score["diversity"].as_f64().unwrap() > 0.0);
     assert!(score["by_attribute"]["pieces"].as_f64().unwrap() < 1.0);
     assert!(score["by_attribute"]["success"].as_f64().unwrap() > 0.0);
+    // Each search that kept nothing is named, with the closest it came.
+    let told = crate::common::stderr(&output);
+    for seed in 0..2 {
+        assert!(
+            told.contains(&format!("ask 3, seed {seed}: no level met `pieces >= 200`")),
+            "{told}"
+        );
+    }
+    assert!(told.contains("never met: pieces >= 200"), "{told}");
     // Nothing is overwritten without --force; a bad ask is named by its place.
     fails_with(
         &arlpcg(words("bench --asks {} --out {}", &[&asks, &out])),

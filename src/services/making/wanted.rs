@@ -15,14 +15,15 @@ use crate::services::panel::Judge;
 use crate::services::verify::{self, Solver, Watch};
 use crate::services::wish::{Attribute, Evidence, Miss, Reads, Strictness, Want};
 
-/// Rounds of candidates, one at each λ or curve per round.
-pub const ROUNDS: u32 = 16;
+/// Rounds of candidates, one at each λ or curve per round: a want the pieces alone miss costs
+/// no plays, so many scenes are looked at before the search gives up.
+pub const ROUNDS: u32 = 48;
 /// Rounds drawn in the seed's own scene; later rounds (unless the goal is given or pieces
 /// are kept) take the whole scene (start, goal) of another seed, `seed ^ (round << 48)`, as
 /// `generate --target-success` does, and the level records that seed: a long or climbing
 /// level needs a goal far or high enough.
 pub const OWN_SCENE_ROUNDS: u32 = 4;
-/// The most candidates played (each `trials` runs): a want that reads runs stops there.
+/// The most candidates played (each `trials` runs): a want that reads runs gives up there.
 pub const MAX_PLAYED: u32 = 40;
 
 /// How a wish list is searched for.
@@ -136,12 +137,16 @@ impl Search<'_> {
         let (mut tried, mut played) = (0u32, 0u32);
         let mut last_error = None;
         let fixed_scene = request.goal.is_some() || request.keep.is_some();
-        for round in 0..ROUNDS {
+        let wants_runs = self.want.reads() > Reads::Pieces;
+        'rounds: for round in 0..ROUNDS {
             let (scene, draw) = match round < OWN_SCENE_ROUNDS || fixed_scene {
                 true => (request.seed, round),
                 false => (request.seed ^ (u64::from(round) << 48), 0),
             };
             for aux in &asks {
+                if wants_runs && played >= MAX_PLAYED {
+                    break 'rounds;
+                }
                 let candidate = LevelRequest {
                     seed: scene,
                     draw,
@@ -159,8 +164,7 @@ impl Search<'_> {
                 tried += 1;
                 // What the pieces alone say first: a miss there is not worth playing.
                 let on_pieces = self.misses(&level, &Evidence::default(), Some(Reads::Pieces));
-                let wants_runs = self.want.reads() > Reads::Pieces;
-                if !on_pieces.is_empty() || (wants_runs && played >= MAX_PLAYED) {
+                if !on_pieces.is_empty() {
                     let what = describe(&level, draw);
                     closest.note(self.want, what, &on_pieces, Reads::Pieces);
                     continue;

@@ -42,7 +42,7 @@ pub struct Search<'a> {
 /// No candidate met the wish list.
 #[derive(Debug, thiserror::Error)]
 #[error(
-    "no level met `{want}` in {tried} candidates ({played} played): {closest}; ask for less, or give more room (--aux, another --seed)"
+    "no level met `{want}` in {tried} candidates ({played} played): {closest}; {hint}ask for less, or give more room (--aux, another --seed)"
 )]
 pub struct Unmet {
     /// The constraints (by index) the closest candidate missed or could not be measured on.
@@ -51,6 +51,8 @@ pub struct Unmet {
     tried: u32,
     played: u32,
     closest: String,
+    /// For a never-met bound a profile can hold every piece to, how (ending in "; "), else empty.
+    hint: String,
 }
 
 /// What the search came closest to: each constraint's closest miss, which constraints some
@@ -104,6 +106,29 @@ impl Closest {
             let which = misses.iter().map(|(i, _)| *i).chain(unmeasured).collect();
             self.best = Some((far, what, whys, which));
         }
+    }
+
+    /// For each never-met upper bound that a profile's piece range can hold every piece to
+    /// (`jump <= 8`, `curve <= 25`), the field to set: the Generator builds within the ranges
+    /// it is given, and its levels rarely stay under a bound of their own accord.
+    fn profile_hints(&self, want: &Want) -> String {
+        want.constraints
+            .iter()
+            .zip(&self.met_somewhere)
+            .filter(|(c, met)| !**met && c.high.is_finite())
+            .filter_map(|(c, _)| {
+                let (field, least, most) = c.attribute.profile_bound()?;
+                if !(least..most).contains(&c.high) {
+                    return None;
+                }
+                Some(format!(
+                    "a profile holds every piece to `{} <= {}`: set `{field}: {}` (`arlpcg profile init`, then --profile); ",
+                    c.attribute.name(),
+                    c.high,
+                    c.high
+                ))
+            })
+            .collect()
     }
 
     /// The constraints no candidate met, each by its closest value, and the closest candidate.
@@ -208,6 +233,7 @@ impl Search<'_> {
             tried,
             played,
             closest: closest.describe(),
+            hint: closest.profile_hints(self.want),
         }
         .into())
     }

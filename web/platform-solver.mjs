@@ -47,13 +47,13 @@ import { ChaCha8Rng } from "./rng.mjs";
 import { headingDirection, quantize, wrapDegrees } from "./levels.mjs";
 import { readLevelYaml } from "./level-file.mjs";
 import {
+  GameSolver,
   SolverNetwork,
   add,
   clipAction,
   dot,
   f32,
   length,
-  playRuns,
   randomRangeF32,
   rotate,
   rotationY,
@@ -434,8 +434,12 @@ function facing(yaw) {
 // ---------------------------------------------------------------------------------------------
 // The policy.
 
-/** An exported platform Solver: the graph (with its unclipped means exposed) and its sampling. */
-export class PlatformSolver {
+/**
+ * An exported platform Solver: the graph (with its unclipped means exposed) and its sampling
+ * (`choose_per_row`, ActMode::Sample: forward, turn, then the jump; deterministic: the means and
+ * the jump on at p ≥ 1/2); `act` and `play` in `GameSolver` (solver.mjs).
+ */
+export class PlatformSolver extends GameSolver {
   /**
    * @param {object} ort an onnxruntime module (onnxruntime-node or onnxruntime-web)
    * @param {Uint8Array} onnx the graph's bytes (`arlpcg export-policy`, contract plain)
@@ -448,37 +452,11 @@ export class PlatformSolver {
       observationSize: PLATFORM_SOLVER_OBSERVATION_SIZE,
       sessionOptions: options.sessionOptions,
     });
-    return new PlatformSolver(network);
-  }
-
-  constructor(network) {
-    this.network = network;
-  }
-
-  /**
-   * The actions of a batch of observations (rows of 40), each row's draws from its own stream
-   * (`choose_per_row`, ActMode::Sample: forward, turn, then the jump; `deterministic`: the
-   * means and p ≥ 1/2, as the graph's `continuous_actions` and `binary_actions` give them).
-   */
-  async act(rows, count, rngs, options = {}) {
-    const raw = await this.network.act(rows, count, rngs, options);
-    return raw.map((row) => this.decode(row));
+    return new PlatformSolver(network, PLATFORM_SOLVER_OBSERVATION_SIZE);
   }
 
   /** The action a row (forward, turn, jump) stands for (`PlatformAction::from_policy_row`: clipped to [-1, 1], NaN as 0; the jump on at 1). */
   decode(row) {
     return { forward: clipAction(row[0]), turn: clipAction(row[1]), jump: row[2] === 1.0 };
-  }
-
-  /**
-   * Plays `trials` runs of a course as `arlpcg verify --seed SEED --trials N` does (`playRuns`
-   * in solver.mjs: run i resets with SEED + i and draws from a stream seeded SEED + i; `pool`
-   * runs side by side, which changes no run).
-   * @returns {Promise<{seed: number, outcome: string, steps: number, furthest: number, progress: number}[]>}
-   */
-  async play(course, options = {}) {
-    const { results, timing } = await playRuns(this, course, PLATFORM_SOLVER_OBSERVATION_SIZE, options);
-    this.lastTiming = timing;
-    return results;
   }
 }

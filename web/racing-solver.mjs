@@ -50,6 +50,7 @@ import { ChaCha8Rng } from "./rng.mjs";
 import { Road, ROAD_SHAPE } from "./racing.mjs";
 import { readLevelYaml } from "./level-file.mjs";
 import {
+  GameSolver,
   SolverNetwork,
   add,
   clipAction,
@@ -57,7 +58,6 @@ import {
   dot,
   f32,
   length,
-  playRuns,
   rotate,
   rotationY,
   scale,
@@ -621,8 +621,12 @@ function planBox(centre, ex, ez) {
 // ---------------------------------------------------------------------------------------------
 // The policy.
 
-/** An exported racing Solver: the graph (with its unclipped means exposed) and its sampling. */
-export class RacingSolver {
+/**
+ * An exported racing Solver: the graph (with its unclipped means exposed) and its sampling
+ * (ActMode::Sample: throttle then steer; deterministic: the means); `act` and `play` in
+ * `GameSolver` (solver.mjs), each run in its own world.
+ */
+export class RacingSolver extends GameSolver {
   /**
    * @param {object} ort an onnxruntime module (onnxruntime-node or onnxruntime-web)
    * @param {Uint8Array} onnx the graph's bytes (`arlpcg export-policy`, contract plain)
@@ -635,37 +639,11 @@ export class RacingSolver {
       observationSize: RACING_SOLVER_OBSERVATION_SIZE,
       sessionOptions: options.sessionOptions,
     });
-    return new RacingSolver(network);
-  }
-
-  constructor(network) {
-    this.network = network;
-  }
-
-  /**
-   * The actions of a batch of observations (rows of 47), each row's draws from its own stream
-   * (ActMode::Sample: throttle then steer; `deterministic`: the means, as the graph's
-   * `continuous_actions` gives them). `CarAction::from_policy_row`: clipped to [-1, 1].
-   */
-  async act(rows, count, rngs, options = {}) {
-    const raw = await this.network.act(rows, count, rngs, options);
-    return raw.map((row) => this.decode(row));
+    return new RacingSolver(network, RACING_SOLVER_OBSERVATION_SIZE);
   }
 
   /** The action a row (throttle, steer) stands for (`CarAction::from_policy_row`: clipped to [-1, 1]). */
   decode(row) {
     return { throttle: clipAction(row[0]), steer: clipAction(row[1]) };
-  }
-
-  /**
-   * Plays `trials` runs of a course as `arlpcg verify --seed SEED --trials N` does (`playRuns`
-   * in solver.mjs: run i resets with SEED + i and draws from a stream seeded SEED + i; `pool`
-   * runs side by side, each in its own world, which changes no run).
-   * @returns {Promise<{seed: number, outcome: string, steps: number, progress: number, segment: number, airSteps: number}[]>}
-   */
-  async play(course, options = {}) {
-    const { results, timing } = await playRuns(this, course, RACING_SOLVER_OBSERVATION_SIZE, options);
-    this.lastTiming = timing;
-    return results;
   }
 }

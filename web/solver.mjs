@@ -177,3 +177,27 @@ export async function playRuns(solver, course, observationSize, { trials = 100, 
   // The time the runs took, and how much of it the graph (onnxruntime) and the draws took.
   return { results, timing: { decisions, ms: performance.now() - started, networkMs } };
 }
+
+/**
+ * What a game's exported Solver shares: its graph, `act` (a batch of observation rows to the
+ * game's actions, each row's draws from its own stream; `deterministic`: the means, as the
+ * graph's outputs give them) and `play` (`playRuns` above; the timing of the last play in
+ * `lastTiming`). A game's class adds `load` and `decode` (a raw action row to its action).
+ */
+export class GameSolver {
+  constructor(network, observationSize) {
+    this.network = network;
+    this.observationSize = observationSize;
+  }
+
+  async act(rows, count, rngs, options = {}) {
+    const raw = await this.network.act(rows, count, rngs, options);
+    return raw.map((row) => this.decode(row));
+  }
+
+  async play(course, options = {}) {
+    const { results, timing } = await playRuns(this, course, this.observationSize, options);
+    this.lastTiming = timing;
+    return results;
+  }
+}

@@ -1598,7 +1598,9 @@ fn the_time_buckets_add_up_to_each_iteration_and_reach_the_cards() {
     ));
     let said = String::from_utf8_lossy(&trained.stdout);
     assert!(
-        said.contains("time, all sessions: env ") && said.contains("GFLOP/s matmul peak"),
+        said.contains("time, all sessions: env ")
+            && said.contains("; Solver phases ")
+            && said.contains("GFLOP/s matmul peak"),
         "{said}"
     );
     let buckets = [
@@ -1640,6 +1642,16 @@ fn the_time_buckets_add_up_to_each_iteration_and_reach_the_cards() {
         assert!(
             card["training"]["update_mfu"].as_f64().unwrap() > 0.0,
             "{text}"
+        );
+        // The same seconds by stretch: each iteration's whole time, rows and bars included.
+        let stretches = &split["stretches"];
+        let by_stretch: f64 = ["solver_phases_s", "generator_phases_s", "finish_s"]
+            .iter()
+            .map(|s| stretches[*s].as_f64().unwrap())
+            .sum();
+        assert!(
+            by_stretch >= run_total - 0.35 && by_stretch <= 1.2 * run_total + 0.35,
+            "stretches {by_stretch} s, iterations {run_total} s: {text}"
         );
     }
 }

@@ -26,7 +26,7 @@ use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingState};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::ActorCritic;
 use arlpcg_core::rl::ppo::Ppo;
-use arlpcg_core::rl::timing::TimeSplit;
+use arlpcg_core::rl::timing::{Stretch, TimeSplit};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -290,45 +290,9 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         }
         Ok((message, stats))
     }
-}
 
-impl<G: GeneratorGame> Training for AdversarialRun<G> {
-    fn solver_steps(&self) -> u64 {
-        self.solver.trainer.global_step
-    }
-
-    fn budget(&self) -> u64 {
-        let config = &self.solver.config;
-        let budget = config.adversarial_budget();
-        match self.solver.trainer.env.state.finish_ended_at {
-            // A finish ended early by its catch-up's success, unless the budget has grown
-            // past where it ended (a resume with more steps trains on).
-            Some(at) if at > config.steps => at.min(budget),
-            _ => budget,
-        }
-    }
-
-    fn wall_before(&self) -> f64 {
-        self.solver.wall_before
-    }
-
-    fn add_session(&mut self, command: String, commit: String) {
-        self.solver.commands.push(command);
-        self.solver.commit = commit;
-    }
-
-    fn set_matmul_peak(&mut self, flops: f64) {
-        self.solver.matmul_peak = flops;
-    }
-
-    fn time_split(&self) -> (TimeSplit, f64) {
-        (
-            self.solver.time,
-            self.solver.time.update_mfu(self.solver.matmul_peak),
-        )
-    }
-
-    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
+    /// One iteration of the agent whose phase it is; the progress bar's message.
+    fn phase_iteration(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
         let config = &self.solver.config;
         let steps = self.solver.trainer.global_step;
         // The stage in force where this iteration starts (a stage begins at a phase's end).
@@ -395,6 +359,62 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
             }
         }
     }
+}
+
+impl<G: GeneratorGame> Training for AdversarialRun<G> {
+    fn solver_steps(&self) -> u64 {
+        self.solver.trainer.global_step
+    }
+
+    fn budget(&self) -> u64 {
+        let config = &self.solver.config;
+        let budget = config.adversarial_budget();
+        match self.solver.trainer.env.state.finish_ended_at {
+            // A finish ended early by its catch-up's success, unless the budget has grown
+            // past where it ended (a resume with more steps trains on).
+            Some(at) if at > config.steps => at.min(budget),
+            _ => budget,
+        }
+    }
+
+    fn wall_before(&self) -> f64 {
+        self.solver.wall_before
+    }
+
+    fn add_session(&mut self, command: String, commit: String) {
+        self.solver.commands.push(command);
+        self.solver.commit = commit;
+    }
+
+    fn set_matmul_peak(&mut self, flops: f64) {
+        self.solver.matmul_peak = flops;
+    }
+
+    fn time_split(&self) -> (TimeSplit, f64) {
+        (
+            self.solver.time,
+            self.solver.time.update_mfu(self.solver.matmul_peak),
+        )
+    }
+
+    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
+        let began = wall();
+        let in_finish = self
+            .solver
+            .config
+            .in_finish(self.solver.trainer.global_step);
+        let stretch = match self.envs().state.phase {
+            _ if in_finish => Stretch::Finish,
+            Phase::Solver => Stretch::SolverPhases,
+            Phase::Generator => Stretch::GeneratorPhases,
+        };
+        let message = self.phase_iteration(wall)?;
+        self.solver.time.stretches.add(stretch, wall() - began);
+        Ok(match stretch {
+            Stretch::Finish => format!("finish, {message}"),
+            _ => message,
+        })
+    }
 
     fn checkpoint_minutes(&self) -> f64 {
         self.solver.config.checkpoint_minutes
@@ -445,7 +465,12 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         &self.solver.out
     }
 
-    fn check_own_control(&mut self, wall: f64, starting: &dyn Fn()) -> Result<Option<String>> {
+    fn check_own_control(
+        &mut self,
+        wall: &dyn Fn() -> f64,
+        starting: &dyn Fn(),
+    ) -> Result<Option<String>> {
+        let began = wall();
         let config = &self.solver.config;
         let profile = config
             .profile
@@ -462,7 +487,12 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
             return Ok(None);
         };
         self.solver.results = control.results();
-        self.save_policies(wall)?;
+        // The cards' wall time stays the training's; the check's own is a stretch of its own.
+        self.solver
+            .time
+            .stretches
+            .add(Stretch::OwnCheck, wall() - began);
+        self.save_policies(began)?;
         Ok(Some(control.describe()))
     }
 }

@@ -306,9 +306,14 @@ pub trait Training {
     fn out(&self) -> &Path;
     /// For a finished run with a Generator: plays its own check ([`own_check`]; `starting`
     /// hears when it begins), writes the figures into its cards' `results` (the policies
-    /// again, `wall` as in [`Training::save_policies`]) and returns them in words; none for a
-    /// run without a Generator or a check of 0 levels.
-    fn check_own_control(&mut self, _wall: f64, _starting: &dyn Fn()) -> Result<Option<String>> {
+    /// again, with the wall-clock seconds where it began as in [`Training::save_policies`];
+    /// `wall` is the shell's clock, as in [`Training::iterate`]) and returns them in words;
+    /// none for a run without a Generator or a check of 0 levels.
+    fn check_own_control(
+        &mut self,
+        _wall: &dyn Fn() -> f64,
+        _starting: &dyn Fn(),
+    ) -> Result<Option<String>> {
         Ok(None)
     }
 }

@@ -25,7 +25,7 @@ use arlpcg_core::rl::checkpoint;
 use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingState};
 use arlpcg_core::rl::policy::ActorCritic;
 use arlpcg_core::rl::ppo::Ppo;
-use arlpcg_core::rl::timing::TimeSplit;
+use arlpcg_core::rl::timing::{Stretch, TimeSplit};
 use arlpcg_core::rl::vec_env::{RolloutStats, Trainer, VecEnv};
 
 /// Environments whose progress is saved in checkpoints.
@@ -320,6 +320,7 @@ impl<G: GameSpec> Training for SolverRun<SolverEnvs<G>> {
         let t0 = wall();
         let lr_scale = self.config.lr_scale(self.trainer.global_step);
         let rollout = self.solver_iteration(lr_scale, None, wall)?;
+        self.time.stretches.add(Stretch::SolverPhases, wall() - t0);
         Ok(format!(
             "return {:.2}, success {:.2}, {:.0} steps/s, {}",
             rollout.mean_return,

@@ -152,7 +152,10 @@ fn train_loop(
                 run.out().display()
             )
         })?;
-        bar.set_message(message);
+        bar.set_message(format!(
+            "{message}, update at {:.0}% of peak",
+            100.0 * run.time_split().1
+        ));
         bar.set_position(run.solver_steps());
         if last_checkpoint.elapsed().as_secs_f64() >= run.checkpoint_minutes() * 60.0 {
             run.save_checkpoint(wall())?;
@@ -161,20 +164,27 @@ fn train_loop(
         }
     }
     bar.finish_and_clear();
-    let wall = wall();
-    run.save_checkpoint(wall)?;
-    run.save_policies(wall)?;
+    // Measured again at the end: a probe that met a busy machine reads a peak too low.
+    let peak = peak.max(arlpcg_core::rl::fused::matmul_peak_flops(
+        PEAK_PROBE_SIZE, 3, &seconds,
+    ));
+    run.set_matmul_peak(peak);
+    let trained = wall();
+    run.save_checkpoint(trained)?;
+    run.save_policies(trained)?;
     train::write_learning_curve(run.out())?;
     let summary = format!(
         "at {} Solver steps after {:.1} min in all; checkpoints and policies in {}",
         run.solver_steps(),
-        wall / 60.0,
+        trained / 60.0,
         run.out().display()
     );
     let (time, mfu) = run.time_split();
     crate::say!(
-        "time, all sessions: {} (update at {:.0}% of this machine's {:.0} GFLOP/s matmul peak)",
+        "time, all sessions: {}; {} (update at {:.0}% of this machine's {:.0} GFLOP/s matmul \
+         peak, the best of its probes at the session's start and end)",
         time.shares(),
+        time.stretches.minutes(),
         100.0 * mfu,
         peak / 1e9
     );
@@ -194,8 +204,11 @@ fn train_loop(
     let starting = || {
         crate::say!("checking the finished pair's knob (its own Solver on its λ = ±1 levels)...")
     };
-    match run.check_own_control(wall, &starting)? {
-        Some(control) => crate::say!("finished {summary}; {control}"),
+    match run.check_own_control(&wall, &starting)? {
+        Some(control) => crate::say!(
+            "finished {summary}; {control} (the check took {:.1} min)",
+            run.time_split().0.stretches.own_check_s / 60.0
+        ),
         None => crate::say!("finished {summary}"),
     }
     Ok(())

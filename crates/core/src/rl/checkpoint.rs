@@ -209,7 +209,13 @@ impl TrainingState {
                     .buckets()
                     .map(|(name, value)| (format!("time_split.{name}_s"), value)),
             )
-            .chain([("time_split.update_flops".into(), split.update_flops)]);
+            .chain([("time_split.update_flops".into(), split.update_flops)])
+            .chain(
+                split
+                    .stretches
+                    .named()
+                    .map(|(name, value)| (format!("time_split.stretches ({name})"), value)),
+            );
         for (name, value) in numbers {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(format!("{name} is {value}, not a finite number >= 0"));

@@ -28,6 +28,76 @@ pub struct TimeSplit {
     pub copies_s: f64,
     /// Floating-point operations of the update's matrix products (forward and backward).
     pub update_flops: f64,
+    /// The same seconds by stretch of the run (none in a split written before they were
+    /// counted, and in one iteration's).
+    #[serde(default, skip_serializing_if = "Stretches::is_empty")]
+    pub stretches: Stretches,
+}
+
+/// Wall-clock seconds of a run by stretch: its Solver's phases, its Generator's phases before
+/// the finish, the finish (docs/training.md), and the finished pair's own check.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stretches {
+    /// The Solver's iterations before the finish (a baseline's every iteration).
+    pub solver_phases_s: f64,
+    /// The Generator's iterations before the finish.
+    pub generator_phases_s: f64,
+    /// Both agents' iterations in the finish.
+    pub finish_s: f64,
+    /// The finished pair's check of its own knob.
+    pub own_check_s: f64,
+}
+
+/// A stretch of a run ([`Stretches`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stretch {
+    /// [`Stretches::solver_phases_s`].
+    SolverPhases,
+    /// [`Stretches::generator_phases_s`].
+    GeneratorPhases,
+    /// [`Stretches::finish_s`].
+    Finish,
+    /// [`Stretches::own_check_s`].
+    OwnCheck,
+}
+
+impl Stretches {
+    /// The stretches by name, in the run's order.
+    pub fn named(&self) -> [(&'static str, f64); 4] {
+        [
+            ("Solver phases", self.solver_phases_s),
+            ("Generator phases", self.generator_phases_s),
+            ("the finish", self.finish_s),
+            ("own check", self.own_check_s),
+        ]
+    }
+
+    /// Whether no stretch took any time (a split written before stretches were counted).
+    pub fn is_empty(&self) -> bool {
+        self.named().iter().all(|(_, s)| *s == 0.0)
+    }
+
+    /// Adds `seconds` to `stretch`.
+    pub fn add(&mut self, stretch: Stretch, seconds: f64) {
+        *match stretch {
+            Stretch::SolverPhases => &mut self.solver_phases_s,
+            Stretch::GeneratorPhases => &mut self.generator_phases_s,
+            Stretch::Finish => &mut self.finish_s,
+            Stretch::OwnCheck => &mut self.own_check_s,
+        } += seconds;
+    }
+
+    /// The stretches that took any time, in minutes (`Solver phases 3.8 min, the finish
+    /// 9.5 min`).
+    pub fn minutes(&self) -> String {
+        self.named()
+            .iter()
+            .filter(|(_, s)| *s > 0.0)
+            .map(|(name, s)| format!("{name} {:.1} min", s / 60.0))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
 }
 
 impl TimeSplit {
@@ -57,6 +127,11 @@ impl TimeSplit {
         self.update_s += other.update_s;
         self.copies_s += other.copies_s;
         self.update_flops += other.update_flops;
+        let (mine, theirs) = (&mut self.stretches, &other.stretches);
+        mine.solver_phases_s += theirs.solver_phases_s;
+        mine.generator_phases_s += theirs.generator_phases_s;
+        mine.finish_s += theirs.finish_s;
+        mine.own_check_s += theirs.own_check_s;
     }
 
     /// The same, seconds rounded to tenths (for a card).
@@ -70,6 +145,12 @@ impl TimeSplit {
             update_s: tenth(self.update_s),
             copies_s: tenth(self.copies_s),
             update_flops: self.update_flops,
+            stretches: Stretches {
+                solver_phases_s: tenth(self.stretches.solver_phases_s),
+                generator_phases_s: tenth(self.stretches.generator_phases_s),
+                finish_s: tenth(self.stretches.finish_s),
+                own_check_s: tenth(self.stretches.own_check_s),
+            },
         }
     }
 

@@ -206,8 +206,8 @@ fn train_loop(
     };
     match run.check_own_control(&wall, &starting)? {
         Some(control) => crate::say!(
-            "finished {summary}; {control} (the check took {:.1} min)",
-            run.time_split().0.stretches.own_check_s / 60.0
+            "finished {summary}; {control} (the check took {:.0} s)",
+            run.time_split().0.stretches.own_check_s
         ),
         None => crate::say!("finished {summary}"),
     }

@@ -8,7 +8,7 @@ use super::arlpcg::{AdversarialEnvs, AdversarialRecord, Generator, MatchRules, M
 use super::cards::{
     card, generator_shape, read_checkpoint, record_commands, save_policy_files, solver_shape,
 };
-use super::config::TrainConfig;
+use super::config::{Schedule, TrainConfig};
 use super::metrics::{
     check_metrics_header, generator_metrics_header, generator_row, open_append, scripted_columns,
     time_columns, truncate_metrics, update_columns,
@@ -222,14 +222,14 @@ impl<G: GeneratorGame> AdversarialRun<G> {
     pub(super) fn generator_iteration(
         &mut self,
         lr_scale: f64,
-        entropy: Option<f32>,
+        schedule: Schedule,
         wall: &dyn Fn() -> f64,
     ) -> Result<(String, MatchStats)> {
         let config = self.solver.config.generator.ppo.clone();
-        let learning_rate = if config.anneal_lr {
-            config.learning_rate * lr_scale
-        } else {
-            config.learning_rate
+        let learning_rate = match schedule.generator_learning_rate {
+            Some(rate) => rate,
+            None if config.anneal_lr => config.learning_rate * lr_scale,
+            None => config.learning_rate,
         };
         let t0 = wall();
         let mut time = TimeSplit::default();
@@ -243,7 +243,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         let t1 = wall();
         time.copies_s += t1 - before_batch;
         let envs = self.envs();
-        envs.generator.ppo.config.ent_coef = entropy.unwrap_or(config.ent_coef);
+        envs.generator.ppo.config.ent_coef = schedule.generator_entropy.unwrap_or(config.ent_coef);
         let update = envs
             .generator
             .ppo
@@ -342,8 +342,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 ))
             }
             Phase::Generator => {
-                let (message, stats) =
-                    self.generator_iteration(lr_scale, schedule.generator_entropy, wall)?;
+                let (message, stats) = self.generator_iteration(lr_scale, schedule, wall)?;
                 let envs = self.envs();
                 // In the finish, the phase may end early once the Solver fails enough.
                 let hard_enough = match finish.generator_until_hard_success {

@@ -122,6 +122,12 @@ fn check_schedule(g: &GeneratorConfig) -> Result<(), String> {
             return Err("finish.generator_entropy must be a number in [0, 1]".into());
         }
         if g.finish
+            .generator_learning_rate
+            .is_some_and(|r| !(r > 0.0 && r <= 1.0))
+        {
+            return Err("finish.generator_learning_rate must be a number in (0, 1]".into());
+        }
+        if g.finish
             .scripted_opponent
             .is_some_and(|o| !(o.share > 0.0 && o.share <= 1.0))
         {

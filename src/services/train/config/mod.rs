@@ -221,6 +221,11 @@ pub struct Finish {
     /// against the final Solver instead of refining those it already makes.
     #[serde(default)]
     pub generator_entropy: Option<f32>,
+    /// The Generator's learning rate in the finish's Generator phases, in place of
+    /// `generator.ppo.learning_rate` (none: that one): against a frozen Solver a larger step
+    /// finds its weak spots in fewer blocks (docs/decisions.md).
+    #[serde(default)]
+    pub generator_learning_rate: Option<f64>,
     /// A scripted player that plays a share of the matches while the finish's Generator
     /// learns, so that its failures pay the Generator as the final Solver's do (none: the final
     /// Solver plays every match). The stops above count the final Solver's matches only.
@@ -282,6 +287,7 @@ impl Finish {
         until_hard_success: None,
         hard_match_block: HARD_MATCH_BLOCK,
         generator_entropy: None,
+        generator_learning_rate: None,
         scripted_opponent: None,
     };
 }
@@ -342,6 +348,7 @@ impl GeneratorConfig {
                 generator_phase_steps: stage.generator_phase_steps,
                 snapshot_share: stage.snapshot_share.or(self.snapshot_share),
                 generator_entropy: None,
+                generator_learning_rate: None,
                 scripted_opponent: None,
             },
             None => Schedule {
@@ -350,6 +357,7 @@ impl GeneratorConfig {
                 generator_phase_steps: self.generator_phase_steps,
                 snapshot_share: self.snapshot_share,
                 generator_entropy: None,
+                generator_learning_rate: None,
                 scripted_opponent: None,
             },
         }
@@ -367,6 +375,8 @@ pub struct Schedule {
     pub snapshot_share: Option<f64>,
     /// The Generator's entropy bonus (`None`: `generator.ppo.ent_coef`).
     pub generator_entropy: Option<f32>,
+    /// The Generator's learning rate (`None`: `generator.ppo.learning_rate`, annealed or not).
+    pub generator_learning_rate: Option<f64>,
     /// The scripted player's share of the matches (`Finish::scripted_opponent`).
     pub scripted_opponent: Option<ScriptedOpponent>,
 }
@@ -509,6 +519,7 @@ impl TrainConfig {
                 generator_phase_steps: finish.generator_phase_steps,
                 snapshot_share: Some(0.0),
                 generator_entropy: finish.generator_entropy,
+                generator_learning_rate: finish.generator_learning_rate,
                 scripted_opponent: finish.scripted_opponent,
             };
         }

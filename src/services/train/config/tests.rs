@@ -46,6 +46,19 @@ fn a_partial_finish_keeps_the_recipes_other_fields() {
     let mut expected = TrainConfig::for_game(Game::Platform);
     expected.generator.finish.generator_entropy = Some(0.02);
     assert_eq!(platform, expected);
+    // The finish's own Generator learning rate reaches its schedule, and no earlier one.
+    let rate = "generator:\n  finish: {generator_learning_rate: 0.001}\n";
+    let platform = TrainConfig::parse_for(rate, Game::Platform).unwrap();
+    assert_eq!(
+        platform.schedule_at(platform.steps).generator_learning_rate,
+        Some(0.001)
+    );
+    assert_eq!(
+        platform
+            .schedule_at(platform.steps - 1)
+            .generator_learning_rate,
+        None
+    );
 }
 
 #[test]
@@ -148,6 +161,16 @@ fn out_of_range_generator_fields_are_named() {
             "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, generator_entropy: -0.1}\n",
             Game::Platform,
             "finish.generator_entropy",
+        ),
+        (
+            "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, generator_learning_rate: .nan}\n",
+            Game::Platform,
+            "finish.generator_learning_rate",
+        ),
+        (
+            "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, generator_learning_rate: 0}\n",
+            Game::Racing,
+            "finish.generator_learning_rate",
         ),
         (
             "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, scripted_opponent: {skill: median, share: 0}}\n",

@@ -941,6 +941,52 @@ fn a_finish_generator_phase_until_a_success_ends_early() {
     );
 }
 
+/// `finish.own_check_every`: every so many Generator steps of the finish the pair plays its own
+/// check aside, on seeds of its own, writing its policies as at a pause. A tiny pair never
+/// passes the bars, so its finish runs to its cap in the bytes of the run without the check;
+/// a step count of 0 is refused by name.
+#[test]
+fn a_finish_own_check_plays_aside_and_leaves_a_pair_that_fails_it_as_it_was() {
+    let run = |check: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let config = tiny_with_finish(&format!(
+            "solver_steps: 128\ngenerator_phase_steps: 64{check}"
+        ));
+        let rows = generator_metrics(&train_tiny_to_640(dir.path(), &config));
+        let card = std::fs::read_to_string(dir.path().join("run/generator.yaml")).unwrap();
+        (rows, card.contains("own_success_at_-1"))
+    };
+    let (plain, plain_checked) = run("");
+    let (checked, checked_checked) = run("\nown_check_every: 16");
+    assert!(
+        plain_checked && checked_checked,
+        "both end with the own check"
+    );
+    assert!(
+        checked.iter().filter(|r| r.0 >= 640).count() >= 4,
+        "{checked:?}"
+    );
+    let rows = |all: &[(u64, String, f64)]| all.iter().map(|r| r.1.clone()).collect::<Vec<_>>();
+    assert_eq!(rows(&plain), rows(&checked));
+    let dir = tempfile::tempdir().unwrap();
+    let zero = dir.path().join("zero.yaml");
+    std::fs::write(
+        &zero,
+        tiny_with_finish("solver_steps: 128\nown_check_every: 0"),
+    )
+    .unwrap();
+    let refused = arlpcg(words(
+        "train --mode arlpcg --steps 640 --config {} --out {}",
+        &[&zero, &dir.path().join("run")],
+    ));
+    assert_eq!(refused.status.code(), Some(1), "{}", stderr(&refused));
+    assert!(
+        stderr(&refused).contains("finish.own_check_every"),
+        "{}",
+        stderr(&refused)
+    );
+}
+
 /// `finish.generator_entropy` is the Generator's entropy bonus in the finish alone: with a large
 /// one its policy spreads out there, and every row before the finish is the run without it.
 #[test]

@@ -7,6 +7,7 @@
 //! | [`EVAL_SEED_BASE`] .. | `eval`'s controllability and cross levels |
 //! | [`VALIDATION_SEED_BASE`] .. | `eval`'s validation set (its Generator half from 2^24 further per λ) |
 //! | [`CURVE_SEED_BASE`] .. | the levels a difficulty curve is measured on (`generate --target-success`) |
+//! | [`FINISH_CHECK_SEED_BASE`] .. | the levels a training run's finish checks its knob on (`generator.finish.own_check_every`) |
 //! | [`TRAINING_SEED_BASE`] .. | every level and match of training |
 
 /// First seed of `eval`'s controllability (and cross) levels.
@@ -17,6 +18,9 @@ pub const VALIDATION_SEED_BASE: u64 = 2 << 32;
 pub const VALIDATION_AUX_STRIDE: u64 = 1 << 24;
 /// First seed of the levels a difficulty curve is measured on.
 pub const CURVE_SEED_BASE: u64 = 3 << 32;
+/// First seed of the levels a training run's finish checks its knob on, apart from the own
+/// check's ([`EVAL_SEED_BASE`]), so that the check a run ends with is not the one it stopped on.
+pub const FINISH_CHECK_SEED_BASE: u64 = 4 << 32;
 /// First seed of training's levels and matches.
 pub const TRAINING_SEED_BASE: u64 = 1 << 40;
 
@@ -25,5 +29,6 @@ pub const TRAINING_SEED_BASE: u64 = 1 << 40;
 const _: () = {
     assert!(VALIDATION_SEED_BASE - EVAL_SEED_BASE >= 6 * VALIDATION_AUX_STRIDE);
     assert!(CURVE_SEED_BASE - VALIDATION_SEED_BASE >= 6 * VALIDATION_AUX_STRIDE);
-    assert!(CURVE_SEED_BASE + (1 << 32) <= TRAINING_SEED_BASE);
+    assert!(CURVE_SEED_BASE + (1 << 32) <= FINISH_CHECK_SEED_BASE);
+    assert!(FINISH_CHECK_SEED_BASE + (1 << 32) <= TRAINING_SEED_BASE);
 };

@@ -21,12 +21,14 @@ use crate::services::fsio;
 use crate::services::fsio::Overwrite;
 use anyhow::{Context, Result};
 use arlpcg_core::game::generator::{BuildLimits, GeneratorGame};
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::rl::checkpoint;
 use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingState};
 use arlpcg_core::rl::normalizer::RunningNorm;
 use arlpcg_core::rl::policy::ActorCritic;
 use arlpcg_core::rl::ppo::Ppo;
 use arlpcg_core::rl::timing::{Stretch, TimeSplit};
+use arlpcg_core::seed_ranges::{EVAL_SEED_BASE, FINISH_CHECK_SEED_BASE};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -291,6 +293,32 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         Ok((message, stats))
     }
 
+    /// The run's profile (none: ours).
+    fn profile(&self) -> Result<Option<Profile>> {
+        self.solver
+            .config
+            .profile
+            .as_ref()
+            .map(|record| record.profile(G::GAME))
+            .transpose()
+            .map_err(|problem| anyhow::anyhow!("the run's profile: {problem}"))
+    }
+
+    /// The own check of the pair as it stands, on the finish's own seeds
+    /// ([`crate::services::train::config::Finish::own_check_every`]): the policies are written
+    /// (as at a pause) and played.
+    fn finish_check(&mut self, wall: &dyn Fn() -> f64) -> Result<Option<own_check::OwnControl>> {
+        self.save_policies(wall())?;
+        let check = self.solver.config.generator.own_check;
+        own_check::own_control(
+            &self.solver.out,
+            G::GAME,
+            self.profile()?.as_ref(),
+            check,
+            FINISH_CHECK_SEED_BASE,
+        )
+    }
+
     /// One iteration of the agent whose phase it is; the progress bar's message.
     fn phase_iteration(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
         let config = &self.solver.config;
@@ -342,16 +370,30 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 ))
             }
             Phase::Generator => {
-                let (message, stats) = self.generator_iteration(lr_scale, schedule, wall)?;
+                let before = self.envs().state.generator_steps;
+                let (mut message, stats) = self.generator_iteration(lr_scale, schedule, wall)?;
+                let after = self.envs().state.generator_steps;
+                // In the finish, the phase may end once the pair passes its own check...
+                let passes = match finish.own_check_every {
+                    Some(every) if in_finish && after / every != before / every => {
+                        let control = self.finish_check(wall)?;
+                        if let Some(c) = control {
+                            message += &format!(", check {:.2} / {:.2}", c.easy, c.hard);
+                        }
+                        control.is_some_and(|c| c.meets_with_margin(own_check::FINISH_HARD_MARGIN))
+                    }
+                    _ => false,
+                };
                 let envs = self.envs();
-                // In the finish, the phase may end early once the Solver fails enough.
+                // ...or once the Solver fails enough.
                 let hard_enough = match finish.generator_until_hard_success {
                     Some(target) if in_finish => envs
                         .count_hard_block(&stats, finish.hard_match_block)
                         .is_some_and(|s| s <= target),
                     _ => false,
                 };
-                if hard_enough || envs.state.phase_steps >= schedule.generator_phase_steps {
+                if passes || hard_enough || envs.state.phase_steps >= schedule.generator_phase_steps
+                {
                     envs.set_phase(Phase::Solver);
                 }
                 Ok(format!("{message}, {}", self.solver.time.largest_two()))
@@ -470,19 +512,15 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         starting: &dyn Fn(),
     ) -> Result<Option<String>> {
         let began = wall();
-        let config = &self.solver.config;
-        let profile = config
-            .profile
-            .as_ref()
-            .map(|record| record.profile(G::GAME))
-            .transpose()
-            .map_err(|problem| anyhow::anyhow!("the run's profile: {problem}"))?;
-        let check = config.generator.own_check;
+        let profile = self.profile()?;
+        let check = self.solver.config.generator.own_check;
         let out = self.solver.out.clone();
         if check.plays() {
             starting();
         }
-        let Some(control) = own_check::own_control(&out, G::GAME, profile.as_ref(), check)? else {
+        let Some(control) =
+            own_check::own_control(&out, G::GAME, profile.as_ref(), check, EVAL_SEED_BASE)?
+        else {
             return Ok(None);
         };
         self.solver.results = control.results();

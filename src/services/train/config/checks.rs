@@ -127,6 +127,9 @@ fn check_schedule(g: &GeneratorConfig) -> Result<(), String> {
         {
             return Err("finish.generator_learning_rate must be a number in (0, 1]".into());
         }
+        if g.finish.own_check_every == Some(0) {
+            return Err("finish.own_check_every must be at least 1 Generator step".into());
+        }
         if g.finish
             .scripted_opponent
             .is_some_and(|o| !(o.share > 0.0 && o.share <= 1.0))

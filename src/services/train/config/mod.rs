@@ -226,6 +226,12 @@ pub struct Finish {
     /// finds its weak spots in fewer blocks (docs/decisions.md).
     #[serde(default)]
     pub generator_learning_rate: Option<f64>,
+    /// Every this many Generator steps of the finish, the pair plays the own check
+    /// (`generator.own_check`) on levels of seeds of its own (`FINISH_CHECK_SEED_BASE`), and
+    /// the finish's Generator phase ends once it passes all three bars: the stop the product
+    /// needs, where the block stop above waits for one lucky block (none: no such check).
+    #[serde(default)]
+    pub own_check_every: Option<u64>,
     /// A scripted player that plays a share of the matches while the finish's Generator
     /// learns, so that its failures pay the Generator as the final Solver's do (none: the final
     /// Solver plays every match). The stops above count the final Solver's matches only.
@@ -288,6 +294,7 @@ impl Finish {
         hard_match_block: HARD_MATCH_BLOCK,
         generator_entropy: None,
         generator_learning_rate: None,
+        own_check_every: None,
         scripted_opponent: None,
     };
 }

@@ -304,12 +304,13 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             .map_err(|problem| anyhow::anyhow!("the run's profile: {problem}"))
     }
 
-    /// The own check of the pair as it stands, on the finish's own seeds
+    /// The own check of the pair as it stands, on twice its levels and the finish's own seeds
     /// ([`crate::services::train::config::Finish::own_check_every`]): the policies are written
     /// (as at a pause) and played.
     fn finish_check(&mut self, wall: &dyn Fn() -> f64) -> Result<Option<own_check::OwnControl>> {
         self.save_policies(wall())?;
-        let check = self.solver.config.generator.own_check;
+        let mut check = self.solver.config.generator.own_check;
+        check.levels = check.levels.saturating_mul(2);
         own_check::own_control(
             &self.solver.out,
             G::GAME,

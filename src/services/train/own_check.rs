@@ -25,8 +25,8 @@ pub const HARD_BAR: f64 = 0.70;
 /// impossible.
 pub const COMPLETED_BAR: f64 = 0.95;
 /// The margin under [`HARD_BAR`] at which a finish stops on its own check
-/// (`generator.finish.own_check_every`): a run whose finish check said 0.70 showed 0.805 on
-/// the levels of its last check (docs/trials.md).
+/// (`generator.finish.own_check_every`, on twice the check's levels): a run whose finish check
+/// of 20 levels said 0.70 showed 0.805 on the levels of its last check (docs/trials.md).
 pub const FINISH_HARD_MARGIN: f64 = 0.1;
 
 /// What the check measured.

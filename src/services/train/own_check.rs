@@ -25,9 +25,10 @@ pub const HARD_BAR: f64 = 0.70;
 /// impossible.
 pub const COMPLETED_BAR: f64 = 0.95;
 /// The margin under [`HARD_BAR`] at which a finish stops on its own check
-/// (`generator.finish.own_check_every`, on twice the check's levels): a run whose finish check
-/// of 20 levels said 0.70 showed 0.805 on the levels of its last check (docs/trials.md).
-pub const FINISH_HARD_MARGIN: f64 = 0.1;
+/// (`generator.finish.own_check_every`, on twice the check's levels): with 0.1 a run stopped
+/// at 0.6 showed 0.74 on the levels of its last check; with 0.15 both seeds tried passed
+/// (docs/trials.md).
+pub const FINISH_HARD_MARGIN: f64 = 0.15;
 
 /// What the check measured.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -147,8 +148,8 @@ mod tests {
         assert!(!control(0.90, 0.55, 1.0).meets(), "easy levels too hard");
         assert!(!control(0.97, 0.82, 1.0).meets(), "hard levels too easy");
         assert!(control(0.97, 0.65, 1.0).meets());
-        assert!(!control(0.97, 0.65, 1.0).meets_with_margin(FINISH_HARD_MARGIN));
-        assert!(control(0.97, 0.55, 1.0).meets_with_margin(FINISH_HARD_MARGIN));
+        assert!(!control(0.97, 0.6, 1.0).meets_with_margin(FINISH_HARD_MARGIN));
+        assert!(control(0.97, 0.5, 1.0).meets_with_margin(FINISH_HARD_MARGIN));
         assert!(
             !control(0.98, 0.30, 0.40).meets(),
             "hard by being impossible"

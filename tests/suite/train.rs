@@ -826,6 +826,15 @@ fn generator_metrics(run: &Path) -> Vec<(u64, String, f64)> {
         .collect()
 }
 
+/// A policy file's tensors, by name, as their values.
+fn tensors(path: &Path) -> std::collections::BTreeMap<String, Vec<f32>> {
+    candle_core::safetensors::load(path, &candle_core::Device::Cpu)
+        .unwrap()
+        .into_iter()
+        .map(|(name, t)| (name, t.flatten_all().unwrap().to_vec1::<f32>().unwrap()))
+        .collect()
+}
+
 /// [`TINY_ADVERSARIAL`] with its finish replaced by `fields` (one `key: value` per line).
 fn tiny_with_finish(fields: &str) -> String {
     let finish: String = fields.lines().map(|line| format!("    {line}\n")).collect();
@@ -943,21 +952,36 @@ fn a_finish_generator_phase_until_a_success_ends_early() {
 
 /// `finish.own_check_every`: every so many Generator steps of the finish the pair plays its own
 /// check aside, on seeds of its own, writing its policies as at a pause. A tiny pair never
-/// passes the bars, so its finish runs to its cap in the bytes of the run without the check;
-/// a step count of 0 is refused by name.
+/// passes the bars, so its finish learns to its cap in the bytes of the run without the check,
+/// then ends with the Generator of its best check, not the one it learned last; a step count
+/// of 0 is refused by name.
 #[test]
-fn a_finish_own_check_plays_aside_and_leaves_a_pair_that_fails_it_as_it_was() {
+fn a_finish_own_check_plays_aside_and_a_pair_that_never_passes_ends_with_its_best_checked_generator()
+ {
     let run = |check: &str| {
         let dir = tempfile::tempdir().unwrap();
         let config = tiny_with_finish(&format!(
             "solver_steps: 128\ngenerator_phase_steps: 64{check}"
         ));
-        let rows = generator_metrics(&train_tiny_to_640(dir.path(), &config));
-        let card = std::fs::read_to_string(dir.path().join("run/generator.yaml")).unwrap();
-        (rows, card.contains("own_success_at_-1"))
+        let out = train_tiny_to_640(dir.path(), &config);
+        let rows = generator_metrics(&out);
+        let card = std::fs::read_to_string(out.join("generator.yaml")).unwrap();
+        let weights = |name: &str| tensors(&out.join(name));
+        let best = out
+            .join("generator-best-check.safetensors")
+            .exists()
+            .then(|| weights("generator-best-check.safetensors"));
+        (
+            rows,
+            card.contains("own_success_at_-1"),
+            weights("generator.safetensors"),
+            best,
+        )
     };
-    let (plain, plain_checked) = run("");
-    let (checked, checked_checked) = run("\nown_check_every: 16");
+    let (plain, plain_checked, plain_generator, none) = run("");
+    // Checks after 32 and 48 of the finish's 64 Generator steps (batches of 16): it learns on
+    // after the last of them.
+    let (checked, checked_checked, generator, best) = run("\nown_check_every: 24");
     assert!(
         plain_checked && checked_checked,
         "both end with the own check"
@@ -968,6 +992,13 @@ fn a_finish_own_check_plays_aside_and_leaves_a_pair_that_fails_it_as_it_was() {
     );
     let rows = |all: &[(u64, String, f64)]| all.iter().map(|r| r.1.clone()).collect::<Vec<_>>();
     assert_eq!(rows(&plain), rows(&checked));
+    assert!(none.is_none(), "no check, no best-checked Generator");
+    assert_eq!(
+        Some(&generator),
+        best.as_ref(),
+        "ends with the best-checked Generator"
+    );
+    assert_ne!(generator, plain_generator, "not the one it learned last");
     let dir = tempfile::tempdir().unwrap();
     let zero = dir.path().join("zero.yaml");
     std::fs::write(

@@ -16,7 +16,10 @@ use super::metrics::{
 use super::own_check;
 use super::population::{PopulationRecord, Snapshot, population_from, population_record};
 use super::solver_run::SolverRun;
-use super::{CHECKPOINT, ConfigChange, GENERATOR_CHECKPOINT, GENERATOR_METRICS, Training};
+use super::{
+    BEST_CHECK_GENERATOR, CHECKPOINT, ConfigChange, GENERATOR_CHECKPOINT, GENERATOR_METRICS,
+    Training,
+};
 use crate::services::fsio;
 use crate::services::fsio::Overwrite;
 use anyhow::{Context, Result};
@@ -320,6 +323,45 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         )
     }
 
+    /// After a finish check that did not pass: its Generator (as `finish_check` just wrote it)
+    /// becomes the best-checked one when its check left more slack than any before.
+    fn keep_if_best_check(&mut self, control: &own_check::OwnControl) -> Result<()> {
+        let slack = control.slack(own_check::FINISH_HARD_MARGIN);
+        let state = &mut self.envs().state;
+        if state.best_check.is_some_and(|best| best >= slack) {
+            return Ok(());
+        }
+        state.best_check = Some(slack);
+        let out = &self.solver.out;
+        let bytes = fsio::read_limited(
+            &out.join("generator.safetensors"),
+            checkpoint::MAX_POLICY_BYTES,
+            "policy",
+        )?;
+        fsio::write_atomic(&out.join(BEST_CHECK_GENERATOR), &bytes, Overwrite::Allowed)
+    }
+
+    /// A finish's Generator phase that ran to its cap without passing its check ends with the
+    /// best-checked Generator: its weights and observation normalizer come back.
+    fn restore_best_check(&mut self) -> Result<()> {
+        let path = self.solver.out.join(BEST_CHECK_GENERATOR);
+        let bytes = fsio::read_limited(&path, checkpoint::MAX_POLICY_BYTES, "policy")?;
+        let loaded = checkpoint::load_policy(
+            &bytes,
+            G::GAME,
+            Role::Generator,
+            arlpcg_core::game::generator::observation_size::<G>(),
+        )
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let generator = &mut self.envs().generator;
+        for (name, var) in generator.ppo.policy.named_vars() {
+            checkpoint::restore_var(&loaded.tensors, &name, &var)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        }
+        generator.norm = loaded.card.normalizer;
+        Ok(())
+    }
+
     /// One iteration of the agent whose phase it is; the progress bar's message.
     fn phase_iteration(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
         let config = &self.solver.config;
@@ -378,10 +420,15 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 let passes = match finish.own_check_every {
                     Some(every) if in_finish && after / every != before / every => {
                         let control = self.finish_check(wall)?;
+                        let passes = control
+                            .is_some_and(|c| c.meets_with_margin(own_check::FINISH_HARD_MARGIN));
                         if let Some(c) = control {
                             message += &format!(", check {:.2} / {:.2}", c.easy, c.hard);
+                            if !passes {
+                                self.keep_if_best_check(&c)?;
+                            }
                         }
-                        control.is_some_and(|c| c.meets_with_margin(own_check::FINISH_HARD_MARGIN))
+                        passes
                     }
                     _ => false,
                 };
@@ -393,9 +440,14 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                         .is_some_and(|s| s <= target),
                     _ => false,
                 };
-                if passes || hard_enough || envs.state.phase_steps >= schedule.generator_phase_steps
-                {
-                    envs.set_phase(Phase::Solver);
+                let capped = envs.state.phase_steps >= schedule.generator_phase_steps;
+                if passes || hard_enough || capped {
+                    // A finish whose checks never passed ends with its best-checked Generator.
+                    if in_finish && !passes && !hard_enough && envs.state.best_check.is_some() {
+                        self.restore_best_check()?;
+                        message += ", back to the best-checked Generator";
+                    }
+                    self.envs().set_phase(Phase::Solver);
                 }
                 Ok(format!("{message}, {}", self.solver.time.largest_two()))
             }

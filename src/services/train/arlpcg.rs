@@ -58,7 +58,7 @@ pub enum Phase {
 }
 
 /// Progress of the match source and the phase schedule, saved in checkpoints.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct AdversarialState {
     /// Matches started so far (each gets its own seed).
     pub episodes_started: u64,
@@ -75,6 +75,11 @@ pub struct AdversarialState {
     /// ...and the Solver steps where the catch-up ended the finish (none: it has not).
     #[serde(default)]
     pub finish_ended_at: Option<u64>,
+    /// The finish's own checks (`Finish::own_check_every`): the largest slack any of them
+    /// left ([`OwnControl::slack`](crate::services::train::own_check::OwnControl::slack)),
+    /// whose Generator the run keeps as `generator-best-check.safetensors` (none: no check yet).
+    #[serde(default)]
+    pub best_check: Option<f64>,
 }
 
 impl Default for AdversarialState {
@@ -86,6 +91,7 @@ impl Default for AdversarialState {
             generator_steps: 0,
             hard_block: [0, 0],
             finish_ended_at: None,
+            best_check: None,
         }
     }
 }

@@ -193,8 +193,12 @@ pub(super) fn checkpoint_identity(path: &Path) -> Result<(Game, TrainMode)> {
 }
 
 /// The policies and cards a run writes into its folder, which a resumed session replaces.
-const RUN_POLICY_FILES: [&str; 4] = [
-    "solver.yaml", "solver.safetensors", "generator.yaml", "generator.safetensors",
+const RUN_POLICY_FILES: [&str; 5] = [
+    "solver.yaml",
+    "solver.safetensors",
+    "generator.yaml",
+    "generator.safetensors",
+    super::BEST_CHECK_GENERATOR,
 ];
 
 /// Refuses to resume from the checkpoint `checkpoint` of the run folder `out` when a policy or

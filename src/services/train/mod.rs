@@ -47,6 +47,9 @@ pub(super) const CHECKPOINT: &str = "checkpoint.safetensors";
 /// `commands/train.rs`); it does not make a folder a run.
 pub const LOCK_FILE: &str = "train.lock";
 pub(super) const GENERATOR_CHECKPOINT: &str = "generator-checkpoint.safetensors";
+/// The Generator of the finish's best own check (`generator.finish.own_check_every`), which a
+/// finish that runs to its cap without passing ends with.
+pub(super) const BEST_CHECK_GENERATOR: &str = "generator-best-check.safetensors";
 /// The run's metrics file, a row per iteration.
 pub const METRICS: &str = "metrics.csv";
 /// The key under which a checkpoint's `source` holds the episodes or matches under way

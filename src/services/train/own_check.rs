@@ -55,6 +55,15 @@ impl OwnControl {
         self.easy >= EASY_BAR && self.hard <= HARD_BAR - margin && self.completed >= COMPLETED_BAR
     }
 
+    /// How far it is from missing a bar (with `margin` at the hard end): the least of the
+    /// three distances, negative by the largest miss when it misses one. A finish keeps the
+    /// Generator whose check left the most.
+    pub fn slack(&self, margin: f64) -> f64 {
+        (self.easy - EASY_BAR)
+            .min(HARD_BAR - margin - self.hard)
+            .min(self.completed - COMPLETED_BAR)
+    }
+
     /// The figures as a card's `results`.
     pub fn results(&self) -> HashMap<String, f64> {
         HashMap::from([
@@ -150,6 +159,17 @@ mod tests {
         assert!(control(0.97, 0.65, 1.0).meets());
         assert!(!control(0.97, 0.6, 1.0).meets_with_margin(FINISH_HARD_MARGIN));
         assert!(control(0.97, 0.5, 1.0).meets_with_margin(FINISH_HARD_MARGIN));
+        // The slack: the least distance to a bar, by which the finish ranks its checks.
+        let slack = |c: OwnControl| c.slack(FINISH_HARD_MARGIN);
+        assert!(
+            (slack(control(0.97, 0.5, 1.0)) - 0.02).abs() < 1e-9,
+            "easy end closest"
+        );
+        assert!(
+            (slack(control(0.99, 0.6, 1.0)) + 0.05).abs() < 1e-9,
+            "hard end missed"
+        );
+        assert!(slack(control(0.99, 0.6, 1.0)) > slack(control(0.99, 0.7, 1.0)));
         assert!(
             !control(0.98, 0.30, 0.40).meets(),
             "hard by being impossible"

@@ -60,7 +60,9 @@ pub struct Finish {
     /// (`generator.own_check`) on levels of seeds of its own (`FINISH_CHECK_SEED_BASE`), and
     /// the finish's Generator phase ends once it passes the bars with a margin at the hard end
     /// (`own_check::FINISH_HARD_MARGIN`): the stop the product needs, where the block stop
-    /// above waits for one lucky block (none: no such check).
+    /// above waits for one lucky block. A phase that runs to `generator_phase_steps` without
+    /// passing ends with the Generator of its best check (the least short of the bars), kept
+    /// in the run folder as `generator-best-check.safetensors` (none: no such check).
     #[serde(default)]
     pub own_check_every: Option<u64>,
     /// A scripted player that plays a share of the matches while the finish's Generator

@@ -293,6 +293,23 @@ impl Want {
         Ok(())
     }
 
+    /// Refuses what [`Want::fit`] refuses, and a constraint no search can meet: `b`, the
+    /// panel's rating, fitted over a batch of levels together (`--panel`), is a check of made
+    /// levels (`--check`, campaigns), not something one candidate can be measured on.
+    pub fn fit_search(&self, game: Game) -> Result<(), String> {
+        self.fit(game)?;
+        match self
+            .constraints
+            .iter()
+            .find(|c| c.attribute == Attribute::B)
+        {
+            Some(b) => Err(format!(
+                "`{b}`: b is the panel's rating of levels fitted together, which one candidate of a search cannot be measured on; check it on made levels instead (`--check \"{b}\"` with --panel)"
+            )),
+            None => Ok(()),
+        }
+    }
+
     /// The most any constraint reads: the pieces alone, runs, or the panel.
     pub fn reads(&self) -> Reads {
         self.constraints

@@ -76,7 +76,7 @@ impl AskSet {
                         false,
                     ),
                 };
-                want.and_then(|w| w.fit(game).map(|()| w))
+                want.and_then(|w| w.fit_search(game).map(|()| w))
                     .map(|w| (text, w, sentence))
                     .map_err(|e| format!("{}: asks[{i}]: {e}", path.display()))
             })

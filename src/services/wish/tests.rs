@@ -68,6 +68,20 @@ fn a_wish_list_refuses_what_cannot_hold_before_any_search() {
             .fit(Game::Racing)
             .is_err()
     );
+    // b is checked on made levels, never searched for: a search refuses it by name.
+    let b = Want::parse("climb >= 4, b >= 0").unwrap();
+    assert!(b.fit(Game::Platform).is_ok(), "a check may read b");
+    let err = b.fit_search(Game::Platform).unwrap_err();
+    assert!(
+        err.starts_with("`b >= 0`") && err.contains("--check"),
+        "{err}"
+    );
+    assert!(
+        Want::parse("climb >= 4")
+            .unwrap()
+            .fit_search(Game::Platform)
+            .is_ok()
+    );
 }
 
 #[test]

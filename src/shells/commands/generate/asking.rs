@@ -76,7 +76,7 @@ pub(super) fn wanted(args: &GenerateArgs) -> Result<Option<Want>> {
         }
         (None, None, None) => return Ok(None),
     };
-    want.fit(args.game).map_err(usage)?;
+    want.fit_search(args.game).map_err(usage)?;
     Ok(Some(want))
 }
 

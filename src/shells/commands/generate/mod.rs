@@ -299,7 +299,7 @@ fn check_arguments(args: &GenerateArgs) -> Result<Vec<u64>> {
         );
     }
     if let Some(want) = &args.want {
-        want.fit(args.game)
+        want.fit_search(args.game)
             .map_err(crate::shells::common::UsageError)?;
     }
     wish::fit_checks(&args.checks, args.game).map_err(crate::shells::common::UsageError)?;

@@ -223,7 +223,7 @@ impl App {
             }),
         };
         let checked = read.and_then(|(want, unused)| {
-            want.fit(self.game)?;
+            want.fit_search(self.game)?;
             match want.judges().iter().any(|j| matches!(j, Judge::Solver(_))) {
                 true => Err("the designer plays the scripted judges; a Solver judge's success: arlpcg generate --want".into()),
                 false => Ok((want, unused)),

@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use crate::services::generation::GeneratorPolicy;
 use crate::services::panel::{Judge, JudgePanel};
 use crate::services::verify::{ProfileFit, SolverPolicy};
+use arlpcg_core::game::facts::facts;
 use arlpcg_core::game::generator::DEFAULT_CURVE_OFFSET;
 use arlpcg_core::game::generator::{BuildLimits, GeneratorGame, observation_size};
 use arlpcg_core::game::{GameSpec, SolverEnv};
@@ -177,8 +178,8 @@ pub fn load_generator(path: &Path, game: Game) -> Result<(GeneratorPolicy, Polic
     ))
 }
 
-/// The piece budget and curve offset a Generator's card (of the file at `path`) records, each
-/// checked against its game's range, or the game's defaults where the card has none.
+/// The piece budget, curve offset and reach a Generator's card (of the file at `path`) records,
+/// each checked against its game's range, or the game's defaults where the card has none.
 pub fn generator_limits(path: &Path, card: &PolicyCard) -> Result<BuildLimits> {
     let (default_max_pieces, most_pieces) =
         arlpcg_core::for_game!(card.game, G => (G::DEFAULT_MAX_PIECES, G::MAX_PIECES));
@@ -186,7 +187,23 @@ pub fn generator_limits(path: &Path, card: &PolicyCard) -> Result<BuildLimits> {
         max_pieces: card.max_pieces.unwrap_or(default_max_pieces),
         curve_offset: card.curve_offset.unwrap_or(DEFAULT_CURVE_OFFSET),
         player: Default::default(),
+        reach_runs: card.reach_runs,
     };
+    if let Some(runs) = limits.reach_runs {
+        match facts(card.game).reach_runs {
+            None => anyhow::bail!(
+                "{}: card field reach_runs is given, but the {} Generator's pieces are not cut \
+                 to a reach",
+                path.display(),
+                card.game
+            ),
+            Some(most) if !(1..=most).contains(&runs) => anyhow::bail!(
+                "{}: card field reach_runs is {runs}, outside [1, {most}]",
+                path.display()
+            ),
+            Some(_) => {}
+        }
+    }
     if !(1..=most_pieces).contains(&limits.max_pieces) {
         anyhow::bail!(
             "{}: card field max_pieces is {}, outside [1, {most_pieces}]",
@@ -461,6 +478,50 @@ pub fn policy_paths(dir: &Path) -> (PathBuf, PathBuf) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A Generator's reach is read from its card: none, or a count of runs within its game's
+    /// range; a card out of range, or one of a game without a reach, names the file and field.
+    #[test]
+    fn a_generators_reach_runs_come_from_its_card_within_its_games_range() {
+        let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
+        let card = load_generator(&shipped.join(GENERATOR_FILE), Game::Platform)
+            .unwrap()
+            .1;
+        let path = Path::new("g.safetensors");
+        assert_eq!(generator_limits(path, &card).unwrap().reach_runs, None);
+        let with = |game, runs| PolicyCard {
+            game,
+            reach_runs: Some(runs),
+            ..card.clone()
+        };
+        let four = generator_limits(path, &with(Game::Platform, 4)).unwrap();
+        assert_eq!(four.reach_runs, Some(4));
+        for (game, runs, says) in [
+            (
+                Game::Platform,
+                0,
+                "card field reach_runs is 0, outside [1, 8]",
+            ),
+            (
+                Game::Platform,
+                9,
+                "card field reach_runs is 9, outside [1, 8]",
+            ),
+            (
+                Game::Racing,
+                4,
+                "the racing Generator's pieces are not cut to a reach",
+            ),
+        ] {
+            let error = generator_limits(path, &with(game, runs))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                error.starts_with("g.safetensors: ") && error.contains(says),
+                "{error}"
+            );
+        }
+    }
 
     /// A profile's λ→success curve is kept in its own file: the built-in game's curve is never
     /// used for a profile's levels, nor the profile's for the built-in game's.

@@ -80,6 +80,41 @@ fn a_weaker_jump_measures_a_shorter_reach_and_its_rule_levels_stay_within_it() {
     assert!(cleared * 100 >= runs * 95, "{cleared} of {runs}");
 }
 
+/// A Generator may cut its jumps to a reach counted in fewer of the eight runs
+/// (`generator.finish.reach_runs`, its card's `reach_runs`): at every height at least the reach
+/// table's gap, longer for Godot 4's template character (`results/platform/profiles/godot4`),
+/// and the build it opens keeps to the reach its limits name.
+#[test]
+fn a_reach_counted_in_fewer_runs_is_longer_and_a_generator_build_keeps_to_the_one_it_is_given() {
+    use arlpcg_core::game::generator::{BuildLimits, GeneratorGame};
+    let player = Player::of(Some(Abilities::Character(CharacterProfile {
+        run_speed: 5.0,
+        jump_speed: 4.5,
+        gravity: 9.8,
+        ..CharacterProfile::default()
+    })));
+    let reliable = Reach::of_player(&player);
+    let makeable = Reach::of_player_in(&player, 4);
+    assert_eq!(Reach::of_player_in(&player, reach::REACH_TRIALS), reliable);
+    assert!(
+        makeable.0.iter().zip(reliable.0).all(|(m, r)| *m >= r),
+        "{makeable:?} against {reliable:?}"
+    );
+    assert_ne!(makeable, reliable);
+    let limits = BuildLimits {
+        player,
+        ..BuildLimits::default_for::<PlatformGame>()
+    };
+    for (runs, reach) in [(None, reliable), (Some(4), makeable)] {
+        let limits = BuildLimits {
+            reach_runs: runs,
+            ..limits
+        };
+        let (build, _) = PlatformGame::new_build(7, None, limits, 0);
+        assert_eq!(build.reach, reach, "reach_runs {runs:?}");
+    }
+}
+
 #[test]
 fn the_documented_reach_table_is_what_the_simulation_measures() {
     assert_eq!(

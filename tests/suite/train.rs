@@ -950,6 +950,31 @@ fn a_finish_generator_phase_until_a_success_ends_early() {
     );
 }
 
+/// `finish.reach_runs`: the finish's Generator cuts its jumps to the reach counted in that many
+/// of the eight runs, and its card says so, so `generate` cuts its levels the same way; the
+/// Solver's card and the Generator's before the finish name no reach.
+#[test]
+fn a_finish_with_its_own_reach_writes_it_on_the_generators_card() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = tiny_with_finish("solver_steps: 128\ngenerator_phase_steps: 8\nreach_runs: 4");
+    let path = dir.path().join("variant.yaml");
+    std::fs::write(&path, &config).unwrap();
+    let out = dir.path().join("run");
+    arlpcg_ok(words(
+        "train --mode arlpcg --steps 640 --pause-at 512 --config {} --out {}",
+        &[&path, &out],
+    ));
+    assert_eq!(load_network(&out, GENERATOR).card.reach_runs, None);
+    arlpcg_ok(words("train --resume --out {}", &[&out]));
+    assert_eq!(load_network(&out, GENERATOR).card.reach_runs, Some(4));
+    assert_eq!(load_network(&out, SOLVER).card.reach_runs, None);
+    let levels = dir.path().join("levels");
+    arlpcg_ok(words(
+        "generate --policies {} --aux -1 --count 2 --out {}",
+        &[&out, &levels],
+    ));
+}
+
 /// `finish.own_check_every`: every so many Generator steps of the finish the pair plays its own
 /// check aside, on seeds of its own, writing its policies as at a pause. A tiny pair never
 /// passes the bars, so its finish learns to its cap in the bytes of the run without the check,

@@ -54,6 +54,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 max_pieces: config.generator.max_pieces,
                 curve_offset: config.generator.curve_offset,
                 player: config.player(G::GAME),
+                reach_runs: None,
             },
             knob_values: config
                 .generator
@@ -196,6 +197,9 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             wall_time_s,
         );
         card.training.population = envs.population.iter().map(|s| s.solver_steps).collect();
+        // The reach it cuts its jumps to from here on (the finish's, once the finish begins).
+        let solver_steps = self.solver.trainer.global_step;
+        card.reach_runs = self.solver.config.schedule_at(solver_steps).reach_runs;
         record_commands(&mut card, &self.solver.commands, &self.solver.commit);
         self.solver.record_time(&mut card);
         card.results = self.solver.results.clone();
@@ -374,6 +378,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         let finish = config.generator.finish;
         self.envs().rules.snapshot_share = schedule.snapshot_share;
         self.envs().rules.scripted_opponent = schedule.scripted_opponent;
+        self.envs().rules.limits.reach_runs = schedule.reach_runs;
         match self.envs().state.phase {
             Phase::Solver => {
                 let rollout = self

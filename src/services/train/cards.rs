@@ -153,6 +153,8 @@ pub(super) fn card(
         max_pieces: (role == Role::Generator).then_some(config.generator.max_pieces),
         curve_offset: (role == Role::Generator && facts(game).curve_offset)
             .then_some(config.generator.curve_offset),
+        // A Generator's is the reach of the Solver step it is saved at (`generator_card`).
+        reach_runs: None,
         profile: config.profile.clone(),
         ability_spread: (config.ability_spread > 0.0).then_some(config.ability_spread),
         ability_ranges: config

@@ -28,6 +28,9 @@ pub struct GameFacts {
     pub max_obstacles: usize,
     /// Whether the Generator's curve offset (its card's `curve_offset`) steers it.
     pub curve_offset: bool,
+    /// The runs a measured reach counts cleared jumps in, where the Generator's jumps are cut to
+    /// one (platform: 8): its card's `reach_runs` lies within [1, that].
+    pub reach_runs: Option<u64>,
     /// Obstacles in each evaluation and designer scene (the racing Generator trained with 3).
     pub scene_obstacles: u32,
     /// The controllability table's piece columns: (name, unit), in [`piece_values`]'s order.

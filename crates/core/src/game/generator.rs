@@ -292,6 +292,10 @@ pub struct BuildLimits {
     /// Who the track is made for and played by in a match: the platform keeps every jump
     /// within the player's reach, and the Solver plays with its abilities.
     pub player: super::Player,
+    /// Platform: the runs of the reach measurement's eight a jump must be cleared in for the
+    /// Generator to place it (`Reach::of_player_in` in `crates/core/src/game/platform/reach.rs`);
+    /// none: all of them, the reach table the rules keep to. Other games ignore it.
+    pub reach_runs: Option<u64>,
 }
 
 impl BuildLimits {
@@ -301,6 +305,7 @@ impl BuildLimits {
             max_pieces: G::DEFAULT_MAX_PIECES,
             curve_offset: DEFAULT_CURVE_OFFSET,
             player: super::Player::default(),
+            reach_runs: None,
         }
     }
 }

@@ -125,6 +125,11 @@ pub struct PolicyCard {
     /// degrees (absent: 30, as every racing Generator before it was trained).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curve_offset: Option<f64>,
+    /// Platform Generators only: its jumps are cut to the gaps the reach measurement clears
+    /// in at least this many of its 8 runs (absent: all 8, the reach table, as every Generator
+    /// before it; `generator.finish.reach_runs`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reach_runs: Option<u64>,
     /// The game profile the policy was trained for (`train --profile`; absent: the built-in
     /// game).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -548,6 +553,7 @@ mod tests {
             results: HashMap::new(),
             max_pieces: None,
             curve_offset: None,
+            reach_runs: None,
             profile: None,
             ability_spread: None,
             ability_ranges: None,

@@ -271,6 +271,19 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
             "curve_offset does not steer the {game} Generator (leave it at {default_offset})"
         ));
     }
+    if let Some(runs) = g.finish.reach_runs {
+        match facts(game).reach_runs {
+            None => {
+                return Err(format!(
+                    "finish.reach_runs: the {game} Generator's pieces are not cut to a reach"
+                ));
+            }
+            Some(most) if !(1..=most).contains(&runs) => {
+                return Err(format!("finish.reach_runs must be within [1, {most}] runs"));
+            }
+            Some(_) => {}
+        }
+    }
     if g.obstacles > arlpcg_core::level::racing::MAX_OBSTACLES as u32 {
         return Err(format!(
             "obstacles must be at most {}",

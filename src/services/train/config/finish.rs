@@ -70,6 +70,13 @@ pub struct Finish {
     /// Solver plays every match). The stops above count the final Solver's matches only.
     #[serde(default)]
     pub scripted_opponent: Option<ScriptedOpponent>,
+    /// Platform: the finish's Generator cuts its jumps to the gaps the reach measurement clears
+    /// in at least this many of its 8 runs, not all 8 (none: the reach table the rules keep
+    /// to, as before the finish), and its card says so (`reach_runs`), so that its levels are
+    /// cut the same way wherever it plays. Against a strong Solver the reliable table leaves
+    /// hard levels easy (docs/decisions.md, D22).
+    #[serde(default)]
+    pub reach_runs: Option<u64>,
 }
 
 /// The scripted player as the Generator's opponent in a finish ([`Finish::scripted_opponent`]);
@@ -129,6 +136,7 @@ impl Finish {
         generator_learning_rate: None,
         own_check_every: None,
         scripted_opponent: None,
+        reach_runs: None,
     };
 }
 

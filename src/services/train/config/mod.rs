@@ -234,6 +234,7 @@ impl GeneratorConfig {
                 generator_entropy: None,
                 generator_learning_rate: None,
                 scripted_opponent: None,
+                reach_runs: None,
             },
             None => Schedule {
                 solver_learning_rate: None,
@@ -243,6 +244,7 @@ impl GeneratorConfig {
                 generator_entropy: None,
                 generator_learning_rate: None,
                 scripted_opponent: None,
+                reach_runs: None,
             },
         }
     }
@@ -263,6 +265,8 @@ pub struct Schedule {
     pub generator_learning_rate: Option<f64>,
     /// The scripted player's share of the matches (`Finish::scripted_opponent`).
     pub scripted_opponent: Option<ScriptedOpponent>,
+    /// The runs the Generator's reach counts (`Finish::reach_runs`; none: all of them).
+    pub reach_runs: Option<u64>,
 }
 
 impl Default for GeneratorConfig {
@@ -387,6 +391,7 @@ impl TrainConfig {
                 generator_entropy: finish.generator_entropy,
                 generator_learning_rate: finish.generator_learning_rate,
                 scripted_opponent: finish.scripted_opponent,
+                reach_runs: finish.reach_runs,
             };
         }
         self.generator.schedule_at(solver_steps)

@@ -102,6 +102,16 @@ fn the_platform_finish_follows_the_budget_and_stages_apply_from_their_step() {
     );
     let narrow = TrainConfig::parse_for("generator:\n  curve_offset: 30\n", Game::Racing).unwrap();
     assert_eq!(narrow.generator.curve_offset, 30.0);
+    // A finish's reach holds in the finish only.
+    let cut = TrainConfig::parse_for(
+        "steps: 100\ngenerator:\n  finish: {reach_runs: 4}\n",
+        Game::Platform,
+    )
+    .unwrap();
+    assert_eq!(
+        [99, 100].map(|steps| cut.schedule_at(steps).reach_runs),
+        [None, Some(4)]
+    );
 }
 
 #[test]
@@ -121,6 +131,21 @@ fn out_of_range_generator_fields_are_named() {
             "generator:\n  curve_offset: 90\n",
             Game::Platform,
             "does not steer the platform Generator",
+        ),
+        (
+            "generator:\n  finish: {reach_runs: 0}\n",
+            Game::Platform,
+            "finish.reach_runs must be within [1, 8] runs",
+        ),
+        (
+            "generator:\n  finish: {reach_runs: 9}\n",
+            Game::Platform,
+            "finish.reach_runs must be within [1, 8] runs",
+        ),
+        (
+            "generator:\n  finish: {reach_runs: 4}\n",
+            Game::Racing,
+            "the racing Generator's pieces are not cut to a reach",
         ),
         (
             "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n  - {from_steps: 5, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n",

@@ -195,6 +195,7 @@ pub const FACTS: GameFacts = GameFacts {
     endings: &[("fell", "fell"), ("timed_out", "out of time")],
     max_obstacles: 0,
     curve_offset: false,
+    reach_runs: None,
     scene_obstacles: 0,
     piece_columns: &[("avg_block_distance", " m"), ("avg_block_size", " m")],
     air_time_step: None,

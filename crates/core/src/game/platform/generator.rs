@@ -343,7 +343,10 @@ impl GeneratorGame for PlatformGame {
             goal,
             max_blocks: limits.max_pieces,
             player: limits.player,
-            reach: Reach::of_player(&limits.player),
+            reach: Reach::of_player_in(
+                &limits.player,
+                limits.reach_runs.unwrap_or(reach::REACH_TRIALS),
+            ),
         };
         (build, rng)
     }
@@ -364,7 +367,10 @@ impl GeneratorGame for PlatformGame {
             goal,
             max_blocks: limits.max_pieces,
             player: limits.player,
-            reach: Reach::of_player(&limits.player),
+            reach: Reach::of_player_in(
+                &limits.player,
+                limits.reach_runs.unwrap_or(reach::REACH_TRIALS),
+            ),
         };
         for params in &kept.block_params()[..pieces] {
             build.track.push(*params).map_err(|e| e.to_string())?;

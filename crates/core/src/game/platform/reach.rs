@@ -63,23 +63,41 @@ impl Reach {
     /// the designer's edits measure each character once. The same abilities always give the
     /// same table, so keeping it changes no result.
     pub fn of_player(player: &crate::game::Player) -> Self {
+        Self::of_player_in(player, REACH_TRIALS)
+    }
+
+    /// The reach of `player`'s character counted in at least `runs` of the [`REACH_TRIALS`]
+    /// runs ([`measure_reach_in`]): [`Reach::of_player`] at all of them, a longer reach at
+    /// fewer (a Generator's `reach_runs`). `runs` is taken within [1, `REACH_TRIALS`]. Measured
+    /// once per process, character and count, and kept.
+    pub fn of_player_in(player: &crate::game::Player, runs: u64) -> Self {
         use std::sync::{Mutex, OnceLock};
-        let Some(Abilities::Character(character)) = player.abilities else {
-            return Self::default();
+        let runs = runs.clamp(1, REACH_TRIALS);
+        let character = match player.abilities {
+            Some(Abilities::Character(character)) => character,
+            _ if runs == REACH_TRIALS => return Self::default(),
+            _ => CharacterProfile::default(),
         };
-        static MEASURED: OnceLock<Mutex<Vec<(CharacterProfile, Reach)>>> = OnceLock::new();
+        type Measured = Vec<(CharacterProfile, u64, Reach)>;
+        static MEASURED: OnceLock<Mutex<Measured>> = OnceLock::new();
         let measured = MEASURED.get_or_init(Default::default);
-        let known = |all: &[(CharacterProfile, Reach)]| {
-            all.iter().find(|(c, _)| *c == character).map(|(_, r)| *r)
+        let known = |all: &Measured| {
+            all.iter()
+                .find(|(c, r, _)| *c == character && *r == runs)
+                .map(|(_, _, reach)| *reach)
         };
         if let Some(reach) = known(&measured.lock().unwrap_or_else(|e| e.into_inner())) {
             return reach;
         }
-        let reach = Self::of(Body::from(character));
+        let body = Body::from(character);
+        let reach = match runs {
+            REACH_TRIALS => Self::of(body),
+            _ => Self(measure_reach_in(body, runs)),
+        };
         measured
             .lock()
             .unwrap_or_else(|e| e.into_inner())
-            .push((character, reach));
+            .push((character, runs, reach));
         reach
     }
 
@@ -170,8 +188,17 @@ pub fn successes(track: &PlatformTrack, body: Body, trials: u64, jitter: f32) ->
 /// Measures the reach table: for each height change, the largest gap such that every chained
 /// jump up to it (in `REACH_STEP` steps from 1 m, at every turn of `REACH_TURNS`) is cleared in
 /// all `REACH_TRIALS` runs, for a character of `body`.
-/// The heights and, at each gap, the turns are measured side by side (rayon): the same table.
 pub fn measure_reach(body: Body) -> [f64; 5] {
+    measure_reach_in(body, REACH_TRIALS)
+}
+
+/// Measures a reach counted in at least `runs` of the `REACH_TRIALS` runs: for each height
+/// change, the largest gap such that every chained jump up to it is cleared in `runs` or more of
+/// them at every turn of `REACH_TURNS` ([`measure_reach`] at all of them). Fewer runs give the
+/// gaps the scripted controller makes only sometimes: what a Generator may cut its jumps to
+/// when the reliable table leaves a strong Solver's hard levels easy (docs/decisions.md, D22).
+/// The heights and, at each gap, the turns are measured side by side (rayon): the same table.
+pub fn measure_reach_in(body: Body, runs: u64) -> [f64; 5] {
     use rayon::prelude::*;
     let gaps: Vec<f64> = REACH_HEIGHTS
         .par_iter()
@@ -186,7 +213,7 @@ pub fn measure_reach(body: Body) -> [f64; 5] {
                         body,
                         REACH_TRIALS,
                         REACH_JITTER,
-                    ) == REACH_TRIALS
+                    ) >= runs
                 });
                 if !cleared {
                     break;

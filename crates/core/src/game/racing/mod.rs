@@ -117,6 +117,7 @@ pub const FACTS: GameFacts = GameFacts {
     ],
     max_obstacles: crate::level::racing::MAX_OBSTACLES,
     curve_offset: true,
+    reach_runs: None,
     scene_obstacles: generator::MATCH_OBSTACLES,
     piece_columns: &[
         ("avg_segment_curve", "°"),

@@ -952,27 +952,83 @@ fn a_finish_generator_phase_until_a_success_ends_early() {
 
 /// `finish.reach_runs`: the finish's Generator cuts its jumps to the reach counted in that many
 /// of the eight runs, and its card says so, so `generate` cuts its levels the same way; the
-/// Solver's card and the Generator's before the finish name no reach.
+/// Solver's card and the Generator's before the finish name no reach. A run with it and with
+/// knobs drawn in the finish only, paused before the finish or where it begins, resumes to the
+/// bytes of the run never paused: the matches it replays follow the finish's rules.
 #[test]
-fn a_finish_with_its_own_reach_writes_it_on_the_generators_card() {
+fn a_finish_with_its_own_reach_writes_it_on_the_card_and_resumes_to_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();
-    let config = tiny_with_finish("solver_steps: 128\ngenerator_phase_steps: 8\nreach_runs: 4");
+    let config = tiny_with_finish(
+        "solver_steps: 384\ngenerator_phase_steps: 64\nreach_runs: 1\nknobs_only: true",
+    )
+    .replace(
+        "generator:\n",
+        "generator:\n  rewards:\n    knobs: [1.0, 0.5]\n",
+    );
     let path = dir.path().join("variant.yaml");
     std::fs::write(&path, &config).unwrap();
-    let out = dir.path().join("run");
-    arlpcg_ok(words(
-        "train --mode arlpcg --steps 640 --pause-at 512 --config {} --out {}",
-        &[&path, &out],
-    ));
-    assert_eq!(load_network(&out, GENERATOR).card.reach_runs, None);
-    arlpcg_ok(words("train --resume --out {}", &[&out]));
-    assert_eq!(load_network(&out, GENERATOR).card.reach_runs, Some(4));
-    assert_eq!(load_network(&out, SOLVER).card.reach_runs, None);
+    let train = |name: &str, pause_at: Option<&str>| {
+        let out = dir.path().join(name);
+        let start = words(
+            "train --mode arlpcg --steps 640 --config {} --out {}",
+            &[&path, &out],
+        );
+        match pause_at {
+            None => arlpcg_ok(start),
+            Some(at) => {
+                arlpcg_ok(start.into_iter().chain(["--pause-at".into(), at.into()]));
+                let card = std::fs::read_to_string(out.join("generator.yaml")).unwrap();
+                let paused_in_finish = curve(&out).last().unwrap().1 >= 640;
+                assert_eq!(card.contains("reach_runs: 1\n"), paused_in_finish, "{card}");
+                arlpcg_ok(words("train --resume --out {}", &[&out]))
+            }
+        };
+        out
+    };
+    let whole = train("whole", None);
+    let card = std::fs::read_to_string(whole.join("generator.yaml")).unwrap();
+    assert!(card.contains("reach_runs: 1\n"), "{card}");
+    let solver_card = std::fs::read_to_string(whole.join("solver.yaml")).unwrap();
+    assert!(!solver_card.contains("reach_runs"), "{solver_card}");
+    for at in ["512", "640", "700"] {
+        let paused = train(&format!("paused-{at}"), Some(at));
+        assert_same_training(&whole, &paused, &[SOLVER, GENERATOR]);
+    }
     let levels = dir.path().join("levels");
     arlpcg_ok(words(
         "generate --policies {} --aux -1 --count 2 --out {}",
-        &[&out, &levels],
+        &[&whole, &levels],
     ));
+}
+
+/// `finish.knobs_only`: a Generator's style knobs are drawn in the finish only, every knob 0
+/// before it. Two such runs whose knobs are drawn from different values learn the same bytes up
+/// to the finish and part in it; without the option they part from the start.
+#[test]
+fn knobs_drawn_in_the_finish_only_leave_the_run_before_it_unchanged() {
+    // The Generator's rows (clock columns out) before the finish (Solver step < 640) and in it.
+    let generator_rows = |knob_values: &str, knobs_only: bool| {
+        let dir = tempfile::tempdir().unwrap();
+        let finish =
+            format!("solver_steps: 128\ngenerator_phase_steps: 64\nknobs_only: {knobs_only}");
+        let knobs = format!(
+            "generator:\n  rewards:\n    knobs: [1.0, 0.5]\n  knob_values: {knob_values}\n"
+        );
+        let config = tiny_with_finish(&finish).replace("generator:\n", &knobs);
+        let out = train_tiny_to_640(dir.path(), &config);
+        let rows = without_clock(&out.join("generator-metrics.csv")).unwrap();
+        let step = |row: &String| row.split(',').nth(1).unwrap().parse::<u64>().unwrap();
+        rows.into_iter()
+            .skip(1)
+            .partition::<Vec<String>, _>(|row| step(row) < 640)
+    };
+    let (before, finish) = generator_rows("[-1, 1]", true);
+    let (ones_before, ones_finish) = generator_rows("[1]", true);
+    assert!(!before.is_empty() && !finish.is_empty());
+    assert_eq!(before, ones_before);
+    assert_ne!(finish, ones_finish);
+    let (drawn_before, _) = generator_rows("[-1, 1]", false);
+    assert_ne!(before, drawn_before);
 }
 
 /// `finish.own_check_every`: every so many Generator steps of the finish the pair plays its own

@@ -44,7 +44,11 @@ pub(super) struct AdversarialRun<G: GeneratorGame> {
 }
 
 impl<G: GeneratorGame> AdversarialRun<G> {
-    pub(super) fn rules(mode: TrainMode, config: &TrainConfig) -> MatchRules {
+    /// The rules of the matches at `solver_steps`: what the schedule there says of the
+    /// Generator's reach and knobs holds from the first match (a resumed run replays its
+    /// matches under way by them); each iteration sets them again.
+    pub(super) fn rules(mode: TrainMode, config: &TrainConfig, solver_steps: u64) -> MatchRules {
+        let schedule = config.schedule_at(solver_steps);
         MatchRules {
             aux_values: match mode {
                 TrainMode::FixedAux => vec![1.0],
@@ -54,13 +58,14 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 max_pieces: config.generator.max_pieces,
                 curve_offset: config.generator.curve_offset,
                 player: config.player(G::GAME),
-                reach_runs: None,
+                reach_runs: schedule.reach_runs,
             },
             knob_values: config
                 .generator
                 .knob_values
                 .clone()
                 .unwrap_or(super::config::DEFAULT_KNOB_VALUES.to_vec()),
+            draw_knobs: schedule.draw_knobs,
             obstacles: config.generator.obstacles,
             rewards: config.generator.rewards.clone(),
             snapshot_share: config.generator.snapshot_share,
@@ -76,7 +81,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
     }
 
     pub(super) fn start(out: &Path, mode: TrainMode, config: TrainConfig) -> Result<Self> {
-        let build = |config: &TrainConfig, _: Option<serde_json::Value>| {
+        let build = |config: &TrainConfig, _: Option<serde_json::Value>, _: u64| {
             let policy = ActorCritic::new(
                 generator_shape(config, G::GAME),
                 config.seed.wrapping_add(1),
@@ -91,7 +96,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 config.solver.num_envs,
                 generator,
                 rng,
-                Self::rules(mode, config),
+                Self::rules(mode, config, 0),
                 AdversarialRecord::default(),
                 Vec::new(),
                 solver_shape(config, G::GAME).action_size(),
@@ -128,46 +133,47 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             source => serde_json::from_value(source.clone())
                 .with_context(|| format!("{}: population", path.display()))?,
         };
-        let build = move |config: &TrainConfig, source: Option<serde_json::Value>| {
-            if let Some(trained) = loaded.card.curve_offset
-                && trained != config.generator.curve_offset
-            {
-                anyhow::bail!(
-                    "{}: this Generator was trained with generator.curve_offset {trained}, the \
+        let build =
+            move |config: &TrainConfig, source: Option<serde_json::Value>, solver_steps: u64| {
+                if let Some(trained) = loaded.card.curve_offset
+                    && trained != config.generator.curve_offset
+                {
+                    anyhow::bail!(
+                        "{}: this Generator was trained with generator.curve_offset {trained}, the \
                      configuration says {}; it maps its actions to curves by that offset, so it \
                      cannot change",
-                    path.display(),
-                    config.generator.curve_offset
-                );
-            }
-            let matches: AdversarialRecord =
-                serde_json::from_value(source.unwrap_or_default()).context("match source")?;
-            let mut population =
-                population_from(&record, &loaded.tensors, &solver_shape(config, G::GAME))
-                    .map_err(|e| anyhow::anyhow!("{}: population: {e}", path.display()))?;
-            // A configuration that keeps fewer snapshots drops the oldest.
-            let surplus = population.len().saturating_sub(config.generator.population);
-            population.drain(..surplus);
-            let vars = loaded.policy.named_vars();
-            let mut ppo = Ppo::new(config.generator.ppo.clone(), loaded.policy)?;
-            ppo.adam
-                .restore(&vars, &loaded.tensors, generator_state.adam_step)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-            let generator = Generator {
-                ppo,
-                norm: loaded.card.normalizer.clone(),
+                        path.display(),
+                        config.generator.curve_offset
+                    );
+                }
+                let matches: AdversarialRecord =
+                    serde_json::from_value(source.unwrap_or_default()).context("match source")?;
+                let mut population =
+                    population_from(&record, &loaded.tensors, &solver_shape(config, G::GAME))
+                        .map_err(|e| anyhow::anyhow!("{}: population: {e}", path.display()))?;
+                // A configuration that keeps fewer snapshots drops the oldest.
+                let surplus = population.len().saturating_sub(config.generator.population);
+                population.drain(..surplus);
+                let vars = loaded.policy.named_vars();
+                let mut ppo = Ppo::new(config.generator.ppo.clone(), loaded.policy)?;
+                ppo.adam
+                    .restore(&vars, &loaded.tensors, generator_state.adam_step)
+                    .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+                let generator = Generator {
+                    ppo,
+                    norm: loaded.card.normalizer.clone(),
+                };
+                // The matches under way are replayed (none if the rules changed: fresh ones start).
+                AdversarialEnvs::new(
+                    config.solver.num_envs,
+                    generator,
+                    generator_state.rng,
+                    Self::rules(mode, config, solver_steps),
+                    matches,
+                    population,
+                    solver_shape(config, G::GAME).action_size(),
+                )
             };
-            // The matches under way are replayed (none if the rules changed: fresh ones start).
-            AdversarialEnvs::new(
-                config.solver.num_envs,
-                generator,
-                generator_state.rng,
-                Self::rules(mode, config),
-                matches,
-                population,
-                solver_shape(config, G::GAME).action_size(),
-            )
-        };
         let solver = SolverRun::resume(out, mode, change, build)?;
         truncate_metrics(
             &out.join(GENERATOR_METRICS),
@@ -379,6 +385,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         self.envs().rules.snapshot_share = schedule.snapshot_share;
         self.envs().rules.scripted_opponent = schedule.scripted_opponent;
         self.envs().rules.limits.reach_runs = schedule.reach_runs;
+        self.envs().rules.draw_knobs = schedule.draw_knobs;
         match self.envs().state.phase {
             Phase::Solver => {
                 let rollout = self

@@ -102,8 +102,10 @@ pub struct MatchRules {
     /// λ is drawn uniformly from these for each match.
     pub aux_values: Vec<f32>,
     /// Each knob of a Generator with knobs (`rewards.knobs`) is drawn uniformly from these for
-    /// each match.
+    /// each match...
     pub knob_values: Vec<f32>,
+    /// ...while this holds; else every knob is 0 (`Finish::knobs_only` before the finish).
+    pub draw_knobs: bool,
     /// The Generator's piece budget and curve offset.
     pub limits: BuildLimits,
     /// Obstacles drawn into each racing match's scene.
@@ -328,7 +330,10 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         let aux = values[rng.random_range(0..values.len())];
         // Drawn only for a Generator with knobs, so that runs without them keep their bytes.
         let knobs = (0..self.rules.rewards.knobs.len())
-            .map(|_| self.rules.knob_values[rng.random_range(0..self.rules.knob_values.len())])
+            .map(|_| match self.rules.draw_knobs {
+                true => self.rules.knob_values[rng.random_range(0..self.rules.knob_values.len())],
+                false => 0.0,
+            })
             .collect();
         let fresh = Match::new(build, vec![aux], seed).with_knobs(knobs);
         // Drawn only when pacing is on, so that runs without it keep their bytes.

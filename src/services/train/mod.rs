@@ -258,7 +258,7 @@ fn solver_run<G: GameSpec>(
     source: solver_envs::SolverMode,
     start: Start,
 ) -> Result<Box<dyn Training>> {
-    let build = |config: &TrainConfig, state: Option<serde_json::Value>| {
+    let build = |config: &TrainConfig, state: Option<serde_json::Value>, _: u64| {
         let record: SourceRecord = match state {
             Some(json) => serde_json::from_value(json).context("level source")?,
             None => SourceRecord::default(),

@@ -77,7 +77,7 @@ impl<E: Resumable> SolverRun<E> {
         out: &Path,
         mode: TrainMode,
         config: TrainConfig,
-        build: impl FnOnce(&TrainConfig, Option<serde_json::Value>) -> Result<E>,
+        build: impl FnOnce(&TrainConfig, Option<serde_json::Value>, u64) -> Result<E>,
     ) -> Result<Self> {
         std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
         fsio::write_atomic(
@@ -92,7 +92,7 @@ impl<E: Resumable> SolverRun<E> {
         )?;
         let policy = ActorCritic::new(solver_shape(&config, E::GAME), config.seed)?;
         let ppo = Ppo::new(config.solver.clone(), policy)?;
-        let envs = build(&config, None)?;
+        let envs = build(&config, None, 0)?;
         let trainer = Trainer::new(ppo, envs, config.seed);
         Ok(Self {
             metrics: open_append(&out.join(METRICS))?,
@@ -116,7 +116,7 @@ impl<E: Resumable> SolverRun<E> {
         out: &Path,
         mode: TrainMode,
         change: ConfigChange,
-        build: impl FnOnce(&TrainConfig, Option<serde_json::Value>) -> Result<E>,
+        build: impl FnOnce(&TrainConfig, Option<serde_json::Value>, u64) -> Result<E>,
     ) -> Result<Self> {
         let path = out.join(CHECKPOINT);
         let (loaded, state) = read_checkpoint(&path, E::GAME, Role::Solver, mode)?;
@@ -163,7 +163,8 @@ impl<E: Resumable> SolverRun<E> {
             fields.remove(UNDER_WAY);
         }
         let replayed = source.get(UNDER_WAY).is_some();
-        let envs = build(&config, Some(source)).with_context(|| format!("{}", path.display()))?;
+        let envs = build(&config, Some(source), state.global_step)
+            .with_context(|| format!("{}", path.display()))?;
         let mut trainer = Trainer::new(ppo, envs, config.seed);
         trainer.norm = loaded.card.normalizer.clone();
         trainer.rng = state.rng;

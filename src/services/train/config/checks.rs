@@ -271,6 +271,12 @@ fn check_generator(g: &GeneratorConfig, game: Game) -> Result<(), String> {
             "curve_offset does not steer the {game} Generator (leave it at {default_offset})"
         ));
     }
+    if g.finish.knobs_only && (g.rewards.knobs.is_empty() || g.finish.solver_steps == 0) {
+        return Err(
+            "finish.knobs_only needs knobs (rewards.knobs) and a finish (finish.solver_steps)"
+                .into(),
+        );
+    }
     if let Some(runs) = g.finish.reach_runs {
         match facts(game).reach_runs {
             None => {

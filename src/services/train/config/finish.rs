@@ -77,6 +77,12 @@ pub struct Finish {
     /// hard levels easy (docs/decisions.md, D22).
     #[serde(default)]
     pub reach_runs: Option<u64>,
+    /// The Generator's style knobs (`generator.rewards.knobs`) are drawn in the finish only:
+    /// before it every knob is 0 (no preference) and pays nothing, so the levels the Solver
+    /// learns from are those of a Generator without knobs, and the knobs cost its validation
+    /// nothing (docs/decisions.md, D20). False: drawn in every match.
+    #[serde(default)]
+    pub knobs_only: bool,
 }
 
 /// The scripted player as the Generator's opponent in a finish ([`Finish::scripted_opponent`]);
@@ -137,6 +143,7 @@ impl Finish {
         own_check_every: None,
         scripted_opponent: None,
         reach_runs: None,
+        knobs_only: false,
     };
 }
 

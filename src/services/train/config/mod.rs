@@ -235,6 +235,7 @@ impl GeneratorConfig {
                 generator_learning_rate: None,
                 scripted_opponent: None,
                 reach_runs: None,
+                draw_knobs: !self.finish.knobs_only,
             },
             None => Schedule {
                 solver_learning_rate: None,
@@ -245,6 +246,7 @@ impl GeneratorConfig {
                 generator_learning_rate: None,
                 scripted_opponent: None,
                 reach_runs: None,
+                draw_knobs: !self.finish.knobs_only,
             },
         }
     }
@@ -267,6 +269,8 @@ pub struct Schedule {
     pub scripted_opponent: Option<ScriptedOpponent>,
     /// The runs the Generator's reach counts (`Finish::reach_runs`; none: all of them).
     pub reach_runs: Option<u64>,
+    /// Whether the Generator's knobs are drawn (`Finish::knobs_only`), else all 0.
+    pub draw_knobs: bool,
 }
 
 impl Default for GeneratorConfig {
@@ -392,6 +396,7 @@ impl TrainConfig {
                 generator_learning_rate: finish.generator_learning_rate,
                 scripted_opponent: finish.scripted_opponent,
                 reach_runs: finish.reach_runs,
+                draw_knobs: true,
             };
         }
         self.generator.schedule_at(solver_steps)

@@ -112,6 +112,14 @@ fn the_platform_finish_follows_the_budget_and_stages_apply_from_their_step() {
         [99, 100].map(|steps| cut.schedule_at(steps).reach_runs),
         [None, Some(4)]
     );
+    // Knobs drawn in the finish only: all 0 before it.
+    let knobs =
+        "steps: 100\ngenerator:\n  rewards: {knobs: [0.1, 0.1]}\n  finish: {knobs_only: true}\n";
+    let knobs = TrainConfig::parse_for(knobs, Game::Platform).unwrap();
+    assert_eq!(
+        [99, 100].map(|steps| knobs.schedule_at(steps).draw_knobs),
+        [false, true]
+    );
 }
 
 #[test]
@@ -146,6 +154,11 @@ fn out_of_range_generator_fields_are_named() {
             "generator:\n  finish: {reach_runs: 4}\n",
             Game::Racing,
             "the racing Generator's pieces are not cut to a reach",
+        ),
+        (
+            "generator:\n  finish: {knobs_only: true}\n",
+            Game::Platform,
+            "finish.knobs_only needs knobs (rewards.knobs)",
         ),
         (
             "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n  - {from_steps: 5, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n",

@@ -122,24 +122,11 @@ fn the_platform_finish_follows_the_budget_and_stages_apply_from_their_step() {
     );
 }
 
+/// The finish's reach and knobs: a count of runs outside the reach measurement's, a reach for
+/// a game whose pieces have none, knobs in the finish of a Generator without knobs.
 #[test]
-fn out_of_range_generator_fields_are_named() {
+fn finish_reach_and_knob_fields_that_cannot_hold_are_named() {
     for (text, game, says) in [
-        (
-            "generator:\n  curve_offset: 200\n",
-            Game::Racing,
-            "in [0, 180]",
-        ),
-        (
-            "generator:\n  curve_offset: .nan\n",
-            Game::Racing,
-            "in [0, 180]",
-        ),
-        (
-            "generator:\n  curve_offset: 90\n",
-            Game::Platform,
-            "does not steer the platform Generator",
-        ),
         (
             "generator:\n  finish: {reach_runs: 0}\n",
             Game::Platform,
@@ -159,6 +146,30 @@ fn out_of_range_generator_fields_are_named() {
             "generator:\n  finish: {knobs_only: true}\n",
             Game::Platform,
             "finish.knobs_only needs knobs (rewards.knobs)",
+        ),
+    ] {
+        let error = TrainConfig::parse_for(text, game).unwrap_err();
+        assert!(error.contains(says), "{text}: {error}");
+    }
+}
+
+#[test]
+fn out_of_range_generator_fields_are_named() {
+    for (text, game, says) in [
+        (
+            "generator:\n  curve_offset: 200\n",
+            Game::Racing,
+            "in [0, 180]",
+        ),
+        (
+            "generator:\n  curve_offset: .nan\n",
+            Game::Racing,
+            "in [0, 180]",
+        ),
+        (
+            "generator:\n  curve_offset: 90\n",
+            Game::Platform,
+            "does not steer the platform Generator",
         ),
         (
             "generator:\n  stages:\n  - {from_steps: 9, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n  - {from_steps: 5, solver_learning_rate: 0, solver_phase_steps: 1, generator_phase_steps: 1}\n",

@@ -106,7 +106,7 @@ pub struct MatchRules {
     pub knob_values: Vec<f32>,
     /// ...while this holds; else every knob is 0 (`Finish::knobs_only` before the finish).
     pub draw_knobs: bool,
-    /// The Generator's piece budget and curve offset.
+    /// The Generator's piece budget, curve offset and reach (the finish's, in the finish).
     pub limits: BuildLimits,
     /// Obstacles drawn into each racing match's scene.
     pub obstacles: u32,

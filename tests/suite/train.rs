@@ -1031,6 +1031,35 @@ fn knobs_drawn_in_the_finish_only_leave_the_run_before_it_unchanged() {
     assert_ne!(before, drawn_before);
 }
 
+/// `generator.hard_success_floor`: a Generator phase before the finish whose hard matches the
+/// Solver succeeds in less often than the floor leaves the next phase with the hard side unpaid.
+/// A tiny Solver never succeeds in every hard match, so at 1 every phase after the first learns
+/// from other rewards than without the floor, while the first one, and a floor of 0 that no
+/// success falls below, keep the bytes of the run without it.
+#[test]
+fn a_hard_success_floor_leaves_the_hard_side_unpaid_after_a_phase_below_it() {
+    let generator_rows = |floor: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let config = tiny_with_finish("solver_steps: 128\ngenerator_phase_steps: 16")
+            .replace("generator:\n", &format!("generator:\n{floor}"));
+        let out = train_tiny_to_640(dir.path(), &config);
+        let rows = without_clock(&out.join("generator-metrics.csv")).unwrap();
+        let step = |row: &String| row.split(',').nth(1).unwrap().parse::<u64>().unwrap();
+        // The rows before the finish (Solver step < 640).
+        rows.into_iter()
+            .skip(1)
+            .filter(|row| step(row) < 640)
+            .collect::<Vec<_>>()
+    };
+    let paid = generator_rows("");
+    let never_below = generator_rows("  hard_success_floor: 0.0\n");
+    let always_below = generator_rows("  hard_success_floor: 1.0\n");
+    assert!(paid.len() >= 3, "{paid:?}");
+    assert_eq!(never_below, paid);
+    assert_eq!(always_below[0], paid[0], "the first phase is paid");
+    assert_ne!(always_below[1..], paid[1..]);
+}
+
 /// `finish.own_check_every`: every so many Generator steps of the finish the pair plays its own
 /// check aside, on seeds of its own, writing its policies as at a pause. A tiny pair never
 /// passes the bars, so its finish learns to its cap in the bytes of the run without the check,

@@ -382,6 +382,10 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         let warmup_steps = config.generator.solver_warmup_steps;
         let in_finish = config.in_finish(steps);
         let finish = config.generator.finish;
+        // Before the finish, the hard side goes unpaid while the Solver is below the floor.
+        let floor = config.generator.hard_success_floor.filter(|_| !in_finish);
+        let unpaid = floor.is_some() && self.envs().state.hard_side_unpaid;
+        self.envs().rules.rewards.hard_side_unpaid = unpaid;
         self.envs().rules.snapshot_share = schedule.snapshot_share;
         self.envs().rules.scripted_opponent = schedule.scripted_opponent;
         self.envs().rules.limits.reach_runs = schedule.reach_runs;
@@ -445,6 +449,12 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                     _ => false,
                 };
                 let envs = self.envs();
+                if floor.is_some() {
+                    envs.add_to_hard_block(&stats);
+                }
+                if unpaid {
+                    message += ", hard side unpaid";
+                }
                 // ...or once the Solver fails enough.
                 let hard_enough = match finish.generator_until_hard_success {
                     Some(target) if in_finish => envs
@@ -458,6 +468,12 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                     if in_finish && !passes && !hard_enough && envs.state.best_check.is_some() {
                         self.restore_best_check()?;
                         message += ", back to the best-checked Generator";
+                    }
+                    // The phase's hard success says whether the next one pays the hard side.
+                    if let Some(floor) = floor
+                        && let Some(success) = self.envs().hard_block_success()
+                    {
+                        self.envs().state.hard_side_unpaid = success < floor;
                     }
                     self.envs().set_phase(Phase::Solver);
                 }

@@ -80,6 +80,11 @@ pub struct AdversarialState {
     /// whose Generator the run keeps as `generator-best-check.safetensors` (none: no check yet).
     #[serde(default)]
     pub best_check: Option<f64>,
+    /// Before the finish: the Solver succeeded in too few of the last Generator phase's hard
+    /// matches (`GeneratorConfig::hard_success_floor`), so this phase leaves the hard side
+    /// unpaid.
+    #[serde(default)]
+    pub hard_side_unpaid: bool,
 }
 
 impl Default for AdversarialState {
@@ -92,6 +97,7 @@ impl Default for AdversarialState {
             hard_block: [0, 0],
             finish_ended_at: None,
             best_check: None,
+            hard_side_unpaid: false,
         }
     }
 }

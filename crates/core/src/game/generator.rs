@@ -75,6 +75,11 @@ pub struct GeneratorRewards {
     /// the Generator has no knobs (it neither observes nor is paid for them).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub knobs: Vec<f32>,
+    /// Set by training while its Solver is below the hard-success floor, never read from a
+    /// file: the terms paid at λ < 0 (the Solver's failure, the piece cost, air time) are paid
+    /// as at λ = 0, that is not at all.
+    #[serde(skip)]
+    pub hard_side_unpaid: bool,
 }
 
 impl Default for GeneratorRewards {
@@ -93,6 +98,7 @@ impl Default for GeneratorRewards {
                 beta: 1.0,
             }],
             knobs: Vec::new(),
+            hard_side_unpaid: false,
         }
     }
 }
@@ -147,7 +153,12 @@ impl GeneratorRewards {
     }
 
     fn weighted(&self, aux: &[f32], term: impl Fn(&AuxWeights, f32) -> f32) -> f32 {
-        self.aux.iter().zip(aux).map(|(w, &l)| term(w, l)).sum()
+        let paid = |l: f32| if self.hard_side_unpaid { l.max(0.0) } else { l };
+        self.aux
+            .iter()
+            .zip(aux)
+            .map(|(w, &l)| term(w, paid(l)))
+            .sum()
     }
 }
 
@@ -660,6 +671,27 @@ mod tests {
             ..GeneratorRewards::default()
         };
         assert_eq!(two.on_failure(&[1.0, -1.0]), -10.0 + 5.0);
+    }
+
+    #[test]
+    fn with_the_hard_side_unpaid_only_the_easy_side_is_paid() {
+        let r = GeneratorRewards {
+            air_step: 0.05,
+            retries: 2,
+            hard_side_unpaid: true,
+            ..GeneratorRewards::default()
+        };
+        assert_eq!(r.on_failure(&[-1.0]), 0.0);
+        assert_eq!(r.on_piece_failure(&[-1.0], 0.5, false), 0.0);
+        assert_eq!(r.on_piece_failure(&[-1.0], 0.5, true), 0.0);
+        assert_eq!(r.per_piece(&[-1.0]), 0.0);
+        assert_eq!(r.per_air_step(&[-1.0]), 0.0);
+        assert_eq!(
+            r.on_failure(&[1.0]),
+            -10.0,
+            "failing an easy level still costs"
+        );
+        assert_eq!(r.on_piece_failure(&[0.5], 0.5, true), -5.0);
     }
 
     #[test]

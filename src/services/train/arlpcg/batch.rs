@@ -64,13 +64,24 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         std::mem::take(&mut self.stats)
     }
 
+    /// Adds the hard matches (λ < 0) of `stats` to the block being counted.
+    pub fn add_to_hard_block(&mut self, stats: &MatchStats) {
+        self.state.hard_block[0] += stats.successes[1];
+        self.state.hard_block[1] += stats.judged[1];
+    }
+
+    /// The Solver's success over the block counted so far (none: it holds no hard match).
+    pub fn hard_block_success(&self) -> Option<f64> {
+        let [successes, judged] = self.state.hard_block;
+        (judged > 0).then(|| f64::from(successes) / f64::from(judged))
+    }
+
     /// Adds the hard matches (λ < 0) of `stats` to the block being counted; once the block
     /// holds `block_size` of them, returns the Solver's success ratio over it and begins a
     /// new one.
     pub fn count_hard_block(&mut self, stats: &MatchStats, block_size: u32) -> Option<f64> {
+        self.add_to_hard_block(stats);
         let block = &mut self.state.hard_block;
-        block[0] += stats.successes[1];
-        block[1] += stats.judged[1];
         if block[1] < block_size {
             return None;
         }

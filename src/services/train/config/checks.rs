@@ -56,6 +56,11 @@ pub(in crate::services::train) fn check_resumable_change(
 
 /// The stages' and the finish's fields.
 fn check_schedule(g: &GeneratorConfig) -> Result<(), String> {
+    if g.hard_success_floor
+        .is_some_and(|r| !(0.0..=1.0).contains(&r))
+    {
+        return Err("hard_success_floor must be a ratio in [0, 1]".into());
+    }
     if g.stages.len() > MAX_STAGES {
         return Err(format!("stages: at most {MAX_STAGES}"));
     }

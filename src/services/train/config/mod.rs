@@ -118,6 +118,16 @@ pub struct GeneratorConfig {
     /// ...and Generator decisions in each Generator phase. The Solver acts about 25 times per
     /// block, so its phase switches about a tenth as often as the Generator's in its own steps.
     pub generator_phase_steps: u64,
+    /// Before the finish: a Generator phase whose hard matches (λ < 0) the Solver succeeds in
+    /// less often than this leaves the next phase with the hard side unpaid (failures, the
+    /// piece cost and air time at λ < 0 pay as at λ = 0, nothing), so the Generator eases its
+    /// hard levels back to where the Solver learns from them before it is paid for beating it
+    /// again (none: always paid, as in the paper). It guards the pre-finish rounds against a
+    /// Generator that at once builds hard levels its young Solver never completes, which then
+    /// learns only the easy ones (a run on the 2026-12-04 candidate, seed 4: hard success
+    /// 0.03 for 8M steps, validation 0.23; docs/trials.md). The finish is always paid.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hard_success_floor: Option<f64>,
     /// While the Generator learns, each match is played by the current Solver or by one of up
     /// to this many earlier snapshots of it, drawn uniformly per match, so that no single
     /// network's blind spot pays (0: the current Solver alone, as in the paper). The snapshots
@@ -298,6 +308,7 @@ impl Default for GeneratorConfig {
             solver_warmup_steps: 500_000,
             solver_phase_steps: 100_000,
             generator_phase_steps: 10_000,
+            hard_success_floor: None,
             population: 4,
             population_every_steps: 500_000,
             snapshot_share: None,

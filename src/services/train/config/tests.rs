@@ -147,6 +147,11 @@ fn finish_reach_and_knob_fields_that_cannot_hold_are_named() {
             Game::Platform,
             "finish.knobs_only needs knobs (rewards.knobs)",
         ),
+        (
+            "generator:\n  hard_success_floor: 1.5\n",
+            Game::Platform,
+            "generator.hard_success_floor must be a ratio in [0, 1]",
+        ),
     ] {
         let error = TrainConfig::parse_for(text, game).unwrap_err();
         assert!(error.contains(says), "{text}: {error}");

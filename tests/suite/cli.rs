@@ -1304,7 +1304,8 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
     let said = String::from_utf8_lossy(&trained.stdout);
     assert!(
         said.contains("own check (2 levels × 2 runs at each end): its Solver succeeds")
-            && said.contains("bars: ≥ 0.95, ≤ 0.7, ≥ 0.95"),
+            && said.contains("bars: ≥ 0.95, ≤ 0.7, ≥ 0.95")
+            && said.contains("on rule levels it succeeds"),
         "{said}"
     );
     // ...and both agents observe the abilities; their cards say over which ranges, and carry
@@ -1319,7 +1320,8 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
         assert!(
             card.contains("own_success_at_+1:")
                 && card.contains("own_success_at_-1:")
-                && card.contains("own_completed_least:"),
+                && card.contains("own_completed_least:")
+                && card.contains("own_success_on_rule_levels:"),
             "{card}"
         );
     }

@@ -328,7 +328,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             &self.solver.out,
             G::GAME,
             self.profile()?.as_ref(),
-            check,
+            (check, false),
             FINISH_CHECK_SEED_BASE,
         )
     }
@@ -599,8 +599,13 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         if check.plays() {
             starting();
         }
-        let Some(control) =
-            own_check::own_control(&out, G::GAME, profile.as_ref(), check, EVAL_SEED_BASE)?
+        let Some(control) = own_check::own_control(
+            &out,
+            G::GAME,
+            profile.as_ref(),
+            (check, true),
+            EVAL_SEED_BASE,
+        )?
         else {
             return Ok(None);
         };

@@ -3,7 +3,10 @@
 //! (success at least [`EASY_BAR`]), makes hard ones hard (at most [`HARD_BAR`]) and builds no
 //! level that none of the runs completes (at least [`COMPLETED_BAR`] of them completed at each
 //! end); a run that misses any says so on its cards (`results`) and in `train`'s last line, so that a seed
-//! whose Generator never learned to make hard levels does not pass for a pair.
+//! whose Generator never learned to make hard levels does not pass for a pair. The finished
+//! run's check also plays its Solver on as many rule levels, and says whether it plays beyond
+//! its own Generator's levels (at least [`RULES_BAR`]): a Solver that learned only those
+//! passes the knob's bars and still plays nothing else.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -12,8 +15,10 @@ use anyhow::Result;
 
 use super::config::OwnCheck;
 use crate::services::eval::generator_levels;
+use crate::services::generation::{self, LevelRequest};
 use crate::services::policies::{load_generator, load_solver};
 use crate::services::verify::{self, Solver};
+use arlpcg_core::game::facts::facts;
 use arlpcg_core::level::Game;
 use arlpcg_core::level::profile::Profile;
 
@@ -29,6 +34,11 @@ pub const COMPLETED_BAR: f64 = 0.95;
 /// at 0.6 showed 0.74 on the levels of its last check; with 0.15 both seeds tried passed
 /// (docs/trials.md).
 pub const FINISH_HARD_MARGIN: f64 = 0.15;
+/// The finished run's Solver's success on rule levels at or above this: it plays beyond its
+/// own Generator's levels. The recipe's Solvers that learned play them at 0.90-0.97; one that
+/// learned only its Generator's levels (the 2026-12-04 floor trial's seed 4, docs/trials.md)
+/// at 0.03.
+pub const RULES_BAR: f64 = 0.80;
 
 /// What the check measured.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,6 +49,9 @@ pub struct OwnControl {
     pub hard: f64,
     /// The smaller of the two ends' shares of levels that at least one run completed.
     pub completed: f64,
+    /// The Solver's mean success on as many rule levels (none: not played; the finish's
+    /// checks, whose Solver is frozen, leave them out).
+    pub rules: Option<f64>,
     /// What was played.
     pub check: OwnCheck,
 }
@@ -66,11 +79,15 @@ impl OwnControl {
 
     /// The figures as a card's `results`.
     pub fn results(&self) -> HashMap<String, f64> {
-        HashMap::from([
+        let mut results = HashMap::from([
             ("own_success_at_+1".to_string(), round3(self.easy)),
             ("own_success_at_-1".to_string(), round3(self.hard)),
             ("own_completed_least".to_string(), round3(self.completed)),
-        ])
+        ]);
+        if let Some(rules) = self.rules {
+            results.insert("own_success_on_rule_levels".to_string(), round3(rules));
+        }
+        results
     }
 
     /// In words, with the verdict.
@@ -80,10 +97,20 @@ impl OwnControl {
         } else {
             "its knob does NOT work"
         };
+        let rules = match self.rules {
+            Some(r) if r >= RULES_BAR => {
+                format!("; on rule levels it succeeds {r:.3}: it plays beyond its own Generator's")
+            }
+            Some(r) => format!(
+                "; on rule levels it succeeds only {r:.3} (bar ≥ {RULES_BAR}): it learned \
+                 its own Generator's levels and little else"
+            ),
+            None => String::new(),
+        };
         format!(
             "own check ({} levels × {} runs at each end): its Solver succeeds {:.3} at λ = +1 \
              and {:.3} at λ = -1, and completes at least {:.3} of the levels at each end: \
-             {verdict} (bars: ≥ {EASY_BAR}, ≤ {HARD_BAR}, ≥ {COMPLETED_BAR})",
+             {verdict} (bars: ≥ {EASY_BAR}, ≤ {HARD_BAR}, ≥ {COMPLETED_BAR}){rules}",
             self.check.levels, self.check.trials, self.easy, self.hard, self.completed
         )
     }
@@ -95,13 +122,14 @@ fn round3(x: f64) -> f64 {
 
 /// Plays the check on the policies of the run folder `out` (its `generator.safetensors` and
 /// `solver.safetensors`), for `profile` (the run's own; none: ours), on levels of the seeds
-/// from `seed_base` (a finished run's: `EVAL_SEED_BASE`). None when `check` plays nothing.
-/// Seeded: the same policies give the same figures on any number of threads.
+/// from `seed_base` (a finished run's: `EVAL_SEED_BASE`), and with `rules` as many rule levels
+/// of those seeds. None when `check` plays nothing. Seeded: the same policies give the same
+/// figures on any number of threads.
 pub fn own_control(
     out: &Path,
     game: Game,
     profile: Option<&Profile>,
-    check: OwnCheck,
+    (check, rules): (OwnCheck, bool),
     seed_base: u64,
 ) -> Result<Option<OwnControl>> {
     if !check.plays() {
@@ -126,12 +154,40 @@ pub fn own_control(
     };
     let (easy, easy_completed) = play(1.0)?;
     let (hard, hard_completed) = play(-1.0)?;
+    let rules = match rules {
+        true => Some(rule_success(&solver, game, profile, check, seed_base)?),
+        false => None,
+    };
     Ok(Some(OwnControl {
         easy,
         hard,
         completed: easy_completed.min(hard_completed),
+        rules,
         check,
     }))
+}
+
+/// The mean success of `solver` on `check.levels` rule levels of the seeds from `seed_base`
+/// for `profile`, `check.trials` runs each (a seed the rules cannot build is skipped).
+fn rule_success(
+    solver: &Solver,
+    game: Game,
+    profile: Option<&Profile>,
+    check: OwnCheck,
+    seed_base: u64,
+) -> Result<f64> {
+    let (mut total, mut played) = (0.0, 0);
+    for seed in seed_base..seed_base + u64::from(check.levels) {
+        let request = LevelRequest::new(seed, None)
+            .obstacles(facts(game).scene_obstacles)
+            .profile(profile.cloned());
+        let Ok(level) = generation::rules_level(game, &request) else {
+            continue;
+        };
+        total += verify::verify(&level, solver, check.trials, seed, &|| {})?.success_ratio;
+        played += 1;
+    }
+    Ok(total / f64::from(played.max(1)))
 }
 
 #[cfg(test)]
@@ -147,6 +203,7 @@ mod tests {
             easy,
             hard,
             completed,
+            rules: None,
             check,
         }
     }
@@ -182,6 +239,33 @@ mod tests {
         assert_eq!(
             control(0.9876, 0.5, 1.0).results()["own_success_at_+1"],
             0.988
+        );
+    }
+
+    #[test]
+    fn the_finished_checks_rule_levels_say_whether_the_solver_plays_beyond_its_generator() {
+        let narrow = OwnControl {
+            rules: Some(0.025),
+            ..control(0.97, 0.55, 1.0)
+        };
+        assert!(narrow.meets(), "the knob's verdict is the knob's alone");
+        let said = narrow.describe();
+        assert!(
+            said.contains("its knob works") && said.contains("only 0.025 (bar ≥ 0.8)"),
+            "{said}"
+        );
+        assert_eq!(narrow.results()["own_success_on_rule_levels"], 0.025);
+        let broad = OwnControl {
+            rules: Some(0.93),
+            ..narrow
+        };
+        assert!(broad.describe().contains("succeeds 0.930: it plays beyond"));
+        let unplayed = control(0.97, 0.55, 1.0);
+        assert!(!unplayed.describe().contains("rule levels"));
+        assert!(
+            !unplayed
+                .results()
+                .contains_key("own_success_on_rule_levels")
         );
     }
 }

@@ -1060,6 +1060,75 @@ fn a_hard_success_floor_leaves_the_hard_side_unpaid_after_a_phase_below_it() {
     assert_ne!(always_below[1..], paid[1..]);
 }
 
+/// `generator.rule_level_share`: some of the Solver's environments play rule levels beside the
+/// Generator's matches. Their episodes under way are part of the checkpoint: a run paused in a
+/// Solver phase or a Generator phase and resumed ends in the bytes of the run never paused;
+/// the share cannot change in a resumed run (it fixes how many matches there are), and one that
+/// would leave the Generator no match is refused by name.
+#[test]
+fn rule_levels_beside_the_matches_resume_to_the_same_bytes_and_keep_their_share() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = TINY_ADVERSARIAL.replace("generator:\n", "generator:\n  rule_level_share: 0.5\n");
+    let path = dir.path().join("variant.yaml");
+    std::fs::write(&path, &config).unwrap();
+    let train = |name: &str, pause_at: Option<&str>| {
+        let out = dir.path().join(name);
+        let start = words(
+            "train --mode arlpcg --steps 640 --config {} --out {}",
+            &[&path, &out],
+        );
+        match pause_at {
+            None => arlpcg_ok(start),
+            Some(at) => {
+                arlpcg_ok(start.into_iter().chain(["--pause-at".into(), at.into()]));
+                arlpcg_ok(words("train --resume --out {}", &[&out]))
+            }
+        };
+        out
+    };
+    let whole = train("whole", None);
+    let plain = dir.path().join("plain");
+    let tiny = dir.path().join("tiny.yaml");
+    std::fs::write(&tiny, TINY_ADVERSARIAL).unwrap();
+    arlpcg_ok(words(
+        "train --mode arlpcg --steps 640 --config {} --out {}",
+        &[&tiny, &plain],
+    ));
+    assert_ne!(
+        without_clock(&whole.join("metrics.csv")),
+        without_clock(&plain.join("metrics.csv"))
+    );
+    // Paused after the warm-up's first Solver iterations and inside a Generator phase.
+    for at in ["300", "400"] {
+        let paused = train(&format!("paused-{at}"), Some(at));
+        assert_same_training(&whole, &paused, &[SOLVER, GENERATOR]);
+    }
+    let changed = arlpcg(words(
+        "train --resume --steps 700 --config {} --out {}",
+        &[&tiny, &whole],
+    ));
+    fails_with(
+        &changed,
+        1,
+        "generator.rule_level_share cannot change in a resumed run",
+    );
+    let every = dir.path().join("every.yaml");
+    std::fs::write(
+        &every,
+        TINY_ADVERSARIAL.replace("generator:\n", "generator:\n  rule_level_share: 0.9\n"),
+    )
+    .unwrap();
+    let refused = arlpcg(words(
+        "train --mode arlpcg --config {} --out {}",
+        &[&every, &dir.path().join("every")],
+    ));
+    fails_with(
+        &refused,
+        1,
+        "generator.rule_level_share must be a share in [0, 1)",
+    );
+}
+
 /// `finish.own_check_every`: every so many Generator steps of the finish the pair plays its own
 /// check aside, on seeds of its own, writing its policies as at a pause. A tiny pair never
 /// passes the bars, so its finish learns to its cap in the bytes of the run without the check,

@@ -15,6 +15,7 @@ use super::metrics::{
 };
 use super::own_check;
 use super::population::{PopulationRecord, Snapshot, population_from, population_record};
+use super::solver_envs::{SolverEnvs, SolverMode, SourceRecord};
 use super::solver_run::SolverRun;
 use super::{
     BEST_CHECK_GENERATOR, CHECKPOINT, ConfigChange, GENERATOR_CHECKPOINT, GENERATOR_METRICS,
@@ -92,15 +93,16 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 norm: RunningNorm::new(generator_shape(config, G::GAME).observation),
             };
             let rng = ChaCha8Rng::seed_from_u64(config.seed.wrapping_add(1));
-            AdversarialEnvs::new(
-                config.solver.num_envs,
+            let envs = AdversarialEnvs::new(
+                config.solver.num_envs - config.rule_level_envs(),
                 generator,
                 rng,
                 Self::rules(mode, config, 0),
                 AdversarialRecord::default(),
                 Vec::new(),
                 solver_shape(config, G::GAME).action_size(),
-            )
+            )?;
+            Ok(envs.with_rule_levels(rule_levels::<G>(config, SourceRecord::default())?))
         };
         let solver = SolverRun::start(out, mode, config, build)?;
         fsio::write_atomic(
@@ -146,8 +148,13 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                         config.generator.curve_offset
                     );
                 }
-                let matches: AdversarialRecord =
+                let mut matches: AdversarialRecord =
                     serde_json::from_value(source.unwrap_or_default()).context("match source")?;
+                // Episodes under way on rule levels go on only beside the matches under way.
+                let mut rule_record = matches.rule_levels.take().unwrap_or_default();
+                if matches.under_way.is_none() {
+                    rule_record.under_way.clear();
+                }
                 let mut population =
                     population_from(&record, &loaded.tensors, &solver_shape(config, G::GAME))
                         .map_err(|e| anyhow::anyhow!("{}: population: {e}", path.display()))?;
@@ -164,15 +171,16 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                     norm: loaded.card.normalizer.clone(),
                 };
                 // The matches under way are replayed (none if the rules changed: fresh ones start).
-                AdversarialEnvs::new(
-                    config.solver.num_envs,
+                let envs = AdversarialEnvs::new(
+                    config.solver.num_envs - config.rule_level_envs(),
                     generator,
                     generator_state.rng,
                     Self::rules(mode, config, solver_steps),
                     matches,
                     population,
                     solver_shape(config, G::GAME).action_size(),
-                )
+                )?;
+                Ok(envs.with_rule_levels(rule_levels::<G>(config, rule_record)?))
             };
         let solver = SolverRun::resume(out, mode, change, build)?;
         truncate_metrics(
@@ -618,4 +626,24 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         self.save_policies(began)?;
         Ok(Some(control.describe()))
     }
+}
+
+/// The Solver's environments on rule levels of an adversarial run, from `record` (none when
+/// the configuration gives the rule levels no share).
+fn rule_levels<G: GeneratorGame>(
+    config: &TrainConfig,
+    record: SourceRecord,
+) -> Result<Option<SolverEnvs<G>>> {
+    let count = config.rule_level_envs();
+    if count == 0 {
+        return Ok(None);
+    }
+    let trained_over = config
+        .trained_over(G::GAME)
+        .map_err(|problem| anyhow::anyhow!("configuration: {problem}"))?;
+    let player = (config.player(G::GAME), trained_over);
+    let action_size = solver_shape(config, G::GAME).action_size();
+    SolverEnvs::new(SolverMode::RulePcg, count, record, action_size, player)
+        .map(Some)
+        .map_err(|problem| anyhow::anyhow!("rule levels: {problem}"))
 }

@@ -27,6 +27,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::services::train::config::ScriptedOpponent;
 use crate::services::train::population::Snapshot;
+use crate::services::train::solver_envs::SolverEnvs;
 use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, GeneratorRewards, Match, MatchPacing, TrackBuild,
 };
@@ -208,6 +209,10 @@ pub struct AdversarialEnvs<G: GeneratorGame> {
     /// Per match, the scripted player (and its skill) that plays it while the Generator
     /// learns, if one does.
     scripted: Vec<Option<ScriptedPlayer<G>>>,
+    /// The Solver's environments on rule levels, after the matches
+    /// ([`GeneratorConfig::rule_level_share`](super::GeneratorConfig::rule_level_share)):
+    /// they step while the Solver learns and wait while the Generator does.
+    rule_levels: Option<SolverEnvs<G>>,
 }
 
 impl<G: GeneratorGame> AdversarialEnvs<G> {
@@ -236,6 +241,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             population,
             opponents: Vec::with_capacity(num_matches),
             scripted: Vec::with_capacity(num_matches),
+            rule_levels: None,
         };
         if let Some(under_way) = record.under_way {
             this.replay(num_matches, under_way, solver_action_size)
@@ -254,6 +260,12 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         }
         this.first_pieces((0..num_matches).collect())?;
         Ok(this)
+    }
+
+    /// The same environments with `rule_levels` after the matches (none: matches only).
+    pub fn with_rule_levels(mut self, rule_levels: Option<SolverEnvs<G>>) -> Self {
+        self.rule_levels = rule_levels;
+        self
     }
 
     /// Lets the Generator place the first piece of the fresh matches `indices`; a match whose
@@ -461,7 +473,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
 
 impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
     fn num_envs(&self) -> usize {
-        self.matches.len()
+        self.matches.len() + self.rule_levels.as_ref().map_or(0, VecEnv::num_envs)
     }
 
     fn observation_size(&self) -> usize {
@@ -469,12 +481,16 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
     }
 
     fn observe(&mut self, out: &mut [f32]) {
+        let (matches, rule_levels) = out.split_at_mut(self.matches.len() * self.observation_size());
         self.matches
             .par_iter()
-            .zip(out.par_chunks_mut(self.observation_size()))
+            .zip(matches.par_chunks_mut(self.observation_size()))
             .for_each(|(game, row)| {
                 observe_solver::<G>(game.env(), game.build().player().abilities.as_ref(), row)
             });
+        if let Some(envs) = &mut self.rule_levels {
+            envs.observe(rule_levels);
+        }
     }
 
     fn step(&mut self, actions: &[f32], out: &mut [Transition]) {
@@ -492,6 +508,10 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
                 (None, Some(_)) => Seat::Scripted,
                 (None, None) => Seat::Learner,
             })
+            .chain(std::iter::repeat_n(
+                Seat::Learner,
+                self.rule_levels.as_ref().map_or(0, VecEnv::num_envs),
+            ))
             .collect();
         if !self.learning() || seats.iter().all(|&s| s == Seat::Learner) {
             return None;
@@ -508,9 +528,15 @@ impl<G: GeneratorGame> VecEnv for AdversarialEnvs<G> {
     }
 
     fn step_timed(&mut self, actions: &[f32], out: &mut [Transition], clock: Clock) -> InnerTime {
-        let width = actions.len() / self.matches.len();
-        let rewards = &self.rules.rewards;
+        let width = actions.len() / self.num_envs();
         let learning = self.learning();
+        let (actions, rule_actions) = actions.split_at(self.matches.len() * width);
+        let (out, rule_out) = out.split_at_mut(self.matches.len());
+        // The rule levels wait while the Generator learns (their rows then go unread).
+        if let Some(envs) = self.rule_levels.as_mut().filter(|_| !learning) {
+            envs.step(rule_actions, rule_out);
+        }
+        let rewards = &self.rules.rewards;
         let steps: Vec<(arlpcg_core::game::Step, f32)> = self
             .matches
             .par_iter_mut()

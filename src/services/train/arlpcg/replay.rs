@@ -6,6 +6,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::{AdversarialEnvs, AdversarialState, Decision, MatchStats, ScriptedPlayer};
+use crate::services::train::solver_envs::{SolverEnvs, SourceRecord};
 use arlpcg_core::game::generator::{GeneratorGame, GeneratorRewards, Match};
 use arlpcg_core::game::{Scripted, SolverEnv};
 use arlpcg_core::level::stats::Skill;
@@ -58,6 +59,9 @@ pub struct AdversarialRecord {
     /// The matches under way, if the checkpoint holds them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub under_way: Option<MatchesUnderWay>,
+    /// The rule levels' source and episodes under way (none: the run has no rule levels).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rule_levels: Option<SourceRecord>,
 }
 
 impl<G: GeneratorGame> AdversarialEnvs<G> {
@@ -80,6 +84,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
                 recorded: self.recorded.clone(),
                 stats: self.stats.clone(),
             }),
+            rule_levels: self.rule_levels.as_ref().map(SolverEnvs::record),
         }
     }
 

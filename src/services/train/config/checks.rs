@@ -45,6 +45,10 @@ pub(in crate::services::train) fn check_resumable_change(
         ("profile", old.profile == new.profile),
         ("ability_spread", old.ability_spread == new.ability_spread),
         ("ability_ranges", old.ability_ranges == new.ability_ranges),
+        (
+            "generator.rule_level_share",
+            old.rule_level_envs() == new.rule_level_envs(),
+        ),
     ];
     match fixed.iter().find(|(_, same)| !same) {
         Some((name, _)) => Err(format!(
@@ -197,6 +201,14 @@ pub(in crate::services::train) fn check_config(
         ("generator.ppo", &config.generator.ppo),
     ] {
         p.check().map_err(|problem| format!("{name}.{problem}"))?;
+    }
+    let share = config.generator.rule_level_share;
+    if !(0.0..1.0).contains(&share) || config.rule_level_envs() >= config.solver.num_envs {
+        return Err(format!(
+            "generator.rule_level_share must be a share in [0, 1) that leaves at least one of \
+             the {} environments (solver.num_envs) to the Generator's matches",
+            config.solver.num_envs
+        ));
     }
     check_generator(&config.generator, game).map_err(|problem| format!("generator.{problem}"))
 }

@@ -69,10 +69,6 @@ pub struct TrainConfig {
     pub ability_ranges: BTreeMap<String, [f64; 2]>,
 }
 
-fn is_zero(x: &f64) -> bool {
-    *x == 0.0
-}
-
 /// The values each style knob of a match is drawn from by default (`knob_values`).
 pub const DEFAULT_KNOB_VALUES: [f32; 5] = [-1.0, -0.5, 0.0, 0.5, 1.0];
 
@@ -128,6 +124,14 @@ pub struct GeneratorConfig {
     /// 0.03 for 8M steps, validation 0.23; docs/trials.md). The finish is always paid.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hard_success_floor: Option<f64>,
+    /// The share of the Solver's environments (`solver.num_envs`, rounded) that play rule
+    /// levels, as `rule-pcg` does, instead of the Generator's matches; they play while the
+    /// Solver learns and wait while the Generator does (0: every environment is a match, as
+    /// in the paper). A Solver that learns only its own Generator's levels may learn them and
+    /// nothing else (the 2026-12-04 floor trial's seed 4: its own levels 0.93, rule levels
+    /// 0.03; docs/trials.md); rule levels keep it playing levels of every kind.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub rule_level_share: f64,
     /// While the Generator learns, each match is played by the current Solver or by one of up
     /// to this many earlier snapshots of it, drawn uniformly per match, so that no single
     /// network's blind spot pays (0: the current Solver alone, as in the paper). The snapshots
@@ -309,6 +313,7 @@ impl Default for GeneratorConfig {
             solver_phase_steps: 100_000,
             generator_phase_steps: 10_000,
             hard_success_floor: None,
+            rule_level_share: 0.0,
             population: 4,
             population_every_steps: 500_000,
             snapshot_share: None,
@@ -380,6 +385,12 @@ impl TrainConfig {
             .as_ref()
             .and_then(|record| record.profile(game).ok());
         crate::services::generation::player_for(profile.as_ref())
+    }
+
+    /// How many of the Solver's environments play rule levels in an adversarial run
+    /// ([`GeneratorConfig::rule_level_share`]); the rest are the Generator's matches.
+    pub fn rule_level_envs(&self) -> usize {
+        (self.solver.num_envs as f64 * self.generator.rule_level_share).round() as usize
     }
 
     /// An adversarial run's budget in Solver steps: `steps`, then the finish's.
@@ -467,6 +478,10 @@ fn rename_aliases(given: &mut serde_yaml::Value) {
             rename(generator, "max_blocks", "max_pieces");
         }
     }
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// `given` laid over `defaults`: mappings merge key by key (recursively), anything else given

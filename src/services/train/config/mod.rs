@@ -118,10 +118,11 @@ pub struct GeneratorConfig {
     /// less often than this leaves the next phase with the hard side unpaid (failures, the
     /// piece cost and air time at λ < 0 pay as at λ = 0, nothing), so the Generator eases its
     /// hard levels back to where the Solver learns from them before it is paid for beating it
-    /// again (none: always paid, as in the paper). It guards the pre-finish rounds against a
-    /// Generator that at once builds hard levels its young Solver never completes, which then
-    /// learns only the easy ones (a run on the 2026-12-04 candidate, seed 4: hard success
-    /// 0.03 for 8M steps, validation 0.23; docs/trials.md). The finish is always paid.
+    /// again (none: always paid, as in the paper). It was made for a Generator that at once
+    /// builds hard levels its young Solver never completes (the 2026-12-04 candidate's seed 4:
+    /// hard success 0.03 for 8M steps, validation 0.23); there it held the hard side at the
+    /// floor, but the Solver still learned only its Generator's levels, which
+    /// `rule_level_share` fixes (docs/trials.md). The finish is always paid.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hard_success_floor: Option<f64>,
     /// The share of the Solver's environments (`solver.num_envs`, rounded) that play rule

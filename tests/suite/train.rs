@@ -861,6 +861,29 @@ fn train_tiny_to_640(dir: &Path, config: &str) -> std::path::PathBuf {
     out
 }
 
+/// An arlpcg run of the configuration file `config` to 640 Solver steps and its finish, in
+/// `out`; with `pause_at`, paused there, looked at by `paused`, and resumed to its end.
+fn train_640_resumed(
+    out: &Path,
+    config: &Path,
+    pause_at: Option<&str>,
+    paused: impl Fn(&Path),
+) -> PathBuf {
+    let start = words(
+        "train --mode arlpcg --steps 640 --config {} --out {}",
+        &[&config, &out],
+    );
+    match pause_at {
+        None => arlpcg_ok(start),
+        Some(at) => {
+            arlpcg_ok(start.into_iter().chain(["--pause-at".into(), at.into()]));
+            paused(out);
+            arlpcg_ok(words("train --resume --out {}", &[&out]))
+        }
+    };
+    out.to_path_buf()
+}
+
 /// A finish in which the Solver learns: it opens with the Generator's phase even when the
 /// budget ends inside a Solver phase, and its Solver phase (here longer than what is left)
 /// learns at the finish's constant rate to the end, against the Generator frozen.
@@ -968,22 +991,11 @@ fn a_finish_with_its_own_reach_writes_it_on_the_card_and_resumes_to_the_same_byt
     let path = dir.path().join("variant.yaml");
     std::fs::write(&path, &config).unwrap();
     let train = |name: &str, pause_at: Option<&str>| {
-        let out = dir.path().join(name);
-        let start = words(
-            "train --mode arlpcg --steps 640 --config {} --out {}",
-            &[&path, &out],
-        );
-        match pause_at {
-            None => arlpcg_ok(start),
-            Some(at) => {
-                arlpcg_ok(start.into_iter().chain(["--pause-at".into(), at.into()]));
-                let card = std::fs::read_to_string(out.join("generator.yaml")).unwrap();
-                let paused_in_finish = curve(&out).last().unwrap().1 >= 640;
-                assert_eq!(card.contains("reach_runs: 1\n"), paused_in_finish, "{card}");
-                arlpcg_ok(words("train --resume --out {}", &[&out]))
-            }
-        };
-        out
+        train_640_resumed(&dir.path().join(name), &path, pause_at, |out| {
+            let card = std::fs::read_to_string(out.join("generator.yaml")).unwrap();
+            let paused_in_finish = curve(out).last().unwrap().1 >= 640;
+            assert_eq!(card.contains("reach_runs: 1\n"), paused_in_finish, "{card}");
+        })
     };
     let whole = train("whole", None);
     let card = std::fs::read_to_string(whole.join("generator.yaml")).unwrap();
@@ -1072,19 +1084,7 @@ fn rule_levels_beside_the_matches_resume_to_the_same_bytes_and_keep_their_share(
     let path = dir.path().join("variant.yaml");
     std::fs::write(&path, &config).unwrap();
     let train = |name: &str, pause_at: Option<&str>| {
-        let out = dir.path().join(name);
-        let start = words(
-            "train --mode arlpcg --steps 640 --config {} --out {}",
-            &[&path, &out],
-        );
-        match pause_at {
-            None => arlpcg_ok(start),
-            Some(at) => {
-                arlpcg_ok(start.into_iter().chain(["--pause-at".into(), at.into()]));
-                arlpcg_ok(words("train --resume --out {}", &[&out]))
-            }
-        };
-        out
+        train_640_resumed(&dir.path().join(name), &path, pause_at, |_| {})
     };
     let whole = train("whole", None);
     let plain = dir.path().join("plain");

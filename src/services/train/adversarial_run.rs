@@ -634,16 +634,10 @@ fn rule_levels<G: GeneratorGame>(
     config: &TrainConfig,
     record: SourceRecord,
 ) -> Result<Option<SolverEnvs<G>>> {
-    let count = config.rule_level_envs();
-    if count == 0 {
-        return Ok(None);
+    match config.rule_level_envs() {
+        0 => Ok(None),
+        count => super::solver_envs(config, SolverMode::RulePcg, count, record)
+            .map(Some)
+            .context("rule levels"),
     }
-    let trained_over = config
-        .trained_over(G::GAME)
-        .map_err(|problem| anyhow::anyhow!("configuration: {problem}"))?;
-    let player = (config.player(G::GAME), trained_over);
-    let action_size = solver_shape(config, G::GAME).action_size();
-    SolverEnvs::new(SolverMode::RulePcg, count, record, action_size, player)
-        .map(Some)
-        .map_err(|problem| anyhow::anyhow!("rule levels: {problem}"))
 }

@@ -263,18 +263,29 @@ fn solver_run<G: GameSpec>(
             Some(json) => serde_json::from_value(json).context("level source")?,
             None => SourceRecord::default(),
         };
-        let action_size = solver_shape(config, G::GAME).action_size();
-        let trained_over = config
-            .trained_over(G::GAME)
-            .map_err(|problem| anyhow::anyhow!("configuration: {problem}"))?;
-        let player = (config.player(G::GAME), trained_over);
-        SolverEnvs::<G>::new(source, config.solver.num_envs, record, action_size, player)
-            .map_err(|problem| anyhow::anyhow!("level source: {problem}"))
+        solver_envs::<G>(config, source, config.solver.num_envs, record)
     };
     Ok(Box::new(match start {
         Start::New(config) => SolverRun::start(out, mode, config, build)?,
         Start::Resume(change) => SolverRun::resume(out, mode, change, build)?,
     }))
+}
+
+/// `count` Solver environments of game `G` on levels from `source`, for the player and
+/// ability ranges of `config`, continuing from `record` (its episodes under way replayed).
+pub(super) fn solver_envs<G: GameSpec>(
+    config: &TrainConfig,
+    source: solver_envs::SolverMode,
+    count: usize,
+    record: SourceRecord,
+) -> Result<SolverEnvs<G>> {
+    let action_size = solver_shape(config, G::GAME).action_size();
+    let trained_over = config
+        .trained_over(G::GAME)
+        .map_err(|problem| anyhow::anyhow!("configuration: {problem}"))?;
+    let player = (config.player(G::GAME), trained_over);
+    SolverEnvs::<G>::new(source, count, record, action_size, player)
+        .map_err(|problem| anyhow::anyhow!("level source: {problem}"))
 }
 
 /// What the training loop drives: one iteration at a time, checkpoints, the final policies.

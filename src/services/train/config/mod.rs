@@ -69,6 +69,10 @@ pub struct TrainConfig {
     pub ability_ranges: BTreeMap<String, [f64; 2]>,
 }
 
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
 /// The values each style knob of a match is drawn from by default (`knob_values`).
 pub const DEFAULT_KNOB_VALUES: [f32; 5] = [-1.0, -0.5, 0.0, 0.5, 1.0];
 
@@ -479,10 +483,6 @@ fn rename_aliases(given: &mut serde_yaml::Value) {
             rename(generator, "max_blocks", "max_pieces");
         }
     }
-}
-
-fn is_zero(x: &f64) -> bool {
-    *x == 0.0
 }
 
 /// `given` laid over `defaults`: mappings merge key by key (recursively), anything else given

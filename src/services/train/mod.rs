@@ -16,6 +16,7 @@ mod adversarial_run;
 pub mod arlpcg;
 mod cards;
 mod config;
+mod finish_checks;
 mod metrics;
 pub mod own_check;
 pub mod population;

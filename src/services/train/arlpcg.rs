@@ -44,7 +44,7 @@ use arlpcg_core::seed_ranges::TRAINING_SEED_BASE;
 mod batch;
 mod replay;
 mod state;
-pub use replay::{AdversarialRecord, MatchEvent, MatchLog, MatchesUnderWay};
+pub use replay::{AdversarialRecord, MadeUnder, MatchEvent, MatchLog, MatchesUnderWay};
 pub use state::{AdversarialState, MatchStats, Phase};
 
 /// The scripted player of a match, with its skill.
@@ -167,10 +167,8 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         }
         for _ in 0..num_matches {
             let (fresh, opponent, scripted) = this.next_match();
-            this.logs.push(MatchLog {
-                seed: fresh.seed(),
-                events: Vec::new(),
-            });
+            this.logs
+                .push(MatchLog::new(fresh.seed(), this.made_under()));
             this.matches.push(fresh);
             this.opponents.push(opponent);
             this.scripted.push(scripted);
@@ -232,7 +230,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
     fn next_match(&mut self) -> (Match<G>, Option<usize>, Option<ScriptedPlayer<G>>) {
         let seed = TRAINING_SEED_BASE + self.state.episodes_started;
         self.state.episodes_started += 1;
-        let (fresh, mut rng) = self.match_of(seed);
+        let (fresh, mut rng) = self.match_of(seed, self.made_under());
         let snapshots = self.population.len();
         let opponent = match (snapshots, self.rules.snapshot_share) {
             (0, _) => None,
@@ -253,10 +251,19 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         (fresh, opponent, scripted)
     }
 
-    /// The match of `seed` before its first piece (its build and λ drawn from the seed), and
-    /// the seed's generator, to draw on from.
-    fn match_of(&self, seed: u64) -> (Match<G>, ChaCha8Rng) {
+    /// The rules a match made now follows that change with the schedule.
+    fn made_under(&self) -> MadeUnder {
+        MadeUnder {
+            reach_runs: self.rules.limits.reach_runs,
+            draw_knobs: self.rules.draw_knobs,
+        }
+    }
+
+    /// The match of `seed` made `under` those rules, before its first piece (its build and λ
+    /// drawn from the seed), and the seed's generator, to draw on from.
+    fn match_of(&self, seed: u64, under: MadeUnder) -> (Match<G>, ChaCha8Rng) {
         let mut limits = self.rules.limits;
+        limits.reach_runs = under.reach_runs;
         limits.player = limits
             .player
             .drawn(G::GAME, self.rules.trained_over.as_ref(), seed);
@@ -265,7 +272,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         let aux = values[rng.random_range(0..values.len())];
         // Drawn only for a Generator with knobs, so that runs without them keep their bytes.
         let knobs = (0..self.rules.rewards.knobs.len())
-            .map(|_| match self.rules.draw_knobs {
+            .map(|_| match under.draw_knobs {
                 true => self.rules.knob_values[rng.random_range(0..self.rules.knob_values.len())],
                 false => 0.0,
             })
@@ -378,10 +385,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             last.ended = true;
         }
         let (fresh, opponent, scripted) = self.next_match();
-        self.logs[i] = MatchLog {
-            seed: fresh.seed(),
-            events: Vec::new(),
-        };
+        self.logs[i] = MatchLog::new(fresh.seed(), self.made_under());
         self.matches[i] = fresh;
         self.opponents[i] = opponent;
         self.scripted[i] = scripted;

@@ -16,8 +16,33 @@ use arlpcg_core::level::stats::Skill;
 pub struct MatchLog {
     /// The seed the match was made from.
     pub seed: u64,
+    /// The schedule's rules it was made under, which a replay follows whatever the rules at
+    /// the resumed step (none: a checkpoint from before they were kept, replayed under those).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub made_under: Option<MadeUnder>,
     /// What happened, in order.
     pub events: Vec<MatchEvent>,
+}
+
+impl MatchLog {
+    /// The log of a match of `seed` made `under` those rules, before anything happened.
+    pub fn new(seed: u64, under: MadeUnder) -> Self {
+        Self {
+            seed,
+            made_under: Some(under),
+            events: Vec::new(),
+        }
+    }
+}
+
+/// The rules of a match that change with the schedule: a match made before the finish keeps
+/// them into it, so a checkpoint taken there must replay it under them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MadeUnder {
+    /// The runs the Generator's reach counts (`Finish::reach_runs`; none: all of them).
+    pub reach_runs: Option<u64>,
+    /// Whether the match's knobs were drawn (else all 0).
+    pub draw_knobs: bool,
 }
 
 /// One thing that happened in a match, as the action row that made it happen.
@@ -167,7 +192,8 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         solver_width: usize,
         rewards: &GeneratorRewards,
     ) -> Result<(Match<G>, Option<ScriptedPlayer<G>>), String> {
-        let (mut game, _) = self.match_of(log.seed);
+        let under = log.made_under.unwrap_or_else(|| self.made_under());
+        let (mut game, _) = self.match_of(log.seed, under);
         let fits =
             |row: &[f32], width: usize| row.len() == width && row.iter().all(|v| v.is_finite());
         for event in &log.events {
@@ -203,5 +229,75 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             }
         }
         Ok((game, player))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::services::train::TrainConfig;
+    use crate::services::train::adversarial_run::AdversarialRun;
+    use crate::services::train::arlpcg::{Generator, MatchRules};
+    use crate::services::train::cards::{generator_shape, solver_shape};
+    use arlpcg_core::game::platform::PlatformGame;
+    use arlpcg_core::level::Game;
+    use arlpcg_core::rl::checkpoint::TrainMode;
+    use arlpcg_core::rl::normalizer::RunningNorm;
+    use arlpcg_core::rl::policy::ActorCritic;
+    use arlpcg_core::rl::ppo::Ppo;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    /// A match made before the finish and under way in a checkpoint taken in it replays as it
+    /// was made: knobs 0 and the cut of before, not the finish's knobs (1) and reach.
+    #[test]
+    fn a_match_replays_under_the_rules_it_was_made_under() {
+        let mut config = TrainConfig::for_game(Game::Platform);
+        config.hidden = vec![16, 16];
+        config.ability_ranges.clear();
+        config.generator.knob_values = Some(vec![1.0]);
+        config.generator.rewards.knobs = vec![1.0, 1.0];
+        config.generator.finish.knobs_only = true;
+        config.generator.finish.reach_runs = Some(1);
+        let shape = generator_shape(&config, Game::Platform);
+        let solver_actions = solver_shape(&config, Game::Platform).action_size();
+        let envs = |rules: MatchRules, record: AdversarialRecord| {
+            let policy = ActorCritic::new(shape.clone(), 1).unwrap();
+            policy.set_log_std(0.5).unwrap();
+            let generator = Generator {
+                ppo: Ppo::new(config.generator.ppo.clone(), policy).unwrap(),
+                norm: RunningNorm::new(shape.observation),
+            };
+            let rng = ChaCha8Rng::seed_from_u64(1);
+            AdversarialEnvs::<PlatformGame>::new(
+                8,
+                generator,
+                rng,
+                rules,
+                record,
+                Vec::new(),
+                solver_actions,
+            )
+            .unwrap()
+        };
+        let rules_at =
+            |step| AdversarialRun::<PlatformGame>::rules(TrainMode::Arlpcg, &config, step);
+        let before = envs(rules_at(0), AdversarialRecord::default());
+        let finish = rules_at(config.steps);
+        assert!(finish.draw_knobs && finish.limits.reach_runs == Some(1));
+        let replayed = envs(finish, before.record());
+        // What the Generator sees of each match: its pieces so far, λ and the knobs.
+        let made = |envs: &AdversarialEnvs<PlatformGame>| -> Vec<Vec<f32>> {
+            envs.matches
+                .iter()
+                .map(|m| {
+                    let mut seen = vec![0.0; shape.observation];
+                    m.observe_generator(&mut seen);
+                    seen
+                })
+                .collect()
+        };
+        assert!(before.matches.iter().all(|m| m.knobs == [0.0, 0.0]));
+        assert_eq!(made(&replayed), made(&before));
     }
 }

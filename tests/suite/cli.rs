@@ -833,7 +833,7 @@ fn generate_verify_eases_a_seed_that_no_run_completes_up_to_lambda_one() {
     let config = dir.path().join("tiny.yaml");
     std::fs::write(
         &config,
-        "seed: 3\nhidden: [16, 16]\nppo:\n  num_envs: 4\n  num_steps: 32\n",
+        "seed: 3\nhidden: [16, 16]\nability_ranges: null\nppo:\n  num_envs: 4\n  num_steps: 32\n",
     )
     .unwrap();
     let run = dir.path().join("run");
@@ -1232,11 +1232,12 @@ fn a_solver_trained_for_a_profile_records_it_and_keeps_it() {
     let low_path = path("low.yaml");
     write_platform_profile(&low_path, "low-jumper", "7.5");
     // Its configuration and card record the profile, a resume keeps it, and it plays under the
-    // low jumper's abilities without a word of warning.
+    // low jumper's abilities without a word of warning. One character (`--ability-spread 0`
+    // turns off the platform recipe's ranges).
     let run = path("run");
     let train = |extra: &[&str]| {
         let mut args = vec![
-            "train", "--mode", "rule-pcg", "--threads", "1", "--out", &run,
+            "train", "--mode", "rule-pcg", "--threads", "1", "--ability-spread", "0", "--out", &run,
         ];
         args.extend_from_slice(extra);
         arlpcg(&args)

@@ -16,6 +16,7 @@ use crate::common::{arlpcg, arlpcg_ok, fails_with, stderr, words};
 const TINY: &str = "\
 seed: 3
 hidden: [16, 16]
+ability_ranges: null
 checkpoint_minutes: 0.0
 ppo:
   num_envs: 4
@@ -518,6 +519,7 @@ fn stopped_by(signal: &str) {
 const TINY_ADVERSARIAL: &str = "\
 seed: 5
 hidden: [16, 16]
+ability_ranges: null
 checkpoint_minutes: 0.0
 solver:
   num_envs: 4
@@ -977,7 +979,7 @@ fn a_finish_generator_phase_until_a_success_ends_early() {
 /// of the eight runs, and its card says so, so `generate` cuts its levels the same way; the
 /// Solver's card and the Generator's before the finish name no reach. A run with it and with
 /// knobs drawn in the finish only, paused before the finish or where it begins, resumes to the
-/// bytes of the run never paused: the matches it replays follow the finish's rules.
+/// bytes of the run never paused: the matches it replays follow the rules they were made under.
 #[test]
 fn a_finish_with_its_own_reach_writes_it_on_the_card_and_resumes_to_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();

@@ -165,6 +165,7 @@ pub fn open(
         }
         if let Some(spread) = ability_spread {
             config.ability_spread = spread;
+            config.ability_ranges.clear();
         }
         Start::New(config)
     };
@@ -234,6 +235,7 @@ impl ConfigChange {
         }
         if let Some(spread) = self.ability_spread {
             new.ability_spread = spread;
+            new.ability_ranges.clear();
         }
         new
     }

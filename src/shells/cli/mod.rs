@@ -323,7 +323,8 @@ pub struct TrainArgs {
     /// record it. A resumed run keeps its own.
     #[arg(long, value_name = "FILE")]
     pub profile: Option<PathBuf>,
-    /// Train ability-aware agents, in place of the configuration's `ability_spread`: each
+    /// Train ability-aware agents, in place of the configuration's `ability_spread` and
+    /// `ability_ranges` (platform's recipe sets ranges): each
     /// episode and match draws jump speed, run speed and gravity (racing: engine force, grip,
     /// steering) within this share of the profile's (0.2: ±20%), and both agents observe them.
     /// A resumed run keeps its own.

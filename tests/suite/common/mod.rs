@@ -31,7 +31,7 @@ pub fn knob_pair() -> &'static (PathBuf, Output) {
     PAIR.get_or_init(|| {
         shared_pair(
             "style-pair",
-            "generator:\n  rewards:\n    knobs: [1.0, 0.5]\n  own_check: {levels: 2, trials: 2}\n",
+            "ability_ranges: null\ngenerator:\n  rewards:\n    knobs: [1.0, 0.5]\n  own_check: {levels: 2, trials: 2}\n",
             4096,
         )
     })

@@ -63,14 +63,28 @@ pub struct TrainConfig {
     pub ability_spread: f64,
     /// Ability-aware agents over ranges of their own, in place of `ability_spread`: each main
     /// ability by name, `[least, most]` (`character.jump_speed: [4, 11]`), drawn per episode and
-    /// match among evenly spaced values (`AbilityRanges::draw`). Empty (the default):
-    /// `ability_spread` decides.
-    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    /// match among evenly spaced values (`AbilityRanges::draw`). Empty (the default, or
+    /// `null` over a recipe that sets ranges): `ability_spread` decides.
+    #[serde(
+        default,
+        deserialize_with = "null_is_empty",
+        skip_serializing_if = "BTreeMap::is_empty"
+    )]
     pub ability_ranges: BTreeMap<String, [f64; 2]>,
 }
 
 fn is_zero(x: &f64) -> bool {
     *x == 0.0
+}
+
+/// A map that `null` leaves empty, so a `--config` file can turn off the recipe's.
+fn null_is_empty<'de, D, V>(deserializer: D) -> Result<BTreeMap<String, V>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    V: serde::Deserialize<'de>,
+{
+    let given: Option<BTreeMap<String, V>> = serde::Deserialize::deserialize(deserializer)?;
+    Ok(given.unwrap_or_default())
 }
 
 /// The values each style knob of a match is drawn from by default (`knob_values`).

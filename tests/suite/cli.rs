@@ -1233,7 +1233,7 @@ fn a_solver_trained_for_a_profile_records_it_and_keeps_it() {
     write_platform_profile(&low_path, "low-jumper", "7.5");
     // Its configuration and card record the profile, a resume keeps it, and it plays under the
     // low jumper's abilities without a word of warning. One character (`--ability-spread 0`
-    // turns off the platform recipe's ranges).
+    // turns off any ranges a recipe names).
     let run = path("run");
     let train = |extra: &[&str]| {
         let mut args = vec![

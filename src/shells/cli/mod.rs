@@ -324,9 +324,9 @@ pub struct TrainArgs {
     #[arg(long, value_name = "FILE")]
     pub profile: Option<PathBuf>,
     /// Train ability-aware agents, in place of the configuration's `ability_spread` and
-    /// `ability_ranges` (platform's recipe sets ranges): each
-    /// episode and match draws jump speed, run speed and gravity (racing: engine force, grip,
-    /// steering) within this share of the profile's (0.2: ±20%), and both agents observe them.
+    /// `ability_ranges`: each episode and match draws jump speed, run speed and gravity (racing:
+    /// engine force, grip, steering) within this share of the profile's (0.2: ±20%), and both
+    /// agents observe them; 0 trains one character or car.
     /// A resumed run keeps its own.
     #[arg(long, value_name = "SHARE", value_parser = parse_ability_spread)]
     pub ability_spread: Option<f64>,

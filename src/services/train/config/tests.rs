@@ -269,11 +269,10 @@ fn ability_ranges_are_read_by_name_and_refused_with_the_field() {
     assert!(config.ability_aware());
     let ranges = config.trained_over(Game::Platform).unwrap().unwrap();
     assert_eq!(ranges.named()["character.gravity"], [9.0, 25.0]);
-    // The platform recipe's ranges are turned off with null, and then a share still reads,
-    // as ranges around the built-in character.
-    assert!(TrainConfig::for_game(Game::Platform).ability_aware());
-    let off = TrainConfig::parse_for("ability_ranges: null\n", Game::Platform).unwrap();
-    assert!(!off.ability_aware());
+    // Ranges given under a file are turned off with null over it, and then a share still
+    // reads, as ranges around the built-in character.
+    let off = TrainConfig::parse_over("ability_ranges: null\n", config.clone(), Game::Platform);
+    assert!(!off.unwrap().ability_aware());
     let spread = TrainConfig::parse_for(
         "ability_ranges: null\nability_spread: 0.2\n",
         Game::Platform,

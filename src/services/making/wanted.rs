@@ -47,6 +47,9 @@ pub struct Search<'a> {
 pub struct Unmet {
     /// The constraints (by index) the closest candidate missed or could not be measured on.
     pub missed: Vec<usize>,
+    /// The closest candidate itself, with its runs (`stats`) when it was played: what a
+    /// benchmark scores as the search's level (its quality), though it is never written.
+    pub closest_level: Option<Box<Level>>,
     want: String,
     tried: u32,
     played: u32,
@@ -62,6 +65,8 @@ struct Closest {
     met_somewhere: Vec<bool>,
     /// (how far it missed in all, what it was, why it missed, which it missed).
     best: Option<(f64, String, Vec<String>, Vec<usize>)>,
+    /// The candidate `best` describes, with its runs when it was played.
+    best_level: Option<Level>,
 }
 
 impl Closest {
@@ -70,12 +75,19 @@ impl Closest {
             each: vec![None; constraints],
             met_somewhere: vec![false; constraints],
             best: None,
+            best_level: None,
         }
     }
 
-    /// A candidate `what` that missed `misses` of the constraints it was measured on (those
-    /// reading at most `measured`).
-    fn note(&mut self, want: &Want, what: String, misses: &[(usize, Miss)], measured: Reads) {
+    /// A candidate `level` that missed `misses` of the constraints it was measured on (those
+    /// reading at most `measured`), `draw` its draw and `stats` its runs when it was played.
+    fn note(
+        &mut self,
+        want: &Want,
+        (level, draw, stats): (&Level, u32, Option<&SolverStats>),
+        misses: &[(usize, Miss)],
+        measured: Reads,
+    ) {
         let mut far = 0.0;
         let mut unmeasured = Vec::new();
         for (index, constraint) in want.constraints.iter().enumerate() {
@@ -104,7 +116,11 @@ impl Closest {
         if self.best.as_ref().is_none_or(|(best, ..)| far < *best) {
             let whys = misses.iter().map(|(_, m)| m.why.clone()).collect();
             let which = misses.iter().map(|(i, _)| *i).chain(unmeasured).collect();
-            self.best = Some((far, what, whys, which));
+            self.best = Some((far, describe(level, draw), whys, which));
+            self.best_level = Some(Level {
+                stats: stats.cloned(),
+                ..level.clone()
+            });
         }
     }
 
@@ -190,8 +206,7 @@ impl Search<'_> {
                 // What the pieces alone say first: a miss there is not worth playing.
                 let on_pieces = self.misses(&level, &Evidence::default(), Some(Reads::Pieces));
                 if !on_pieces.is_empty() {
-                    let what = describe(&level, draw);
-                    closest.note(self.want, what, &on_pieces, Reads::Pieces);
+                    closest.note(self.want, (&level, draw, None), &on_pieces, Reads::Pieces);
                     continue;
                 }
                 let Some(solver) = self.solver else {
@@ -213,8 +228,12 @@ impl Search<'_> {
                     judges: &judged,
                 };
                 let misses = self.misses(&level, &evidence, None);
-                let what = describe(&level, draw);
-                closest.note(self.want, what, &misses, Reads::Panel);
+                closest.note(
+                    self.want,
+                    (&level, draw, Some(&stats)),
+                    &misses,
+                    Reads::Panel,
+                );
                 if !misses.is_empty() || stats.successes == 0 {
                     continue;
                 }
@@ -229,6 +248,7 @@ impl Search<'_> {
         }
         Err(Unmet {
             missed: closest.best.as_ref().map_or(Vec::new(), |b| b.3.clone()),
+            closest_level: closest.best_level.take().map(Box::new),
             want: self.want.to_string(),
             tried,
             played,

@@ -86,9 +86,12 @@ impl AskSet {
 
 /// What one search came to.
 pub struct Outcome {
-    /// The level it kept, or none when no candidate met the want.
+    /// The level it ended with: the one it kept, else its closest candidate (none when it
+    /// built none).
     pub level: Option<Level>,
-    /// Without a level, the constraints (by index) its closest candidate missed.
+    /// Whether the level met every constraint (the search kept it).
+    pub met: bool,
+    /// When it met nothing, the constraints (by index) its closest candidate missed.
     pub missed: Vec<usize>,
     /// Seconds from the ask to the certified level (or to giving up).
     pub seconds: f64,
@@ -108,13 +111,14 @@ pub struct Score {
     pub levels_per_ask: u32,
     /// Levels searched in all.
     pub searched: usize,
-    /// The share of searches whose level is certified (a recorded run completes it).
+    /// The share of searches whose level (kept, or else the closest candidate) is certified (a
+    /// recorded run completes it).
     pub quality: f64,
     /// The share of searches whose level meets every constraint of its ask.
     pub controllability: f64,
     /// Per attribute: the share of its constraints met by the searched level.
     pub by_attribute: BTreeMap<String, f64>,
-    /// The mean distance between two kept levels ([`distance`]) over pairs.
+    /// The mean distance between two of the searches' levels ([`distance`]) over pairs.
     pub diversity: f64,
     /// The same for plain levels of the Generator at λ = 0, one per seed searched.
     pub plain_diversity: f64,
@@ -146,7 +150,7 @@ pub fn score(
         // A kept level met every constraint when it was measured (with its judges' runs,
         // which the file does not hold); a search that kept none is read by its closest
         // candidate.
-        let all = outcome.level.is_some();
+        let all = outcome.met;
         for (i, constraint) in want.constraints.iter().enumerate() {
             let met = all || !outcome.missed.contains(&i);
             let entry = by_attribute
@@ -157,7 +161,7 @@ pub fn score(
         }
         met_all += usize::from(all);
     }
-    let kept: Vec<&Level> = outcomes.iter().filter_map(|o| o.level.as_ref()).collect();
+    let ended: Vec<&Level> = outcomes.iter().filter_map(|o| o.level.as_ref()).collect();
     let mut seconds: Vec<f64> = outcomes.iter().map(|o| o.seconds).collect();
     seconds.sort_by(f64::total_cmp);
     Score {
@@ -172,7 +176,7 @@ pub fn score(
             .into_iter()
             .map(|(name, (met, of))| (name, share(met, of)))
             .collect(),
-        diversity: mean_distance(&kept),
+        diversity: mean_distance(&ended),
         plain_diversity: mean_distance(&plain.iter().collect::<Vec<_>>()),
         median_seconds: seconds.get(seconds.len() / 2).copied().unwrap_or(0.0),
     }

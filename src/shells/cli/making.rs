@@ -208,7 +208,7 @@ pub struct GenerateArgs {
     Quality: the share of levels certified (a recorded run completes them). Controllability: \
     the share meeting every constraint of their ask, and per attribute. Diversity: the mean \
     distance between the levels over pairs (docs/wish.md), beside plain levels of the \
-    Generator at λ = 0. A search that meets no candidate counts as a miss, and is named (its ask, its seed and the closest it came).")]
+    Generator at λ = 0. A search that meets no candidate counts as a miss for controllability, and is named (its ask, its seed and the closest it came); its closest candidate, played and certified, is its level for quality and diversity.")]
 pub struct BenchArgs {
     /// Which game.
     #[arg(long, default_value = "platform", value_parser = parse_game)]

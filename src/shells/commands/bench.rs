@@ -7,6 +7,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::Result;
+use arlpcg_core::level::Level;
 use rayon::prelude::*;
 
 use crate::services::fsio::{self, Overwrite};
@@ -17,7 +18,7 @@ use crate::services::panel::Judge;
 use crate::services::policies::{
     load_folder_solver, load_generator, load_judges_under, policy_paths,
 };
-use crate::services::verify::{Solver, Watch};
+use crate::services::verify::{self, Solver, Watch};
 use crate::services::wish::score::{AskSet, Outcome, Score, score};
 use crate::shells::cli::BenchArgs;
 use crate::shells::common::{UsageError, shipped_dir};
@@ -79,31 +80,34 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             );
             bar.inc(1);
             let seconds = started.elapsed().as_secs_f64();
-            match made {
-                Ok(level) => Ok((
-                    Outcome {
-                        level,
-                        missed: Vec::new(),
-                        seconds,
-                    },
-                    None,
-                )),
+            let outcome = match made {
+                Ok(level) => Outcome {
+                    met: level.is_some(),
+                    level,
+                    missed: Vec::new(),
+                    seconds,
+                },
                 Err(e) => match e.downcast::<Unmet>() {
                     Ok(unmet) => {
                         let why = format!("ask {}, seed {seed}: {unmet}", ask + 1);
-                        let missed = unmet.missed;
-                        Ok((
-                            Outcome {
-                                level: None,
-                                missed,
-                                seconds,
-                            },
-                            Some(why),
-                        ))
+                        let level = match unmet.closest_level {
+                            Some(closest) => {
+                                closest_certified(*closest, &who, args.trials, seed, &watch)?
+                            }
+                            None => None,
+                        };
+                        let outcome = Outcome {
+                            level,
+                            met: false,
+                            missed: unmet.missed,
+                            seconds,
+                        };
+                        return Ok((outcome, Some(why)));
                     }
-                    Err(e) => Err(e.context(format!("ask {}, seed {seed}", ask + 1))),
+                    Err(e) => return Err(e.context(format!("ask {}, seed {seed}", ask + 1))),
                 },
-            }
+            };
+            Ok((outcome, None))
         })
         .collect::<Result<_>>()?;
     bar.finish_and_clear();
@@ -122,6 +126,24 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         crate::warn!("wrote {}", out.display());
     }
     Ok(())
+}
+
+/// The closest candidate of a search that met nothing, played (when the search had not) and
+/// certified as a kept level would be: the level a benchmark scores that search by.
+fn closest_certified(
+    mut closest: Level,
+    who: &Solver,
+    trials: u32,
+    seed: u64,
+    watch: &Watch,
+) -> Result<Option<Level>> {
+    if closest.stats.is_none() {
+        match verify::verify_watched(&closest, who, trials, seed, watch)? {
+            Some(stats) => closest.stats = Some(stats),
+            None => return Ok(None),
+        }
+    }
+    Ok(Some(verify::certified(closest, who, seed)?))
 }
 
 fn overwrite(args: &BenchArgs) -> Overwrite {

@@ -5,9 +5,7 @@ use std::io::Write;
 use std::path::Path;
 
 use super::arlpcg::{AdversarialEnvs, AdversarialRecord, Generator, MatchRules, MatchStats, Phase};
-use super::cards::{
-    card, generator_shape, read_checkpoint, record_commands, save_policy_files, solver_shape,
-};
+use super::cards::{card, read_checkpoint, record_commands, save_policy_files, solver_shape};
 use super::config::{Schedule, TrainConfig};
 use super::metrics::{
     check_metrics_header, generator_metrics_header, generator_row, open_append, scripted_columns,
@@ -24,8 +22,6 @@ use anyhow::{Context, Result};
 use arlpcg_core::game::generator::{BuildLimits, GeneratorGame};
 use arlpcg_core::rl::checkpoint;
 use arlpcg_core::rl::checkpoint::{PolicyCard, Role, TrainMode, TrainingState};
-use arlpcg_core::rl::normalizer::RunningNorm;
-use arlpcg_core::rl::policy::ActorCritic;
 use arlpcg_core::rl::ppo::Ppo;
 use arlpcg_core::rl::timing::{Stretch, TimeSplit};
 use arlpcg_core::seed_ranges::EVAL_SEED_BASE;
@@ -79,15 +75,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
 
     pub(super) fn start(out: &Path, mode: TrainMode, config: TrainConfig) -> Result<Self> {
         let build = |config: &TrainConfig, _: Option<serde_json::Value>, _: u64| {
-            let policy = ActorCritic::new(
-                generator_shape(config, G::GAME),
-                config.seed.wrapping_add(1),
-            )?;
-            policy.set_log_std(config.generator.initial_log_std)?;
-            let generator = Generator {
-                ppo: Ppo::new(config.generator.ppo.clone(), policy)?,
-                norm: RunningNorm::new(generator_shape(config, G::GAME).observation),
-            };
+            let generator = Generator::fresh(config, G::GAME)?;
             let rng = ChaCha8Rng::seed_from_u64(config.seed.wrapping_add(1));
             let envs = AdversarialEnvs::new(
                 config.solver.num_envs - config.rule_level_envs(),

@@ -25,17 +25,19 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::services::train::config::ScriptedOpponent;
+use crate::services::train::cards::generator_shape;
+use crate::services::train::config::{ScriptedOpponent, TrainConfig};
 use crate::services::train::population::Snapshot;
 use crate::services::train::solver_envs::SolverEnvs;
 use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, GeneratorRewards, Match, MatchPacing, TrackBuild,
 };
 use arlpcg_core::game::{Scripted, SolverEnv, observe_solver};
+use arlpcg_core::level::Game;
 use arlpcg_core::level::profile::{AbilityRanges, ability_columns};
 use arlpcg_core::level::stats::{Outcome, Skill};
 use arlpcg_core::rl::normalizer::RunningNorm;
-use arlpcg_core::rl::policy::ActMode;
+use arlpcg_core::rl::policy::{ActMode, ActorCritic};
 use arlpcg_core::rl::ppo::Ppo;
 use arlpcg_core::rl::timing::{Clock, InnerTime};
 use arlpcg_core::rl::vec_env::{OtherPlayers, Seat, Transition, VecEnv};
@@ -85,6 +87,20 @@ pub struct Generator {
     pub ppo: Ppo,
     /// Its observation normalizer.
     pub norm: RunningNorm,
+}
+
+impl Generator {
+    /// A Generator that has learned nothing yet: `config`'s networks for `game`, its weights
+    /// seeded by the run's seed + 1, its exploration at `initial_log_std`.
+    pub fn fresh(config: &TrainConfig, game: Game) -> anyhow::Result<Self> {
+        let shape = generator_shape(config, game);
+        let policy = ActorCritic::new(shape.clone(), config.seed.wrapping_add(1))?;
+        policy.set_log_std(config.generator.initial_log_std)?;
+        Ok(Generator {
+            ppo: Ppo::new(config.generator.ppo.clone(), policy)?,
+            norm: RunningNorm::new(shape.observation),
+        })
+    }
 }
 
 /// One recorded Generator decision.

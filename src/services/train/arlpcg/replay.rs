@@ -242,9 +242,6 @@ mod tests {
     use arlpcg_core::game::platform::PlatformGame;
     use arlpcg_core::level::Game;
     use arlpcg_core::rl::checkpoint::TrainMode;
-    use arlpcg_core::rl::normalizer::RunningNorm;
-    use arlpcg_core::rl::policy::ActorCritic;
-    use arlpcg_core::rl::ppo::Ppo;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
@@ -262,12 +259,7 @@ mod tests {
         let shape = generator_shape(&config, Game::Platform);
         let solver_actions = solver_shape(&config, Game::Platform).action_size();
         let envs = |rules: MatchRules, record: AdversarialRecord| {
-            let policy = ActorCritic::new(shape.clone(), 1).unwrap();
-            policy.set_log_std(0.5).unwrap();
-            let generator = Generator {
-                ppo: Ppo::new(config.generator.ppo.clone(), policy).unwrap(),
-                norm: RunningNorm::new(shape.observation),
-            };
+            let generator = Generator::fresh(&config, Game::Platform).unwrap();
             let rng = ChaCha8Rng::seed_from_u64(1);
             AdversarialEnvs::<PlatformGame>::new(
                 8,

@@ -90,12 +90,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 Err(e) => match e.downcast::<Unmet>() {
                     Ok(unmet) => {
                         let why = format!("ask {}, seed {seed}: {unmet}", ask + 1);
-                        let level = match unmet.closest_level {
-                            Some(closest) => {
-                                closest_certified(*closest, &who, args.trials, seed, &watch)?
-                            }
-                            None => None,
-                        };
+                        let level = unmet
+                            .closest_level
+                            .map(|closest| {
+                                closest_certified(*closest, &who, args.trials, seed, &watch)
+                            })
+                            .transpose()?
+                            .flatten();
                         let outcome = Outcome {
                             level,
                             met: false,

@@ -6,6 +6,7 @@
 //! A want no candidate meets is named: each constraint's closest value, the candidates tried.
 
 use arlpcg_core::level::pacing::AuxCurve;
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::stats::SolverStats;
 use arlpcg_core::level::{Level, MeasuredConstraint, WantRecord};
 
@@ -42,7 +43,7 @@ pub struct Search<'a> {
 /// No candidate met the wish list.
 #[derive(Debug, thiserror::Error)]
 #[error(
-    "no level met `{want}` in {tried} candidates ({played} played): {closest}; {hint}ask for less, or give more room (--aux, another --seed)"
+    "no level met `{want}` in {tried} candidates ({played} played): {closest}; ask for less, or give more room (--aux, another --seed)"
 )]
 pub struct Unmet {
     /// The constraints (by index) the closest candidate missed or could not be measured on.
@@ -54,8 +55,6 @@ pub struct Unmet {
     tried: u32,
     played: u32,
     closest: String,
-    /// For a never-met bound a profile can hold every piece to, how (ending in "; "), else empty.
-    hint: String,
 }
 
 /// What the search came closest to: each constraint's closest miss, which constraints some
@@ -63,10 +62,21 @@ pub struct Unmet {
 struct Closest {
     each: Vec<Option<Miss>>,
     met_somewhere: Vec<bool>,
-    /// (how far it missed in all, what it was, why it missed, which it missed).
-    best: Option<(f64, String, Vec<String>, Vec<usize>)>,
-    /// The candidate `best` describes, with its runs when it was played.
-    best_level: Option<Level>,
+    best: Option<Candidate>,
+}
+
+/// The candidate that missed least.
+struct Candidate {
+    /// How far it missed, all constraints together.
+    far: f64,
+    /// What it was (`describe`).
+    what: String,
+    /// Why it missed each constraint it missed.
+    whys: Vec<String>,
+    /// The constraints (by index) it missed or could not be measured on.
+    missed: Vec<usize>,
+    /// The level itself, with its runs when it was played.
+    level: Level,
 }
 
 impl Closest {
@@ -75,7 +85,6 @@ impl Closest {
             each: vec![None; constraints],
             met_somewhere: vec![false; constraints],
             best: None,
-            best_level: None,
         }
     }
 
@@ -113,38 +122,18 @@ impl Closest {
                 }
             }
         }
-        if self.best.as_ref().is_none_or(|(best, ..)| far < *best) {
-            let whys = misses.iter().map(|(_, m)| m.why.clone()).collect();
-            let which = misses.iter().map(|(i, _)| *i).chain(unmeasured).collect();
-            self.best = Some((far, describe(level, draw), whys, which));
-            self.best_level = Some(Level {
-                stats: stats.cloned(),
-                ..level.clone()
+        if self.best.as_ref().is_none_or(|best| far < best.far) {
+            self.best = Some(Candidate {
+                far,
+                what: describe(level, draw),
+                whys: misses.iter().map(|(_, m)| m.why.clone()).collect(),
+                missed: misses.iter().map(|(i, _)| *i).chain(unmeasured).collect(),
+                level: Level {
+                    stats: stats.cloned(),
+                    ..level.clone()
+                },
             });
         }
-    }
-
-    /// For each never-met upper bound that a profile's piece range can hold every piece to
-    /// (`jump <= 8`, `curve <= 25`), the field to set: the Generator builds within the ranges
-    /// it is given, and its levels rarely stay under a bound of their own accord.
-    fn profile_hints(&self, want: &Want) -> String {
-        want.constraints
-            .iter()
-            .zip(&self.met_somewhere)
-            .filter(|(c, met)| !**met && c.high.is_finite())
-            .filter_map(|(c, _)| {
-                let (field, least, most) = c.attribute.profile_bound()?;
-                if !(least..most).contains(&c.high) {
-                    return None;
-                }
-                Some(format!(
-                    "a profile holds every piece to `{} <= {}`: set `{field}: {}` (`arlpcg profile init`, then --profile); ",
-                    c.attribute.name(),
-                    c.high,
-                    c.high
-                ))
-            })
-            .collect()
     }
 
     /// The constraints no candidate met, each by its closest value, and the closest candidate.
@@ -156,8 +145,12 @@ impl Closest {
             .filter(|(_, met)| !**met)
             .filter_map(|(miss, _)| miss.as_ref().map(|m| format!("never met: {}", m.why)))
             .collect();
-        let best = self.best.as_ref().map(|(_, what, whys, _)| {
-            format!("the closest candidate ({what}) missed {}", whys.join("; "))
+        let best = self.best.as_ref().map(|best| {
+            format!(
+                "the closest candidate ({}) missed {}",
+                best.what,
+                best.whys.join("; ")
+            )
         });
         never.into_iter().chain(best).collect::<Vec<_>>().join("; ")
     }
@@ -172,6 +165,7 @@ impl Search<'_> {
         request: &LevelRequest,
         watch: &Watch,
     ) -> anyhow::Result<Option<Level>> {
+        let request = &self.bounded(source, request);
         let asks = self.asks(source, request);
         let knobs = self.knobs(source, request);
         let mut closest = Closest::new(self.want.constraints.len());
@@ -246,14 +240,17 @@ impl Search<'_> {
         if tried == 0 {
             return Err(last_error.unwrap_or_else(|| anyhow::anyhow!("no candidate was built")));
         }
+        let described = closest.describe();
+        let (missed, closest_level) = closest.best.map_or((Vec::new(), None), |best| {
+            (best.missed, Some(Box::new(best.level)))
+        });
         Err(Unmet {
-            missed: closest.best.as_ref().map_or(Vec::new(), |b| b.3.clone()),
-            closest_level: closest.best_level.take().map(Box::new),
+            missed,
+            closest_level,
             want: self.want.to_string(),
             tried,
             played,
-            closest: closest.describe(),
-            hint: closest.profile_hints(self.want),
+            closest: described,
         }
         .into())
     }
@@ -307,6 +304,38 @@ impl Search<'_> {
             }
         }
         Ok(Some(judged))
+    }
+
+    /// `request` with its profile holding every piece to each upper bound asked of an attribute
+    /// a piece range bounds (`curve <= 25`: `segments.max_curve: 25`; `jump <= 8`:
+    /// `blocks.max_distance: 8`) where that is tighter than the profile's own range: the
+    /// Generator builds within the ranges it is given, and its levels rarely keep under such a
+    /// bound of their own accord (the shipped racing Generator turns its most, 30°, somewhere on
+    /// nearly every track). The level records the profile it was made under.
+    fn bounded(&self, source: LevelSource, request: &LevelRequest) -> LevelRequest {
+        let game = source.game();
+        let mut profile = request
+            .profile
+            .clone()
+            .unwrap_or_else(|| Profile::default_of(game));
+        let mut tightened = false;
+        for constraint in &self.want.constraints {
+            let Some(field) = constraint.attribute.profile_bound() else {
+                continue;
+            };
+            let Some((now, _)) = profile.value(field) else {
+                continue;
+            };
+            if constraint.high < now
+                && let Some(tighter) = profile.with_value(field, constraint.high)
+            {
+                (profile, tightened) = (tighter, true);
+            }
+        }
+        LevelRequest {
+            profile: tightened.then_some(profile).or(request.profile.clone()),
+            ..request.clone()
+        }
     }
 
     /// The λ (or curves) tried in each round: the one asked, else (a Generator's) the ladder

@@ -134,15 +134,11 @@ impl Attribute {
     }
 
     /// The profile field (`arlpcg profile init`) that holds every piece's value of it at most a
-    /// bound, and the bounds that field takes: the jump at `blocks.max_distance`, the curve at
-    /// `segments.max_curve`.
-    pub fn profile_bound(&self) -> Option<(&'static str, f64, f64)> {
-        use arlpcg_core::level::params::{BLOCK_DISTANCE, SEGMENT_CURVE};
+    /// bound: the jump at `blocks.max_distance`, the curve at `segments.max_curve`.
+    pub fn profile_bound(&self) -> Option<&'static str> {
         match self {
-            Attribute::Jump => Some((
-                "blocks.max_distance", BLOCK_DISTANCE.min, BLOCK_DISTANCE.max,
-            )),
-            Attribute::Curve => Some(("segments.max_curve", 0.0, SEGMENT_CURVE.max)),
+            Attribute::Jump => Some("blocks.max_distance"),
+            Attribute::Curve => Some("segments.max_curve"),
             _ => None,
         }
     }

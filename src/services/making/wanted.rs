@@ -313,27 +313,23 @@ impl Search<'_> {
     /// bound of their own accord (the shipped racing Generator turns its most, 30°, somewhere on
     /// nearly every track). The level records the profile it was made under.
     fn bounded(&self, source: LevelSource, request: &LevelRequest) -> LevelRequest {
-        let game = source.game();
-        let mut profile = request
+        let given = request
             .profile
             .clone()
-            .unwrap_or_else(|| Profile::default_of(game));
-        let mut tightened = false;
-        for constraint in &self.want.constraints {
-            let Some(field) = constraint.attribute.profile_bound() else {
-                continue;
-            };
-            let Some((now, _)) = profile.value(field) else {
-                continue;
-            };
-            if constraint.high < now
-                && let Some(tighter) = profile.with_value(field, constraint.high)
-            {
-                (profile, tightened) = (tighter, true);
-            }
-        }
+            .unwrap_or_else(|| Profile::default_of(source.game()));
+        let held = self
+            .want
+            .constraints
+            .iter()
+            .fold(given.clone(), |profile, c| {
+                let tighter = c.attribute.profile_bound().and_then(|field| {
+                    let (now, _) = profile.value(field)?;
+                    (c.high < now).then(|| profile.with_value(field, c.high))?
+                });
+                tighter.unwrap_or(profile)
+            });
         LevelRequest {
-            profile: tightened.then_some(profile).or(request.profile.clone()),
+            profile: (held != given).then_some(held).or(request.profile.clone()),
             ..request.clone()
         }
     }

@@ -1,10 +1,11 @@
 //! The recipe: what `train` does by default for each game, so that `arlpcg train --game G
-//! --mode M --seed S --out D` alone makes what ships. The configuration's defaults
-//! (config/mod.rs) are the platform game's; every game lays its own recipe over them, a
-//! configuration file in its folder ([`GeneratorGame::RECIPE`]; racing's differs in its
-//! budget, the Solver's discount and constant learning rate, the Generator's phases, curve
-//! offset, paced matches and finish), and sets the Generator's rewards, piece budget and
-//! obstacles from its own. docs/decisions.md says why each value is what it is.
+//! --mode M --seed S --out D` alone makes what ships. Every game lays its own recipe over the
+//! configuration's defaults (config/mod.rs), a configuration file in its folder
+//! ([`GeneratorGame::RECIPE`]: platform's sets the networks' width, the characters' ranges,
+//! rule levels and the finish; racing's the budget, the Solver's discount and constant
+//! learning rate, the Generator's phases, curve offset, paced matches and finish), and sets
+//! the Generator's rewards, piece budget and obstacles from its own. docs/decisions.md says
+//! why each value is what it is.
 
 use super::config::{Finish, SOLO_SOLVER_UPDATE_EPOCHS, TrainConfig, overlay};
 use arlpcg_core::game::generator::GeneratorGame;
@@ -89,11 +90,7 @@ mod tests {
         );
         assert_eq!(racing.generator.paced_share, 0.5);
         assert_eq!(platform.generator.paced_share, 0.0);
-        assert_eq!(
-            platform,
-            TrainConfig::default(),
-            "the defaults are platform's"
-        );
+        assert!(racing.ability_ranges.is_empty() && racing.generator.rule_level_share == 0.0);
         assert_eq!(racing.adversarial_budget(), 5_016_384);
         // The finish: the Generator's phase against the Solver frozen.
         let finish = racing.schedule_at(5_000_000);
@@ -102,6 +99,44 @@ mod tests {
             (Some(0.0), 800_000)
         );
         assert_eq!(racing.schedule_at(4_999_999).solver_learning_rate, None);
+    }
+
+    #[test]
+    fn the_platform_recipe_trains_narrow_networks_over_the_designers_characters() {
+        let platform = TrainConfig::for_game(Game::Platform);
+        assert_eq!(platform.hidden, vec![256, 256]);
+        let ranges: Vec<(&str, [f64; 2])> = platform
+            .ability_ranges
+            .iter()
+            .map(|(name, range)| (name.as_str(), *range))
+            .collect();
+        assert_eq!(
+            ranges,
+            [
+                ("character.gravity", [9.0, 25.0]),
+                ("character.jump_speed", [4.0, 11.0]),
+                ("character.run_speed", [4.0, 9.0]),
+            ]
+        );
+        let generator = &platform.generator;
+        assert_eq!(generator.generator_phase_steps, 5_000);
+        assert_eq!(generator.hard_success_floor, Some(0.25));
+        assert_eq!(generator.rule_level_share, 0.25);
+        assert_eq!(generator.rewards.knobs, [0.25, 0.25]);
+        let finish = &generator.finish;
+        assert_eq!(
+            (finish.solver_steps, finish.generator_phase_steps),
+            (40_000, 300_000)
+        );
+        assert_eq!(finish.generator_until_hard_success, Some(0.4));
+        assert_eq!(finish.reach_runs, Some(4));
+        assert!(finish.knobs_only);
+        assert!(
+            finish
+                .scripted_opponent
+                .as_ref()
+                .is_some_and(|o| o.easy_only)
+        );
     }
 
     #[test]

@@ -63,10 +63,11 @@ fn a_partial_finish_keeps_the_recipes_other_fields() {
 
 #[test]
 fn the_platform_finish_follows_the_budget_and_stages_apply_from_their_step() {
-    // The platform recipe's finish starts where its Solver's 8M end (racing's: recipe.rs).
+    // The platform recipe's finish starts where its Solver's 8M end (its fields and racing's:
+    // recipe.rs).
+    assert_eq!(TrainConfig::default().generator.finish, PLATFORM_FINISH);
     let platform = TrainConfig::for_game(Game::Platform);
-    assert_eq!(platform.generator.finish, PLATFORM_FINISH);
-    assert_eq!(platform.adversarial_budget(), 8_016_384);
+    assert_eq!(platform.adversarial_budget(), 8_040_000);
     let finish = platform.schedule_at(8_000_000);
     assert_eq!(
         (finish.solver_learning_rate, finish.snapshot_share),
@@ -88,7 +89,7 @@ fn the_platform_finish_follows_the_budget_and_stages_apply_from_their_step() {
     let staged = TrainConfig::parse_for(staged, Game::Platform)
         .unwrap()
         .generator;
-    assert_eq!(staged.schedule_at(99).generator_phase_steps, 10_000);
+    assert_eq!(staged.schedule_at(99).generator_phase_steps, 5_000);
     let last = staged.schedule_at(100);
     assert_eq!(
         (
@@ -143,7 +144,7 @@ fn finish_reach_and_knob_fields_that_cannot_hold_are_named() {
             "the racing Generator's pieces are not cut to a reach",
         ),
         (
-            "generator:\n  finish: {knobs_only: true}\n",
+            "generator:\n  rewards: {knobs: []}\n  finish: {knobs_only: true}\n",
             Game::Platform,
             "finish.knobs_only needs knobs (rewards.knobs)",
         ),
@@ -310,7 +311,9 @@ fn ability_ranges_are_read_by_name_and_refused_with_the_field() {
             "character.gravity: missing",
         ),
     ] {
-        let problem = TrainConfig::parse_for(&text, game).unwrap_err();
+        // Over the configuration's defaults, which name no ranges: platform's recipe names all
+        // three, so a file laid over it cannot leave one out.
+        let problem = TrainConfig::parse_over(&text, TrainConfig::default(), game).unwrap_err();
         assert!(problem.contains(says), "{text}: {problem}");
     }
 }

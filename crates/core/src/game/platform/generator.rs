@@ -317,8 +317,7 @@ impl GeneratorGame for PlatformGame {
     const MAX_PIECES: usize = crate::level::platform::MAX_BLOCKS;
     const KNOBS: &'static [Knob] = &KNOBS;
     const PIECE_FEATURES: [&'static str; 2] = ["distance", "size"];
-    /// The training configuration's defaults are the platform game's recipe.
-    const RECIPE: &'static str = "{}";
+    const RECIPE: &'static str = include_str!("recipe.yaml");
 
     /// The paper's rewards, but each block placed at λ < 0 costs 0.5·|λ| (the paper's 0.1 let
     /// a hard level be a long one: 22.6 blocks at λ = -1 for 8.4 at +1). Why:

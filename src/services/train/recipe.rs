@@ -135,7 +135,7 @@ mod tests {
             finish
                 .scripted_opponent
                 .as_ref()
-                .is_some_and(|o| o.easy_only)
+                .is_some_and(|o| !o.easy_only && o.share == 0.5)
         );
     }
 

@@ -12,7 +12,7 @@ fn a_partial_file_takes_its_games_defaults_and_old_names_still_read() {
     let platform = TrainConfig::parse_for(text, Game::Platform).unwrap();
     assert_eq!(platform.generator.rewards.air_step, 0.0);
     assert_eq!(platform.solver.gamma, 0.99);
-    assert_eq!((platform.steps, racing.steps), (PLATFORM_STEPS, 5_000_000));
+    assert_eq!((platform.steps, racing.steps), (12_000_000, 5_000_000));
     let old = "ppo:\n  gamma: 0.95\ngenerator:\n  max_blocks: 12\n";
     let read = TrainConfig::parse_for(old, Game::Racing).unwrap();
     assert_eq!((read.solver.gamma, read.generator.max_pieces), (0.95, 12));
@@ -63,18 +63,18 @@ fn a_partial_finish_keeps_the_recipes_other_fields() {
 
 #[test]
 fn the_platform_finish_follows_the_budget_and_stages_apply_from_their_step() {
-    // The platform recipe's finish starts where its Solver's 8M end (its fields and racing's:
+    // The platform recipe's finish starts where its Solver's 12M end (its fields and racing's:
     // recipe.rs).
     assert_eq!(TrainConfig::default().generator.finish, PLATFORM_FINISH);
     let platform = TrainConfig::for_game(Game::Platform);
-    assert_eq!(platform.adversarial_budget(), 8_040_000);
-    let finish = platform.schedule_at(8_000_000);
+    assert_eq!(platform.adversarial_budget(), 12_040_000);
+    let finish = platform.schedule_at(12_000_000);
     assert_eq!(
         (finish.solver_learning_rate, finish.snapshot_share),
         (Some(0.0), Some(0.0))
     );
-    assert_eq!(platform.schedule_at(7_999_999).solver_learning_rate, None);
-    assert_eq!(platform.lr_scale(8_010_000), 0.0);
+    assert_eq!(platform.schedule_at(11_999_999).solver_learning_rate, None);
+    assert_eq!(platform.lr_scale(12_010_000), 0.0);
     // A finish in which the Solver keeps learning, with its own phases.
     let learning = "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, solver_learning_rate: 1.0e-4, solver_phase_steps: 16}\n";
     let learning = TrainConfig::parse_for(learning, Game::Platform).unwrap();

@@ -8,7 +8,6 @@
 use crate::services::verify::{Solver, SolverPolicy, Watch, WrongGame, verify_watched};
 use arlpcg_core::game::Skill;
 use arlpcg_core::level::Level;
-use arlpcg_core::level::profile::Profile;
 use arlpcg_core::level::stats::{JudgeStats, PanelStats, Rating, SolverRef, SolverStats};
 use arlpcg_core::rl::checkpoint::TrainMode;
 use arlpcg_core::statistics::rating::{Outcomes, fit};
@@ -72,18 +71,12 @@ impl Judge {
 pub struct JudgePanel {
     /// Each judge with its Solver policy (none for the scripted player), in order.
     pub judges: Vec<(Judge, Option<SolverPolicy>)>,
-    /// The folder's ability-aware Solver, which plays for the ARLPCG judge under a profile whose
-    /// abilities that judge's Solver did not train with ([`SolverPolicy::or_aware`]).
-    pub aware: Option<SolverPolicy>,
 }
 
 impl JudgePanel {
-    /// How judge `k` plays under `played` (none: the built-in abilities).
-    pub fn solver(&self, k: usize, played: Option<&Profile>) -> Solver<'_> {
+    /// How judge `k` plays.
+    pub fn solver(&self, k: usize) -> Solver<'_> {
         match &self.judges[k] {
-            (Judge::Solver(TrainMode::Arlpcg), Some(policy)) => {
-                Solver::Policy(policy.or_aware(self.aware.as_ref(), played))
-            }
             (_, Some(policy)) => Solver::Policy(policy),
             (Judge::Scripted(skill), None) => Solver::Scripted(*skill),
             (Judge::Solver(_), None) => unreachable!("a Solver judge is loaded with its policy"),
@@ -140,14 +133,7 @@ pub fn play(
 ) -> Result<Option<PanelStats>, WrongGame> {
     let mut played = Vec::with_capacity(panel.judges.len());
     for k in 0..panel.judges.len() {
-        let Some(stats) = verify_watched(
-            level,
-            &panel.solver(k, level.profile.as_ref()),
-            trials,
-            seed,
-            watch,
-        )?
-        else {
+        let Some(stats) = verify_watched(level, &panel.solver(k), trials, seed, watch)? else {
             return Ok(None);
         };
         on_judge(k, &stats);

@@ -329,7 +329,7 @@ pub fn panel_fit(
     use crate::services::verify::{ProfileFit, Solver};
     let mut said: Vec<(String, Vec<String>)> = Vec::new();
     for (k, (judge, _)) in panel.judges.iter().enumerate() {
-        let Solver::Policy(policy) = panel.solver(k, profile) else {
+        let Solver::Policy(policy) = panel.solver(k) else {
             continue;
         };
         let (ProfileFit::Untrained(problem) | ProfileFit::Beyond(problem)) = policy.fit(profile)

@@ -200,7 +200,7 @@ pub fn regenerate_level(
     let judge = Judge::parse(&record.judge).map_err(anyhow::Error::msg)?;
     let judged = crate::services::policies::load_panel(dir, record.game, Some(&[judge]))?;
     let profile = record.ask().profile;
-    let solver = judged.solver(0, profile.as_ref());
+    let solver = judged.solver(0);
     let curve = crate::services::policies::difficulty_curve(
         (dir, cache),
         generator,

@@ -264,7 +264,7 @@ pub fn golden_path(onnx: &std::path::Path) -> std::path::PathBuf {
 mod tests {
     use super::*;
     use crate::services::policies::{generator_limits, load_any};
-    use arlpcg_core::game::PlatformGame;
+    use arlpcg_core::game::{PlatformGame, RacingGame};
 
     fn shipped(name: &str) -> std::path::PathBuf {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("policies/{name}"))
@@ -318,16 +318,15 @@ mod tests {
     /// ours; a Solver that is not aware has neither.
     #[test]
     fn an_ability_aware_solvers_golden_state_holds_its_abilities() {
-        for (name, aware) in [("solver-aware", true), ("solver", false)] {
-            let path = shipped(&format!("platform/{name}.safetensors"));
-            let (policy, card, reference) = load_any(&path).unwrap();
-            let episode = golden_episode::<PlatformGame>(&policy, &card, reference).unwrap();
-            let state = &episode.frames[0].state;
-            assert_eq!(state.contains_key("abilities"), aware, "{name}");
-            if aware {
-                assert_eq!(state["abilities"], [9.25, 8.0, 20.0]);
-                assert_eq!(state["abilities"], state["abilities_built_in"]);
-            }
-        }
+        let path = shipped("platform/solver.safetensors");
+        let (policy, card, reference) = load_any(&path).unwrap();
+        let episode = golden_episode::<PlatformGame>(&policy, &card, reference).unwrap();
+        let state = &episode.frames[0].state;
+        assert_eq!(state["abilities"], [9.25, 8.0, 20.0]);
+        assert_eq!(state["abilities"], state["abilities_built_in"]);
+        let path = shipped("racing/solver.safetensors");
+        let (policy, card, reference) = load_any(&path).unwrap();
+        let episode = golden_episode::<RacingGame>(&policy, &card, reference).unwrap();
+        assert!(!episode.frames[0].state.contains_key("abilities"));
     }
 }

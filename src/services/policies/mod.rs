@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 
 use crate::services::generation::GeneratorPolicy;
 use crate::services::panel::{Judge, JudgePanel};
-use crate::services::verify::{ProfileFit, SolverPolicy};
+use crate::services::verify::SolverPolicy;
 use arlpcg_core::game::facts::facts;
 use arlpcg_core::game::generator::DEFAULT_CURVE_OFFSET;
 use arlpcg_core::game::generator::{BuildLimits, GeneratorGame, observation_size};
@@ -24,9 +24,6 @@ use arlpcg_core::rl::policy::ActorCritic;
 pub const GENERATOR_FILE: &str = "generator.safetensors";
 /// The Solver's file name inside a policies folder.
 pub const SOLVER_FILE: &str = "solver.safetensors";
-/// An ability-aware Solver beside a folder's Solver: it plays where a profile's abilities differ
-/// from those `solver.safetensors` trained with ([`SolverPolicy::or_aware`]).
-pub const AWARE_SOLVER_FILE: &str = "solver-aware.safetensors";
 
 /// What a policy of one game and role must act with: `(continuous, binary)` action names.
 type Actions = (&'static [&'static str], &'static [&'static str]);
@@ -102,51 +99,6 @@ pub fn load_solver(path: &Path, game: Game) -> Result<(SolverPolicy, PolicyCard)
         },
         card,
     ))
-}
-
-/// Loads the ability-aware Solver of the policies folder `dir` ([`AWARE_SOLVER_FILE`]), if it
-/// holds one; an error when that file's card trained one character or car.
-pub fn load_aware_solver(dir: &Path, game: Game) -> Result<Option<SolverPolicy>> {
-    let path = dir.join(AWARE_SOLVER_FILE);
-    if !path.exists() {
-        return Ok(None);
-    }
-    let (policy, _) = load_solver(&path, game)?;
-    if policy.trained_over.is_none() {
-        anyhow::bail!(
-            "{}: card field ability_ranges is missing: {AWARE_SOLVER_FILE} must be an ability-aware Solver (trained with ability_ranges or ability_spread)",
-            path.display()
-        );
-    }
-    Ok(Some(policy))
-}
-
-/// The Solver of the policies folder `dir` that plays under `profile` (none: the built-in game):
-/// its `solver.safetensors`, or its ability-aware one where [`SolverPolicy::or_aware`] picks it.
-pub fn load_folder_solver(
-    dir: &Path,
-    game: Game,
-    profile: Option<&Profile>,
-) -> Result<SolverPolicy> {
-    let solver = load_solver(&dir.join(SOLVER_FILE), game)?.0;
-    or_folders_aware(dir, game, solver, profile)
-}
-
-/// `solver`, or the ability-aware Solver of the policies folder `dir` where it plays in its
-/// place under `profile` ([`SolverPolicy::or_aware`]).
-fn or_folders_aware(
-    dir: &Path,
-    game: Game,
-    solver: SolverPolicy,
-    profile: Option<&Profile>,
-) -> Result<SolverPolicy> {
-    if solver.fit(profile) == ProfileFit::Fits {
-        return Ok(solver);
-    }
-    Ok(match load_aware_solver(dir, game)? {
-        Some(aware) if solver.yields_to(&aware, profile) => aware,
-        _ => solver,
-    })
 }
 
 /// Loads a Generator policy of `game`.
@@ -396,14 +348,7 @@ pub fn load_panel(dir: &Path, game: Game, chosen: Option<&[Judge]>) -> Result<Ju
             .filter(|&j| judge_file(dir, j).is_none_or(|p| p.exists()))
             .collect(),
     };
-    let aware = match judges.contains(&Judge::Solver(TrainMode::Arlpcg)) {
-        true => load_aware_solver(dir, game)?,
-        false => None,
-    };
-    let mut panel = JudgePanel {
-        judges: Vec::new(),
-        aware,
-    };
+    let mut panel = JudgePanel { judges: Vec::new() };
     for judge in judges {
         let policy = load_judge(dir, game, judge)?.map(|(policy, _)| policy);
         panel.judges.push((judge, policy));
@@ -435,37 +380,21 @@ pub fn load_judge(
     Ok(Some((policy, card)))
 }
 
-/// The policy that plays for `judge` of the policies folder `dir` under `profile`: the judge's
-/// own, or for the ARLPCG judge the folder's ability-aware Solver where it plays in its place
-/// (as in a panel); `None` for the scripted player.
-pub fn load_judge_under(
-    dir: &Path,
-    game: Game,
-    judge: Judge,
-    profile: Option<&Profile>,
-) -> Result<Option<SolverPolicy>> {
-    let Some((policy, _)) = load_judge(dir, game, judge)? else {
-        return Ok(None);
-    };
-    Ok(Some(match judge {
-        Judge::Solver(TrainMode::Arlpcg) => or_folders_aware(dir, game, policy, profile)?,
-        Judge::Solver(_) | Judge::Scripted(_) => policy,
-    }))
-}
-
-/// Each of `judges` with the policy that plays for it under `profile` ([`load_judge_under`]:
-/// none for the scripted player, whose folder is never read).
+/// Each of `judges` with its Solver policy ([`load_judge`]: none for the scripted player, whose
+/// folder is never read).
 pub fn load_judges_under(
     dir: impl Fn() -> Result<PathBuf>,
     game: Game,
     judges: &[Judge],
-    profile: Option<&Profile>,
 ) -> Result<Vec<(Judge, Option<SolverPolicy>)>> {
     judges
         .iter()
         .map(|&judge| match judge {
             Judge::Scripted(_) => Ok((judge, None)),
-            Judge::Solver(_) => Ok((judge, load_judge_under(&dir()?, game, judge, profile)?)),
+            Judge::Solver(_) => Ok((
+                judge,
+                load_judge(&dir()?, game, judge)?.map(|(policy, _)| policy),
+            )),
         })
         .collect()
 }

@@ -1,4 +1,5 @@
 use super::*;
+use crate::services::verify::ProfileFit;
 
 /// A Generator's reach is read from its card: none, or a count of runs within its game's
 /// range; a card out of range, or one of a game without a reach, names the file and field.
@@ -142,39 +143,24 @@ fn only_the_folders_own_solver_uses_the_folders_curve_file() {
     );
 }
 
-/// A folder's Solver plays under the abilities it trained with; its ability-aware Solver
-/// under others within its range; and a file named as the ability-aware one that is not is
-/// refused, naming the file and the field.
+/// The shipped platform Solver plays every character within the ranges it trained over and
+/// refuses one beyond them, naming the range.
 #[test]
-fn a_folders_ability_aware_solver_plays_under_other_abilities_within_its_range() {
+fn the_shipped_platform_solver_plays_the_characters_within_its_ranges() {
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/platform");
     let jumping = |jump_speed: f64| {
         Profile::default_of(Game::Platform)
             .with_value("character.jump_speed", jump_speed)
             .unwrap()
     };
-    let played = |profile: Option<&Profile>| {
-        let solver = load_folder_solver(&shipped, Game::Platform, profile).unwrap();
-        let path = PathBuf::from(&solver.reference.path);
-        path.file_name().unwrap().to_str().unwrap().to_string()
-    };
-    assert_eq!(played(None), SOLVER_FILE);
-    assert_eq!(played(Some(&jumping(8.0))), AWARE_SOLVER_FILE);
-    assert_eq!(played(Some(&jumping(6.0))), SOLVER_FILE);
-
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::copy(shipped.join(SOLVER_FILE), dir.path().join(SOLVER_FILE)).unwrap();
-    std::fs::copy(
-        shipped.join(SOLVER_FILE),
-        dir.path().join(AWARE_SOLVER_FILE),
-    )
-    .unwrap();
-    let problem = load_folder_solver(dir.path(), Game::Platform, Some(&jumping(8.0)))
-        .err()
+    let solver = load_solver(&shipped.join(SOLVER_FILE), Game::Platform)
         .unwrap()
-        .to_string();
-    assert!(
-        problem.contains(AWARE_SOLVER_FILE) && problem.contains("card field ability_ranges"),
-        "{problem}"
-    );
+        .0;
+    for profile in [None, Some(jumping(4.5)), Some(jumping(10.5))] {
+        assert_eq!(solver.fit(profile.as_ref()), ProfileFit::Fits);
+    }
+    match solver.fit(Some(&jumping(12.0))) {
+        ProfileFit::Beyond(problem) => assert!(problem.contains("jump_speed"), "{problem}"),
+        other => panic!("{other:?}"),
+    }
 }

@@ -1,6 +1,5 @@
 //! A trained Solver ready to play, and how it stands to the abilities of a profile it is to play
-//! under (who plays a level made for other abilities: [`SolverPolicy::or_aware`], and where no
-//! player was named, [`default_player`]).
+//! under (who plays where no player was named: [`default_player`]).
 
 use arlpcg_core::level::profile::{Abilities, AbilityRanges, Profile};
 use arlpcg_core::level::{Game, Level, PolicyRef};
@@ -66,39 +65,10 @@ impl SolverPolicy {
         }
     }
 
-    /// Of this Solver and a folder's ability-aware one, the one that plays under `played`: the
-    /// ability-aware one when this one did not train with those abilities and its range holds
-    /// them; else this one (its [`fit`](Self::fit) says why it may not).
-    pub fn or_aware<'a>(
-        &'a self,
-        aware: Option<&'a SolverPolicy>,
-        played: Option<&Profile>,
-    ) -> &'a SolverPolicy {
-        match aware {
-            Some(aware) if self.yields_to(aware, played) => aware,
-            _ => self,
-        }
-    }
-
-    /// Whether `aware` plays under `played` in place of this Solver ([`Self::or_aware`]).
-    pub fn yields_to(&self, aware: &SolverPolicy, played: Option<&Profile>) -> bool {
-        self.fit(played) != ProfileFit::Fits && aware.fit(played) == ProfileFit::Fits
-    }
-
     /// Who plays in its place under `played` when no player was named
     /// ([`default_player`]): none where it trained with those abilities, else the scripted
     /// expert and the line that says why.
     pub fn stand_in(&self, played: Option<&Profile>) -> Option<(Skill, String)> {
-        self.stand_in_beside(None, played)
-    }
-
-    /// [`Self::stand_in`], naming the range of the folder's ability-aware Solver `aware` too
-    /// where it does not hold the abilities either.
-    pub fn stand_in_beside(
-        &self,
-        aware: Option<&SolverPolicy>,
-        played: Option<&Profile>,
-    ) -> Option<(Skill, String)> {
         let name = |profile: Option<&Profile>| {
             profile.map_or("the built-in abilities".to_string(), |p| {
                 format!("profile `{}`", p.name)
@@ -118,22 +88,10 @@ impl SolverPolicy {
                 self.trained_over.map(|r| r.describe()).unwrap_or_default()
             ),
         };
-        let nor = aware
-            .filter(|aware| !std::ptr::eq(*aware, self))
-            .and_then(|aware| {
-                aware.trained_over.map(|range| {
-                    format!(
-                        ", nor within the abilities the ability-aware Solver policy {} trained over ({})",
-                        aware.reference.path,
-                        range.describe()
-                    )
-                })
-            })
-            .unwrap_or_default();
         Some((
             Skill::Expert,
             format!(
-                "{why}{nor}: the scripted expert, who plays with any abilities, plays in its place (name a Solver policy to have it play anyway)"
+                "{why}: the scripted expert, who plays with any abilities, plays in its place (name a Solver policy to have it play anyway)"
             ),
         ))
     }
@@ -149,18 +107,16 @@ impl SolverPolicy {
     }
 }
 
-/// Who plays under `played` when no player was named: `solver`, or `aware` in its place
-/// ([`SolverPolicy::or_aware`]), where it trained with those abilities; else the scripted
-/// expert, who plays with any abilities, and the line that says why (a command says it and
-/// plays on: it never reports a Solver's play of a character it cannot play).
+/// Who plays under `played` when no player was named: `solver` where it trained with those
+/// abilities, else the scripted expert, who plays with any abilities, and the line that says
+/// why (a command says it and plays on: it never reports a Solver's play of a character it
+/// cannot play).
 pub fn default_player<'a>(
     solver: &'a SolverPolicy,
-    aware: Option<&'a SolverPolicy>,
     played: Option<&Profile>,
 ) -> (Solver<'a>, Option<String>) {
-    let policy = solver.or_aware(aware, played);
-    match policy.stand_in_beside(aware, played) {
-        None => (Solver::Policy(policy), None),
+    match solver.stand_in(played) {
+        None => (Solver::Policy(solver), None),
         Some((skill, why)) => (Solver::Scripted(skill), Some(why)),
     }
 }

@@ -123,9 +123,8 @@ pub struct GenerateArgs {
     pub gltf: GltfArgs,
     /// Play each level this many times with the Solver (with --policies the one beside the
     /// Generator, with --rules the shipped one; under a --profile whose abilities it did not
-    /// train with, the folder's solver-aware.safetensors where its range holds them, else the
-    /// scripted expert, who plays with any abilities, and a line says so) and store the
-    /// statistics in the YAML.
+    /// train with, the scripted expert, who plays with any abilities, and a line says so) and
+    /// store the statistics in the YAML.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub verify: Option<u32>,
     /// Play --verify and --target-success with this Solver policy (.safetensors) instead of the

@@ -194,7 +194,7 @@ pub struct EvalArgs {
     pub game: Game,
     /// Folders of trained policies: the Generator (generator.safetensors, from the first folder
     /// that has one) and every Solver (solver*.safetensors; each named by its card's training
-    /// mode, solver-aware.safetensors as `arlpcg-aware`). One Solver must be the arlpcg one.
+    /// mode). One Solver must be the arlpcg one.
     #[arg(long, num_args = 1.., required_unless_present_any = ["merge", "runs"], value_name = "DIR")]
     pub policies: Vec<PathBuf>,
     /// Score training runs over their seeds instead: each folder is one run (its

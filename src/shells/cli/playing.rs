@@ -63,14 +63,12 @@ pub struct VerifyArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Who plays (default: the trained Solver of the level's game when one is found, else the
-    /// scripted player; on a level made for abilities no shipped Solver trained with, the
+    /// scripted player; on a level made for abilities the shipped Solver did not train with, the
     /// scripted expert, and a line says so).
     #[arg(long, value_enum)]
     pub solver: Option<SolverChoice>,
     /// The Solver policy file (.safetensors) for --solver policy (default:
-    /// policies/<game>/solver.safetensors for each level's game, and on a level made for
-    /// abilities it did not train with policies/<game>/solver-aware.safetensors where that
-    /// file's range holds them).
+    /// policies/<game>/solver.safetensors for each level's game).
     #[arg(long)]
     pub policy: Option<PathBuf>,
     /// Print one JSON object per level instead of text.

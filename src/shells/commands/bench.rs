@@ -15,9 +15,7 @@ use crate::services::generation::LevelRequest;
 use crate::services::making::wanted::{Search, Unmet};
 use crate::services::making::{self, LevelSource, Proof};
 use crate::services::panel::Judge;
-use crate::services::policies::{
-    load_folder_solver, load_generator, load_judges_under, policy_paths,
-};
+use crate::services::policies::{load_generator, load_judges_under, load_solver, policy_paths};
 use crate::services::verify::{self, Solver, Watch};
 use crate::services::wish::score::{AskSet, Outcome, Score, score};
 use crate::shells::cli::BenchArgs;
@@ -36,7 +34,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         None => shipped_dir(args.game)?,
     };
     let generator = load_generator(&policy_paths(&dir).0, args.game)?.0;
-    let solver = load_folder_solver(&dir, args.game, None)?;
+    let solver = load_solver(&policy_paths(&dir).1, args.game)?.0;
     let who = Solver::Policy(&solver);
     let mut asked: Vec<Judge> = Vec::new();
     for judge in asks.iter().flat_map(|(_, want, _)| want.judges()) {
@@ -44,7 +42,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             asked.push(judge);
         }
     }
-    let judges = load_judges_under(|| Ok(dir.clone()), args.game, &asked, None)?;
+    let judges = load_judges_under(|| Ok(dir.clone()), args.game, &asked)?;
     let stop = AtomicBool::new(false);
     let jobs: Vec<(usize, u64)> = (0..asks.len())
         .flat_map(|a| (0..u64::from(args.levels)).map(move |seed| (a, seed)))

@@ -82,7 +82,7 @@ pub fn run(args: &CampaignArgs) -> Result<()> {
     let n = args.levels as usize;
     let generator = load_generator(&policy_paths(&dir).0, args.game)?.0;
     let judged = load_panel(&dir, args.game, Some(&[judge]))?;
-    let solver = judged.solver(0, ask.profile.as_ref());
+    let solver = judged.solver(0);
     if let Solver::Policy(policy) = &solver {
         crate::shells::common::check_fit(policy, ask.profile.as_ref())?;
     }
@@ -493,7 +493,7 @@ fn campaign_judge(args: &CampaignArgs, dir: &Path, profile: Option<&Profile>) ->
     }
     let solver = Judge::Solver(TrainMode::Arlpcg);
     let panel = load_panel(dir, args.game, Some(&[solver]))?;
-    let Solver::Policy(policy) = panel.solver(0, profile) else {
+    let Solver::Policy(policy) = panel.solver(0) else {
         return Ok(solver);
     };
     Ok(match policy.stand_in(profile) {
@@ -518,7 +518,7 @@ pub fn replay(args: &VerifyArgs, file: &Path) -> Result<()> {
     };
     let judged = load_panel(&dir, campaign.game, Some(&[judge]))?;
     let profile = campaign.ask().profile;
-    let solver = judged.solver(0, profile.as_ref());
+    let solver = judged.solver(0);
     if let Solver::Policy(policy) = &solver {
         crate::shells::common::check_fit(policy, profile.as_ref())?;
     }

@@ -9,7 +9,7 @@ use crate::services::eval::{self, Budget, NamedSolver, PART_FILE, Part};
 use crate::services::fsio::{self, Overwrite};
 use crate::services::generation::GeneratorPolicy;
 use crate::services::panel::Judge;
-use crate::services::policies::{AWARE_SOLVER_FILE, GENERATOR_FILE, load_generator, load_solver};
+use crate::services::policies::{GENERATOR_FILE, load_generator, load_solver};
 use crate::services::profile;
 use crate::services::verify::{Solver, SolverPolicy};
 use crate::shells::cli::EvalArgs;
@@ -313,8 +313,7 @@ fn merge(args: &EvalArgs) -> Result<()> {
 }
 
 /// Every `solver*.safetensors` in the `--policies` folders, named by its card's training mode
-/// (`solver-aware.safetensors`: the mode and `-aware`; the first of each name wins); the ARLPCG
-/// one must be among them.
+/// (the first of each mode wins); the ARLPCG one must be among them.
 fn load_solvers(args: &EvalArgs) -> Result<Vec<(String, SolverPolicy)>> {
     let mut solvers: Vec<(String, SolverPolicy)> = Vec::new();
     for dir in &args.policies {
@@ -331,11 +330,7 @@ fn load_solvers(args: &EvalArgs) -> Result<Vec<(String, SolverPolicy)>> {
         files.sort();
         for path in files {
             let (solver, card) = load_solver(&path, args.game)?;
-            // A folder's ability-aware Solver plays beside its Solver, under its own name.
-            let name = match path.file_name().and_then(|n| n.to_str()) {
-                Some(AWARE_SOLVER_FILE) => format!("{}-aware", card.training.mode),
-                _ => card.training.mode.to_string(),
-            };
+            let name = card.training.mode.to_string();
             if let Some((mode, _)) = solvers.iter().find(|(m, _)| *m == name) {
                 crate::warn!(
                     "note: {} skipped: a {mode} Solver is already loaded",

@@ -17,13 +17,10 @@ use arlpcg_core::rl::checkpoint::PolicyCard;
 /// The largest results file, card or page read.
 const MAX_FILE_BYTES: u64 = 64 * 1024 * 1024;
 
-/// The shipped policies a game's table lists, in its order; [`OPTIONAL_POLICY`] where a game
-/// ships one.
-const POLICIES: [&str; 6] = [
-    "generator", "solver", "solver-aware", "solver-rule-pcg", "solver-fixed-track",
-    "solver-fixed-aux",
+/// The shipped policies a game's table lists, in its order.
+const POLICIES: [&str; 5] = [
+    "generator", "solver", "solver-rule-pcg", "solver-fixed-track", "solver-fixed-aux",
 ];
-const OPTIONAL_POLICY: &str = "solver-aware";
 
 pub fn run(args: &ReportArgs) -> Result<()> {
     if !args.curves.is_empty() {
@@ -94,7 +91,6 @@ fn read_game(game: Game, results: &Path, policies: &Path) -> Result<GamePage> {
                 policies.join(game.name()).join(format!("{name}.yaml")),
             )
         })
-        .filter(|(name, path)| **name != OPTIONAL_POLICY || path.is_file())
         .map(|(name, path)| {
             let card: PolicyCard = serde_yaml::from_slice(&read(&path)?)
                 .with_context(|| format!("{}", path.display()))?;

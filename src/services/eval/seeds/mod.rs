@@ -368,7 +368,7 @@ pub fn score_runs(
                             judge,
                             success_ratio: levels
                                 .iter()
-                                .map(|at| mean(&play(&judges.solver(k, None), at, budget.trials)))
+                                .map(|at| mean(&play(&judges.solver(k), at, budget.trials)))
                                 .collect(),
                         })
                         .collect();

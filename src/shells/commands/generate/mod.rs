@@ -15,8 +15,8 @@ use crate::services::level_files::{Format, LevelFiles, render};
 use crate::services::making::{self, LevelSource, Proof, Redraw};
 use crate::services::panel::{Judge, JudgePanel};
 use crate::services::policies::{
-    load_aware_solver, load_folder_solver, load_generator, load_judge_under, load_judges_under,
-    load_panel, load_solver, policy_paths,
+    SOLVER_FILE, load_generator, load_judge, load_judges_under, load_panel, load_solver,
+    policy_paths,
 };
 use crate::services::verify::{self, Solver, SolverPolicy};
 use crate::services::wish::{self, Evidence, Reads, Want};
@@ -86,12 +86,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         &stop,
     )?;
     let judges = match &want {
-        Some(want) => load_judges_under(
-            || policies_dir(args),
-            args.game,
-            &want.judges(),
-            template.profile.as_ref(),
-        )?,
+        Some(want) => load_judges_under(|| policies_dir(args), args.game, &want.judges())?,
         None => Vec::new(),
     };
     let players: Vec<(Judge, Solver)> = judges
@@ -296,9 +291,8 @@ const TARGET_TRIALS: u32 = 100;
 const WANT_TRIALS: u32 = 20;
 
 /// The Solver that plays `--verify` and `--target-success`: the judge asked for, the file asked
-/// for, the one beside the Generator, or the shipped one (of a folder, the one that plays under
-/// `profile`, where one trained with its abilities); none for the scripted player (the expert
-/// where a folder's Solvers cannot play the profile) or when nothing is verified.
+/// for, the one beside the Generator, or the shipped one; none for the scripted player (the
+/// expert where a folder's Solver cannot play `profile`'s character) or when nothing is verified.
 fn chosen_solver(
     args: &GenerateArgs,
     verify_trials: Option<u32>,
@@ -309,7 +303,7 @@ fn chosen_solver(
         (None, _, _) => None,
         // A Solver judge's policy; none for the scripted player.
         (Some(_), Some(judge), _) => {
-            load_judge_under(&policies_dir(args)?, args.game, judge, profile)?
+            load_judge(&policies_dir(args)?, args.game, judge)?.map(|(policy, _)| policy)
         }
         (Some(_), None, Some(path)) => Some(load_solver(path, args.game)?.0),
         (Some(_), None, None) => {
@@ -330,17 +324,15 @@ fn chosen_solver(
                     return Ok(None);
                 }
             };
-            let policy = load_folder_solver(folder, args.game, profile)?;
-            // A folder's Solver that cannot play the character gives way to the scripted expert
-            // (the line names the ability-aware one's range too, read only then).
-            if policy.stand_in(profile).is_none() {
-                return Ok(Some(policy));
+            let policy = load_solver(&folder.join(SOLVER_FILE), args.game)?.0;
+            // A folder's Solver that cannot play the character gives way to the scripted expert.
+            match policy.stand_in(profile) {
+                None => Some(policy),
+                Some((_, why)) => {
+                    crate::warn!("{why}");
+                    None
+                }
             }
-            let aware = load_aware_solver(folder, args.game)?;
-            if let Some((_, why)) = policy.stand_in_beside(aware.as_ref(), profile) {
-                crate::warn!("{why}");
-            }
-            None
         }
     })
 }

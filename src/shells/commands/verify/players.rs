@@ -8,7 +8,7 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use crate::services::policies::{load_aware_solver, load_solver};
+use crate::services::policies::load_solver;
 use crate::services::verify::{ProfileFit, Solver, SolverPolicy, default_player};
 use crate::shells::cli::{SolverChoice, VerifyArgs, default_solver};
 use arlpcg_core::game::Skill;
@@ -24,13 +24,10 @@ pub(super) struct Solvers {
 }
 
 enum Resolved {
-    /// A Solver policy and, for the shipped one, the shipped ability-aware Solver that plays
-    /// levels made for abilities it did not train with ([`SolverPolicy::or_aware`]). Unless
-    /// `named` (by --policy or --solver policy), the scripted expert plays levels made for
-    /// abilities neither trained with ([`default_player`]).
+    /// A Solver policy. Unless `named` (by --policy or --solver policy), the scripted expert
+    /// plays levels made for abilities it did not train with ([`default_player`]).
     Policy {
         policy: Box<SolverPolicy>,
-        aware: Option<Box<SolverPolicy>>,
         named: bool,
     },
     Scripted(Skill),
@@ -54,18 +51,12 @@ impl Solvers {
             SolverChoice::Policy => match &args.policy {
                 Some(policy) => Resolved::Policy {
                     policy: Box::new(load_solver(policy, game)?.0),
-                    aware: None,
                     named: true,
                 },
                 None => {
                     let policy = shipped.as_ref().map_err(|e| anyhow::anyhow!("{e:#}"))?;
-                    let dir = policy
-                        .parent()
-                        .expect("the Solver file of a policies folder");
-                    let aware = load_aware_solver(dir, game)?.map(Box::new);
                     Resolved::Policy {
                         policy: Box::new(load_solver(policy, game)?.0),
-                        aware,
                         named: args.solver.is_some(),
                     }
                 }
@@ -75,19 +66,7 @@ impl Solvers {
         };
         if !args.json {
             let who = match &resolved {
-                Resolved::Policy {
-                    policy,
-                    aware: None,
-                    ..
-                } => format!("policy {}", policy.reference.path),
-                Resolved::Policy {
-                    policy,
-                    aware: Some(aware),
-                    ..
-                } => format!(
-                    "policy {} (under other abilities, {})",
-                    policy.reference.path, aware.reference.path
-                ),
+                Resolved::Policy { policy, .. } => format!("policy {}", policy.reference.path),
                 Resolved::Scripted(_) if args.solver.is_none() => match &shipped {
                     Ok(path) => {
                         format!("scripted player (no trained Solver at {})", path.display())
@@ -107,18 +86,13 @@ impl Solvers {
     /// trained with, or gives way to the scripted expert there; refuses a level beyond a named
     /// ability-aware policy's range.
     pub(super) fn check_profile(&mut self, level: &Level, file: &Path) -> Result<()> {
-        let Resolved::Policy {
-            policy,
-            aware,
-            named,
-        } = &self.resolved[&level.game()]
-        else {
+        let Resolved::Policy { policy, named } = &self.resolved[&level.game()] else {
             return Ok(());
         };
         let played = level.profile.as_ref();
-        let said = match default_player(policy, aware.as_deref(), played) {
+        let said = match default_player(policy, played) {
             (_, Some(gave_way)) if !named => gave_way,
-            _ => match policy.or_aware(aware.as_deref(), played).fit(played) {
+            _ => match policy.fit(played) {
                 ProfileFit::Fits => return Ok(()),
                 ProfileFit::Beyond(problem) => anyhow::bail!("{}: {problem}", file.display()),
                 ProfileFit::Untrained(said) => said,
@@ -136,12 +110,9 @@ impl Solvers {
         match &self.resolved[&level.game()] {
             Resolved::Policy {
                 policy,
-                aware,
                 named: false,
-            } => default_player(policy, aware.as_deref(), played).0,
-            Resolved::Policy { policy, aware, .. } => {
-                Solver::Policy(policy.or_aware(aware.as_deref(), played))
-            }
+            } => default_player(policy, played).0,
+            Resolved::Policy { policy, .. } => Solver::Policy(policy),
             Resolved::Scripted(skill) => Solver::Scripted(*skill),
             Resolved::Random => Solver::Random,
         }

@@ -306,7 +306,7 @@ fn wanted_level(
         .generator
         .as_deref()
         .map_or(LevelSource::Rules(game), LevelSource::Generator);
-    let solver = match policies.policy_under(request.profile.as_ref()) {
+    let solver = match policies.solver.as_deref() {
         Some(policy) => Solver::Policy(policy),
         None => Solver::Scripted(policies.skill),
     };
@@ -500,7 +500,8 @@ fn target_level(
         .as_deref()
         .ok_or("a success target needs a Generator")?;
     let solver = policies
-        .policy_under(asked.profile.as_ref())
+        .solver
+        .as_deref()
         .ok_or("a success target needs a trained Solver to measure success with (p loads one)")?;
     let folder = Path::new(&generator.reference.path)
         .parent()

@@ -1,5 +1,5 @@
 //! The policies the designer's workers hold, per game: loading a folder or a file, and switching
-//! the judge that plays (each Solver judge with the ability-aware Solver that goes with it).
+//! the judge that plays.
 
 use std::path::Path;
 use std::sync::{Arc, Mutex};
@@ -10,12 +10,12 @@ use super::super::app::{JudgeSwitch, LoadedInfo, PolicyInfo};
 use crate::services::generation::{GeneratorPolicy, LevelRequest};
 use crate::services::making::LevelSource;
 use crate::services::panel::Judge;
-use crate::services::policies::{load_aware_solver, load_generator, load_solver, policy_paths};
+use crate::services::policies::{load_generator, load_solver, policy_paths};
 use crate::services::verify::{self, Solver, SolverPolicy};
 use arlpcg_core::game::Skill;
-use arlpcg_core::level::profile::Profile;
+
 use arlpcg_core::level::{Game, Level, PerGame};
-use arlpcg_core::rl::checkpoint::{PolicyError, TrainMode};
+use arlpcg_core::rl::checkpoint::PolicyError;
 
 /// The policies of one game in use; either may be missing (rule levels; the scripted player).
 #[derive(Default, Clone)]
@@ -24,9 +24,6 @@ pub struct Policies {
     pub generator: Option<Arc<GeneratorPolicy>>,
     /// The Solver, if one is loaded (none: the scripted player).
     pub solver: Option<Arc<SolverPolicy>>,
-    /// The folder's ability-aware Solver, which plays levels made for abilities the Solver did
-    /// not train with ([`SolverPolicy::or_aware`]).
-    pub aware: Option<Arc<SolverPolicy>>,
     /// The scripted player's skill, when it plays (no Solver).
     pub skill: Skill,
 }
@@ -35,20 +32,12 @@ pub struct Policies {
 pub type GamePolicies = PerGame<Policies>;
 
 impl Policies {
-    /// The Solver policy that plays under `profile` (none: the built-in abilities), if one does.
-    pub(super) fn policy_under(&self, profile: Option<&Profile>) -> Option<&SolverPolicy> {
-        let solver = self.solver.as_deref()?;
-        Some(solver.or_aware(self.aware.as_deref(), profile))
-    }
-
-    /// Who plays `level`: the Solver, or the ability-aware one in its place, where it trained
-    /// with the level's abilities; else the scripted expert, and the line that says why
-    /// ([`verify::default_player`]). Without a Solver, the scripted player at its skill.
+    /// Who plays `level`: the Solver, where it trained with the level's abilities; else the
+    /// scripted expert, and the line that says why ([`verify::default_player`]). Without a
+    /// Solver, the scripted player at its skill.
     pub(super) fn player(&self, level: &Level) -> (Solver<'_>, Option<String>) {
         match self.solver.as_deref() {
-            Some(solver) => {
-                verify::default_player(solver, self.aware.as_deref(), level.profile.as_ref())
-            }
+            Some(solver) => verify::default_player(solver, level.profile.as_ref()),
             None => (Solver::Scripted(self.skill), None),
         }
     }
@@ -101,7 +90,6 @@ pub fn load(path: &Path, game: Game) -> Result<(Policies, LoadedInfo)> {
         if solver.exists() {
             let (policy, card) = load_solver(&solver, game)?;
             policies.solver = Some(Arc::new(policy));
-            policies.aware = load_aware_solver(path, game)?.map(Arc::new);
             info.solver = Some(PolicyInfo { path: solver, card });
         }
         return Ok((policies, info));
@@ -133,10 +121,6 @@ pub(super) fn load_into(
         let old = &mut shared[game];
         *old = Policies {
             generator: loaded.generator.or(old.generator.clone()),
-            aware: match loaded.solver {
-                Some(_) => loaded.aware,
-                None => old.aware.clone(),
-            },
             solver: loaded.solver.or(old.solver.clone()),
             skill: old.skill,
         };
@@ -156,7 +140,7 @@ pub(super) fn next_judge(
     for k in 1..=Judge::ALL.len() {
         let judge = Judge::ALL[(start + k) % Judge::ALL.len()];
         let (solver, info, skill) = match judge {
-            Judge::Scripted(skill) => ((None, None), None, skill),
+            Judge::Scripted(skill) => (None, None, skill),
             Judge::Solver(_) => {
                 let path = crate::services::policies::judge_file(folder, judge)
                     .expect("a Solver judge has a file");
@@ -166,15 +150,8 @@ pub(super) fn next_judge(
                 let (policy, card) = crate::services::policies::load_judge(folder, game, judge)
                     .map_err(|e| format!("{e:#}"))?
                     .expect("a Solver judge is loaded with its policy");
-                // The ARLPCG judge brings the folder's ability-aware Solver with it.
-                let aware = match judge {
-                    Judge::Solver(TrainMode::Arlpcg) => load_aware_solver(folder, game)
-                        .map_err(|e| format!("{e:#}"))?
-                        .map(Arc::new),
-                    Judge::Solver(_) | Judge::Scripted(_) => None,
-                };
                 (
-                    (Some(Arc::new(policy)), aware),
+                    Some(Arc::new(policy)),
                     Some(PolicyInfo { path, card }),
                     Skill::Expert,
                 )
@@ -182,7 +159,7 @@ pub(super) fn next_judge(
         };
         if let Ok(mut shared) = policies.lock() {
             let current = &mut shared[game];
-            (current.solver, current.aware) = solver;
+            current.solver = solver;
             current.skill = skill;
         }
         return Ok(JudgeSwitch {

@@ -1065,7 +1065,8 @@ fn a_hard_success_floor_leaves_the_hard_side_unpaid_after_a_phase_below_it() {
             .filter(|row| step(row) < 640)
             .collect::<Vec<_>>()
     };
-    let paid = generator_rows("");
+    // The recipe's own floor is 0.25: `null` turns it off.
+    let paid = generator_rows("  hard_success_floor: null\n");
     let never_below = generator_rows("  hard_success_floor: 0.0\n");
     let always_below = generator_rows("  hard_success_floor: 1.0\n");
     assert!(paid.len() >= 3, "{paid:?}");

@@ -65,7 +65,9 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             scripted_opponent: None,
             paced_share: match mode {
                 TrainMode::FixedAux => 0.0,
-                _ => config.generator.paced_share,
+                _ => schedule
+                    .paced_share
+                    .unwrap_or(config.generator.paced_share),
             },
             trained_over: config
                 .trained_over(G::GAME)
@@ -316,6 +318,9 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         self.envs().rules.scripted_opponent = schedule.scripted_opponent;
         self.envs().rules.limits.reach_runs = schedule.reach_runs;
         self.envs().rules.draw_knobs = schedule.draw_knobs;
+        if let Some(share) = schedule.paced_share {
+            self.envs().rules.paced_share = share;
+        }
         match self.envs().state.phase {
             Phase::Solver => {
                 let rollout = self

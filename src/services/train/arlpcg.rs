@@ -272,6 +272,7 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
         MadeUnder {
             reach_runs: self.rules.limits.reach_runs,
             draw_knobs: self.rules.draw_knobs,
+            paced_share: Some(self.rules.paced_share),
         }
     }
 
@@ -295,7 +296,8 @@ impl<G: GeneratorGame> AdversarialEnvs<G> {
             .collect();
         let fresh = Match::new(build, vec![aux], seed).with_knobs(knobs);
         // Drawn only when pacing is on, so that runs without it keep their bytes.
-        if self.rules.paced_share > 0.0 && rng.random_bool(self.rules.paced_share) {
+        let paced_share = under.paced_share.unwrap_or(self.rules.paced_share);
+        if paced_share > 0.0 && rng.random_bool(paced_share) {
             let pacing = MatchPacing {
                 before: aux,
                 after: values[rng.random_range(0..values.len())],

@@ -43,6 +43,10 @@ pub struct MadeUnder {
     pub reach_runs: Option<u64>,
     /// Whether the match's knobs were drawn (else all 0).
     pub draw_knobs: bool,
+    /// The share of paced matches it was drawn under (none, in a checkpoint from before the
+    /// field: the share in force when it is replayed).
+    #[serde(default)]
+    pub paced_share: Option<f64>,
 }
 
 /// One thing that happened in a match, as the action row that made it happen.

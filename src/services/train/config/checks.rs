@@ -110,6 +110,7 @@ fn check_schedule(g: &GeneratorConfig) -> Result<(), String> {
                 "generator_until_hard_success", g.finish.generator_until_hard_success,
             ),
             ("until_hard_success", g.finish.until_hard_success),
+            ("paced_share", g.finish.paced_share),
         ] {
             if ratio.is_some_and(|r| !(0.0..=1.0).contains(&r)) {
                 return Err(format!("finish.{name} must be a ratio in [0, 1]"));

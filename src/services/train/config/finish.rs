@@ -83,6 +83,11 @@ pub struct Finish {
     /// nothing (docs/decisions.md, D20). False: drawn in every match.
     #[serde(default)]
     pub knobs_only: bool,
+    /// The share of the finish's matches that are paced (λ changes once along the level), in
+    /// place of `generator.paced_share` (none: that one), so that a Generator that learns
+    /// against the final Solver for long keeps following λ after a stretch of another λ.
+    #[serde(default)]
+    pub paced_share: Option<f64>,
 }
 
 /// The scripted player as the Generator's opponent in a finish ([`Finish::scripted_opponent`]);
@@ -144,6 +149,7 @@ impl Finish {
         scripted_opponent: None,
         reach_runs: None,
         knobs_only: false,
+        paced_share: None,
     };
 }
 

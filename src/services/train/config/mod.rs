@@ -269,6 +269,7 @@ impl GeneratorConfig {
                 scripted_opponent: None,
                 reach_runs: None,
                 draw_knobs: !self.finish.knobs_only,
+                paced_share: None,
             },
             None => Schedule {
                 solver_learning_rate: None,
@@ -280,6 +281,7 @@ impl GeneratorConfig {
                 scripted_opponent: None,
                 reach_runs: None,
                 draw_knobs: !self.finish.knobs_only,
+                paced_share: None,
             },
         }
     }
@@ -304,6 +306,8 @@ pub struct Schedule {
     pub reach_runs: Option<u64>,
     /// Whether the Generator's knobs are drawn (`Finish::knobs_only`), else all 0.
     pub draw_knobs: bool,
+    /// The finish's share of paced matches (`Finish::paced_share`; none: the Generator's own).
+    pub paced_share: Option<f64>,
 }
 
 impl Default for GeneratorConfig {
@@ -438,6 +442,7 @@ impl TrainConfig {
                 scripted_opponent: finish.scripted_opponent,
                 reach_runs: finish.reach_runs,
                 draw_knobs: true,
+                paced_share: finish.paced_share,
             };
         }
         self.generator.schedule_at(solver_steps)

@@ -978,13 +978,14 @@ fn a_finish_generator_phase_until_a_success_ends_early() {
 /// `finish.reach_runs`: the finish's Generator cuts its jumps to the reach counted in that many
 /// of the eight runs, and its card says so, so `generate` cuts its levels the same way; the
 /// Solver's card and the Generator's before the finish name no reach. A run with it and with
-/// knobs drawn in the finish only, paused before the finish or where it begins, resumes to the
-/// bytes of the run never paused: the matches it replays follow the rules they were made under.
+/// knobs drawn and matches paced in the finish only, paused before the finish or where it
+/// begins, resumes to the bytes of the run never paused: the matches it replays follow the
+/// rules they were made under.
 #[test]
 fn a_finish_with_its_own_reach_writes_it_on_the_card_and_resumes_to_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();
     let config = tiny_with_finish(
-        "solver_steps: 384\ngenerator_phase_steps: 64\nreach_runs: 1\nknobs_only: true",
+        "solver_steps: 384\ngenerator_phase_steps: 64\nreach_runs: 1\nknobs_only: true\npaced_share: 1.0",
     )
     .replace(
         "generator:\n",
@@ -1013,6 +1014,30 @@ fn a_finish_with_its_own_reach_writes_it_on_the_card_and_resumes_to_the_same_byt
         "generate --policies {} --aux -1 --count 2 --out {}",
         &[&whole, &levels],
     ));
+}
+
+/// `finish.paced_share`: the finish's matches are paced in that share, the matches before it
+/// as `generator.paced_share` says (none on platform): every Generator row before the finish is
+/// the run's without it, and the finish's differ.
+#[test]
+fn matches_paced_in_the_finish_only_leave_the_run_before_it_unchanged() {
+    let rows = |paced: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let config = tiny_with_finish(&format!(
+            "solver_steps: 128\ngenerator_phase_steps: 64{paced}"
+        ));
+        let out = train_tiny_to_640(dir.path(), &config);
+        let rows = without_clock(&out.join("generator-metrics.csv")).unwrap();
+        let step = |row: &String| row.split(',').nth(1).unwrap().parse::<u64>().unwrap();
+        let (before, finish): (Vec<String>, Vec<String>) =
+            rows.into_iter().skip(1).partition(|row| step(row) < 640);
+        (before, finish)
+    };
+    let (before, finish) = rows("");
+    let (paced_before, paced_finish) = rows("\npaced_share: 1.0");
+    assert!(!before.is_empty() && !finish.is_empty());
+    assert_eq!(before, paced_before);
+    assert_ne!(finish, paced_finish);
 }
 
 /// `finish.knobs_only`: a Generator's style knobs are drawn in the finish only, every knob 0

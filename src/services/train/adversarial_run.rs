@@ -65,9 +65,7 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             scripted_opponent: None,
             paced_share: match mode {
                 TrainMode::FixedAux => 0.0,
-                _ => schedule
-                    .paced_share
-                    .unwrap_or(config.generator.paced_share),
+                _ => schedule.paced_share.unwrap_or(config.generator.paced_share),
             },
             trained_over: config
                 .trained_over(G::GAME)

@@ -248,6 +248,11 @@ fn out_of_range_generator_fields_are_named() {
             "generator.paced_share must be a number in [0, 1]",
         ),
         (
+            "generator:\n  finish: {solver_steps: 64, generator_phase_steps: 9, paced_share: 2}\n",
+            Game::Platform,
+            "finish.paced_share must be a ratio in [0, 1]",
+        ),
+        (
             "generator:\n  population: 99\n",
             Game::Platform,
             "generator.population must be within [0, 16]",

@@ -131,6 +131,7 @@ mod tests {
         assert_eq!(finish.generator_until_hard_success, Some(0.4));
         assert_eq!(finish.reach_runs, Some(4));
         assert!(finish.knobs_only);
+        assert_eq!(finish.paced_share, Some(0.5));
         assert!(
             finish
                 .scripted_opponent

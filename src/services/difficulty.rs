@@ -4,8 +4,8 @@
 //! One level's success at a λ varies a lot from seed to seed (the curve is an average), so the
 //! search starts at the λ the curve gives for `P` and then moves λ by how far each verified
 //! candidate missed, drawing a new level of the same seed and goal each time, until one
-//! measures within [`BAND`] of `P`. A seed's scene can rule a band out (seed 1's goal: no level
-//! of the shipped platform policies under 0.31), so after [`OWN_SCENE_CANDIDATES`] misses,
+//! measures within [`BAND`] of `P`. A seed's scene can rule a band out (seed 3's goal: no level
+//! of the shipped platform policies under 0.55), so after [`OWN_SCENE_CANDIDATES`] misses,
 //! unless the goal was given, each candidate is built from another seed's scene (the level
 //! records that seed). Each candidate plays [`SCREEN_TRIALS`] runs first and the rest only if
 //! their 95% interval still meets the band: a kept level's statistics are those of all its

@@ -673,7 +673,7 @@ fn sharded_eval_merges_into_the_unsharded_results() {
 fn verified_levels_are_completable_and_their_certificates_replay() {
     let dir = tempfile::tempdir().unwrap();
     let out = arlpcg_ok(words(
-        "generate --policies policies/platform --aux -1 --count 12 --verify 3 --format yaml --out {}",
+        "generate --policies policies/platform --aux -1 --count 12 --verify 1 --format yaml --out {}",
         &[&dir.path()],
     ));
     let said = String::from_utf8_lossy(&out.stdout);
@@ -688,7 +688,7 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
         redraws += stats.redraws;
         levels.push(path.display().to_string());
     }
-    // At λ = -1 (success about 0.4) a level verified with 3 runs is often completed by none.
+    // At λ = -1 (success about 0.7) a level verified with one run is often completed by none.
     assert!(redraws > 0, "nothing was redrawn: {said}");
     assert!(said.contains("redrew"), "{said}");
     let mut args = vec!["verify", "--replay"];
@@ -712,24 +712,24 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
 
 /// `--target-success P` hands out levels whose measured success is within ±0.1 of P, recording
 /// the λ it used; the curve it starts from is the one kept beside the shipped policies.
-/// A seed whose goal rules the band out (seed 1's scene: no λ or draw of the shipped Generator
-/// measures under 0.31) gets a level of another seed's scene, which it records.
+/// A seed whose goal rules the band out (seed 3's scene: no λ or draw of the shipped Generator
+/// measures under 0.55) gets a level of another seed's scene, which it records.
 #[test]
 fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band() {
     let dir = tempfile::tempdir().unwrap();
     arlpcg_ok(words(
-        "generate --policies policies/platform --target-success 0.2 --seed 1 --verify 100 --format yaml --out {}",
+        "generate --policies policies/platform --target-success 0.2 --seed 3 --verify 100 --format yaml --out {}",
         &[&dir.path()],
     ));
     let files = files_of(dir.path());
     assert_eq!(files.len(), 1);
     let (name, _) = &files[0];
-    assert!(name.starts_with("platform_seed1_"), "{name}");
+    assert!(name.starts_with("platform_seed3_"), "{name}");
     let level = arlpcg_core::level::yaml::load(&dir.path().join(name)).unwrap();
     assert_ne!(
         level.seed,
-        Some(1),
-        "{name} was built from seed 1's own scene"
+        Some(3),
+        "{name} was built from seed 3's own scene"
     );
     let stats = level.stats.unwrap();
     assert!(
@@ -737,18 +737,18 @@ fn target_success_borrows_another_seeds_scene_when_its_own_cannot_meet_the_band(
         "{}",
         stats.success_ratio
     );
-    // Given the goal, the search keeps to it, and seed 1's goal rules 0.2 out (closest 0.31).
+    // Given the goal, the search keeps to it, and seed 3's goal rules 0.2 out (closest 0.55).
     let own = dir.path().join("own");
     arlpcg_ok(words(
-        "generate --policies policies/platform --aux -1 --seed 1 --format yaml --out {}",
+        "generate --policies policies/platform --aux -1 --seed 3 --format yaml --out {}",
         &[&own],
     ));
-    let goal = arlpcg_core::level::yaml::load(&own.join("platform_seed1_aux-1.00.yaml"))
+    let goal = arlpcg_core::level::yaml::load(&own.join("platform_seed3_aux-1.00.yaml"))
         .unwrap()
         .goal;
     let goal = format!("{},{},{}", goal[0], goal[1], goal[2]);
     let out = arlpcg(words(
-        "generate --policies policies/platform --target-success 0.2 --seed 1 {} --out {}",
+        "generate --policies policies/platform --target-success 0.2 --seed 3 {} --out {}",
         &[&format!("--goal={goal}"), &dir.path().join("given")],
     ));
     fails_with(&out, 1, "no level within ±0.1 of success 0.2");

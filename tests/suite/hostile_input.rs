@@ -257,8 +257,19 @@ fn a_card_that_disagrees_with_its_weights_or_its_game_is_refused_by_name() {
         env!("CARGO_MANIFEST_DIR"),
         "/levels/platform/platform_seed7_aux+0.50.yaml"
     );
+    // The shipped Solver observes the game's values and the character's abilities after them.
+    let observation = load_policy(
+        &shipped_solver(),
+        Game::Platform,
+        Role::Solver,
+        OBSERVATION_SIZE,
+    )
+    .unwrap()
+    .card
+    .network
+    .observation;
     let solver_shape = |continuous, binary| arlpcg_core::rl::policy::PolicyShape {
-        observation: OBSERVATION_SIZE,
+        observation,
         hidden: vec![8],
         continuous,
         binary,
@@ -338,6 +349,11 @@ fn files_meet_the_limits_of_the_arguments_that_make_them() {
     ))
     .unwrap();
     let file = dir.path().join("campaign.yaml");
+    let theta_sd = shipped
+        .lines()
+        .find(|line| line.trim_start().starts_with("theta_sd: "))
+        .unwrap()
+        .trim_start();
     for (from, to, expected) in [
         (
             "trials: 100\n",
@@ -345,12 +361,12 @@ fn files_meet_the_limits_of_the_arguments_that_make_them() {
             "trials: 4000000000 is not within [10, 100000]",
         ),
         (
-            "theta_sd: 2.9968", "theta_sd: 1.0e308", "population.theta_sd 1e308 must be",
+            theta_sd, "theta_sd: 1.0e308", "population.theta_sd 1e308 must be",
         ),
         (
             "  measured: 1.0\n",
             "  measured: 1.0e308\n",
-            "levels[0].measured: 1e308 is not a number within [0, 1]",
+            "].measured: 1e308 is not a number within [0, 1]",
         ),
     ] {
         assert!(shipped.contains(from), "{from}");

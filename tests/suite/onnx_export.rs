@@ -53,40 +53,63 @@ fn export_policy_writes_the_graph_and_its_sidecar_once() {
     assert!(!other.exists() && !Path::new("model.pt").exists());
 }
 
+/// Plays a Solver's golden episode again from its level and recorded actions: each frame's
+/// observation and state are the game's, with the abilities an ability-aware Solver observes.
+fn replay_golden<G: arlpcg_core::game::GameSpec>(
+    episode: &serde_json::Value,
+    state_names: &[&str],
+) {
+    use arlpcg_core::game::SolverEnv;
+    let level = arlpcg_core::level::yaml::parse(episode["level"].as_str().unwrap()).unwrap();
+    let mut env = G::solver_env(&level).unwrap();
+    env.reset(episode["run_seed"].as_u64().unwrap());
+    let frames = episode["frames"].as_array().unwrap();
+    assert!(frames.len() > 50, "{} frames", frames.len());
+    for frame in frames {
+        let mut observation = vec![0.0f32; G::Env::OBSERVATION_SIZE];
+        env.observe(&mut observation);
+        let recorded: Vec<f32> = serde_json::from_value(frame["observation"].clone()).unwrap();
+        let (game_part, ability_part) = recorded.split_at(G::Env::OBSERVATION_SIZE);
+        assert_eq!(observation, game_part);
+        let mut names: Vec<&str> = frame["state"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(String::as_str)
+            .collect();
+        // An ability-aware Solver observes `value/ours - 1` of each main ability after the
+        // game's values, and its state holds both (a golden episode plays with ours: 0).
+        if !ability_part.is_empty() {
+            let read = |key: &str| -> Vec<f64> {
+                serde_json::from_value(frame["state"][key].clone()).unwrap()
+            };
+            let (played, ours) = (read("abilities"), read("abilities_built_in"));
+            let expected: Vec<f32> = played
+                .iter()
+                .zip(&ours)
+                .map(|(p, o)| (p / o - 1.0) as f32)
+                .collect();
+            assert_eq!(ability_part, expected);
+            names.retain(|name| !name.starts_with("abilities"));
+        }
+        assert_eq!(names, state_names);
+        let action: Vec<f32> = serde_json::from_value(frame["action"].clone()).unwrap();
+        assert!(action.iter().all(|a| (-1.0..=1.0).contains(a)));
+        env.step(G::Env::action_from_policy_row(&action));
+    }
+    assert_eq!(
+        episode["outcome"], "Success",
+        "the shipped Solver completes its level"
+    );
+}
+
 /// A policy's export has its golden episode beside it. A Solver's is a real run on the level
 /// it carries, which plays again to the same observations from the recorded actions (so a port
 /// checks itself against a run the game really has), each frame's state holding every group a
 /// port reads; a Generator's has one frame per piece of the level it built.
 #[test]
 fn a_policys_golden_episode_replays_from_its_level_and_actions() {
-    use arlpcg_core::game::{GameSpec, PlatformGame, RacingGame, SolverEnv};
-    fn replay<G: GameSpec>(episode: &serde_json::Value, state_names: &[&str]) {
-        let level = arlpcg_core::level::yaml::parse(episode["level"].as_str().unwrap()).unwrap();
-        let mut env = G::solver_env(&level).unwrap();
-        env.reset(episode["run_seed"].as_u64().unwrap());
-        let frames = episode["frames"].as_array().unwrap();
-        assert!(frames.len() > 50, "{} frames", frames.len());
-        for frame in frames {
-            let mut observation = vec![0.0f32; G::Env::OBSERVATION_SIZE];
-            env.observe(&mut observation);
-            let recorded: Vec<f32> = serde_json::from_value(frame["observation"].clone()).unwrap();
-            assert_eq!(observation, recorded);
-            let names: Vec<&str> = frame["state"]
-                .as_object()
-                .unwrap()
-                .keys()
-                .map(String::as_str)
-                .collect();
-            assert_eq!(names, state_names);
-            let action: Vec<f32> = serde_json::from_value(frame["action"].clone()).unwrap();
-            assert!(action.iter().all(|a| (-1.0..=1.0).contains(a)));
-            env.step(G::Env::action_from_policy_row(&action));
-        }
-        assert_eq!(
-            episode["outcome"], "Success",
-            "the shipped Solver completes its level"
-        );
-    }
+    use arlpcg_core::game::{PlatformGame, RacingGame};
     let dir = tempfile::tempdir().unwrap();
     for (game, names) in [
         (
@@ -116,8 +139,8 @@ fn a_policys_golden_episode_replays_from_its_level_and_actions() {
             serde_json::from_slice(&std::fs::read(&golden).unwrap()).unwrap();
         assert_eq!(episode["format"], "arlpcg-golden-episode");
         match game {
-            "platform" => replay::<PlatformGame>(&episode, names),
-            _ => replay::<RacingGame>(&episode, names),
+            "platform" => replay_golden::<PlatformGame>(&episode, names),
+            _ => replay_golden::<RacingGame>(&episode, names),
         }
     }
     // A Generator's: each piece it placed at λ = -1, the level it built loading as a level.

@@ -276,13 +276,13 @@ fn a_paced_campaign_moves_one_shape_per_level() {
         ],
     );
     assert!(done.status.success(), "{}", stderr(&done));
-    // The panel's Solvers of one character never trained with the profile's run speed, and the
-    // campaign says so as `verify` does, once, naming them (the ability-aware Solver plays for
-    // arlpcg: its range holds 8.5 m/s).
+    // Every Solver of the shipped panel trained over ranges that hold 8.5 m/s, so the campaign
+    // warns of none (one beyond them is named, as `verify` does).
     let said = stderr(&done);
-    let never = "panel judges rule-pcg, fixed-track, fixed-aux: the Solver policy trained for the built-in abilities plays under profile `quick`: its statistics are of a player who never trained with them";
-    assert!(said.contains(never), "{said}");
-    assert_eq!(said.matches("never trained").count(), 1, "{said}");
+    assert!(
+        !said.contains("never trained") && !said.contains("lies beyond"),
+        "{said}"
+    );
     let level01 = std::fs::read_to_string(out.join("level01.yaml")).unwrap();
     assert!(level01.contains("profile:\n  name: quick"), "{level01}");
     let record: serde_yaml::Value =
@@ -347,12 +347,12 @@ fn checks_fail_a_batch_with_exit_code_3_and_bad_checks_are_usage_errors() {
         2,
         "with --panel, `completed` has no one player's runs",
     );
-    // A check on the pieces reads the same level file: the shipped level has 11 blocks.
-    assert!(verify(&["pieces 11", "jump 5..10"]).status.success());
+    // A check on the pieces reads the same level file: the shipped level has 5 blocks.
+    assert!(verify(&["pieces 5", "jump 5..10"]).status.success());
     let pieces = verify(&["pieces >= 20"]);
     fails_with(&pieces, 3, "1 of 1 levels failed their checks");
     assert!(
-        String::from_utf8_lossy(&pieces.stdout).contains("pieces >= 20: measured 11"),
+        String::from_utf8_lossy(&pieces.stdout).contains("pieces >= 20: measured 5"),
         "{}",
         String::from_utf8_lossy(&pieces.stdout)
     );
@@ -379,17 +379,17 @@ fn checks_fail_a_batch_with_exit_code_3_and_bad_checks_are_usage_errors() {
     fails_with(&racing, 2, "`curve` is not an attribute of these levels");
 }
 
-/// A campaign's checks on the pieces are met by search, not only checked: levels 1 and 2 of
-/// this campaign have 7 and 6 blocks when searched for their ramp point alone.
+/// A campaign's checks on the pieces are met by search, not only checked: the three levels of
+/// this campaign have 7, 3 and 9 blocks when searched for their ramp point alone.
 #[test]
 fn a_campaign_searches_for_its_checks_on_the_pieces() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("campaign");
-    let done = small_campaign(&out, &["--check", "pieces 10..11"]);
+    let done = small_campaign(&out, &["--check", "pieces 5..6"]);
     assert!(done.status.success(), "{}", stderr(&done));
     for k in 1..=3 {
         let level = arlpcg_core::level::yaml::load(&out.join(format!("level0{k}.yaml"))).unwrap();
         let blocks = level.platform().unwrap().block_count();
-        assert!((10..=11).contains(&blocks), "level {k}: {blocks} blocks");
+        assert!((5..=6).contains(&blocks), "level {k}: {blocks} blocks");
     }
 }

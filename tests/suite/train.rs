@@ -919,12 +919,13 @@ fn a_learning_finish_opens_with_the_generator_and_ends_with_the_solver_catching_
 }
 
 /// A catch-up that ends at a success: with `until_hard_success: 0` the first block of hard
-/// matches the Solver finishes in it ends the run, long before the finish's limit.
+/// matches the Solver finishes in it ends the run, long before the finish's limit. Its matches
+/// are unpaced (the recipe paces half of the finish's, which the stops do not count).
 #[test]
 fn a_catch_up_until_a_success_ends_the_run_early() {
     let dir = tempfile::tempdir().unwrap();
     let until = tiny_with_finish(
-        "solver_steps: 64000\ngenerator_phase_steps: 8\nsolver_learning_rate: 1.0e-4\nsolver_phase_steps: 1000000\nuntil_hard_success: 0.0",
+        "solver_steps: 64000\ngenerator_phase_steps: 8\nsolver_learning_rate: 1.0e-4\nsolver_phase_steps: 1000000\nuntil_hard_success: 0.0\npaced_share: null",
     );
     let out = train_tiny_to_640(dir.path(), &until);
     let last = curve(&out).last().unwrap().1;
@@ -937,13 +938,13 @@ fn a_catch_up_until_a_success_ends_the_run_early() {
 /// A finish's Generator phase that ends at a success: with `generator_until_hard_success: 1`
 /// the first block of 32 hard matches ends it, long before its limit of 4,000 decisions, and
 /// the catch-up that follows runs to the budget. With blocks of 96 (`hard_match_block`) the
-/// same phase plays on until three times as many hard matches have ended.
+/// same phase plays on until three times as many hard matches have ended. Unpaced, as above.
 #[test]
 fn a_finish_generator_phase_until_a_success_ends_early() {
     let finish_decisions = |block: &str| {
         let dir = tempfile::tempdir().unwrap();
         let until = tiny_with_finish(&format!(
-            "solver_steps: 256\ngenerator_phase_steps: 4000\nsolver_learning_rate: 1.0e-4\nsolver_phase_steps: 1000000\ngenerator_until_hard_success: 1.0{block}"
+            "solver_steps: 256\ngenerator_phase_steps: 4000\nsolver_learning_rate: 1.0e-4\nsolver_phase_steps: 1000000\npaced_share: null\ngenerator_until_hard_success: 1.0{block}"
         ));
         let out = train_tiny_to_640(dir.path(), &until);
         // Generator rows of the finish (its phase opens at the budget, 640), each with the
@@ -2016,7 +2017,7 @@ fn a_generator_with_knobs_records_them_and_generates() {
             &[&policies, &aux, &dir.path().join("refused")],
         ))
     };
-    let shipped = concat!(env!("CARGO_MANIFEST_DIR"), "/policies/platform");
+    let without_knobs = concat!(env!("CARGO_MANIFEST_DIR"), "/policies/racing");
     let out_s = out.to_str().unwrap();
     fails_with(
         &refused("difficulty=1,curviness=1", out_s),
@@ -2029,7 +2030,10 @@ fn a_generator_with_knobs_records_them_and_generates() {
         "`stride` is given twice",
     );
     fails_with(
-        &refused("difficulty=1,stride=1", shipped),
+        &arlpcg(words(
+            "generate --game racing --policies {} --aux difficulty=1,curviness=1 --out {}",
+            &[&without_knobs, &dir.path().join("refused")],
+        )),
         1,
         "was trained without knobs",
     );

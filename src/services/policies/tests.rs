@@ -10,7 +10,12 @@ fn a_generators_reach_runs_come_from_its_card_within_its_games_range() {
         .unwrap()
         .1;
     let path = Path::new("g.safetensors");
-    assert_eq!(generator_limits(path, &card).unwrap().reach_runs, None);
+    assert_eq!(generator_limits(path, &card).unwrap().reach_runs, Some(4));
+    let uncut = PolicyCard {
+        reach_runs: None,
+        ..card.clone()
+    };
+    assert_eq!(generator_limits(path, &uncut).unwrap().reach_runs, None);
     let with = |game, runs| PolicyCard {
         game,
         reach_runs: Some(runs),

@@ -467,6 +467,8 @@ pub fn load_policy(
             expected: format!("{game} {role}"),
         });
     }
+    // The card must agree with its own network before either is held against the game.
+    check_card_agrees(&card)?;
     // An ability-aware Solver observes the game's main abilities after the game's observation.
     let observation_size = observation_size + knob_part(&card) + ability_part(&card)?;
     if card.network.observation != observation_size {
@@ -485,7 +487,6 @@ pub fn load_policy(
         )));
     }
     check_normalizer(&card.normalizer)?;
-    check_card_agrees(&card)?;
     if card.network.hidden.len() > MAX_HIDDEN_LAYERS {
         return Err(PolicyError::Card(format!(
             "its network has {} hidden layers, more than {MAX_HIDDEN_LAYERS}",

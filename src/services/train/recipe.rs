@@ -1,8 +1,8 @@
 //! The recipe: what `train` does by default for each game, so that `arlpcg train --game G
 //! --mode M --seed S --out D` alone makes what ships. Every game lays its own recipe over the
 //! configuration's defaults (config/mod.rs), a configuration file in its folder
-//! ([`GeneratorGame::RECIPE`]: platform's sets the networks' width, the characters' ranges,
-//! rule levels and the finish; racing's the budget, the Solver's discount and constant
+//! ([`GeneratorGame::RECIPE`]: platform's sets the budget, the networks' width, the characters'
+//! ranges, rule levels and the finish; racing's the budget, the Solver's discount and constant
 //! learning rate, the Generator's phases, curve offset, paced matches and finish), and sets
 //! the Generator's rewards, piece budget and obstacles from its own. docs/decisions.md says
 //! why each value is what it is.

@@ -105,7 +105,7 @@ let failed = false;
 {
   const golden = JSON.parse(fs.readFileSync(`${onnxPath}.golden.json`, "utf8"));
   const course = new game.Course(RAPIER, game.parse(golden.level));
-  const observation = new Float32Array(game.observationSize);
+  const observation = new Float32Array(solver.observationSize);
   let worst = 0;
   golden.frames.forEach((frame, i) => {
     const run = course.runFromState(frame.state, i);

@@ -188,6 +188,11 @@ export class PlatformCourse {
    */
   constructor(RAPIER, level, character = BUILT_IN_CHARACTER) {
     this.RAPIER = RAPIER;
+    // What an ability-aware Solver observes after the game's columns: each main ability
+    // (jump speed, run speed, gravity) as value/ours - 1 (0 for ours; `ability_columns`).
+    this.abilityPart = ["jump_speed", "run_speed", "gravity"].map((k) =>
+      f32(character[k] / BUILT_IN_CHARACTER[k] - 1.0),
+    );
     this.goal = level.goal.map(f32);
     this.body = {
       runSpeed: f32(character.run_speed),
@@ -294,7 +299,7 @@ export class PlatformCourse {
     return hits;
   }
 
-  /** The Solver's observation of a run into `out` (40 floats; `observe`, env.rs). */
+  /** The Solver's observation of a run into `out` (40 floats, and an ability-aware Solver's 3 abilities; `observe`, env.rs). */
   observe(run, out) {
     const forward = facing(run.yaw);
     const left = [forward[2], 0.0, f32(-forward[0])];
@@ -317,6 +322,10 @@ export class PlatformCourse {
     for (let i = 0; i < STATE_SIZE; i++) out[i] = state[i];
     const hits = this.heightMapHits(run);
     for (let i = 0; i < hits.length; i++) out[STATE_SIZE + i] = f32(f32(RAY_START_HEIGHT - hits[i]) / 4.0);
+    // An ability-aware Solver's row is longer: the abilities follow.
+    for (let i = PLATFORM_SOLVER_OBSERVATION_SIZE; i < out.length; i++) {
+      out[i] = this.abilityPart[i - PLATFORM_SOLVER_OBSERVATION_SIZE];
+    }
     return out;
   }
 
@@ -452,7 +461,7 @@ export class PlatformSolver extends GameSolver {
       observationSize: PLATFORM_SOLVER_OBSERVATION_SIZE,
       sessionOptions: options.sessionOptions,
     });
-    return new PlatformSolver(network, PLATFORM_SOLVER_OBSERVATION_SIZE);
+    return new PlatformSolver(network, network.observationSize);
   }
 
   /** The action a row (forward, turn, jump) stands for (`PlatformAction::from_policy_row`: clipped to [-1, 1], NaN as 0; the jump on at 1). */

@@ -81,13 +81,14 @@ export class SolverNetwork {
     if (sidecar.profile !== "plain") throw new Error("export the Solver with --contract plain");
     if (!sidecar.sampling) throw new Error("the sidecar has no `sampling`: export it again with a newer arlpcg");
     const size = sidecar.inputs[0].shape[1];
-    if (size !== observationSize) {
-      // An ability-aware Solver observes the abilities too; not supported here.
-      throw new Error(`this module plays the ${observationSize}-column ${game} Solver; this one observes ${size}`);
+    // An ability-aware Solver observes the character's main abilities after the game's columns.
+    const abilities = sidecar.inputs[0].columns?.find((c) => c.name === "abilities")?.width ?? 0;
+    if (size !== observationSize + abilities) {
+      throw new Error(`this module plays the ${observationSize}-column ${game} Solver (and its abilities); this one observes ${size}`);
     }
     const { bytes, meanOutput } = exposeMeans(onnx);
     const session = await ort.InferenceSession.create(bytes, sessionOptions);
-    return new SolverNetwork(ort, session, meanOutput, sidecar, observationSize);
+    return new SolverNetwork(ort, session, meanOutput, sidecar, size);
   }
 
   constructor(ort, session, meanOutput, sidecar, observationSize) {

@@ -870,6 +870,55 @@ fn generate_verify_eases_a_seed_that_no_run_completes_up_to_lambda_one() {
     assert!(!dir.path().join("levels").exists(), "nothing written");
 }
 
+/// A seed whose goal the Generator cannot build toward at the asked λ (goals 7-8 m up for
+/// Godot's 1 m jumper at λ = -1) is eased as an unsolved one is, each step said, instead of
+/// failing the batch; the level records the λ it was built at.
+#[test]
+fn generate_verify_eases_a_seed_the_generator_cannot_build_at_its_lambda() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let policies = root.join("policies/platform");
+    let profile = root.join("results/platform/profiles/godot4/profile.yaml");
+    // The goals of seeds 4, 32 and 55 (7.4-8.1 m up), where the shipped Generator builds no
+    // valid level at λ = -1 for this character; one of them is enough.
+    let goal = [
+        "4.868,8.056,-32.429", "15.277,7.435,-27.372", "28.818,7.753,-12.616",
+    ]
+    .into_iter()
+    .find(|goal| {
+        let plain = arlpcg(words(
+            "generate --policies {} --profile {} --aux=-1 --goal {} --count 1 --out {}",
+            &[&policies, &profile, goal, &dir.path().join("plain")],
+        ));
+        !plain.status.success() && stderr(&plain).contains("no valid level")
+    })
+    .expect("the shipped Generator builds a level toward every goal: pick higher ones");
+    let levels = dir.path().join("levels");
+    let out = arlpcg(words(
+        "generate --policies {} --profile {} --aux=-1 --goal {} --count 1 --verify 5 --format yaml --out {}",
+        &[&policies, &profile, &goal, &levels],
+    ));
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("the Generator built no valid level at λ = -1.00; asking λ = -0.75"),
+        "{err}"
+    );
+    let file = std::fs::read_dir(&levels)
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let yaml = std::fs::read_to_string(&file).unwrap();
+    let aux: f64 = yaml
+        .lines()
+        .find_map(|line| line.strip_prefix("aux: "))
+        .and_then(|aux| aux.parse().ok())
+        .unwrap_or_else(|| panic!("no aux in {yaml}"));
+    assert!(aux > -1.0, "{aux}");
+}
+
 #[test]
 fn options_that_would_do_nothing_or_count_twice_are_refused_by_name() {
     let dir = tempfile::tempdir().unwrap();

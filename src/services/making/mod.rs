@@ -8,7 +8,7 @@
 pub mod wanted;
 
 use crate::services::difficulty::{self, Curve};
-use crate::services::generation::{self, GeneratorPolicy, LevelRequest};
+use crate::services::generation::{self, GenerationError, GeneratorPolicy, LevelRequest};
 use crate::services::verify::{self, Solver, Watch};
 use crate::services::wish::Constraint;
 use arlpcg_core::level::{Game, Level};
@@ -144,9 +144,39 @@ pub fn verified_level(
     }
 }
 
+/// Whether `error` says a Generator built no valid level (which a lower λ may build).
+fn built_nothing(error: &anyhow::Error) -> bool {
+    matches!(
+        error.downcast_ref::<GenerationError>(),
+        Some(GenerationError::NoLevel { .. })
+    )
+}
+
+/// Whether `source` builds the seed's first draw of `request` at its λ or at a lower one (λ
+/// eased by `step`, up to λ = 1), as [`Proof::Played`] eases it; the error of the last λ tried
+/// when it builds none (rule levels have no λ to ease). `generate --verify` checks every seed
+/// of a batch with it before any level is played.
+pub fn buildable(source: LevelSource, request: &LevelRequest, step: f64) -> anyhow::Result<()> {
+    let mut request = LevelRequest {
+        draw: 0,
+        ..request.clone()
+    };
+    loop {
+        match source.level(&request) {
+            Err(e) if built_nothing(&e) && matches!(source, LevelSource::Generator(_)) => {
+                match request.aux.as_ref().and_then(|asked| asked.eased(step)) {
+                    Some(easier) => request.aux = Some(easier),
+                    None => return Err(e),
+                }
+            }
+            built => return built.map(drop),
+        }
+    }
+}
+
 /// [`Proof::Played`]: each draw of the seed played in turn until one is completed by a run;
-/// after `redraw.max_draws` of them a Generator's λ is eased by `redraw.ease_step`, and so on
-/// up to λ = 1.
+/// after `redraw.max_draws` of them, or when the Generator builds no further valid level, a
+/// Generator's λ is eased by `redraw.ease_step`, and so on up to λ = 1.
 fn played_level(
     source: LevelSource,
     request: &LevelRequest,
@@ -158,11 +188,19 @@ fn played_level(
     let mut request = request.clone();
     let mut replaced = 0;
     loop {
+        // The draws tried at this λ before the Generator built no further valid level.
+        let mut built_only = None;
         for draw in 0..redraw.max_draws {
-            let mut level = source.level(&LevelRequest {
+            let mut level = match source.level(&LevelRequest {
                 draw,
                 ..request.clone()
-            })?;
+            }) {
+                Err(e) if built_nothing(&e) && matches!(source, LevelSource::Generator(_)) => {
+                    built_only = Some(draw);
+                    break;
+                }
+                built => built?,
+            };
             let Some(mut stats) = verify::verify_watched(&level, solver, trials, seed, watch)?
             else {
                 return Ok(None);
@@ -181,16 +219,20 @@ fn played_level(
             LevelSource::Rules(_) => None,
         };
         let at = asked.map_or(String::new(), |a| format!(" at {a}"));
-        let Some(easier) = asked.and_then(|a| a.eased(redraw.ease_step)) else {
-            anyhow::bail!(
-                "none of the {} levels drawn for this seed{at} was completed by any of {trials} runs (--allow-unsolved keeps the first anyway)",
+        let why = match built_only {
+            Some(0) => format!("the Generator built no valid level{at}"),
+            Some(draws) => format!(
+                "none of the {draws} levels{at} was completed by any of {trials} runs and the Generator built no further one"
+            ),
+            None => format!(
+                "none of the {} levels drawn for this seed{at} was completed by any of {trials} runs",
                 redraw.max_draws
-            )
+            ),
         };
-        eased(&format!(
-            "seed {seed}: none of {} levels{at} was completed by any of {trials} runs; asking {easier}",
-            redraw.max_draws
-        ));
+        let Some(easier) = asked.and_then(|a| a.eased(redraw.ease_step)) else {
+            anyhow::bail!("{why} (--allow-unsolved keeps the first anyway)")
+        };
+        eased(&format!("seed {seed}: {why}; asking {easier}"));
         request.aux = Some(easier);
     }
 }

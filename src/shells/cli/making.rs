@@ -152,8 +152,9 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "P", allow_hyphen_values = true, value_parser = parse_target, conflicts_with = "aux")]
     pub target_success: Option<f64>,
     /// With --verify, keep a level that no run completed. By default it is redrawn (the next
-    /// level of the seed, toward the same goal; after 10 such draws a Generator's λ is eased by
-    /// 0.25, and the level records the λ it was built at), and each level records one
+    /// level of the seed, toward the same goal; after 10 such draws, or when the Generator
+    /// builds no further valid level toward that goal, its λ is eased by 0.25, each step said,
+    /// and the level records the λ it was built at), and each level records one
     /// successful run's seed as its certificate (`verify --replay` re-runs it).
     #[arg(long, requires = "verify")]
     pub allow_unsolved: bool,

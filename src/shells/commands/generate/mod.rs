@@ -383,16 +383,16 @@ fn build_levels(
         on_trial: &|_| {},
         stop: &|| stop.load(Ordering::SeqCst),
     };
-    // A seed whose level cannot be built fails the batch before any level is played: each
-    // seed's first draw is built, unplayed, first (milliseconds beside the runs).
-    if let Proof::Played { .. } = proof {
+    // A seed whose level cannot be built at any λ fails the batch before any level is played:
+    // each seed's first draw is built, unplayed, first (milliseconds beside the runs); a seed
+    // the Generator builds only at a lower λ is eased when it is played.
+    if let Proof::Played { redraw, .. } = proof {
         plans.par_iter().try_for_each(|(seed, _)| {
             let request = LevelRequest {
                 seed: *seed,
                 ..template.clone()
             };
-            source
-                .level(&request)
+            making::buildable(source, &request, redraw.ease_step)
                 .map(drop)
                 .with_context(|| format!("seed {seed} (nothing was played or written)"))
         })?;

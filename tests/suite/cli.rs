@@ -1411,6 +1411,34 @@ fn an_ability_aware_pair_plays_within_its_range_and_refuses_beyond() {
     assert!(!Path::new(&path("campaign")).exists());
 }
 
+/// `eval` under a profile beyond the shipped Solvers' ranges names the pair's Solver, not the
+/// first baseline it loaded, and writes nothing.
+#[test]
+fn eval_refuses_a_profile_beyond_the_shipped_solvers_naming_the_pairs_solver() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = dir.path().join("eval");
+    let refused = arlpcg(words(
+        "eval --game platform --policies {} --profile {} --out {}",
+        &[
+            &root.join("policies/platform"),
+            &root.join("results/platform/profiles/threejs-fps/profile.yaml"),
+            &out,
+        ],
+    ));
+    fails_with(
+        &refused,
+        1,
+        "profile `threejs-fps` lies beyond the abilities the Solver policy",
+    );
+    assert!(
+        stderr(&refused).contains("platform/solver.safetensors trained over"),
+        "{}",
+        stderr(&refused)
+    );
+    assert!(!out.exists());
+}
+
 /// `--threads` on the commands that play: one worker or two, the same bytes.
 #[test]
 fn generate_and_verify_give_the_same_bytes_on_any_thread_count() {

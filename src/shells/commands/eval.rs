@@ -36,7 +36,9 @@ pub fn run(args: &EvalArgs) -> Result<()> {
     let (generator, _) = load_generator(&generator_path, args.game)?;
     let solvers = load_solvers(args)?;
     let profile = asked_profile(args)?;
-    for (_, policy) in &solvers {
+    // The shipped pair's Solver is named first when the profile lies beyond the Solvers.
+    let arlpcg_first = solvers.iter().filter(|(mode, _)| mode == "arlpcg");
+    for (_, policy) in arlpcg_first.chain(solvers.iter().filter(|(mode, _)| mode != "arlpcg")) {
         crate::shells::common::check_fit(policy, profile.as_ref())?;
     }
     let budget = budget(args);

@@ -188,6 +188,24 @@ pub fn measure(
 }
 
 impl Curve {
+    /// The curve's span, in words, when `target` lies more than [`BAND`] beyond the success
+    /// it measured at every λ (a search then meets it only on seeds far from the mean).
+    pub fn beyond(&self, target: f64) -> Option<String> {
+        let (least, most) = self
+            .points
+            .iter()
+            .fold((None, None), |(least, most), &point| {
+                let pick = |old: Option<(f64, f64)>, better: fn(f64, f64) -> bool| match old {
+                    Some(old) if !better(point.1, old.1) => Some(old),
+                    _ => Some(point),
+                };
+                (pick(least, |a, b| a < b), pick(most, |a, b| a > b))
+            });
+        let ((hard_aux, hard), (easy_aux, easy)) = (least?, most?);
+        (target < hard - BAND || target > easy + BAND)
+            .then(|| format!("{hard:.2} at λ {hard_aux:+.2} … {easy:.2} at λ {easy_aux:+.2}"))
+    }
+
     /// The λ at which the curve passes `target` (linear between its points; the end λ when the
     /// target is beyond what the curve spans). Where the curve is not monotone, the easiest
     /// crossing wins.
@@ -420,5 +438,20 @@ mod tests {
         // Not monotone: the easiest crossing.
         let zigzag = curve(&[(1.0, 0.9), (0.0, 0.5), (-1.0, 0.7)]);
         assert!((zigzag.aux_for(0.6) - 0.25).abs() < 1e-9);
+    }
+
+    /// A target more than the band beyond the curve's least and most success is said, with
+    /// the span; within the band of either end it is not.
+    #[test]
+    fn a_target_beyond_the_curve_is_said_with_its_span() {
+        let zigzag = curve(&[(1.0, 0.9), (0.0, 0.5), (-1.0, 0.7)]);
+        assert_eq!(
+            zigzag.beyond(0.3).as_deref(),
+            Some("0.50 at λ +0.00 … 0.90 at λ +1.00")
+        );
+        assert!(zigzag.beyond(0.41).is_none());
+        assert!(zigzag.beyond(0.99).is_none());
+        assert!(curve(&[(1.0, 0.85), (-1.0, 0.6)]).beyond(0.96).is_some());
+        assert!(curve(&[]).beyond(0.5).is_none());
     }
 }

@@ -148,7 +148,8 @@ pub struct GenerateArgs {
     /// Ask for a success rate instead of λ (0 < P < 1, with --policies): each level is searched
     /// (λ and draws) until its measured success is within ±0.1 of P; the λ used is recorded.
     /// Verifies with 100 runs unless --verify says otherwise. The policies' λ→success curve is
-    /// measured once and kept as difficulty-curve.yaml beside them.
+    /// measured once and kept as difficulty-curve.yaml beside them; a P more than 0.1 beyond
+    /// the curve's span is said before the search (only some seeds can meet it).
     #[arg(long, value_name = "P", allow_hyphen_values = true, value_parser = parse_target, conflicts_with = "aux")]
     pub target_success: Option<f64>,
     /// With --verify, keep a level that no run completed. By default it is redrawn (the next

@@ -225,7 +225,7 @@ fn target_curve(
     profile: Option<&Profile>,
     stop: &AtomicBool,
 ) -> Result<Option<difficulty::Curve>> {
-    let (Some(Ask::Success(_)), Some(generator), Some(dir)) =
+    let (Some(Ask::Success(target)), Some(generator), Some(dir)) =
         (args.ask(), generator, &args.policies)
     else {
         return Ok(None);
@@ -247,6 +247,13 @@ fn target_curve(
         announce,
         &|| stop.load(Ordering::SeqCst),
     )
+    .inspect(|curve| {
+        if let Some(span) = curve.beyond(target) {
+            crate::warn!(
+                "success {target} lies beyond the span of this pair's λ→success curve for that judge ({span}): seeds whose levels cannot reach it fail the batch; a weaker judge (--judge scripted-median) spans more"
+            );
+        }
+    })
     .map(Some)
     .map_err(|e| match e.downcast_ref::<difficulty::TargetError>() {
         Some(difficulty::TargetError::Stopped) => crate::shells::common::Interrupted(

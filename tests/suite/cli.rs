@@ -904,6 +904,11 @@ fn generate_verify_eases_a_seed_the_generator_cannot_build_at_its_lambda() {
         err.contains("the Generator built no valid level at λ = -1.00; asking λ = -0.75"),
         "{err}"
     );
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains("over 1 levels; 1 of them built at an eased λ"),
+        "{said}"
+    );
     let file = std::fs::read_dir(&levels)
         .unwrap()
         .next()

@@ -140,7 +140,13 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         plans.len(),
         args.out.display()
     );
-    report_verification(&levels);
+    report_verification(
+        &levels,
+        args.ask().as_ref().and_then(|ask| match ask {
+            Ask::Aux(aux) => Some(*aux),
+            _ => None,
+        }),
+    );
     apply_checks(args, &levels, &plans)
 }
 
@@ -171,8 +177,44 @@ fn play_panel(panel: &JudgePanel, levels: &mut Vec<Level>, trials: u32, stop: &A
 }
 
 /// What verification did across the batch: redrawn, unsolved and uncertified levels.
-fn report_verification(levels: &[Level]) {
+/// What the batch's runs measured, a line per player: the Solver's (or verifying judge's) mean
+/// success over the levels and their range, how many levels were built at a λ other than the
+/// one asked for (`asked`), and each judge's mean with --panel.
+fn report_verification(levels: &[Level], asked: Option<f64>) {
     let stats: Vec<_> = levels.iter().filter_map(|l| l.stats.as_ref()).collect();
+    if let Some(summary) = mean_and_range(stats.iter().map(|s| s.success_ratio)) {
+        let eased = asked.map_or(0, |asked| {
+            levels
+                .iter()
+                .filter(|l| l.aux.is_some_and(|aux| (aux - asked).abs() > 1e-9))
+                .count()
+        });
+        let eased = match eased {
+            0 => String::new(),
+            n => format!("; {n} of them built at an eased λ"),
+        };
+        crate::say!(
+            "success of the runs that verified: {summary} over {} levels{eased}",
+            stats.len()
+        );
+    }
+    let panels: Vec<_> = stats.iter().filter_map(|s| s.panel.as_ref()).collect();
+    if let Some(first) = panels.first() {
+        let judges: Vec<String> = first
+            .judges
+            .iter()
+            .enumerate()
+            .filter_map(|(k, judge)| {
+                let ratios = panels.iter().filter_map(|p| p.judges.get(k));
+                Some(format!(
+                    "{} {}",
+                    judge.judge,
+                    mean_and_range(ratios.map(|j| j.success_ratio))?
+                ))
+            })
+            .collect();
+        crate::say!("panel, each judge's success: {}", judges.join(", "));
+    }
     let redrawn: Vec<u32> = stats.iter().map(|s| s.redraws).filter(|&r| r > 0).collect();
     if !redrawn.is_empty() {
         crate::say!(
@@ -194,6 +236,18 @@ fn report_verification(levels: &[Level]) {
             "{uncertified} levels have no certificate: no single run succeeded within the search (their success ratio is tiny)"
         );
     }
+}
+
+/// "mean (lowest-highest)" of `ratios`, none when there are none.
+fn mean_and_range(ratios: impl Iterator<Item = f64>) -> Option<String> {
+    let ratios: Vec<f64> = ratios.collect();
+    let (lowest, highest) = ratios
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &r| {
+            (lo.min(r), hi.max(r))
+        });
+    let mean = ratios.iter().sum::<f64>() / ratios.len().max(1) as f64;
+    (!ratios.is_empty()).then(|| format!("{mean:.3} ({lowest:.2}-{highest:.2})"))
 }
 
 /// With `--panel`, the panel of judges, having said which of its Solvers never trained with

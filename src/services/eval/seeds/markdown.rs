@@ -1,6 +1,6 @@
 //! The report of `eval --runs` as markdown (seeds.md).
 
-use super::{DROP_TOLERANCE, Improvement, RunScores, SeedResults};
+use super::{DROP_TOLERANCE, Improvement, RunScores, SeedResults, SeedsEstimate};
 use arlpcg_core::statistics::over_seeds::Estimate;
 
 /// Each ARLPCG Generator's λ = -1 levels: its own Solver's success (its controllability at
@@ -38,7 +38,7 @@ fn generator_by_generator(results: &SeedResults) -> String {
         let own = run
             .controllability
             .as_ref()
-            .and_then(|c| c.last())
+            .and_then(|c| *c.last()?)
             .map_or(String::from("—"), |x| format!("{x:.3}"));
         md += &format!("| {} | {own} | {} |", run.run, on(&run.run, "arlpcg"));
         for b in &baselines {
@@ -73,6 +73,22 @@ fn improvement_rows(beats: &[Improvement], e: impl Fn(&Estimate) -> String) -> S
 /// An estimate with its interval, as every table here prints it.
 fn estimate(x: &Estimate) -> String {
     format!("{:.3} [{:.3}, {:.3}]", x.value, x.ci95[0], x.ci95[1])
+}
+
+/// An estimate over some of a mode's seeds: how many when not all, "—" where no seed's
+/// Generator built a level.
+fn seeds_estimate(x: &Option<SeedsEstimate>) -> String {
+    match x {
+        None => String::from("— (no level built)"),
+        Some(SeedsEstimate {
+            estimate: e,
+            seeds: None,
+        }) => estimate(e),
+        Some(SeedsEstimate {
+            estimate: e,
+            seeds: Some(n),
+        }) => format!("{} (seeds that built levels: {n})", estimate(e)),
+    }
 }
 
 /// The report as markdown: every section below, in order.
@@ -148,7 +164,7 @@ pub fn controllability(results: &SeedResults) -> String {
         if let Some(by_aux) = &m.controllability {
             md += &format!("| {} |", m.mode);
             for x in by_aux {
-                md += &format!(" {} |", estimate(x));
+                md += &format!(" {} |", seeds_estimate(x));
             }
             md += "\n";
         }
@@ -166,7 +182,7 @@ pub fn outside_judges(results: &SeedResults) -> String {
         for j in &m.controllability_by_judge {
             md += &format!("| {} | {} |", m.mode, j.judge);
             for x in &j.success_ratio {
-                md += &format!(" {} |", estimate(x));
+                md += &format!(" {} |", seeds_estimate(x));
             }
             md += "\n";
         }
@@ -176,9 +192,9 @@ pub fn outside_judges(results: &SeedResults) -> String {
 
 /// One row per run: its validation, controllability, judges' drop and other Generators.
 pub fn each_run(results: &SeedResults) -> String {
-    let list = |xs: &[f64]| {
+    let list = |xs: &[Option<f64>]| {
         xs.iter()
-            .map(|x| format!("{x:.2}"))
+            .map(|x| x.map_or(String::from("— (no level)"), |x| format!("{x:.2}")))
             .collect::<Vec<_>>()
             .join(", ")
     };

@@ -46,9 +46,10 @@ pub struct RunScores {
     /// ...and on all of it.
     pub validation: f64,
     /// An adversarial run's own pair: its Solver on its Generator's levels at each λ of
-    /// [`AUX_VALUES`].
+    /// [`AUX_VALUES`] (null at a λ where the Generator built no level: a fixed-aux Generator
+    /// may build only at the λ it trained at).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub controllability: Option<Vec<f64>>,
+    pub controllability: Option<Vec<Option<f64>>>,
     /// The same levels played by the outside judges (the rule-pcg Solver of the evaluation's
     /// policies, the scripted player at median and expert skill; the recipe's finish plays the
     /// median player in both games, so for its runs that one is not a stranger).
@@ -77,18 +78,23 @@ pub struct GeneratorScore {
 pub struct JudgeCurve {
     /// The judge's name.
     pub judge: String,
-    /// Its success at each λ, in order.
-    pub success_ratio: Vec<f64>,
+    /// Its success at each λ, in order (null where the Generator built no level).
+    pub success_ratio: Vec<Option<f64>>,
 }
 
 impl RunScores {
     /// The median over the judges of their drop in success from λ = +1 to λ = -1, and whether
-    /// every judge's success falls monotonically (within `tolerance`); `None` without judges.
+    /// every judge's success falls monotonically (within `tolerance`); `None` without judges,
+    /// or when the Generator built no level at some λ.
     pub fn judges_drop(&self, tolerance: f64) -> Option<(f64, bool)> {
-        let mut drops: Vec<f64> = self
+        let curves: Vec<Vec<f64>> = self
             .controllability_by_judge
             .iter()
-            .map(|c| c.success_ratio[0] - c.success_ratio[c.success_ratio.len() - 1])
+            .map(|c| c.success_ratio.iter().copied().collect())
+            .collect::<Option<_>>()?;
+        let mut drops: Vec<f64> = curves
+            .iter()
+            .filter_map(|c| Some(c.first()? - c.last()?))
             .collect();
         if drops.is_empty() {
             return None;
@@ -100,10 +106,9 @@ impl RunScores {
         } else {
             0.5 * (drops[n / 2 - 1] + drops[n / 2])
         };
-        let monotone = self
-            .controllability_by_judge
+        let monotone = curves
             .iter()
-            .all(|c| c.success_ratio.windows(2).all(|w| w[1] <= w[0] + tolerance));
+            .all(|c| c.windows(2).all(|w| w[1] <= w[0] + tolerance));
         Some((median, monotone))
     }
 }
@@ -119,9 +124,10 @@ pub struct ModeSummary {
     pub validation_iqm: Estimate,
     /// Validation success: the mean over (half, seed).
     pub validation_mean: Estimate,
-    /// Mean controllability success at each λ (adversarial modes).
+    /// Mean controllability success at each λ (adversarial modes), over the seeds whose
+    /// Generator built levels there (null where none did).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub controllability: Option<Vec<Estimate>>,
+    pub controllability: Option<Vec<Option<SeedsEstimate>>>,
     /// The same for each outside judge.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub controllability_by_judge: Vec<JudgeSummary>,
@@ -135,8 +141,30 @@ pub struct ModeSummary {
 pub struct JudgeSummary {
     /// The judge's name.
     pub judge: String,
-    /// Its mean success at each λ, in order.
-    pub success_ratio: Vec<Estimate>,
+    /// Its mean success at each λ, in order, as [`ModeSummary::controllability`].
+    pub success_ratio: Vec<Option<SeedsEstimate>>,
+}
+
+/// An estimate over the seeds that have a value (a λ where a seed's Generator built no level
+/// has none).
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+pub struct SeedsEstimate {
+    /// The estimate.
+    #[serde(flatten)]
+    pub estimate: Estimate,
+    /// How many of the mode's seeds it is over, when not all of them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seeds: Option<usize>,
+}
+
+/// The estimate over seeds of `values` (one per seed; none where a seed has no value),
+/// none when no seed has one.
+fn over_seeds(values: &[Option<f64>], stream: u64) -> Option<SeedsEstimate> {
+    let at: Vec<f64> = values.iter().flatten().copied().collect();
+    (!at.is_empty()).then(|| SeedsEstimate {
+        seeds: (at.len() < values.len()).then_some(at.len()),
+        estimate: estimate(&[at], Aggregate::Mean, stream),
+    })
 }
 
 /// P(arlpcg's validation success > the baseline's), over seeds.
@@ -186,7 +214,7 @@ impl SeedResults {
             within(&format!("aux[{a}]"), *aux, (-1.0, 1.0))?;
         }
         // Every curve has one value per λ.
-        let curve = |field: &str, values: &[f64]| -> Result<(), String> {
+        let curve = |field: &str, values: &[Option<f64>]| -> Result<(), String> {
             if values.len() != self.aux.len() {
                 return Err(format!(
                     "{field}: {} values, one per λ ({}) expected",
@@ -195,7 +223,9 @@ impl SeedResults {
                 ));
             }
             for (a, value) in values.iter().enumerate() {
-                within(&format!("{field}[{a}]"), *value, SHARE)?;
+                if let Some(value) = value {
+                    within(&format!("{field}[{a}]"), *value, SHARE)?;
+                }
             }
             Ok(())
         };
@@ -259,7 +289,9 @@ impl SeedResults {
                     return Err(format!("{}: one value per λ expected", at(&field)));
                 }
                 for (a, e) in estimates.iter().enumerate() {
-                    estimate(&at(&format!("{field}[{a}]")), e)?;
+                    if let Some(e) = e {
+                        estimate(&at(&format!("{field}[{a}]")), &e.estimate)?;
+                    }
                 }
             }
             if let Some(hard) = &mode.other_generators_hard {
@@ -319,6 +351,8 @@ pub fn score_runs(
             .collect()
     };
     let mean = |xs: &[f64]| xs.iter().sum::<f64>() / xs.len().max(1) as f64;
+    // At a λ where the Generator built no level there is no success to measure.
+    let mean_of_any = |xs: &[f64]| (!xs.is_empty()).then(|| mean(xs));
     // Each adversarial run's controllability levels, at every λ of AUX_VALUES, built once:
     // its own pair and the judges play them, and every other run its λ = -1 ones.
     let controllability_levels: Vec<Option<Vec<Vec<Level>>>> = runs
@@ -358,7 +392,7 @@ pub fn score_runs(
                 Some(levels) => {
                     let own_curve = levels
                         .iter()
-                        .map(|at| mean(&play(&own, at, budget.trials)))
+                        .map(|at| mean_of_any(&play(&own, at, budget.trials)))
                         .collect();
                     let curves = judges
                         .names()
@@ -368,7 +402,7 @@ pub fn score_runs(
                             judge,
                             success_ratio: levels
                                 .iter()
-                                .map(|at| mean(&play(&judges.solver(k), at, budget.trials)))
+                                .map(|at| mean_of_any(&play(&judges.solver(k), at, budget.trials)))
                                 .collect(),
                         })
                         .collect();
@@ -448,10 +482,10 @@ pub fn summarize(budget: Budget, validation_generator: &str, runs: Vec<RunScores
                 .then(|| {
                     (0..AUX_VALUES.len())
                         .map(|a| {
-                            let at: Vec<f64> = of(&runs, mode)
+                            let at: Vec<Option<f64>> = of(&runs, mode)
                                 .map(|r| r.controllability.as_ref().expect("checked")[a])
                                 .collect();
-                            estimate(&[at], Aggregate::Mean, a as u64)
+                            over_seeds(&at, a as u64)
                         })
                         .collect()
                 });
@@ -529,8 +563,9 @@ fn judge_summaries(runs: Vec<&RunScores>) -> Vec<JudgeSummary> {
                 .collect::<Option<_>>()?;
             let success_ratio = (0..curve.success_ratio.len())
                 .map(|a| {
-                    let at: Vec<f64> = of_judge.iter().map(|c| c.success_ratio[a]).collect();
-                    estimate(&[at], Aggregate::Mean, a as u64)
+                    let at: Vec<Option<f64>> =
+                        of_judge.iter().map(|c| c.success_ratio[a]).collect();
+                    over_seeds(&at, a as u64)
                 })
                 .collect();
             Some(JudgeSummary {

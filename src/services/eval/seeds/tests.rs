@@ -1,5 +1,9 @@
 use super::*;
 
+fn some(values: &[f64]) -> Vec<Option<f64>> {
+    values.iter().copied().map(Some).collect()
+}
+
 fn run(mode: &str, seed: u64, rules: f64, generated: f64) -> RunScores {
     RunScores {
         run: format!("runs/{mode}-{seed}"),
@@ -8,16 +12,16 @@ fn run(mode: &str, seed: u64, rules: f64, generated: f64) -> RunScores {
         validation_rule_levels: rules,
         validation_generator_levels: generated,
         validation: 0.5 * (rules + generated),
-        controllability: (mode == "arlpcg").then(|| vec![1.0, 0.9, 0.8, 0.6, 0.5]),
+        controllability: (mode == "arlpcg").then(|| some(&[1.0, 0.9, 0.8, 0.6, 0.5])),
         controllability_by_judge: match mode {
             "arlpcg" => vec![
                 JudgeCurve {
                     judge: "scripted-median".into(),
-                    success_ratio: vec![1.0, 0.95, 0.9, 0.8, 0.7],
+                    success_ratio: some(&[1.0, 0.95, 0.9, 0.8, 0.7]),
                 },
                 JudgeCurve {
                     judge: "scripted-expert".into(),
-                    success_ratio: vec![1.0, 1.0, 1.0, 0.98, 0.9 - 0.1 * seed as f64],
+                    success_ratio: some(&[1.0, 1.0, 1.0, 0.98, 0.9 - 0.1 * seed as f64]),
                 },
             ],
             _ => Vec::new(),
@@ -44,7 +48,7 @@ fn modes_are_summarized_over_their_seeds() {
     assert!((mean.value - 0.85).abs() < 1e-12, "{mean:?}");
     assert!(mean.ci95[0] <= mean.value && mean.value <= mean.ci95[1]);
     let control = results.modes[0].controllability.as_ref().unwrap();
-    assert_eq!(control[4].value, 0.5);
+    assert_eq!(control[4].as_ref().unwrap().estimate.value, 0.5);
     assert!(results.modes[1].controllability.is_none());
     // On the rule half arlpcg's seeds (0.9, 0.92, 0.88) against rule-pcg's (0.8, 0.9) win
     // 4 pairs, tie 1 and lose 1 (0.75); on the Generator half they win all 6.
@@ -57,8 +61,9 @@ fn modes_are_summarized_over_their_seeds() {
     // Each judge over the seeds, and each run's median drop over its judges.
     let judges = &results.modes[0].controllability_by_judge;
     assert_eq!(judges[0].judge, "scripted-median");
-    assert!((judges[0].success_ratio[4].value - 0.7).abs() < 1e-12);
-    assert!((judges[1].success_ratio[4].value - 0.8).abs() < 1e-12);
+    let at = |j: usize, a: usize| judges[j].success_ratio[a].as_ref().unwrap().estimate.value;
+    assert!((at(0, 4) - 0.7).abs() < 1e-12);
+    assert!((at(1, 4) - 0.8).abs() < 1e-12);
     assert!(results.modes[1].controllability_by_judge.is_empty());
     assert_eq!(results.seeds["arlpcg"].len(), 3);
     assert_eq!(results.seeds["rule-pcg"][1].seed, 1);
@@ -141,4 +146,42 @@ fn other_generators_hard_levels_are_summarized_over_seeds() {
     assert_eq!(other_generators_plays(5, true, 20), 80);
     assert_eq!(other_generators_plays(5, false, 20), 100);
     assert_eq!(other_generators_plays(1, false, 20), 0);
+}
+
+/// A λ where a run's Generator built no level has no success: null in the run's curve, "—" in
+/// its row and no judges' drop; the mode's estimate there is over the seeds that built levels,
+/// and says how many; none built: "—". The file reads back.
+#[test]
+fn a_lambda_without_levels_has_no_success_rather_than_zero() {
+    let unbuilt = |seed: u64| RunScores {
+        controllability: Some(vec![Some(0.95), None, None, None, None]),
+        controllability_by_judge: vec![JudgeCurve {
+            judge: "scripted-median".into(),
+            success_ratio: vec![Some(0.9), None, None, None, None],
+        }],
+        ..run("fixed-aux", seed, 0.9, 0.8)
+    };
+    let built = RunScores {
+        controllability: Some(some(&[0.98, 1.0, 1.0, 1.0, 1.0])),
+        controllability_by_judge: vec![JudgeCurve {
+            judge: "scripted-median".into(),
+            success_ratio: some(&[1.0, 1.0, 1.0, 1.0, 1.0]),
+        }],
+        ..run("fixed-aux", 1, 0.9, 0.8)
+    };
+    assert_eq!(unbuilt(0).judges_drop(0.05), None);
+    let results = summarize(Budget::QUICK, "g", vec![unbuilt(0), built, unbuilt(2)]);
+    let control = results.modes[0].controllability.as_ref().unwrap();
+    assert_eq!(control[1].as_ref().unwrap().seeds, Some(1));
+    assert!((control[1].as_ref().unwrap().estimate.value - 1.0).abs() < 1e-12);
+    assert_eq!(control[0].as_ref().unwrap().seeds, None);
+    let md = markdown(&results);
+    assert!(md.contains("(seeds that built levels: 1)"), "{md}");
+    assert!(md.contains("| 0.95, — (no level), — (no level)"), "{md}");
+    assert!(!md.contains("-0.00"), "{md}");
+    let alone = summarize(Budget::QUICK, "g", vec![unbuilt(0)]);
+    assert!(alone.modes[0].controllability.as_ref().unwrap()[4].is_none());
+    assert!(markdown(&alone).contains("— (no level built)"));
+    let json = serde_json::to_vec(&results).unwrap();
+    assert_eq!(SeedResults::read(&json).unwrap(), results);
 }

@@ -230,7 +230,10 @@ fn played_level(
             ),
         };
         let Some(easier) = asked.and_then(|a| a.eased(redraw.ease_step)) else {
-            anyhow::bail!("{why} (--allow-unsolved keeps the first anyway)")
+            match built_only {
+                Some(0) => anyhow::bail!("{why}"),
+                _ => anyhow::bail!("{why} (--allow-unsolved keeps the first anyway)"),
+            }
         };
         eased(&format!("seed {seed}: {why}; asking {easier}"));
         request.aux = Some(easier);

@@ -144,7 +144,8 @@ pub fn verified_level(
     }
 }
 
-/// Whether `error` says a Generator built no valid level (which a lower λ may build).
+/// Whether `error` says a Generator built no valid level (which a lower λ may build); rule
+/// levels fail with another error.
 fn built_nothing(error: &anyhow::Error) -> bool {
     matches!(
         error.downcast_ref::<GenerationError>(),
@@ -163,7 +164,7 @@ pub fn buildable(source: LevelSource, request: &LevelRequest, step: f64) -> anyh
     };
     loop {
         match source.level(&request) {
-            Err(e) if built_nothing(&e) && matches!(source, LevelSource::Generator(_)) => {
+            Err(e) if built_nothing(&e) => {
                 match request.aux.as_ref().and_then(|asked| asked.eased(step)) {
                     Some(easier) => request.aux = Some(easier),
                     None => return Err(e),
@@ -195,7 +196,7 @@ fn played_level(
                 draw,
                 ..request.clone()
             }) {
-                Err(e) if built_nothing(&e) && matches!(source, LevelSource::Generator(_)) => {
+                Err(e) if built_nothing(&e) => {
                     built_only = Some(draw);
                     break;
                 }

@@ -3,8 +3,6 @@
 
 use std::process::ExitCode;
 
-use clap::Parser;
-
 /// mimalloc: about 3x faster PPO updates than glibc's allocator (fewer page faults).
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
@@ -26,7 +24,7 @@ fn main() -> ExitCode {
         );
         return ExitCode::from(2);
     }
-    let cli = match arlpcg::shells::cli::Cli::try_parse() {
+    let cli = match arlpcg::shells::cli::Cli::parse_args() {
         Ok(cli) => cli,
         // A usage error quotes the argument it refuses: a huge one is cut down to its ends.
         Err(e) if e.use_stderr() => {

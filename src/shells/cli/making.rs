@@ -68,7 +68,7 @@ pub enum PhysicsArg {
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("source").required(true).args(["rules", "policies"])))]
 pub struct GenerateArgs {
-    /// Which game.
+    /// Which game (default: the game of --policies or --profile, else platform).
     #[arg(long, default_value = "platform", value_parser = parse_game)]
     pub game: Game,
     /// Use the rule-based generator (random parameters within the game's ranges, kept valid
@@ -211,7 +211,7 @@ pub struct GenerateArgs {
     distance between the levels over pairs (docs/wish.md), beside plain levels of the \
     Generator at λ = 0. A search that meets no candidate counts as a miss for controllability, and is named (its ask, its seed and the closest it came); its closest candidate, played and certified, is its level for quality and diversity.")]
 pub struct BenchArgs {
-    /// Which game.
+    /// Which game (default: the game of --policies, else platform).
     #[arg(long, default_value = "platform", value_parser = parse_game)]
     pub game: Game,
     /// The ask set: YAML, `asks:` a list, each `want: WISHES` or `ask: SENTENCE` (docs/wish.md).

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+mod game;
 mod making;
 mod playing;
 mod values;
@@ -152,7 +153,7 @@ pub struct ReportArgs {
     arlpcg design\n  \
     arlpcg design --policies runs/my-arlpcg --out levels/mine --seed 7")]
 pub struct DesignArgs {
-    /// Which game.
+    /// Which game (default: the game of --policies or --profile, else platform).
     #[arg(long, default_value = "platform", value_parser = parse_game)]
     pub game: Game,
     /// A policies folder (generator.safetensors and/or solver.safetensors) or one policy file.
@@ -189,7 +190,7 @@ pub struct DesignArgs {
     arlpcg eval --policies policies/platform --shard 0/3 --out parts/0   (and 1/3, 2/3 elsewhere)\n  \
     arlpcg eval --merge parts/0 parts/1 parts/2 --out results/platform")]
 pub struct EvalArgs {
-    /// Which game.
+    /// Which game (default: the game of --policies or --profile, else platform).
     #[arg(long, default_value = "platform", value_parser = parse_game)]
     pub game: Game,
     /// Folders of trained policies: the Generator (generator.safetensors, from the first folder

@@ -126,7 +126,7 @@ pub struct VerifyArgs {
     Exit codes: 0 done, 1 an error (a file, a policy), 2 arguments that do not fit, 3 a level \
     failed a --check (the files are written), 130 interrupted (--resume finishes).")]
 pub struct CampaignArgs {
-    /// Which game.
+    /// Which game (default: the game of --policies or --profile, else platform).
     #[arg(long, default_value = "platform", value_parser = parse_game)]
     pub game: Game,
     /// The Generator, the judge and the panel's Solvers (default: the shipped policies/<game>:

@@ -19,8 +19,9 @@ impl Cli {
     }
 
     /// `args` parsed; a command that takes `--game` and was not given it plays the game its
-    /// `--policies` (the first policy card found: a folder's Generator, else its Solver, or the
-    /// file itself) or its `--profile` names, in that order; else platform. A file that cannot
+    /// `--policies` (eval's `--runs` too: the first policy card found, a folder's Generator,
+    /// else its Solver, or the file itself) or its `--profile` names, in that order; else
+    /// platform. A file that cannot
     /// be read names no game: the command reads it again and says what is wrong with it.
     pub fn parse_from_args<I, T>(args: I) -> Result<Cli, clap::Error>
     where
@@ -61,8 +62,9 @@ impl Command {
             ),
             Command::Bench(a) => (&mut a.game, vec![a.policies.as_deref()]),
             Command::Eval(a) => {
-                let mut named: Vec<Option<&Path>> =
-                    a.policies.iter().map(|p| Some(p.as_path())).collect();
+                let mut named: Vec<Option<&Path>> = (a.policies.iter().chain(&a.runs))
+                    .map(|p| Some(p.as_path()))
+                    .collect();
                 named.push(a.profile.as_deref());
                 (&mut a.game, named)
             }
@@ -83,10 +85,21 @@ fn game_named_by(path: &Path) -> Option<Game> {
             .ok()
             .map(|card| card.game)
     };
+    // The card written beside a policy (`generator.yaml`), which a run's record keeps alone.
+    let card_text_game = |file: &Path| {
+        let text = std::fs::read_to_string(file).ok()?;
+        let card: serde_yaml::Value = serde_yaml::from_str(&text).ok()?;
+        card.get("game")?.as_str()?.parse().ok()
+    };
     if path.is_dir() {
         return [GENERATOR_FILE, SOLVER_FILE]
             .into_iter()
-            .find_map(|file| card_game(&path.join(file)));
+            .find_map(|file| card_game(&path.join(file)))
+            .or_else(|| {
+                ["generator.yaml", "solver.yaml"]
+                    .into_iter()
+                    .find_map(|file| card_text_game(&path.join(file)))
+            });
     }
     match path.extension().and_then(|e| e.to_str()) {
         Some("safetensors") => card_game(path),
@@ -131,6 +144,11 @@ mod tests {
         );
         assert_eq!(
             game_of(&["eval", "--policies", "policies/racing"]),
+            Game::Racing
+        );
+        // A run's record in the repository keeps its cards alone.
+        assert_eq!(
+            game_of(&["eval", "--runs", "runs/racing-rule-pcg-s0"]),
             Game::Racing
         );
         // Nothing that names a game, or a file that is not one: platform, as before.

@@ -38,15 +38,18 @@ impl Cli {
                 && sub.value_source("game") == Some(ValueSource::DefaultValue)
         });
         if let Some(command) = cli.command.as_mut().filter(|_| game_left_out) {
-            command.imply_game();
+            command.imply_game().map_err(|e| {
+                clap::Error::raw(clap::error::ErrorKind::ArgumentConflict, e + "\n")
+            })?;
         }
         Ok(cli)
     }
 }
 
 impl Command {
-    /// Sets the command's game to the one its policies or profile name, if any does.
-    fn imply_game(&mut self) {
+    /// Sets the command's game to the one its policies or profile name, if any does; refused
+    /// when they name two games, naming both.
+    fn imply_game(&mut self) -> Result<(), String> {
         let (game, named): (&mut Game, Vec<Option<&Path>>) = match self {
             Command::Design(a) => (
                 &mut a.game,
@@ -68,11 +71,25 @@ impl Command {
                 named.push(a.profile.as_deref());
                 (&mut a.game, named)
             }
-            _ => return,
+            _ => return Ok(()),
         };
-        if let Some(implied) = named.into_iter().flatten().find_map(game_named_by) {
-            *game = implied;
+        let mut games = named
+            .into_iter()
+            .flatten()
+            .filter_map(|path| Some((path, game_named_by(path)?)));
+        let Some((first, implied)) = games.next() else {
+            return Ok(());
+        };
+        if let Some((other, its)) = games.find(|(_, its)| *its != implied) {
+            return Err(format!(
+                "{} is for the {implied} game and {} for the {its} game: name the game with \
+                 --game, and policies and a profile of that game",
+                first.display(),
+                other.display()
+            ));
         }
+        *game = implied;
+        Ok(())
     }
 }
 
@@ -159,6 +176,22 @@ mod tests {
             ]),
             Game::Platform
         );
+        // Policies of one game and a profile of the other: refused, naming both.
+        let mixed = Cli::parse_from_args([
+            "arlpcg", "generate", "--policies", "policies/platform", "--aux=1", "--profile",
+            racing_car, "--out", "unwritten",
+        ])
+        .expect_err("two games");
+        let said = mixed.to_string();
+        assert!(
+            said.contains("policies/platform is for the platform game"),
+            "{said}"
+        );
+        assert!(
+            said.contains("godot4/profile.yaml for the racing game"),
+            "{said}"
+        );
+        assert_eq!(mixed.exit_code(), 2);
         // Given, it is kept: the command then says the policies are another game's.
         assert_eq!(
             game_of(&[

@@ -8,8 +8,10 @@ use clap::parser::ValueSource;
 use clap::{ArgMatches, CommandFactory, FromArgMatches};
 
 use super::{Cli, Command};
+use crate::services::fsio::read_limited;
 use crate::services::policies::{GENERATOR_FILE, SOLVER_FILE};
 use arlpcg_core::level::Game;
+use arlpcg_core::rl::checkpoint::{MAX_POLICY_BYTES, read_card};
 
 impl Cli {
     /// The command line of this process, parsed, with `--game` implied where it is left out
@@ -19,10 +21,10 @@ impl Cli {
     }
 
     /// `args` parsed; a command that takes `--game` and was not given it plays the game its
-    /// `--policies` (eval's `--runs` too: the first policy card found, a folder's Generator,
-    /// else its Solver, or the file itself) or its `--profile` names, in that order; else
-    /// platform. A file that cannot
-    /// be read names no game: the command reads it again and says what is wrong with it.
+    /// `--policies` (eval's `--runs` too: a folder's Generator card, else its Solver's, or the
+    /// file's own) and its `--profile` name; else platform. Files of two games are refused,
+    /// naming both. A file that cannot be read names no game: the command reads it again and
+    /// says what is wrong with it.
     pub fn parse_from_args<I, T>(args: I) -> Result<Cli, clap::Error>
     where
         I: IntoIterator<Item = T>,
@@ -82,8 +84,8 @@ impl Command {
         };
         if let Some((other, its)) = games.find(|(_, its)| *its != implied) {
             return Err(format!(
-                "{} is for the {implied} game and {} for the {its} game: name the game with \
-                 --game, and policies and a profile of that game",
+                "{} is for the {implied} game and {} for the {its} game: give files of one \
+                 game (--game names it)",
                 first.display(),
                 other.display()
             ));
@@ -97,14 +99,12 @@ impl Command {
 /// read as one.
 fn game_named_by(path: &Path) -> Option<Game> {
     let card_game = |file: &Path| {
-        let bytes = std::fs::read(file).ok()?;
-        arlpcg_core::rl::checkpoint::read_card(&bytes)
-            .ok()
-            .map(|card| card.game)
+        let bytes = read_limited(file, MAX_POLICY_BYTES, "policy").ok()?;
+        read_card(&bytes).ok().map(|card| card.game)
     };
     // The card written beside a policy (`generator.yaml`), which a run's record keeps alone.
     let card_text_game = |file: &Path| {
-        let text = std::fs::read_to_string(file).ok()?;
+        let text = String::from_utf8(read_limited(file, 1 << 20, "policy card").ok()?).ok()?;
         let card: serde_yaml::Value = serde_yaml::from_str(&text).ok()?;
         card.get("game")?.as_str()?.parse().ok()
     };

@@ -96,32 +96,27 @@ impl Command {
 }
 
 /// The game a policies folder, a policy file or a profile file is for; none when it cannot be
-/// read as one.
+/// read as one. A policy's game is read from the card written beside it (`solver.yaml`, a few
+/// hundred bytes, which a run's record keeps alone), else from the policy file's own header.
 fn game_named_by(path: &Path) -> Option<Game> {
-    let card_game = |file: &Path| {
-        let bytes = read_limited(file, MAX_POLICY_BYTES, "policy").ok()?;
-        read_card(&bytes).ok().map(|card| card.game)
-    };
-    // The card written beside a policy (`generator.yaml`), which a run's record keeps alone.
-    let card_text_game = |file: &Path| {
-        let text = String::from_utf8(read_limited(file, 1 << 20, "policy card").ok()?).ok()?;
-        let card: serde_yaml::Value = serde_yaml::from_str(&text).ok()?;
-        card.get("game")?.as_str()?.parse().ok()
-    };
     if path.is_dir() {
         return [GENERATOR_FILE, SOLVER_FILE]
             .into_iter()
-            .find_map(|file| card_game(&path.join(file)))
-            .or_else(|| {
-                ["generator.yaml", "solver.yaml"]
-                    .into_iter()
-                    .find_map(|file| card_text_game(&path.join(file)))
-            });
+            .find_map(|file| game_named_by(&path.join(file)));
     }
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("safetensors") => card_game(path),
-        _ => crate::services::profile::load(path).ok().map(|p| p.game()),
+    if path.extension().is_some_and(|e| e == "safetensors") {
+        let card_beside = || {
+            let bytes = read_limited(&path.with_extension("yaml"), 1 << 20, "policy card").ok()?;
+            let card: serde_yaml::Value = serde_yaml::from_slice(&bytes).ok()?;
+            card.get("game")?.as_str()?.parse().ok()
+        };
+        let own_card = || {
+            let bytes = read_limited(path, MAX_POLICY_BYTES, "policy").ok()?;
+            read_card(&bytes).ok().map(|card| card.game)
+        };
+        return card_beside().or_else(own_card);
     }
+    crate::services::profile::load(path).ok().map(|p| p.game())
 }
 
 #[cfg(test)]

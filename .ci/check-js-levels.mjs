@@ -6,19 +6,23 @@
 // rounding (1e-3). Prints each mismatch and the milliseconds per level; exits 1 on any mismatch
 // (or, with --min-exact and --drift, beyond those bars; below).
 //
+// With --plain the network runs in plain JavaScript (web/network.mjs), from the numbers
+// `arlpcg view` serves at /generator.json, as the view's page builds levels: no onnxruntime.
+//
 // With --browser=CHROMIUM the module runs in a page of headless Chromium (driven by
 // puppeteer-core) on onnxruntime-web's WebAssembly build, served with the module from memory:
 // the page asks nothing of the network.
 //
 //   node .ci/check-js-levels.mjs ARLPCG_BINARY [SEEDS (100)] [FIRST_SEED (0)] [--aux=-1,0,1]
-//       [--min-exact=N --drift=D] [--ort=MODULE | --browser=CHROMIUM] [--game=racing --obstacles=N]
+//       [--min-exact=N --drift=D] [--ort=MODULE | --browser=CHROMIUM | --plain] [--game=racing --obstacles=N]
 
-import { execFileSync } from "node:child_process";
+import { execFileSync, spawn } from "node:child_process";
 import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
 import { fileURLToPath, pathToFileURL } from "node:url";
 import { PlatformGenerator } from "../web/levels.mjs";
+import { PlainNetwork } from "../web/network.mjs";
 import { RacingGenerator } from "../web/racing.mjs";
 import { ChaCha8Rng } from "../web/rng.mjs";
 
@@ -45,8 +49,13 @@ const TOLERANCE = 1e-3 + 1e-9;
 // The runtime: onnxruntime-node (pinned in .ci/package.json) unless `--ort=` names another
 // module (a path to onnxruntime-web's ESM entry, say: the same module runs in a page).
 const browserPath = flag("browser");
-const ortModule = browserPath ? "onnxruntime-web in headless Chromium" : flag("ort") ?? "onnxruntime-node";
-const ort = browserPath ? null : await import(ortModule.startsWith("/") ? pathToFileURL(ortModule).href : ortModule);
+const plain = args.includes("--plain");
+const ortModule = browserPath
+  ? "onnxruntime-web in headless Chromium"
+  : plain
+    ? "web/network.mjs, no onnxruntime"
+    : flag("ort") ?? "onnxruntime-node";
+const ort = browserPath || plain ? null : await import(ortModule.startsWith("/") ? pathToFileURL(ortModule).href : ortModule);
 if (ort?.env?.wasm) ort.env.wasm.numThreads = 1;
 // The game (`--game=racing`: web/racing.mjs and the racing Generator), and for racing the
 // obstacles drawn from each seed (`--obstacles=N`, generate's flag).
@@ -96,7 +105,9 @@ const Generator = GAME === "racing" ? RacingGenerator : PlatformGenerator;
 const { build, close } = browserPath
   ? await inPage(browserPath)
   : await (async () => {
-    const generator = await Generator.load(ort, fs.readFileSync(onnxPath), sidecar);
+    const generator = plain
+      ? new Generator(PlainNetwork.fromKit(await viewedKit(), GAME))
+      : await Generator.load(ort, fs.readFileSync(onnxPath), sidecar);
     return {
       build: async (request) => {
         const began = performance.now();
@@ -106,6 +117,29 @@ const { build, close } = browserPath
       close: async () => {},
     };
   })();
+
+/** The shipped Generator as `arlpcg view` serves it to its page (/generator.json). */
+async function viewedKit() {
+  const dir = path.join(root, "levels", GAME);
+  const level = path.join(dir, fs.readdirSync(dir).filter((f) => f.endsWith(".yaml")).sort()[0]);
+  const server = spawn(path.resolve(binary), ["view", level], { cwd: root, stdio: ["ignore", "pipe", "inherit"] });
+  try {
+    const address = await new Promise((resolve, reject) => {
+      let seen = "";
+      server.stdout.on("data", (chunk) => {
+        seen += chunk;
+        const found = seen.match(/http:\/\/[0-9.:]+\//);
+        if (found) resolve(found[0]);
+      });
+      server.on("exit", (code) => reject(new Error(`arlpcg view exited with ${code}`)));
+    });
+    const answer = await fetch(`${address}generator.json`);
+    if (!answer.ok) throw new Error(`/generator.json: ${answer.status} ${await answer.text()}`);
+    return await answer.json();
+  } finally {
+    server.kill();
+  }
+}
 
 /** The module in a page of headless Chromium, on onnxruntime-web (one WebAssembly thread). */
 async function inPage(chromium) {

@@ -1,7 +1,9 @@
 // `arlpcg view` in a real browser (headless Chromium, driven by puppeteer-core): the page draws
 // the level (not a blank canvas) and its certificate run within 2 s of opening, a new level
 // written to the folder it follows changes the picture within 1 s, moving the page's λ slider
-// shows that level rebuilt at the new λ (by the shipped Generator) within 1 s, and the page's
+// shows each level rebuilt at the new λ by the shipped Generator within 1 s, built in the page
+// itself (web/network.mjs; the page never asks the server for a rebuilt scene) and equal to
+// the scene the server rebuilds (every box and mesh vertex within 1e-3), and the page's
 // console has no errors.
 // Usage: node .ci/check-view.mjs ARLPCG_BINARY CHROMIUM LEVEL_A LEVEL_B SCREENSHOT_DIR
 import { spawn } from "node:child_process";
@@ -41,7 +43,9 @@ try {
   page.on("pageerror", (error) => errors.push(String(error)));
   // Offline: the page may ask only the server it came from.
   await page.setRequestInterception(true);
+  const asked = [];
   page.on("request", (request) => {
+    asked.push(request.url());
     if (request.url().startsWith(address)) request.continue();
     else { errors.push(`asked the network for ${request.url()}`); request.abort(); }
   });
@@ -53,6 +57,7 @@ try {
   console.log(`first picture after ${Date.now() - opened} ms: ${first.drawn} pixels drawn`);
   await page.screenshot({ path: join(shots, "view-first.png") });
   if (!(Number(first.trail) > 10)) fail(`the certificate run is not drawn (${first.trail} points)`);
+  const afterA = await moveSlider(page, first, "a");
 
   const written = Date.now();
   copyFileSync(levelB, join(folder, "b.yaml"));
@@ -61,26 +66,9 @@ try {
   const second = await page.evaluate(() => ({ ...document.body.dataset }));
   console.log(`new level shown ${Date.now() - written} ms after it was written: ${second.drawn} pixels drawn`);
   await page.screenshot({ path: join(shots, "view-second.png") });
-  if (second.drawn === first.drawn) fail("the new level did not change the picture");
-
-  // The λ slider: the shipped Generator rebuilds the level shown at λ = -1, then +1.
-  if (await page.evaluate(() => document.getElementById("slider").hidden)) fail("no λ slider");
-  let before = second;
-  for (const aux of ["-1", "1"]) {
-    const moved = Date.now();
-    await page.evaluate((aux) => {
-      const input = document.getElementById("aux");
-      input.value = aux;
-      input.dispatchEvent(new Event("input"));
-    }, aux);
-    await page.waitForFunction((aux) => document.body.dataset.aux === aux, { timeout: 1000 }, aux);
-    const rebuilt = await page.evaluate(() => ({ ...document.body.dataset, caption: document.getElementById("caption").textContent }));
-    console.log(`λ = ${aux} shown ${Date.now() - moved} ms after the slider moved: ${rebuilt.drawn} pixels drawn (${rebuilt.caption})`);
-    await page.screenshot({ path: join(shots, `view-aux${aux}.png`) });
-    if (rebuilt.drawn === before.drawn) fail(`λ = ${aux} did not change the picture`);
-    if (rebuilt.errors) fail(`the page reported errors: ${rebuilt.errors}`);
-    before = rebuilt;
-  }
+  if (second.drawn === afterA.drawn) fail("the new level did not change the picture");
+  await moveSlider(page, second, "b");
+  if (asked.some((url) => url.includes("/scene.json?aux"))) fail("the page asked the server for a rebuilt scene");
   if (first.errors || second.errors) fail(`the page reported errors: ${first.errors}${second.errors}`);
   if (errors.length) fail(`console errors: ${errors.join("; ")}`);
 } catch (error) {
@@ -91,6 +79,52 @@ try {
   await Promise.race([browser.close(), new Promise((resolve) => setTimeout(resolve, 5000))]);
   browser.process()?.kill("SIGKILL");
 }
+/**
+ * The λ slider: the shipped Generator rebuilds the level shown at λ = -1, then +1, in the page;
+ * each picture changes, and the page's scene is the one the server rebuilds at that λ.
+ */
+async function moveSlider(page, before, name) {
+  if (await page.evaluate(() => document.getElementById("slider").hidden)) fail(`${name}: no λ slider`);
+  for (const aux of ["-1", "1"]) {
+    const moved = Date.now();
+    await page.evaluate((aux) => {
+      const input = document.getElementById("aux");
+      input.value = aux;
+      input.dispatchEvent(new Event("input"));
+    }, aux);
+    await page.waitForFunction((aux) => document.body.dataset.aux === aux, { timeout: 1000 }, aux);
+    const rebuilt = await page.evaluate(() => ({ ...document.body.dataset, caption: document.getElementById("caption").textContent }));
+    console.log(`${name}: λ = ${aux} shown ${Date.now() - moved} ms after the slider moved, built by the ${rebuilt.rebuilt}: ${rebuilt.drawn} pixels drawn (${rebuilt.caption})`);
+    await page.screenshot({ path: join(shots, `view-${name}-aux${aux}.png`) });
+    if (rebuilt.rebuilt !== "page") fail(`${name}: λ = ${aux} was not built in the page (${rebuilt.caption})`);
+    if (rebuilt.drawn === before.drawn) fail(`${name}: λ = ${aux} did not change the picture`);
+    if (rebuilt.errors) fail(`${name}: the page reported errors: ${rebuilt.errors}`);
+    const mine = await page.evaluate(() => window.viewScene);
+    const server = (await (await fetch(`${address}scene.json?aux=${aux}`)).json()).scene;
+    const off = sceneDifference(mine, server);
+    console.log(`${name}: λ = ${aux}: the page's scene against the server's: ${off}`);
+    if (off !== "equal") fail(`${name}: λ = ${aux}: the page's level is not the server's: ${off}`);
+    before = rebuilt;
+  }
+  return before;
+}
+
+/** "equal" where every box and mesh of two scenes agree within 1e-3 (m, °), else the first difference. */
+function sceneDifference(a, b) {
+  if (a.pieces !== b.pieces) return `${a.pieces} pieces against ${b.pieces}`;
+  const close = (x, y) => x.length === y.length && x.every((v, i) => Math.abs(v - y[i]) <= 1e-3);
+  for (const [part, fields] of [["boxes", ["centre", "extents"]], ["meshes", ["positions", "indices"]]]) {
+    if (a[part].length !== b[part].length) return `${a[part].length} ${part} against ${b[part].length}`;
+    for (let i = 0; i < a[part].length; i++) {
+      const [x, y] = [a[part][i], b[part][i]];
+      if (x.name !== y.name) return `${part}[${i}] ${x.name} against ${y.name}`;
+      for (const field of fields) if (!close(x[field], y[field])) return `${x.name}'s ${field} differ`;
+      if (part === "boxes" && Math.abs(x.heading - y.heading) > 1e-3) return `${x.name}'s heading ${x.heading} against ${y.heading}`;
+    }
+  }
+  return "equal";
+}
+
 if (failed) process.exit(1);
 console.log("check-view: ok");
 process.exit(0);

@@ -293,6 +293,14 @@ export class GeneratorNetwork {
    * @param {object} [options] `sessionOptions` for onnxruntime
    */
   static async load(ort, onnx, sidecar, game, options = {}) {
+    GeneratorNetwork.check(sidecar, game);
+    const { bytes, meanOutput } = exposeMeans(onnx);
+    const session = await ort.InferenceSession.create(bytes, options.sessionOptions ?? {});
+    return new GeneratorNetwork(ort, session, meanOutput, sidecar);
+  }
+
+  /** Throws unless `sidecar` is a plain export's of a `game` Generator with its build rules. */
+  static check(sidecar, game) {
     if (sidecar.format !== "arlpcg-onnx" || sidecar.game !== game || sidecar.role !== "generator") {
       throw new Error(`not a ${game} Generator's sidecar: ${sidecar.game} ${sidecar.role}`);
     }
@@ -300,11 +308,9 @@ export class GeneratorNetwork {
     if (!sidecar.sampling || !sidecar.generator) {
       throw new Error("the sidecar has no `sampling` or `generator`: export it again with a newer arlpcg");
     }
-    const { bytes, meanOutput } = exposeMeans(onnx);
-    const session = await ort.InferenceSession.create(bytes, options.sessionOptions ?? {});
-    return new GeneratorNetwork(ort, session, meanOutput, sidecar);
   }
 
+  /** `ort`, `session`, `meanOutput`: the graph (none for a subclass with its own `means`). */
   constructor(ort, session, meanOutput, sidecar) {
     this.ort = ort;
     this.session = session;
@@ -317,11 +323,16 @@ export class GeneratorNetwork {
     this.builtIn = flatRules(sidecar.generator.piece_rules);
   }
 
-  /** The continuous actions sampled for one raw observation (`choose`, ActMode::Sample). */
-  async choose(observation, rng) {
+  /** The actor's unclipped means for one raw observation. */
+  async means(observation) {
     const tensor = new this.ort.Tensor("float32", observation, [1, observation.length]);
     const result = await this.session.run({ [this.input]: tensor }, [this.meanOutput]);
-    const mean = result[this.meanOutput].data;
+    return result[this.meanOutput].data;
+  }
+
+  /** The continuous actions sampled for one raw observation (`choose`, ActMode::Sample). */
+  async choose(observation, rng) {
+    const mean = await this.means(observation);
     const action = new Float32Array(this.std.length);
     for (let k = 0; k < this.std.length; k++) {
       const noise = rng.standardNormalF32();

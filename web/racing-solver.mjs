@@ -47,7 +47,7 @@
 // rapier.js".
 
 import { ChaCha8Rng } from "./rng.mjs";
-import { Road, ROAD_SHAPE } from "./racing.mjs";
+import { Road, ROAD_SHAPE, across } from "./racing.mjs";
 import { readLevelYaml } from "./level-file.mjs";
 import {
   GameSolver,
@@ -193,21 +193,6 @@ export function buildRoad(level) {
   const road = new Road(level.start.position, level.start.heading, level.road);
   for (const s of level.segments) road.push(s);
   return road;
-}
-
-/** A cross-section's unit vector across the road to the left, tilted by its bank (`RoadSample::left`). */
-function leftOf(sample) {
-  const s = Math.sin(sample.heading);
-  const c = Math.cos(sample.heading);
-  const sb = Math.sin(sample.bank);
-  const cb = Math.cos(sample.bank);
-  return [-s * cb, -sb, -c * cb];
-}
-
-/** A point `lateral` m left of a cross-section's centre (`RoadSample::across`), float64. */
-function across(sample, lateral) {
-  const l = leftOf(sample);
-  return [0, 1, 2].map((k) => sample.centre[k] + lateral * l[k]);
 }
 
 // ---------------------------------------------------------------------------------------------

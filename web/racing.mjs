@@ -146,6 +146,32 @@ export const ROAD_SHAPE = Object.freeze({ width: ROAD_WIDTH, banking: 10.0 });
 const MAX_BANK_DEGREES = 15.0;
 const BANK_BLEND = 6.0;
 
+/** A cross-section's unit vector across the road to the left, tilted by its bank (`RoadSample::left`). */
+export function leftOf(sample) {
+  const s = Math.sin(sample.heading);
+  const c = Math.cos(sample.heading);
+  const sb = Math.sin(sample.bank);
+  const cb = Math.cos(sample.bank);
+  return [-s * cb, -sb, -c * cb];
+}
+
+/** A point `lateral` m left of a cross-section's centre (`RoadSample::across`), float64. */
+export function across(sample, lateral) {
+  const l = leftOf(sample);
+  return [0, 1, 2].map((k) => sample.centre[k] + lateral * l[k]);
+}
+
+/** A cross-section's surface normal (`RoadSample::up`: forward × left, unit length). */
+export function upOf(sample) {
+  const unit = (v) => {
+    const n = Math.hypot(v[0], v[1], v[2]);
+    return v.map((x) => x / n);
+  };
+  const f = unit([Math.cos(sample.heading), sample.slope, -Math.sin(sample.heading)]);
+  const l = leftOf(sample);
+  return unit([f[1] * l[2] - f[2] * l[1], f[2] * l[0] - f[0] * l[2], f[0] * l[1] - f[1] * l[0]]);
+}
+
 /**
  * The road as `Road` keeps it (crates/core/src/level/road.rs): its cross-sections (`samples`:
  * s, segment, centre, heading in radians, slope, bank in radians), where each segment starts

@@ -122,26 +122,34 @@ pub fn scene_json(level: &Level, title: &str, trail: &Trail) -> Value {
 /// (0 for a hand-made level), its profile and its style knobs. The seed's first draw: rebuilt at
 /// the λ a Generator made it with, a level that was its seed's first draw comes back as it was.
 pub fn rebuild_request(level: Arc<Level>, from: PolicyRef, aux: f64) -> LevelRequest {
-    let obstacles = match level.track.shape() {
-        Shape::Road(road) => road.obstacles.len() as u32,
-        Shape::Blocks(_) => 0,
-    };
-    let knobs = level
-        .game()
-        .shape()
-        .knobs()
-        .iter()
-        .map(|name| level.knobs.get(*name).copied().unwrap_or(0.0) as f32)
-        .collect();
     LevelRequest::new(level.seed.unwrap_or(0), Some(aux))
-        .obstacles(obstacles)
+        .obstacles(obstacle_count(&level))
         .profile(level.profile.clone())
-        .knobs(knobs)
+        .knobs(knob_values(&level))
         .keep(KeptPrefix {
             level,
             pieces: 0,
             from,
         })
+}
+
+/// How many obstacles `level` has (a Generator draws that many again from its seed).
+pub fn obstacle_count(level: &Level) -> u32 {
+    match level.track.shape() {
+        Shape::Road(road) => road.obstacles.len() as u32,
+        Shape::Blocks(_) => 0,
+    }
+}
+
+/// `level`'s value of each of its game's style knobs, in the game's order (0: not recorded).
+pub fn knob_values(level: &Level) -> Vec<f32> {
+    level
+        .game()
+        .shape()
+        .knobs()
+        .iter()
+        .map(|name| level.knobs.get(*name).copied().unwrap_or(0.0) as f32)
+        .collect()
 }
 
 /// Each piece's share of the failures the level's statistics record, scaled so that the most

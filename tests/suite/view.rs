@@ -1,6 +1,6 @@
 //! `arlpcg view`: the page, the scene and the version it serves on 127.0.0.1, following a
 //! folder's newest level. (The page's drawing in a real browser is checked by `.ci/run`, with
-//! headless Chromium: `.ci/check-view.sh`.)
+//! headless Chromium: `.ci/check-view.mjs`.)
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
@@ -164,6 +164,45 @@ fn the_slider_rebuilds_the_level_shown_at_another_aux() {
             .contains("not played")
     );
     assert_ne!(easy["pieces"], file["pieces"]);
+    // What the page builds a level from itself: the seed and goal, and the Generator's numbers.
+    let slider = &file["slider"];
+    assert_eq!(
+        (slider["game"].as_str(), slider["seed"].as_u64()),
+        (Some("platform"), Some(7))
+    );
+    assert_eq!(slider["profile"], false);
+    assert_eq!(slider["obstacles"], 0);
+    let (status, body) = get(&viewer.address, "/generator.json");
+    assert_eq!(status, 200, "{body}");
+    let kit: serde_json::Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(kit["sidecar"]["role"], "generator");
+    assert!(kit["sidecar"]["generator"]["piece_rules"].is_object());
+    let observation = kit["sidecar"]["inputs"][0]["shape"][1].as_u64().unwrap();
+    let layers = kit["network"]["layers"].as_array().unwrap();
+    assert_eq!(layers[0]["inputs"].as_u64(), Some(observation));
+    for layer in layers {
+        let (inputs, outputs) = (
+            layer["inputs"].as_u64().unwrap(),
+            layer["outputs"].as_u64().unwrap(),
+        );
+        assert_eq!(
+            layer["weight"].as_array().unwrap().len() as u64,
+            inputs * outputs
+        );
+        assert_eq!(layer["bias"].as_array().unwrap().len() as u64, outputs);
+    }
+    let normalizer = &kit["network"]["normalizer"];
+    assert_eq!(
+        normalizer["mean"].as_array().unwrap().len() as u64,
+        observation
+    );
+    // The page's modules, and nothing else under /web/.
+    let (status, body) = get(&viewer.address, "/web/network.mjs");
+    assert_eq!(status, 200);
+    assert!(body.contains("export class PlainNetwork"));
+    for missing in ["/web/solver.mjs", "/web/../Cargo.toml", "/web/"] {
+        assert_eq!(get(&viewer.address, missing).0, 404, "{missing}");
+    }
     for bad in ["?aux=1.5", "?aux=nan", "?aux=easy"] {
         let (status, body) = get(&viewer.address, &format!("/scene.json{bad}"));
         assert_eq!(status, 400, "{bad}: {body}");
@@ -182,6 +221,9 @@ fn the_slider_rebuilds_the_level_shown_at_another_aux() {
         "{none}"
     );
     let (status, body) = get(&viewer.address, "/scene.json?aux=0");
+    assert_eq!(status, 500);
+    assert!(body.contains("generator.safetensors"), "{body}");
+    let (status, body) = get(&viewer.address, "/generator.json");
     assert_eq!(status, 500);
     assert!(body.contains("generator.safetensors"), "{body}");
 }

@@ -14,12 +14,13 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use super::GeneratorRules;
 use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, Placement, TrackBuild, observe_build,
 };
 use arlpcg_core::game::{GameSpec, PortState, SolverEnv, observe_solver};
-use arlpcg_core::level::PolicyRef;
 use arlpcg_core::level::profile::{ABILITIES_PART, Abilities, main_abilities};
+use arlpcg_core::level::{Game, PolicyRef};
 use arlpcg_core::rl::checkpoint::PolicyCard;
 use arlpcg_core::rl::policy::{ActMode, ActorCritic};
 
@@ -139,6 +140,20 @@ pub fn golden_episode<G: GameSpec>(
         format!("{outcome:?}"),
         frames,
     ))
+}
+
+/// What `generate` reads besides a Generator's graph (the sidecar's `generator`): its piece
+/// budget, the attempts and the built-in player's piece rules, for a Generator of `game`.
+pub fn generator_rules(game: Game, limits: BuildLimits) -> GeneratorRules {
+    let piece_rules = arlpcg_core::for_game!(game, G => {
+        let obstacles = arlpcg_core::game::facts::facts(G::GAME).scene_obstacles;
+        G::new_build(GOLDEN_RUN_SEED, None, limits, obstacles).0.port_piece_rules()
+    });
+    GeneratorRules {
+        max_pieces: limits.max_pieces,
+        attempts: crate::services::generation::ATTEMPTS,
+        piece_rules,
+    }
 }
 
 /// The golden episode of Generator `policy` (with its `card` and `limits`) of game `G`: each

@@ -26,6 +26,7 @@ mod examples;
 pub mod golden;
 pub mod proto;
 mod sidecar;
+pub mod web;
 
 use arlpcg_core::level::profile::{ABILITIES_PART, main_abilities};
 use prost::Message;

@@ -5,7 +5,7 @@ use anyhow::{Context, Result};
 use arlpcg_core::rl::checkpoint::Role;
 
 use crate::services::fsio::{FileBatch, Overwrite};
-use crate::services::onnx::golden::{generator_golden_episode, golden_episode};
+use crate::services::onnx::golden::{generator_golden_episode, generator_rules, golden_episode};
 use crate::shells::cli::ExportPolicyArgs;
 
 pub fn run(args: &ExportPolicyArgs) -> Result<()> {
@@ -47,11 +47,7 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
             })
             .with_context(|| format!("{}: building its golden episode", args.policy.display()))?;
             // What `generate` reads besides the graph, for a port that builds levels.
-            exported.sidecar.generator = Some(crate::services::onnx::GeneratorRules {
-                max_pieces: limits.max_pieces,
-                attempts: crate::services::generation::ATTEMPTS,
-                piece_rules: episode.piece_rules.clone(),
-            });
+            exported.sidecar.generator = Some(generator_rules(card.game, limits));
             Some(serde_json::to_string(&episode)? + "\n")
         }
     };

@@ -11,12 +11,13 @@ use serde_json::{Value, json};
 
 use crate::services::generation::GeneratorPolicy;
 use crate::services::making::LevelSource;
+use crate::services::onnx::web::web_generator;
 use crate::services::policies::{GENERATOR_FILE, load_generator};
-use crate::services::view::{Trail, rebuild_request, scene_json};
+use crate::services::view::{Trail, knob_values, obstacle_count, rebuild_request, scene_json};
 use crate::shells::cli::ViewArgs;
 use crate::shells::common::shipped_dir;
 use crate::shells::view::{self, Shown};
-use arlpcg_core::level::{Game, yaml};
+use arlpcg_core::level::{Game, Level, yaml};
 
 pub fn run(args: &ViewArgs) -> Result<()> {
     let shown = ShownFile::new(&args.level, args.policies.clone())?;
@@ -64,29 +65,45 @@ impl ShownFile {
         if let Some((_, known)) = loaded.iter().find(|(g, _)| *g == game) {
             return known.clone();
         }
-        let load = || -> Result<Arc<(GeneratorPolicy, PathBuf)>> {
+        let load = || -> Result<Arc<LoadedGenerator>> {
             let path = match &self.policies {
                 Some(path) if path.is_dir() => path.join(GENERATOR_FILE),
                 Some(path) => path.clone(),
                 None => shipped_dir(game)?.join(GENERATOR_FILE),
             };
-            let (generator, _card) = load_generator(&path, game)?;
-            Ok(Arc::new((generator, path)))
+            let (policy, _card) = load_generator(&path, game)?;
+            let web = web_generator(&path)?.to_string();
+            Ok(Arc::new(LoadedGenerator { policy, path, web }))
         };
         let known = load().map_err(|e| format!("{e:#}"));
         loaded.push((game, known.clone()));
         known
     }
 
-    /// What the page's λ slider needs for `level`: the λ it was made at and the Generator that
-    /// rebuilds it, or why there is none.
-    fn slider(&self, level: &arlpcg_core::level::Level) -> Value {
-        match self.generator(level.game()) {
-            Ok(generator) => {
-                json!({"aux": level.aux, "generator": generator.1.display().to_string()})
-            }
-            Err(why) => json!({"none": why}),
-        }
+    /// What the page's λ slider needs for `level`: the λ it was made at, the Generator that
+    /// rebuilds it and what the page builds from (`seed`, `obstacles`, `knobs`; `goal`: the page
+    /// builds a level itself only where its seed gives its goal and its start (the scene's
+    /// `spawn`); `profile`: only for the built-in player), or why there is none.
+    fn slider(&self, title: &str, level: &Level) -> Value {
+        let generator = match self.generator(level.game()) {
+            Ok(generator) => generator,
+            Err(why) => return json!({"none": why}),
+        };
+        let knobs = match generator.policy.knobs {
+            0 => Vec::new(),
+            _ => knob_values(level),
+        };
+        json!({
+            "aux": level.aux,
+            "generator": generator.path.display().to_string(),
+            "title": title,
+            "game": level.game().name(),
+            "seed": level.seed,
+            "obstacles": obstacle_count(level),
+            "knobs": knobs,
+            "goal": level.goal,
+            "profile": level.profile.is_some(),
+        })
     }
 
     /// The level file shown now, and when it last changed.
@@ -139,7 +156,7 @@ impl Shown for ShownFile {
         let (version, path) = self.version_and_file()?;
         let level = yaml::load(&path)?;
         let mut scene = scene_json(&level, &title(&path), &Trail::of_certificate(&level));
-        scene["slider"] = self.slider(&level);
+        scene["slider"] = self.slider(&title(&path), &level);
         Ok((version, scene))
     }
 
@@ -148,20 +165,34 @@ impl Shown for ShownFile {
         let (level, from) = yaml::load_pinned(&path)?;
         let generator = self.generator(level.game()).map_err(anyhow::Error::msg)?;
         let request = rebuild_request(Arc::new(level), from, aux);
-        let rebuilt = LevelSource::Generator(&generator.0).level(&request)?;
+        let rebuilt = LevelSource::Generator(&generator.policy).level(&request)?;
         let title = format!("{} at λ = {aux:+.2}", title(&path));
         let unplayed = Trail::None(format!(
             "rebuilt by {} (its seed's first draw, not played)",
-            generator.1.display()
+            generator.path.display()
         ));
         let mut scene = scene_json(&rebuilt, &title, &unplayed);
-        scene["slider"] = self.slider(&rebuilt);
+        scene["slider"] = self.slider(&title, &rebuilt);
         Ok((version, scene))
+    }
+
+    fn web_generator(&self) -> Result<String> {
+        let (_, path) = self.version_and_file()?;
+        let game = yaml::load(&path)?.game();
+        let generator = self.generator(game).map_err(anyhow::Error::msg)?;
+        Ok(generator.web.clone())
     }
 }
 
-/// A game's Generator and its file, or why it could not be loaded.
-type Loaded = Result<Arc<(GeneratorPolicy, PathBuf)>, String>;
+/// A game's Generator: the policy, its file and the same as a page builds with it (JSON).
+struct LoadedGenerator {
+    policy: GeneratorPolicy,
+    path: PathBuf,
+    web: String,
+}
+
+/// A game's Generator, or why it could not be loaded.
+type Loaded = Result<Arc<LoadedGenerator>, String>;
 
 /// A level file's name as the page's caption gives it.
 fn title(path: &Path) -> String {

@@ -2,8 +2,11 @@
 //! the designer (`V`: the level on screen). It serves one page on 127.0.0.1 (`page.html`:
 //! WebGL with no library, so it works offline) with the first scene inside
 //! ([`crate::services::view::scene_json`]); the page asks for `/version` a few times a second
-//! and fetches `/scene.json` again when it changes, and `/scene.json?aux=λ` when its λ slider
-//! moves (a [`Shown`] that can rebuild its level: `arlpcg view`'s file).
+//! and fetches `/scene.json` again when it changes. When its λ slider moves (a [`Shown`] that
+//! can rebuild its level: `arlpcg view`'s file), the page builds the level itself from
+//! `/generator.json` with the modules of `web/` served at `/web/NAME` (levels from the seed, as
+//! a web game would), or asks for `/scene.json?aux=λ` where those cannot (a profile's level, a
+//! level whose start and goal are not its seed's).
 
 use std::net::SocketAddr;
 use std::sync::{Arc, Mutex, PoisonError};
@@ -24,7 +27,33 @@ pub trait Shown: Send + Sync {
     fn rebuilt(&self, aux: f64) -> Result<(String, Value)> {
         anyhow::bail!("this view cannot rebuild its level at λ = {aux}: it has no Generator")
     }
+    /// The Generator that rebuilds the level shown now, as the page builds with it
+    /// ([`crate::services::onnx::web::web_generator`], JSON).
+    fn web_generator(&self) -> Result<String> {
+        anyhow::bail!("this view has no Generator")
+    }
 }
+
+/// The modules of `web/` the page imports, served at `/web/NAME`: a Generator's levels built in
+/// the page (`network.mjs` over the levels' own modules) and drawn (`view-scene.mjs`).
+const MODULES: [(&str, &str); 7] = [
+    ("levels.mjs", include_str!("../../../web/levels.mjs")),
+    ("network.mjs", include_str!("../../../web/network.mjs")),
+    (
+        "onnx-means.mjs",
+        include_str!("../../../web/onnx-means.mjs"),
+    ),
+    ("racing.mjs", include_str!("../../../web/racing.mjs")),
+    ("rng.mjs", include_str!("../../../web/rng.mjs")),
+    (
+        "view-scene.mjs",
+        include_str!("../../../web/view-scene.mjs"),
+    ),
+    (
+        "ziggurat-normal.mjs",
+        include_str!("../../../web/ziggurat-normal.mjs"),
+    ),
+];
 
 /// A server on 127.0.0.1:`port` (0: any free port) and the address it listens on.
 pub fn bind(port: u16) -> Result<(tiny_http::Server, SocketAddr)> {
@@ -66,7 +95,16 @@ pub fn serve(server: &tiny_http::Server, shown: &dyn Shown) {
             "/version" => shown
                 .version()
                 .map(|version| reply(version, "text/plain; charset=utf-8")),
-            _ => Ok(tiny_http::Response::from_string("not found").with_status_code(404)),
+            "/generator.json" => shown
+                .web_generator()
+                .map(|kit| reply(kit, "application/json")),
+            path => match MODULES
+                .iter()
+                .find(|(name, _)| path.strip_prefix("/web/") == Some(*name))
+            {
+                Some((_, module)) => Ok(reply(module.to_string(), "text/javascript")),
+                None => Ok(tiny_http::Response::from_string("not found").with_status_code(404)),
+            },
         };
         let response = answer.unwrap_or_else(|problem| {
             crate::warn!("{problem:#}");

@@ -1,0 +1,56 @@
+//! A Generator for a web page that has no onnxruntime (`arlpcg view`'s λ slider, through
+//! `web/network.mjs`): the sidecar its plain ONNX export would carry (observation, sampling,
+//! build rules) and, instead of the graph, its actor's weights and its observation normalizer
+//! as JSON numbers. The same numbers the graph holds: a page that evaluates them as
+//! `web/network.mjs` does builds the levels `generate` builds (docs/engines.md).
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use serde_json::{Value, json};
+
+use super::golden::generator_rules;
+use super::{Contract, export};
+use crate::services::policies::{generator_limits, load_any};
+use arlpcg_core::rl::checkpoint::Role;
+use arlpcg_core::rl::normalizer::CLIP;
+
+/// The Generator at `path` as a page builds levels with it: `sidecar` (the plain export's, with
+/// its `generator` build rules) and `network` (`normalizer`: mean, var and clip; `layers`: each
+/// layer's `inputs`, `outputs`, `weight` row-major inputs × outputs and `bias`, ReLU between).
+pub fn web_generator(path: &Path) -> Result<Value> {
+    let (policy, card, reference) = load_any(path)?;
+    anyhow::ensure!(
+        card.role == Role::Generator,
+        "{}: a {} policy, not a Generator",
+        path.display(),
+        card.role
+    );
+    let limits = generator_limits(path, &card)?;
+    let mut exported = export(&policy, &card, reference, Contract::Plain)
+        .with_context(|| format!("{}: reading the actor", path.display()))?;
+    exported.sidecar.generator = Some(generator_rules(card.game, limits));
+    let actor: Vec<_> = policy
+        .named_vars()
+        .into_iter()
+        .filter(|(name, _)| name.starts_with("actor."))
+        .collect();
+    let mut layers = Vec::new();
+    for pair in actor.chunks(2) {
+        let weight = pair[0].1.as_tensor();
+        let (inputs, outputs) = weight.dims2()?;
+        layers.push(json!({
+            "inputs": inputs,
+            "outputs": outputs,
+            "weight": weight.flatten_all()?.to_vec1::<f32>()?,
+            "bias": pair[1].1.as_tensor().flatten_all()?.to_vec1::<f32>()?,
+        }));
+    }
+    Ok(json!({
+        "sidecar": exported.sidecar,
+        "network": {
+            "normalizer": {"mean": card.normalizer.mean, "var": card.normalizer.var, "clip": CLIP},
+            "layers": layers,
+        },
+    }))
+}

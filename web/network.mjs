@@ -45,7 +45,12 @@ export class PlainNetwork extends GeneratorNetwork {
         throw new Error(`layer ${k}: ${layer.inputs} × ${layer.outputs} does not follow ${width} inputs`);
       }
       width = layer.outputs;
-      return { inputs: layer.inputs, outputs: layer.outputs, weight: Float32Array.from(layer.weight), bias: Float32Array.from(layer.bias) };
+      // Stored output by output (each output's weights side by side), for the sums below.
+      const byOutput = new Float32Array(layer.weight.length);
+      for (let i = 0; i < layer.inputs; i++) {
+        for (let j = 0; j < layer.outputs; j++) byOutput[j * layer.inputs + i] = layer.weight[i * layer.outputs + j];
+      }
+      return { inputs: layer.inputs, outputs: layer.outputs, byOutput, bias: Float32Array.from(layer.bias) };
     });
     if (width < this.std.length) throw new Error(`the actor has ${width} outputs for ${this.std.length} actions`);
   }
@@ -60,9 +65,21 @@ export class PlainNetwork extends GeneratorNetwork {
     this.layers.forEach((layer, k) => {
       const out = new Float32Array(layer.outputs);
       const last = k === this.layers.length - 1;
+      const { inputs, byOutput } = layer;
+      // An input at 0 (half the ReLU outputs) adds nothing to any sum: skipped.
+      const live = new Int32Array(inputs);
+      const values = new Float64Array(inputs);
+      let count = 0;
+      for (let i = 0; i < inputs; i++) {
+        if (h[i] !== 0) {
+          live[count] = i;
+          values[count++] = h[i];
+        }
+      }
       for (let j = 0; j < layer.outputs; j++) {
         let sum = 0.0;
-        for (let i = 0; i < layer.inputs; i++) sum = Math.fround(sum + h[i] * layer.weight[i * layer.outputs + j]);
+        const row = j * inputs;
+        for (let n = 0; n < count; n++) sum = Math.fround(sum + values[n] * byOutput[row + live[n]]);
         const value = Math.fround(sum + layer.bias[j]);
         out[j] = last || value > 0 ? value : 0.0;
       }

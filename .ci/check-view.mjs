@@ -1,5 +1,6 @@
 // `arlpcg view` in a real browser (headless Chromium, driven by puppeteer-core): the page draws
-// the level (not a blank canvas) and its certificate run within 2 s of opening, a new level
+// the level (not a blank canvas) and its certificate run within 2 s of opening, then the first
+// trials of its verification played again (/runs.json), a new level
 // written to the folder it follows changes the picture within 1 s, moving the page's λ slider
 // shows each level rebuilt at the new λ by the shipped Generator within 1 s, built in the page
 // itself (web/network.mjs; the page never asks the server for a rebuilt scene) and equal to
@@ -57,7 +58,13 @@ try {
   console.log(`first picture after ${Date.now() - opened} ms: ${first.drawn} pixels drawn`);
   await page.screenshot({ path: join(shots, "view-first.png") });
   if (!(Number(first.trail) > 10)) fail(`the certificate run is not drawn (${first.trail} points)`);
-  const afterA = await moveSlider(page, first, "a");
+  // The first trials of its verification, played again by the server, drawn after the picture.
+  await page.waitForFunction(() => Number(document.body.dataset.runs) > 0, { timeout: 5000 });
+  const withRuns = await page.evaluate(() => ({ ...document.body.dataset, caption: document.getElementById("caption").textContent }));
+  console.log(`${withRuns.runs} runs replayed ${Date.now() - opened} ms after the page opened: ${withRuns.drawn} pixels drawn (${withRuns.caption})`);
+  await page.screenshot({ path: join(shots, "view-runs.png") });
+  if (withRuns.drawn === first.drawn) fail("the replayed runs did not change the picture");
+  const afterA = await moveSlider(page, withRuns, "a");
 
   const written = Date.now();
   copyFileSync(levelB, join(folder, "b.yaml"));

@@ -1,8 +1,9 @@
 //! What `arlpcg view` draws: a level's scene (the same boxes, road and markers the glTF export
 //! writes, `crates/core/src/level/scene.rs`) as flat JSON a browser turns into triangles, each
 //! piece tinted toward red by its share of the recorded failures, and the certificate's run
-//! (the recorded run that reaches the goal) as a trail over it; and the request that builds a
-//! level's scene again at another λ (the page's slider).
+//! (the recorded run that reaches the goal) as a trail over it, the first trials of its
+//! verification played again; and the request that builds a level's scene again at another λ
+//! (the page's slider).
 
 use std::sync::Arc;
 
@@ -53,6 +54,32 @@ impl Trail {
             } => json!({"seed": seed, "succeeded": succeeded, "points": path.concat()}),
             Trail::None(why) => json!({"none": why}),
         }
+    }
+}
+
+/// How many of a level's verification trials the view plays again and draws.
+pub const REPLAYED_RUNS: u32 = 8;
+
+/// The first [`REPLAYED_RUNS`] trials of `level`'s verification played again
+/// ([`certificate::replays`]), as the view page draws them: `runs` (each one's `seed`,
+/// `succeeded` and flat world `points`) and `solver` (who played), or `none` and why.
+pub fn runs_json(level: &Level) -> Value {
+    match certificate::replays(level, REPLAYED_RUNS) {
+        Ok(runs) => {
+            let runs: Vec<Value> = runs
+                .into_iter()
+                .map(|(seed, run)| {
+                    json!({
+                        "seed": seed,
+                        "succeeded": run.result.outcome == Outcome::Success,
+                        "points": run.path.concat(),
+                    })
+                })
+                .collect();
+            let solver = level.stats.as_ref().map(|s| s.solver.describe());
+            json!({"runs": runs, "solver": solver})
+        }
+        Err(why) => json!({"none": format!("{why:#}")}),
     }
 }
 

@@ -703,7 +703,7 @@ fn verified_levels_are_completable_and_their_certificates_replay() {
     let forged = format!("{}{}{}", &text[..at], "0".repeat(64), &text[at + 64..]);
     std::fs::write(first, forged).unwrap();
     let out = arlpcg(words("verify --replay {}", &[&first]));
-    fails_with(&out, 1, "is not the policy that recorded the certificate");
+    fails_with(&out, 1, "is not the policy that verified the level");
     let out = arlpcg(words("verify --replay levels/hand/staircase.yaml", &[]));
     fails_with(&out, 1, "no statistics");
     let out = arlpcg(words("generate --rules --allow-unsolved --out x", &[]));

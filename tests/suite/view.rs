@@ -229,6 +229,58 @@ fn the_slider_rebuilds_the_level_shown_at_another_aux() {
 }
 
 #[test]
+fn the_view_replays_the_first_trials_of_a_verified_level() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let verified = root.join("levels/platform/platform_seed7_aux-1.00.yaml");
+    let viewer = view(&verified);
+    let (status, body) = get(&viewer.address, "/runs.json");
+    assert_eq!(status, 200, "{body}");
+    let answer: serde_json::Value = serde_json::from_str(&body).unwrap();
+    let runs = answer["runs"]
+        .as_array()
+        .unwrap_or_else(|| panic!("{answer}"));
+    // Its verification: 100 trials from seed 7, certificate 7, success 0.66.
+    let seeds: Vec<u64> = runs.iter().map(|r| r["seed"].as_u64().unwrap()).collect();
+    assert_eq!(seeds, (7..15).collect::<Vec<u64>>());
+    assert_eq!(runs[0]["succeeded"], true, "the certificate's run");
+    assert!(
+        runs.iter()
+            .all(|r| r["points"].as_array().unwrap().len() > 30)
+    );
+    assert!(
+        answer["solver"]
+            .as_str()
+            .unwrap()
+            .contains("solver.safetensors")
+    );
+    drop(viewer);
+
+    // A level never verified: no runs, and why.
+    let dir = tempfile::tempdir().unwrap();
+    let bare = dir.path().join("bare.yaml");
+    let out = arlpcg([
+        "generate",
+        "--rules",
+        "--count",
+        "1",
+        "--seed",
+        "3",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let written = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .find(|path| path.extension().is_some_and(|e| e == "yaml"))
+        .unwrap();
+    std::fs::rename(written, &bare).unwrap();
+    let viewer = view(&bare);
+    let (_, body) = get(&viewer.address, "/runs.json");
+    assert!(body.contains("verify the level first"), "{body}");
+}
+
+#[test]
 fn a_missing_level_or_an_empty_folder_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let out = arlpcg(["view", dir.path().join("none.yaml").to_str().unwrap()]);

@@ -13,7 +13,9 @@ use crate::services::generation::GeneratorPolicy;
 use crate::services::making::LevelSource;
 use crate::services::onnx::web::web_generator;
 use crate::services::policies::{GENERATOR_FILE, load_generator};
-use crate::services::view::{Trail, knob_values, obstacle_count, rebuild_request, scene_json};
+use crate::services::view::{
+    Trail, knob_values, obstacle_count, rebuild_request, runs_json, scene_json,
+};
 use crate::shells::cli::ViewArgs;
 use crate::shells::common::shipped_dir;
 use crate::shells::view::{self, Shown};
@@ -174,6 +176,13 @@ impl Shown for ShownFile {
         let mut scene = scene_json(&rebuilt, &title, &unplayed);
         scene["slider"] = self.slider(&title, &rebuilt);
         Ok((version, scene))
+    }
+
+    fn runs(&self) -> Result<Value> {
+        let (version, path) = self.version_and_file()?;
+        let mut runs = runs_json(&yaml::load(&path)?);
+        runs["version"] = json!(version);
+        Ok(runs)
     }
 
     fn web_generator(&self) -> Result<String> {

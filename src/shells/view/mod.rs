@@ -32,6 +32,12 @@ pub trait Shown: Send + Sync {
     fn web_generator(&self) -> Result<String> {
         anyhow::bail!("this view has no Generator")
     }
+    /// The first trials of the shown level's verification played again
+    /// ([`crate::services::view::runs_json`]), fetched once the page has loaded; nothing (an
+    /// empty object) for a view that replays none (the designer's, which shows its own trials).
+    fn runs(&self) -> Result<Value> {
+        Ok(serde_json::json!({}))
+    }
 }
 
 /// The modules of `web/` the page imports, served at `/web/NAME`: a Generator's levels built in
@@ -68,51 +74,59 @@ pub fn bind(port: u16) -> Result<(tiny_http::Server, SocketAddr)> {
 
 /// Answers the page's requests for `shown`, for as long as the server lives.
 pub fn serve(server: &tiny_http::Server, shown: &dyn Shown) {
-    for request in server.incoming_requests() {
-        let answer = match request.url().split('?').next().unwrap_or("") {
-            "/" => shown.current().map(|(version, scene)| {
-                let first = serde_json::json!({"version": version, "scene": scene});
-                // Inside a <script> element "</" would end it early.
-                let inline = first.to_string().replace("</", "<\\/");
-                reply(
-                    PAGE.replace("/*SCENE*/", &inline),
-                    "text/html; charset=utf-8",
-                )
-            }),
-            "/scene.json" => match asked_aux(request.url()) {
-                Err(problem) => {
-                    let answer = tiny_http::Response::from_string(problem).with_status_code(400);
-                    let _ = request.respond(answer);
-                    continue;
-                }
-                Ok(aux) => aux
-                    .map_or_else(|| shown.current(), |aux| shown.rebuilt(aux))
-                    .map(|(version, scene)| {
-                        let body = serde_json::json!({"version": version, "scene": scene});
-                        reply(body.to_string(), "application/json")
-                    }),
-            },
-            "/version" => shown
-                .version()
-                .map(|version| reply(version, "text/plain; charset=utf-8")),
-            "/generator.json" => shown
-                .web_generator()
-                .map(|kit| reply(kit, "application/json")),
-            path => match MODULES
-                .iter()
-                .find(|(name, _)| path.strip_prefix("/web/") == Some(*name))
-            {
-                Some((_, module)) => Ok(reply(module.to_string(), "text/javascript")),
-                None => Ok(tiny_http::Response::from_string("not found").with_status_code(404)),
-            },
-        };
-        let response = answer.unwrap_or_else(|problem| {
-            crate::warn!("{problem:#}");
-            tiny_http::Response::from_string(format!("{problem:#}")).with_status_code(500)
-        });
-        // A browser that went away is no reason to stop serving.
-        let _ = request.respond(response);
-    }
+    // Each request on a thread of its own: a slow answer (runs played again, a Generator
+    // loaded) holds up no other (the page's modules, its polling, a rebuild).
+    std::thread::scope(|scope| {
+        for request in server.incoming_requests() {
+            scope.spawn(move || answer(request, shown));
+        }
+    });
+}
+
+/// Answers one of the page's requests.
+fn answer(request: tiny_http::Request, shown: &dyn Shown) {
+    let answer = match request.url().split('?').next().unwrap_or("") {
+        "/" => shown.current().map(|(version, scene)| {
+            let first = serde_json::json!({"version": version, "scene": scene});
+            // Inside a <script> element "</" would end it early.
+            let inline = first.to_string().replace("</", "<\\/");
+            reply(
+                PAGE.replace("/*SCENE*/", &inline),
+                "text/html; charset=utf-8",
+            )
+        }),
+        "/scene.json" => match asked_aux(request.url()) {
+            Err(problem) => Ok(tiny_http::Response::from_string(problem).with_status_code(400)),
+            Ok(aux) => aux
+                .map_or_else(|| shown.current(), |aux| shown.rebuilt(aux))
+                .map(|(version, scene)| {
+                    let body = serde_json::json!({"version": version, "scene": scene});
+                    reply(body.to_string(), "application/json")
+                }),
+        },
+        "/version" => shown
+            .version()
+            .map(|version| reply(version, "text/plain; charset=utf-8")),
+        "/runs.json" => shown
+            .runs()
+            .map(|runs| reply(runs.to_string(), "application/json")),
+        "/generator.json" => shown
+            .web_generator()
+            .map(|kit| reply(kit, "application/json")),
+        path => match MODULES
+            .iter()
+            .find(|(name, _)| path.strip_prefix("/web/") == Some(*name))
+        {
+            Some((_, module)) => Ok(reply(module.to_string(), "text/javascript")),
+            None => Ok(tiny_http::Response::from_string("not found").with_status_code(404)),
+        },
+    };
+    let response = answer.unwrap_or_else(|problem| {
+        crate::warn!("{problem:#}");
+        tiny_http::Response::from_string(format!("{problem:#}")).with_status_code(500)
+    });
+    // A browser that went away is no reason to stop serving.
+    let _ = request.respond(response);
 }
 
 /// The λ a `/scene.json?aux=λ` request asks for (none without `aux`), or why it is refused.

@@ -6,8 +6,8 @@
 // rounding (1e-3). Prints each mismatch and the milliseconds per level; exits 1 on any mismatch
 // (or, with --min-exact and --drift, beyond those bars; below).
 //
-// With --plain the network runs in plain JavaScript (web/network.mjs), from the numbers
-// `arlpcg view` serves at /generator.json, as the view's page builds levels: no onnxruntime.
+// With --plain the network runs in plain JavaScript (web/network.mjs), from the Generator's
+// numbers (`export-policy --out G.json`, what `arlpcg view` serves its page): no onnxruntime.
 //
 // With --browser=CHROMIUM the module runs in a page of headless Chromium (driven by
 // puppeteer-core) on onnxruntime-web's WebAssembly build, served with the module from memory:
@@ -16,7 +16,7 @@
 //   node .ci/check-js-levels.mjs ARLPCG_BINARY [SEEDS (100)] [FIRST_SEED (0)] [--aux=-1,0,1]
 //       [--min-exact=N --drift=D] [--ort=MODULE | --browser=CHROMIUM | --plain] [--game=racing --obstacles=N]
 
-import { execFileSync, spawn } from "node:child_process";
+import { execFileSync } from "node:child_process";
 import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
@@ -106,7 +106,7 @@ const { build, close } = browserPath
   ? await inPage(browserPath)
   : await (async () => {
     const generator = plain
-      ? new Generator(PlainNetwork.fromKit(await viewedKit(), GAME))
+      ? new Generator(PlainNetwork.fromKit(plainNumbers(), GAME))
       : await Generator.load(ort, fs.readFileSync(onnxPath), sidecar);
     return {
       build: async (request) => {
@@ -118,27 +118,11 @@ const { build, close } = browserPath
     };
   })();
 
-/** The shipped Generator as `arlpcg view` serves it to its page (/generator.json). */
-async function viewedKit() {
-  const dir = path.join(root, "levels", GAME);
-  const level = path.join(dir, fs.readdirSync(dir).filter((f) => f.endsWith(".yaml")).sort()[0]);
-  const server = spawn(path.resolve(binary), ["view", level], { cwd: root, stdio: ["ignore", "pipe", "inherit"] });
-  try {
-    const address = await new Promise((resolve, reject) => {
-      let seen = "";
-      server.stdout.on("data", (chunk) => {
-        seen += chunk;
-        const found = seen.match(/http:\/\/[0-9.:]+\//);
-        if (found) resolve(found[0]);
-      });
-      server.on("exit", (code) => reject(new Error(`arlpcg view exited with ${code}`)));
-    });
-    const answer = await fetch(`${address}generator.json`);
-    if (!answer.ok) throw new Error(`/generator.json: ${answer.status} ${await answer.text()}`);
-    return await answer.json();
-  } finally {
-    server.kill();
-  }
+/** The shipped Generator's numbers (`export-policy --out G.json`, as `arlpcg view` serves them). */
+function plainNumbers() {
+  const file = path.join(tmp, "generator.json");
+  arlpcg("export-policy", `policies/${GAME}/generator.safetensors`, "--out", file);
+  return JSON.parse(fs.readFileSync(file, "utf8"));
 }
 
 /** The module in a page of headless Chromium, on onnxruntime-web (one WebAssembly thread). */

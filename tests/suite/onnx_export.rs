@@ -53,6 +53,56 @@ fn export_policy_writes_the_graph_and_its_sidecar_once() {
     assert!(!other.exists() && !Path::new("model.pt").exists());
 }
 
+#[test]
+fn a_generators_numbers_for_a_web_page_follow_its_graph() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = env!("CARGO_MANIFEST_DIR");
+    let generator = format!("{root}/policies/platform/generator.safetensors");
+    let (numbers, graph) = (dir.path().join("g.json"), dir.path().join("g.onnx"));
+    arlpcg_ok(words(
+        "export-policy {} --out {}",
+        &[&generator, &numbers.to_str().unwrap()],
+    ));
+    arlpcg_ok(words(
+        "export-policy {} --out {}",
+        &[&generator, &graph.to_str().unwrap()],
+    ));
+    let read = |path: &Path| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+    };
+    let (kit, sidecar) = (read(&numbers), read(&dir.path().join("g.onnx.json")));
+    // The graph's sidecar, build rules included, and the actor layer by layer.
+    assert_eq!(kit["sidecar"], sidecar);
+    let observation = sidecar["inputs"][0]["shape"][1].as_u64().unwrap();
+    let layers = kit["network"]["layers"].as_array().unwrap();
+    assert_eq!(layers[0]["inputs"].as_u64(), Some(observation));
+    let actions = sidecar["sampling"]["std"].as_array().unwrap().len() as u64;
+    assert!(layers.last().unwrap()["outputs"].as_u64().unwrap() >= actions);
+    for pair in layers.windows(2) {
+        assert_eq!(pair[0]["outputs"], pair[1]["inputs"]);
+    }
+    for layer in layers {
+        let (inputs, outputs) = (
+            layer["inputs"].as_u64().unwrap(),
+            layer["outputs"].as_u64().unwrap(),
+        );
+        assert_eq!(
+            layer["weight"].as_array().unwrap().len() as u64,
+            inputs * outputs
+        );
+    }
+    // A Solver has no levels to build: refused, nothing written.
+    let solver = format!("{root}/policies/platform/solver.safetensors");
+    let refused = dir.path().join("s.json");
+    let out = arlpcg(words(
+        "export-policy {} --out {}",
+        &[&solver, &refused.to_str().unwrap()],
+    ));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("for a Generator"), "{}", stderr(&out));
+    assert!(!refused.exists());
+}
+
 /// Plays a Solver's golden episode again from its level and recorded actions: each frame's
 /// observation and state are the game's, with the abilities an ability-aware Solver observes.
 fn replay_golden<G: arlpcg_core::game::GameSpec>(

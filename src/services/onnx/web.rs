@@ -7,18 +7,19 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use serde_json::{Value, json};
+use serde::Serialize;
 
 use super::golden::generator_rules;
-use super::{Contract, export};
+use super::{Contract, Sidecar, export};
 use crate::services::policies::{generator_limits, load_any};
 use arlpcg_core::rl::checkpoint::Role;
 use arlpcg_core::rl::normalizer::CLIP;
 
-/// The Generator at `path` as a page builds levels with it: `sidecar` (the plain export's, with
-/// its `generator` build rules) and `network` (`normalizer`: mean, var and clip; `layers`: each
-/// layer's `inputs`, `outputs`, `weight` row-major inputs × outputs and `bias`, ReLU between).
-pub fn web_generator(path: &Path) -> Result<Value> {
+/// The Generator at `path` as a page builds levels with it, as JSON: `sidecar` (the plain
+/// export's, with its `generator` build rules) and `network` (`normalizer`: mean, var and clip;
+/// `layers`: each layer's `inputs`, `outputs`, `weight` row-major inputs × outputs and `bias`,
+/// ReLU between), each float32 written in its shortest decimal that reads back to it.
+pub fn web_generator(path: &Path) -> Result<String> {
     let (policy, card, reference) = load_any(path)?;
     anyhow::ensure!(
         card.role == Role::Generator,
@@ -39,18 +40,50 @@ pub fn web_generator(path: &Path) -> Result<Value> {
     for pair in actor.chunks(2) {
         let weight = pair[0].1.as_tensor();
         let (inputs, outputs) = weight.dims2()?;
-        layers.push(json!({
-            "inputs": inputs,
-            "outputs": outputs,
-            "weight": weight.flatten_all()?.to_vec1::<f32>()?,
-            "bias": pair[1].1.as_tensor().flatten_all()?.to_vec1::<f32>()?,
-        }));
+        layers.push(Layer {
+            inputs,
+            outputs,
+            weight: weight.flatten_all()?.to_vec1::<f32>()?,
+            bias: pair[1].1.as_tensor().flatten_all()?.to_vec1::<f32>()?,
+        });
     }
-    Ok(json!({
-        "sidecar": exported.sidecar,
-        "network": {
-            "normalizer": {"mean": card.normalizer.mean, "var": card.normalizer.var, "clip": CLIP},
-            "layers": layers,
+    let numbers = WebGenerator {
+        sidecar: exported.sidecar,
+        network: Network {
+            normalizer: Normalizer {
+                mean: &card.normalizer.mean,
+                var: &card.normalizer.var,
+                clip: CLIP,
+            },
+            layers,
         },
-    }))
+    };
+    Ok(serde_json::to_string(&numbers)?)
+}
+
+#[derive(Serialize)]
+struct WebGenerator<'a> {
+    sidecar: Sidecar,
+    network: Network<'a>,
+}
+
+#[derive(Serialize)]
+struct Network<'a> {
+    normalizer: Normalizer<'a>,
+    layers: Vec<Layer>,
+}
+
+#[derive(Serialize)]
+struct Normalizer<'a> {
+    mean: &'a [f64],
+    var: &'a [f64],
+    clip: f32,
+}
+
+#[derive(Serialize)]
+struct Layer {
+    inputs: usize,
+    outputs: usize,
+    weight: Vec<f32>,
+    bias: Vec<f32>,
 }

@@ -293,7 +293,9 @@ pub struct ViewArgs {
 pub struct ExportPolicyArgs {
     /// The policy file (.safetensors): a Solver or a Generator of either game.
     pub policy: PathBuf,
-    /// Output file (.onnx); the sidecar goes beside it as OUT.json.
+    /// Output file: .onnx, the graph, with its sidecar beside it as OUT.json (and a golden
+    /// episode); or, for a Generator, .json: its sidecar with the actor's numbers, for
+    /// web/network.mjs, which builds its levels in JavaScript with no ONNX runtime.
     #[arg(long)]
     pub out: PathBuf,
     /// Whose names the graph uses: `plain` (this tool's) or `mlagents` (ML-Agents' model

@@ -62,7 +62,8 @@ pub enum Command {
     Generate(GenerateArgs),
     /// Convert a level file to glTF (.glb, or .gltf with a .bin beside it).
     Export(ExportArgs),
-    /// Write a trained policy's actor as ONNX (with a JSON sidecar), to run it in an engine.
+    /// Write a trained policy's actor as ONNX (with a JSON sidecar), to run it in an engine; a
+    /// Generator also as JSON numbers for a web page (--out G.json).
     ExportPolicy(ExportPolicyArgs),
     /// Show a level in 3D in a web browser: a page served on this machine (127.0.0.1), offline,
     /// that follows the level file, or the newest level of a folder, as it changes.

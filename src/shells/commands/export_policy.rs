@@ -9,12 +9,17 @@ use crate::services::onnx::golden::{generator_golden_episode, generator_rules, g
 use crate::shells::cli::ExportPolicyArgs;
 
 pub fn run(args: &ExportPolicyArgs) -> Result<()> {
-    if args.out.extension().and_then(|e| e.to_str()) != Some("onnx") {
-        return Err(crate::shells::common::UsageError(format!(
-            "--out {}: the file name must end in .onnx",
-            args.out.display()
-        ))
-        .into());
+    match args.out.extension().and_then(|e| e.to_str()) {
+        Some("onnx") => {}
+        Some("json") => return web(args),
+        _ => {
+            return Err(crate::shells::common::UsageError(format!(
+                "--out {}: the file name must end in .onnx (the graph) or .json (a Generator's \
+                 numbers for web/network.mjs)",
+                args.out.display()
+            ))
+            .into());
+        }
     }
     let sidecar_path = crate::services::onnx::sidecar_path(&args.out);
     let golden_path = crate::services::onnx::golden::golden_path(&args.out);
@@ -71,6 +76,37 @@ pub fn run(args: &ExportPolicyArgs) -> Result<()> {
         args.contract.name(),
         crate::services::onnx::OPSET,
         sidecar_path.display()
+    );
+    Ok(())
+}
+
+/// `--out G.json`: a Generator's sidecar and actor as numbers, for `web/network.mjs`.
+fn web(args: &ExportPolicyArgs) -> Result<()> {
+    let overwrite = if args.force {
+        Overwrite::Allowed
+    } else {
+        Overwrite::Never
+    };
+    crate::services::fsio::check_writable(&args.out, overwrite)?;
+    let (_, card, _) = crate::services::policies::load_any(&args.policy)?;
+    if card.role != Role::Generator || args.contract != crate::services::onnx::Contract::Plain {
+        return Err(crate::shells::common::UsageError(format!(
+            "--out {}: numbers for a web page are written for a Generator in the plain \
+             contract; {} is a {} (write .onnx for it)",
+            args.out.display(),
+            args.policy.display(),
+            card.role
+        ))
+        .into());
+    }
+    let numbers = crate::services::onnx::web::web_generator(&args.policy)? + "\n";
+    let mut batch = FileBatch::new();
+    batch.stage(&args.out, numbers.as_bytes(), overwrite)?;
+    batch.commit()?;
+    crate::say!(
+        "wrote {} ({} generator: its sidecar and actor as numbers, for web/network.mjs)",
+        args.out.display(),
+        card.game
     );
     Ok(())
 }

@@ -74,7 +74,7 @@ impl ShownFile {
                 None => shipped_dir(game)?.join(GENERATOR_FILE),
             };
             let (policy, _card) = load_generator(&path, game)?;
-            let web = web_generator(&path)?.to_string();
+            let web = web_generator(&path)?;
             Ok(Arc::new(LoadedGenerator { policy, path, web }))
         };
         let known = load().map_err(|e| format!("{e:#}"));

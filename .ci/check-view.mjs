@@ -4,7 +4,7 @@
 // written to the folder it follows changes the picture within 1 s, moving the page's λ slider
 // shows each level rebuilt at the new λ by the shipped Generator within 1 s, built in the page
 // itself (web/network.mjs; the page never asks the server for a rebuilt scene) and equal to
-// the scene the server rebuilds (every box and mesh vertex within 1e-3), and the page's
+// the scene the server rebuilds (every box, mesh vertex and point within 1e-3), and the page's
 // console has no errors.
 // Usage: node .ci/check-view.mjs ARLPCG_BINARY CHROMIUM LEVEL_A LEVEL_B SCREENSHOT_DIR
 import { spawn } from "node:child_process";
@@ -116,17 +116,18 @@ async function moveSlider(page, before, name) {
   return before;
 }
 
-/** "equal" where every box and mesh of two scenes agree within 1e-3 (m, °), else the first difference. */
+/** "equal" where every box, mesh and point of two scenes agree within 1e-3 (m, °), else the first difference. */
 function sceneDifference(a, b) {
   if (a.pieces !== b.pieces) return `${a.pieces} pieces against ${b.pieces}`;
   const close = (x, y) => x.length === y.length && x.every((v, i) => Math.abs(v - y[i]) <= 1e-3);
-  for (const [part, fields] of [["boxes", ["centre", "extents"]], ["meshes", ["positions", "indices"]]]) {
+  for (const [part, fields] of [["boxes", ["centre", "extents"]], ["meshes", ["positions", "indices"]], ["points", ["position"]]]) {
     if (a[part].length !== b[part].length) return `${a[part].length} ${part} against ${b[part].length}`;
     for (let i = 0; i < a[part].length; i++) {
       const [x, y] = [a[part][i], b[part][i]];
       if (x.name !== y.name) return `${part}[${i}] ${x.name} against ${y.name}`;
       for (const field of fields) if (!close(x[field], y[field])) return `${x.name}'s ${field} differ`;
-      if (part === "boxes" && Math.abs(x.heading - y.heading) > 1e-3) return `${x.name}'s heading ${x.heading} against ${y.heading}`;
+      if (part !== "meshes" && Math.abs(x.heading - y.heading) > 1e-3) return `${x.name}'s heading ${x.heading} against ${y.heading}`;
+      if (part === "points" && !close(x.size ?? [], y.size ?? [])) return `${x.name}'s size differ`;
     }
   }
   return "equal";

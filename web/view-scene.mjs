@@ -26,6 +26,11 @@ const BLOCK_THICKNESS = 1.0;
 const SKIRT_DEPTH = 0.8;
 /** Sides of a cylinder obstacle's mesh (`CYLINDER_SIDES`). */
 const CYLINDER_SIDES = 24;
+/** The finish region (`finish_zone`): over a platform goal block's top, m; along a road's last metres, below and above its centre line, m. */
+const PLATFORM_FINISH_HEIGHT = 2.0;
+const RACING_FINISH_LENGTH = 3.0;
+const RACING_FINISH_BELOW = 2.0;
+const RACING_FINISH_ABOVE = 4.0;
 
 /** A post over `base` (`marker`): seen, not collided with. */
 function marker(name, base, height, material) {
@@ -54,9 +59,16 @@ export function platformScene(level, title, why) {
   level.blocks.forEach((b, i) => boxes.push(block(`block_${String(i).padStart(3, "0")}`, b, i === last ? "goal_block" : "block")));
   boxes.push(marker("start", start.position, 2.0, "start_marker"), marker("goal", level.goal, 3.0, "goal_marker"));
   const goal = level.blocks[last];
+  const h = PLATFORM_FINISH_HEIGHT;
   const points = [
     { name: "spawn", position: start.position, heading: start.heading },
     { name: "finish", position: goal.position, heading: goal.heading },
+    {
+      name: "finish_zone",
+      position: [goal.position[0], goal.position[1] + 0.5 * h, goal.position[2]],
+      heading: goal.heading,
+      size: [goal.size, h, goal.size],
+    },
   ];
   return scene("platform", title, level.blocks.length, boxes, [], points, why);
 }
@@ -152,9 +164,20 @@ export function racingScene(level, title, why, width) {
     }
   });
   const end = level.samples[level.samples.length - 1];
+  // The road's last metres, back from its end along its heading and slope.
+  const along = [Math.cos(end.heading), end.slope, -Math.sin(end.heading)];
+  const norm = Math.hypot(...along);
+  const centre = [0, 1, 2].map((k) => end.centre[k] - (0.5 * RACING_FINISH_LENGTH * along[k]) / norm);
+  const height = RACING_FINISH_BELOW + RACING_FINISH_ABOVE;
   const points = [
     { name: "spawn", position: level.start.position, heading: level.start.heading },
     { name: "finish", position: end.centre, heading: (end.heading * 180) / Math.PI },
+    {
+      name: "finish_zone",
+      position: [centre[0], centre[1] + 0.5 * height - RACING_FINISH_BELOW, centre[2]],
+      heading: (end.heading * 180) / Math.PI,
+      size: [width, height, RACING_FINISH_LENGTH],
+    },
   ];
   return scene("racing", title, level.segments.length, boxes, meshes, points, why);
 }

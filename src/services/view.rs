@@ -11,7 +11,7 @@ use serde_json::{Value, json};
 
 use crate::services::certificate;
 use crate::services::generation::{KeptPrefix, LevelRequest};
-use arlpcg_core::level::scene::{Material, Scene};
+use arlpcg_core::level::scene::{Material, Physics, Scene};
 use arlpcg_core::level::stats::Outcome;
 use arlpcg_core::level::{Level, PolicyRef, Shape};
 
@@ -88,7 +88,7 @@ const FAILURE_RED: [f32; 4] = [0.9, 0.12, 0.1, 1.0];
 
 /// The scene of `level` as the view page reads it: `boxes` (centre, heading in degrees,
 /// extents, colour), `meshes` (world positions, normals and triangle indices, colour),
-/// `points` (spawn, finish), the `trail` (flat world positions, or why there is none) and a
+/// `points` (spawn, finish, and the finish region with its `size`), the `trail` (flat world positions, or why there is none) and a
 /// `title`. Pure: the same level and trail give the same bytes.
 pub fn scene_json(level: &Level, title: &str, trail: &Trail) -> Value {
     let scene = Scene::of_level(level);
@@ -131,7 +131,15 @@ pub fn scene_json(level: &Level, title: &str, trail: &Trail) -> Value {
     let points: Vec<Value> = scene
         .points
         .iter()
-        .map(|point| json!({"name": point.name, "position": point.position, "heading": point.heading}))
+        .map(|point| {
+            let mut json =
+                json!({"name": point.name, "position": point.position, "heading": point.heading});
+            // The finish region: the box where reaching it counts a success.
+            if let Physics::TriggerBox { size } = point.physics {
+                json["size"] = json!(size);
+            }
+            json
+        })
         .collect();
     json!({
         "title": title,
@@ -245,6 +253,16 @@ mod tests {
             blocks
         );
         assert_eq!(names(&scene, "points"), ["spawn", "finish", "finish_zone"]);
+        // Only the finish region has a size: the goal block's top, 2 m high.
+        let sizes: Vec<&Value> = scene["points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| &p["size"])
+            .collect();
+        assert!(sizes[0].is_null() && sizes[1].is_null());
+        let goal_size = level.platform().unwrap().last().size;
+        assert_eq!(sizes[2], &json!([goal_size, 2.0, goal_size]));
         assert_eq!(scene, scene_json(&level, "a level", &none()), "pure");
 
         let rgba = |scene: &Value, name: &str| {

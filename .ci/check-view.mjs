@@ -6,14 +6,15 @@
 // itself (web/network.mjs; the page never asks the server for a rebuilt scene) and equal to
 // the scene the server rebuilds (every box, mesh vertex and point within 1e-3), and the page's
 // console has no errors.
-// Usage: node .ci/check-view.mjs ARLPCG_BINARY CHROMIUM LEVEL_A LEVEL_B SCREENSHOT_DIR
+// LEVEL_C, where given, is a level made for a profile, rebuilt in the page the same way.
+// Usage: node .ci/check-view.mjs ARLPCG_BINARY CHROMIUM LEVEL_A LEVEL_B SCREENSHOT_DIR [LEVEL_C]
 import { spawn } from "node:child_process";
 import { copyFileSync, mkdtempSync, mkdirSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import puppeteer from "puppeteer-core";
 
-const [binary, chromium, levelA, levelB, shots] = process.argv.slice(2);
+const [binary, chromium, levelA, levelB, shots, levelC] = process.argv.slice(2);
 const fail = (message) => { console.error(`check-view: ${message}`); failed = true; };
 let failed = false;
 const folder = mkdtempSync(join(tmpdir(), "arlpcg-view-"));
@@ -63,7 +64,7 @@ try {
   const withRuns = await page.evaluate(() => ({ ...document.body.dataset, caption: document.getElementById("caption").textContent }));
   console.log(`${withRuns.runs} runs replayed ${Date.now() - opened} ms after the page opened: ${withRuns.drawn} pixels drawn (${withRuns.caption})`);
   await page.screenshot({ path: join(shots, "view-runs.png") });
-  if (withRuns.drawn === first.drawn) fail("the replayed runs did not change the picture");
+  if (withRuns.runs !== "8" || !withRuns.caption.includes("8 runs of its verification replayed")) fail(`not 8 runs replayed: ${withRuns.runs}`);
   const afterA = await moveSlider(page, withRuns, "a");
 
   const written = Date.now();
@@ -74,7 +75,20 @@ try {
   console.log(`new level shown ${Date.now() - written} ms after it was written: ${second.drawn} pixels drawn`);
   await page.screenshot({ path: join(shots, "view-second.png") });
   if (second.drawn === afterA.drawn) fail("the new level did not change the picture");
-  await moveSlider(page, second, "b");
+  const afterB = await moveSlider(page, second, "b");
+  // A level made for a profile: the page builds it with the profile's rules the server measured.
+  if (levelC) {
+    const last = await page.evaluate(() => ({ ...document.body.dataset }));
+    const written = Date.now();
+    copyFileSync(levelC, join(folder, "c.yaml"));
+    await page.waitForFunction((version) => document.body.dataset.version !== version, { timeout: 5000 }, last.version);
+    console.log(`the profile's level shown ${Date.now() - written} ms after it was written`);
+    const third = await page.evaluate(() => ({ ...document.body.dataset }));
+    if (third.drawn === afterB.drawn) fail("the profile's level did not change the picture");
+    // Its own λ (-1) last: the first move must change the level, and a level with no runs
+    // drawn over it looks the same rebuilt at its own λ.
+    await moveSlider(page, third, "c", ["1", "-1"]);
+  }
   if (asked.some((url) => url.includes("/scene.json?aux"))) fail("the page asked the server for a rebuilt scene");
   if (first.errors || second.errors) fail(`the page reported errors: ${first.errors}${second.errors}`);
   if (errors.length) fail(`console errors: ${errors.join("; ")}`);
@@ -87,12 +101,12 @@ try {
   browser.process()?.kill("SIGKILL");
 }
 /**
- * The λ slider: the shipped Generator rebuilds the level shown at λ = -1, then +1, in the page;
+ * The λ slider: the shipped Generator rebuilds the level shown at λ = -1, then +1 (or `order`), in the page;
  * each picture changes, and the page's scene is the one the server rebuilds at that λ.
  */
-async function moveSlider(page, before, name) {
+async function moveSlider(page, before, name, order = ["-1", "1"]) {
   if (await page.evaluate(() => document.getElementById("slider").hidden)) fail(`${name}: no λ slider`);
-  for (const aux of ["-1", "1"]) {
+  for (const aux of order) {
     const moved = Date.now();
     await page.evaluate((aux) => {
       const input = document.getElementById("aux");

@@ -210,6 +210,44 @@ fn the_slider_rebuilds_the_level_shown_at_another_aux() {
     }
     drop(viewer);
 
+    // A level made for a profile: the page gets the profile's piece rules, with the reach the
+    // server measured for its character, and the abilities the Generator observes.
+    let dir = tempfile::tempdir().unwrap();
+    let profile = root.join("results/platform/profiles/godot4/profile.yaml");
+    let out = arlpcg([
+        "generate",
+        "--policies",
+        root.join("policies/platform").to_str().unwrap(),
+        "--profile",
+        profile.to_str().unwrap(),
+        "--aux=-1",
+        "--count",
+        "1",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--format",
+        "yaml",
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let viewer = view(dir.path());
+    let (_, body) = get(&viewer.address, "/scene.json");
+    let slider =
+        serde_json::from_str::<serde_json::Value>(&body).unwrap()["scene"]["slider"].clone();
+    assert_eq!(slider["profile"], true);
+    let build = &slider["build"];
+    assert_eq!(
+        build["rules"]["reach_table"].as_array().map(Vec::len),
+        Some(5),
+        "{build}"
+    );
+    let abilities: Vec<f64> = serde_json::from_value(build["abilities"].clone()).unwrap();
+    // Godot's character jumps slower, runs slower and falls slower than ours: each below 0.
+    assert!(
+        abilities.len() == 3 && abilities.iter().all(|a| *a < 0.0),
+        "{abilities:?}"
+    );
+    drop(viewer);
+
     // A folder with no Generator: no slider, and why.
     let empty = tempfile::tempdir().unwrap();
     let viewer = view_with(&hard, &["--policies", empty.path().to_str().unwrap()]);

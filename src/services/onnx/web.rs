@@ -8,10 +8,16 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
+use serde_json::{Value, json};
 
 use super::golden::generator_rules;
 use super::{Contract, Sidecar, export};
+use crate::services::generation::{GeneratorPolicy, player_for};
 use crate::services::policies::{generator_limits, load_any};
+use arlpcg_core::game::generator::{
+    BuildLimits, GeneratorGame, TrackBuild, observation_size, observe_build,
+};
+use arlpcg_core::level::profile::Profile;
 use arlpcg_core::rl::checkpoint::Role;
 use arlpcg_core::rl::normalizer::CLIP;
 
@@ -86,4 +92,23 @@ struct Layer {
     outputs: usize,
     weight: Vec<f32>,
     bias: Vec<f32>,
+}
+
+/// What a page's `build` takes to make `generator`'s levels for `profile`, as JSON: `rules`, its
+/// piece rules with the reach table measured for its player (as a golden episode's
+/// `piece_rules`), and `abilities`, the columns an ability-aware Generator observes (empty for
+/// one that observes none).
+pub fn profile_build(generator: &GeneratorPolicy, profile: &Profile) -> Value {
+    let limits = BuildLimits {
+        player: player_for(Some(profile)),
+        ..generator.limits
+    };
+    let observation = generator.policy.shape().observation;
+    arlpcg_core::for_game!(generator.game, G => {
+        let (build, _) = G::new_build(0, None, limits, 0);
+        let mut row = vec![0.0; observation];
+        observe_build::<G>(&build, &[0.0], &vec![0.0; generator.knobs], &mut row);
+        let own = observation_size::<G>() + generator.knobs;
+        json!({"rules": build.port_piece_rules(), "abilities": row[own.min(observation)..]})
+    })
 }

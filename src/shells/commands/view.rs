@@ -11,7 +11,7 @@ use serde_json::{Value, json};
 
 use crate::services::generation::GeneratorPolicy;
 use crate::services::making::LevelSource;
-use crate::services::onnx::web::web_generator;
+use crate::services::onnx::web::{profile_build, web_generator};
 use crate::services::policies::{GENERATOR_FILE, load_generator};
 use crate::services::view::{
     Trail, knob_values, obstacle_count, rebuild_request, runs_json, scene_json,
@@ -85,7 +85,8 @@ impl ShownFile {
     /// What the page's λ slider needs for `level`: the λ it was made at, the Generator that
     /// rebuilds it and what the page builds from (`seed`, `obstacles`, `knobs`; `goal`: the page
     /// builds a level itself only where its seed gives its goal and its start (the scene's
-    /// `spawn`); `profile`: only for the built-in player), or why there is none.
+    /// `spawn`); `profile`: made for one, and `build`, its piece rules and abilities as the
+    /// page's build takes them), or why there is none.
     fn slider(&self, title: &str, level: &Level) -> Value {
         let generator = match self.generator(level.game()) {
             Ok(generator) => generator,
@@ -105,6 +106,7 @@ impl ShownFile {
             "knobs": knobs,
             "goal": level.goal,
             "profile": level.profile.is_some(),
+            "build": level.profile.as_ref().map(|p| profile_build(&generator.policy, p)),
         })
     }
 

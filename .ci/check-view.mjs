@@ -86,8 +86,10 @@ try {
     const third = await page.evaluate(() => ({ ...document.body.dataset }));
     if (third.drawn === afterB.drawn) fail("the profile's level did not change the picture");
     // Its own λ (-1) last: the first move must change the level, and a level with no runs
-    // drawn over it looks the same rebuilt at its own λ.
-    await moveSlider(page, third, "c", ["1", "-1"]);
+    // drawn over it looks the same rebuilt at its own λ. The first move may wait for the
+    // profile's rules (the page asks for them as the level is shown; measuring the character's
+    // reach takes the server 1-2 s): 3 s.
+    await moveSlider(page, third, "c", ["1", "-1"], 3000);
   }
   if (asked.some((url) => url.includes("/scene.json?aux"))) fail("the page asked the server for a rebuilt scene");
   if (first.errors || second.errors) fail(`the page reported errors: ${first.errors}${second.errors}`);
@@ -104,7 +106,7 @@ try {
  * The λ slider: the shipped Generator rebuilds the level shown at λ = -1, then +1 (or `order`), in the page;
  * each picture changes, and the page's scene is the one the server rebuilds at that λ.
  */
-async function moveSlider(page, before, name, order = ["-1", "1"]) {
+async function moveSlider(page, before, name, order = ["-1", "1"], firstTimeout = 1000) {
   if (await page.evaluate(() => document.getElementById("slider").hidden)) fail(`${name}: no λ slider`);
   for (const aux of order) {
     const moved = Date.now();
@@ -113,7 +115,8 @@ async function moveSlider(page, before, name, order = ["-1", "1"]) {
       input.value = aux;
       input.dispatchEvent(new Event("input"));
     }, aux);
-    await page.waitForFunction((aux) => document.body.dataset.aux === aux, { timeout: 1000 }, aux);
+    const timeout = aux === order[0] ? firstTimeout : 1000;
+    await page.waitForFunction((aux) => document.body.dataset.aux === aux, { timeout }, aux);
     const rebuilt = await page.evaluate(() => ({ ...document.body.dataset, caption: document.getElementById("caption").textContent }));
     console.log(`${name}: λ = ${aux} shown ${Date.now() - moved} ms after the slider moved, built by the ${rebuilt.rebuilt}: ${rebuilt.drawn} pixels drawn (${rebuilt.caption})`);
     await page.screenshot({ path: join(shots, `view-${name}-aux${aux}.png`) });

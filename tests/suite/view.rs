@@ -234,7 +234,9 @@ fn the_slider_rebuilds_the_level_shown_at_another_aux() {
     let slider =
         serde_json::from_str::<serde_json::Value>(&body).unwrap()["scene"]["slider"].clone();
     assert_eq!(slider["profile"], true);
-    let build = &slider["build"];
+    let (status, body) = get(&viewer.address, "/build.json");
+    assert_eq!(status, 200, "{body}");
+    let build: serde_json::Value = serde_json::from_str(&body).unwrap();
     assert_eq!(
         build["rules"]["reach_table"].as_array().map(Vec::len),
         Some(5),

@@ -85,8 +85,8 @@ impl ShownFile {
     /// What the page's λ slider needs for `level`: the λ it was made at, the Generator that
     /// rebuilds it and what the page builds from (`seed`, `obstacles`, `knobs`; `goal`: the page
     /// builds a level itself only where its seed gives its goal and its start (the scene's
-    /// `spawn`); `profile`: made for one, and `build`, its piece rules and abilities as the
-    /// page's build takes them), or why there is none.
+    /// `spawn`); `profile`: made for one, whose rules the page asks for at `/build.json`), or
+    /// why there is none.
     fn slider(&self, title: &str, level: &Level) -> Value {
         let generator = match self.generator(level.game()) {
             Ok(generator) => generator,
@@ -106,7 +106,6 @@ impl ShownFile {
             "knobs": knobs,
             "goal": level.goal,
             "profile": level.profile.is_some(),
-            "build": level.profile.as_ref().map(|p| profile_build(&generator.policy, p)),
         })
     }
 
@@ -185,6 +184,16 @@ impl Shown for ShownFile {
         let mut runs = runs_json(&yaml::load(&path)?);
         runs["version"] = json!(version);
         Ok(runs)
+    }
+
+    fn profile_build(&self) -> Result<Value> {
+        let (_, path) = self.version_and_file()?;
+        let level = yaml::load(&path)?;
+        let generator = self.generator(level.game()).map_err(anyhow::Error::msg)?;
+        Ok(level
+            .profile
+            .as_ref()
+            .map_or(Value::Null, |p| profile_build(&generator.policy, p)))
     }
 
     fn web_generator(&self) -> Result<String> {

@@ -32,6 +32,12 @@ pub trait Shown: Send + Sync {
     fn web_generator(&self) -> Result<String> {
         anyhow::bail!("this view has no Generator")
     }
+    /// What the page's build takes to make the shown level's profile's levels
+    /// ([`crate::services::onnx::web::profile_build`]; null for a level made for no profile),
+    /// asked for when the slider first moves: measuring a character's reach takes a moment.
+    fn profile_build(&self) -> Result<Value> {
+        anyhow::bail!("this view has no Generator")
+    }
     /// The first trials of the shown level's verification played again
     /// ([`crate::services::view::runs_json`]), fetched once the page has loaded; nothing (an
     /// empty object) for a view that replays none (the designer's, which shows its own trials).
@@ -107,6 +113,9 @@ fn answer(request: tiny_http::Request, shown: &dyn Shown) {
         "/version" => shown
             .version()
             .map(|version| reply(version, "text/plain; charset=utf-8")),
+        "/build.json" => shown
+            .profile_build()
+            .map(|build| reply(build.to_string(), "application/json")),
         "/runs.json" => shown
             .runs()
             .map(|runs| reply(runs.to_string(), "application/json")),

@@ -210,8 +210,29 @@ fn the_slider_rebuilds_the_level_shown_at_another_aux() {
     }
     drop(viewer);
 
-    // A level made for a profile: the page gets the profile's piece rules, with the reach the
-    // server measured for its character, and the abilities the Generator observes.
+    // A folder with no Generator: no slider, and why.
+    let empty = tempfile::tempdir().unwrap();
+    let viewer = view_with(&hard, &["--policies", empty.path().to_str().unwrap()]);
+    let (_, body) = get(&viewer.address, "/scene.json");
+    let none = serde_json::from_str::<serde_json::Value>(&body).unwrap()["scene"]["slider"]["none"]
+        .clone();
+    assert!(
+        none.as_str().unwrap().contains("generator.safetensors"),
+        "{none}"
+    );
+    let (status, body) = get(&viewer.address, "/scene.json?aux=0");
+    assert_eq!(status, 500);
+    assert!(body.contains("generator.safetensors"), "{body}");
+    let (status, body) = get(&viewer.address, "/generator.json");
+    assert_eq!(status, 500);
+    assert!(body.contains("generator.safetensors"), "{body}");
+}
+
+/// A level made for a profile: the page gets the profile's piece rules at `/build.json`, with
+/// the reach the server measured for its character, and the abilities the Generator observes.
+#[test]
+fn a_profiles_level_gives_the_page_its_rules() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = tempfile::tempdir().unwrap();
     let profile = root.join("results/platform/profiles/godot4/profile.yaml");
     let out = arlpcg([
@@ -248,24 +269,6 @@ fn the_slider_rebuilds_the_level_shown_at_another_aux() {
         abilities.len() == 3 && abilities.iter().all(|a| *a < 0.0),
         "{abilities:?}"
     );
-    drop(viewer);
-
-    // A folder with no Generator: no slider, and why.
-    let empty = tempfile::tempdir().unwrap();
-    let viewer = view_with(&hard, &["--policies", empty.path().to_str().unwrap()]);
-    let (_, body) = get(&viewer.address, "/scene.json");
-    let none = serde_json::from_str::<serde_json::Value>(&body).unwrap()["scene"]["slider"]["none"]
-        .clone();
-    assert!(
-        none.as_str().unwrap().contains("generator.safetensors"),
-        "{none}"
-    );
-    let (status, body) = get(&viewer.address, "/scene.json?aux=0");
-    assert_eq!(status, 500);
-    assert!(body.contains("generator.safetensors"), "{body}");
-    let (status, body) = get(&viewer.address, "/generator.json");
-    assert_eq!(status, 500);
-    assert!(body.contains("generator.safetensors"), "{body}");
 }
 
 #[test]

@@ -4,8 +4,6 @@
 //! as JSON numbers. The same numbers the graph holds: a page that evaluates them as
 //! `web/network.mjs` does builds the levels `generate` builds (docs/engines.md).
 
-use std::path::Path;
-
 use anyhow::{Context, Result};
 use serde::Serialize;
 use serde_json::{Value, json};
@@ -13,29 +11,28 @@ use serde_json::{Value, json};
 use super::golden::generator_rules;
 use super::{Contract, Sidecar, export};
 use crate::services::generation::{GeneratorPolicy, player_for};
-use crate::services::policies::{generator_limits, load_any};
 use arlpcg_core::game::generator::{
     BuildLimits, GeneratorGame, TrackBuild, observation_size, observe_build,
 };
+use arlpcg_core::level::PolicyRef;
 use arlpcg_core::level::profile::Profile;
-use arlpcg_core::rl::checkpoint::Role;
+use arlpcg_core::rl::checkpoint::PolicyCard;
 use arlpcg_core::rl::normalizer::CLIP;
+use arlpcg_core::rl::policy::ActorCritic;
 
-/// The Generator at `path` as a page builds levels with it, as JSON: `sidecar` (the plain
-/// export's, with its `generator` build rules) and `network` (`normalizer`: mean, var and clip;
-/// `layers`: each layer's `inputs`, `outputs`, `weight` row-major inputs × outputs and `bias`,
-/// ReLU between), each float32 written in its shortest decimal that reads back to it.
-pub fn web_generator(path: &Path) -> Result<String> {
-    let (policy, card, reference) = load_any(path)?;
-    anyhow::ensure!(
-        card.role == Role::Generator,
-        "{}: a {} policy, not a Generator",
-        path.display(),
-        card.role
-    );
-    let limits = generator_limits(path, &card)?;
-    let mut exported = export(&policy, &card, reference, Contract::Plain)
-        .with_context(|| format!("{}: reading the actor", path.display()))?;
+/// Generator `policy` (with its `card`, file and build `limits`) as a page builds levels with
+/// it, as JSON: `sidecar` (the plain export's, with its `generator` build rules) and `network`
+/// (`normalizer`: mean, var and clip; `layers`: each layer's `inputs`, `outputs`, `weight`
+/// row-major inputs × outputs and `bias`, ReLU between), each float32 written in its shortest
+/// decimal that reads back to it.
+pub fn web_generator(
+    policy: &ActorCritic,
+    card: &PolicyCard,
+    reference: PolicyRef,
+    limits: BuildLimits,
+) -> Result<String> {
+    let mut exported =
+        export(policy, card, reference, Contract::Plain).context("reading the actor")?;
     exported.sidecar.generator = Some(generator_rules(card.game, limits));
     let actor: Vec<_> = policy
         .named_vars()

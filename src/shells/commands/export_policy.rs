@@ -88,7 +88,7 @@ fn web(args: &ExportPolicyArgs) -> Result<()> {
         Overwrite::Never
     };
     crate::services::fsio::check_writable(&args.out, overwrite)?;
-    let (_, card, _) = crate::services::policies::load_any(&args.policy)?;
+    let (policy, card, reference) = crate::services::policies::load_any(&args.policy)?;
     if card.role != Role::Generator || args.contract != crate::services::onnx::Contract::Plain {
         return Err(crate::shells::common::UsageError(format!(
             "--out {}: numbers for a web page are written for a Generator in the plain \
@@ -99,7 +99,10 @@ fn web(args: &ExportPolicyArgs) -> Result<()> {
         ))
         .into());
     }
-    let numbers = crate::services::onnx::web::web_generator(&args.policy)? + "\n";
+    let limits = crate::services::policies::generator_limits(&args.policy, &card)?;
+    let numbers = crate::services::onnx::web::web_generator(&policy, &card, reference, limits)
+        .with_context(|| format!("{}", args.policy.display()))?
+        + "\n";
     let mut batch = FileBatch::new();
     batch.stage(&args.out, numbers.as_bytes(), overwrite)?;
     batch.commit()?;

@@ -73,8 +73,14 @@ impl ShownFile {
                 Some(path) => path.clone(),
                 None => shipped_dir(game)?.join(GENERATOR_FILE),
             };
-            let (policy, _card) = load_generator(&path, game)?;
-            let web = web_generator(&path)?;
+            let (policy, card) = load_generator(&path, game)?;
+            let web = web_generator(
+                &policy.policy,
+                &card,
+                policy.reference.clone(),
+                policy.limits,
+            )
+            .with_context(|| format!("{}", path.display()))?;
             Ok(Arc::new(LoadedGenerator { policy, path, web }))
         };
         let known = load().map_err(|e| format!("{e:#}"));

@@ -22,6 +22,10 @@ use ratatui::Terminal;
 use ratatui::backend::TestBackend;
 use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
+/// The allocator the binary runs with (src/main.rs), so the figures are the designer's own.
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 const LEVELS: usize = 20;
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -62,7 +66,11 @@ fn campaign_view() {
         String::from_utf8_lossy(&made.stderr)
     );
     let (tx, rx) = channel();
-    let workers = worker::Workers::start(worker::GamePolicies::default(), tx);
+    let workers = worker::Workers::start(
+        worker::GamePolicies::default(),
+        tx,
+        arlpcg::shells::common::thread_pool(None).unwrap(),
+    );
     let mut app = App::new(
         Game::Platform,
         Default::default(),
@@ -114,7 +122,11 @@ fn measure(game: Game, keys: &[char], what: &str) {
     let (tx, rx) = channel();
     let mut shelf = worker::GamePolicies::default();
     shelf[game] = policies;
-    let workers = worker::Workers::start(shelf, tx);
+    let workers = worker::Workers::start(
+        shelf,
+        tx,
+        arlpcg::shells::common::thread_pool(None).unwrap(),
+    );
     let out = tempfile::tempdir().expect("a temporary folder");
     let mut app = App::new(game, info, 1, out.path().to_path_buf());
     let mut terminal = Terminal::new(TestBackend::new(80, 24)).expect("a test terminal");

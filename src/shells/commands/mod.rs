@@ -70,12 +70,6 @@ fn in_pool(threads: Option<u64>, run: impl FnOnce() -> Result<()> + Send) -> Res
 }
 
 fn design(args: crate::shells::cli::DesignArgs) -> Result<()> {
-    // The designer's workers are threads of their own: its trials run in the global pool.
-    if let Some(threads) = args.threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads as usize)
-            .build_global()?;
-    }
     crate::shells::design::run(crate::shells::design::DesignOptions {
         game: args.game,
         policies: args.policies,
@@ -84,5 +78,6 @@ fn design(args: crate::shells::cli::DesignArgs) -> Result<()> {
         campaign: args.campaign,
         profile: args.profile,
         gltf: args.gltf.into(),
+        threads: args.threads,
     })
 }

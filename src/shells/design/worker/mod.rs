@@ -9,6 +9,7 @@ use std::sync::mpsc::{Receiver, Sender};
 use std::sync::{Arc, Mutex};
 
 use anyhow::Result;
+use rayon::ThreadPool;
 
 use super::app::campaign::OpenedCampaign;
 use super::app::judges::{PANEL_SEED, PanelUpdate};
@@ -65,7 +66,10 @@ impl Latest {
 }
 
 /// The worker threads: one for levels, trials, replays, exports and loads; one for sweeps and
-/// one for the panel (so neither holds up the level on screen).
+/// one for the panel (so neither holds up the level on screen). Each does its work inside one
+/// rayon pool, as a command does (`shells::commands::in_pool`): the worlds' steps and the
+/// matrix products it splits across threads are then handed on within the pool, not woken
+/// from outside it on every call (which took a racing level's 100 trials from 0.4 s to 1.2 s).
 pub struct Workers {
     latest: Arc<Latest>,
     main: Sender<Effect>,
@@ -74,16 +78,18 @@ pub struct Workers {
 }
 
 impl Workers {
-    /// Starts the workers on `policies`; their answers go to `answers`.
-    pub fn start(policies: GamePolicies, answers: Sender<Response>) -> Self {
+    /// Starts the workers on `policies`, working in `pool`; their answers go to `answers`.
+    pub fn start(policies: GamePolicies, answers: Sender<Response>, pool: ThreadPool) -> Self {
         let policies = Arc::new(Mutex::new(policies));
         let latest = Arc::new(Latest::default());
+        let pool = Arc::new(pool);
         let spawn = |name: &str| {
             let (tx, rx) = std::sync::mpsc::channel();
             let (policies, latest, answers) = (policies.clone(), latest.clone(), answers.clone());
+            let pool = pool.clone();
             std::thread::Builder::new()
                 .name(name.into())
-                .spawn(move || serve(rx, &policies, &latest, &answers))
+                .spawn(move || serve(rx, &policies, &latest, &answers, &pool))
                 .expect("the OS starts a thread");
             tx
         };
@@ -118,21 +124,24 @@ fn serve(
     policies: &SharedPolicies,
     latest: &Latest,
     answers: &Sender<Response>,
+    pool: &ThreadPool,
 ) {
     while let Ok(effect) = requests.recv() {
         let (slot, id) = slot(&effect);
         if latest.superseded(slot, id) {
             continue;
         }
-        perform(
-            effect,
-            policies,
-            &|| latest.superseded(slot, id),
-            &|response| {
-                // The designer may have quit; its answers are then of no use.
-                let _ = answers.send(response);
-            },
-        );
+        pool.install(|| {
+            perform(
+                effect,
+                policies,
+                &|| latest.superseded(slot, id),
+                &|response| {
+                    // The designer may have quit; its answers are then of no use.
+                    let _ = answers.send(response);
+                },
+            )
+        });
     }
 }
 

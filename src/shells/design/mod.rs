@@ -46,8 +46,8 @@ pub struct DesignOptions {
     pub profile: Option<PathBuf>,
     /// How exported glTF files carry their colliders.
     pub gltf: crate::services::level_files::GltfOptions,
-    /// The worker threads the designer's trials, sweeps and panel share (default: one per
-    /// core).
+    /// The threads each of the designer's workers (levels and trials, sweeps, the panel) plays
+    /// on (default: one per core).
     pub threads: Option<u64>,
 }
 
@@ -104,11 +104,7 @@ pub fn run(mut options: DesignOptions) -> Result<()> {
         others.push((game, info));
     }
     let (answers, responses) = channel();
-    let workers = Workers::start(
-        shelf,
-        answers,
-        crate::shells::common::thread_pool(options.threads)?,
-    );
+    let workers = Workers::start(shelf, answers, options.threads);
     let mut app = App::new(options.game, info, options.seed, options.out);
     app.gltf = options.gltf;
     app.profile_mut().profile = profile;

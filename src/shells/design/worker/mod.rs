@@ -66,10 +66,11 @@ impl Latest {
 }
 
 /// The worker threads: one for levels, trials, replays, exports and loads; one for sweeps and
-/// one for the panel (so neither holds up the level on screen). Each does its work inside one
-/// rayon pool, as a command does (`shells::commands::in_pool`): the worlds' steps and the
-/// matrix products it splits across threads are then handed on within the pool, not woken
-/// from outside it on every call (which took a racing level's 100 trials from 0.4 s to 1.2 s).
+/// one for the panel (so neither holds up the level on screen). Each does its work inside a
+/// rayon pool of its own, as a command does (`shells::commands::in_pool`): the worlds' steps and
+/// the matrix products a tick splits across threads are handed on within the pool, not woken
+/// from outside it on every call, and a long sweep never holds a pool thread that the level on
+/// screen waits for.
 pub struct Workers {
     latest: Arc<Latest>,
     main: Sender<Effect>,
@@ -78,15 +79,15 @@ pub struct Workers {
 }
 
 impl Workers {
-    /// Starts the workers on `policies`, working in `pool`; their answers go to `answers`.
-    pub fn start(policies: GamePolicies, answers: Sender<Response>, pool: ThreadPool) -> Self {
+    /// Starts the workers on `policies`, each with a pool of `threads` (default: one per
+    /// core); their answers go to `answers`.
+    pub fn start(policies: GamePolicies, answers: Sender<Response>, threads: Option<u64>) -> Self {
         let policies = Arc::new(Mutex::new(policies));
         let latest = Arc::new(Latest::default());
-        let pool = Arc::new(pool);
         let spawn = |name: &str| {
             let (tx, rx) = std::sync::mpsc::channel();
             let (policies, latest, answers) = (policies.clone(), latest.clone(), answers.clone());
-            let pool = pool.clone();
+            let pool = crate::shells::common::thread_pool(threads).expect("the OS starts threads");
             std::thread::Builder::new()
                 .name(name.into())
                 .spawn(move || serve(rx, &policies, &latest, &answers, &pool))

@@ -178,7 +178,8 @@ pub struct DesignArgs {
     /// How the glTF files carry their colliders (`--collision-names`, `--physics`).
     #[command(flatten)]
     pub gltf: GltfArgs,
-    /// Worker threads for the trials the designer plays (default: all cores).
+    /// Threads the designer plays on: its trials, and apart from them its λ sweep and its
+    /// panel (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=256))]
     pub threads: Option<u64>,
 }

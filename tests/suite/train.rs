@@ -586,10 +586,18 @@ fn an_adversarial_run_alternates_phases_resumes_and_its_generator_builds_levels(
     let (dir, config, out) = scratch(TINY_ADVERSARIAL);
     let out_s = out.to_str().unwrap();
     let config_s = config.to_str().unwrap();
-    arlpcg_ok(words(
+    let first = arlpcg_ok(words(
         "train --mode arlpcg --steps 512 --config {} --out {}",
         &[&config_s, &out_s],
     ));
+    // Its standard error is a pipe, where no bar is drawn: each phase change has its line.
+    let log = String::from_utf8_lossy(&first.stderr);
+    for phase_ends in ["Solver steps: solver: ", "Solver steps: generator: "] {
+        assert!(
+            log.contains(phase_ends),
+            "no line for {phase_ends:?} in {log}"
+        );
+    }
     // 512 Solver steps in phases of 128: both agents learned, in turn; then the finish's 128.
     assert_eq!(curve(&out).last().unwrap().1, 512 + 128);
     let generator_before = generator_rows(&out);

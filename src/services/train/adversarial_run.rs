@@ -15,7 +15,9 @@ use super::own_check;
 use super::population::{PopulationRecord, Snapshot, population_from, population_record};
 use super::solver_envs::{SolverEnvs, SolverMode, SourceRecord};
 use super::solver_run::SolverRun;
-use super::{CHECKPOINT, ConfigChange, GENERATOR_CHECKPOINT, GENERATOR_METRICS, Training};
+use super::{
+    CHECKPOINT, ConfigChange, GENERATOR_CHECKPOINT, GENERATOR_METRICS, Progress, Training,
+};
 use crate::services::fsio;
 use crate::services::fsio::Overwrite;
 use anyhow::{Context, Result};
@@ -299,7 +301,9 @@ impl<G: GeneratorGame> AdversarialRun<G> {
     }
 
     /// One iteration of the agent whose phase it is; the progress bar's message.
-    fn phase_iteration(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
+    /// One iteration of the agent whose phase it is: the progress message, and whether the
+    /// iteration played a finish check (a line a log without a progress bar keeps).
+    fn phase_iteration(&mut self, wall: &dyn Fn() -> f64) -> Result<(String, bool)> {
         let config = &self.solver.config;
         let steps = self.solver.trainer.global_step;
         // The stage in force where this iteration starts (a stage begins at a phase's end).
@@ -350,20 +354,24 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                     self.snapshot_if_due()?;
                     self.envs().set_phase(Phase::Generator);
                 }
-                Ok(format!(
+                let message = format!(
                     "solver: return {:.2}, success {:.2}, {}",
                     rollout.mean_return,
                     rollout.success_ratio,
                     self.solver.time.largest_two()
-                ))
+                );
+                Ok((message, false))
             }
             Phase::Generator => {
                 let before = self.envs().state.generator_steps;
                 let (mut message, stats) = self.generator_iteration(lr_scale, schedule, wall)?;
                 let after = self.envs().state.generator_steps;
                 // In the finish, the phase may end once the pair passes its own check...
+                let checked = finish
+                    .own_check_every
+                    .is_some_and(|every| in_finish && after / every != before / every);
                 let passes = match finish.own_check_every {
-                    Some(every) if in_finish && after / every != before / every => {
+                    Some(_) if checked => {
                         let control = self.finish_check(wall)?;
                         let passes = control
                             .is_some_and(|c| c.meets_with_margin(own_check::FINISH_HARD_MARGIN));
@@ -406,7 +414,10 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                     }
                     self.envs().set_phase(Phase::Solver);
                 }
-                Ok(format!("{message}, {}", self.solver.time.largest_two()))
+                Ok((
+                    format!("{message}, {}", self.solver.time.largest_two()),
+                    checked,
+                ))
             }
         }
     }
@@ -448,7 +459,7 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
         )
     }
 
-    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
+    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<Progress> {
         let began = wall();
         let in_finish = self
             .solver
@@ -459,11 +470,15 @@ impl<G: GeneratorGame> Training for AdversarialRun<G> {
             Phase::Solver => Stretch::SolverPhases,
             Phase::Generator => Stretch::GeneratorPhases,
         };
-        let message = self.phase_iteration(wall)?;
+        let phase = self.envs().state.phase;
+        let (message, checked) = self.phase_iteration(wall)?;
         self.solver.time.stretches.add(stretch, wall() - began);
-        Ok(match stretch {
-            Stretch::Finish => format!("finish, {message}"),
-            _ => message,
+        Ok(Progress {
+            message: match stretch {
+                Stretch::Finish => format!("finish, {message}"),
+                _ => message,
+            },
+            notable: checked || self.envs().state.phase != phase,
         })
     }
 

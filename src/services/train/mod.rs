@@ -291,6 +291,15 @@ pub(super) fn solver_envs<G: GameSpec>(
         .map_err(|problem| anyhow::anyhow!("level source: {problem}"))
 }
 
+/// What one training iteration tells the shell.
+pub struct Progress {
+    /// The progress bar's message: the agent that learned and its figures.
+    pub message: String,
+    /// The iteration changed phase or played a finish check: a log without a progress bar
+    /// keeps its line.
+    pub notable: bool,
+}
+
 /// What the training loop drives: one iteration at a time, checkpoints, the final policies.
 pub trait Training {
     /// Solver environment steps taken so far...
@@ -312,7 +321,7 @@ pub trait Training {
     /// One PPO iteration (of whichever agent learns now); returns the progress bar's message.
     /// `wall` is the clock the shell lends: the run's wall-clock seconds over every session,
     /// for the metrics' time columns.
-    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String>;
+    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<Progress>;
     /// Minutes between checkpoints.
     fn checkpoint_minutes(&self) -> f64;
     /// Writes the checkpoint, with `wall` the run's wall-clock seconds so far.

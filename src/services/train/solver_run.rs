@@ -13,7 +13,7 @@ use super::metrics::{
     check_metrics_header, open_append, time_columns, truncate_metrics, update_columns,
 };
 use super::solver_envs::SolverEnvs;
-use super::{CHECKPOINT, ConfigChange, METRICS, METRICS_HEADER, Training, UNDER_WAY};
+use super::{CHECKPOINT, ConfigChange, METRICS, METRICS_HEADER, Progress, Training, UNDER_WAY};
 use crate::services::fsio;
 use crate::services::fsio::Overwrite;
 use anyhow::bail;
@@ -317,18 +317,21 @@ impl<G: GameSpec> Training for SolverRun<SolverEnvs<G>> {
         (self.time, self.time.update_mfu(self.matmul_peak))
     }
 
-    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<String> {
+    fn iterate(&mut self, wall: &dyn Fn() -> f64) -> Result<Progress> {
         let t0 = wall();
         let lr_scale = self.config.lr_scale(self.trainer.global_step);
         let rollout = self.solver_iteration(lr_scale, None, wall)?;
         self.time.stretches.add(Stretch::SolverPhases, wall() - t0);
-        Ok(format!(
-            "return {:.2}, success {:.2}, {:.0} steps/s, {}",
-            rollout.mean_return,
-            rollout.success_ratio,
-            rollout.steps as f64 / (wall() - t0),
-            self.time.largest_two()
-        ))
+        Ok(Progress {
+            message: format!(
+                "return {:.2}, success {:.2}, {:.0} steps/s, {}",
+                rollout.mean_return,
+                rollout.success_ratio,
+                rollout.steps as f64 / (wall() - t0),
+                self.time.largest_two()
+            ),
+            notable: false,
+        })
     }
 
     fn checkpoint_minutes(&self) -> f64 {

@@ -2,6 +2,7 @@
 //! must not touch: the clock, signals (Ctrl-C, and SIGTERM and SIGHUP as schedulers send them:
 //! each saves a checkpoint and stops), the progress bar and what is printed.
 
+use std::io::IsTerminal;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -117,6 +118,9 @@ fn make_run_folder(out: &std::path::Path) -> Result<bool> {
 /// each session (about 0.1 s on two threads).
 const PEAK_PROBE_SIZE: usize = 1024;
 
+/// Seconds between the progress lines of a run whose standard error is not a terminal.
+const PLAIN_LINE_SECONDS: f64 = 60.0;
+
 /// Iterates `run` until its budget of Solver steps, `minutes` of this session, `pause_at` Solver
 /// steps, or a signal (`stop`); checkpoints on the run's interval and at the end, then writes the
 /// policies.
@@ -136,6 +140,8 @@ fn train_loop(
     let total = run.budget();
     let bar = crate::shells::common::progress_bar(total, "training");
     bar.set_position(run.solver_steps());
+    let drawn = std::io::stderr().is_terminal();
+    let mut last_line = Instant::now();
     loop {
         // The budget may end early (a finish whose catch-up reached its success).
         let done_by_steps = run.solver_steps() >= run.budget();
@@ -144,7 +150,7 @@ fn train_loop(
         if done_by_steps || done_by_time || paused || stop.load(Ordering::SeqCst) {
             break;
         }
-        let message = run.iterate(&wall).with_context(|| {
+        let progress = run.iterate(&wall).with_context(|| {
             format!(
                 "training stopped at {} Solver steps; the last checkpoint in {} is kept \
                  (--resume, with --config for a smaller learning rate, continues from it)",
@@ -152,10 +158,23 @@ fn train_loop(
                 run.out().display()
             )
         })?;
-        bar.set_message(format!(
-            "{message}, update at {:.0}% of peak",
+        let message = format!(
+            "{}, update at {:.0}% of peak",
+            progress.message,
             100.0 * run.time_split().1
-        ));
+        );
+        // Without a terminal the bar draws nothing: a log gets a line a minute, and every
+        // phase change and finish check.
+        if !drawn && (progress.notable || last_line.elapsed().as_secs_f64() >= PLAIN_LINE_SECONDS) {
+            crate::warn!(
+                "{:.1} min, {} of {} Solver steps: {message}",
+                wall() / 60.0,
+                run.solver_steps(),
+                total
+            );
+            last_line = Instant::now();
+        }
+        bar.set_message(message);
         bar.set_position(run.solver_steps());
         if last_checkpoint.elapsed().as_secs_f64() >= run.checkpoint_minutes() * 60.0 {
             run.save_checkpoint(wall())?;

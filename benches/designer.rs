@@ -66,7 +66,7 @@ fn campaign_view() {
         String::from_utf8_lossy(&made.stderr)
     );
     let (tx, rx) = channel();
-    let workers = worker::Workers::start(worker::GamePolicies::default(), tx, None);
+    let workers = worker::Workers::start(worker::GamePolicies::default(), tx, None).unwrap();
     let mut app = App::new(
         Game::Platform,
         Default::default(),
@@ -118,7 +118,7 @@ fn measure(game: Game, keys: &[char], what: &str) {
     let (tx, rx) = channel();
     let mut shelf = worker::GamePolicies::default();
     shelf[game] = policies;
-    let workers = worker::Workers::start(shelf, tx, None);
+    let workers = worker::Workers::start(shelf, tx, None).unwrap();
     let out = tempfile::tempdir().expect("a temporary folder");
     let mut app = App::new(game, info, 1, out.path().to_path_buf());
     let mut terminal = Terminal::new(TestBackend::new(80, 24)).expect("a test terminal");

@@ -665,7 +665,7 @@ fn newer_requests_supersede_older_ones() {
     h.settle();
     let level = h.app.level.clone().unwrap();
     let (tx, rx) = std::sync::mpsc::channel();
-    let workers = Workers::start(GamePolicies::default(), tx, None);
+    let workers = Workers::start(GamePolicies::default(), tx, None).unwrap();
     let deadline = Instant::now() + Duration::from_secs(60);
     let next = || {
         rx.recv_timeout(deadline.saturating_duration_since(Instant::now()))

@@ -300,7 +300,6 @@ impl<G: GeneratorGame> AdversarialRun<G> {
         Ok((message, stats))
     }
 
-    /// One iteration of the agent whose phase it is; the progress bar's message.
     /// One iteration of the agent whose phase it is: the progress message, and whether the
     /// iteration played a finish check (a line a log without a progress bar keeps).
     fn phase_iteration(&mut self, wall: &dyn Fn() -> f64) -> Result<(String, bool)> {
@@ -370,21 +369,14 @@ impl<G: GeneratorGame> AdversarialRun<G> {
                 let checked = finish
                     .own_check_every
                     .is_some_and(|every| in_finish && after / every != before / every);
-                let passes = match finish.own_check_every {
-                    Some(_) if checked => {
-                        let control = self.finish_check(wall)?;
-                        let passes = control
-                            .is_some_and(|c| c.meets_with_margin(own_check::FINISH_HARD_MARGIN));
-                        if let Some(c) = control {
-                            message += &format!(", check {:.2} / {:.2}", c.easy, c.hard);
-                            if !passes {
-                                self.keep_if_best_check(&c)?;
-                            }
-                        }
-                        passes
+                let mut passes = false;
+                if checked && let Some(c) = self.finish_check(wall)? {
+                    passes = c.meets_with_margin(own_check::FINISH_HARD_MARGIN);
+                    message += &format!(", check {:.2} / {:.2}", c.easy, c.hard);
+                    if !passes {
+                        self.keep_if_best_check(&c)?;
                     }
-                    _ => false,
-                };
+                }
                 let envs = self.envs();
                 if floor.is_some() {
                     envs.add_to_hard_block(&stats);

@@ -104,7 +104,7 @@ pub fn run(mut options: DesignOptions) -> Result<()> {
         others.push((game, info));
     }
     let (answers, responses) = channel();
-    let workers = Workers::start(shelf, answers, options.threads);
+    let workers = Workers::start(shelf, answers, options.threads)?;
     let mut app = App::new(options.game, info, options.seed, options.out);
     app.gltf = options.gltf;
     app.profile_mut().profile = profile;

@@ -80,26 +80,29 @@ pub struct Workers {
 
 impl Workers {
     /// Starts the workers on `policies`, each with a pool of `threads` (default: one per
-    /// core); their answers go to `answers`.
-    pub fn start(policies: GamePolicies, answers: Sender<Response>, threads: Option<u64>) -> Self {
+    /// core); their answers go to `answers`. Fails when the system starts no more threads.
+    pub fn start(
+        policies: GamePolicies,
+        answers: Sender<Response>,
+        threads: Option<u64>,
+    ) -> anyhow::Result<Self> {
         let policies = Arc::new(Mutex::new(policies));
         let latest = Arc::new(Latest::default());
-        let spawn = |name: &str| {
+        let spawn = |name: &str| -> anyhow::Result<Sender<Effect>> {
             let (tx, rx) = std::sync::mpsc::channel();
             let (policies, latest, answers) = (policies.clone(), latest.clone(), answers.clone());
-            let pool = crate::shells::common::thread_pool(threads).expect("the OS starts threads");
+            let pool = crate::shells::common::thread_pool(threads)?;
             std::thread::Builder::new()
                 .name(name.into())
-                .spawn(move || serve(rx, &policies, &latest, &answers, &pool))
-                .expect("the OS starts a thread");
-            tx
+                .spawn(move || serve(rx, &policies, &latest, &answers, &pool))?;
+            Ok(tx)
         };
-        Self {
-            main: spawn("designer-worker"),
-            sweeps: spawn("designer-sweeps"),
-            panel: spawn("designer-panel"),
+        Ok(Self {
+            main: spawn("designer-worker")?,
+            sweeps: spawn("designer-sweeps")?,
+            panel: spawn("designer-panel")?,
             latest,
-        }
+        })
     }
 
     /// Hands `effect` to its worker; it supersedes older requests of its kind.

@@ -283,16 +283,21 @@ impl<G: GeneratorGame> AdversarialRun<G> {
             time_columns(&time),
             time.update_mfu(self.solver.matmul_peak),
         )?;
-        let ratio = |a: u32, b: u32| a as f64 / b.max(1) as f64;
+        // A side no match was judged on (the scripted opponent's hard side when it plays
+        // easy matches only) reads "—", not a success of 0.
+        let ratio = |a: u32, b: u32| match b {
+            0 => "—".to_string(),
+            b => format!("{:.2}", f64::from(a) / f64::from(b)),
+        };
         let mut message = format!(
-            "generator: success easy {:.2} / hard {:.2}, invalid {:.2}",
+            "generator: success easy {} / hard {}, invalid {}",
             ratio(stats.successes[0], stats.judged[0]),
             ratio(stats.successes[1], stats.judged[1]),
             ratio(stats.invalid, stats.episodes)
         );
         if stats.scripted_judged != [0, 0] {
             message += &format!(
-                ", scripted opponent easy {:.2} / hard {:.2}",
+                ", scripted opponent easy {} / hard {}",
                 ratio(stats.scripted_successes[0], stats.scripted_judged[0]),
                 ratio(stats.scripted_successes[1], stats.scripted_judged[1])
             );
